@@ -1,0 +1,1 @@
+"""Deploy profiles, the robot descriptions and the launcher."""

@@ -1,0 +1,1 @@
+"""Parsimony: whole-body LP control of nonholonomic mobile manipulators."""
