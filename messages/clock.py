@@ -1,0 +1,11 @@
+"""The simulator's clock."""
+
+from __future__ import annotations
+
+from messages.base import Count, Message
+
+
+class Clock(Message):
+    """Simulated time, published by the simulator each step (``stamp_ns`` in ns)."""
+
+    stamp_ns: Count

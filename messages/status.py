@@ -1,0 +1,29 @@
+"""What a running component reports about itself."""
+
+from __future__ import annotations
+
+from pydantic import Field
+
+from messages.base import Count, Finite, Message
+from messages.header import Header
+
+ParameterValue = bool | int | Finite | str
+"""A parameter's value; pydantic keeps the exact type (``True`` stays a bool, ``1`` an int)."""
+
+
+class ComponentStatus(Message):
+    """A component's periodic self-report.
+
+    ``name`` is the instance name from the profile, ``module`` the Python module
+    it runs, ``state`` its life-cycle state, ``pid`` its process id,
+    ``counters`` monotonic event counts (messages in, out, dropped...) and
+    ``parameters`` its current tunable parameters.
+    """
+
+    header: Header
+    name: str
+    module: str
+    state: str
+    pid: Count
+    counters: dict[str, Count] = Field(default_factory=dict)
+    parameters: dict[str, ParameterValue] = Field(default_factory=dict)

@@ -1,0 +1,205 @@
+"""The topic table: every Zenoh key expression of the project is spelled here.
+
+Keys live under a namespace (one per robot or profile, e.g. ``"sim"`` or
+``"lab/robot1"``) so that several robots can share a network::
+
+    ROBOT_STATE.key("sim")                  -> "sim/robot/state"
+    liveliness_key("sim", "lp_controller")  -> "sim/alive/lp_controller"
+    status_selector("sim")                  -> "sim/component/*/status"
+
+A namespace is one or more ``/``-separated chunks; a component name is a single
+chunk. Neither may be empty or contain the Zenoh wildcard and verbatim
+characters ``* $ # ?``. Invalid names raise ``KeyExpressionError``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from types import MappingProxyType
+from typing import Generic, TypeVar
+
+from pydantic import BaseModel
+
+from messages.camera import CameraFrame
+from messages.clock import Clock
+from messages.commands import ArmCommand, BaseCommand
+from messages.diagnostics import ControllerDiagnostics
+from messages.goal import Goal
+from messages.joints import JointStates
+from messages.markers import MarkerDetections
+from messages.obstacles import Obstacles
+from messages.odometry import BaseOdometry
+from messages.state import RobotState
+from messages.status import ComponentStatus
+
+M = TypeVar("M", bound=BaseModel)
+
+_FORBIDDEN = frozenset("*$#?")
+
+
+class KeyExpressionError(ValueError):
+    """A namespace, component or parameter name that cannot form a key, or a key
+    that is not of the expected shape."""
+
+
+@dataclass(frozen=True)
+class Topic(Generic[M]):
+    """A topic: its ``name`` in this table (what profiles refer to), the
+    ``suffix`` its key ends with, and the message ``type`` it carries."""
+
+    name: str
+    suffix: str
+    type: type[M]
+
+    def key(self, namespace: str) -> str:
+        """This topic's key under ``namespace``: ``"<namespace>/<suffix>"``."""
+        return f"{check_namespace(namespace)}/{self.suffix}"
+
+
+CAMERA_IMAGE = Topic("camera/image", "camera/image", CameraFrame)
+VISION_MARKERS = Topic("vision/markers", "vision/markers", MarkerDetections)
+BASE_ODOMETRY = Topic("base/odometry", "base/odometry", BaseOdometry)
+ARM_JOINT_STATES = Topic("arm/joint_states", "arm/joint_states", JointStates)
+ROBOT_STATE = Topic("robot/state", "robot/state", RobotState)
+WORLD_OBSTACLES = Topic("world/obstacles", "world/obstacles", Obstacles)
+CONTROL_GOAL = Topic("control/goal", "control/goal", Goal)
+BASE_COMMAND = Topic("base/command", "base/command", BaseCommand)
+ARM_COMMAND = Topic("arm/command", "arm/command", ArmCommand)
+CONTROL_DIAGNOSTICS = Topic("control/diagnostics", "control/diagnostics", ControllerDiagnostics)
+SIM_CLOCK = Topic("sim/clock", "sim/clock", Clock)
+
+TOPICS: Mapping[str, Topic] = MappingProxyType(
+    {
+        topic.name: topic
+        for topic in (
+            CAMERA_IMAGE,
+            VISION_MARKERS,
+            BASE_ODOMETRY,
+            ARM_JOINT_STATES,
+            ROBOT_STATE,
+            WORLD_OBSTACLES,
+            CONTROL_GOAL,
+            BASE_COMMAND,
+            ARM_COMMAND,
+            CONTROL_DIAGNOSTICS,
+            SIM_CLOCK,
+        )
+    }
+)
+"""Every topic, by name."""
+
+STATUS_TYPE = ComponentStatus
+"""The message type published on ``status_key(namespace, component)``."""
+
+MESSAGE_TYPES: tuple[type[BaseModel], ...] = (*(t.type for t in TOPICS.values()), STATUS_TYPE)
+"""Every type that travels on its own on the wire (nested models excluded)."""
+
+_BY_SUFFIX: Mapping[str, Topic] = MappingProxyType({t.suffix: t for t in TOPICS.values()})
+
+
+def check_namespace(namespace: str) -> str:
+    """Return ``namespace`` if it can prefix a key, else raise ``KeyExpressionError``."""
+    return _check_path(namespace, "namespace")
+
+
+def check_component(component: str) -> str:
+    """Return ``component`` if it is a valid single-chunk component name."""
+    if "/" in component:
+        raise KeyExpressionError(f"component name {component!r} must not contain '/'")
+    return _check_path(component, "component name")
+
+
+def key(namespace: str, topic: Topic | str) -> str:
+    """The key of ``topic`` (a ``Topic`` or a name in ``TOPICS``) under ``namespace``."""
+    if isinstance(topic, str):
+        if topic not in TOPICS:
+            raise KeyExpressionError(f"unknown topic {topic!r}; known: {', '.join(TOPICS)}")
+        topic = TOPICS[topic]
+    return topic.key(namespace)
+
+
+def topic_of_key(namespace: str, key_expr: str) -> Topic:
+    """The topic whose key under ``namespace`` is ``key_expr`` (the inverse of ``key``)."""
+    suffix = _strip_prefix(key_expr, f"{check_namespace(namespace)}/")
+    if suffix not in _BY_SUFFIX:
+        raise KeyExpressionError(f"{key_expr!r} is no topic of namespace {namespace!r}")
+    return _BY_SUFFIX[suffix]
+
+
+def namespace_selector(namespace: str) -> str:
+    """Selects every key of the namespace: ``"<namespace>/**"``."""
+    return f"{check_namespace(namespace)}/**"
+
+
+def liveliness_key(namespace: str, component: str) -> str:
+    """The liveliness token of a running component: ``"<ns>/alive/<component>"``."""
+    return f"{check_namespace(namespace)}/alive/{check_component(component)}"
+
+
+def liveliness_selector(namespace: str) -> str:
+    """Selects every component's liveliness token: ``"<ns>/alive/*"``."""
+    return f"{check_namespace(namespace)}/alive/*"
+
+
+def component_of_liveliness_key(namespace: str, key_expr: str) -> str:
+    """The component name in a liveliness key (the inverse of ``liveliness_key``)."""
+    rest = _strip_prefix(key_expr, f"{check_namespace(namespace)}/alive/")
+    return check_component(rest)
+
+
+def status_key(namespace: str, component: str) -> str:
+    """Where a component publishes its ``ComponentStatus``:
+    ``"<ns>/component/<component>/status"``."""
+    return f"{_component_prefix(namespace, component)}/status"
+
+
+def status_selector(namespace: str) -> str:
+    """Selects every component's status: ``"<ns>/component/*/status"``."""
+    return f"{check_namespace(namespace)}/component/*/status"
+
+
+def component_of_status_key(namespace: str, key_expr: str) -> str:
+    """The component name in a status key (the inverse of ``status_key``)."""
+    rest = _strip_prefix(key_expr, f"{check_namespace(namespace)}/component/")
+    if not rest.endswith("/status"):
+        raise KeyExpressionError(f"{key_expr!r} is no status key of namespace {namespace!r}")
+    return check_component(rest.removesuffix("/status"))
+
+
+def param_key(namespace: str, component: str, name: str) -> str:
+    """A component's parameter: ``"<ns>/component/<component>/param/<name>"``.
+
+    ``name`` may have several chunks (``"gains/eta"``).
+    """
+    return f"{_component_prefix(namespace, component)}/param/{_check_path(name, 'parameter')}"
+
+
+def param_selector(namespace: str, component: str) -> str:
+    """Selects every parameter of a component: ``"<ns>/component/<component>/param/**"``."""
+    return f"{_component_prefix(namespace, component)}/param/**"
+
+
+def _component_prefix(namespace: str, component: str) -> str:
+    return f"{check_namespace(namespace)}/component/{check_component(component)}"
+
+
+def _strip_prefix(key_expr: str, prefix: str) -> str:
+    if not key_expr.startswith(prefix):
+        raise KeyExpressionError(f"{key_expr!r} does not start with {prefix!r}")
+    return key_expr.removeprefix(prefix)
+
+
+def _check_path(path: str, what: str) -> str:
+    if not path:
+        raise KeyExpressionError(f"{what} must not be empty")
+    if path.startswith("/") or path.endswith("/"):
+        raise KeyExpressionError(f"{what} {path!r} must not start or end with '/'")
+    if "//" in path:
+        raise KeyExpressionError(f"{what} {path!r} must not contain an empty chunk '//'")
+    forbidden = sorted(_FORBIDDEN.intersection(path))
+    if forbidden:
+        raise KeyExpressionError(
+            f"{what} {path!r} must not contain the wildcard characters {' '.join(forbidden)}"
+        )
+    return path
