@@ -1,0 +1,106 @@
+"""The cascade of appendix B: a pseudoinverse outer loop, a linearising inner loop for the base.
+
+The outer loop computes u = -J^+ eta e for a holonomic base (B.1). Its base part u_b drives a
+reference base (x_r, y_r, phi_r), integrated over time. The inner loop makes the offset point
+(x1, y1) = (x + d cos phi, y + d sin phi) of the real, nonholonomic base track the same point
+of the reference by input-output linearisation (Skaar 2007):
+
+    [u1, u2] = [x1_r', y1_r'] + diag(k1, k2) [x1_r - x1, y1_r - y1]
+    phi' = (u2 cos phi - u1 sin phi) / d,   v = u1 cos phi + u2 sin phi
+
+and the base part of the output is (v cos phi, v sin phi, phi'), which obeys 5.11 exactly.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from wbc.law_output import LawOutput, summarise
+from wbc.obstacles import Circle
+from wbc.pinv_law import PinvParams, PseudoinverseLaw
+from wbc.robot import MobileManipulator
+from wbc.task import Task, same_task
+from wbc.validation import require_finite
+
+Array = np.ndarray
+
+
+@dataclass(frozen=True)
+class CascadeParams:
+    eta: float = 0.6
+    """Outer-loop task gain (1/s)."""
+    offset: float = 0.1
+    """d, the distance of the tracked point ahead of the wheel axle (m)."""
+    k1: float = 2.0
+    k2: float = 2.0
+    """Inner-loop gains on the offset point's position error (1/s)."""
+
+    def __post_init__(self) -> None:
+        for name in ("eta", "offset", "k1", "k2"):
+            value = getattr(self, name)
+            if not np.isfinite(value) or value <= 0.0:
+                raise ValueError(f"CascadeParams.{name} must be finite and > 0, got {value}")
+
+
+def offset_point(x: float, y: float, phi: float, d: float) -> tuple[float, float]:
+    """(x + d cos phi, y + d sin phi)."""
+    return x + d * math.cos(phi), y + d * math.sin(phi)
+
+
+@dataclass
+class CascadeLaw:
+    """Pseudoinverse outer loop, input-output linearising inner loop (appendix B)."""
+
+    robot: MobileManipulator
+    params: CascadeParams = field(default_factory=CascadeParams)
+    _reference: Array | None = field(default=None, init=False, repr=False)
+    _task: Task | None = field(default=None, init=False, repr=False)
+
+    def set_params(self, params: CascadeParams) -> None:
+        self.params = params
+
+    def reset(self) -> None:
+        """Restart the reference base at the real one on the next step."""
+        self._reference = None
+        self._task = None
+
+    def step(
+        self, q: Array, task: Task, dt: float, obstacles: Sequence[Circle] = ()
+    ) -> LawOutput:
+        """One step; the reference base advances by the outer loop's u_b over ``dt``."""
+        start = time.perf_counter()
+        q = require_finite("configuration q", q)
+        dt = float(require_finite("dt", dt))
+        if dt <= 0.0:
+            raise ValueError(f"dt must be > 0, got {dt}")
+        if self._reference is None or self._task is None or not same_task(self._task, task):
+            self._reference = q[:3].copy()
+        self._task = task
+
+        outer = PseudoinverseLaw(self.robot, PinvParams(self.params.eta))
+        reference_u = outer.step(q, task, dt).u
+        x_r, y_r, phi_r = self._reference
+        xr_dot, yr_dot, phir_dot = reference_u[:3]
+        d = self.params.offset
+        target_x, target_y = offset_point(x_r, y_r, phi_r, d)
+        target_x_dot = xr_dot - d * math.sin(phi_r) * phir_dot
+        target_y_dot = yr_dot + d * math.cos(phi_r) * phir_dot
+
+        x, y, phi = q[0], q[1], q[2]
+        point_x, point_y = offset_point(x, y, phi, d)
+        u1 = target_x_dot + self.params.k1 * (target_x - point_x)
+        u2 = target_y_dot + self.params.k2 * (target_y - point_y)
+        forward = u1 * math.cos(phi) + u2 * math.sin(phi)
+        angular = (u2 * math.cos(phi) - u1 * math.sin(phi)) / d
+
+        self._reference = self._reference + dt * reference_u[:3]
+        u = reference_u.copy()
+        u[:3] = forward * math.cos(phi), forward * math.sin(phi), angular
+        pose, jacobian = self.robot.kinematics(q)
+        error, _ = task.error(pose, jacobian)
+        return summarise(u, "optimal", None, (), error, start)

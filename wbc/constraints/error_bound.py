@@ -1,0 +1,28 @@
+"""The bound on ||u||_1 that makes u vanish when the task stops: 5.10, or the original 5.7."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+
+from wbc.constraints.base import OneNormBound, StepContext
+
+
+class ErrorBound:
+    """||u||_1 <= beta ||vec e'||_1 (5.10), or ||u||_1 <= beta ||vec e||_1 (5.7).
+
+    With the error-derivative form the joints stop when the end effector stalls short of the
+    goal (e' = 0); with the error form they may keep moving as long as e != 0.
+    """
+
+    def __init__(self, beta: float, mode: Literal["derivative", "error"] = "derivative") -> None:
+        if beta <= 0.0 or mode not in ("derivative", "error"):
+            raise ValueError("error bound needs beta > 0 and mode 'derivative' or 'error'")
+        self.beta = beta
+        self.mode = mode
+        self.name = "error_derivative_bound" if mode == "derivative" else "error_bound"
+
+    def rows(self, context: StepContext) -> OneNormBound:
+        measure = context.error_rate if self.mode == "derivative" else context.error
+        return OneNormBound(self.name, self.beta * float(np.abs(measure).sum()))

@@ -1,0 +1,35 @@
+"""Joint position and velocity limits as bounds on u (5.13-5.18), the base included."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from wbc.constraints.base import StepContext, VelocityBounds
+
+
+class JointLimits:
+    """max(q'-, k (b_l q- - q)) <= u <= min(q'+, k (b_l q+ - q)) (5.15).
+
+    k > 0 (``gain``, 1/s) scales how fast a joint may approach its limit; 0 << b_l <= 1
+    (``safety_factor``) shrinks the range [q-, q+] about zero. Entries with infinite position
+    limits (the base's x, y, phi) keep their velocity bounds only. Where a joint already lies
+    outside b_l [q-, q+], the bounds leave it only the way back, at most at its speed limit.
+    """
+
+    name = "joint_limits"
+
+    def __init__(self, gain: float = 1.0, safety_factor: float = 0.9) -> None:
+        if gain <= 0.0 or not 0.0 < safety_factor <= 1.0:
+            raise ValueError("joint limits need gain > 0 and 0 < safety_factor <= 1")
+        self.gain = gain
+        self.safety_factor = safety_factor
+
+    def rows(self, context: StepContext) -> VelocityBounds:
+        robot, q = context.robot, context.q
+        speed = robot.velocity_max
+        with np.errstate(invalid="ignore"):
+            towards_min = self.gain * (self.safety_factor * robot.q_min - q)
+            towards_max = self.gain * (self.safety_factor * robot.q_max - q)
+        lower = np.clip(np.fmax(-speed, towards_min), -speed, speed)
+        upper = np.clip(np.fmin(speed, towards_max), -speed, speed)
+        return VelocityBounds(self.name, np.minimum(lower, upper), np.maximum(lower, upper))

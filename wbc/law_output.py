@@ -1,0 +1,57 @@
+"""What every control law returns: the whole-body velocity and its diagnostics."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+Array = np.ndarray
+
+ZERO_THRESHOLD = 1e-9
+"""|u_i| above this counts as a nonzero entry of u."""
+PRACTICAL_THRESHOLD = 0.01
+"""Upsilon of section 6.2.1: the smallest velocity a motor acts on (rad/s or m/s)."""
+
+
+@dataclass(frozen=True)
+class LawOutput:
+    """u = [x', y', phi', q1'..q5'] and how it was obtained."""
+
+    u: Array
+    status: str
+    objective: float | None
+    nonzero: int
+    practical_nonzero: int
+    active_constraints: tuple[str, ...]
+    solve_time_s: float
+    error_norm: float
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "optimal"
+
+
+def summarise(
+    u: Array,
+    status: str,
+    objective: float | None,
+    active: tuple[str, ...],
+    error: Array,
+    start: float,
+) -> LawOutput:
+    """Freeze u and count its nonzero entries (section 5.7) and practical ones (6.2.1)."""
+    u = np.array(u, dtype=float)
+    u.flags.writeable = False
+    magnitude = np.abs(u)
+    return LawOutput(
+        u=u,
+        status=status,
+        objective=objective,
+        nonzero=int(np.count_nonzero(magnitude > ZERO_THRESHOLD)),
+        practical_nonzero=int(np.count_nonzero(magnitude >= PRACTICAL_THRESHOLD)),
+        active_constraints=active,
+        solve_time_s=time.perf_counter() - start,
+        error_norm=float(np.linalg.norm(error)),
+    )

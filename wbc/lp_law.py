@@ -1,0 +1,131 @@
+"""The parsimonious whole-body law: u from the linear program 5.29, one step at a time."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from wbc.constraints.base import Constraint, StepContext
+from wbc.constraints.error_bound import ErrorBound
+from wbc.constraints.joint_limits import JointLimits
+from wbc.constraints.nonholonomic import Nonholonomic
+from wbc.constraints.obstacle_border import BorderObstacle
+from wbc.constraints.obstacle_conservative import ConservativeObstacle
+from wbc.law_output import LawOutput, summarise
+from wbc.linear_program import WarmStartedLP
+from wbc.obstacles import Circle
+from wbc.robot import MobileManipulator
+from wbc.task import Task, same_task
+from wbc.validation import require_finite
+
+Array = np.ndarray
+
+
+@dataclass(frozen=True)
+class LPParams:
+    """Gains of the LP law; the defaults are those of the pose experiment (section 6.2.1)."""
+
+    eta: float = 0.6
+    """Task gain: the LP seeks J u = -eta e (1/s)."""
+    beta: float = 15.0
+    """Bound gain of 5.10 / 5.7."""
+    joint_gain: float = 1.0
+    """k of 5.14 (1/s)."""
+    safety_factor: float = 0.9
+    """beta_l of 5.14."""
+    error_bound: Literal["derivative", "error"] = "derivative"
+    """5.10 (bound on ||e'||_1) or the original 5.7 (bound on ||e||_1)."""
+    obstacle_mode: Literal["border", "conservative", "off"] = "border"
+    obstacle_gain: float = 2.0
+    """lambda of 5.26 for 'border', the gain on the clearance for 'conservative' (1/s)."""
+    obstacle_margin: float = 0.05
+    """Extra clearance kept around each obstacle and the base body (m)."""
+    nonholonomic: bool = True
+    """False models a holonomic base (the first test of section 6.3)."""
+
+    def __post_init__(self) -> None:
+        for name in ("eta", "beta", "joint_gain", "safety_factor", "obstacle_gain"):
+            value = getattr(self, name)
+            if not np.isfinite(value) or value <= 0.0:
+                raise ValueError(f"LPParams.{name} must be finite and > 0, got {value}")
+
+
+def default_constraints(params: LPParams) -> list[Constraint]:
+    """The constraints of 5.29 that ``params`` selects."""
+    constraints: list[Constraint] = [
+        JointLimits(params.joint_gain, params.safety_factor),
+        ErrorBound(params.beta, params.error_bound),
+    ]
+    if params.nonholonomic:
+        constraints.insert(0, Nonholonomic())
+    if params.obstacle_mode == "border":
+        constraints.append(BorderObstacle(params.obstacle_gain, params.obstacle_margin))
+    elif params.obstacle_mode == "conservative":
+        constraints.append(ConservativeObstacle(params.obstacle_gain, params.obstacle_margin))
+    return constraints
+
+
+@dataclass
+class LPLaw:
+    """u = argmin ||J u + eta e||_1 subject to the constraints (5.29), solved by HiGHS simplex.
+
+    ``step`` never raises for a solver failure: it returns u = 0 with HiGHS's status. Inputs
+    that are not finite raise NonFiniteInputError before any solve. The law remembers the last
+    error to measure e' = (e_k - e_{k-1}) / dt; on the first step of a task it uses the
+    commanded rate e' = -eta e.
+    """
+
+    robot: MobileManipulator
+    params: LPParams = field(default_factory=LPParams)
+    constraints: list[Constraint] | None = None
+    _lp: WarmStartedLP = field(default_factory=WarmStartedLP, init=False, repr=False)
+    _last: tuple[Task, Array] | None = field(default=None, init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self._explicit_constraints = self.constraints is not None
+
+    def set_params(self, params: LPParams) -> None:
+        """Change the gains between steps (the constraints are rebuilt from them)."""
+        self.params = params
+        if not self._explicit_constraints:
+            self.constraints = None
+
+    def reset(self) -> None:
+        """Forget the previous error and basis, as for a new task."""
+        self._last = None
+        self._lp.reset()
+
+    def step(
+        self, q: Array, task: Task, dt: float, obstacles: Sequence[Circle] = ()
+    ) -> LawOutput:
+        """One control step at configuration q (8,) towards ``task``; dt in seconds."""
+        start = time.perf_counter()
+        q = require_finite("configuration q", q)
+        dt = float(require_finite("dt", dt))
+        if dt <= 0.0:
+            raise ValueError(f"dt must be > 0, got {dt}")
+        for index, obstacle in enumerate(obstacles):
+            require_finite(f"obstacle {index}", (obstacle.x, obstacle.y, obstacle.radius))
+        if self.constraints is None:
+            self.constraints = default_constraints(self.params)
+
+        pose, jacobian = self.robot.kinematics(q)
+        error, task_jacobian = task.error(pose, jacobian)
+        if self._last is not None and same_task(self._last[0], task):
+            error_rate = (error - self._last[1]) / dt
+        else:
+            error_rate = -self.params.eta * error
+        self._last = (task, error)
+
+        context = StepContext(
+            self.robot, q, error, error_rate, task.goal_position[:2], tuple(obstacles)
+        )
+        rows = [constraint.rows(context) for constraint in self.constraints]
+        solution = self._lp.solve(task_jacobian, -self.params.eta * error, rows)
+        return summarise(
+            solution.u, solution.status, solution.objective, solution.active, error, start
+        )

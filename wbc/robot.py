@@ -1,0 +1,229 @@
+"""The whole-body kinematic model of chapter 4: a holonomic base model carrying a DH arm.
+
+Configuration q = [x, y, phi, q1..q5] (m, m, rad, rad...). The end-effector pose is
+x_3^0 = x_1^0 x_2^1 x_3^2 (4.6): the base pose (4.1), the constant base-height displacement
+(4.2) and the arm's DH product (4.4). The nonholonomic constraint is not in the model: the
+laws impose it (5.12).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from wbc import dq
+
+Array = np.ndarray
+
+REVOLUTE = 0.0
+"""Joint type code of a revolute joint in the 5th row of the DH table (as in DQ Robotics)."""
+
+BASE_DOF = 3
+
+
+class RobotDescriptionError(ValueError):
+    """A robot description file is missing a field or has a value of the wrong shape."""
+
+
+def _readonly(values: object, shape: tuple[int, ...], what: str, allow_inf: bool = False) -> Array:
+    array = np.array(values, dtype=float)
+    if array.shape != shape:
+        raise RobotDescriptionError(f"{what}: expected shape {shape}, got {array.shape}")
+    if np.any(np.isnan(array)) or not (allow_inf or np.all(np.isfinite(array))):
+        raise RobotDescriptionError(f"{what}: values must be finite, got {array.tolist()}")
+    array.flags.writeable = False
+    return array
+
+
+def _dh_link(theta: float, d: float, a: float, alpha: float) -> Array:
+    """r_theta p_d p_a r_alpha: one DH link Rz(theta) Tz(d) Tx(a) Rx(alpha) (4.4)."""
+    r_theta = dq.from_parts(dq.rotation_quaternion(theta, [0, 0, 1]), np.zeros(4))
+    p_d = dq.pose(dq.ONE[:4], [0.0, 0.0, d])
+    p_a = dq.pose(dq.ONE[:4], [a, 0.0, 0.0])
+    r_alpha = dq.from_parts(dq.rotation_quaternion(alpha, [1, 0, 0]), np.zeros(4))
+    return dq.mul(dq.mul(dq.mul(r_theta, p_d), p_a), r_alpha)
+
+
+# Flat positions of c and +-s in H+(cos(q/2) + k sin(q/2)), an 8x8 block-diagonal matrix.
+_RZ_COS = np.array([r * 8 + r for r in range(8)])
+_RZ_SIN_POS = np.array([r * 8 + c for r, c in ((2, 1), (3, 0), (6, 5), (7, 4))])
+_RZ_SIN_NEG = np.array([r * 8 + c for r, c in ((0, 3), (1, 2), (4, 7), (5, 6))])
+_HALF_K = 0.5 * dq.hamiplus8(np.concatenate((dq.K_, np.zeros(4))))
+
+
+@dataclass(frozen=True)
+class BaseDescription:
+    """The differential-drive base: geometry and the bounds on u_b = [x', y', phi']."""
+
+    height: float
+    body_radius: float
+    wheel_base: float
+    wheel_radius: float
+    wheel_speed_max: float
+    velocity_max: Array
+
+
+class MobileManipulator:
+    """Forward kinematics (4.6), pose Jacobian (4.9) and translation Jacobian (4.18)."""
+
+    def __init__(
+        self,
+        dh: Array,
+        base: BaseDescription,
+        joint_min: Array,
+        joint_max: Array,
+        arm_velocity_max: Array,
+        name: str = "robot",
+    ) -> None:
+        self.name = name
+        self.dh = _readonly(dh, (5, dh.shape[1]), "dh")
+        if np.any(self.dh[4] != REVOLUTE):
+            raise RobotDescriptionError("dh: only revolute joints are supported")
+        self.arm_dof = self.dh.shape[1]
+        self.dof = BASE_DOF + self.arm_dof
+        self.base = base
+        self.base_height = base.height
+        inf = np.full(BASE_DOF, np.inf)
+        self.q_min = _readonly(np.concatenate((-inf, joint_min)), (self.dof,), "joint_min", True)
+        self.q_max = _readonly(np.concatenate((inf, joint_max)), (self.dof,), "joint_max", True)
+        if np.any(self.q_min > self.q_max):
+            raise RobotDescriptionError("joint_min must not exceed joint_max")
+        self.velocity_max = _readonly(
+            np.concatenate((base.velocity_max, arm_velocity_max)), (self.dof,), "velocity_max"
+        )
+        links = [_dh_link(*self.dh[:4, i]) for i in range(self.arm_dof)]
+        self._link_plus = np.stack([dq.hamiplus8(link) for link in links])
+        self._height_plus = dq.hamiplus8(dq.pose(dq.ONE[:4], [0.0, 0.0, base.height]))
+
+    @classmethod
+    def from_yaml(cls, path: str | Path) -> MobileManipulator:
+        """Build the model from a robot description such as deploy/robots/little_john.yaml."""
+        path = Path(path)
+        try:
+            data = yaml.safe_load(path.read_text())
+            arm, base = data["arm"], data["base"]
+            table = arm["dh"]
+            types = [REVOLUTE if t == "revolute" else -1.0 for t in table["type"]]
+            dh = np.array([table["theta"], table["d"], table["a"], table["alpha"], types], float)
+            description = BaseDescription(
+                height=float(base["height"]),
+                body_radius=float(base["body_radius"]),
+                wheel_base=float(base["wheel_base"]),
+                wheel_radius=0.5 * float(base["wheel_diameter"]),
+                wheel_speed_max=float(base["wheel_speed_max"]),
+                velocity_max=_readonly(base["velocity_max"], (3,), "base.velocity_max"),
+            )
+            return cls(
+                dh,
+                description,
+                np.array(arm["joint_min"], float),
+                np.array(arm["joint_max"], float),
+                np.array(arm["velocity_max"], float),
+                name=str(data.get("name", path.stem)),
+            )
+        except (KeyError, TypeError, ValueError) as error:
+            if isinstance(error, RobotDescriptionError):
+                raise RobotDescriptionError(f"{path}: {error}") from None
+            raise RobotDescriptionError(f"{path}: missing or invalid field: {error}") from None
+
+    def _check(self, q: Array) -> Array:
+        q = np.asarray(q, dtype=float)
+        if q.shape != (self.dof,):
+            raise ValueError(f"configuration must have shape ({self.dof},), got {q.shape}")
+        return q
+
+    def base_pose(self, q: Array) -> Array:
+        """x_2^0 = x_1^0 x_2^1: base pose (4.1) raised by the base height (4.2)."""
+        x, y, phi = q[0], q[1], q[2]
+        c, s, z = math.cos(0.5 * phi), math.sin(0.5 * phi), self.base.height
+        # D = (1/2) p r with p = x i + y j + z k and r = c + s k.
+        return np.array(
+            [c, 0.0, 0.0, s, -0.5 * z * s, 0.5 * (x * c + y * s), 0.5 * (y * c - x * s), 0.5 * z * c]
+        )
+
+    @staticmethod
+    def base_jacobian(q: Array) -> Array:
+        """J_b of eq. 4.3: vec8(x_1^0)' = J_b [x', y', phi']."""
+        x, y, phi = q[0], q[1], q[2]
+        c, s = 0.5 * math.cos(0.5 * phi), 0.5 * math.sin(0.5 * phi)
+        jb = np.zeros((8, 3))
+        jb[0, 2] = jb[6, 0] = -s
+        jb[5, 1] = s
+        jb[3, 2] = jb[5, 0] = jb[6, 1] = c
+        jb[5, 2] = 0.5 * (-x * s + y * c)
+        jb[6, 2] = 0.5 * (-x * c - y * s)
+        return jb
+
+    def _arm_link_operators(self, q_arm: Array) -> Array:
+        """H+(x_i) for every arm link, x_i = r_z(q_i) (r_theta_i p_d_i p_a_i r_alpha_i)."""
+        n = self.arm_dof
+        half = 0.5 * q_arm
+        rz = np.zeros((n, 64))
+        rz[:, _RZ_COS] = np.cos(half)[:, None]
+        sin = np.sin(half)[:, None]
+        rz[:, _RZ_SIN_POS] = sin
+        rz[:, _RZ_SIN_NEG] = -sin
+        return np.matmul(rz.reshape(n, 8, 8), self._link_plus)
+
+    def kinematics(self, q: Array) -> tuple[Array, Array]:
+        """(vec8 x_3^0, J) for configuration q: the pose (4.6) and its Jacobian (4.9).
+
+        J = [H-(x_3^1) J_b, H+(x_2^0) J_a]; column i of H+(x_2^0) J_a is
+        vec8(x_{0,i-1} (k/2) x_{i-1,n}), the derivative of the DH product in q_i.
+        """
+        q = self._check(q)
+        links = self._arm_link_operators(q[BASE_DOF:])
+        n = self.arm_dof
+        prefixes = np.empty((n, 8, 8))
+        prefixes[0] = dq.hamiplus8(self.base_pose(q))
+        for i in range(1, n):
+            prefixes[i] = prefixes[i - 1] @ links[i - 1]
+        suffixes = np.empty((8, n))
+        suffixes[:, n - 1] = links[n - 1][:, 0]
+        for i in range(n - 2, -1, -1):
+            suffixes[:, i] = links[i] @ suffixes[:, i + 1]
+        pose = prefixes[n - 1] @ suffixes[:, n - 1]
+        jacobian = np.empty((8, self.dof))
+        jacobian[:, BASE_DOF:] = np.matmul(prefixes, (_HALF_K @ suffixes).T[:, :, None])[..., 0].T
+        arm_in_base = self._height_plus @ suffixes[:, 0]
+        jacobian[:, :BASE_DOF] = dq.haminus8(arm_in_base) @ self.base_jacobian(q)
+        return pose, jacobian
+
+    def fkm(self, q: Array) -> Array:
+        """vec8 of the end-effector pose x_3^0 = x_1^0 x_2^1 x_3^2 (4.6)."""
+        q = self._check(q)
+        pose = self.base_pose(q)
+        for link in self._arm_link_operators(q[BASE_DOF:]):
+            pose = dq.mul(pose, link[:, 0])
+        return pose
+
+    def pose_jacobian(self, q: Array) -> Array:
+        """The 8 x dof whole-body pose Jacobian J of eq. 4.9."""
+        return self.kinematics(q)[1]
+
+    def translation_jacobian(self, q: Array) -> Array:
+        """J_p of eq. 4.18 (4 x dof), with vec4(p)' = J_p q'."""
+        pose, jacobian = self.kinematics(q)
+        return translation_jacobian(pose, jacobian)
+
+    def link_points(self, q: Array) -> Array:
+        """World positions (n+2, 3) of the base top and every DH frame origin, for geometry checks."""
+        q = self._check(q)
+        pose = self.base_pose(q)
+        points = [dq.translation(pose)[1:]]
+        for link in self._arm_link_operators(q[BASE_DOF:]):
+            pose = dq.mul(pose, link[:, 0])
+            points.append(dq.translation(pose)[1:])
+        return np.array(points)
+
+
+def translation_jacobian(pose: Array, jacobian: Array) -> Array:
+    """J_p = 2 H-_4(P(x*)) J_D + 2 H+_4(D(x)) C4 J_P (4.14-4.18), rows of vec4(p)'."""
+    return 2.0 * (
+        dq.haminus4(dq.qconj(pose[:4])) @ jacobian[4:]
+        + dq.hamiplus4(pose[4:]) @ (dq.C4 @ jacobian[:4])
+    )

@@ -1,0 +1,75 @@
+"""Tasks: the error and the task Jacobian that every law drives to zero (5.1, 4.18).
+
+The pose task uses e = vec8(x - x_d) with the 8 x n Jacobian J (4.9); the position task uses
+e = p - p_d with the rows of the translation Jacobian J_p (4.18) for i, j and k.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from wbc import dq
+from wbc.robot import translation_jacobian
+from wbc.validation import require_finite
+
+Array = np.ndarray
+
+
+@dataclass(frozen=True)
+class PoseTask:
+    """Drive the end-effector pose to the unit dual quaternion ``pose`` (6 DOF)."""
+
+    pose: Array
+    dof = 6
+
+    def __post_init__(self) -> None:
+        pose = require_finite("goal pose", self.pose).copy()
+        if pose.shape != (8,) or not dq.is_unit(pose, 1e-6):
+            raise ValueError(f"goal pose must be a unit dual quaternion (8,), got {pose}")
+        pose.flags.writeable = False
+        object.__setattr__(self, "pose", pose)
+
+    @property
+    def goal_position(self) -> Array:
+        return dq.translation(self.pose)[1:]
+
+    def error(self, pose: Array, jacobian: Array) -> tuple[Array, Array]:
+        """(vec8(x - x_d), J), x_d taken with the sign nearer to x (x_d and -x_d are one pose)."""
+        return pose - dq.nearest_equivalent(self.pose, pose), jacobian
+
+
+@dataclass(frozen=True)
+class PositionTask:
+    """Drive the end-effector position to ``position`` = (x, y, z), orientation free (3 DOF)."""
+
+    position: Array
+    dof = 3
+
+    def __post_init__(self) -> None:
+        position = require_finite("goal position", self.position).copy()
+        if position.shape != (3,):
+            raise ValueError(f"goal position must have shape (3,), got {position.shape}")
+        position.flags.writeable = False
+        object.__setattr__(self, "position", position)
+
+    @property
+    def goal_position(self) -> Array:
+        return self.position
+
+    def error(self, pose: Array, jacobian: Array) -> tuple[Array, Array]:
+        """(p - p_d, rows i, j, k of J_p) (4.18)."""
+        return dq.translation(pose)[1:] - self.position, translation_jacobian(pose, jacobian)[1:]
+
+
+Task = PoseTask | PositionTask
+
+
+def same_task(a: Task, b: Task) -> bool:
+    """True when a and b are the same kind of task with the same goal."""
+    if type(a) is not type(b):
+        return False
+    goal_a = a.pose if isinstance(a, PoseTask) else a.position
+    goal_b = b.pose if isinstance(b, PoseTask) else b.position
+    return bool(np.array_equal(goal_a, goal_b))
