@@ -101,9 +101,7 @@ def _is_large_bytes(value: object) -> bool:
 
 
 def _bin_header(length: int) -> bytes:
-    """The msgpack bin 8/16/32 header of a ``length``-byte string."""
-    if length < 1 << 8:
-        return b"\xc4" + length.to_bytes(1, "big")
+    """The msgpack bin 16/32 header of a string longer than ``_INLINE_LIMIT`` bytes."""
     if length < 1 << 16:
         return b"\xc5" + length.to_bytes(2, "big")
     return b"\xc6" + length.to_bytes(4, "big")
