@@ -1,0 +1,272 @@
+"""Deploy profiles: one YAML file names every process of a system and how they talk.
+
+A profile is validated before anything starts. Every error names the file, the
+field path (``components[1].restart.policy``) and what was expected. Zenoh
+endpoints must be on the loopback interface (or a unix socket) and multicast
+scouting is off, unless the profile says ``allow_remote: true``: running across
+hosts is an explicit choice, never the default.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import ipaddress
+import json
+from pathlib import Path
+from typing import Annotated, Literal
+
+import yaml
+import zenoh
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+COMPONENT_PACKAGE = "components"
+"""The package of component modules: ``module: echo`` means ``components.echo``."""
+
+ROLES = ("driver", "estimator", "controller", "tool")
+"""Start order of the roles; the launcher stops them in the reverse order."""
+
+Identifier = Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]*$")]
+"""A lower-case Python identifier, also safe inside a key expression."""
+
+Namespace = Annotated[str, Field(pattern=r"^[A-Za-z0-9_-]+(/[A-Za-z0-9_-]+)*$")]
+"""One or more key-expression chunks without wildcards, e.g. ``sim`` or ``lab/robot1``."""
+
+ParamValue = bool | int | float | str
+"""A value a profile may give a component parameter."""
+
+LOCAL_PROTOCOLS = ("unixsock-stream",)
+"""Zenoh link protocols that never leave the host."""
+
+
+class ProfileError(Exception):
+    """A profile that cannot be used; the message says where and what was expected."""
+
+
+class StrictModel(BaseModel):
+    """Base of the profile models: unknown keys are errors, values are immutable."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+def is_local_endpoint(endpoint: str) -> bool:
+    """Whether a Zenoh endpoint (``tcp/127.0.0.1:7447``, ``unixsock-stream//tmp/s``) is local."""
+    protocol, _, address = endpoint.partition("/")
+    if protocol in LOCAL_PROTOCOLS:
+        return True
+    host = address.split("#")[0].split("?")[0].rpartition(":")[0].strip("[]")
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
+class ZenohSettings(StrictModel):
+    """How the processes of a profile reach each other.
+
+    The launcher opens a router listening on ``router``; components open a
+    ``mode`` session connecting to ``connect`` (the router endpoints when
+    omitted). Peer-mode components also listen on ``listen``.
+    """
+
+    mode: Literal["client", "peer"] = "client"
+    router: list[str] = Field(default=["tcp/127.0.0.1:7447"], min_length=1)
+    connect: list[str] | None = None
+    listen: list[str] = ["tcp/127.0.0.1:0"]
+    multicast_scouting: bool = False
+    allow_remote: bool = False
+
+    @model_validator(mode="after")
+    def _local_unless_allowed(self) -> ZenohSettings:
+        if self.allow_remote:
+            return self
+        if self.multicast_scouting:
+            raise ValueError("multicast_scouting: reaches other hosts; it needs allow_remote: true")
+        for field in ("router", "connect", "listen"):
+            for index, endpoint in enumerate(getattr(self, field) or ()):
+                if not is_local_endpoint(endpoint):
+                    raise ValueError(
+                        f"{field}[{index}]: {endpoint!r} is not on the loopback interface "
+                        "(expected 127.0.0.1, [::1], localhost or unixsock-stream); "
+                        "set allow_remote: true to run across hosts"
+                    )
+        return self
+
+    @property
+    def connect_endpoints(self) -> list[str]:
+        """Where component and tool sessions connect."""
+        return self.router if self.connect is None else self.connect
+
+    def router_config(self) -> zenoh.Config:
+        """The config of the launcher's router session."""
+        return self._config("router", listen=self.router, connect=[])
+
+    def client_config(self) -> zenoh.Config:
+        """The config of a client session, as used by tools such as ``parsimony status``."""
+        return self._config("client", listen=[], connect=self.connect_endpoints)
+
+    def component_config(self) -> zenoh.Config:
+        """The config of a component's session, in the profile's ``mode``."""
+        if self.mode == "client":
+            return self.client_config()
+        return self._config("peer", listen=self.listen, connect=self.connect_endpoints)
+
+    def _config(self, mode: str, listen: list[str], connect: list[str]) -> zenoh.Config:
+        config = zenoh.Config()
+        config.insert_json5("mode", json.dumps(mode))
+        config.insert_json5("listen/endpoints", json.dumps(listen))
+        config.insert_json5("connect/endpoints", json.dumps(connect))
+        config.insert_json5("scouting/multicast/enabled", json.dumps(self.multicast_scouting))
+        config.insert_json5("scouting/gossip/enabled", json.dumps(self.allow_remote))
+        return config
+
+
+class RestartPolicy(StrictModel):
+    """What the launcher does when a component exits.
+
+    ``on-failure`` restarts after a non-zero exit, ``always`` after any exit,
+    at most ``max_restarts`` times, waiting ``backoff_initial_s`` doubled per
+    restart up to ``backoff_max_s``. A run longer than ``reset_after_s``
+    resets the count. Exit code 2 (a configuration error) is never restarted.
+    """
+
+    policy: Literal["never", "on-failure", "always"] = "on-failure"
+    max_restarts: int = Field(default=5, ge=0)
+    backoff_initial_s: float = Field(default=0.5, gt=0.0)
+    backoff_max_s: float = Field(default=10.0, gt=0.0)
+    reset_after_s: float = Field(default=60.0, gt=0.0)
+
+    @model_validator(mode="after")
+    def _backoff_ordered(self) -> RestartPolicy:
+        if self.backoff_max_s < self.backoff_initial_s:
+            raise ValueError(
+                f"backoff_max_s: expected >= backoff_initial_s ({self.backoff_initial_s})"
+            )
+        return self
+
+    def backoff_s(self, restarts: int) -> float:
+        """The wait before restart number ``restarts + 1``."""
+        return min(self.backoff_initial_s * 2.0**restarts, self.backoff_max_s)
+
+
+class ComponentSpec(StrictModel):
+    """One process: ``python -m components.<module> --profile P --name <name>``."""
+
+    name: Identifier
+    module: Identifier
+    role: Literal["driver", "estimator", "controller", "tool"]
+    params: dict[str, ParamValue] = {}
+    restart: RestartPolicy = RestartPolicy()
+    enabled: bool = True
+
+    @property
+    def module_path(self) -> str:
+        """The dotted Python module this component runs."""
+        return f"{COMPONENT_PACKAGE}.{self.module}"
+
+
+class Profile(StrictModel):
+    """A whole system: its namespace, its network, its clock and its processes."""
+
+    namespace: Namespace
+    zenoh: ZenohSettings = ZenohSettings()
+    robot: Path | None = None
+    clock: Literal["wall", "sim"] = "wall"
+    components: list[ComponentSpec] = Field(min_length=1)
+
+    @model_validator(mode="after")
+    def _unique_names(self) -> Profile:
+        seen: dict[str, int] = {}
+        for index, spec in enumerate(self.components):
+            if spec.name in seen:
+                raise ValueError(
+                    f"components[{index}].name: {spec.name!r} is already used by "
+                    f"components[{seen[spec.name]}]; names must be unique"
+                )
+            seen[spec.name] = index
+        return self
+
+    def component(self, name: str) -> ComponentSpec:
+        """The component called ``name``; ``KeyError`` if the profile has none."""
+        for spec in self.components:
+            if spec.name == name:
+                return spec
+        raise KeyError(f"no component named {name!r} (have {[c.name for c in self.components]})")
+
+    def start_order(self) -> list[ComponentSpec]:
+        """The enabled components, drivers first, then estimators, controllers, tools."""
+        enabled = [spec for spec in self.components if spec.enabled]
+        return sorted(enabled, key=lambda spec: ROLES.index(spec.role))
+
+
+def field_path(loc: tuple[int | str, ...]) -> str:
+    """Render a pydantic error location as ``components[1].restart.policy``."""
+    path = ""
+    for part in loc:
+        path += f"[{part}]" if isinstance(part, int) else (f".{part}" if path else str(part))
+    return path
+
+
+def _format_validation(path: Path, error: ValidationError) -> str:
+    """One line per error. Model validators raise ``"sub.path: message"``, relative to the model."""
+    lines = [f"{path}: invalid profile"]
+    for item in error.errors():
+        location = field_path(item["loc"])
+        if item["type"] == "value_error":
+            message = str(item["ctx"]["error"])
+            lines.append(f"  {location}.{message}" if item["loc"] else f"  {message}")
+        elif item["type"] == "missing":
+            lines.append(f"  {location}: {item['msg']}")
+        else:
+            lines.append(f"  {location}: {item['msg']} (got {item['input']!r})")
+    return "\n".join(lines)
+
+
+def _read_yaml(path: Path) -> object:
+    try:
+        text = path.read_text()
+    except OSError as error:
+        raise ProfileError(f"{path}: cannot read profile: {error.strerror}") from error
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as error:
+        mark = getattr(error, "problem_mark", None)
+        where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else str(path)
+        problem = getattr(error, "problem", None) or str(error)
+        raise ProfileError(f"{where}: YAML syntax error: {problem}") from error
+
+
+def _check_files_and_modules(path: Path, profile: Profile) -> Profile:
+    errors = []
+    for index, spec in enumerate(profile.components):
+        if importlib.util.find_spec(spec.module_path) is None:
+            errors.append(
+                f"  components[{index}].module: no module {spec.module_path!r} "
+                f"(expected a module in the {COMPONENT_PACKAGE}/ package)"
+            )
+    robot = profile.robot
+    if robot is not None:
+        robot = (path.parent / robot).resolve()
+        if not robot.is_file():
+            errors.append(f"  robot: no robot description at {robot}")
+    if errors:
+        raise ProfileError("\n".join([f"{path}: invalid profile", *errors]))
+    return profile.model_copy(update={"robot": robot})
+
+
+def load_profile(path: str | Path) -> Profile:
+    """Read and validate a profile; ``robot`` comes back as an absolute path.
+
+    Raises ``ProfileError`` naming the file, the field and what was expected.
+    """
+    path = Path(path)
+    data = _read_yaml(path)
+    if not isinstance(data, dict):
+        got = type(data).__name__
+        raise ProfileError(f"{path}: expected a mapping at the top level, got {got}")
+    try:
+        profile = Profile.model_validate(data)
+    except ValidationError as error:
+        raise ProfileError(_format_validation(path, error)) from error
+    return _check_files_and_modules(path, profile)

@@ -1,0 +1,166 @@
+"""Profile validation: every refusal names the file, the field and what was expected."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+import yaml
+
+from deploy.profile import ProfileError, ZenohSettings, is_local_endpoint, load_profile
+
+PUB = {"name": "pub", "module": "scripted_publisher", "role": "tool"}
+
+
+def write(tmp_path: Path, data: object) -> Path:
+    path = tmp_path / "profile.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def refusal(tmp_path: Path, data: object) -> str:
+    with pytest.raises(ProfileError) as error:
+        load_profile(write(tmp_path, data))
+    return str(error.value)
+
+
+def test_a_minimal_profile_gets_safe_defaults(tmp_path: Path) -> None:
+    (tmp_path / "robot.yaml").write_text("links: []\n")
+    profile = load_profile(
+        write(tmp_path, {"namespace": "sim", "robot": "robot.yaml", "components": [PUB]})
+    )
+    assert profile.robot == tmp_path / "robot.yaml"
+    assert profile.clock == "wall"
+    assert profile.zenoh.mode == "client"
+    assert profile.zenoh.connect_endpoints == ["tcp/127.0.0.1:7447"]
+    assert profile.zenoh.multicast_scouting is False
+    spec = profile.component("pub")
+    assert spec.restart.policy == "on-failure" and spec.enabled and spec.params == {}
+    assert spec.module_path == "components.scripted_publisher"
+
+
+@pytest.mark.parametrize(
+    ("change", "field", "expected"),
+    [
+        (
+            {"components": [{**PUB, "restart": {"policy": "sometimes"}}]},
+            "components[0].restart.policy",
+            "'never', 'on-failure' or 'always'",
+        ),
+        (
+            {"components": [PUB, {**PUB, "name": "b", "role": "boss"}]},
+            "components[1].role",
+            "'driver', 'estimator', 'controller' or 'tool'",
+        ),
+        ({"components": [{**PUB, "colour": "red"}]}, "components[0].colour", "Extra inputs"),
+        (
+            {"components": [{**PUB, "params": {"gains": [1, 2]}}]},
+            "components[0].params.gains",
+            "valid",
+        ),
+        ({"components": [PUB, PUB]}, "components[1].name", "already used by components[0]"),
+        (
+            {"components": [{**PUB, "module": "no_such_component"}]},
+            "components[0].module",
+            "no module 'components.no_such_component'",
+        ),
+        (
+            {"components": [{**PUB, "restart": {"backoff_initial_s": 2, "backoff_max_s": 1}}]},
+            "components[0].restart.backoff_max_s",
+            "expected >= backoff_initial_s",
+        ),
+        ({"components": [{**PUB, "name": "Bad Name"}]}, "components[0].name", "pattern"),
+        ({"namespace": "sim/*"}, "namespace", "pattern"),
+        ({"components": []}, "components", "at least 1"),
+        ({"clock": "sundial"}, "clock", "'wall' or 'sim'"),
+        ({"robot": "missing.yaml"}, "robot", "no robot description"),
+        ({"zenoh": {"mode": "router"}}, "zenoh.mode", "'client' or 'peer'"),
+    ],
+)
+def test_invalid_profiles_name_the_field(
+    tmp_path: Path, change: dict[str, object], field: str, expected: str
+) -> None:
+    message = refusal(tmp_path, {"namespace": "sim", "components": [PUB], **change})
+    assert message.startswith(f"{tmp_path / 'profile.yaml'}: invalid profile")
+    assert f"  {field}" in message and expected in message, message
+
+
+def test_missing_namespace_is_named(tmp_path: Path) -> None:
+    assert "namespace: Field required" in refusal(tmp_path, {"components": [PUB]})
+
+
+def test_yaml_syntax_errors_give_the_line(tmp_path: Path) -> None:
+    path = tmp_path / "broken.yaml"
+    path.write_text("namespace: sim\ncomponents:\n  - {name: pub, module: x\n  - other\n")
+    with pytest.raises(ProfileError, match=r"broken\.yaml:5:1: YAML syntax error: expected ','"):
+        load_profile(path)
+
+
+def test_a_profile_that_is_not_a_mapping_or_not_there_is_refused(tmp_path: Path) -> None:
+    assert "expected a mapping at the top level, got list" in refusal(tmp_path, [1, 2])
+    with pytest.raises(ProfileError, match="cannot read profile"):
+        load_profile(tmp_path / "absent.yaml")
+
+
+@pytest.mark.parametrize(
+    "zenoh",
+    [
+        {"router": ["tcp/192.168.1.20:7447"]},
+        {"router": ["tcp/0.0.0.0:7447"]},
+        {"connect": ["tcp/[::]:7447"]},
+        {"mode": "peer", "listen": ["udp/10.0.0.1:0"]},
+        {"router": ["tcp/robot.local:7447"]},
+        {"multicast_scouting": True},
+    ],
+)
+def test_remote_endpoints_and_multicast_are_refused(
+    tmp_path: Path, zenoh: dict[str, object]
+) -> None:
+    message = refusal(tmp_path, {"namespace": "sim", "zenoh": zenoh, "components": [PUB]})
+    assert "allow_remote: true" in message
+    assert ZenohSettings(**zenoh, allow_remote=True).allow_remote
+
+
+@pytest.mark.parametrize(
+    "endpoint",
+    [
+        "tcp/127.0.0.1:7447",
+        "tcp/127.0.0.2:1",
+        "tcp/[::1]:7447",
+        "tcp/localhost:7447",
+        "udp/127.0.0.1:7447#iface=lo",
+        "unixsock-stream//tmp/parsimony.sock",
+    ],
+)
+def test_loopback_and_unix_socket_endpoints_are_local(endpoint: str) -> None:
+    assert is_local_endpoint(endpoint)
+
+
+def test_zenoh_configs_stay_on_loopback_without_scouting() -> None:
+    settings = ZenohSettings(router=["tcp/127.0.0.1:7500"], mode="peer")
+    configs = {
+        "router": settings.router_config(),
+        "peer": settings.component_config(),
+        "client": settings.client_config(),
+    }
+    for mode, config in configs.items():
+        assert json.loads(config.get_json("mode")) == mode
+        assert json.loads(config.get_json("scouting/multicast/enabled")) is False
+        assert json.loads(config.get_json("scouting/gossip/enabled")) is False
+    assert json.loads(configs["router"].get_json("listen/endpoints")) == ["tcp/127.0.0.1:7500"]
+    assert json.loads(configs["peer"].get_json("listen/endpoints")) == ["tcp/127.0.0.1:0"]
+    assert json.loads(configs["client"].get_json("listen/endpoints")) == []
+    assert json.loads(configs["client"].get_json("connect/endpoints")) == ["tcp/127.0.0.1:7500"]
+
+
+def test_start_order_is_by_role_and_skips_disabled_components(tmp_path: Path) -> None:
+    components = [
+        {**PUB, "name": "tool"},
+        {**PUB, "name": "ctrl", "role": "controller"},
+        {**PUB, "name": "off", "role": "driver", "enabled": False},
+        {**PUB, "name": "drv", "role": "driver"},
+        {**PUB, "name": "est", "role": "estimator"},
+    ]
+    profile = load_profile(write(tmp_path, {"namespace": "sim", "components": components}))
+    assert [spec.name for spec in profile.start_order()] == ["drv", "est", "ctrl", "tool"]
