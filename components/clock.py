@@ -1,0 +1,115 @@
+"""A component's clock and timers: wall time, or the simulator's time from ``sim/clock``.
+
+Both clocks give two readings. ``now_ns`` stamps messages (Unix time, or
+simulated time). ``monotonic_ns`` measures periods and ages (``time.monotonic``,
+or simulated time again), so a wall-clock step never stalls a timer.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+
+class WallClock:
+    """The host's clocks."""
+
+    simulated = False
+
+    def now_ns(self) -> int:
+        """Unix time in ns, for stamps."""
+        return time.time_ns()
+
+    def monotonic_ns(self) -> int:
+        """Monotonic time in ns, for periods and ages."""
+        return time.monotonic_ns()
+
+
+class SimClock:
+    """The simulator's time: zero until the first ``sim/clock`` message, then its stamp.
+
+    ``advance`` is called on the handler thread; reading an int is safe from any thread.
+    """
+
+    simulated = True
+
+    def __init__(self) -> None:
+        self._stamp_ns = 0
+
+    def advance(self, stamp_ns: int) -> None:
+        """Set the time to ``stamp_ns`` (it may go back when a replay restarts)."""
+        self._stamp_ns = stamp_ns
+
+    def now_ns(self) -> int:
+        """Simulated time in ns."""
+        return self._stamp_ns
+
+    def monotonic_ns(self) -> int:
+        """Simulated time in ns."""
+        return self._stamp_ns
+
+
+Clock = WallClock | SimClock
+
+
+@dataclass
+class Timer:
+    """A callback due every ``period_ns`` on a clock's monotonic time."""
+
+    period_ns: int
+    callback: Callable[[], None]
+    deadline_ns: int
+
+    @property
+    def name(self) -> str:
+        """The callback's name, for logs and counters."""
+        return getattr(self.callback, "__qualname__", repr(self.callback))
+
+    def reschedule(self, now_ns: int) -> bool:
+        """Move the deadline if the timer is due; return whether it was.
+
+        A due timer moves one period on, skipping missed periods. A deadline
+        more than a period away means the clock was set back: it restarts from now.
+        """
+        if self.deadline_ns <= now_ns:
+            self.deadline_ns += self.period_ns
+            if self.deadline_ns <= now_ns:
+                self.deadline_ns = now_ns + self.period_ns
+            return True
+        if self.deadline_ns > now_ns + self.period_ns:
+            self.deadline_ns = now_ns + self.period_ns
+        return False
+
+
+class Timers:
+    """The timers of one component, fired by its handler thread."""
+
+    def __init__(self, clock: Clock) -> None:
+        self.clock = clock
+        self._timers: list[Timer] = []
+
+    def add(self, period_s: float, callback: Callable[[], None]) -> Timer:
+        """Call ``callback`` every ``period_s`` seconds of the clock, first after one period."""
+        if not period_s > 0.0:
+            raise ValueError(f"timer period must be > 0 s, got {period_s}")
+        period_ns = max(1, round(period_s * 1e9))
+        timer = Timer(period_ns, callback, self.clock.monotonic_ns() + period_ns)
+        self._timers.append(timer)
+        return timer
+
+    def due(self) -> list[Timer]:
+        """The timers whose deadline has passed, each moved to its next deadline."""
+        now = self.clock.monotonic_ns()
+        return [timer for timer in self._timers if timer.reschedule(now)]
+
+    def wait_s(self) -> float | None:
+        """How long the handler thread may block before a timer is due.
+
+        ``None`` (block until the next event) when there are no timers or the
+        clock is simulated: simulated time only moves with a ``sim/clock`` message.
+        """
+        if not self._timers or self.clock.simulated:
+            return None
+        next_deadline = min(timer.deadline_ns for timer in self._timers)
+        return max(0.0, (next_deadline - self.clock.monotonic_ns()) / 1e9)

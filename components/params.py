@@ -1,0 +1,138 @@
+"""Declared parameters of a component, set by the profile and changed at run time.
+
+A component declares each parameter with its type, default and optional
+bounds; the profile's ``params`` override the defaults at start, and
+``parsimony param set`` changes them while the component runs. On the wire
+(the param queryable), a get has no payload, a set carries the new value as
+text (``"0.5"``, ``"true"``), and the reply is the value as JSON; errors are
+replied as plain text.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Iterable, Iterator, Mapping
+from dataclasses import dataclass
+
+ParamValue = bool | int | float | str
+"""A parameter's value."""
+
+_TRUE = ("true", "yes", "on", "1")
+_FALSE = ("false", "no", "off", "0")
+
+
+class ParamError(ValueError):
+    """An unknown parameter name, or a value of the wrong type or out of bounds."""
+
+
+@dataclass(frozen=True)
+class Param:
+    """A declared parameter: ``name``, ``type`` (bool, int, float or str), ``default``,
+    optional inclusive bounds ``low`` and ``high`` for numbers, optional ``choices``
+    (the only values allowed), and a one-line ``doc``."""
+
+    name: str
+    type: type[bool] | type[int] | type[float] | type[str]
+    default: ParamValue
+    low: float | None = None
+    high: float | None = None
+    choices: tuple[ParamValue, ...] | None = None
+    doc: str = ""
+
+    def __post_init__(self) -> None:
+        self.check(self.default)
+
+    def expected(self) -> str:
+        """What a valid value is, in words: ``"a float in [0, 10]"``."""
+        what = f"a {self.type.__name__}"
+        if self.choices is not None:
+            return f"{what} in {{{', '.join(map(repr, self.choices))}}}"
+        if self.low is not None and self.high is not None:
+            return f"{what} in [{self.low}, {self.high}]"
+        if self.low is not None:
+            return f"{what} >= {self.low}"
+        if self.high is not None:
+            return f"{what} <= {self.high}"
+        return what
+
+    def check(self, value: object) -> ParamValue:
+        """``value`` as this parameter's type, or ``ParamError`` saying what was expected.
+
+        An int is accepted for a float; a bool is never accepted as a number.
+        """
+        if self.type is float and isinstance(value, int) and not isinstance(value, bool):
+            value = float(value)
+        if type(value) is not self.type or (self.type is float and not math.isfinite(value)):
+            raise ParamError(f"{self.name}: expected {self.expected()}, got {value!r}")
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            if (self.low is not None and value < self.low) or (
+                self.high is not None and value > self.high
+            ):
+                raise ParamError(f"{self.name}: expected {self.expected()}, got {value!r}")
+        if self.choices is not None and value not in self.choices:
+            raise ParamError(f"{self.name}: expected {self.expected()}, got {value!r}")
+        return value
+
+    def parse(self, text: str) -> ParamValue:
+        """The value written as ``text`` (as typed on a command line), checked."""
+        text = text.strip() if self.type is not str else text
+        try:
+            if self.type is bool:
+                if text.lower() not in _TRUE + _FALSE:
+                    raise ValueError(text)
+                value: ParamValue = text.lower() in _TRUE
+            else:
+                value = self.type(text)
+        except ValueError:
+            raise ParamError(f"{self.name}: expected {self.expected()}, got {text!r}") from None
+        return self.check(value)
+
+
+class Parameters(Mapping[str, ParamValue]):
+    """The current values of a component's declared parameters, read like a dict."""
+
+    def __init__(self, declared: Iterable[Param], overrides: Mapping[str, object]) -> None:
+        self.declared = {param.name: param for param in declared}
+        unknown = sorted(set(overrides) - set(self.declared))
+        if unknown:
+            raise ParamError(
+                f"{', '.join(unknown)}: unknown parameter; "
+                f"declared: {', '.join(self.declared) or 'none'}"
+            )
+        self._values = {name: param.default for name, param in self.declared.items()}
+        for name, value in overrides.items():
+            self._values[name] = self.declared[name].check(value)
+
+    def __getitem__(self, name: str) -> ParamValue:
+        return self._values[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._values)
+
+    def __len__(self) -> int:
+        return len(self._values)
+
+    def param(self, name: str) -> Param:
+        """The declaration of ``name``, or ``ParamError`` listing the declared names."""
+        if name not in self.declared:
+            raise ParamError(
+                f"unknown parameter {name!r}; declared: {', '.join(self.declared) or 'none'}"
+            )
+        return self.declared[name]
+
+    def set_text(self, name: str, text: str) -> ParamValue:
+        """Set ``name`` from its text form and return the new value."""
+        value = self.param(name).parse(text)
+        self._values[name] = value
+        return value
+
+
+def encode_value(value: ParamValue) -> bytes:
+    """A parameter value as a reply payload (JSON)."""
+    return json.dumps(value).encode()
+
+
+def decode_value(payload: bytes) -> ParamValue:
+    """The parameter value in a reply payload."""
+    return json.loads(payload)

@@ -1,0 +1,351 @@
+"""The runtime every component process shares: one process is one component.
+
+A component module defines a ``Component`` subclass and ends with::
+
+    if __name__ == "__main__":
+        run_component(MyComponent)
+
+It runs as ``python -m components.<module> --profile PATH --name NAME``. The
+``Node`` gives it a Zenoh session opened from the profile, typed publishers
+and subscriptions (names from ``messages.topics``), declared parameters,
+timers on the profile's clock, counters, a liveliness token, and queryables
+that answer its status and get or set its parameters.
+
+Every handler, timer and query runs on one handler thread, one at a time, so
+component code needs no locks. A malformed message is dropped, counted as
+``rejected.<topic>`` and logged (rate-limited); an exception in a handler is
+counted as ``errors.<topic>``; the process keeps running either way.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import os
+import queue
+import signal
+import sys
+import threading
+import time
+from collections.abc import Callable, Iterable, Sequence
+from functools import partial
+from typing import ClassVar, NoReturn, TypeVar
+
+import zenoh
+from pydantic import BaseModel
+
+from components.clock import Clock, SimClock, Timer, Timers, WallClock
+from components.params import Param, ParamError, Parameters, encode_value
+from components.pubsub import Publisher, Subscription
+from deploy.profile import Profile, ProfileError, load_profile
+from messages import codec, topics
+from messages.header import Header
+from messages.status import ComponentStatus
+
+M = TypeVar("M", bound=BaseModel)
+
+EXIT_CONFIG_ERROR = 2
+"""Exit code of a component refused by its configuration; the launcher never restarts it."""
+
+LAUNCHER_PID_ENV = "PARSIMONY_LAUNCHER_PID"
+"""Set by the launcher; a component whose parent is no longer that pid stops."""
+
+SUMMARY_INTERVAL_S = 5.0
+"""Repeated warnings of one kind are summarised at most this often."""
+
+STOP_TIMEOUT_S = 2.0
+"""How long closing waits for the handler thread to finish its current event."""
+
+log = logging.getLogger("components")
+
+
+class RateLimitedLog:
+    """Logs the first warning of a kind, then at most one summary per interval."""
+
+    def __init__(self, logger: logging.Logger, interval_s: float = SUMMARY_INTERVAL_S) -> None:
+        self._logger = logger
+        self._interval_ns = round(interval_s * 1e9)
+        self._last_ns: dict[str, int] = {}
+        self._suppressed: dict[str, int] = {}
+
+    def warning(self, kind: str, message: str, exc_info: bool = False) -> None:
+        """Log ``message`` unless a ``kind`` warning was logged less than an interval ago."""
+        now = time.monotonic_ns()
+        last = self._last_ns.get(kind)
+        if last is not None and now - last < self._interval_ns:
+            self._suppressed[kind] = self._suppressed.get(kind, 0) + 1
+            return
+        self._last_ns[kind] = now
+        suppressed = self._suppressed.pop(kind, 0)
+        suffix = f" ({suppressed} more since the last report)" if suppressed else ""
+        self._logger.warning("%s%s", message, suffix, exc_info=exc_info)
+
+
+class Node:
+    """One component's runtime: session, parameters, clock, timers, counters, handler thread.
+
+    Use as a context manager: entering opens the Zenoh session, ``start()``
+    makes the component visible and starts handling, leaving closes it all.
+    """
+
+    def __init__(self, profile: Profile, name: str, params: Iterable[Param] = ()) -> None:
+        """Raise ``KeyError`` for a name not in the profile, ``ParamError`` for bad params."""
+        self.profile = profile
+        self.spec = profile.component(name)
+        self.name = name
+        self.namespace = profile.namespace
+        self.params = Parameters(params, self.spec.params)
+        self.clock: Clock = SimClock() if profile.clock == "sim" else WallClock()
+        self.counters: dict[str, int] = {}
+        self.state = "starting"
+        self._timers = Timers(self.clock)
+        self._events: queue.SimpleQueue[Callable[[], None] | None] = queue.SimpleQueue()
+        self._warnings = RateLimitedLog(log)
+        self._session: zenoh.Session | None = None
+        self._declared: list[object] = []
+        self._thread: threading.Thread | None = None
+        self._on_shutdown: Callable[[], None] | None = None
+
+    def __enter__(self) -> Node:
+        self._session = zenoh.open(self.profile.zenoh.component_config())
+        clock = self.clock
+        if isinstance(clock, SimClock):
+            self.subscribe(topics.SIM_CLOCK, lambda tick: clock.advance(tick.stamp_ns))
+        return self
+
+    def __exit__(self, *_exc: object) -> None:
+        self.close()
+
+    @property
+    def session(self) -> zenoh.Session:
+        """The open Zenoh session."""
+        if self._session is None:
+            raise RuntimeError("the node's session is not open; use `with Node(...) as node`")
+        return self._session
+
+    def publisher(self, topic: topics.Topic[M]) -> Publisher[M]:
+        """A typed publisher on ``topic`` in this node's namespace, declared until close."""
+        publisher = Publisher(self, topic)
+        self._declared.append(publisher)
+        return publisher
+
+    def subscribe(
+        self, topic: topics.Topic[M], handler: Callable[[M], None] | None = None
+    ) -> Subscription[M]:
+        """Subscribe to ``topic`` until close; ``handler`` (optional) gets each valid message."""
+        subscription = Subscription(self, topic, handler)
+        self._declared.append(subscription)
+        return subscription
+
+    def timer(self, period_s: float, callback: Callable[[], None]) -> Timer:
+        """Call ``callback`` on the handler thread every ``period_s`` of the component clock."""
+        timer = self._timers.add(period_s, callback)
+        self.counters[f"errors.timer.{timer.name}"] = 0
+        return timer
+
+    def header(self, frame: str = "", stamp_ns: int | None = None) -> Header:
+        """A header from this component, stamped now unless ``stamp_ns`` is given."""
+        stamp = self.clock.now_ns() if stamp_ns is None else stamp_ns
+        return Header(stamp_ns=stamp, frame=frame, seq=0, source=self.name)
+
+    def count(self, counter: str, amount: int = 1) -> None:
+        """Add ``amount`` to a component counter (handler thread only)."""
+        self.counters[counter] = self.counters.get(counter, 0) + amount
+
+    def warn(self, kind: str, message: str, exc_info: bool = False) -> None:
+        """Log a warning, rate-limited per ``kind`` (handler thread only)."""
+        self._warnings.warning(kind, message, exc_info)
+
+    def status(self) -> ComponentStatus:
+        """This component's self-report."""
+        return ComponentStatus(
+            header=self.header(),
+            name=self.name,
+            module=self.spec.module,
+            state=self.state,
+            pid=os.getpid(),
+            counters=dict(self.counters),
+            parameters=dict(self.params),
+        )
+
+    def post(self, event: Callable[[], None]) -> None:
+        """Run ``event`` on the handler thread (callable from any thread)."""
+        self._events.put(event)
+
+    def start(self, on_shutdown: Callable[[], None] | None = None) -> None:
+        """Answer queries, start the handler thread and declare the liveliness token.
+
+        ``on_shutdown`` runs on the handler thread when the node closes.
+        """
+        self._on_shutdown = on_shutdown
+        session = self.session
+        status_key = topics.status_key(self.namespace, self.name)
+        param_keys = {topics.param_key(self.namespace, self.name, p): p for p in self.params}
+        self._declared += [
+            session.declare_queryable(
+                status_key, lambda query: self.post(partial(self._answer_status, query))
+            ),
+            session.declare_queryable(
+                topics.param_selector(self.namespace, self.name),
+                lambda query: self.post(partial(self._answer_param, query, param_keys)),
+            ),
+        ]
+        self._thread = threading.Thread(
+            target=self._handle, name=f"{self.name}-handler", daemon=True
+        )
+        self._thread.start()
+        self.state = "running"
+        self._declared.append(
+            session.liveliness().declare_token(topics.liveliness_key(self.namespace, self.name))
+        )
+        log.info("%s running (%s, pid %d)", self.name, self.spec.module_path, os.getpid())
+
+    def close(self) -> None:
+        """Stop the handler thread (after ``on_shutdown``) and close the session."""
+        self.state = "stopping"
+        if self._thread is not None:
+            self._events.put(None)
+            self._thread.join(STOP_TIMEOUT_S)
+            if self._thread.is_alive():
+                log.warning("handler thread busy after %.1f s; closing anyway", STOP_TIMEOUT_S)
+        if self._session is not None:
+            self._session.close()
+        self._declared.clear()
+
+    def _handle(self) -> None:
+        """The handler thread: run events and due timers one at a time until closed."""
+        while True:
+            try:
+                event = self._events.get(timeout=self._timers.wait_s())
+            except queue.Empty:
+                pass
+            else:
+                if event is None:
+                    break
+                self._run(event, "errors.events")
+            for timer in self._timers.due():
+                self._run(timer.callback, f"errors.timer.{timer.name}")
+        if self._on_shutdown is not None:
+            self._run(self._on_shutdown, "errors.shutdown")
+
+    def _run(self, callback: Callable[[], None], counter: str) -> None:
+        try:
+            callback()
+        except Exception:
+            self.count(counter)
+            self.warn(counter, f"{getattr(callback, '__qualname__', callback)} failed", True)
+
+    def _answer_status(self, query: zenoh.Query) -> None:
+        with query:
+            status = self.status()
+            query.reply(topics.status_key(self.namespace, self.name), codec.encode(status))
+
+    def _answer_param(self, query: zenoh.Query, keys: dict[str, str]) -> None:
+        """Reply every parameter the query's key matches; set it first if there is a payload."""
+        with query:
+            matching = {key: name for key, name in keys.items() if query.key_expr.intersects(key)}
+            try:
+                if not matching:
+                    raise ParamError(
+                        f"{self.name} has no parameter at {query.key_expr}; "
+                        f"declared: {', '.join(self.params) or 'none'}"
+                    )
+                if query.payload is not None:
+                    if len(matching) != 1:
+                        raise ParamError(f"set one parameter at a time; {query.key_expr} is many")
+                    (name,) = matching.values()
+                    value = self.params.set_text(name, query.payload.to_string())
+                    log.info("parameter %s set to %r", name, value)
+            except ParamError as error:
+                query.reply_err(str(error))
+                return
+            for key, name in matching.items():
+                query.reply(key, encode_value(self.params[name]))
+
+
+class Component:
+    """Base of every component: declare ``params``, build publishers, subscriptions and
+    timers on ``self.node`` in ``__init__``, react in handlers."""
+
+    params: ClassVar[tuple[Param, ...]] = ()
+
+    def __init__(self, node: Node) -> None:
+        self.node = node
+
+    def shutdown(self) -> None:
+        """Runs on the handler thread before the session closes (a driver stops the robot here)."""
+
+
+class _StopRequested(Exception):
+    """Raised in the main thread by SIGINT or SIGTERM."""
+
+
+def _on_stop_signal(signum: int, _frame: object) -> None:
+    for stop_signal in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(stop_signal, signal.SIG_IGN)
+    raise _StopRequested(signal.Signals(signum).name)
+
+
+def _wait_for_stop() -> None:
+    """Sleep until a stop signal, or until the launcher that started us is gone."""
+    launcher = os.environ.get(LAUNCHER_PID_ENV)
+    while True:
+        time.sleep(1.0)
+        if launcher is not None and os.getppid() != int(launcher):
+            log.warning("launcher (pid %s) is gone; stopping", launcher)
+            return
+
+
+def _parse_args(component_class: type[Component], argv: Sequence[str] | None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(description=component_class.__doc__)
+    parser.add_argument("--profile", required=True, help="the deploy profile (YAML)")
+    parser.add_argument("--name", required=True, help="this component's name in the profile")
+    parser.add_argument("--log-level", default="INFO", help="DEBUG, INFO, WARNING or ERROR")
+    return parser.parse_args(argv)
+
+
+def _configure(component_class: type[Component], args: argparse.Namespace) -> Node | None:
+    """The component's node, or ``None`` after logging why the configuration is refused."""
+    try:
+        profile = load_profile(args.profile)
+    except ProfileError as error:
+        log.error("%s", error)
+        return None
+    names = [spec.name for spec in profile.components]
+    if args.name not in names:
+        log.error("%s: no component named %r (have %s)", args.profile, args.name, names)
+        return None
+    try:
+        return Node(profile, args.name, component_class.params)
+    except ParamError as error:
+        log.error("%s: components[%d].params.%s", args.profile, names.index(args.name), error)
+        return None
+
+
+def main(component_class: type[Component], argv: Sequence[str] | None = None) -> int:
+    """Run ``component_class`` until SIGINT or SIGTERM; return the exit code."""
+    args = _parse_args(component_class, argv)
+    logging.basicConfig(
+        level=args.log_level.upper(), stream=sys.stderr, format="%(levelname)s %(message)s"
+    )
+    for stop_signal in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(stop_signal, _on_stop_signal)
+    try:
+        node = _configure(component_class, args)
+        if node is None:
+            return EXIT_CONFIG_ERROR
+        with node:
+            component = component_class(node)
+            node.start(component.shutdown)
+            _wait_for_stop()
+    except _StopRequested as stop:
+        log.info("%s stopping on %s", args.name, stop)
+    except zenoh.ZError as error:
+        log.error("%s: Zenoh failed: %s", args.name, error)
+        return 1
+    return 0
+
+
+def run_component(component_class: type[Component]) -> NoReturn:
+    """The entry point of every component module: run it and exit with its code."""
+    sys.exit(main(component_class))

@@ -1,0 +1,72 @@
+"""A tool that publishes a fixed robot state and goal from its parameters, at a rate.
+
+It stands in for the estimator and the operator when a controller is tested or
+demonstrated alone. The state is ``(base_x, base_y, base_phi)`` and the five
+arm joints ``q1..q5``; its end effector is left at ``IDENTITY_POSE`` (a
+consumer computes kinematics from the configuration). The goal is a position
+``(goal_x, goal_y, goal_z)``, or with ``goal_task: pose`` the pose at that
+position rotated ``goal_yaw`` about the world z axis. Parameters changed with
+``parsimony param set`` apply from the next message (``rate_hz`` from the next period).
+"""
+
+from __future__ import annotations
+
+from components.params import Param
+from components.runtime import Component, Node, run_component
+from messages import topics
+from messages.base import IDENTITY_POSE
+from messages.goal import Goal
+from messages.state import RobotState
+from wbc import dq
+
+WORLD_FRAME = "world"
+
+
+class ScriptedPublisher(Component):
+    """Publishes ``robot/state`` and ``control/goal`` from parameters every ``1 / rate_hz`` s."""
+
+    params = (
+        Param("rate_hz", float, 10.0, low=0.1, high=1000.0, doc="publishing rate"),
+        Param("base_x", float, 0.0, doc="base position x, m"),
+        Param("base_y", float, 0.0, doc="base position y, m"),
+        Param("base_phi", float, 0.0, doc="base heading, rad"),
+        *(Param(f"q{i}", float, 0.0, doc=f"arm joint {i}, rad") for i in range(1, 6)),
+        Param("goal_task", str, "position", choices=("position", "pose"), doc="task kind"),
+        Param("goal_x", float, 1.0, doc="goal position x, m"),
+        Param("goal_y", float, 0.0, doc="goal position y, m"),
+        Param("goal_z", float, 0.5, doc="goal position z, m"),
+        Param("goal_yaw", float, 0.0, doc="goal rotation about z for a pose task, rad"),
+    )
+
+    def __init__(self, node: Node) -> None:
+        super().__init__(node)
+        self.state = node.publisher(topics.ROBOT_STATE)
+        self.goal = node.publisher(topics.CONTROL_GOAL)
+        self.timer = node.timer(1.0 / float(node.params["rate_hz"]), self.publish)
+
+    def publish(self) -> None:
+        """Publish one state and one goal from the current parameters."""
+        p = self.node.params
+        self.timer.period_ns = round(1e9 / float(p["rate_hz"]))
+        header = self.node.header(WORLD_FRAME)
+        self.state.put(
+            RobotState(
+                header=header,
+                base_pose=(p["base_x"], p["base_y"], p["base_phi"]),
+                arm_joints=tuple(p[f"q{i}"] for i in range(1, 6)),
+                end_effector=IDENTITY_POSE,
+                valid=True,
+                age_s=0.0,
+            )
+        )
+        position = (p["goal_x"], p["goal_y"], p["goal_z"])
+        if p["goal_task"] == "pose":
+            rotation = dq.rotation_quaternion(float(p["goal_yaw"]), [0.0, 0.0, 1.0])
+            pose = tuple(float(v) for v in dq.pose(rotation, position))
+            self.goal.put(Goal(header=header, task="pose", pose=pose))
+        else:
+            self.goal.put(Goal(header=header, task="position", position=position))
+
+
+if __name__ == "__main__":
+    run_component(ScriptedPublisher)

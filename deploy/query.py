@@ -1,0 +1,125 @@
+"""What a tool asks a running system: who is alive, their status, their parameters.
+
+Used by ``parsimony status`` and ``parsimony param``. A ``Target`` says which
+namespace to look at and how to reach its router; each question is a Zenoh
+query with a timeout on a client session.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import zenoh
+
+from components.params import ParamValue, decode_value
+from deploy.profile import ZenohSettings, load_profile
+from messages import codec, topics
+from messages.status import ComponentStatus
+
+DEFAULT_ROUTER = "tcp/127.0.0.1:7447"
+"""Where tools look for the router when given a namespace and no endpoint."""
+
+DEFAULT_TIMEOUT_S = 2.0
+"""How long a tool waits for replies."""
+
+
+class QueryError(Exception):
+    """A question the running system did not or could not answer."""
+
+
+@dataclass(frozen=True)
+class Target:
+    """A namespace and how to reach the router that serves it."""
+
+    namespace: str
+    zenoh: ZenohSettings
+
+    @classmethod
+    def from_profile(cls, path: str | Path) -> Target:
+        """The namespace and router of a profile (raises ``ProfileError``)."""
+        profile = load_profile(path)
+        return cls(profile.namespace, profile.zenoh)
+
+    @classmethod
+    def from_namespace(cls, namespace: str, router: str = DEFAULT_ROUTER) -> Target:
+        """A namespace served by the router at ``router`` (a loopback endpoint)."""
+        topics.check_namespace(namespace)
+        return cls(namespace, ZenohSettings(router=[router]))
+
+    def open(self) -> zenoh.Session:
+        """A client session to the router; ``QueryError`` if it cannot connect."""
+        try:
+            return zenoh.open(self.zenoh.client_config())
+        except zenoh.ZError as error:
+            where = ", ".join(self.zenoh.connect_endpoints)
+            raise QueryError(f"cannot reach a router at {where}: {error}") from error
+
+
+def live_components(
+    session: zenoh.Session, namespace: str, timeout_s: float = DEFAULT_TIMEOUT_S
+) -> list[str]:
+    """The names of the components whose liveliness token is present, sorted."""
+    names = {
+        topics.component_of_liveliness_key(namespace, str(reply.ok.key_expr))
+        for reply in session.liveliness().get(
+            topics.liveliness_selector(namespace), timeout=timeout_s
+        )
+        if reply.ok is not None
+    }
+    return sorted(names)
+
+
+def statuses(
+    session: zenoh.Session, namespace: str, timeout_s: float = DEFAULT_TIMEOUT_S
+) -> dict[str, ComponentStatus]:
+    """The status every component of the namespace answers, by name."""
+    found = {}
+    for reply in session.get(topics.status_selector(namespace), timeout=timeout_s):
+        if reply.ok is not None:
+            key = str(reply.ok.key_expr)
+            status = codec.decode(reply.ok.payload.to_bytes(), topics.STATUS_TYPE, key)
+            found[status.name] = status
+    return found
+
+
+def get_param(
+    session: zenoh.Session,
+    namespace: str,
+    component: str,
+    name: str,
+    timeout_s: float = DEFAULT_TIMEOUT_S,
+) -> ParamValue:
+    """The current value of a component's parameter."""
+    return _param_query(session, namespace, component, name, None, timeout_s)
+
+
+def set_param(
+    session: zenoh.Session,
+    namespace: str,
+    component: str,
+    name: str,
+    text: str,
+    timeout_s: float = DEFAULT_TIMEOUT_S,
+) -> ParamValue:
+    """Set a component's parameter from its text form; return the value it now has."""
+    return _param_query(session, namespace, component, name, text, timeout_s)
+
+
+def _param_query(
+    session: zenoh.Session,
+    namespace: str,
+    component: str,
+    name: str,
+    text: str | None,
+    timeout_s: float,
+) -> ParamValue:
+    key = topics.param_key(namespace, component, name)
+    for reply in session.get(key, payload=text, timeout=timeout_s):
+        if reply.ok is not None:
+            return decode_value(reply.ok.payload.to_bytes())
+        raise QueryError(reply.err.payload.to_string())
+    raise QueryError(
+        f"no reply from {component!r} in namespace {namespace!r} within {timeout_s} s "
+        "(is it running?)"
+    )

@@ -1,0 +1,58 @@
+"""Clocks and timers: periods on monotonic or simulated time, skipped periods, clock resets."""
+
+from __future__ import annotations
+
+import pytest
+
+from components.clock import SimClock, Timers, WallClock
+
+MS = 1_000_000
+
+
+def test_timers_fire_on_simulated_time_only() -> None:
+    clock = SimClock()
+    timers = Timers(clock)
+    fired: list[int] = []
+    timers.add(0.1, lambda: fired.append(clock.now_ns()))
+    assert timers.wait_s() is None
+    clock.advance(99 * MS)
+    assert timers.due() == []
+    clock.advance(100 * MS)
+    for timer in timers.due():
+        timer.callback()
+    assert fired == [100 * MS]
+
+
+def test_missed_periods_are_skipped_not_replayed() -> None:
+    clock = SimClock()
+    timers = Timers(clock)
+    (timer,) = [timers.add(0.1, lambda: None)]
+    clock.advance(1050 * MS)
+    assert timers.due() == [timer]
+    assert timer.deadline_ns == 1150 * MS
+    assert timers.due() == []
+
+
+def test_a_clock_set_back_reschedules_from_the_new_time() -> None:
+    clock = SimClock()
+    timers = Timers(clock)
+    clock.advance(10_000 * MS)
+    timer = timers.add(0.1, lambda: None)
+    clock.advance(10_100 * MS)
+    assert timers.due() == [timer]
+    clock.advance(5 * MS)
+    timers.due()
+    assert timer.deadline_ns == 105 * MS
+
+
+def test_wall_timers_report_how_long_to_wait() -> None:
+    timers = Timers(WallClock())
+    assert timers.wait_s() is None
+    timers.add(60.0, lambda: None)
+    assert 59.0 < timers.wait_s() <= 60.0
+    assert timers.due() == []
+
+
+def test_a_period_must_be_positive() -> None:
+    with pytest.raises(ValueError, match="must be > 0 s"):
+        Timers(WallClock()).add(0.0, lambda: None)

@@ -1,0 +1,93 @@
+"""Declared parameters: types, bounds, choices, text parsing and profile overrides."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from components.params import Param, ParamError, Parameters, decode_value, encode_value
+
+RATE = Param("rate_hz", float, 10.0, low=0.1, high=100.0)
+TASK = Param("task", str, "pose", choices=("pose", "position"))
+ENABLED = Param("enabled", bool, True)
+STEPS = Param("steps", int, 3, low=1)
+
+
+@pytest.mark.parametrize(
+    ("param", "value", "expected"),
+    [
+        (RATE, 5, 5.0),
+        (RATE, 0.1, 0.1),
+        (STEPS, 7, 7),
+        (ENABLED, False, False),
+        (TASK, "position", "position"),
+    ],
+)
+def test_valid_values_are_accepted_with_their_declared_type(
+    param: Param, value: object, expected: object
+) -> None:
+    checked = param.check(value)
+    assert checked == expected and type(checked) is param.type
+
+
+@pytest.mark.parametrize(
+    ("param", "value", "message"),
+    [
+        (RATE, 0.0, "rate_hz: expected a float in [0.1, 100.0], got 0.0"),
+        (RATE, math.nan, "rate_hz: expected a float in [0.1, 100.0], got nan"),
+        (RATE, True, "got True"),
+        (RATE, "5", "got '5'"),
+        (STEPS, 2.0, "steps: expected a int >= 1, got 2.0"),
+        (STEPS, 0, "steps: expected a int >= 1, got 0"),
+        (ENABLED, 1, "enabled: expected a bool, got 1"),
+        (TASK, "dance", "task: expected a str in {'pose', 'position'}, got 'dance'"),
+    ],
+)
+def test_wrong_types_and_out_of_bounds_values_say_what_was_expected(
+    param: Param, value: object, message: str
+) -> None:
+    with pytest.raises(ParamError) as error:
+        param.check(value)
+    assert message in str(error.value)
+
+
+@pytest.mark.parametrize(
+    ("param", "text", "value"),
+    [
+        (RATE, " 2.5 ", 2.5),
+        (STEPS, "4", 4),
+        (ENABLED, "off", False),
+        (ENABLED, "True", True),
+        (TASK, "position", "position"),
+    ],
+)
+def test_text_values_parse_to_the_declared_type(param: Param, text: str, value: object) -> None:
+    assert param.parse(text) == value
+
+
+@pytest.mark.parametrize(("param", "text"), [(RATE, "fast"), (STEPS, "1.5"), (ENABLED, "maybe")])
+def test_unparsable_text_is_refused(param: Param, text: str) -> None:
+    with pytest.raises(ParamError, match=f"got '{text}'"):
+        param.parse(text)
+
+
+def test_a_bad_default_is_refused_at_declaration() -> None:
+    with pytest.raises(ParamError, match="beta: expected a float >= 0.0"):
+        Param("beta", float, -1.0, low=0.0)
+
+
+def test_profile_overrides_replace_defaults_and_unknown_names_are_refused() -> None:
+    params = Parameters([RATE, TASK], {"rate_hz": 20})
+    assert dict(params) == {"rate_hz": 20.0, "task": "pose"}
+    assert params.set_text("task", "position") == "position" and params["task"] == "position"
+    with pytest.raises(ParamError, match="gain: unknown parameter; declared: rate_hz, task"):
+        Parameters([RATE, TASK], {"gain": 1.0})
+    with pytest.raises(ParamError, match="unknown parameter 'gain'"):
+        params.set_text("gain", "1")
+
+
+@pytest.mark.parametrize("value", [True, 3, 2.5, "pose"])
+def test_reply_values_round_trip_with_their_type(value: object) -> None:
+    decoded = decode_value(encode_value(value))
+    assert decoded == value and type(decoded) is type(value)

@@ -1,0 +1,154 @@
+"""The component runtime on real Zenoh sessions over loopback, in-process and as processes."""
+
+from __future__ import annotations
+
+import math
+import signal
+import threading
+from typing import TYPE_CHECKING
+
+from components.params import Param
+from components.runtime import Node
+from deploy import query
+from messages import codec, topics
+from messages.base import IDENTITY_POSE
+from messages.goal import Goal
+from messages.header import Header
+from messages.state import RobotState
+
+if TYPE_CHECKING:
+    from tests.components.conftest import System, WaitUntil
+
+
+def robot_state(base_x: float = 0.25, valid: bool = True) -> RobotState:
+    return RobotState(
+        header=Header(stamp_ns=1, frame="world", seq=99, source="test"),
+        base_pose=(base_x, 0.0, 0.0),
+        arm_joints=(0.0, 0.1, 0.2, 0.3, 0.4),
+        end_effector=IDENTITY_POSE,
+        valid=valid,
+        age_s=0.0,
+    )
+
+
+def test_typed_round_trip_between_two_nodes(system: System, wait_until: WaitUntil) -> None:
+    received: list[RobotState] = []
+    arrived = threading.Event()
+
+    def on_state(message: RobotState) -> None:
+        received.append(message)
+        arrived.set()
+
+    with Node(system.profile, "listener") as listener, Node(system.profile, "talker") as talker:
+        subscription = listener.subscribe(topics.ROBOT_STATE, on_state)
+        listener.start()
+        publisher = talker.publisher(topics.ROBOT_STATE)
+        talker.timer(0.02, lambda: publisher.put(robot_state()))
+        talker.start()
+        assert arrived.wait(system.deadline_s), "no RobotState arrived"
+        assert received[0].base_pose == (0.25, 0.0, 0.0)
+        assert received[0].header.source == "test"
+        assert [m.header.seq for m in received[:2]] in ([0], [0, 1])
+        assert subscription.latest is not None and subscription.age_s() < system.deadline_s
+    assert listener.counters["received.robot/state"] >= 1
+    assert listener.counters["rejected.robot/state"] == 0
+
+
+def test_component_process_publishes_its_params_and_stops_on_sigterm(
+    system: System, wait_until: WaitUntil
+) -> None:
+    goals: list[Goal] = []
+    got_goal = threading.Event()
+    liveliness = system.liveliness()
+    process = system.start("pub")
+    try:
+        with Node(system.profile, "listener") as listener:
+            state = listener.subscribe(topics.ROBOT_STATE)
+            listener.subscribe(topics.CONTROL_GOAL, lambda g: (goals.append(g), got_goal.set()))
+            listener.start()
+            liveliness.wait_for("pub", alive=True)
+            assert got_goal.wait(system.deadline_s), "no goal from the scripted publisher"
+            wait_until(lambda: state.latest is not None, "a robot state")
+        assert state.latest.base_pose == (1.5, 0.0, 0.0)
+        assert state.latest.header.source == "pub"
+        assert goals[0].task == "pose" and goals[0].pose == (
+            1.0,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            0.5,
+            0.0,
+            0.25,
+        )
+        process.send_signal(signal.SIGTERM)
+        assert process.wait(system.deadline_s) == 0
+        liveliness.wait_for("pub", alive=False)
+    finally:
+        process.kill()
+        process.wait()
+
+
+def test_malformed_messages_are_dropped_counted_and_the_component_keeps_answering(
+    system: System, wait_until: WaitUntil
+) -> None:
+    handled: list[RobotState] = []
+
+    def on_state(message: RobotState) -> None:
+        if not message.valid:
+            raise RuntimeError("the handler refuses invalid states")
+        handled.append(message)
+
+    nan_state = robot_state().model_construct(**{**dict(robot_state()), "age_s": math.nan})
+    key = topics.ROBOT_STATE.key("test")
+    with Node(system.profile, "listener") as listener:
+        listener.subscribe(topics.ROBOT_STATE, on_state)
+        listener.start()
+        publisher = system.router.declare_publisher(key)
+        wait_until(lambda: publisher.matching_status.matching, "the subscription to propagate")
+        counters = listener.counters
+        for payload, counter, count in (
+            (b"\x00garbage\xff", "rejected.robot/state", 1),
+            (codec.encode(nan_state), "rejected.robot/state", 2),
+            (codec.encode(robot_state(valid=False)), "errors.robot/state", 1),
+            (codec.encode(robot_state(base_x=2.0)), "received.robot/state", 2),
+        ):
+            publisher.put(payload)
+            wait_until(lambda c=counter, n=count: counters[c] == n, f"{counter} == {count}")
+        assert [m.base_pose[0] for m in handled] == [2.0]
+        status = query.statuses(system.router, "test")["listener"]
+    assert status.state == "running"
+    assert status.counters["rejected.robot/state"] == 2
+    assert status.counters["errors.robot/state"] == 1
+    assert status.counters["received.robot/state"] == 2
+
+
+def test_sim_clock_drives_stamps_and_timers(system: System, wait_until: WaitUntil) -> None:
+    profile = system.profile.model_copy(update={"clock": "sim"})
+    fired: list[int] = []
+    with Node(profile, "listener") as node:
+        node.timer(0.1, lambda: fired.append(node.clock.now_ns()))
+        node.start()
+        clock = system.router.declare_publisher(topics.SIM_CLOCK.key("test"))
+        wait_until(lambda: clock.matching_status.matching, "the clock subscription")
+        assert node.header().stamp_ns == 0
+        clock.put(codec.encode(topics.SIM_CLOCK.type(stamp_ns=50_000_000)))
+        wait_until(lambda: node.clock.now_ns() == 50_000_000, "simulated time 0.05 s")
+        assert fired == []
+        clock.put(codec.encode(topics.SIM_CLOCK.type(stamp_ns=1_000_000_000)))
+        wait_until(lambda: fired == [1_000_000_000], "the timer at simulated time 1 s")
+        assert node.header("world").stamp_ns == 1_000_000_000
+
+
+def test_declared_params_take_profile_values_and_reject_unknown_names(
+    system: System, wait_until: WaitUntil
+) -> None:
+    declared = [Param("rate_hz", float, 1.0, low=0.1), Param("goal_task", str, "x")]
+    node = Node(system.profile, "pub", declared + [Param("base_x", float, 0.0)])
+    assert dict(node.params) == {"rate_hz": 50.0, "goal_task": "pose", "base_x": 1.5}
+    try:
+        Node(system.profile, "pub", declared)
+    except ValueError as error:
+        assert "base_x: unknown parameter" in str(error)
+    else:
+        raise AssertionError("an undeclared profile parameter was accepted")
