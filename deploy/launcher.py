@@ -1,0 +1,234 @@
+"""The launcher: one Zenoh router and one supervised process per component of a profile.
+
+It opens the router the components connect to, starts the enabled components
+(drivers, estimators, controllers, tools), prefixes every line they print with
+``[name]``, restarts the ones that exit according to their restart policy,
+reports liveliness changes, and on SIGINT, SIGTERM or the end of the duration
+stops them in the reverse order: SIGTERM, then SIGKILL after a timeout.
+
+Children run in their own session, so a Ctrl-C reaches the launcher alone and
+the stop order holds; a child whose launcher dies stops by itself
+(``components.runtime.LAUNCHER_PID_ENV``).
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import IO
+
+import zenoh
+
+from components.runtime import EXIT_CONFIG_ERROR, LAUNCHER_PID_ENV
+from deploy.profile import ROLES, ComponentSpec, Profile
+from messages import topics
+
+POLL_S = 0.05
+"""How often the launcher looks at its children and the clock."""
+
+STOP_TIMEOUT_S = 5.0
+"""How long a role's components get to exit after SIGTERM before SIGKILL."""
+
+CLEAN_STOP_CODES = (0, -signal.SIGTERM)
+"""Exit codes that count as a clean stop after SIGTERM."""
+
+
+class Output:
+    """Writes whole prefixed lines from many threads to two streams."""
+
+    def __init__(self, out: IO[str], err: IO[str]) -> None:
+        self.out = out
+        self.err = err
+        self._lock = threading.Lock()
+
+    def line(self, stream: IO[str], prefix: str, text: str) -> None:
+        """Write ``[prefix] text`` as one line and flush it."""
+        with self._lock:
+            stream.write(f"[{prefix}] {text.rstrip()}\n")
+            stream.flush()
+
+    def say(self, text: str) -> None:
+        """A line of the launcher's own, on the error stream."""
+        self.line(self.err, "launch", text)
+
+
+@dataclass
+class Child:
+    """One component's process and its restart bookkeeping."""
+
+    spec: ComponentSpec
+    process: subprocess.Popen[str] | None = None
+    started_at: float = 0.0
+    restarts: int = 0
+    restart_at: float | None = None
+    done: bool = False
+    failed: bool = False
+
+
+class Launcher:
+    """Runs and supervises the components of one profile."""
+
+    def __init__(
+        self,
+        profile: Profile,
+        profile_path: Path,
+        out: IO[str] = sys.stdout,
+        err: IO[str] = sys.stderr,
+    ) -> None:
+        self.profile = profile
+        self.profile_path = Path(profile_path).resolve()
+        self.output = Output(out, err)
+        self.children = [Child(spec) for spec in profile.start_order()]
+        self._stop_reason: str | None = None
+
+    def run(self, duration_s: float | None = None) -> int:
+        """Run until a stop signal, the duration, or no component is left; return 0 or 1.
+
+        Must be called from the main thread (it installs SIGINT and SIGTERM handlers).
+        """
+        for stop_signal in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(stop_signal, self._on_signal)
+        endpoints = ", ".join(self.profile.zenoh.router)
+        with zenoh.open(self.profile.zenoh.router_config()) as router:
+            self.output.say(f"router listening on {endpoints}, namespace {self.profile.namespace}")
+            watcher = router.liveliness().declare_subscriber(
+                topics.liveliness_selector(self.profile.namespace),
+                self._on_liveliness,
+                history=True,
+            )
+            try:
+                for child in self.children:
+                    self._start(child)
+                self._supervise(None if duration_s is None else time.monotonic() + duration_s)
+            finally:
+                for stop_signal in (signal.SIGINT, signal.SIGTERM):
+                    signal.signal(stop_signal, signal.SIG_IGN)
+                self._stop_all()
+                watcher.undeclare()
+        failed = [child.spec.name for child in self.children if child.failed]
+        if failed:
+            self.output.say(f"failed: {', '.join(failed)}")
+        return 1 if failed else 0
+
+    def _on_signal(self, signum: int, _frame: object) -> None:
+        self._stop_reason = signal.Signals(signum).name
+
+    def _on_liveliness(self, sample: zenoh.Sample) -> None:
+        name = topics.component_of_liveliness_key(self.profile.namespace, str(sample.key_expr))
+        alive = sample.kind == zenoh.SampleKind.PUT
+        self.output.say(f"{name} {'alive' if alive else 'lost'}")
+
+    def _supervise(self, deadline: float | None) -> None:
+        while self._stop_reason is None:
+            now = time.monotonic()
+            if deadline is not None and now >= deadline:
+                self._stop_reason = "end of duration"
+                break
+            for child in self.children:
+                code = None if child.process is None else child.process.poll()
+                if code is not None:
+                    self._on_exit(child, code, now)
+                elif child.restart_at is not None and now >= child.restart_at:
+                    self._start(child)
+            if all(child.done for child in self.children):
+                self._stop_reason = "no component left running"
+                break
+            time.sleep(POLL_S)
+        self.output.say(f"stopping ({self._stop_reason})")
+
+    def _start(self, child: Child) -> None:
+        spec = child.spec
+        command = [
+            sys.executable,
+            "-m",
+            spec.module_path,
+            "--profile",
+            str(self.profile_path),
+            "--name",
+            spec.name,
+        ]
+        env = dict(os.environ, PYTHONUNBUFFERED="1", **{LAUNCHER_PID_ENV: str(os.getpid())})
+        child.process = subprocess.Popen(
+            command,
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            env=env,
+            text=True,
+            errors="replace",
+            start_new_session=True,
+        )
+        child.started_at = time.monotonic()
+        child.restart_at = None
+        for pipe, stream in (
+            (child.process.stdout, self.output.out),
+            (child.process.stderr, self.output.err),
+        ):
+            threading.Thread(
+                target=self._forward, args=(pipe, stream, spec.name), daemon=True
+            ).start()
+        self.output.say(f"started {spec.name} ({spec.module_path}, pid {child.process.pid})")
+
+    def _forward(self, pipe: IO[str], stream: IO[str], name: str) -> None:
+        with pipe:
+            for text in pipe:
+                self.output.line(stream, name, text)
+
+    def _on_exit(self, child: Child, code: int, now: float) -> None:
+        """Decide what a child's exit means: done, failed, or a restart after a backoff."""
+        spec, policy = child.spec, child.spec.restart
+        child.process = None
+        if now - child.started_at >= policy.reset_after_s:
+            child.restarts = 0
+        wanted = policy.policy == "always" or (policy.policy == "on-failure" and code != 0)
+        if code == EXIT_CONFIG_ERROR or not wanted or child.restarts >= policy.max_restarts:
+            child.done, child.failed = True, code != 0
+            if code == EXIT_CONFIG_ERROR:
+                why = "; configuration error, not restarting"
+            elif wanted:
+                why = f"; no restarts left ({child.restarts}/{policy.max_restarts})"
+            else:
+                why = ""
+            self.output.say(f"{spec.name} exited with {code}{why}")
+            return
+        delay = policy.backoff_s(child.restarts)
+        child.restarts += 1
+        child.restart_at = now + delay
+        self.output.say(
+            f"{spec.name} exited with {code}; "
+            f"restart {child.restarts}/{policy.max_restarts} in {delay:.1f} s"
+        )
+
+    def _stop_all(self) -> None:
+        """Stop the running children role by role, tools first and drivers last."""
+        for child in self.children:
+            if child.restart_at is not None:
+                child.failed = True
+                self.output.say(f"{child.spec.name} was waiting to restart; counted as failed")
+        for role in reversed(ROLES):
+            group = [c for c in self.children if c.spec.role == role and c.process is not None]
+            for child in group:
+                child.process.send_signal(signal.SIGTERM)
+            deadline = time.monotonic() + STOP_TIMEOUT_S
+            for child in group:
+                self._reap(child, child.process, deadline)
+
+    def _reap(self, child: Child, process: subprocess.Popen[str], deadline: float) -> None:
+        """Wait for a child sent SIGTERM until ``deadline``, then kill it."""
+        try:
+            code = process.wait(max(0.0, deadline - time.monotonic()))
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()
+            self.output.say(f"{child.spec.name} did not stop in {STOP_TIMEOUT_S:.0f} s; killed")
+            child.failed = True
+        else:
+            child.failed = child.failed or code not in CLEAN_STOP_CODES
+            self.output.say(f"{child.spec.name} stopped ({code})")
+        child.process = None

@@ -1,0 +1,44 @@
+"""`parsimony launch PROFILE`: start and supervise every component of a profile."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import zenoh
+
+from deploy.launcher import Launcher
+from deploy.profile import ProfileError, load_profile
+
+EXIT_INVALID_PROFILE = 2
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Declare `launch` and its arguments."""
+    parser = subparsers.add_parser(
+        "launch",
+        help="start and supervise the components of a profile",
+        description="Open the profile's router, start one process per enabled component, "
+        "stream their logs, restart them by policy, stop them in order on Ctrl-C. "
+        "Exits 0, 1 if a component failed, 2 if the profile is invalid.",
+    )
+    parser.add_argument("profile", type=Path, help="deploy profile (YAML)")
+    parser.add_argument(
+        "--duration", type=float, metavar="S", help="stop everything after S seconds"
+    )
+    return parser
+
+
+def run(args: argparse.Namespace) -> int:
+    """Validate the profile, then launch it until stopped."""
+    try:
+        profile = load_profile(args.profile)
+    except ProfileError as error:
+        print(error, file=sys.stderr)
+        return EXIT_INVALID_PROFILE
+    try:
+        return Launcher(profile, args.profile).run(args.duration)
+    except zenoh.ZError as error:
+        print(f"{args.profile}: cannot open the router: {error}", file=sys.stderr)
+        return 1

@@ -1,0 +1,117 @@
+"""`parsimony launch` as a real process tree on loopback: start, restart, stop, exit codes."""
+
+from __future__ import annotations
+
+import os
+import signal
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from tests.deploy.conftest import LaunchFixture, ProfileWriter
+
+
+def publisher(name: str, role: str = "tool", **fields: object) -> dict[str, object]:
+    """A scripted publisher component that restarts quickly."""
+    return {
+        "name": name,
+        "module": "scripted_publisher",
+        "role": role,
+        "params": {"rate_hz": 20.0},
+        "restart": {"backoff_initial_s": 0.1},
+        **fields,
+    }
+
+
+def process_gone(pid: int) -> bool:
+    """Whether ``pid`` has exited (a zombie counts as exited)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except FileNotFoundError:
+        return True
+    return state == "Z"
+
+
+def test_killed_component_is_back_within_2_s_until_restarts_run_out(
+    write_profile: ProfileWriter, launch: LaunchFixture
+) -> None:
+    launched = launch(
+        write_profile([publisher("pub", restart={"backoff_initial_s": 0.1, "max_restarts": 1})])
+    )
+    started, _, match = launched.wait_for(r"\[launch\] started pub \(.*pid (\d+)\)")
+    launched.wait_for(r"\[launch\] pub alive", after=started)
+    killed_at = time.monotonic()
+    os.kill(int(match.group(1)), signal.SIGKILL)
+
+    exited, _, _ = launched.wait_for(r"\[launch\] pub exited with -9; restart 1/1 in 0\.1 s")
+    restarted, _, match = launched.wait_for(r"\[launch\] started pub \(.*pid (\d+)\)", exited)
+    _, back_at, _ = launched.wait_for(r"\[launch\] pub alive", after=restarted)
+    assert back_at - killed_at < 2.0, f"back after {back_at - killed_at:.2f} s"
+
+    os.kill(int(match.group(1)), signal.SIGKILL)
+    launched.wait_for(r"\[launch\] pub exited with -9; no restarts left \(1/1\)")
+    launched.wait_for(r"\[launch\] stopping \(no component left running\)")
+    assert launched.process.wait(10.0) == 1
+    assert "[launch] failed: pub" in launched.text()
+
+
+def test_sigint_stops_in_reverse_role_order_and_exit_code_reports_failures(
+    write_profile: ProfileWriter, launch: LaunchFixture
+) -> None:
+    profile = write_profile(
+        [
+            publisher("arm", role="tool"),
+            publisher("lp", role="controller"),
+            publisher("bad", role="estimator", params={"rate_hz": -3.0}),
+            publisher("base", role="driver"),
+        ]
+    )
+    launched = launch(profile)
+    launched.wait_for(r"\[bad\] ERROR .*components\[2\]\.params\.rate_hz: expected a float")
+    launched.wait_for(r"\[launch\] bad exited with 2; configuration error, not restarting")
+    for name in ("arm", "lp", "base"):
+        launched.wait_for(rf"\[launch\] {name} alive")
+
+    assert launched.stop(signal.SIGINT) == 1
+    text = launched.text()
+    starts = [text.index(f"[launch] started {name} ") for name in ("base", "bad", "lp", "arm")]
+    stops = [text.index(f"[launch] {name} stopped (0)") for name in ("arm", "lp", "base")]
+    assert starts == sorted(starts) and stops == sorted(stops)
+    assert "[launch] failed: bad" in text
+    assert "INFO arm stopping on SIGTERM" in text
+
+
+def test_duration_ends_the_launch_cleanly(
+    write_profile: ProfileWriter, launch: LaunchFixture
+) -> None:
+    launched = launch(write_profile([publisher("pub")]), "--duration", "1.5")
+    launched.wait_for(r"\[launch\] pub alive")
+    assert launched.process.wait(10.0) == 0
+    launched.wait_for(r"\[launch\] stopping \(end of duration\)")
+    launched.wait_for(r"\[launch\] pub stopped \(0\)")
+
+
+def test_components_stop_when_the_launcher_is_killed(
+    write_profile: ProfileWriter, launch: LaunchFixture
+) -> None:
+    launched = launch(write_profile([publisher("pub")]))
+    started, _, match = launched.wait_for(r"\[launch\] started pub \(.*pid (\d+)\)")
+    launched.wait_for(r"\[launch\] pub alive", after=started)
+    launched.process.kill()
+    launched.process.wait()
+    pid = int(match.group(1))
+    deadline = time.monotonic() + 10.0
+    while not process_gone(pid):
+        assert time.monotonic() < deadline, "component outlived its launcher by 10 s"
+        time.sleep(0.02)
+
+
+def test_an_invalid_profile_is_refused_before_anything_starts(
+    write_profile: ProfileWriter, launch: LaunchFixture
+) -> None:
+    launched = launch(write_profile([publisher("pub", restart={"policy": "sometimes"})]))
+    assert launched.process.wait(10.0) == 2
+    text = launched.text()
+    assert "components[0].restart.policy" in text and "'on-failure'" in text
+    assert "started" not in text
