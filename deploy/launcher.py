@@ -117,14 +117,17 @@ class Launcher:
         return 1 if failed else 0
 
     def _on_signal(self, signum: int, _frame: object) -> None:
+        """Main thread, between two polls: ask the supervision loop to stop."""
         self._stop_reason = signal.Signals(signum).name
 
     def _on_liveliness(self, sample: zenoh.Sample) -> None:
+        """Zenoh thread: report a component's token appearing or disappearing."""
         name = topics.component_of_liveliness_key(self.profile.namespace, str(sample.key_expr))
         alive = sample.kind == zenoh.SampleKind.PUT
         self.output.say(f"{name} {'alive' if alive else 'lost'}")
 
     def _supervise(self, deadline: float | None) -> None:
+        """Poll the children until a stop is asked, the deadline passes or none is left."""
         while self._stop_reason is None:
             now = time.monotonic()
             if deadline is not None and now >= deadline:
@@ -143,6 +146,7 @@ class Launcher:
         self.output.say(f"stopping ({self._stop_reason})")
 
     def _start(self, child: Child) -> None:
+        """Start a child's process and the threads that forward its output."""
         spec = child.spec
         command = [
             sys.executable,
@@ -176,6 +180,7 @@ class Launcher:
         self.output.say(f"started {spec.name} ({spec.module_path}, pid {child.process.pid})")
 
     def _forward(self, pipe: IO[str], stream: IO[str], name: str) -> None:
+        """Copy a child's pipe to ``stream`` line by line, prefixed with its name."""
         with pipe:
             for text in pipe:
                 self.output.line(stream, name, text)

@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
+import logging
 import math
 import signal
 import threading
 from typing import TYPE_CHECKING
 
+import pytest
+
+from components import runtime
 from components.params import Param
 from components.runtime import Node
 from deploy import query
@@ -20,9 +24,13 @@ if TYPE_CHECKING:
     from tests.components.conftest import System, WaitUntil
 
 
+UNSTAMPED_SEQ = 10**9
+"""A seq the publisher must overwrite with its own count."""
+
+
 def robot_state(base_x: float = 0.25, valid: bool = True) -> RobotState:
     return RobotState(
-        header=Header(stamp_ns=1, frame="world", seq=99, source="test"),
+        header=Header(stamp_ns=1, frame="world", seq=UNSTAMPED_SEQ, source="test"),
         base_pose=(base_x, 0.0, 0.0),
         arm_joints=(0.0, 0.1, 0.2, 0.3, 0.4),
         end_effector=IDENTITY_POSE,
@@ -33,22 +41,17 @@ def robot_state(base_x: float = 0.25, valid: bool = True) -> RobotState:
 
 def test_typed_round_trip_between_two_nodes(system: System, wait_until: WaitUntil) -> None:
     received: list[RobotState] = []
-    arrived = threading.Event()
-
-    def on_state(message: RobotState) -> None:
-        received.append(message)
-        arrived.set()
-
     with Node(system.profile, "listener") as listener, Node(system.profile, "talker") as talker:
-        subscription = listener.subscribe(topics.ROBOT_STATE, on_state)
+        subscription = listener.subscribe(topics.ROBOT_STATE, received.append)
         listener.start()
         publisher = talker.publisher(topics.ROBOT_STATE)
         talker.timer(0.02, lambda: publisher.put(robot_state()))
         talker.start()
-        assert arrived.wait(system.deadline_s), "no RobotState arrived"
+        wait_until(lambda: len(received) >= 2, "two RobotStates")
         assert received[0].base_pose == (0.25, 0.0, 0.0)
         assert received[0].header.source == "test"
-        assert [m.header.seq for m in received[:2]] in ([0], [0, 1])
+        seqs = [message.header.seq for message in received]
+        assert seqs == sorted(set(seqs)) and seqs[-1] < UNSTAMPED_SEQ
         assert subscription.latest is not None and subscription.age_s() < system.deadline_s
     assert listener.counters["received.robot/state"] >= 1
     assert listener.counters["rejected.robot/state"] == 0
@@ -71,16 +74,9 @@ def test_component_process_publishes_its_params_and_stops_on_sigterm(
             wait_until(lambda: state.latest is not None, "a robot state")
         assert state.latest.base_pose == (1.5, 0.0, 0.0)
         assert state.latest.header.source == "pub"
-        assert goals[0].task == "pose" and goals[0].pose == (
-            1.0,
-            0.0,
-            0.0,
-            0.0,
-            0.0,
-            0.5,
-            0.0,
-            0.25,
-        )
+        # pose at (1, 0, 0.5) without rotation: dual part = t / 2 = (0, 0.5, 0, 0.25)
+        assert goals[0].task == "pose"
+        assert goals[0].pose == (1.0, 0.0, 0.0, 0.0, 0.0, 0.5, 0.0, 0.25)
         process.send_signal(signal.SIGTERM)
         assert process.wait(system.deadline_s) == 0
         liveliness.wait_for("pub", alive=False)
@@ -99,7 +95,7 @@ def test_malformed_messages_are_dropped_counted_and_the_component_keeps_answerin
             raise RuntimeError("the handler refuses invalid states")
         handled.append(message)
 
-    nan_state = robot_state().model_construct(**{**dict(robot_state()), "age_s": math.nan})
+    nan_state = RobotState.model_construct(**{**dict(robot_state()), "age_s": math.nan})
     key = topics.ROBOT_STATE.key("test")
     with Node(system.profile, "listener") as listener:
         listener.subscribe(topics.ROBOT_STATE, on_state)
@@ -152,3 +148,28 @@ def test_declared_params_take_profile_values_and_reject_unknown_names(
         assert "base_x: unknown parameter" in str(error)
     else:
         raise AssertionError("an undeclared profile parameter was accepted")
+
+
+def test_shutdown_runs_on_the_handler_thread_before_the_session_closes(system: System) -> None:
+    threads: list[str] = []
+    with Node(system.profile, "listener") as node:
+        node.start(lambda: threads.append(threading.current_thread().name))
+    assert threads == ["listener-handler"]
+    assert node.session.is_closed()
+
+
+def test_repeated_warnings_are_logged_once_then_summarised(
+    monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    now = [0]
+    monkeypatch.setattr(runtime.time, "monotonic_ns", lambda: now[0])
+    warnings = runtime.RateLimitedLog(logging.getLogger("test"), interval_s=5.0)
+    for step_s in (0, 1, 2, 3, 6, 7):
+        now[0] = step_s * 1_000_000_000
+        warnings.warning("rejected.robot/state", f"bad message at {step_s} s")
+    warnings.warning("errors.robot/state", "handler failed")
+    assert [record.getMessage() for record in caplog.records] == [
+        "bad message at 0 s",
+        "bad message at 6 s (3 more since the last report)",
+        "handler failed",
+    ]
