@@ -4,11 +4,16 @@ Columns g = [u_P, u_N, y] (each >= 0, u = u_P - u_N); HiGHS takes row bounds dir
 slack columns z_A, z_B, z_C of the canonical form 5.29 stay implicit. With task Jacobian
 J (m x n) and error e:
 
-    min   1'(2y - (J u + eta e))            (= ||J u + eta e||_1 at the optimum, 5.4-5.5)
+    min   1'(2y - (J u + eta e)) + w 1'(u_P + u_N)   (= ||J u + eta e||_1 + w ||u||_1, 5.4-5.5)
     s.t.  J u_P - J u_N - y <= -eta e
           lower <= A u_P - A u_N <= upper   for every LinearRows
           1'u_P + 1'u_N <= limit            for every OneNormBound
           column bounds on u_P, u_N         from every VelocityBounds
+
+The tie-break weight w >= 0 is not in the dissertation: 5.29 (w = 0) has a whole face of
+optimal u whenever the task can be met exactly, and the simplex returns any vertex of it,
+often one with a joint at its velocity bound. A small w picks, among the best residuals, a
+vertex of least ||u||_1; it stays a vertex, so the solution stays parsimonious (5.30).
 
 One HiGHS model lives across steps; each step passes the new arrays and, when the shape is
 unchanged, the previous optimal basis, so the dual simplex starts from the last vertex.
@@ -65,8 +70,13 @@ class WarmStartedLP:
         self._basis = None
         self._shape = None
 
-    def solve(self, jacobian: Array, rhs: Array, rows: list[Rows]) -> LPSolution:
-        """Solve 5.29 for task rows ``J u - y <= rhs`` (rhs = -eta e) and the constraint rows."""
+    def solve(
+        self, jacobian: Array, rhs: Array, rows: list[Rows], velocity_cost: float = 0.0
+    ) -> LPSolution:
+        """Solve 5.29 for task rows ``J u - y <= rhs`` (rhs = -eta e) and the constraint rows.
+
+        ``velocity_cost`` w adds w ||u||_1 to the objective (0 gives 5.29 exactly).
+        """
         m, n = jacobian.shape
         linear = [r for r in rows if isinstance(r, LinearRows)]
         norms = [r for r in rows if isinstance(r, OneNormBound)]
@@ -92,7 +102,9 @@ class WarmStartedLP:
         )
         row_upper = np.concatenate([rhs] + [r.upper for r in linear] + [[b.limit for b in norms]])
         column_sums = jacobian.sum(axis=0)
-        cost = np.concatenate((-column_sums, column_sums, np.full(m, 2.0)))
+        cost = np.concatenate(
+            (velocity_cost - column_sums, velocity_cost + column_sums, np.full(m, 2.0))
+        )
         col_lower = np.concatenate((p_low, n_low, np.zeros(m)))
         col_upper = np.concatenate((p_up, n_up, np.full(m, INF)))
         self._pass(dense, cost, float(rhs.sum()), col_lower, col_upper, row_lower, row_upper)

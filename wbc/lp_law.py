@@ -44,6 +44,11 @@ class LPParams:
     """lambda of 5.26 for 'border', the gain on the clearance for 'conservative' (1/s)."""
     obstacle_margin: float = 0.05
     """Extra clearance kept around each obstacle and the base body (m)."""
+    obstacle_lookahead: float = 0.1
+    """d: the border constraint acts on the point d ahead of the wheel axle (m)."""
+    velocity_cost: float = 1e-3
+    """w: weight of ||u||_1 added to the objective to break ties between optimal vertices;
+    0 solves 5.29 exactly (see wbc.linear_program)."""
     nonholonomic: bool = True
     """False models a holonomic base (the first test of section 6.3)."""
 
@@ -52,6 +57,8 @@ class LPParams:
             value = getattr(self, name)
             if not np.isfinite(value) or value <= 0.0:
                 raise ValueError(f"LPParams.{name} must be finite and > 0, got {value}")
+        if not np.isfinite(self.velocity_cost) or self.velocity_cost < 0.0:
+            raise ValueError(f"LPParams.velocity_cost must be >= 0, got {self.velocity_cost}")
 
 
 def default_constraints(params: LPParams) -> list[Constraint]:
@@ -63,7 +70,9 @@ def default_constraints(params: LPParams) -> list[Constraint]:
     if params.nonholonomic:
         constraints.insert(0, Nonholonomic())
     if params.obstacle_mode == "border":
-        constraints.append(BorderObstacle(params.obstacle_gain, params.obstacle_margin))
+        constraints.append(
+            BorderObstacle(params.obstacle_gain, params.obstacle_margin, params.obstacle_lookahead)
+        )
     elif params.obstacle_mode == "conservative":
         constraints.append(ConservativeObstacle(params.obstacle_gain, params.obstacle_margin))
     return constraints
@@ -125,7 +134,9 @@ class LPLaw:
             self.robot, q, error, error_rate, task.goal_position[:2], tuple(obstacles)
         )
         rows = [constraint.rows(context) for constraint in self.constraints]
-        solution = self._lp.solve(task_jacobian, -self.params.eta * error, rows)
+        solution = self._lp.solve(
+            task_jacobian, -self.params.eta * error, rows, self.params.velocity_cost
+        )
         return summarise(
             solution.u, solution.status, solution.objective, solution.active, error, start
         )

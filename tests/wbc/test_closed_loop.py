@@ -1,0 +1,139 @@
+"""Closed-loop behaviour of the laws under kinematic integration q += u dt (chapters 5, 6)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from wbc_scenarios import (
+    DT,
+    HOME,
+    STARTS_AND_GOALS,
+    integrate,
+    pose_task,
+    position_task,
+    robot,
+)
+
+from wbc.cascade_law import CascadeLaw
+from wbc.lp_law import LPLaw, LPParams
+from wbc.obstacles import Circle
+from wbc.pinv_law import PseudoinverseLaw
+from wbc.task import PositionTask
+
+MODEL = robot()
+POSE_PARAMS = LPParams(eta=0.6, beta=15.0)  # section 6.2.1
+POSITION_PARAMS = LPParams(eta=1.0, beta=10.0)  # section 6.2.2
+
+
+def nonholonomic_residual(q: np.ndarray, u: np.ndarray) -> float:
+    """|x' sin(phi) - y' cos(phi)| (5.11)."""
+    return abs(u[0] * np.sin(q[2]) - u[1] * np.cos(q[2]))
+
+
+def check_lp_outputs(run, task_dof: int) -> None:
+    """Every LP output: 5.11 to 1e-9, inside the bounds, parsimonious (5.30)."""
+    arm_min, arm_max = MODEL.q_min[3:], MODEL.q_max[3:]
+    for q, out in zip(run.configurations, run.outputs, strict=True):
+        assert out.status == "optimal"
+        assert nonholonomic_residual(q, out.u) <= 1e-9
+        assert np.all(np.abs(out.u) <= MODEL.velocity_max + 1e-9)
+        assert np.all(q[3:] >= arm_min) and np.all(q[3:] <= arm_max)
+        others = [name for name in out.active_constraints if "bound" not in name]
+        assert out.nonzero <= task_dof + 1 + len(others), (out.nonzero, out.active_constraints)
+
+
+@pytest.mark.parametrize("start, goal", STARTS_AND_GOALS)
+def test_lp_law_reaches_pose_goals_within_every_constraint(start, goal):
+    task = pose_task(MODEL, goal)
+    run = integrate(LPLaw(MODEL, POSE_PARAMS), start, task, steps=3000)
+    assert run.final_error < 1e-3
+    check_lp_outputs(run, task.dof)
+
+
+@pytest.mark.parametrize("start, goal", STARTS_AND_GOALS)
+def test_lp_law_reaches_position_goals_with_few_joints(start, goal):
+    task = position_task(MODEL, goal)
+    run = integrate(LPLaw(MODEL, POSITION_PARAMS), start, task, steps=3000)
+    assert run.final_error < 1e-3
+    check_lp_outputs(run, task.dof)
+    # More redundancy, more parsimony (fig. 6.12): the LP leaves joints idle most steps.
+    assert np.median([out.nonzero for out in run.outputs]) < MODEL.dof
+
+
+@pytest.mark.parametrize("start, goal", STARTS_AND_GOALS)
+@pytest.mark.parametrize("make_task", [pose_task, position_task])
+def test_cascade_law_reaches_goals_and_obeys_the_nonholonomic_constraint(start, goal, make_task):
+    run = integrate(CascadeLaw(MODEL), start, make_task(MODEL, goal), steps=3000)
+    assert run.final_error < 1e-3
+    for q, out in zip(run.configurations, run.outputs, strict=True):
+        assert nonholonomic_residual(q, out.u) <= 1e-9
+
+
+def test_pseudoinverse_law_uses_every_joint_where_the_lp_law_does_not():
+    start, goal = STARTS_AND_GOALS[0]
+    task = position_task(MODEL, goal)
+    pinv = integrate(PseudoinverseLaw(MODEL), start, task, steps=3000)
+    lp = integrate(LPLaw(MODEL, POSITION_PARAMS), start, task, steps=3000)
+    assert pinv.final_error < 1e-3
+    assert all(out.nonzero == MODEL.dof for out in pinv.outputs)
+    assert max(out.nonzero for out in lp.outputs[5:]) < MODEL.dof
+
+
+def test_joint_limit_kept_by_lp_law_and_passed_by_pseudoinverse_law():
+    """Figure 6.10: a goal whose nearest arm pose puts q5 beyond its limit."""
+    goal = HOME.copy()
+    goal[0], goal[7] = 0.3, 2.2
+    task = pose_task(MODEL, goal)
+    wrist = 7
+    pinv = integrate(PseudoinverseLaw(MODEL), HOME, task, steps=2000)
+    lp = integrate(LPLaw(MODEL, POSE_PARAMS), HOME, task, steps=2000)
+    assert max(q[wrist] for q in pinv.configurations) > MODEL.q_max[wrist]
+    assert max(q[wrist] for q in lp.configurations) <= 0.9 * MODEL.q_max[wrist] + 1e-9
+
+
+OBSTACLE_GOAL = np.array([1.4, 0.6, 0.4, 0.0, 0.3, 0.6, 0.0, 0.5])
+OBSTACLE = Circle(0.911, 0.061, 0.1)
+
+
+def base_clearance(run) -> np.ndarray:
+    """Distance between the base's rim and the obstacle's edge at every step (m)."""
+    centres = np.array(run.configurations)[:, :2]
+    distance = np.hypot(centres[:, 0] - OBSTACLE.x, centres[:, 1] - OBSTACLE.y)
+    return distance - OBSTACLE.radius - MODEL.base.body_radius
+
+
+def test_obstacle_lies_on_the_free_path():
+    free = integrate(LPLaw(MODEL, POSE_PARAMS), HOME, pose_task(MODEL, OBSTACLE_GOAL), 3000)
+    assert free.final_error < 1e-3
+    assert base_clearance(free).min() < 0.0
+
+
+def test_border_following_constraint_goes_round_the_obstacle_to_the_goal():
+    law = LPLaw(MODEL, LPParams(obstacle_mode="border"))
+    run = integrate(law, HOME, pose_task(MODEL, OBSTACLE_GOAL), 4000, obstacles=[OBSTACLE])
+    assert base_clearance(run).min() > 0.0
+    assert any("obstacle_border" in out.active_constraints for out in run.outputs)
+    assert run.final_error < 1e-3
+
+
+def test_conservative_constraint_stops_the_base_before_the_obstacle():
+    law = LPLaw(MODEL, LPParams(obstacle_mode="conservative"))
+    run = integrate(law, HOME, pose_task(MODEL, OBSTACLE_GOAL), 3000, obstacles=[OBSTACLE])
+    assert base_clearance(run).min() > 0.0
+    assert run.final_error > 0.1
+    assert np.hypot(*run.outputs[-1].u[:2]) < 1e-3
+
+
+def test_error_derivative_bound_stops_joints_when_the_end_effector_stalls():
+    """A position out of reach (1.3 m high): the end effector stalls short of it (5.9, 5.10)."""
+    unreachable = PositionTask(np.array([0.5, 0.0, 1.3]))
+
+    def last_second_speed(bound: str) -> float:
+        params = LPParams(eta=1.0, beta=10.0, error_bound=bound, velocity_cost=0.0)
+        run = integrate(LPLaw(MODEL, params), HOME, unreachable, steps=1500)
+        assert run.final_error > 0.3
+        steps = int(1.0 / DT)
+        return float(np.mean([np.abs(out.u).sum() for out in run.outputs[-steps:]]))
+
+    assert last_second_speed("derivative") < 1e-6
+    assert last_second_speed("error") > 0.1

@@ -1,0 +1,75 @@
+"""Start configurations and goals shared by the closed-loop tests, and a kinematic integrator.
+
+The goals are end-effector poses and positions of configurations some 0.4 to 0.9 m ahead of
+the robot, as in the pick-and-place experiments of section 6.2.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from wbc import dq
+from wbc.law_output import LawOutput
+from wbc.robot import MobileManipulator
+from wbc.task import PoseTask, PositionTask, Task
+
+ROBOT_FILE = Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"
+HOME = np.array([0.0, 0.0, 0.0, 0.0, 0.3, 0.6, 0.0, 0.5])
+DT = 0.02
+
+STARTS_AND_GOALS = [
+    (
+        np.array([-0.15, 0.0, 0.04, -0.28, 0.09, 0.86, -0.26, 0.28]),
+        np.array([0.87, 0.07, -0.08, 0.01, 0.46, 0.38, -0.36, 0.79]),
+    ),
+    (
+        np.array([0.07, 0.0, 0.13, 0.03, 0.59, 0.42, 0.03, 0.49]),
+        np.array([0.58, 0.05, -0.16, 0.3, 0.67, 0.23, -0.03, 0.28]),
+    ),
+    (
+        np.array([0.1, -0.12, -0.18, 0.06, 0.54, 0.32, 0.18, 0.31]),
+        np.array([0.45, -0.29, -0.12, 0.23, 0.29, 0.95, -0.28, 0.32]),
+    ),
+]
+
+
+def robot() -> MobileManipulator:
+    return MobileManipulator.from_yaml(ROBOT_FILE)
+
+
+def pose_task(model: MobileManipulator, q_goal: np.ndarray) -> PoseTask:
+    return PoseTask(model.fkm(q_goal))
+
+
+def position_task(model: MobileManipulator, q_goal: np.ndarray) -> PositionTask:
+    return PositionTask(dq.translation(model.fkm(q_goal))[1:])
+
+
+@dataclass
+class Run:
+    """A closed-loop run: configurations before each step and each step's output."""
+
+    configurations: list[np.ndarray] = field(default_factory=list)
+    outputs: list[LawOutput] = field(default_factory=list)
+
+    @property
+    def final_error(self) -> float:
+        return self.outputs[-1].error_norm
+
+
+def integrate(law, q0: np.ndarray, task: Task, steps: int, tolerance: float = 1e-3,
+              obstacles=()) -> Run:
+    """q += u dt until the error norm falls below ``tolerance`` or ``steps`` run out."""
+    run = Run()
+    q = np.array(q0, dtype=float)
+    for _ in range(steps):
+        out = law.step(q, task, DT, obstacles)
+        run.configurations.append(q.copy())
+        run.outputs.append(out)
+        if out.error_norm < tolerance:
+            break
+        q = q + out.u * DT
+    return run
