@@ -35,6 +35,7 @@ def _block_tables(sign4: Array) -> tuple[Array, Array]:
 
 _PLUS8_INDEX, _PLUS8_SIGN = _block_tables(_PLUS4_SIGN)
 _MINUS8_INDEX, _MINUS8_SIGN = _block_tables(_MINUS4_SIGN)
+_ZERO = np.zeros(1)
 _CONJ8 = np.array([1.0, -1, -1, -1, 1, -1, -1, -1])
 C4 = np.diag([1.0, -1, -1, -1])
 """Conjugating matrix: vec4(h*) = C4 vec4(h) (3.8)."""
@@ -59,12 +60,12 @@ def haminus4(h: Array) -> Array:
 
 def hamiplus8(x: Array) -> Array:
     """H+(x) = [[H+_4(P), 0], [H+_4(D), H+_4(P)]], with vec8(x a) = H+(x) vec8(a) (3.12)."""
-    return np.append(x, 0.0)[_PLUS8_INDEX] * _PLUS8_SIGN
+    return np.concatenate((x, _ZERO))[_PLUS8_INDEX] * _PLUS8_SIGN
 
 
 def haminus8(x: Array) -> Array:
     """H-(x) = [[H-_4(P), 0], [H-_4(D), H-_4(P)]], with vec8(a x) = H-(x) vec8(a) (3.12)."""
-    return np.append(x, 0.0)[_MINUS8_INDEX] * _MINUS8_SIGN
+    return np.concatenate((x, _ZERO))[_MINUS8_INDEX] * _MINUS8_SIGN
 
 
 def qmul(a: Array, b: Array) -> Array:
@@ -153,8 +154,9 @@ def log(x: Array) -> Array:
     r = x[:4]
     imaginary = float(np.linalg.norm(r[1:]))
     half_angle = math.atan2(imaginary, r[0])
-    # n phi/2 = Im(r) (phi/2) / sin(phi/2), whose limit at phi -> 0 is Im(r).
-    scale = half_angle / imaginary if imaginary > 1e-12 else 1.0
+    # n phi/2 = Im(r) (phi/2) / sin(phi/2); at r = +-1 exactly the axis is undefined and
+    # Im(r) = 0 is returned (log 1 = 0).
+    scale = half_angle / imaginary if imaginary > 0.0 else 1.0
     out = np.zeros(8)
     out[1:4] = scale * r[1:]
     out[4:] = 0.5 * translation(x)

@@ -2,12 +2,12 @@
 
 Columns g = [u_P, u_N, y] (each >= 0, u = u_P - u_N); HiGHS takes row bounds directly, so the
 slack columns z_A, z_B, z_C of the canonical form 5.29 stay implicit. With task Jacobian
-J (m x n) and error e:
+J (m x n), error e and tie-break weight w:
 
     min   1'(2y - (J u + eta e)) + w 1'(u_P + u_N)   (= ||J u + eta e||_1 + w ||u||_1, 5.4-5.5)
-    s.t.  J u_P - J u_N - y <= -eta e
+    s.t.  1'u_P + 1'u_N <= limit            for every OneNormBound
+          J u_P - J u_N - y <= -eta e
           lower <= A u_P - A u_N <= upper   for every LinearRows
-          1'u_P + 1'u_N <= limit            for every OneNormBound
           column bounds on u_P, u_N         from every VelocityBounds
 
 The tie-break weight w >= 0 is not in the dissertation: 5.29 (w = 0) has a whole face of
@@ -15,8 +15,9 @@ optimal u whenever the task can be met exactly, and the simplex returns any vert
 often one with a joint at its velocity bound. A small w picks, among the best residuals, a
 vertex of least ||u||_1; it stays a vertex, so the solution stays parsimonious (5.30).
 
-One HiGHS model lives across steps; each step passes the new arrays and, when the shape is
-unchanged, the previous optimal basis, so the dual simplex starts from the last vertex.
+One HiGHS model lives across steps. While the shape of the problem holds, each step changes
+costs and bounds in place, replaces the rows that hold J and A, and restores the last optimal
+basis, so the dual simplex starts from the previous vertex (usually 0 to 8 iterations).
 """
 
 from __future__ import annotations
@@ -53,22 +54,39 @@ def split_bounds(lower: Array, upper: Array) -> tuple[Array, Array, Array, Array
     )
 
 
+class _Layout:
+    """Index arrays and buffers for one shape of the problem, built once per shape."""
+
+    def __init__(self, m: int, n: int, linear_rows: int, norm_rows: int) -> None:
+        self.m, self.n, self.norm_rows = m, n, norm_rows
+        self.columns = 2 * n + m
+        self.varying_rows = m + linear_rows
+        self.column_index = np.arange(self.columns, dtype=np.int32)
+        self.norm_index = np.arange(norm_rows, dtype=np.int32)
+        self.varying_index = np.arange(norm_rows, norm_rows + self.varying_rows, dtype=np.int32)
+        # Rows [J -J -I] then [A -A 0], dense: every entry passed, zeros included.
+        self.matrix = np.zeros((self.varying_rows, self.columns))
+        self.matrix[np.arange(m), 2 * n + np.arange(m)] = -1.0
+        self.starts = np.arange(0, self.varying_rows * self.columns, self.columns, dtype=np.int32)
+        self.indices = np.tile(self.column_index, self.varying_rows)
+        self.row_lower = np.full(self.varying_rows, -INF)
+        self.row_upper = np.zeros(self.varying_rows)
+        self.cost = np.full(self.columns, 2.0)
+        self.col_lower = np.zeros(self.columns)
+        self.col_upper = np.full(self.columns, INF)
+
+
 class WarmStartedLP:
     """One HiGHS model solved once per control step, warm-started from the last basis."""
 
     def __init__(self) -> None:
         self._highs = highspy.Highs()
-        self._highs.setOptionValue("output_flag", False)
-        self._highs.setOptionValue("solver", "simplex")
-        self._highs.setOptionValue("presolve", "off")
-        self._highs.setOptionValue("primal_feasibility_tolerance", 1e-10)
+        self._layout: _Layout | None = None
         self._basis: object | None = None
-        self._shape: tuple[int, int] | None = None
 
     def reset(self) -> None:
         """Forget the previous basis: the next solve starts cold."""
         self._basis = None
-        self._shape = None
 
     def solve(
         self, jacobian: Array, rhs: Array, rows: list[Rows], velocity_cost: float = 0.0
@@ -81,91 +99,112 @@ class WarmStartedLP:
         linear = [r for r in rows if isinstance(r, LinearRows)]
         norms = [r for r in rows if isinstance(r, OneNormBound)]
         bounds = [r for r in rows if isinstance(r, VelocityBounds)]
+        layout = self._layout_for(m, n, sum(r.matrix.shape[0] for r in linear), len(norms))
 
         u_lower, u_upper = np.full(n, -INF), np.full(n, INF)
         for bound in bounds:
-            u_lower = np.maximum(u_lower, bound.lower)
-            u_upper = np.minimum(u_upper, bound.upper)
-        u_lower = np.minimum(u_lower, u_upper)
-        p_low, p_up, n_low, n_up = split_bounds(u_lower, u_upper)
-
-        a_u = np.vstack([jacobian] + [r.matrix for r in linear])
-        num_rows = a_u.shape[0] + len(norms)
-        # Dense column-major blocks: [A; 1'] for u_P, [-A; 1'] for u_N, [-I; 0] for y.
-        dense = np.zeros((num_rows, 2 * n + m))
-        dense[: a_u.shape[0], :n] = a_u
-        dense[: a_u.shape[0], n : 2 * n] = -a_u
-        dense[a_u.shape[0] :, : 2 * n] = 1.0
-        dense[np.arange(m), 2 * n + np.arange(m)] = -1.0
-        row_lower = np.concatenate(
-            [np.full(m, -INF)] + [r.lower for r in linear] + [np.full(len(norms), -INF)]
-        )
-        row_upper = np.concatenate([rhs] + [r.upper for r in linear] + [[b.limit for b in norms]])
+            np.maximum(u_lower, bound.lower, out=u_lower)
+            np.minimum(u_upper, bound.upper, out=u_upper)
+        np.minimum(u_lower, u_upper, out=u_lower)
+        split = split_bounds(u_lower, u_upper)
+        layout.col_lower[:n], layout.col_upper[:n] = split[0], split[1]
+        layout.col_lower[n : 2 * n], layout.col_upper[n : 2 * n] = split[2], split[3]
         column_sums = jacobian.sum(axis=0)
-        cost = np.concatenate(
-            (velocity_cost - column_sums, velocity_cost + column_sums, np.full(m, 2.0))
-        )
-        col_lower = np.concatenate((p_low, n_low, np.zeros(m)))
-        col_upper = np.concatenate((p_up, n_up, np.full(m, INF)))
-        self._pass(dense, cost, float(rhs.sum()), col_lower, col_upper, row_lower, row_upper)
+        layout.cost[:n] = velocity_cost - column_sums
+        layout.cost[n : 2 * n] = velocity_cost + column_sums
 
-        status = self._run(dense.shape)
+        matrix = layout.matrix
+        matrix[:m, :n] = jacobian
+        np.negative(jacobian, out=matrix[:m, n : 2 * n])
+        layout.row_upper[:m] = rhs
+        row = m
+        for rows_ in linear:
+            count = rows_.matrix.shape[0]
+            matrix[row : row + count, :n] = rows_.matrix
+            np.negative(rows_.matrix, out=matrix[row : row + count, n : 2 * n])
+            layout.row_lower[row : row + count] = rows_.lower
+            layout.row_upper[row : row + count] = rows_.upper
+            row += count
+        limits = np.array([bound.limit for bound in norms])
+        status = self._run(layout, limits)
         if status != "optimal":
             return LPSolution(np.zeros(n), status, None, ())
         values = np.asarray(self._highs.getSolution().col_value)
         u = values[:n] - values[n : 2 * n]
-        objective = float(self._highs.getInfo().objective_function_value)
-        return LPSolution(u, status, objective, _active(u, values[: 2 * n], linear, norms, bounds))
+        objective = float(layout.cost @ values + rhs.sum())
+        active = _active(u, float(values[: 2 * n].sum()), linear, norms, bounds)
+        return LPSolution(u, status, objective, active)
 
-    def _pass(self, dense: Array, cost: Array, offset: float, col_lower: Array,
-              col_upper: Array, row_lower: Array, row_upper: Array) -> None:
-        columns = dense.T
-        mask = columns != 0.0
-        a_start = np.concatenate(([0], np.cumsum(mask.sum(axis=1)))).astype(np.int32)
-        a_index = np.nonzero(mask)[1].astype(np.int32)
-        num_rows, num_cols = dense.shape
-        self._highs.passModel(
-            num_cols, num_rows, int(a_start[-1]), highspy.MatrixFormat.kColwise,
-            highspy.ObjSense.kMinimize, offset, cost, col_lower, col_upper,
-            row_lower, row_upper, a_start, a_index, columns[mask],
-            np.zeros(num_cols, dtype=np.int32),
-        )  # fmt: skip
+    def _layout_for(self, m: int, n: int, linear_rows: int, norm_rows: int) -> _Layout:
+        layout = self._layout
+        if layout is None or (layout.m, layout.n, layout.varying_rows - layout.m,
+                              layout.norm_rows) != (m, n, linear_rows, norm_rows):  # fmt: skip
+            layout = _Layout(m, n, linear_rows, norm_rows)
+            self._build(layout)
+        return layout
 
-    def _run(self, shape: tuple[int, int]) -> str:
-        if self._basis is not None and self._shape == shape:
-            self._highs.setBasis(self._basis)
-        self._highs.run()
-        model_status = self._highs.getModelStatus()
+    def _build(self, layout: _Layout) -> None:
+        """A new model: the columns, the constant one-norm rows, empty varying rows."""
+        highs = self._highs
+        highs.clearModel()
+        highs.setOptionValue("output_flag", False)
+        highs.setOptionValue("solver", "simplex")
+        highs.setOptionValue("presolve", "off")
+        highs.setOptionValue("primal_feasibility_tolerance", 1e-10)
+        empty_int, empty = np.zeros(0, dtype=np.int32), np.zeros(0)
+        highs.addCols(layout.columns, layout.cost, layout.col_lower, layout.col_upper, 0,
+                      empty_int, empty_int, empty)  # fmt: skip
+        width = 2 * layout.n
+        count = layout.norm_rows
+        if count:
+            highs.addRows(count, np.full(count, -INF), np.zeros(count), count * width,
+                          np.arange(0, count * width, width, dtype=np.int32),
+                          np.tile(np.arange(width, dtype=np.int32), count),
+                          np.ones(count * width))  # fmt: skip
+        highs.addRows(layout.varying_rows, layout.row_lower, layout.row_upper, 0,
+                      np.zeros(layout.varying_rows, dtype=np.int32), empty_int, empty)  # fmt: skip
+        self._layout = layout
+        self._basis = None
+
+    def _run(self, layout: _Layout, limits: Array) -> str:
+        highs = self._highs
+        highs.changeColsCost(layout.columns, layout.column_index, layout.cost)
+        highs.changeColsBounds(layout.columns, layout.column_index, layout.col_lower,
+                               layout.col_upper)  # fmt: skip
+        if layout.norm_rows:
+            highs.changeRowsBounds(layout.norm_rows, layout.norm_index,
+                                   np.full(layout.norm_rows, -INF), limits)  # fmt: skip
+        highs.deleteRows(layout.varying_rows, layout.varying_index)
+        highs.addRows(layout.varying_rows, layout.row_lower, layout.row_upper, layout.matrix.size,
+                      layout.starts, layout.indices, layout.matrix.ravel())  # fmt: skip
+        if self._basis is not None:
+            highs.setBasis(self._basis)
+        highs.run()
+        model_status = highs.getModelStatus()
         if model_status != highspy.HighsModelStatus.kOptimal:
-            self.reset()
-            return self._highs.modelStatusToString(model_status).lower()
-        self._basis = self._highs.getBasis()
-        self._shape = shape
+            self._basis = None
+            return highs.modelStatusToString(model_status).lower()
+        self._basis = highs.getBasis()
         return "optimal"
 
 
 def _active(
     u: Array,
-    split: Array,
+    split_sum: float,
     linear: list[LinearRows],
     norms: list[OneNormBound],
     bounds: list[VelocityBounds],
 ) -> tuple[str, ...]:
-    """Names of the rows that hold with equality at the solution (engaged equalities included)."""
-    active = [r.name for r in linear if r.engaged and _tight(r, u)]
-    active += [b.name for b in norms if split.sum() >= b.limit - ACTIVE_TOLERANCE]
+    """Names of the constraints that hold with equality at the solution.
+
+    Engaged equality rows are active; a one-norm bound when 1'(u_P + u_N) reaches it; a
+    velocity bound entry (named ``name[i]``) when u_i sits on a finite, non-degenerate bound.
+    """
+    active = [rows.name for rows in linear if rows.engaged]
+    active += [bound.name for bound in norms if split_sum >= bound.limit - ACTIVE_TOLERANCE]
     for bound in bounds:
-        at = (np.abs(u - bound.lower) <= ACTIVE_TOLERANCE) | (
-            np.abs(u - bound.upper) <= ACTIVE_TOLERANCE
-        )
-        at &= np.isfinite(bound.lower) & (bound.upper - bound.lower > ACTIVE_TOLERANCE)
-        active += [f"{bound.name}[{i}]" for i in np.flatnonzero(at)]
+        at_bound = (u - bound.lower <= ACTIVE_TOLERANCE) | (bound.upper - u <= ACTIVE_TOLERANCE)
+        at_bound &= np.isfinite(bound.upper) & (bound.upper - bound.lower > ACTIVE_TOLERANCE)
+        if at_bound.any():
+            active += [f"{bound.name}[{i}]" for i in np.flatnonzero(at_bound)]
     return tuple(active)
-
-
-def _tight(rows: LinearRows, u: Array) -> bool:
-    value = rows.matrix @ u
-    return bool(
-        np.any(np.abs(value - rows.lower) <= ACTIVE_TOLERANCE)
-        or np.any(np.abs(value - rows.upper) <= ACTIVE_TOLERANCE)
-    )

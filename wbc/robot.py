@@ -48,11 +48,8 @@ def _dh_link(theta: float, d: float, a: float, alpha: float) -> Array:
     return dq.mul(dq.mul(dq.mul(r_theta, p_d), p_a), r_alpha)
 
 
-# Flat positions of c and +-s in H+(cos(q/2) + k sin(q/2)), an 8x8 block-diagonal matrix.
-_RZ_COS = np.array([r * 8 + r for r in range(8)])
-_RZ_SIN_POS = np.array([r * 8 + c for r, c in ((2, 1), (3, 0), (6, 5), (7, 4))])
-_RZ_SIN_NEG = np.array([r * 8 + c for r, c in ((0, 3), (1, 2), (4, 7), (5, 6))])
 _HALF_K = 0.5 * dq.hamiplus8(np.concatenate((dq.K_, np.zeros(4))))
+_HALF_K_CONJ = _HALF_K @ dq.C8
 
 
 @dataclass(frozen=True)
@@ -95,9 +92,10 @@ class MobileManipulator:
         self.velocity_max = _readonly(
             np.concatenate((base.velocity_max, arm_velocity_max)), (self.dof,), "velocity_max"
         )
-        links = [_dh_link(*self.dh[:4, i]) for i in range(self.arm_dof)]
-        self._link_plus = np.stack([dq.hamiplus8(link) for link in links])
-        self._height_plus = dq.hamiplus8(dq.pose(dq.ONE[:4], [0.0, 0.0, base.height]))
+        links = np.stack([dq.hamiplus8(_dh_link(*self.dh[:4, i])) for i in range(self.arm_dof)])
+        # H+(r_z(q) L) = cos(q/2) H+(L) + sin(q/2) H+(k) H+(L), with r_z(q) = cos(q/2) + k sin(q/2).
+        self._link_cos = links
+        self._link_sin = np.matmul(2.0 * _HALF_K, links)
 
     @classmethod
     def from_yaml(cls, path: str | Path) -> MobileManipulator:
@@ -160,20 +158,15 @@ class MobileManipulator:
 
     def _arm_link_operators(self, q_arm: Array) -> Array:
         """H+(x_i) for every arm link, x_i = r_z(q_i) (r_theta_i p_d_i p_a_i r_alpha_i)."""
-        n = self.arm_dof
-        half = 0.5 * q_arm
-        rz = np.zeros((n, 64))
-        rz[:, _RZ_COS] = np.cos(half)[:, None]
-        sin = np.sin(half)[:, None]
-        rz[:, _RZ_SIN_POS] = sin
-        rz[:, _RZ_SIN_NEG] = -sin
-        return np.matmul(rz.reshape(n, 8, 8), self._link_plus)
+        half = 0.5 * q_arm[:, None, None]
+        return np.cos(half) * self._link_cos + np.sin(half) * self._link_sin
 
     def kinematics(self, q: Array) -> tuple[Array, Array]:
-        """(vec8 x_3^0, J) for configuration q: the pose (4.6) and its Jacobian (4.9).
+        """(vec8 x, J) for configuration q: the pose x = x_3^0 (4.6) and its Jacobian (4.9).
 
-        J = [H-(x_3^1) J_b, H+(x_2^0) J_a]; column i of H+(x_2^0) J_a is
-        vec8(x_{0,i-1} (k/2) x_{i-1,n}), the derivative of the DH product in q_i.
+        x' = (x_1^0' x_1^0*) x + sum_i (1/2) z_i x q_i', where z_i = x_{0,i-1} k x_{0,i-1}*
+        is the axis of joint i, so J = H-(x) T with the twists T = [H-(x_1^0*) J_b, z_i / 2];
+        H-(x) T equals [H-(x_3^1) J_b, H+(x_2^0) J_a] of eq. 4.9 term by term.
         """
         q = self._check(q)
         links = self._arm_link_operators(q[BASE_DOF:])
@@ -182,16 +175,14 @@ class MobileManipulator:
         prefixes[0] = dq.hamiplus8(self.base_pose(q))
         for i in range(1, n):
             prefixes[i] = prefixes[i - 1] @ links[i - 1]
-        suffixes = np.empty((8, n))
-        suffixes[:, n - 1] = links[n - 1][:, 0]
-        for i in range(n - 2, -1, -1):
-            suffixes[:, i] = links[i] @ suffixes[:, i + 1]
-        pose = prefixes[n - 1] @ suffixes[:, n - 1]
-        jacobian = np.empty((8, self.dof))
-        jacobian[:, BASE_DOF:] = np.matmul(prefixes, (_HALF_K @ suffixes).T[:, :, None])[..., 0].T
-        arm_in_base = self._height_plus @ suffixes[:, 0]
-        jacobian[:, :BASE_DOF] = dq.haminus8(arm_in_base) @ self.base_jacobian(q)
-        return pose, jacobian
+        pose = prefixes[n - 1] @ links[n - 1][:, 0]
+        # vec(x k x*) = H+(x) H+(k) C8 vec(x), for every prefix pose x = H+(x) e_1.
+        axes = np.matmul(prefixes, (_HALF_K_CONJ @ prefixes[:, :, 0].T).T[:, :, None])
+        twists = np.zeros((8, self.dof))
+        twists[5, 0] = twists[6, 1] = twists[3, 2] = 0.5
+        twists[5, 2], twists[6, 2] = 0.5 * q[1], -0.5 * q[0]
+        twists[:, BASE_DOF:] = axes[:, :, 0].T
+        return pose, dq.haminus8(pose) @ twists
 
     def fkm(self, q: Array) -> Array:
         """vec8 of the end-effector pose x_3^0 = x_1^0 x_2^1 x_3^2 (4.6)."""

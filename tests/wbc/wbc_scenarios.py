@@ -6,15 +6,14 @@ the robot, as in the pick-and-place experiments of section 6.2.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from wbc import dq
-from wbc.law_output import LawOutput
+from wbc import dq, kinematic_run
+from wbc.kinematic_run import Run
 from wbc.robot import MobileManipulator
-from wbc.task import PoseTask, PositionTask, Task
+from wbc.task import PoseTask, PositionTask
 
 ROBOT_FILE = Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"
 HOME = np.array([0.0, 0.0, 0.0, 0.0, 0.3, 0.6, 0.0, 0.5])
@@ -48,28 +47,6 @@ def position_task(model: MobileManipulator, q_goal: np.ndarray) -> PositionTask:
     return PositionTask(dq.translation(model.fkm(q_goal))[1:])
 
 
-@dataclass
-class Run:
-    """A closed-loop run: configurations before each step and each step's output."""
-
-    configurations: list[np.ndarray] = field(default_factory=list)
-    outputs: list[LawOutput] = field(default_factory=list)
-
-    @property
-    def final_error(self) -> float:
-        return self.outputs[-1].error_norm
-
-
-def integrate(law, q0: np.ndarray, task: Task, steps: int, tolerance: float = 1e-3,
-              obstacles=()) -> Run:
-    """q += u dt until the error norm falls below ``tolerance`` or ``steps`` run out."""
-    run = Run()
-    q = np.array(q0, dtype=float)
-    for _ in range(steps):
-        out = law.step(q, task, DT, obstacles)
-        run.configurations.append(q.copy())
-        run.outputs.append(out)
-        if out.error_norm < tolerance:
-            break
-        q = q + out.u * DT
-    return run
+def integrate(law, q0, task, steps: int, tolerance: float = 1e-3, obstacles=()) -> Run:
+    """Integrate at the dissertation's 50 Hz (section 6.3)."""
+    return kinematic_run.integrate(law, q0, task, DT, steps, tolerance, obstacles)

@@ -1,0 +1,91 @@
+"""Closed-loop kinematic runs, q_{k+1} = q_k + u_k dt, and the control-effort metrics of table 6.1."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from wbc.law_output import LawOutput
+from wbc.obstacles import Circle
+from wbc.task import Task
+
+Array = np.ndarray
+
+
+class Law(Protocol):
+    def step(
+        self, q: Array, task: Task, dt: float, obstacles: Sequence[Circle] = ()
+    ) -> LawOutput: ...
+
+
+@dataclass
+class Run:
+    """Configurations before each step, and each step's output."""
+
+    dt: float
+    tolerance: float = 1e-3
+    configurations: list[Array] = field(default_factory=list)
+    outputs: list[LawOutput] = field(default_factory=list)
+
+    @property
+    def final_error(self) -> float:
+        return self.outputs[-1].error_norm
+
+    @property
+    def converged(self) -> bool:
+        return bool(self.outputs) and self.outputs[-1].error_norm < self.tolerance
+
+    def velocities(self) -> Array:
+        return np.array([out.u for out in self.outputs])
+
+
+def integrate(
+    law: Law,
+    q0: Array,
+    task: Task,
+    dt: float,
+    steps: int,
+    tolerance: float = 1e-3,
+    obstacles: Sequence[Circle] = (),
+) -> Run:
+    """Step ``law`` and integrate q += u dt until ||e|| < ``tolerance`` or ``steps`` run out."""
+    run = Run(dt=dt, tolerance=tolerance)
+    q = np.array(q0, dtype=float)
+    for _ in range(steps):
+        out = law.step(q, task, dt, obstacles)
+        run.configurations.append(q.copy())
+        run.outputs.append(out)
+        if out.error_norm < tolerance:
+            break
+        q = q + out.u * dt
+    return run
+
+
+@dataclass(frozen=True)
+class ControlEffort:
+    """The four metrics of table 6.1, integrals over the run by the rectangle rule."""
+
+    velocity_l1: float
+    """int ||q'||_1 dt"""
+    velocity_l2: float
+    """sqrt(int ||q'||_2^2 dt)"""
+    acceleration_l1: float
+    """int ||q''||_1 dt, with q'' the finite difference of q'"""
+    acceleration_l2: float
+    """sqrt(int ||q''||_2^2 dt)"""
+
+
+def control_effort(run: Run) -> ControlEffort:
+    """Table 6.1's metrics of a run's velocities."""
+    velocity = run.velocities()
+    acceleration = np.diff(velocity, axis=0) / run.dt
+    dt = run.dt
+    return ControlEffort(
+        velocity_l1=float(np.abs(velocity).sum() * dt),
+        velocity_l2=float(np.sqrt((velocity**2).sum() * dt)),
+        acceleration_l1=float(np.abs(acceleration).sum() * dt),
+        acceleration_l2=float(np.sqrt((acceleration**2).sum() * dt)),
+    )
