@@ -22,7 +22,7 @@ import numpy as np
 
 from wbc.law_output import LawOutput, summarise
 from wbc.obstacles import Circle
-from wbc.pinv_law import PinvParams, PseudoinverseLaw
+from wbc.pinv_law import pinv_velocity
 from wbc.robot import MobileManipulator
 from wbc.task import Task, same_task
 from wbc.validation import require_finite
@@ -82,8 +82,9 @@ class CascadeLaw:
             self._reference = q[:3].copy()
         self._task = task
 
-        outer = PseudoinverseLaw(self.robot, PinvParams(self.params.eta))
-        reference_u = outer.step(q, task, dt).u
+        pose, jacobian = self.robot.kinematics(q)
+        error, task_jacobian = task.error(pose, jacobian)
+        reference_u = pinv_velocity(task_jacobian, error, self.params.eta)
         x_r, y_r, phi_r = self._reference
         xr_dot, yr_dot, phir_dot = reference_u[:3]
         d = self.params.offset
@@ -101,6 +102,4 @@ class CascadeLaw:
         self._reference = self._reference + dt * reference_u[:3]
         u = reference_u.copy()
         u[:3] = forward * math.cos(phi), forward * math.sin(phi), angular
-        pose, jacobian = self.robot.kinematics(q)
-        error, _ = task.error(pose, jacobian)
         return summarise(u, "optimal", None, (), error, start)

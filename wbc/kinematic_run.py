@@ -1,4 +1,4 @@
-"""Closed-loop kinematic runs, q_{k+1} = q_k + u_k dt, and the control-effort metrics of table 6.1."""
+"""Closed-loop kinematic runs, q_{k+1} = q_k + u_k dt, and the control effort of table 6.1."""
 
 from __future__ import annotations
 

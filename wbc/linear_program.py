@@ -44,16 +44,6 @@ class LPSolution:
     active: tuple[str, ...]
 
 
-def split_bounds(lower: Array, upper: Array) -> tuple[Array, Array, Array, Array]:
-    """Column bounds of u_P and u_N such that u_P - u_N covers exactly [lower, upper]."""
-    return (
-        np.maximum(lower, 0.0),
-        np.maximum(upper, 0.0),
-        np.maximum(-upper, 0.0),
-        np.maximum(-lower, 0.0),
-    )
-
-
 class _Layout:
     """Index arrays and buffers for one shape of the problem, built once per shape."""
 
@@ -63,6 +53,7 @@ class _Layout:
         self.varying_rows = m + linear_rows
         self.column_index = np.arange(self.columns, dtype=np.int32)
         self.norm_index = np.arange(norm_rows, dtype=np.int32)
+        self.norm_lower = np.full(norm_rows, -INF)
         self.varying_index = np.arange(norm_rows, norm_rows + self.varying_rows, dtype=np.int32)
         # Rows [J -J -I] then [A -A 0], dense: every entry passed, zeros included.
         self.matrix = np.zeros((self.varying_rows, self.columns))
@@ -96,22 +87,35 @@ class WarmStartedLP:
         ``velocity_cost`` w adds w ||u||_1 to the objective (0 gives 5.29 exactly).
         """
         m, n = jacobian.shape
-        linear = [r for r in rows if isinstance(r, LinearRows)]
-        norms = [r for r in rows if isinstance(r, OneNormBound)]
-        bounds = [r for r in rows if isinstance(r, VelocityBounds)]
+        linear: list[LinearRows] = []
+        norms: list[OneNormBound] = []
+        bounds: list[VelocityBounds] = []
+        for rows_ in rows:
+            if isinstance(rows_, LinearRows):
+                linear.append(rows_)
+            elif isinstance(rows_, OneNormBound):
+                norms.append(rows_)
+            else:
+                bounds.append(rows_)
         layout = self._layout_for(m, n, sum(r.matrix.shape[0] for r in linear), len(norms))
 
-        u_lower, u_upper = np.full(n, -INF), np.full(n, INF)
-        for bound in bounds:
-            np.maximum(u_lower, bound.lower, out=u_lower)
-            np.minimum(u_upper, bound.upper, out=u_upper)
-        np.minimum(u_lower, u_upper, out=u_lower)
-        split = split_bounds(u_lower, u_upper)
-        layout.col_lower[:n], layout.col_upper[:n] = split[0], split[1]
-        layout.col_lower[n : 2 * n], layout.col_upper[n : 2 * n] = split[2], split[3]
+        if not bounds:
+            bounds.append(VelocityBounds("free", np.full(n, -INF), np.full(n, INF)))
+        u_lower, u_upper = bounds[0].lower, bounds[0].upper
+        if len(bounds) > 1:
+            u_lower, u_upper = u_lower.copy(), u_upper.copy()
+            for bound in bounds[1:]:
+                np.maximum(u_lower, bound.lower, out=u_lower)
+                np.minimum(u_upper, bound.upper, out=u_upper)
+            np.minimum(u_lower, u_upper, out=u_lower)
+        # u_P in [max(lower, 0), max(upper, 0)], u_N in [max(-upper, 0), max(-lower, 0)].
+        np.maximum(u_lower, 0.0, out=layout.col_lower[:n])
+        np.maximum(u_upper, 0.0, out=layout.col_upper[:n])
+        np.maximum(-u_upper, 0.0, out=layout.col_lower[n : 2 * n])
+        np.maximum(-u_lower, 0.0, out=layout.col_upper[n : 2 * n])
         column_sums = jacobian.sum(axis=0)
-        layout.cost[:n] = velocity_cost - column_sums
-        layout.cost[n : 2 * n] = velocity_cost + column_sums
+        np.subtract(velocity_cost, column_sums, out=layout.cost[:n])
+        np.add(velocity_cost, column_sums, out=layout.cost[n : 2 * n])
 
         matrix = layout.matrix
         matrix[:m, :n] = jacobian
@@ -172,8 +176,8 @@ class WarmStartedLP:
         highs.changeColsBounds(layout.columns, layout.column_index, layout.col_lower,
                                layout.col_upper)  # fmt: skip
         if layout.norm_rows:
-            highs.changeRowsBounds(layout.norm_rows, layout.norm_index,
-                                   np.full(layout.norm_rows, -INF), limits)  # fmt: skip
+            highs.changeRowsBounds(layout.norm_rows, layout.norm_index, layout.norm_lower,
+                                   limits)  # fmt: skip
         highs.deleteRows(layout.varying_rows, layout.varying_index)
         highs.addRows(layout.varying_rows, layout.row_lower, layout.row_upper, layout.matrix.size,
                       layout.starts, layout.indices, layout.matrix.ravel())  # fmt: skip

@@ -20,6 +20,11 @@ PINV_RCOND = 1e-9
 """Singular values below this fraction of the largest are dropped (J of a pose task is rank 6)."""
 
 
+def pinv_velocity(task_jacobian: Array, error: Array, eta: float) -> Array:
+    """u = -J^+ eta e (5.3)."""
+    return -eta * (np.linalg.pinv(task_jacobian, rcond=PINV_RCOND) @ error)
+
+
 @dataclass(frozen=True)
 class PinvParams:
     eta: float = 0.6
@@ -51,5 +56,5 @@ class PseudoinverseLaw:
         q = require_finite("configuration q", q)
         pose, jacobian = self.robot.kinematics(q)
         error, task_jacobian = task.error(pose, jacobian)
-        u = -self.params.eta * (np.linalg.pinv(task_jacobian, rcond=PINV_RCOND) @ error)
+        u = pinv_velocity(task_jacobian, error, self.params.eta)
         return summarise(u, "optimal", None, (), error, start)

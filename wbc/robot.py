@@ -140,7 +140,8 @@ class MobileManipulator:
         c, s, z = math.cos(0.5 * phi), math.sin(0.5 * phi), self.base.height
         # D = (1/2) p r with p = x i + y j + z k and r = c + s k.
         return np.array(
-            [c, 0.0, 0.0, s, -0.5 * z * s, 0.5 * (x * c + y * s), 0.5 * (y * c - x * s), 0.5 * z * c]
+            [c, 0.0, 0.0, s, -0.5 * z * s, 0.5 * (x * c + y * s), 0.5 * (y * c - x * s),
+             0.5 * z * c]  # fmt: skip
         )
 
     @staticmethod
@@ -202,7 +203,7 @@ class MobileManipulator:
         return translation_jacobian(pose, jacobian)
 
     def link_points(self, q: Array) -> Array:
-        """World positions (n+2, 3) of the base top and every DH frame origin, for geometry checks."""
+        """World positions (n + 1, 3) of the base top and every DH frame origin."""
         q = self._check(q)
         pose = self.base_pose(q)
         points = [dq.translation(pose)[1:]]

@@ -25,11 +25,12 @@ class JointLimits:
         self.safety_factor = safety_factor
 
     def rows(self, context: StepContext) -> VelocityBounds:
-        robot, q = context.robot, context.q
+        robot = context.robot
         speed = robot.velocity_max
-        with np.errstate(invalid="ignore"):
-            towards_min = self.gain * (self.safety_factor * robot.q_min - q)
-            towards_max = self.gain * (self.safety_factor * robot.q_max - q)
-        lower = np.clip(np.fmax(-speed, towards_min), -speed, speed)
-        upper = np.clip(np.fmin(speed, towards_max), -speed, speed)
+        scaled_q = self.gain * context.q
+        # k (b_l q-+ - q), infinite for the base's x, y, phi; then held inside [-q'+, q'+].
+        lower = np.maximum(self.gain * self.safety_factor * robot.q_min - scaled_q, -speed)
+        upper = np.minimum(self.gain * self.safety_factor * robot.q_max - scaled_q, speed)
+        np.minimum(lower, speed, out=lower)
+        np.maximum(upper, -speed, out=upper)
         return VelocityBounds(self.name, np.minimum(lower, upper), np.maximum(lower, upper))

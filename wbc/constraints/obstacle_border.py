@@ -41,6 +41,8 @@ class BorderObstacle:
     def rows(self, context: StepContext) -> LinearRows:
         count = len(context.obstacles)
         matrix = np.zeros((count, context.robot.dof))
+        if count == 0:
+            return LinearRows(self.name, matrix, np.zeros(0), np.zeros(0), engaged=False)
         rhs = np.zeros(count)
         d = self.lookahead
         phi = float(context.q[2])
