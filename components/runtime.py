@@ -265,7 +265,10 @@ class Node:
 
 class Component:
     """Base of every component: declare ``params``, build publishers, subscriptions and
-    timers on ``self.node`` in ``__init__``, react in handlers."""
+    timers on ``self.node`` in ``__init__``, react in handlers.
+
+    ``__init__`` raises ``ParamError`` for a parameter value it cannot use (a missing
+    file, say): the process then exits with ``EXIT_CONFIG_ERROR`` and is not restarted."""
 
     params: ClassVar[tuple[Param, ...]] = ()
 
@@ -335,7 +338,11 @@ def main(component_class: type[Component], argv: Sequence[str] | None = None) ->
         if node is None:
             return EXIT_CONFIG_ERROR
         with node:
-            component = component_class(node)
+            try:
+                component = component_class(node)
+            except ParamError as error:
+                log.error("%s: %s: %s", args.profile, args.name, error)
+                return EXIT_CONFIG_ERROR
             node.start(component.shutdown)
             _wait_for_stop()
     except _StopRequested as stop:
