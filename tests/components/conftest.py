@@ -8,18 +8,26 @@ import sys
 import threading
 import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from contextlib import ExitStack
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any, Generic, TypeVar
 
 import pytest
 import yaml
 import zenoh
+from pydantic import BaseModel
 
 from deploy.profile import Profile, load_profile
-from messages import topics
+from messages import codec, topics
+
+M = TypeVar("M", bound=BaseModel)
 
 DEADLINE_S = 10.0
 """Generous limit for anything that involves starting a process on a loaded machine."""
+
+DEPLOY = Path(__file__).resolve().parents[2] / "deploy"
+"""The directory of the project's profiles and robot descriptions."""
 
 
 def free_port() -> int:
@@ -55,16 +63,34 @@ class System:
     profile: Profile
     router: zenoh.Session
     deadline_s: float = DEADLINE_S
+    processes: list[subprocess.Popen[str]] = field(default_factory=list)
 
     def liveliness(self) -> LivelinessLog:
         """Start recording the liveliness changes of the namespace."""
         return LivelinessLog(self.router, self.profile.namespace)
 
+    def inbox(self, topic: topics.Topic[M]) -> Inbox[M]:
+        """Start collecting the messages of ``topic`` in the namespace."""
+        return Inbox(self.router, self.profile.namespace, topic)
+
     def start(self, name: str) -> subprocess.Popen[str]:
         """Start the profile's component ``name`` as its own process."""
         module = self.profile.component(name).module_path
         command = [sys.executable, "-m", module, "--profile", str(self.path), "--name", name]
-        return subprocess.Popen(command, stderr=subprocess.PIPE, text=True)
+        self.processes.append(subprocess.Popen(command, stderr=subprocess.PIPE, text=True))
+        return self.processes[-1]
+
+    def stop_processes(self) -> None:
+        """Teardown: SIGTERM every process started, SIGKILL those that do not stop."""
+        for process in self.processes:
+            if process.poll() is None:
+                process.terminate()
+        for process in self.processes:
+            try:
+                process.wait(self.deadline_s)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait()
 
 
 @pytest.fixture
@@ -89,7 +115,34 @@ def system(tmp_path: Path) -> Iterator[System]:
     path.write_text(yaml.safe_dump(data))
     profile = load_profile(path)
     with zenoh.open(profile.zenoh.router_config()) as router:
-        yield System(path, profile, router)
+        system = System(path, profile, router)
+        yield system
+        system.stop_processes()
+
+
+@pytest.fixture
+def deployed(tmp_path: Path) -> Iterator[Callable[[str], System]]:
+    """``deployed(text)``: a profile of ``deploy/`` (its YAML text) with its router open.
+
+    The copy's router moves to a free loopback port and its robot path becomes absolute
+    (the copy lives in a temporary directory); nothing else changes. The processes
+    started are stopped at teardown.
+    """
+    with ExitStack() as stack:
+
+        def deploy(text: str) -> System:
+            data: dict[str, Any] = yaml.safe_load(text)
+            data["zenoh"]["router"] = [f"tcp/127.0.0.1:{free_port()}"]
+            data["robot"] = str(DEPLOY / data["robot"])
+            path = tmp_path / f"deployed{len(list(tmp_path.glob('*.yaml')))}.yaml"
+            path.write_text(yaml.safe_dump(data, sort_keys=False))
+            profile = load_profile(path)
+            router = stack.enter_context(zenoh.open(profile.zenoh.router_config()))
+            system = System(path, profile, router)
+            stack.callback(system.stop_processes)
+            return system
+
+        yield deploy
 
 
 class LivelinessLog:
@@ -125,3 +178,33 @@ class LivelinessLog:
                 state = "alive" if alive else "lost"
                 pytest.fail(f"{name} not {state} within {timeout_s} s; saw {self.events}")
             return found()
+
+
+class Inbox(Generic[M]):
+    """Every message of one topic that reaches a session; payloads that fail to decode
+    (a non-finite float, say) are kept in ``undecodable``."""
+
+    def __init__(self, session: zenoh.Session, namespace: str, topic: topics.Topic[M]) -> None:
+        self.topic = topic
+        self.messages: list[M] = []
+        self.undecodable: list[str] = []
+        self._changed = threading.Condition()
+        self._subscriber = session.declare_subscriber(topic.key(namespace), self._on_sample)
+
+    def _on_sample(self, sample: zenoh.Sample) -> None:
+        with self._changed:
+            try:
+                self.messages.append(codec.decode(sample.payload.to_bytes(), self.topic.type))
+            except codec.DecodeError as error:
+                self.undecodable.append(str(error))
+            self._changed.notify_all()
+
+    def wait_for(self, match: Callable[[M], bool], what: str, timeout_s: float = DEADLINE_S) -> M:
+        """The first message that ``match`` accepts, waiting for it up to ``timeout_s``."""
+        with self._changed:
+            found = self._changed.wait_for(
+                lambda: next((m for m in self.messages if match(m)), None), timeout_s
+            )
+        if found is None:
+            pytest.fail(f"no {self.topic.name} {what} within {timeout_s} s")
+        return found

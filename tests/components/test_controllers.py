@@ -1,0 +1,278 @@
+"""The LP and cascade controllers as processes, on real Zenoh sessions over loopback.
+
+The test plays the estimator and the operator: it publishes states and goals on the
+profile's router and reads what the controller answers. Every command and diagnostics
+message carries the stamp of the state it answers, so each answer is found by its stamp.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import msgpack
+import pytest
+
+from deploy import query
+from messages import codec, topics
+from messages.commands import ArmCommand, BaseCommand
+from messages.diagnostics import ControllerDiagnostics
+from messages.goal import Goal
+from messages.header import Header
+from messages.state import RobotState
+from parsimony.commands import param
+
+if TYPE_CHECKING:
+    from tests.components.conftest import System
+
+DEPLOY = Path(__file__).resolve().parents[2] / "deploy"
+LP_PROFILE = DEPLOY / "controllers.yaml"
+CASCADE_PROFILE = DEPLOY / "controllers_cascade.yaml"
+
+DEADLINE_S = 10.0
+"""Generous limit for anything that involves starting a process on a loaded machine."""
+
+START = (0.07, 0.0, 0.13, 0.03, 0.59, 0.42, 0.03, 0.49)
+"""The configuration the states report: [x, y, phi, q1..q5]."""
+
+GOAL_POSE = (
+    *(-0.872989241287903, -0.003896628796899587, -0.43510881846061733, -0.2203518027550398),
+    *(0.0394281332159116, -0.40576390866673206, 0.029886072718136703, -0.208044218317936),
+)
+"""The end-effector pose of [0.6, 0.05, -0.1, 0.3, 0.67, 0.23, -0.03, 0.28], as in the profile."""
+
+STALE_TIMEOUT_S = 0.5
+"""The controller's ``stale_timeout_s`` in the profile."""
+
+
+class Operator:
+    """The test's side of a controller: states and goals out, commands and diagnostics in."""
+
+    def __init__(self, system: System) -> None:
+        self.system = system
+        namespace = system.profile.namespace
+        session = system.router
+        self.namespace = namespace
+        self.state_key = topics.ROBOT_STATE.key(namespace)
+        self.state = session.declare_publisher(self.state_key)
+        self.goal = session.declare_publisher(topics.CONTROL_GOAL.key(namespace))
+        self.base = system.inbox(topics.BASE_COMMAND)
+        self.arm = system.inbox(topics.ARM_COMMAND)
+        self.diagnostics = system.inbox(topics.CONTROL_DIAGNOSTICS)
+        self._stamps: set[int] = set()
+
+    def wait_connected(self) -> None:
+        """Wait until the controller is alive (answers queries) and subscribes to its inputs."""
+        self.system.liveliness().wait_for("controller", alive=True)
+        deadline = time.monotonic() + DEADLINE_S
+        while not (self.state.matching_status.matching and self.goal.matching_status.matching):
+            assert time.monotonic() < deadline, "the controller did not subscribe in time"
+            time.sleep(0.005)
+
+    def stamp(self, age_s: float = 0.0) -> int:
+        """A fresh stamp, ``age_s`` in the past, distinct from every earlier one."""
+        stamp = time.time_ns() - round(age_s * 1e9)
+        while stamp in self._stamps:
+            stamp += 1
+        self._stamps.add(stamp)
+        return stamp
+
+    def send_state(self, valid: bool = True, age_s: float = 0.0) -> int:
+        """Publish a state at ``START``; return its stamp."""
+        stamp = self.stamp(age_s)
+        state = RobotState(
+            header=Header(stamp_ns=stamp, frame="world", seq=0, source="test"),
+            base_pose=START[:3],
+            arm_joints=START[3:],
+            end_effector=GOAL_POSE,
+            valid=valid,
+            age_s=0.0,
+        )
+        self.state.put(codec.encode(state))
+        return stamp
+
+    def send_goal(self, eta: float | None = None) -> None:
+        """Publish a pose goal and wait until the controller has taken it.
+
+        (Zenoh calls each subscription's handler on its own thread: a goal published
+        before a state may still be handled after it.)
+        """
+        taken = self.counters()["received.control/goal"]
+        header = Header(stamp_ns=self.stamp(), frame="world", seq=0, source="test")
+        self.goal.put(codec.encode(Goal(header=header, task="pose", pose=GOAL_POSE, eta=eta)))
+        deadline = time.monotonic() + DEADLINE_S
+        while self.counters()["received.control/goal"] == taken:
+            assert time.monotonic() < deadline, "the controller did not take the goal"
+
+    def answer(self, stamp: int) -> tuple[ControllerDiagnostics, BaseCommand, ArmCommand]:
+        """The diagnostics and commands that answer the state stamped ``stamp``."""
+        what = f"stamped {stamp}"
+        return (
+            self.diagnostics.wait_for(lambda m: m.header.stamp_ns == stamp, what),
+            self.base.wait_for(lambda m: m.header.stamp_ns == stamp, what),
+            self.arm.wait_for(lambda m: m.header.stamp_ns == stamp, what),
+        )
+
+    def step(self, valid: bool = True, age_s: float = 0.0) -> tuple[ControllerDiagnostics, ...]:
+        """Publish a state and wait for the controller's answer."""
+        return self.answer(self.send_state(valid, age_s))
+
+    def counters(self) -> dict[str, int]:
+        """The controller's counters, from its status queryable."""
+        return query.statuses(self.system.router, self.namespace)["controller"].counters
+
+    def assert_every_command_finite(self) -> None:
+        assert self.base.undecodable == self.arm.undecodable == []
+        assert self.diagnostics.undecodable == []
+        for command in self.base.messages:
+            wheels = command.left_wheel, command.right_wheel, command.forward_velocity
+            assert all(math.isfinite(v) for v in (*wheels, command.angular_velocity))
+        for command in self.arm.messages:
+            assert all(math.isfinite(v) for v in command.joint_velocities)
+
+
+def is_zero(base: BaseCommand, arm: ArmCommand) -> bool:
+    wheels = (base.forward_velocity, base.angular_velocity, base.left_wheel, base.right_wheel)
+    return wheels == (0.0,) * 4 and arm.joint_velocities == (0.0,) * 5
+
+
+@pytest.fixture
+def operator(deployed: Callable[[str], System]) -> Operator:
+    """The LP profile's controller alone, started and subscribed."""
+    system = deployed(LP_PROFILE.read_text())
+    system.start("controller")
+    operator = Operator(system)
+    operator.wait_connected()
+    return operator
+
+
+def test_the_cascade_profile_is_the_lp_profile_with_another_module() -> None:
+    lp = LP_PROFILE.read_text()
+    assert lp.count("module: lp_controller") == 1
+    swapped = lp.replace("module: lp_controller", "module: cascade_controller")
+    assert CASCADE_PROFILE.read_text() == swapped
+
+
+@pytest.mark.parametrize(("profile", "law"), [(LP_PROFILE, "lp"), (CASCADE_PROFILE, "cascade")])
+def test_a_profile_with_a_scripted_state_and_goal_makes_finite_optimal_commands(
+    deployed: Callable[[str], System], profile: Path, law: str
+) -> None:
+    system = deployed(profile.read_text())
+    operator = Operator(system)
+    system.start("controller")
+    system.start("publisher")
+    diagnostics = operator.diagnostics.wait_for(lambda m: m.status == "optimal", "optimal")
+    _, base, arm = operator.answer(diagnostics.header.stamp_ns)
+    assert diagnostics.law == law and diagnostics.reason == ""
+    assert diagnostics.error_norm is not None and diagnostics.error_norm > 0.1
+    assert diagnostics.parameters["eta"] == 0.6
+    assert abs(base.left_wheel) <= 0.5 and abs(base.right_wheel) <= 0.5
+    assert base.header.source == arm.header.source == "controller"
+    operator.assert_every_command_finite()
+
+
+def test_malformed_states_are_counted_and_never_reach_a_motor(operator: Operator) -> None:
+    operator.send_goal()
+    assert operator.step()[0].status == "optimal"
+    header = Header(stamp_ns=operator.stamp(), frame="world", seq=0, source="test")
+    goal = Goal(header=header, task="position", position=(0.5, 0.0, 0.3))
+    nan_state = {
+        "header": {"stamp_ns": operator.stamp(), "frame": "world", "seq": 0, "source": "test"},
+        "base_pose": (math.nan, 0.0, 0.0),
+        "arm_joints": START[3:],
+        "end_effector": GOAL_POSE,
+        "valid": True,
+        "age_s": 0.0,
+    }
+    malformed = (
+        b"\x00garbage\xff",
+        codec.encode(goal),
+        msgpack.packb([codec.FORMAT_TAG, "RobotState", nan_state], use_bin_type=True),
+    )
+    for count, payload in enumerate(malformed, start=1):
+        operator.state.put(payload)
+        deadline = time.monotonic() + DEADLINE_S
+        while operator.counters()["rejected.robot/state"] < count:
+            assert time.monotonic() < deadline, f"malformed state {count} was not rejected"
+    diagnostics, _, _ = operator.step()
+    assert diagnostics.status == "optimal"
+    counters = operator.counters()
+    assert counters["rejected.robot/state"] >= 3
+    assert counters["errors.robot/state"] == counters["non_finite_commands"] == 0
+    assert operator.system.processes[0].poll() is None
+    operator.assert_every_command_finite()
+
+
+def test_no_goal_an_invalid_state_and_an_old_state_command_zero_and_say_why(
+    operator: Operator,
+) -> None:
+    diagnostics, base, arm = operator.step()
+    assert (diagnostics.status, diagnostics.reason) == ("no goal", "no control/goal received yet")
+    assert is_zero(base, arm)
+
+    operator.send_goal()
+    diagnostics, base, arm = operator.step()
+    assert diagnostics.status == "optimal" and not is_zero(base, arm)
+
+    diagnostics, base, arm = operator.step(valid=False)
+    assert diagnostics.status == "invalid state" and is_zero(base, arm)
+
+    diagnostics, base, arm = operator.step(age_s=2.0)
+    assert diagnostics.status == "stale" and is_zero(base, arm)
+    assert diagnostics.reason.startswith("robot/state is 2.0")
+    assert diagnostics.reason.endswith(f"s old (timeout {STALE_TIMEOUT_S} s)")
+    operator.assert_every_command_finite()
+
+
+def test_states_that_stop_arriving_command_zero_within_the_timeout(operator: Operator) -> None:
+    operator.send_goal()
+    last = operator.send_state()
+    sent = time.monotonic()
+    assert operator.answer(last)[0].status == "optimal"
+    stale = operator.diagnostics.wait_for(
+        lambda m: m.header.stamp_ns > last and m.status == "stale", "stale after the last state"
+    )
+    elapsed = time.monotonic() - sent
+    assert stale.reason.startswith("no robot/state for")
+    timer_period_s, margin_s = 0.1, 0.4
+    assert STALE_TIMEOUT_S <= elapsed <= STALE_TIMEOUT_S + timer_period_s + margin_s
+    _, base, arm = operator.answer(stale.header.stamp_ns)
+    assert is_zero(base, arm)
+
+
+def set_param(operator: Operator, name: str, value: str) -> int:
+    """`parsimony param set controller NAME VALUE --profile P` through its own parser."""
+    root = argparse.ArgumentParser(prog="parsimony")
+    param.add_parser(root.add_subparsers())
+    argv = ["param", "set", "controller", name, value, "--profile", str(operator.system.path)]
+    return param.run(root.parse_args(argv))
+
+
+def test_param_set_and_goal_gains_reach_the_next_step(
+    operator: Operator, capsys: pytest.CaptureFixture[str]
+) -> None:
+    operator.send_goal()
+    assert operator.step()[0].parameters["eta"] == 0.6
+    assert set_param(operator, "eta", "2.0") == 0
+    assert capsys.readouterr().out.strip() == "controller.eta = 2.0"
+    diagnostics = operator.step()[0]
+    assert diagnostics.status == "optimal" and diagnostics.parameters["eta"] == 2.0
+
+    operator.send_goal(eta=1.5)
+    assert operator.step()[0].parameters["eta"] == 1.5
+    assert set_param(operator, "eta", "-1") == 1
+    assert "eta: expected a float in [0.001, 100.0]" in capsys.readouterr().err
+
+
+def test_a_robot_description_that_cannot_be_loaded_is_a_configuration_error(
+    deployed: Callable[[str], System],
+) -> None:
+    text = LP_PROFILE.read_text().replace("eta: 0.6", "robot: /nonexistent/robot.yaml")
+    system = deployed(text)
+    process = system.start("controller")
+    assert process.wait(DEADLINE_S) == 2
+    assert "robot: cannot load /nonexistent/robot.yaml" in process.stderr.read()
