@@ -1,0 +1,318 @@
+"""The whole-body model (wbc/robot.py): chapter 4 against DQ Robotics and finite differences."""
+
+from __future__ import annotations
+
+import itertools
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from dqrobotics import E_, k_
+from dqrobotics.robot_modeling import (
+    DQ_HolonomicBase,
+    DQ_Kinematics,
+    DQ_SerialManipulatorDH,
+    DQ_WholeBody,
+)
+
+from wbc import dq
+from wbc.robot import MobileManipulator, RobotDescriptionError, translation_jacobian
+
+ROBOT_FILE = Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"
+ORACLE_TOL = 1e-12
+FINITE_DIFFERENCE_STEP = 1e-6
+FINITE_DIFFERENCE_TOL = 1e-7
+
+
+@pytest.fixture(scope="module")
+def robot() -> MobileManipulator:
+    return MobileManipulator.from_yaml(ROBOT_FILE)
+
+
+@pytest.fixture(scope="module")
+def description() -> dict:
+    return yaml.safe_load(ROBOT_FILE.read_text())
+
+
+@pytest.fixture(scope="module")
+def oracle(robot: MobileManipulator) -> DQ_WholeBody:
+    """The same robot built from DQ Robotics: holonomic base, height displacement, DH arm."""
+    arm = DQ_SerialManipulatorDH(np.array(robot.dh))
+    base = DQ_HolonomicBase()
+    base.set_frame_displacement(1 + E_ * 0.5 * 0.170 * k_)
+    whole_body = DQ_WholeBody(base)
+    whole_body.add(arm)
+    return whole_body
+
+
+def random_configurations(robot: MobileManipulator, count: int, seed: int) -> np.ndarray:
+    """Base anywhere in a 6 m square facing anywhere; arm joints over their whole servo travel."""
+    rng = np.random.default_rng(seed)
+    base = rng.uniform([-3.0, -3.0, -np.pi], [3.0, 3.0, np.pi], (count, 3))
+    arm = rng.uniform(-2.618, 2.618, (count, robot.arm_dof))
+    return np.hstack((base, arm))
+
+
+# --- Description ------------------------------------------------------------------------------
+
+
+def test_dh_is_the_yaml_table_and_read_only(robot: MobileManipulator, description: dict) -> None:
+    table = description["arm"]["dh"]
+    expected = np.array([table["theta"], table["d"], table["a"], table["alpha"], np.zeros(5)])
+    assert robot.dh.shape == (5, 5)
+    np.testing.assert_array_equal(robot.dh, expected)
+    with pytest.raises(ValueError):
+        robot.dh[1, 0] = 0.0
+
+
+def test_base_and_limits_come_from_the_yaml(robot: MobileManipulator, description: dict) -> None:
+    arm, base = description["arm"], description["base"]
+    assert robot.base_height == 0.170
+    assert robot.base.body_radius == 0.165
+    assert robot.base.wheel_radius == 0.5 * base["wheel_diameter"]
+    assert robot.dof == 8 and robot.arm_dof == 5
+    np.testing.assert_array_equal(robot.q_min, [-np.inf] * 3 + arm["joint_min"])
+    np.testing.assert_array_equal(robot.q_max, [np.inf] * 3 + arm["joint_max"])
+    np.testing.assert_array_equal(robot.velocity_max, base["velocity_max"] + arm["velocity_max"])
+    for array in (robot.q_min, robot.q_max, robot.velocity_max):
+        with pytest.raises(ValueError):
+            array[4] = 0.0
+
+
+# --- Against DQ Robotics ----------------------------------------------------------------------
+
+
+def test_fkm_and_pose_jacobian_match_dqrobotics(
+    robot: MobileManipulator, oracle: DQ_WholeBody
+) -> None:
+    for q in random_configurations(robot, 200, seed=1):
+        np.testing.assert_allclose(robot.fkm(q), oracle.fkm(q).vec8(), rtol=0, atol=ORACLE_TOL)
+        np.testing.assert_allclose(
+            robot.pose_jacobian(q), oracle.pose_jacobian(q), rtol=0, atol=ORACLE_TOL
+        )
+
+
+def test_translation_jacobian_matches_dqrobotics(
+    robot: MobileManipulator, oracle: DQ_WholeBody
+) -> None:
+    for q in random_configurations(robot, 200, seed=2):
+        pose = oracle.fkm(q)
+        expected = DQ_Kinematics.translation_jacobian(oracle.pose_jacobian(q), pose)
+        np.testing.assert_allclose(robot.translation_jacobian(q), expected, rtol=0, atol=ORACLE_TOL)
+        x, jacobian = robot.kinematics(q)
+        np.testing.assert_allclose(
+            translation_jacobian(x, jacobian), expected, rtol=0, atol=ORACLE_TOL
+        )
+
+
+# --- Consistency ------------------------------------------------------------------------------
+
+
+def central_difference(function, q: np.ndarray) -> np.ndarray:
+    columns = []
+    for i in range(q.size):
+        step = np.zeros_like(q)
+        step[i] = FINITE_DIFFERENCE_STEP
+        columns.append((function(q + step) - function(q - step)) / (2 * FINITE_DIFFERENCE_STEP))
+    return np.stack(columns, axis=1)
+
+
+def test_pose_jacobian_is_the_derivative_of_fkm(robot: MobileManipulator) -> None:
+    for q in random_configurations(robot, 20, seed=3):
+        np.testing.assert_allclose(
+            robot.pose_jacobian(q),
+            central_difference(robot.fkm, q),
+            rtol=0,
+            atol=FINITE_DIFFERENCE_TOL,
+        )
+
+
+def test_translation_jacobian_is_the_derivative_of_the_translation(
+    robot: MobileManipulator,
+) -> None:
+    def position(q: np.ndarray) -> np.ndarray:
+        return dq.translation(robot.fkm(q))
+
+    for q in random_configurations(robot, 20, seed=4):
+        np.testing.assert_allclose(
+            robot.translation_jacobian(q),
+            central_difference(position, q),
+            rtol=0,
+            atol=FINITE_DIFFERENCE_TOL,
+        )
+
+
+def test_fkm_is_a_unit_dual_quaternion(robot: MobileManipulator) -> None:
+    for q in random_configurations(robot, 50, seed=5):
+        x = robot.fkm(q)
+        np.testing.assert_allclose(dq.mul(dq.conj(x), x), dq.ONE, rtol=0, atol=1e-12)
+
+
+def test_kinematics_is_fkm_and_pose_jacobian(robot: MobileManipulator) -> None:
+    for q in random_configurations(robot, 20, seed=6):
+        x, jacobian = robot.kinematics(q)
+        np.testing.assert_allclose(x, robot.fkm(q), rtol=0, atol=1e-14)
+        np.testing.assert_array_equal(jacobian, robot.pose_jacobian(q))
+
+
+def test_base_pose_follows_equation_4_1(robot: MobileManipulator) -> None:
+    """With the arm at q_a = 0 the base part moves the pose by x, y and turns it by phi about z."""
+    q = np.array([1.0, -2.0, 0.7, 0.0, 0.0, 0.0, 0.0, 0.0])
+    at_origin = robot.fkm(np.concatenate(([0.0, 0.0, 0.0], q[3:])))
+    base = dq.pose(dq.rotation_quaternion(0.7, [0, 0, 1]), [1.0, -2.0, 0.0])
+    np.testing.assert_allclose(robot.fkm(q), dq.mul(base, at_origin), rtol=0, atol=1e-14)
+
+
+def test_link_points_run_from_the_base_top_to_the_end_effector(robot: MobileManipulator) -> None:
+    for q in random_configurations(robot, 20, seed=7):
+        points = robot.link_points(q)
+        assert points.shape == (robot.arm_dof + 1, 3)
+        np.testing.assert_allclose(points[0], [q[0], q[1], robot.base_height], atol=1e-14)
+        np.testing.assert_allclose(points[-1], dq.translation(robot.fkm(q))[1:], atol=1e-14)
+
+
+def test_link_points_at_zero_follow_the_dh_lengths(robot: MobileManipulator) -> None:
+    """At q = 0 the arm stands d1 above the base top and stretches along x by a2, d4 and a5."""
+    expected = [
+        [0.0, 0.0, 0.170],
+        [0.0, 0.0, 0.337],
+        [0.159, 0.0, 0.337],
+        [0.159, 0.0, 0.359250],
+        [0.2815, 0.0, 0.359250],
+        [0.4515, 0.0, 0.359250],
+    ]
+    np.testing.assert_allclose(robot.link_points(np.zeros(8)), expected, atol=1e-12)
+
+
+@pytest.mark.parametrize("shape", [(7,), (9,), (8, 1), (1, 8), ()])
+@pytest.mark.parametrize(
+    "method", ["fkm", "pose_jacobian", "translation_jacobian", "kinematics", "link_points"]
+)
+def test_wrong_shape_configuration_raises(
+    robot: MobileManipulator, method: str, shape: tuple[int, ...]
+) -> None:
+    with pytest.raises(ValueError, match="shape"):
+        getattr(robot, method)(np.zeros(shape))
+
+
+# --- Broken descriptions ----------------------------------------------------------------------
+
+
+def _without(data: dict, path: tuple[str, ...]) -> dict:
+    broken = yaml.safe_load(yaml.safe_dump(data))
+    node = broken
+    for key in path[:-1]:
+        node = node[key]
+    del node[path[-1]]
+    return broken
+
+
+MISSING_FIELDS = [
+    ("arm",),
+    ("base",),
+    ("arm", "dh"),
+    ("arm", "dh", "theta"),
+    ("arm", "dh", "alpha"),
+    ("arm", "dh", "type"),
+    ("arm", "joint_min"),
+    ("arm", "joint_max"),
+    ("arm", "velocity_max"),
+    ("base", "height"),
+    ("base", "body_radius"),
+    ("base", "wheel_base"),
+    ("base", "wheel_diameter"),
+    ("base", "wheel_speed_max"),
+    ("base", "velocity_max"),
+]
+
+
+@pytest.mark.parametrize("field", MISSING_FIELDS, ids=".".join)
+def test_missing_field_names_file_and_field(
+    tmp_path: Path, description: dict, field: tuple[str, ...]
+) -> None:
+    path = tmp_path / "broken_robot.yaml"
+    path.write_text(yaml.safe_dump(_without(description, field)))
+    with pytest.raises(RobotDescriptionError) as raised:
+        MobileManipulator.from_yaml(path)
+    message = str(raised.value)
+    assert str(path) in message
+    assert field[-1] in message
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [
+        (("arm", "joint_min"), [-1.0, -1.0, -1.0, -1.0]),
+        (("base", "velocity_max"), [0.2, 0.2]),
+        (("arm", "joint_max"), [1.0, 1.0, float("nan"), 1.0, 1.0]),
+    ],
+    ids=["short_joint_min", "short_base_velocity_max", "nan_joint_max"],
+)
+def test_invalid_field_names_file_and_field(
+    tmp_path: Path, description: dict, field: tuple[str, str], value: list[float]
+) -> None:
+    broken = yaml.safe_load(yaml.safe_dump(description))
+    broken[field[0]][field[1]] = value
+    path = tmp_path / "invalid_robot.yaml"
+    path.write_text(yaml.safe_dump(broken))
+    with pytest.raises(RobotDescriptionError) as raised:
+        MobileManipulator.from_yaml(path)
+    assert str(path) in str(raised.value)
+    assert field[1] in str(raised.value)
+
+
+def test_prismatic_joint_is_rejected(tmp_path: Path, description: dict) -> None:
+    broken = yaml.safe_load(yaml.safe_dump(description))
+    broken["arm"]["dh"]["type"][2] = "prismatic"
+    path = tmp_path / "prismatic_robot.yaml"
+    path.write_text(yaml.safe_dump(broken))
+    with pytest.raises(RobotDescriptionError, match="revolute"):
+        MobileManipulator.from_yaml(path)
+
+
+# --- Geometry of the joint limits -------------------------------------------------------------
+
+CLEARANCE = 0.03
+SEGMENT_SAMPLES = np.linspace(0.0, 1.0, 41)[:, None]
+
+
+def _points_too_close_to_the_base(robot: MobileManipulator, q: np.ndarray) -> bool:
+    """True when a point of the arm from the elbow on lies within 3 cm of the base's top disc.
+
+    The base sits at the origin facing x, so world and base frames coincide. The disc is the
+    top of a cylinder of radius body_radius whose top is at base_height; a point clears it when
+    it is above base_height + 3 cm or outside body_radius + 3 cm.
+    """
+    points = robot.link_points(q)[2:]
+    segments = (
+        points[:-1, None, :] * (1.0 - SEGMENT_SAMPLES) + points[1:, None, :] * SEGMENT_SAMPLES
+    )
+    samples = segments.reshape(-1, 3)
+    low = samples[:, 2] < robot.base_height + CLEARANCE
+    inside = np.hypot(samples[:, 0], samples[:, 1]) < robot.base.body_radius + CLEARANCE
+    return bool(np.any(low & inside))
+
+
+def test_joint_limits_keep_the_arm_off_the_base_top(robot: MobileManipulator) -> None:
+    """Over a grid of the arm's joint box (end points included), no link comes near the base."""
+    low, high = robot.q_min[3:], robot.q_max[3:]
+    counts = (3, 7, 7, 9, 7)  # q1 only turns the arm about the base axis: three values suffice
+    grids = [np.linspace(lo, hi, n) for lo, hi, n in zip(low, high, counts, strict=True)]
+    colliding = [
+        arm
+        for arm in itertools.product(*grids)
+        if _points_too_close_to_the_base(robot, np.concatenate(([0.0, 0.0, 0.0], arm)))
+    ]
+    if colliding:
+        pytest.fail(
+            f"{len(colliding)} of {np.prod(counts)} grid configurations bring the arm within "
+            f"{CLEARANCE} m of the base top, e.g. q_arm = {np.round(colliding[0], 3).tolist()}"
+        )
+
+
+def test_clearance_check_detects_an_arm_folded_onto_the_base(robot: MobileManipulator) -> None:
+    """The check itself can fail: forearm folded down, gripper pointing down at the base."""
+    folded = np.array([0.0, 0.0, 0.0, 0.0, -0.7, 1.6, -1.9, 0.85])
+    assert _points_too_close_to_the_base(robot, folded)
+    assert not _points_too_close_to_the_base(robot, np.zeros(8))
