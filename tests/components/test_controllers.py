@@ -207,9 +207,13 @@ def test_malformed_states_are_counted_and_never_reach_a_motor(operator: Operator
     operator.assert_every_command_finite()
 
 
-def test_no_goal_an_invalid_state_and_an_old_state_command_zero_and_say_why(
+def test_no_state_no_goal_an_invalid_and_an_old_state_command_zero_and_say_why(
     operator: Operator,
 ) -> None:
+    before = operator.diagnostics.wait_for(lambda m: m.status == "stale", "before any state")
+    assert before.reason == "no robot/state received yet"
+    assert is_zero(*operator.answer(before.header.stamp_ns)[1:])
+
     diagnostics, base, arm = operator.step()
     assert (diagnostics.status, diagnostics.reason) == ("no goal", "no control/goal received yet")
     assert is_zero(base, arm)
