@@ -40,6 +40,7 @@ import yaml
 from components.params import Param, ParamError
 from components.runtime import Component, Node
 from messages import topics
+from messages.base import ARM_JOINTS
 from messages.commands import ArmCommand, BaseCommand
 from messages.diagnostics import ControllerDiagnostics
 from messages.goal import Goal
@@ -59,9 +60,6 @@ FIRST_DT_S = 0.02
 
 DT_MIN_S, DT_MAX_S = 1e-3, 0.2
 """dt is clamped to this range, whatever the stamps say."""
-
-ARM_JOINTS = 5
-"""Joints of the arm command (``messages.base.ARM_JOINTS``)."""
 
 CONTROLLER_PARAMS = (
     Param("stale_timeout_s", float, 0.5, low=0.01, high=10.0, doc="command zero after this, s"),
@@ -130,8 +128,13 @@ class Controller(Component):
         node.timer(STALE_CHECK_PERIOD_S, self.check_inputs_arrive)
 
     def on_goal(self, goal: Goal) -> None:
-        """Take a goal; a different task than the current one resets the law."""
-        task = task_of(goal)
+        """Take a goal; a different task resets the law. A goal the law refuses (ValueError,
+        counted in ``errors.control/goal``) drops the current one: no goal, zero commands."""
+        try:
+            task = task_of(goal)
+        except ValueError:
+            self.goal = self.task = None
+            raise
         if self.task is None or not same_task(self.task, task):
             self.law.reset()
         self.goal, self.task = goal, task
