@@ -29,8 +29,8 @@ from wbc.robot import MobileManipulator
 
 NAMESPACE = "bench"
 ROBOT = Path(__file__).resolve().parents[1] / "deploy" / "robots" / "little_john.yaml"
-START = np.array([0.07, 0.0, 0.13, 0.03, 0.59, 0.42, 0.03, 0.49])
-GOAL_Q = np.array([0.6, 0.05, -0.1, 0.3, 0.67, 0.23, -0.03, 0.28])
+START = np.array([0.07, 0.0, 0.13, 0.03, 0.09, 0.02, 0.03, 0.49])
+GOAL_Q = np.array([0.58, 0.05, -0.16, 0.3, 0.15, -0.66, -0.03, -0.36])
 WIDTH, HEIGHT = 640, 480
 WAIT_S = 15.0
 """How long anything may take before the bench gives up."""

@@ -15,7 +15,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import msgpack
+import numpy as np
 import pytest
+import yaml
 
 from deploy import query
 from messages import codec, topics
@@ -25,6 +27,7 @@ from messages.goal import Goal
 from messages.header import Header
 from messages.state import RobotState
 from parsimony.commands import param
+from wbc.robot import MobileManipulator
 
 if TYPE_CHECKING:
     from tests.components.conftest import System
@@ -36,14 +39,14 @@ CASCADE_PROFILE = DEPLOY / "controllers_cascade.yaml"
 DEADLINE_S = 10.0
 """Generous limit for anything that involves starting a process on a loaded machine."""
 
-START = (0.07, 0.0, 0.13, 0.03, 0.59, 0.42, 0.03, 0.49)
+START = (0.07, 0.0, 0.13, 0.03, 0.09, 0.02, 0.03, 0.49)
 """The configuration the states report: [x, y, phi, q1..q5]."""
 
-GOAL_POSE = (
-    *(-0.872989241287903, -0.003896628796899587, -0.43510881846061733, -0.2203518027550398),
-    *(0.0394281332159116, -0.40576390866673206, 0.029886072718136703, -0.208044218317936),
-)
-"""The end-effector pose of [0.6, 0.05, -0.1, 0.3, 0.67, 0.23, -0.03, 0.28], as in the profile."""
+GOAL_Q = (0.58, 0.05, -0.16, 0.3, 0.15, -0.66, -0.03, -0.36)
+"""The configuration whose end-effector pose is the profile's goal."""
+
+ROBOT = MobileManipulator.from_yaml(DEPLOY / "robots" / "little_john.yaml")
+GOAL_POSE = tuple(ROBOT.fkm(np.array(GOAL_Q)).tolist())
 
 STALE_TIMEOUT_S = 0.5
 """The controller's ``stale_timeout_s`` in the profile."""
@@ -155,6 +158,16 @@ def test_the_cascade_profile_is_the_lp_profile_with_another_module() -> None:
     assert lp.count("module: lp_controller") == 1
     swapped = lp.replace("module: lp_controller", "module: cascade_controller")
     assert CASCADE_PROFILE.read_text() == swapped
+
+
+def test_the_profile_starts_inside_the_joint_limits_with_the_pose_of_goal_q_as_goal() -> None:
+    params = yaml.safe_load(LP_PROFILE.read_text())["components"][0]["params"]
+    names = ("base_x", "base_y", "base_phi", "q1", "q2", "q3", "q4", "q5")
+    assert tuple(params[name] for name in names) == START
+    assert np.all(ROBOT.q_min < START) and np.all(np.array(START) < ROBOT.q_max)
+    assert np.all(ROBOT.q_min < GOAL_Q) and np.all(np.array(GOAL_Q) < ROBOT.q_max)
+    goal = [float(value) for value in params["goal_pose"].split(",")]
+    np.testing.assert_allclose(goal, GOAL_POSE, atol=1e-12)
 
 
 @pytest.mark.parametrize(("profile", "law"), [(LP_PROFILE, "lp"), (CASCADE_PROFILE, "cascade")])
