@@ -22,8 +22,11 @@ from wbc.task import PoseTask
 
 ROBOT_FILE = Path(__file__).resolve().parents[1] / "deploy" / "robots" / "little_john.yaml"
 DT = 0.02
-START = np.array([0.0, 0.0, 0.0, 0.0, 0.3, 0.6, 0.0, 0.5])
-GOAL = np.array([0.6, 0.05, -0.16, 0.3, 0.67, 0.23, -0.03, 0.28])
+START = np.array([0.0, 0.0, 0.0, 0.0, -0.2, 0.2, 0.0, 0.5])
+GOAL = np.array([0.58, 0.05, -0.16, 0.3, 0.15, -0.66, -0.03, -0.36])
+CONVERGENCE_GOAL = np.array([0.45, -0.29, -0.12, 0.23, -0.26, 0.14, -0.28, -0.3])
+ARM_GOAL_LOW = np.array([-0.5, -0.8, -0.8, -0.5, -0.8])
+ARM_GOAL_HIGH = np.array([0.5, 0.3, 0.3, 0.5, 0.8])
 
 
 def percentiles(samples_s: list[float]) -> dict[str, float]:
@@ -98,7 +101,7 @@ def convergence_test(robot: MobileManipulator, trials: int) -> dict[str, dict[st
     Test 1 (holonomic): classic law and LP without extra constraints; test 2 (nonholonomic):
     the cascade and the LP with 5.12 and joint limits (k = 1, b_l = 0.99). eta = 5, beta = 40.
     """
-    task = PoseTask(robot.fkm(GOAL))
+    task = PoseTask(robot.fkm(CONVERGENCE_GOAL))
     tests = {
         "holonomic/classic": lambda: PseudoinverseLaw(robot, PinvParams(eta=5.0)),
         "holonomic/lp": lambda: LPLaw(
@@ -129,9 +132,8 @@ def convergence_test(robot: MobileManipulator, trials: int) -> dict[str, dict[st
 
 
 def random_goal_success(robot: MobileManipulator, goals: int, seed: int = 1) -> dict[str, float]:
-    """Share of random pose goals 0.3-1 m ahead reached within 60 s, per law."""
+    """Share of random pose goals (base 0.3-1 m ahead, arm inside its limits) reached in 60 s."""
     rng = np.random.default_rng(seed)
-    home = START[3:]
     laws = {
         "lp (5.29 exactly, w = 0)": lambda: LPLaw(robot, LPParams(velocity_cost=0.0)),
         "lp (default, w = 1e-3)": lambda: LPLaw(robot),
@@ -139,9 +141,10 @@ def random_goal_success(robot: MobileManipulator, goals: int, seed: int = 1) -> 
     }
     reached = dict.fromkeys(laws, 0)
     for _ in range(goals):
-        start = np.concatenate((np.zeros(3), home + rng.uniform(-0.3, 0.3, 5)))
+        arm_start = np.clip(START[3:] + rng.uniform(-0.3, 0.3, 5), ARM_GOAL_LOW, ARM_GOAL_HIGH)
+        start = np.concatenate((np.zeros(3), arm_start))
         base_goal = [rng.uniform(0.3, 1.0), rng.uniform(-0.4, 0.4), rng.uniform(-0.4, 0.4)]
-        goal = np.concatenate((base_goal, home + rng.uniform(-0.5, 0.5, 5)))
+        goal = np.concatenate((base_goal, rng.uniform(ARM_GOAL_LOW, ARM_GOAL_HIGH)))
         task = PoseTask(robot.fkm(goal))
         for name, make_law in laws.items():
             reached[name] += integrate(make_law(), start, task, DT, 3000).converged

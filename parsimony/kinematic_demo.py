@@ -24,7 +24,7 @@ from wbc.task import PoseTask, PositionTask, Task
 ROBOT_FILE = Path(__file__).resolve().parents[1] / "deploy" / "robots" / "little_john.yaml"
 DT = 0.02
 STEPS = 4000
-START = np.array([0.0, 0.0, 0.0, 0.0, 0.3, 0.6, 0.0, 0.5])
+START = np.array([0.0, 0.0, 0.0, 0.0, -0.2, 0.2, 0.0, 0.5])
 
 
 @dataclass(frozen=True)
@@ -37,9 +37,9 @@ class Experiment:
 
 def experiments(robot: MobileManipulator) -> list[Experiment]:
     """Pose (6.2.1), position (6.2.2), obstacle (6.2.3) and the joint limit of figure 6.10."""
-    reach = robot.fkm(np.array([0.6, 0.05, -0.16, 0.3, 0.67, 0.23, -0.03, 0.28]))
-    beyond_obstacle = robot.fkm(np.array([1.4, 0.6, 0.4, 0.0, 0.3, 0.6, 0.0, 0.5]))
-    past_wrist_limit = robot.fkm(np.array([0.3, 0.0, 0.0, 0.0, 0.3, 0.6, 0.0, 2.2]))
+    reach = robot.fkm(np.array([0.58, 0.05, -0.16, 0.3, 0.15, -0.66, -0.03, -0.36]))
+    beyond_obstacle = robot.fkm(np.concatenate(([1.3, 0.3, 0.2], START[3:])))
+    past_elbow_limit = robot.fkm(np.array([0.3, 0.0, 0.0, 0.0, -0.2, 0.9, 0.0, 0.5]))
     return [
         Experiment(
             "pose",
@@ -58,11 +58,11 @@ def experiments(robot: MobileManipulator) -> list[Experiment]:
                 "LP border": LPLaw(robot, LPParams(obstacle_mode="border")),
                 "LP conservative": LPLaw(robot, LPParams(obstacle_mode="conservative")),
             },
-            (Circle(0.911, 0.061, 0.1),),
+            (Circle(1.42, -0.084, 0.1),),
         ),
         Experiment(
             "joint limit",
-            PoseTask(past_wrist_limit),
+            PoseTask(past_elbow_limit),
             {"LP": LPLaw(robot), "pinv": PseudoinverseLaw(robot)},
         ),
     ]

@@ -107,7 +107,8 @@ class WarmStartedLP:
             for bound in bounds[1:]:
                 np.maximum(u_lower, bound.lower, out=u_lower)
                 np.minimum(u_upper, bound.upper, out=u_upper)
-            np.minimum(u_lower, u_upper, out=u_lower)
+            if np.any(u_lower > u_upper):
+                return LPSolution(np.zeros(n), "infeasible", None, ())
         # u_P in [max(lower, 0), max(upper, 0)], u_N in [max(-upper, 0), max(-lower, 0)].
         np.maximum(u_lower, 0.0, out=layout.col_lower[:n])
         np.maximum(u_upper, 0.0, out=layout.col_upper[:n])

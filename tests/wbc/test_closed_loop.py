@@ -80,19 +80,19 @@ def test_pseudoinverse_law_uses_every_joint_where_the_lp_law_does_not():
 
 
 def test_joint_limit_kept_by_lp_law_and_passed_by_pseudoinverse_law():
-    """Figure 6.10: a goal whose nearest arm pose puts q5 beyond its limit."""
+    """Figure 6.10: a goal whose nearest arm pose puts the elbow q3 beyond its limit."""
     goal = HOME.copy()
-    goal[0], goal[7] = 0.3, 2.2
+    goal[0], goal[5] = 0.3, 0.9
     task = pose_task(MODEL, goal)
-    wrist = 7
+    elbow = 5
     pinv = integrate(PseudoinverseLaw(MODEL), HOME, task, steps=2000)
     lp = integrate(LPLaw(MODEL, POSE_PARAMS), HOME, task, steps=2000)
-    assert max(q[wrist] for q in pinv.configurations) > MODEL.q_max[wrist]
-    assert max(q[wrist] for q in lp.configurations) <= 0.9 * MODEL.q_max[wrist] + 1e-9
+    assert max(q[elbow] for q in pinv.configurations) > MODEL.q_max[elbow]
+    assert max(q[elbow] for q in lp.configurations) <= 0.9 * MODEL.q_max[elbow] + 1e-9
 
 
-OBSTACLE_GOAL = np.array([1.4, 0.6, 0.4, 0.0, 0.3, 0.6, 0.0, 0.5])
-OBSTACLE = Circle(0.911, 0.061, 0.1)
+OBSTACLE_GOAL = np.concatenate(([1.3, 0.3, 0.2], HOME[3:]))
+OBSTACLE = Circle(1.42, -0.084, 0.1)
 
 
 def base_clearance(run) -> np.ndarray:
