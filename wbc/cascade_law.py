@@ -25,7 +25,7 @@ from wbc.obstacles import Circle
 from wbc.pinv_law import pinv_velocity
 from wbc.robot import MobileManipulator
 from wbc.task import Task, same_task
-from wbc.validation import require_finite
+from wbc.validation import require_finite, require_positive
 
 Array = np.ndarray
 
@@ -41,10 +41,7 @@ class CascadeParams:
     """Inner-loop gains on the offset point's position error (1/s)."""
 
     def __post_init__(self) -> None:
-        for name in ("eta", "offset", "k1", "k2"):
-            value = getattr(self, name)
-            if not np.isfinite(value) or value <= 0.0:
-                raise ValueError(f"CascadeParams.{name} must be finite and > 0, got {value}")
+        require_positive(self, "eta", "offset", "k1", "k2")
 
 
 def offset_point(x: float, y: float, phi: float, d: float) -> tuple[float, float]:

@@ -20,7 +20,7 @@ from wbc.linear_program import WarmStartedLP
 from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
 from wbc.task import Task, same_task
-from wbc.validation import require_finite
+from wbc.validation import require_finite, require_positive
 
 Array = np.ndarray
 
@@ -53,12 +53,18 @@ class LPParams:
     """False models a holonomic base (the first test of section 6.3)."""
 
     def __post_init__(self) -> None:
-        for name in ("eta", "beta", "joint_gain", "safety_factor", "obstacle_gain"):
-            value = getattr(self, name)
-            if not np.isfinite(value) or value <= 0.0:
-                raise ValueError(f"LPParams.{name} must be finite and > 0, got {value}")
-        if not np.isfinite(self.velocity_cost) or self.velocity_cost < 0.0:
-            raise ValueError(f"LPParams.velocity_cost must be >= 0, got {self.velocity_cost}")
+        require_positive(self, "eta", "beta", "joint_gain", "safety_factor", "obstacle_gain")
+        if self.safety_factor > 1.0:
+            raise ValueError(f"LPParams.safety_factor must be <= 1, got {self.safety_factor}")
+        for name in ("velocity_cost", "obstacle_margin", "obstacle_lookahead"):
+            if not np.isfinite(getattr(self, name)) or getattr(self, name) < 0.0:
+                raise ValueError(f"LPParams.{name} must be >= 0, got {getattr(self, name)}")
+        if self.error_bound not in ("derivative", "error"):
+            raise ValueError(f"LPParams.error_bound must be 'derivative' or 'error', got "
+                             f"{self.error_bound!r}")  # fmt: skip
+        if self.obstacle_mode not in ("border", "conservative", "off"):
+            raise ValueError("LPParams.obstacle_mode must be 'border', 'conservative' or 'off', "
+                             f"got {self.obstacle_mode!r}")  # fmt: skip
 
 
 def default_constraints(params: LPParams) -> list[Constraint]:

@@ -12,7 +12,7 @@ from wbc.law_output import LawOutput, summarise
 from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
 from wbc.task import Task
-from wbc.validation import require_finite
+from wbc.validation import require_finite, require_positive
 
 Array = np.ndarray
 
@@ -31,8 +31,7 @@ class PinvParams:
     """Task gain (1/s)."""
 
     def __post_init__(self) -> None:
-        if not np.isfinite(self.eta) or self.eta <= 0.0:
-            raise ValueError(f"PinvParams.eta must be finite and > 0, got {self.eta}")
+        require_positive(self, "eta")
 
 
 @dataclass

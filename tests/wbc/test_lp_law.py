@@ -1,0 +1,78 @@
+"""The LP law's contract: inputs checked, failures reported as zero velocity, gains validated."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from wbc_scenarios import DT, HOME, STARTS_AND_GOALS, pose_task, robot
+
+from wbc.lp_law import LPLaw, LPParams
+from wbc.obstacles import Circle
+from wbc.task import PoseTask
+from wbc.validation import NonFiniteInputError
+
+MODEL = robot()
+
+
+def test_nan_configuration_is_rejected_before_any_solve():
+    law = LPLaw(MODEL)
+    q = HOME.copy()
+    q[4] = np.nan
+    with pytest.raises(NonFiniteInputError, match="configuration q"):
+        law.step(q, pose_task(MODEL, STARTS_AND_GOALS[0][1]), DT)
+
+
+def test_nan_obstacle_and_non_positive_dt_are_rejected():
+    law = LPLaw(MODEL)
+    task = pose_task(MODEL, STARTS_AND_GOALS[0][1])
+    with pytest.raises(NonFiniteInputError, match="obstacle 0"):
+        law.step(HOME, task, DT, [Circle(np.inf, 0.0, 0.1)])
+    with pytest.raises(ValueError, match="dt"):
+        law.step(HOME, task, 0.0)
+
+
+def test_an_infeasible_program_gives_zero_velocity_and_the_status():
+    """At the goal (e = 0) the original bound 5.7 forces u = 0, while the engaged border
+    constraint demands an outward velocity: no u satisfies both."""
+    at_goal = PoseTask(MODEL.fkm(HOME))
+    obstacle = Circle(0.3, 0.0, 0.1)  # the base is inside its extended disc
+    law = LPLaw(MODEL, LPParams(error_bound="error"))
+    out = law.step(HOME, at_goal, DT, [obstacle])
+    assert out.status == "infeasible"
+    assert np.array_equal(out.u, np.zeros(MODEL.dof))
+    assert out.nonzero == 0
+
+
+def test_error_derivative_is_measured_between_steps_of_the_same_task():
+    """Holding q still makes e' = 0 from the second step on, so 5.10 forces u = 0."""
+    law = LPLaw(MODEL)
+    task = pose_task(MODEL, STARTS_AND_GOALS[0][1])
+    first = law.step(HOME, task, DT)
+    second = law.step(HOME, task, DT)
+    assert np.abs(first.u).sum() > 0.0
+    assert np.abs(second.u).sum() == pytest.approx(0.0, abs=1e-12)
+    law.reset()
+    assert np.abs(law.step(HOME, task, DT).u).sum() > 0.0
+
+
+def test_output_u_is_read_only():
+    out = LPLaw(MODEL).step(HOME, pose_task(MODEL, STARTS_AND_GOALS[0][1]), DT)
+    with pytest.raises(ValueError):
+        out.u[0] = 1.0
+
+
+@pytest.mark.parametrize(
+    "field, value",
+    [
+        ("eta", 0.0),
+        ("beta", -1.0),
+        ("safety_factor", 1.5),
+        ("joint_gain", np.nan),
+        ("velocity_cost", -1e-3),
+        ("error_bound", "sometimes"),
+        ("obstacle_mode", "around"),
+    ],
+)
+def test_invalid_gains_name_the_field(field, value):
+    with pytest.raises(ValueError, match=f"LPParams.{field}"):
+        LPParams(**{field: value})
