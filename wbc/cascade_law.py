@@ -9,6 +9,7 @@ of the reference by input-output linearisation (Skaar 2007):
     phi' = (u2 cos phi - u1 sin phi) / d,   v = u1 cos phi + u2 sin phi
 
 and the base part of the output is (v cos phi, v sin phi, phi'), which obeys 5.11 exactly.
+The reference point is kept within ``max_lead`` of the real one (anti-windup).
 """
 
 from __future__ import annotations
@@ -39,9 +40,13 @@ class CascadeParams:
     k1: float = 2.0
     k2: float = 2.0
     """Inner-loop gains on the offset point's position error (1/s)."""
+    max_lead: float = 0.2
+    """How far the reference point may run ahead of the real one (m): beyond it the reference
+    base is pulled back, so a base that cannot follow (stalled, saturated) does not wind the
+    inner loop up."""
 
     def __post_init__(self) -> None:
-        require_positive(self, "eta", "offset", "k1", "k2")
+        require_positive(self, "eta", "offset", "k1", "k2", "max_lead")
 
 
 def offset_point(x: float, y: float, phi: float, d: float) -> tuple[float, float]:
@@ -91,6 +96,12 @@ class CascadeLaw:
 
         x, y, phi = q[0], q[1], q[2]
         point_x, point_y = offset_point(x, y, phi, d)
+        lead = math.hypot(target_x - point_x, target_y - point_y)
+        if lead > self.params.max_lead:
+            pull = 1.0 - self.params.max_lead / lead
+            shift_x, shift_y = pull * (point_x - target_x), pull * (point_y - target_y)
+            target_x, target_y = target_x + shift_x, target_y + shift_y
+            self._reference = self._reference + np.array([shift_x, shift_y, 0.0])
         u1 = target_x_dot + self.params.k1 * (target_x - point_x)
         u2 = target_y_dot + self.params.k2 * (target_y - point_y)
         forward = u1 * math.cos(phi) + u2 * math.sin(phi)

@@ -76,3 +76,17 @@ def test_output_u_is_read_only():
 def test_invalid_gains_name_the_field(field, value):
     with pytest.raises(ValueError, match=f"LPParams.{field}"):
         LPParams(**{field: value})
+
+
+def test_cascade_reference_does_not_wind_up_when_the_base_cannot_move():
+    """A base that never moves: the command stays at the outer loop's feedforward plus the
+    inner-loop gain times the max lead, instead of growing with the reference's drift."""
+    from wbc.cascade_law import CascadeLaw, CascadeParams
+
+    params = CascadeParams()
+    law = CascadeLaw(MODEL, params)
+    task = pose_task(MODEL, np.concatenate(([2.0, 0.0, 0.0], HOME[3:])))
+    speeds = [np.hypot(*law.step(HOME, task, DT).u[:2]) for _ in range(500)]
+    feedforward = speeds[0]
+    assert max(speeds) <= feedforward + max(params.k1, params.k2) * params.max_lead + 1e-9
+    assert speeds[-1] == pytest.approx(speeds[100], rel=1e-6)
