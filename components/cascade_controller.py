@@ -24,6 +24,8 @@ class CascadeController(Controller):
         Param("offset", float, CascadeParams.offset, low=0.01, high=1.0, doc="d, m"),
         Param("k1", float, CascadeParams.k1, low=1e-3, high=100.0, doc="inner gain on x1, 1/s"),
         Param("k2", float, CascadeParams.k2, low=1e-3, high=100.0, doc="inner gain on y1, 1/s"),
+        Param("max_lead", float, CascadeParams.max_lead, low=0.01, high=10.0,
+              doc="how far the reference point may lead the base, m"),  # fmt: skip
         *CONTROLLER_PARAMS,
     )
 
