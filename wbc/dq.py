@@ -179,6 +179,5 @@ def power(x: Array, exponent: float) -> Array:
 
 def nearest_equivalent(x_desired: Array, x: Array) -> Array:
     """The one of {x_d, -x_d} nearer to x: both are the same pose, the nearer one turns short."""
-    if np.dot(x - x_desired, x - x_desired) > np.dot(x + x_desired, x + x_desired):
-        return -x_desired
-    return x_desired
+    # ||x - x_d||^2 - ||x + x_d||^2 = -4 x . x_d
+    return -x_desired if np.dot(x, x_desired) < 0.0 else x_desired

@@ -6,7 +6,7 @@ e = p - p_d with the rows of the translation Jacobian J_p (4.18) for i, j and k.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -22,6 +22,8 @@ class PoseTask:
     """Drive the end-effector pose to the unit dual quaternion ``pose`` (6 DOF)."""
 
     pose: Array
+    goal_position: Array = field(init=False, repr=False, compare=False)
+    """The goal's translation (x, y, z)."""
     dof = 6
 
     def __post_init__(self) -> None:
@@ -30,10 +32,9 @@ class PoseTask:
             raise ValueError(f"goal pose must be a unit dual quaternion (8,), got {pose}")
         pose.flags.writeable = False
         object.__setattr__(self, "pose", pose)
-
-    @property
-    def goal_position(self) -> Array:
-        return dq.translation(self.pose)[1:]
+        position = dq.translation(pose)[1:]
+        position.flags.writeable = False
+        object.__setattr__(self, "goal_position", position)
 
     def error(self, pose: Array, jacobian: Array) -> tuple[Array, Array]:
         """(vec8(x - x_d), J), x_d taken with the sign nearer to x (x_d and -x_d are one pose)."""
@@ -68,6 +69,8 @@ Task = PoseTask | PositionTask
 
 def same_task(a: Task, b: Task) -> bool:
     """True when a and b are the same kind of task with the same goal."""
+    if a is b:
+        return True
     if type(a) is not type(b):
         return False
     goal_a = a.pose if isinstance(a, PoseTask) else a.position
