@@ -144,19 +144,6 @@ class MobileManipulator:
              0.5 * z * c]  # fmt: skip
         )
 
-    @staticmethod
-    def base_jacobian(q: Array) -> Array:
-        """J_b of eq. 4.3: vec8(x_1^0)' = J_b [x', y', phi']."""
-        x, y, phi = q[0], q[1], q[2]
-        c, s = 0.5 * math.cos(0.5 * phi), 0.5 * math.sin(0.5 * phi)
-        jb = np.zeros((8, 3))
-        jb[0, 2] = jb[6, 0] = -s
-        jb[5, 1] = s
-        jb[3, 2] = jb[5, 0] = jb[6, 1] = c
-        jb[5, 2] = 0.5 * (-x * s + y * c)
-        jb[6, 2] = 0.5 * (-x * c - y * s)
-        return jb
-
     def _arm_link_operators(self, q_arm: Array) -> Array:
         """H+(x_i) for every arm link, x_i = r_z(q_i) (r_theta_i p_d_i p_a_i r_alpha_i)."""
         half = 0.5 * q_arm[:, None, None]
@@ -167,7 +154,9 @@ class MobileManipulator:
 
         x' = (x_1^0' x_1^0*) x + sum_i (1/2) z_i x q_i', where z_i = x_{0,i-1} k x_{0,i-1}*
         is the axis of joint i, so J = H-(x) T with the twists T = [H-(x_1^0*) J_b, z_i / 2];
-        H-(x) T equals [H-(x_3^1) J_b, H+(x_2^0) J_a] of eq. 4.9 term by term.
+        H-(x) T equals [H-(x_3^1) J_b, H+(x_2^0) J_a] of eq. 4.9 term by term. With J_b of
+        eq. 4.3, the base twists x_1^0' x_1^0* are eps i/2 for x', eps j/2 for y' and
+        k/2 + eps (y i - x j)/2 for phi'.
         """
         q = self._check(q)
         links = self._arm_link_operators(q[BASE_DOF:])
