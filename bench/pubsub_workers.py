@@ -1,6 +1,7 @@
 """The two processes of ``bench.zenoh_latency``: a publisher and a subscriber.
 
-Each connects to the bench's router as a client and serves requests from a queue: the
+Each connects to the bench's router as a component does (``ZenohSettings.component_config``,
+the profile's ``mode``) and serves requests from a queue: the
 publisher sends a ``Phase`` and replies the stamps it sent; the subscriber replies, per
 topic, the (stamp, arrival, note) of every message it received since it was last asked.
 """
@@ -73,7 +74,7 @@ def message(kind: str, index: int, count: int, image: bytes) -> tuple[topics.Top
 def publisher_main(settings: ZenohSettings, commands: Queue, results: Queue) -> None:
     """Publisher process: run each phase it is sent; reply the stamps sent and the duration."""
     image = os.urandom(WIDTH * HEIGHT)
-    with zenoh.open(settings.client_config()) as session:
+    with zenoh.open(settings.component_config()) as session:
         publishers: dict[str, zenoh.Publisher] = {}
         results.put("ready")
         while (phase := commands.get()) is not None:
@@ -111,7 +112,7 @@ def subscriber_main(settings: ZenohSettings, commands: Queue, results: Queue) ->
         with lock:
             received.setdefault(topic.name, []).append((decoded.header.stamp_ns, arrival, note))
 
-    with zenoh.open(settings.client_config()) as session:
+    with zenoh.open(settings.component_config()) as session:
         subscriber = session.declare_subscriber(f"{NAMESPACE}/**", on_sample)
         results.put("ready")
         while (topic_name := commands.get()) is not None:

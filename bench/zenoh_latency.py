@@ -1,7 +1,9 @@
 """Zenoh latency between processes on loopback, and the latency of a real controller loop.
 
-Run as ``python -m bench.zenoh_latency``. This process opens a router; a publisher
-process and a subscriber process connect to it as clients, as components do. Every
+Run as ``python -m bench.zenoh_latency [--mode peer|client]``. This process opens a router;
+a publisher process and a subscriber process connect to it as components do: in ``peer``
+mode (the profile default) they link directly and the router only brokers, in ``client``
+mode every sample goes through the router. Every
 message is stamped ``time.time_ns()`` just before it is encoded and published; the
 subscriber takes ``time.time_ns()`` once it has decoded it (one machine, one clock).
 
@@ -19,6 +21,7 @@ Prints a table, then one JSON line. Runs in about 30 s.
 
 from __future__ import annotations
 
+import argparse
 import json
 import multiprocessing as mp
 import os
@@ -155,7 +158,7 @@ def controller_loop(
     with tempfile.TemporaryDirectory() as directory:
         profile = Path(directory) / "bench.yaml"
         component = {"name": "controller", "module": "lp_controller", "role": "controller"}
-        data = {"namespace": NAMESPACE, "zenoh": {"router": settings.router}}
+        data = {"namespace": NAMESPACE, "zenoh": {"router": settings.router, "mode": settings.mode}}
         data |= {"robot": str(ROBOT), "components": [component]}
         profile.write_text(yaml.safe_dump(data))
         command = [sys.executable, "-m", "components.lp_controller", "--profile", str(profile)]
@@ -219,8 +222,11 @@ def free_port() -> int:
         return probe.getsockname()[1]
 
 
-def main() -> int:
-    settings = ZenohSettings(router=[f"tcp/127.0.0.1:{free_port()}"])
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--mode", choices=("peer", "client"), default=ZenohSettings().mode)
+    args = parser.parse_args(argv)
+    settings = ZenohSettings(router=[f"tcp/127.0.0.1:{free_port()}"], mode=args.mode)
     started = time.monotonic()
     with zenoh.open(settings.router_config()) as router:
         bench = Bench(settings)
@@ -232,7 +238,7 @@ def main() -> int:
             bench.close()
     print(format_table(results))
     print("lp_controller counters:", " ".join(f"{k}={v}" for k, v in sorted(counters.items())))
-    report = {"bench": "zenoh_latency", "cpus": os.cpu_count()}
+    report = {"bench": "zenoh_latency", "mode": settings.mode, "cpus": os.cpu_count()}
     report |= {"duration_s": round(time.monotonic() - started, 1)}
     report |= {"results": [asdict(r) for r in results], "controller_counters": counters}
     print(json.dumps(report))

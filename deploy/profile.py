@@ -68,9 +68,18 @@ class ZenohSettings(StrictModel):
     The launcher opens a router listening on ``router``; components open a
     ``mode`` session connecting to ``connect`` (the router endpoints when
     omitted). Peer-mode components also listen on ``listen``.
+
+    In ``peer`` mode (the default) the router and the peers gossip their listen
+    endpoints over the sessions they already have (never multicast), so every
+    pair of components opens a direct link and a sample takes one hop instead of
+    two through the router; the router brokers between peers that have no
+    direct link yet. Without gossip a Zenoh router does not route between two
+    peers at all. Every endpoint gossiped is one of the profile's, all on the
+    loopback interface unless ``allow_remote``. ``client`` mode routes every
+    sample through the router.
     """
 
-    mode: Literal["client", "peer"] = "client"
+    mode: Literal["client", "peer"] = "peer"
     router: list[str] = Field(default=["tcp/127.0.0.1:7447"], min_length=1)
     connect: list[str] | None = None
     listen: list[str] = ["tcp/127.0.0.1:0"]
@@ -118,7 +127,8 @@ class ZenohSettings(StrictModel):
         config.insert_json5("listen/endpoints", json.dumps(listen))
         config.insert_json5("connect/endpoints", json.dumps(connect))
         config.insert_json5("scouting/multicast/enabled", json.dumps(self.multicast_scouting))
-        config.insert_json5("scouting/gossip/enabled", json.dumps(self.allow_remote))
+        gossip = self.allow_remote or (self.mode == "peer" and mode != "client")
+        config.insert_json5("scouting/gossip/enabled", json.dumps(gossip))
         return config
 
 

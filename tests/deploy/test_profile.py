@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 import json
+import queue
+import socket
+import time
 from pathlib import Path
 
 import pytest
 import yaml
+import zenoh
 
 from deploy.profile import ProfileError, ZenohSettings, is_local_endpoint, load_profile
 
@@ -32,7 +36,7 @@ def test_a_minimal_profile_gets_safe_defaults(tmp_path: Path) -> None:
     )
     assert profile.robot == tmp_path / "robot.yaml"
     assert profile.clock == "wall"
-    assert profile.zenoh.mode == "client"
+    assert profile.zenoh.mode == "peer"
     assert profile.zenoh.connect_endpoints == ["tcp/127.0.0.1:7447"]
     assert profile.zenoh.multicast_scouting is False
     spec = profile.component("pub")
@@ -137,7 +141,7 @@ def test_loopback_and_unix_socket_endpoints_are_local(endpoint: str) -> None:
     assert is_local_endpoint(endpoint)
 
 
-def test_zenoh_configs_stay_on_loopback_without_scouting() -> None:
+def test_zenoh_configs_stay_on_loopback_without_multicast() -> None:
     settings = ZenohSettings(router=["tcp/127.0.0.1:7500"], mode="peer")
     configs = {
         "router": settings.router_config(),
@@ -147,11 +151,41 @@ def test_zenoh_configs_stay_on_loopback_without_scouting() -> None:
     for mode, config in configs.items():
         assert json.loads(config.get_json("mode")) == mode
         assert json.loads(config.get_json("scouting/multicast/enabled")) is False
+        # Peers learn each other's (loopback) listen endpoints over their sessions.
+        assert json.loads(config.get_json("scouting/gossip/enabled")) is (mode != "client")
+    client_mode = ZenohSettings(router=["tcp/127.0.0.1:7500"], mode="client")
+    for config in (client_mode.router_config(), client_mode.component_config()):
+        assert json.loads(config.get_json("scouting/multicast/enabled")) is False
         assert json.loads(config.get_json("scouting/gossip/enabled")) is False
     assert json.loads(configs["router"].get_json("listen/endpoints")) == ["tcp/127.0.0.1:7500"]
     assert json.loads(configs["peer"].get_json("listen/endpoints")) == ["tcp/127.0.0.1:0"]
     assert json.loads(configs["client"].get_json("listen/endpoints")) == []
     assert json.loads(configs["client"].get_json("connect/endpoints")) == ["tcp/127.0.0.1:7500"]
+
+
+def test_peers_behind_the_router_link_directly_on_loopback() -> None:
+    """Two peer sessions and the launcher's router: samples flow, over a direct peer link."""
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    settings = ZenohSettings(router=[f"tcp/127.0.0.1:{port}"], mode="peer")
+    received: queue.SimpleQueue[bytes] = queue.SimpleQueue()
+    with (
+        zenoh.open(settings.router_config()),
+        zenoh.open(settings.component_config()) as sub_session,
+        zenoh.open(settings.component_config()) as pub_session,
+    ):
+        sub_session.declare_subscriber("test/peer", lambda s: received.put(s.payload.to_bytes()))
+        publisher = pub_session.declare_publisher("test/peer")
+        deadline = time.monotonic() + 10.0
+        while sub_session.info.zid() not in list(pub_session.info.peers_zid()):
+            assert time.monotonic() < deadline, "the peers never linked directly"
+            time.sleep(0.01)
+        while not publisher.matching_status.matching:
+            assert time.monotonic() < deadline, "the subscriber never matched"
+            time.sleep(0.01)
+        publisher.put(b"hello")
+        assert received.get(timeout=5.0) == b"hello"
 
 
 def test_start_order_is_by_role_and_skips_disabled_components(tmp_path: Path) -> None:
