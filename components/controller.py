@@ -117,8 +117,10 @@ class Controller(Component):
         self.obstacles: tuple[Circle, ...] = ()
         self.robot_path = self._robot_path()
         self.robot = load_robot(self.robot_path)
-        self.gains = self.wanted_gains()
+        self._gains_cache: tuple[int, Goal | None, Any, dict[str, float]] | None = None
+        self.gains = self.current_gains()[0]
         self.law = self.law_type(self.robot, self.gains)
+        self._robot_version = node.params.version
         self._last_stamp_ns: int | None = None
         node.counters["non_finite_commands"] = 0
         node.counters["law_errors"] = 0
@@ -198,20 +200,37 @@ class Controller(Component):
                     values[name] = override
         return self.gains_type(**values)
 
+    def current_gains(self) -> tuple[Any, dict[str, float]]:
+        """``wanted_gains()`` and its float fields (the diagnostics' ``parameters``), computed
+        again only after a parameter or the goal changed."""
+        version, goal = self.node.params.version, self.goal
+        cached = self._gains_cache
+        if cached is None or cached[0] != version or cached[1] is not goal:
+            gains = self.wanted_gains()
+            values = dataclasses.asdict(gains)
+            floats = {name: v for name, v in values.items() if isinstance(v, float)}
+            cached = self._gains_cache = (version, goal, gains, floats)
+        return cached[2], cached[3]
+
     def update_law(self) -> None:
-        """Reload the robot if its parameter changed; pass changed gains to the law."""
-        try:
-            path = self._robot_path()
-            robot = load_robot(path) if path != self.robot_path else self.robot
-        except ParamError as error:
-            raise Hold("error", str(error)) from error
-        if path != self.robot_path:
-            self.robot, self.robot_path = robot, path
-            self.gains = self.wanted_gains()
-            self.law = self.law_type(robot, self.gains)
-        gains = self.wanted_gains()
-        if gains != self.gains:
-            self.law.set_params(gains)
+        """Reload the robot if its parameter changed; pass changed gains to the law.
+        Both are looked at only after a parameter or the goal changed."""
+        version = self.node.params.version
+        if version != self._robot_version:
+            try:
+                path = self._robot_path()
+                robot = load_robot(path) if path != self.robot_path else self.robot
+            except ParamError as error:
+                raise Hold("error", str(error)) from error
+            if path != self.robot_path:
+                self.robot, self.robot_path = robot, path
+                self.gains = self.current_gains()[0]
+                self.law = self.law_type(robot, self.gains)
+            self._robot_version = version
+        gains = self.current_gains()[0]
+        if gains is not self.gains:
+            if gains != self.gains:
+                self.law.set_params(gains)
             self.gains = gains
 
     def publish(self, stamp_ns: int, output: LawOutput, phi: float) -> None:
@@ -225,7 +244,7 @@ class Controller(Component):
         wheels = (base.forward, base.angular, base.left_wheel, base.right_wheel)
         if not all(math.isfinite(value) for value in wheels):
             self._non_finite(np.array(wheels))
-        self._put_commands(stamp_ns, wheels, tuple(float(value) for value in u[3:]))
+        self._put_commands(stamp_ns, wheels, tuple(u[3:].tolist()))
         self._put_diagnostics(stamp_ns, "optimal", "", output)
 
     def publish_zero(
@@ -244,27 +263,29 @@ class Controller(Component):
         self, stamp_ns: int, wheels: tuple[float, ...], joints: tuple[float, ...]
     ) -> None:
         forward, angular, left, right = wheels
-        self.base_command.put(
+        base, arm = self.base_command, self.arm_command
+        base.put(
             BaseCommand(
-                header=self.node.header("base", stamp_ns),
+                header=self.node.header("base", stamp_ns, base.next_seq),
                 forward_velocity=forward,
                 angular_velocity=angular,
                 left_wheel=left,
                 right_wheel=right,
             )
         )
-        self.arm_command.put(
-            ArmCommand(header=self.node.header("arm", stamp_ns), joint_velocities=joints)
+        arm.put(
+            ArmCommand(
+                header=self.node.header("arm", stamp_ns, arm.next_seq), joint_velocities=joints
+            )
         )
 
     def _put_diagnostics(
         self, stamp_ns: int, status: str, reason: str, output: LawOutput | None
     ) -> None:
-        gains = dataclasses.asdict(self.wanted_gains())
-        parameters = {name: v for name, v in gains.items() if isinstance(v, float)}
+        parameters = self.current_gains()[1]
         self.diagnostics.put(
             ControllerDiagnostics(
-                header=self.node.header("world", stamp_ns),
+                header=self.node.header("world", stamp_ns, self.diagnostics.next_seq),
                 law=self.law_name,
                 status=status,
                 reason=reason,

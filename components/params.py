@@ -90,7 +90,11 @@ class Param:
 
 
 class Parameters(Mapping[str, ParamValue]):
-    """The current values of a component's declared parameters, read like a dict."""
+    """The current values of a component's declared parameters, read like a dict.
+
+    ``version`` counts the changes since start, so a component can tell cheaply whether
+    anything derived from the values must be computed again.
+    """
 
     def __init__(self, declared: Iterable[Param], overrides: Mapping[str, object]) -> None:
         self.declared = {param.name: param for param in declared}
@@ -101,6 +105,7 @@ class Parameters(Mapping[str, ParamValue]):
                 f"declared: {', '.join(self.declared) or 'none'}"
             )
         self._values = {name: param.default for name, param in self.declared.items()}
+        self.version = 0
         for name, value in overrides.items():
             self._values[name] = self.declared[name].check(value)
 
@@ -125,6 +130,7 @@ class Parameters(Mapping[str, ParamValue]):
         """Set ``name`` from its text form and return the new value."""
         value = self.param(name).parse(text)
         self._values[name] = value
+        self.version += 1
         return value
 
 

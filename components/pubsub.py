@@ -25,7 +25,11 @@ M = TypeVar("M", bound=BaseModel)
 
 
 class Publisher(Generic[M]):
-    """Publishes messages of one topic; ``put`` sets the header's ``seq``."""
+    """Publishes messages of one topic; ``put`` sets the header's ``seq``.
+
+    A message whose header already carries ``next_seq`` is published as it is; any
+    other is copied with the right ``seq`` first.
+    """
 
     def __init__(self, node: Node, topic: topics.Topic[M]) -> None:
         self.topic = topic
@@ -35,13 +39,18 @@ class Publisher(Generic[M]):
         self._counter = f"published.{topic.name}"
         node.counters[self._counter] = 0
 
+    @property
+    def next_seq(self) -> int:
+        """The ``seq`` the next ``put`` gives its message's header."""
+        return self._seq
+
     def put(self, message: M) -> None:
         """Encode and publish ``message``, its header's ``seq`` replaced by this topic's count."""
         if not isinstance(message, self.topic.type):
             expected = self.topic.type.__name__
             raise TypeError(f"{self.topic.name} carries {expected}, not {type(message).__name__}")
         header = getattr(message, "header", None)
-        if isinstance(header, Header):
+        if isinstance(header, Header) and header.seq != self._seq:
             stamped = header.model_copy(update={"seq": self._seq})
             message = message.model_copy(update={"header": stamped})
         self._seq += 1

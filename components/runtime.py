@@ -143,10 +143,13 @@ class Node:
         self.counters[f"errors.timer.{timer.name}"] = 0
         return timer
 
-    def header(self, frame: str = "", stamp_ns: int | None = None) -> Header:
-        """A header from this component, stamped now unless ``stamp_ns`` is given."""
+    def header(self, frame: str = "", stamp_ns: int | None = None, seq: int = 0) -> Header:
+        """A header from this component, stamped now unless ``stamp_ns`` is given.
+
+        ``Publisher.put`` sets ``seq``; passing the publisher's ``next_seq`` spares it a copy.
+        """
         stamp = self.clock.now_ns() if stamp_ns is None else stamp_ns
-        return Header(stamp_ns=stamp, frame=frame, seq=0, source=self.name)
+        return Header(stamp_ns=stamp, frame=frame, seq=seq, source=self.name)
 
     def count(self, counter: str, amount: int = 1) -> None:
         """Add ``amount`` to a component counter (handler thread only)."""

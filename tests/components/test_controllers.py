@@ -19,6 +19,8 @@ import numpy as np
 import pytest
 import yaml
 
+from components.lp_controller import LPController
+from components.runtime import Node
 from deploy import query
 from messages import codec, topics
 from messages.commands import ArmCommand, BaseCommand
@@ -293,3 +295,27 @@ def test_a_robot_description_that_cannot_be_loaded_is_a_configuration_error(
     process = system.start("controller")
     assert process.wait(DEADLINE_S) == 2
     assert "robot: cannot load /nonexistent/robot.yaml" in process.stderr.read()
+
+
+def test_the_law_gets_changed_gains_and_only_then(deployed: Callable[[str], System]) -> None:
+    """Gains are computed again after a parameter or goal change, and reach the law."""
+    system = deployed(LP_PROFILE.read_text())
+    with Node(system.profile, "controller", LPController.params) as node:
+        controller = LPController(node)
+        law = controller.law
+        gains = controller.gains
+        controller.update_law()
+        assert controller.gains is gains and law.params.eta == 0.6
+
+        node.params.set_text("eta", "2.0")
+        controller.update_law()
+        assert controller.law is law and law.params.eta == 2.0
+        assert controller.current_gains()[1]["eta"] == 2.0
+
+        header = Header(stamp_ns=1, frame="world", seq=0, source="test")
+        controller.on_goal(Goal(header=header, task="pose", pose=GOAL_POSE, eta=1.5))
+        controller.update_law()
+        assert law.params.eta == 1.5 and controller.current_gains()[1]["eta"] == 1.5
+        node.params.set_text("joint_gain", "3.0")
+        controller.update_law()
+        assert (law.params.eta, law.params.joint_gain) == (1.5, 3.0)
