@@ -30,9 +30,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, ClassVar, Protocol
+from typing import Any, ClassVar
 
 import numpy as np
 import yaml
@@ -47,7 +47,7 @@ from messages.goal import Goal
 from messages.obstacles import Obstacles
 from messages.state import RobotState
 from wbc.base_motion import unicycle, wheel_speeds
-from wbc.law_output import LawOutput
+from wbc.law_output import Law, LawOutput
 from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
 from wbc.task import PoseTask, PositionTask, Task, same_task
@@ -66,20 +66,6 @@ CONTROLLER_PARAMS = (
     Param("robot", str, "", doc="robot description (YAML); empty: the profile's robot"),
 )
 """The parameters of every controller, after those of its law."""
-
-
-class Law(Protocol):
-    """What ``wbc`` control laws offer: ``LPLaw``, ``CascadeLaw``, ``PseudoinverseLaw``."""
-
-    params: Any
-
-    def step(
-        self, q: np.ndarray, task: Task, dt: float, obstacles: Sequence[Circle] = ()
-    ) -> LawOutput: ...
-
-    def set_params(self, params: Any) -> None: ...
-
-    def reset(self) -> None: ...
 
 
 class Hold(Exception):
@@ -219,13 +205,12 @@ class Controller(Component):
         if version != self._robot_version:
             try:
                 path = self._robot_path()
-                robot = load_robot(path) if path != self.robot_path else self.robot
+                if path != self.robot_path:
+                    self.robot, self.robot_path = load_robot(path), path
+                    self.gains = self.current_gains()[0]
+                    self.law = self.law_type(self.robot, self.gains)
             except ParamError as error:
                 raise Hold("error", str(error)) from error
-            if path != self.robot_path:
-                self.robot, self.robot_path = robot, path
-                self.gains = self.current_gains()[0]
-                self.law = self.law_type(robot, self.gains)
             self._robot_version = version
         gains = self.current_gains()[0]
         if gains is not self.gains:

@@ -4,21 +4,14 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Protocol
 
 import numpy as np
 
-from wbc.law_output import LawOutput
+from wbc.law_output import Law, LawOutput
 from wbc.obstacles import Circle
 from wbc.task import Task
 
 Array = np.ndarray
-
-
-class Law(Protocol):
-    def step(
-        self, q: Array, task: Task, dt: float, obstacles: Sequence[Circle] = ()
-    ) -> LawOutput: ...
 
 
 @dataclass

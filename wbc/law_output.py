@@ -3,9 +3,15 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from wbc.obstacles import Circle
+    from wbc.task import Task
 
 Array = np.ndarray
 
@@ -31,6 +37,20 @@ class LawOutput:
     @property
     def ok(self) -> bool:
         return self.status == "optimal"
+
+
+class Law(Protocol):
+    """What every control law offers: ``LPLaw``, ``CascadeLaw``, ``PseudoinverseLaw``."""
+
+    params: Any
+
+    def step(
+        self, q: Array, task: Task, dt: float, obstacles: Sequence[Circle] = ()
+    ) -> LawOutput: ...
+
+    def set_params(self, params: Any) -> None: ...
+
+    def reset(self) -> None: ...
 
 
 def summarise(
