@@ -174,13 +174,17 @@ class MobileManipulator:
         twists[:, BASE_DOF:] = axes[:, :, 0].T
         return pose, dq.haminus8(pose) @ twists
 
+    def frames(self, q: Array) -> list[Array]:
+        """Poses of the base top x_2^0 and of every DH frame after it; the last is x_3^0."""
+        q = self._check(q)
+        poses = [self.base_pose(q)]
+        for link in self._arm_link_operators(q[BASE_DOF:]):
+            poses.append(dq.mul(poses[-1], link[:, 0]))
+        return poses
+
     def fkm(self, q: Array) -> Array:
         """vec8 of the end-effector pose x_3^0 = x_1^0 x_2^1 x_3^2 (4.6)."""
-        q = self._check(q)
-        pose = self.base_pose(q)
-        for link in self._arm_link_operators(q[BASE_DOF:]):
-            pose = dq.mul(pose, link[:, 0])
-        return pose
+        return self.frames(q)[-1]
 
     def pose_jacobian(self, q: Array) -> Array:
         """The 8 x dof whole-body pose Jacobian J of eq. 4.9."""
@@ -193,13 +197,7 @@ class MobileManipulator:
 
     def link_points(self, q: Array) -> Array:
         """World positions (n + 1, 3) of the base top and every DH frame origin."""
-        q = self._check(q)
-        pose = self.base_pose(q)
-        points = [dq.translation(pose)[1:]]
-        for link in self._arm_link_operators(q[BASE_DOF:]):
-            pose = dq.mul(pose, link[:, 0])
-            points.append(dq.translation(pose)[1:])
-        return np.array(points)
+        return np.array([dq.translation(pose)[1:] for pose in self.frames(q)])
 
 
 def translation_jacobian(pose: Array, jacobian: Array) -> Array:
