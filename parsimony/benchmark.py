@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from parsimony.kinematic_demo import DT, ROBOT_FILE, START
 from wbc import dq
 from wbc.cascade_law import CascadeLaw, CascadeParams
 from wbc.kinematic_run import integrate
@@ -20,9 +21,6 @@ from wbc.pinv_law import PinvParams, PseudoinverseLaw
 from wbc.robot import MobileManipulator
 from wbc.task import PoseTask
 
-ROBOT_FILE = Path(__file__).resolve().parents[1] / "deploy" / "robots" / "little_john.yaml"
-DT = 0.02
-START = np.array([0.0, 0.0, 0.0, 0.0, -0.2, 0.2, 0.0, 0.5])
 GOAL = np.array([0.58, 0.05, -0.16, 0.3, 0.15, -0.66, -0.03, -0.36])
 CONVERGENCE_GOAL = np.array([0.45, -0.29, -0.12, 0.23, -0.26, 0.14, -0.28, -0.3])
 ARM_GOAL_LOW = np.array([-0.5, -0.8, -0.8, -0.5, -0.8])
