@@ -1,15 +1,19 @@
 # The two commands of the README: `make demo` and `make test`.
-# Each (re)creates .venv when it is missing or older than pyproject.toml.
+# Each builds .venv from requirements.lock (exact versions, hashes) when it is missing or older
+# than the lock or pyproject.toml; `make lock` regenerates the lock from pyproject.toml.
 PYTHON ?= $(shell command -v python3.11 || command -v python3)
 VENV := .venv
 STAMP := $(VENV)/.installed
+LOCK := requirements.lock
+UV_VERSION := 0.13.8
 
-.PHONY: demo test bench lint clean
+.PHONY: demo test bench lint lock clean
 
-$(STAMP): pyproject.toml
-	test -x $(VENV)/bin/python || $(PYTHON) -m venv $(VENV)
-	$(VENV)/bin/python -m pip install --quiet --upgrade pip
-	$(VENV)/bin/python -m pip install --quiet -e '.[test]'
+$(STAMP): $(LOCK) pyproject.toml
+	rm -rf $(VENV)
+	$(PYTHON) -m venv $(VENV)
+	$(VENV)/bin/python -m pip install --quiet --require-hashes --no-deps -r $(LOCK)
+	$(VENV)/bin/python -m pip install --quiet --no-deps --no-build-isolation -e .
 	touch $(STAMP)
 
 demo: $(STAMP)
@@ -24,6 +28,13 @@ bench: $(STAMP)
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .
+
+# Resolve pyproject.toml (runtime and test dependencies, and setuptools to build the project)
+# into exact versions with hashes, for every platform, on Python 3.11.
+lock: $(STAMP)
+	$(VENV)/bin/python -m pip install --quiet uv==$(UV_VERSION)
+	printf 'setuptools>=68\n' | $(VENV)/bin/uv pip compile pyproject.toml - --extra test \
+		--universal --python-version 3.11 --generate-hashes --quiet -o $(LOCK)
 
 clean:
 	rm -rf $(VENV) build *.egg-info
