@@ -6,12 +6,15 @@ small changes it sees in a control loop. Every figure comes from one run on this
 
 from __future__ import annotations
 
+import copy
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
+from parsimony.goal_sets import goal_report
 from parsimony.kinematic_demo import DT, ROBOT_FILE, START
 from wbc import dq
 from wbc.cascade_law import CascadeLaw, CascadeParams
@@ -42,23 +45,82 @@ def time_calls(call: Callable[[], object], repeats: int) -> list[float]:
     return samples
 
 
+BLOCK = 100
+"""Steps each law takes in turn: long enough to run with warm caches, short enough that a
+drift of the machine's speed reaches every law alike."""
+
+
 def step_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str, float]]:
-    """Whole control steps (model, Jacobian, rows, solve) along a recorded LP trajectory."""
+    """Whole control steps (model, Jacobian, rows, solve) along a recorded LP trajectory.
+
+    The laws take turns, BLOCK steps each, over the same states.
+    """
     task = PoseTask(robot.fkm(GOAL))
     trajectory = integrate(LPLaw(robot), START, task, DT, 3000).configurations
-    results: dict[str, dict[str, float]] = {}
     laws = {"lp": LPLaw(robot), "classic": PseudoinverseLaw(robot), "cascade": CascadeLaw(robot)}
-    for name, law in laws.items():
-        samples: list[float] = []
-        while len(samples) < repeats:
-            law.reset()
-            for q in trajectory[: repeats - len(samples)]:
+    samples: dict[str, list[float]] = {name: [] for name in laws}
+    position = 0
+    while len(samples["lp"]) < repeats:
+        if position == 0:
+            for law in laws.values():
+                law.reset()
+        block = trajectory[position : position + min(BLOCK, repeats - len(samples["lp"]))]
+        for name, law in laws.items():
+            for q in block:
                 start = time.perf_counter()
                 law.step(q, task, DT)
-                samples.append(time.perf_counter() - start)
-        results[name] = percentiles(samples)
+                samples[name].append(time.perf_counter() - start)
+        position = (position + len(block)) % len(trajectory)
+    results = {name: percentiles(values) for name, values in samples.items()}
     results["kinematics"] = percentiles(time_calls(lambda: robot.kinematics(GOAL), repeats))
     return results
+
+
+def lp_breakdown(robot: MobileManipulator, repeats: int) -> dict[str, float]:
+    """Median microseconds of one LP step spent in each part, the rest being Python glue.
+
+    The law's own objects are wrapped with timers: the kinematics (fkm and J), the rows of
+    the constraints and objective terms, the vertex (the kept basis tested, or the calls into
+    HiGHS: model update, basis, run, solution) and HiGHS alone; ``highs_runs`` is the share of
+    steps that called HiGHS.
+    """
+    task = PoseTask(robot.fkm(GOAL))
+    trajectory = integrate(LPLaw(robot), START, task, DT, 3000).configurations
+    law = LPLaw(robot)
+    law.step(START, task, DT)
+    spent = {"kinematics": 0.0, "rows": 0.0, "vertex": 0.0, "highs": 0.0}
+
+    def timed(part: str, call: Callable) -> Callable:
+        def wrapper(*args: object) -> object:
+            start = time.perf_counter()
+            result = call(*args)
+            spent[part] += time.perf_counter() - start
+            return result
+
+        return wrapper
+
+    law.robot = copy.copy(robot)
+    law.robot.kinematics = timed("kinematics", robot.kinematics)  # type: ignore[method-assign]
+    for item in [*law.constraints, *law.objectives]:  # type: ignore[misc]
+        method = "rows" if hasattr(item, "rows") else "cost"
+        setattr(item, method, timed("rows", getattr(item, method)))
+    law._lp._vertex = timed("vertex", law._lp._vertex)  # type: ignore[method-assign]
+    law._lp._run = timed("highs", law._lp._run)  # type: ignore[method-assign]
+    parts: dict[str, list[float]] = {name: [] for name in (*spent, "glue", "total")}
+    while len(parts["total"]) < repeats:
+        law.reset()
+        for q in trajectory[: repeats - len(parts["total"])]:
+            spent.update(dict.fromkeys(spent, 0.0))
+            start = time.perf_counter()
+            law.step(q, task, DT)
+            total = time.perf_counter() - start
+            for name, value in spent.items():
+                parts[name].append(value)
+            parts["glue"].append(total - spent["kinematics"] - spent["rows"] - spent["vertex"])
+            parts["total"].append(total)
+    result = {name: float(np.median(values) * 1e6) for name, values in parts.items()}
+    result["highs_runs"] = float(np.mean(np.array(parts["highs"]) > 0.0))
+    return result
 
 
 def dqrobotics_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str, float]]:
@@ -129,31 +191,14 @@ def convergence_test(robot: MobileManipulator, trials: int) -> dict[str, dict[st
     return results
 
 
-def random_goal_success(robot: MobileManipulator, goals: int, seed: int = 1) -> dict[str, float]:
-    """Share of random pose goals (base 0.3-1 m ahead, arm inside its limits) reached in 60 s."""
-    rng = np.random.default_rng(seed)
-    laws = {
-        "lp (5.29 exactly, w = 0)": lambda: LPLaw(robot, LPParams(velocity_cost=0.0)),
-        "lp (default, w = 1e-3)": lambda: LPLaw(robot),
-        "cascade": lambda: CascadeLaw(robot),
-    }
-    reached = dict.fromkeys(laws, 0)
-    for _ in range(goals):
-        arm_start = np.clip(START[3:] + rng.uniform(-0.3, 0.3, 5), ARM_GOAL_LOW, ARM_GOAL_HIGH)
-        start = np.concatenate((np.zeros(3), arm_start))
-        base_goal = [rng.uniform(0.3, 1.0), rng.uniform(-0.4, 0.4), rng.uniform(-0.4, 0.4)]
-        goal = np.concatenate((base_goal, rng.uniform(ARM_GOAL_LOW, ARM_GOAL_HIGH)))
-        task = PoseTask(robot.fkm(goal))
-        for name, make_law in laws.items():
-            reached[name] += integrate(make_law(), start, task, DT, 3000).converged
-    return {name: count / goals for name, count in reached.items()}
-
-
 def run_bench(repeats: int, trials: int, goals: int, robot_file: Path = ROBOT_FILE) -> dict:
+    """Every figure of `parsimony bench`, measured in this run; progress goes to stderr."""
     robot = MobileManipulator.from_yaml(robot_file)
+    progress("control steps")
     steps = step_times(robot, repeats)
+    breakdown = lp_breakdown(robot, repeats)
     reference = dqrobotics_times(robot, repeats)
-    report: dict = {"step": steps, "dqrobotics": reference}
+    report: dict = {"step": steps, "lp_breakdown_us": breakdown, "dqrobotics": reference}
     report["ratios"] = {
         "lp_over_classic": steps["lp"]["median_us"] / steps["classic"]["median_us"]
     }
@@ -164,11 +209,17 @@ def run_bench(repeats: int, trials: int, goals: int, robot_file: Path = ROBOT_FI
         report["ratios"]["classic_over_dqrobotics"] = (
             steps["classic"]["median_us"] / reference["classic"]["median_us"]
         )
+    progress("section 6.3 convergence test")
     report["convergence"] = convergence_test(robot, trials)
     if goals:
-        report["random_goal_success"] = random_goal_success(robot, goals)
+        progress(f"{goals} random goals per family and law")
+        report["goals"] = goal_report(robot_file, goals)
     report["goal_pose"] = dq.translation(robot.fkm(GOAL))[1:].tolist()
     return report
+
+
+def progress(what: str) -> None:
+    print(f"bench: {what}", file=sys.stderr, flush=True)
 
 
 def format_report(report: dict) -> str:
@@ -178,6 +229,8 @@ def format_report(report: dict) -> str:
     for name, figures in report["dqrobotics"].items():
         label = f"DQ Robotics {name}"
         lines.append(f"  {label:<44} {figures['median_us']:9.1f} {figures['p99_us']:9.1f}")
+    lines.append("LP step, median us by part")
+    lines.append("  " + "  ".join(f"{k} {v:.1f}" for k, v in report["lp_breakdown_us"].items()))
     lines.append("ratios (medians, same run)")
     lines += [f"  {name:<44} {value:9.2f}" for name, value in report["ratios"].items()]
     lines.append("section 6.3 convergence   iterations  converged  time ms (std)   us/iteration")
@@ -187,9 +240,13 @@ def format_report(report: dict) -> str:
             f"  {row['convergence_time_ms']:7.2f} ({row['convergence_time_std_ms']:.2f})"
             f"  {row['time_per_iteration_us']:10.1f}"
         )
-    if "random_goal_success" in report:
-        lines.append("random pose goals reached (share)")
-        lines += [
-            f"  {name:<44} {share:9.2f}" for name, share in report["random_goal_success"].items()
-        ]
+    for family, result in report.get("goals", {}).items():
+        lines.append(f"{family} goals ({result['goals']}): share reached   "
+                     "overall  in joint limits  in joint+speed limits")  # fmt: skip
+        for law, row in result["laws"].items():
+            lines.append(f"  {law:<32} {row['reached']:9.2f} {row['within_joint_limits']:16.2f}"
+                         f" {row['within_joint_and_speed_limits']:22.2f}")  # fmt: skip
+        for law, row in result["laws"].items():
+            if "nonzero_histogram" in row:
+                lines.append(f"  {law} steps by nonzero count 0..8: {row['nonzero_histogram']}")
     return "\n".join(lines)

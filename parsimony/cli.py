@@ -6,6 +6,8 @@ import argparse
 import importlib
 import sys
 
+from parsimony.output import result_only_stdout
+
 COMMANDS = ("demo", "bench", "launch", "status", "param", "schema")
 
 
@@ -20,7 +22,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    return int(args.run(args) or 0)
+    with result_only_stdout():
+        return int(args.run(args) or 0)
 
 
 if __name__ == "__main__":

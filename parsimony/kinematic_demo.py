@@ -25,6 +25,12 @@ ROBOT_FILE = Path(__file__).resolve().parents[1] / "deploy" / "robots" / "little
 DT = 0.02
 STEPS = 4000
 START = np.array([0.0, 0.0, 0.0, 0.0, -0.2, 0.2, 0.0, 0.5])
+OBSTACLE_GOAL = np.concatenate(([1.3, 0.3, 0.2], START[3:]))
+OBSTACLE = Circle(0.56, 0.16, 0.1)
+"""On the path the default LP law's base takes to OBSTACLE_GOAL when nothing is in the way."""
+BORDER_PARAMS = LPParams(obstacle_mode="border", base_target=0.0)
+"""The border-following law of 6.2.3 without the base target term, whose straight-line
+heading towards where the base should stand fights the detour round the obstacle."""
 
 
 @dataclass(frozen=True)
@@ -38,7 +44,7 @@ class Experiment:
 def experiments(robot: MobileManipulator) -> list[Experiment]:
     """Pose (6.2.1), position (6.2.2), obstacle (6.2.3) and the joint limit of figure 6.10."""
     reach = robot.fkm(np.array([0.58, 0.05, -0.16, 0.3, 0.15, -0.66, -0.03, -0.36]))
-    beyond_obstacle = robot.fkm(np.concatenate(([1.3, 0.3, 0.2], START[3:])))
+    beyond_obstacle = robot.fkm(OBSTACLE_GOAL)
     past_elbow_limit = robot.fkm(np.array([0.3, 0.0, 0.0, 0.0, -0.2, 0.9, 0.0, 0.5]))
     return [
         Experiment(
@@ -55,10 +61,10 @@ def experiments(robot: MobileManipulator) -> list[Experiment]:
             "obstacle",
             PoseTask(beyond_obstacle),
             {
-                "LP border": LPLaw(robot, LPParams(obstacle_mode="border")),
+                "LP border": LPLaw(robot, BORDER_PARAMS),
                 "LP conservative": LPLaw(robot, LPParams(obstacle_mode="conservative")),
             },
-            (Circle(1.42, -0.084, 0.1),),
+            (OBSTACLE,),
         ),
         Experiment(
             "joint limit",

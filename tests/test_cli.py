@@ -6,6 +6,8 @@ import json
 import subprocess
 import sys
 
+import pytest
+
 from parsimony.cli import COMMANDS
 
 
@@ -26,15 +28,57 @@ def test_help_lists_every_subcommand():
 
 
 def test_bench_prints_step_times_and_the_convergence_test_as_json():
-    result = run_cli("bench", "--repeats", "50", "--trials", "1", "--goals", "0")
+    result = run_cli("bench", "--json", "--repeats", "50", "--trials", "1", "--goals", "2")
     assert result.returncode == 0, result.stderr
-    report = json.loads(result.stdout.splitlines()[0])
+    report = json.loads(result.stdout)
     for law in ("lp", "classic", "cascade", "kinematics"):
         assert 0.0 < report["step"][law]["median_us"] <= report["step"][law]["p99_us"]
     assert report["ratios"]["lp_over_classic"] > 0.0
+    parts = report["lp_breakdown_us"]
+    assert {"kinematics", "rows", "vertex", "highs", "glue", "highs_runs"} <= parts.keys()
+    assert min(parts["kinematics"], parts["rows"], parts["vertex"]) > 0.0
+    assert 0.0 < parts["highs_runs"] <= 1.0  # the first step of each pass calls HiGHS
     for test in ("holonomic/classic", "holonomic/lp", "nonholonomic/cascade", "nonholonomic/lp"):
         assert report["convergence"][test]["converged_trials"] == 1
-    assert "lp_over_classic" in result.stdout
+    for family in ("ahead", "anywhere"):
+        laws = report["goals"][family]["laws"]
+        assert laws.keys() == {"lp", "lp 5.29 exactly", "cascade"}
+        for row in laws.values():
+            assert row["reached"] >= row["within_joint_limits"] >= (
+                row["within_joint_and_speed_limits"])
+        assert sum(laws["lp"]["nonzero_histogram"]) > 0
+    assert "bench:" in result.stderr  # progress goes to stderr
+
+
+def test_bench_table_names_each_figure():
+    result = run_cli("bench", "--repeats", "20", "--trials", "1", "--goals", "0")
+    assert result.returncode == 0, result.stderr
+    assert "lp_over_classic" in result.stdout and "LP step, median us by part" in result.stdout
+
+
+@pytest.mark.parametrize("command", [("demo", "--json"), ("schema",)])
+def test_json_commands_print_nothing_but_json(command):
+    """The whole of stdout parses, whatever a library prints (HiGHS 1.16 prints a banner)."""
+    result = run_cli(*command)
+    assert result.returncode == 0, result.stderr
+    json.loads(result.stdout)
+
+
+def test_a_library_writing_to_file_descriptor_1_reaches_stderr():
+    """What C code writes to fd 1 while a command runs is routed to stderr, not the result."""
+    code = (
+        "import os, sys\n"
+        "from parsimony.output import emit, result_only_stdout\n"
+        "with result_only_stdout():\n"
+        "    os.write(1, b'banner from C\\n')\n"
+        "    print('a log line')\n"
+        "    emit('{\"result\": 1}')\n"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            timeout=60)  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert json.loads(result.stdout) == {"result": 1}
+    assert "banner from C" in result.stderr and "a log line" in result.stderr
 
 
 def test_demo_reports_every_experiment_and_exits_zero():

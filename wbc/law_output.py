@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -73,5 +74,5 @@ def summarise(
         practical_nonzero=int(np.count_nonzero(magnitude >= PRACTICAL_THRESHOLD)),
         active_constraints=active,
         solve_time_s=time.perf_counter() - start,
-        error_norm=float(np.linalg.norm(error)),
+        error_norm=math.sqrt(float(error @ error)),
     )

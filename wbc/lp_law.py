@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -9,7 +10,7 @@ from typing import Literal
 
 import numpy as np
 
-from wbc.constraints.base import Constraint, StepContext
+from wbc.constraints.base import Constraint
 from wbc.constraints.error_bound import ErrorBound
 from wbc.constraints.joint_limits import JointLimits
 from wbc.constraints.nonholonomic import Nonholonomic
@@ -17,9 +18,14 @@ from wbc.constraints.obstacle_border import BorderObstacle
 from wbc.constraints.obstacle_conservative import ConservativeObstacle
 from wbc.law_output import LawOutput, summarise
 from wbc.linear_program import WarmStartedLP
+from wbc.objectives.base import ObjectiveTerm, ResidualCost
+from wbc.objectives.base_target import BaseTarget
+from wbc.objectives.velocity_cost import LeastVelocity
+from wbc.objectives.waist_centring import WaistCentring
 from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
-from wbc.task import Task, same_task
+from wbc.step_context import StepContext
+from wbc.task import PoseTask, Task, same_task
 from wbc.validation import require_finite, require_positive
 
 Array = np.ndarray
@@ -48,15 +54,34 @@ class LPParams:
     """d: the border constraint acts on the point d ahead of the wheel axle (m)."""
     velocity_cost: float = 1e-3
     """w: weight of ||u||_1 added to the objective to break ties between optimal vertices;
-    0 solves 5.29 exactly (see wbc.linear_program)."""
+    0 solves 5.29 exactly (see wbc.linear_program and wbc.objectives.velocity_cost)."""
+    waist_centring: float = 0.02
+    """Weight of |q1' + k q1|, spending the waist/base-yaw self-motion on a centred waist
+    (wbc.objectives.waist_centring); 0 switches it off."""
+    waist_gain: float = 1.0
+    """k of the waist centring (1/s)."""
+    waist_fade: float = 0.05
+    """||e||_1 below which the waist centring fades out (0: never)."""
+    base_target: float = 0.05
+    """Weight of |phi' - k angle to T|, turning the base towards where it should stand for a
+    pose goal (wbc.objectives.base_target); 0 switches it off."""
+    base_target_gain: float = 2.0
+    """k of the base target (1/s)."""
+    base_target_reach: float = 0.36
+    """How far behind the goal, along its arm plane, the base should stand (m): the mean
+    horizontal reach of the arm over the box of arm goals of `parsimony bench` (0.36 +- 0.08)."""
+    base_target_stop: float = 0.15
+    """Distance from T within which the base target is off; its weight is full at twice (m)."""
     nonholonomic: bool = True
     """False models a holonomic base (the first test of section 6.3)."""
 
     def __post_init__(self) -> None:
-        require_positive(self, "eta", "beta", "joint_gain", "safety_factor", "obstacle_gain")
+        require_positive(self, "eta", "beta", "joint_gain", "safety_factor", "obstacle_gain",
+                         "waist_gain", "base_target_gain", "base_target_stop")  # fmt: skip
         if self.safety_factor > 1.0:
             raise ValueError(f"LPParams.safety_factor must be <= 1, got {self.safety_factor}")
-        for name in ("velocity_cost", "obstacle_margin", "obstacle_lookahead"):
+        for name in ("velocity_cost", "obstacle_margin", "obstacle_lookahead", "waist_centring",
+                     "waist_fade", "base_target", "base_target_reach"):  # fmt: skip
             if not np.isfinite(getattr(self, name)) or getattr(self, name) < 0.0:
                 raise ValueError(f"LPParams.{name} must be >= 0, got {getattr(self, name)}")
         if self.error_bound not in ("derivative", "error"):
@@ -84,6 +109,19 @@ def default_constraints(params: LPParams) -> list[Constraint]:
     return constraints
 
 
+def default_objectives(params: LPParams) -> list[ObjectiveTerm]:
+    """The terms added to the task residual of 5.29 that ``params`` selects."""
+    terms: list[ObjectiveTerm] = []
+    if params.velocity_cost > 0.0:
+        terms.append(LeastVelocity(params.velocity_cost))
+    if params.waist_centring > 0.0:
+        terms.append(WaistCentring(params.waist_centring, params.waist_gain, params.waist_fade))
+    if params.base_target > 0.0:
+        terms.append(BaseTarget(params.base_target, params.base_target_gain,
+                                params.base_target_reach, params.base_target_stop))  # fmt: skip
+    return terms
+
+
 @dataclass
 class LPLaw:
     """u = argmin ||J u + eta e||_1 subject to the constraints (5.29), solved by HiGHS simplex.
@@ -97,17 +135,21 @@ class LPLaw:
     robot: MobileManipulator
     params: LPParams = field(default_factory=LPParams)
     constraints: list[Constraint] | None = None
+    objectives: list[ObjectiveTerm] | None = None
     _lp: WarmStartedLP = field(default_factory=WarmStartedLP, init=False, repr=False)
     _last: tuple[Task, Array] | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
         self._explicit_constraints = self.constraints is not None
+        self._explicit_objectives = self.objectives is not None
 
     def set_params(self, params: LPParams) -> None:
         """Change the gains between steps (the constraints are rebuilt from them)."""
         self.params = params
         if not self._explicit_constraints:
             self.constraints = None
+        if not self._explicit_objectives:
+            self.objectives = None
 
     def reset(self) -> None:
         """Forget the previous error and basis, as for a new task."""
@@ -120,13 +162,17 @@ class LPLaw:
         """One control step at configuration q (8,) towards ``task``; dt in seconds."""
         start = time.perf_counter()
         q = require_finite("configuration q", q)
-        dt = float(require_finite("dt", dt))
+        dt = float(dt)
+        if not math.isfinite(dt):
+            require_finite("dt", dt)
         if dt <= 0.0:
             raise ValueError(f"dt must be > 0, got {dt}")
         for index, obstacle in enumerate(obstacles):
             require_finite(f"obstacle {index}", (obstacle.x, obstacle.y, obstacle.radius))
         if self.constraints is None:
             self.constraints = default_constraints(self.params)
+        if self.objectives is None:
+            self.objectives = default_objectives(self.params)
 
         pose, jacobian = self.robot.kinematics(q)
         error, task_jacobian = task.error(pose, jacobian)
@@ -136,13 +182,13 @@ class LPLaw:
             error_rate = -self.params.eta * error
         self._last = (task, error)
 
-        context = StepContext(
-            self.robot, q, error, error_rate, task.goal_position[:2], tuple(obstacles)
-        )
+        goal_pose = task.pose if isinstance(task, PoseTask) else None
+        context = StepContext(self.robot, q, error, error_rate, task.goal_position[:2],
+                              tuple(obstacles), goal_pose)  # fmt: skip
         rows = [constraint.rows(context) for constraint in self.constraints]
-        solution = self._lp.solve(
-            task_jacobian, -self.params.eta * error, rows, self.params.velocity_cost
-        )
+        costs = [ResidualCost("task", task_jacobian, self.params.eta * error)]
+        costs += [term.cost(context) for term in self.objectives]
+        solution = self._lp.solve(costs, rows)
         return summarise(
             solution.u, solution.status, solution.objective, solution.active, error, start
         )

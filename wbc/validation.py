@@ -12,7 +12,7 @@ class NonFiniteInputError(ValueError):
 def require_finite(name: str, value: object) -> np.ndarray:
     """``value`` as a float array, or NonFiniteInputError naming ``name`` and the bad entries."""
     array = np.asarray(value, dtype=float)
-    if not np.all(np.isfinite(array)):
+    if not np.isfinite(array).all():
         bad = np.flatnonzero(~np.isfinite(array.ravel())).tolist()
         raise NonFiniteInputError(f"{name} must be finite; entries {bad} are {array.ravel()[bad]}")
     return array

@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 from parsimony.kinematic_demo import ROBOT_FILE, format_table, run_demo
+from parsimony.output import emit
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -20,7 +21,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
 
 def run(args: argparse.Namespace) -> int:
     rows = run_demo(args.robot)
-    print(json.dumps(rows, indent=2) if args.json else format_table(rows))
+    emit(json.dumps(rows, indent=2) if args.json else format_table(rows))
     expected = all(
         row["converged"] != (row["law"] in ("LP conservative",)) for row in rows
         if row["experiment"] != "joint limit"

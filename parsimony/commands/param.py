@@ -9,6 +9,7 @@ import sys
 
 from deploy.profile import ProfileError
 from deploy.query import DEFAULT_TIMEOUT_S, QueryError, Target, get_param, set_param
+from parsimony.output import emit
 
 PROFILE_ENV = "PARSIMONY_PROFILE"
 """The profile used when `--profile` is not given."""
@@ -59,5 +60,5 @@ def run(args: argparse.Namespace) -> int:
     except (ProfileError, QueryError, ValueError) as error:
         print(error, file=sys.stderr)
         return 1
-    print(f"{args.component}.{args.name} = {json.dumps(value)}")
+    emit(f"{args.component}.{args.name} = {json.dumps(value)}")
     return 0

@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 from messages.schema import export_schemas, schema_index
+from parsimony.output import emit
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -26,8 +27,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
 
 def run(args: argparse.Namespace) -> int:
     if args.out is None:
-        print(json.dumps(schema_index(), indent=2))
+        emit(json.dumps(schema_index(), indent=2))
         return 0
     for path in export_schemas(args.out):
-        print(path)
+        emit(str(path))
     return 0

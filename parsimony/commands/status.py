@@ -17,6 +17,7 @@ from deploy.query import (
     statuses,
 )
 from messages.status import ComponentStatus
+from parsimony.output import emit
 
 COLUMNS = ("NAME", "MODULE", "STATE", "PID", "COUNTERS (non-zero)")
 
@@ -69,9 +70,9 @@ def run(args: argparse.Namespace) -> int:
             {"name": name, "status": found[name].model_dump(mode="json") if name in found else None}
             for name in names
         ]
-        print(json.dumps(rows, indent=2))
+        emit(json.dumps(rows, indent=2))
     else:
-        print(format_table([(name, found.get(name)) for name in names]))
+        emit(format_table([(name, found.get(name)) for name in names]))
     if not names:
         print(f"no live component in namespace {target.namespace!r}", file=sys.stderr)
     return 0 if names else 1

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -44,6 +46,18 @@ def test_status_lists_live_components_with_counters(
     assert row["name"] == "pub" and row["status"]["module"] == "scripted_publisher"
     assert set(row["status"]["parameters"]) >= {"rate_hz", "goal_task"}
     assert row["status"]["counters"]["published.control/goal"] >= 1
+
+
+def test_status_json_is_the_whole_stdout_of_the_command(running_pub: Path) -> None:
+    """`parsimony status --json` as a user runs it: a process whose stdout is only JSON."""
+    wait_for_first_message(running_pub)
+    result = subprocess.run(
+        [sys.executable, "-m", "parsimony.cli", "status", str(running_pub), "--json"],
+        capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    (row,) = json.loads(result.stdout)
+    assert row["name"] == "pub"
 
 
 def test_status_of_an_empty_namespace_or_a_remote_router_fails(

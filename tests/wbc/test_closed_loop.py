@@ -14,9 +14,9 @@ from wbc_scenarios import (
     robot,
 )
 
+from parsimony.kinematic_demo import BORDER_PARAMS, OBSTACLE, OBSTACLE_GOAL
 from wbc.cascade_law import CascadeLaw
 from wbc.lp_law import LPLaw, LPParams
-from wbc.obstacles import Circle
 from wbc.pinv_law import PseudoinverseLaw
 from wbc.task import PositionTask
 
@@ -30,6 +30,10 @@ def nonholonomic_residual(q: np.ndarray, u: np.ndarray) -> float:
     return abs(u[0] * np.sin(q[2]) - u[1] * np.cos(q[2]))
 
 
+SECONDARY_ROWS = 2
+"""The default LP's two secondary residual rows (waist centring, base target): task rows too."""
+
+
 def check_lp_outputs(run, task_dof: int) -> None:
     """Every LP output: 5.11 to 1e-9, inside the bounds, parsimonious (5.30)."""
     arm_min, arm_max = MODEL.q_min[3:], MODEL.q_max[3:]
@@ -39,7 +43,8 @@ def check_lp_outputs(run, task_dof: int) -> None:
         assert np.all(np.abs(out.u) <= MODEL.velocity_max + 1e-9)
         assert np.all(q[3:] >= arm_min) and np.all(q[3:] <= arm_max)
         others = [name for name in out.active_constraints if "bound" not in name]
-        assert out.nonzero <= task_dof + 1 + len(others), (out.nonzero, out.active_constraints)
+        bound = task_dof + SECONDARY_ROWS + 1 + len(others)
+        assert out.nonzero <= bound, (out.nonzero, out.active_constraints)
 
 
 @pytest.mark.parametrize("start, goal", STARTS_AND_GOALS)
@@ -70,10 +75,12 @@ def test_cascade_law_reaches_goals_and_obeys_the_nonholonomic_constraint(start, 
 
 
 def test_pseudoinverse_law_uses_every_joint_where_the_lp_law_does_not():
+    """5.29 itself (no secondary term) against the classic law on a position task."""
     start, goal = STARTS_AND_GOALS[0]
     task = position_task(MODEL, goal)
     pinv = integrate(PseudoinverseLaw(MODEL), start, task, steps=3000)
-    lp = integrate(LPLaw(MODEL, POSITION_PARAMS), start, task, steps=3000)
+    params = LPParams(eta=1.0, beta=10.0, waist_centring=0.0, base_target=0.0)
+    lp = integrate(LPLaw(MODEL, params), start, task, steps=3000)
     assert pinv.final_error < 1e-3
     assert all(out.nonzero == MODEL.dof for out in pinv.outputs)
     assert max(out.nonzero for out in lp.outputs[5:]) < MODEL.dof
@@ -91,8 +98,6 @@ def test_joint_limit_kept_by_lp_law_and_passed_by_pseudoinverse_law():
     assert max(q[elbow] for q in lp.configurations) <= 0.9 * MODEL.q_max[elbow] + 1e-9
 
 
-OBSTACLE_GOAL = np.concatenate(([1.3, 0.3, 0.2], HOME[3:]))
-OBSTACLE = Circle(1.42, -0.084, 0.1)
 
 
 def base_clearance(run) -> np.ndarray:
@@ -103,13 +108,13 @@ def base_clearance(run) -> np.ndarray:
 
 
 def test_obstacle_lies_on_the_free_path():
-    free = integrate(LPLaw(MODEL, POSE_PARAMS), HOME, pose_task(MODEL, OBSTACLE_GOAL), 3000)
+    free = integrate(LPLaw(MODEL), HOME, pose_task(MODEL, OBSTACLE_GOAL), 3000)
     assert free.final_error < 1e-3
     assert base_clearance(free).min() < 0.0
 
 
 def test_border_following_constraint_goes_round_the_obstacle_to_the_goal():
-    law = LPLaw(MODEL, LPParams(obstacle_mode="border"))
+    law = LPLaw(MODEL, BORDER_PARAMS)
     run = integrate(law, HOME, pose_task(MODEL, OBSTACLE_GOAL), 4000, obstacles=[OBSTACLE])
     assert base_clearance(run).min() > 0.0
     assert any("obstacle_border" in out.active_constraints for out in run.outputs)

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from wbc.constraints.base import LinearRows, OneNormBound, StepContext, VelocityBounds
+from wbc.constraints.base import LinearRows, OneNormBound, VelocityBounds
 from wbc.constraints.error_bound import ErrorBound
 from wbc.constraints.joint_limits import JointLimits
 from wbc.constraints.nonholonomic import Nonholonomic
@@ -18,6 +18,7 @@ from wbc.constraints.obstacle_border import BorderObstacle
 from wbc.constraints.obstacle_conservative import ConservativeObstacle
 from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
+from wbc.step_context import StepContext
 
 ROBOT = MobileManipulator.from_yaml(
     Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"

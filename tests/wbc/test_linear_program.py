@@ -7,10 +7,24 @@ import pytest
 from scipy.optimize import linprog
 
 from wbc.constraints.base import LinearRows, OneNormBound, Rows, VelocityBounds
-from wbc.linear_program import WarmStartedLP
+from wbc.linear_program import LPSolution, WarmStartedLP
+from wbc.objectives.base import ResidualCost, VelocityCost
 
 EQUALITY_TOL = 1e-9
 OBJECTIVE_TOL = 1e-8
+
+
+def solve(
+    lp: WarmStartedLP,
+    jacobian: np.ndarray,
+    rhs: np.ndarray,
+    rows: list[Rows],
+    velocity_cost: float = 0.0,
+) -> LPSolution:
+    """min ||J u - rhs||_1 + w ||u||_1 under the rows (rhs = -eta e, as the task gives it)."""
+    costs = [ResidualCost("task", jacobian, -rhs),
+             VelocityCost("velocity", np.full(jacobian.shape[1], velocity_cost))]  # fmt: skip
+    return lp.solve(costs, rows)
 
 
 def reference_objective(
@@ -99,7 +113,7 @@ def assert_feasible(u: np.ndarray, rows: list[Rows]) -> None:
 @pytest.mark.parametrize("seed", range(20))
 def test_minimises_the_one_norm_of_the_task_residual(seed: int) -> None:
     jacobian, rhs, rows = random_problem(seed)
-    solution = WarmStartedLP().solve(jacobian, rhs, rows)
+    solution = solve(WarmStartedLP(), jacobian, rhs, rows)
     assert solution.status == "optimal"
     assert_feasible(solution.u, rows)
     expected = reference_objective(jacobian, rhs, rows)
@@ -111,7 +125,7 @@ def test_minimises_the_one_norm_of_the_task_residual(seed: int) -> None:
 def test_velocity_cost_adds_the_weighted_one_norm_of_u(seed: int) -> None:
     jacobian, rhs, rows = random_problem(seed)
     weight = 0.05
-    solution = WarmStartedLP().solve(jacobian, rhs, rows, velocity_cost=weight)
+    solution = solve(WarmStartedLP(), jacobian, rhs, rows, velocity_cost=weight)
     assert solution.status == "optimal"
     expected = reference_objective(jacobian, rhs, rows, weight)
     achieved = residual_norm(jacobian, rhs, solution.u) + weight * np.abs(solution.u).sum()
@@ -123,7 +137,7 @@ def test_exactly_solvable_task_is_solved_exactly() -> None:
     """With J invertible and no active constraint, u = J^-1 rhs and the objective is 0."""
     jacobian = np.array([[2.0, 1.0], [0.0, 1.0]])
     rhs = np.array([0.3, -0.1])
-    solution = WarmStartedLP().solve(jacobian, rhs, [])
+    solution = solve(WarmStartedLP(), jacobian, rhs, [])
     assert solution.status == "optimal"
     np.testing.assert_allclose(solution.u, np.linalg.solve(jacobian, rhs), atol=1e-12)
     assert solution.objective == pytest.approx(0.0, abs=1e-12)
@@ -135,7 +149,7 @@ def test_exactly_solvable_task_is_solved_exactly() -> None:
 def test_velocity_bounds_that_exclude_zero() -> None:
     """Bounds [0.2, 0.5] and [-0.5, -0.2]: with nothing to do, u sits on the bound nearest 0."""
     bounds = VelocityBounds("band", np.array([0.2, -0.5]), np.array([0.5, -0.2]))
-    solution = WarmStartedLP().solve(np.eye(2), np.zeros(2), [bounds])
+    solution = solve(WarmStartedLP(), np.eye(2), np.zeros(2), [bounds])
     assert solution.status == "optimal"
     np.testing.assert_allclose(solution.u, [0.2, -0.2], atol=1e-12)
     assert solution.objective == pytest.approx(0.4)
@@ -143,10 +157,10 @@ def test_velocity_bounds_that_exclude_zero() -> None:
 
 def test_velocity_bounds_clip_a_far_target() -> None:
     bounds = VelocityBounds("band", np.array([0.2, -0.5]), np.array([0.5, -0.2]))
-    solution = WarmStartedLP().solve(np.eye(2), np.array([3.0, -3.0]), [bounds])
+    solution = solve(WarmStartedLP(), np.eye(2), np.array([3.0, -3.0]), [bounds])
     np.testing.assert_allclose(solution.u, [0.5, -0.5], atol=1e-12)
     assert solution.objective == pytest.approx(5.0)
-    target_inside = WarmStartedLP().solve(np.eye(2), np.array([0.3, -0.4]), [bounds])
+    target_inside = solve(WarmStartedLP(), np.eye(2), np.array([0.3, -0.4]), [bounds])
     np.testing.assert_allclose(target_inside.u, [0.3, -0.4], atol=1e-12)
 
 
@@ -158,7 +172,7 @@ def test_velocity_bounds_are_covered_exactly(lower: float, upper: float) -> None
     """Through the split u = u_P - u_N, u reaches both ends of [lower, upper] and no further."""
     bounds = VelocityBounds("band", np.array([lower]), np.array([upper]))
     for target, end in ((10.0, upper), (-10.0, lower)):
-        solution = WarmStartedLP().solve(np.eye(1), np.array([target]), [bounds])
+        solution = solve(WarmStartedLP(), np.eye(1), np.array([target]), [bounds])
         assert solution.status == "optimal"
         expected = end if np.isfinite(end) else target
         np.testing.assert_allclose(solution.u, [expected], atol=1e-12)
@@ -167,7 +181,7 @@ def test_velocity_bounds_are_covered_exactly(lower: float, upper: float) -> None
 def test_several_velocity_bounds_intersect() -> None:
     wide = VelocityBounds("wide", np.full(3, -1.0), np.full(3, 1.0))
     narrow = VelocityBounds("narrow", np.array([-0.1, 0.3, -np.inf]), np.array([0.1, 0.6, 0.2]))
-    solution = WarmStartedLP().solve(np.eye(3), np.array([5.0, 5.0, 5.0]), [wide, narrow])
+    solution = solve(WarmStartedLP(), np.eye(3), np.array([5.0, 5.0, 5.0]), [wide, narrow])
     np.testing.assert_allclose(solution.u, [0.1, 0.6, 0.2], atol=1e-12)
 
 
@@ -175,7 +189,7 @@ def test_contradictory_velocity_bounds_are_infeasible() -> None:
     """[0.2, 0.5] and [-0.5, -0.2] on the same entry leave no u: the LP must not pretend."""
     positive = VelocityBounds("positive", np.array([0.2]), np.array([0.5]))
     negative = VelocityBounds("negative", np.array([-0.5]), np.array([-0.2]))
-    solution = WarmStartedLP().solve(np.eye(1), np.zeros(1), [positive, negative])
+    solution = solve(WarmStartedLP(), np.eye(1), np.zeros(1), [positive, negative])
     assert solution.status != "optimal", f"u = {solution.u} violates one of the bounds"
     np.testing.assert_array_equal(solution.u, [0.0])
 
@@ -190,7 +204,7 @@ def test_equality_rows_hold() -> None:
                      np.zeros(1))  # fmt: skip
     speed = VelocityBounds("speed", np.full(3, -1.0), np.full(3, 1.0))
     jacobian = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
-    solution = WarmStartedLP().solve(jacobian, np.array([0.5, 0.5]), [row, speed])
+    solution = solve(WarmStartedLP(), jacobian, np.array([0.5, 0.5]), [row, speed])
     assert solution.status == "optimal"
     assert abs((row.matrix @ solution.u)[0]) <= EQUALITY_TOL
     np.testing.assert_allclose(solution.u, [0.5, 0.5 * np.tan(phi), 0.0], atol=1e-9)
@@ -200,7 +214,7 @@ def test_equality_rows_hold() -> None:
 
 def test_inequality_rows_hold() -> None:
     row = LinearRows("sum", np.array([[1.0, 1.0]]), np.array([-0.3]), np.array([0.3]))
-    solution = WarmStartedLP().solve(np.eye(2), np.array([1.0, 1.0]), [row])
+    solution = solve(WarmStartedLP(), np.eye(2), np.array([1.0, 1.0]), [row])
     assert solution.status == "optimal"
     assert (row.matrix @ solution.u)[0] == pytest.approx(0.3, abs=EQUALITY_TOL)
     assert solution.objective == pytest.approx(1.7, abs=OBJECTIVE_TOL)
@@ -208,7 +222,7 @@ def test_inequality_rows_hold() -> None:
 
 def test_one_norm_bound_holds_and_is_reported_active() -> None:
     bound = OneNormBound("error_derivative_bound", 0.5)
-    solution = WarmStartedLP().solve(np.eye(3), np.array([1.0, -2.0, 0.5]), [bound])
+    solution = solve(WarmStartedLP(), np.eye(3), np.array([1.0, -2.0, 0.5]), [bound])
     assert solution.status == "optimal"
     assert np.abs(solution.u).sum() == pytest.approx(0.5, abs=EQUALITY_TOL)
     assert solution.objective == pytest.approx(3.5 - 0.5, abs=OBJECTIVE_TOL)
@@ -216,7 +230,7 @@ def test_one_norm_bound_holds_and_is_reported_active() -> None:
 
 
 def test_zero_one_norm_bound_stops_every_joint() -> None:
-    solution = WarmStartedLP().solve(np.eye(3), np.ones(3), [OneNormBound("stop", 0.0)])
+    solution = solve(WarmStartedLP(), np.eye(3), np.ones(3), [OneNormBound("stop", 0.0)])
     assert solution.status == "optimal"
     np.testing.assert_allclose(solution.u, np.zeros(3), atol=1e-12)
 
@@ -233,7 +247,7 @@ def infeasible_rows() -> list[Rows]:
 
 
 def test_infeasible_problem_returns_zero_without_raising() -> None:
-    solution = WarmStartedLP().solve(np.eye(2), np.array([0.2, 0.2]), infeasible_rows())
+    solution = solve(WarmStartedLP(), np.eye(2), np.array([0.2, 0.2]), infeasible_rows())
     assert solution.status != "optimal"
     np.testing.assert_array_equal(solution.u, np.zeros(2))
     assert solution.objective is None
@@ -244,7 +258,7 @@ def test_infeasible_one_norm_bound_returns_zero() -> None:
         LinearRows("pin", np.array([[1.0, 0.0]]), np.ones(1), np.ones(1)),
         OneNormBound("norm", 0.5),
     ]
-    solution = WarmStartedLP().solve(np.eye(2), np.zeros(2), rows)
+    solution = solve(WarmStartedLP(), np.eye(2), np.zeros(2), rows)
     assert solution.status != "optimal"
     np.testing.assert_array_equal(solution.u, np.zeros(2))
 
@@ -252,9 +266,9 @@ def test_infeasible_one_norm_bound_returns_zero() -> None:
 def test_a_feasible_problem_after_an_infeasible_one_is_solved() -> None:
     lp = WarmStartedLP()
     jacobian, rhs, rows = random_problem(3)
-    cold = WarmStartedLP().solve(jacobian, rhs, rows)
-    assert lp.solve(np.eye(2), np.zeros(2), infeasible_rows()).status != "optimal"
-    after = lp.solve(jacobian, rhs, rows)
+    cold = solve(WarmStartedLP(), jacobian, rhs, rows)
+    assert solve(lp, np.eye(2), np.zeros(2), infeasible_rows()).status != "optimal"
+    after = solve(lp, jacobian, rhs, rows)
     assert after.status == "optimal"
     assert after.objective == pytest.approx(cold.objective, abs=OBJECTIVE_TOL)
 
@@ -263,8 +277,8 @@ def test_a_feasible_problem_after_an_infeasible_one_is_solved() -> None:
 def test_warm_started_solve_gives_the_same_objective(seed: int) -> None:
     lp = WarmStartedLP()
     jacobian, rhs, rows = random_problem(seed)
-    first = lp.solve(jacobian, rhs, rows)
-    second = lp.solve(jacobian, rhs, rows)
+    first = solve(lp, jacobian, rhs, rows)
+    second = solve(lp, jacobian, rhs, rows)
     assert second.status == first.status == "optimal"
     assert second.objective == pytest.approx(first.objective, abs=OBJECTIVE_TOL)
     assert residual_norm(jacobian, rhs, second.u) == pytest.approx(first.objective, abs=1e-8)
@@ -278,7 +292,7 @@ def test_warm_start_across_different_problems_of_one_shape() -> None:
     for _ in range(10):
         step_rhs = rhs + 0.3 * rng.normal(size=rhs.size)
         step_jacobian = jacobian + 0.1 * rng.normal(size=jacobian.shape)
-        warm = lp.solve(step_jacobian, step_rhs, rows)
+        warm = solve(lp, step_jacobian, step_rhs, rows)
         expected = reference_objective(step_jacobian, step_rhs, rows)
         assert warm.status == "optimal"
         assert warm.objective == pytest.approx(expected, abs=OBJECTIVE_TOL)
@@ -289,7 +303,7 @@ def test_problems_of_changing_shape_share_one_solver() -> None:
     lp = WarmStartedLP()
     for seed in (1, 2, 1, 4):
         jacobian, rhs, rows = random_problem(seed)
-        solution = lp.solve(jacobian, rhs, rows)
+        solution = solve(lp, jacobian, rhs, rows)
         assert solution.u.shape == (jacobian.shape[1],)
         assert solution.objective == pytest.approx(
             reference_objective(jacobian, rhs, rows), abs=OBJECTIVE_TOL
@@ -299,7 +313,7 @@ def test_problems_of_changing_shape_share_one_solver() -> None:
 def test_reset_forgets_the_basis_only() -> None:
     lp = WarmStartedLP()
     jacobian, rhs, rows = random_problem(5)
-    first = lp.solve(jacobian, rhs, rows)
+    first = solve(lp, jacobian, rhs, rows)
     lp.reset()
-    again = lp.solve(jacobian, rhs, rows)
+    again = solve(lp, jacobian, rhs, rows)
     assert again.objective == pytest.approx(first.objective, abs=OBJECTIVE_TOL)

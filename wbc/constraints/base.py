@@ -1,4 +1,4 @@
-"""What a constraint of the LP (5.29) sees and what it returns.
+"""What a constraint of the LP (5.29) returns: rows on the whole-body velocity u.
 
 A constraint is a small object with a ``name`` and ``rows(context)``; it returns one of three
 kinds of rows on the whole-body velocity u, and the LP builder only stacks them:
@@ -14,22 +14,9 @@ from typing import Protocol
 
 import numpy as np
 
-from wbc.obstacles import Circle
-from wbc.robot import MobileManipulator
+from wbc.step_context import StepContext
 
 Array = np.ndarray
-
-
-@dataclass(frozen=True)
-class StepContext:
-    """The state of one control step, as the constraints need it."""
-
-    robot: MobileManipulator
-    q: Array
-    error: Array
-    error_rate: Array
-    goal_xy: Array
-    obstacles: tuple[Circle, ...] = ()
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,8 @@ from typing import Literal
 
 import numpy as np
 
-from wbc.constraints.base import OneNormBound, StepContext
+from wbc.constraints.base import OneNormBound
+from wbc.step_context import StepContext
 
 
 class ErrorBound:

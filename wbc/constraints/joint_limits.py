@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from wbc.constraints.base import StepContext, VelocityBounds
+from wbc.constraints.base import VelocityBounds
+from wbc.step_context import StepContext
 
 
 class JointLimits:

@@ -6,7 +6,8 @@ import math
 
 import numpy as np
 
-from wbc.constraints.base import LinearRows, StepContext
+from wbc.constraints.base import LinearRows
+from wbc.step_context import StepContext
 
 
 class BorderObstacle:

@@ -6,7 +6,8 @@ import math
 
 import numpy as np
 
-from wbc.constraints.base import StepContext, VelocityBounds
+from wbc.constraints.base import VelocityBounds
+from wbc.step_context import StepContext
 
 
 class ConservativeObstacle:

@@ -1,0 +1,155 @@
+"""Random pose goals, and the share of them a law reaches inside the robot's limits.
+
+A goal is the end-effector pose of a goal configuration: the base placed some distance and
+bearing from the start, at some heading, with the arm in a box of joint angles; so every goal
+is reachable. Each family declares its ranges once.
+"""
+
+from __future__ import annotations
+
+import math
+import multiprocessing
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from parsimony.kinematic_demo import DT, START
+from wbc.cascade_law import CascadeLaw
+from wbc.kinematic_run import integrate
+from wbc.law_output import Law
+from wbc.lp_law import LPLaw, LPParams
+from wbc.robot import MobileManipulator
+from wbc.task import PoseTask
+
+Array = np.ndarray
+
+ARM_BOX = (np.array([-0.5, -0.8, -0.8, -0.5, -0.8]), np.array([0.5, 0.3, 0.3, 0.5, 0.8]))
+"""A moderate box of arm angles (rad), inside the 0.9-scaled joint limits."""
+START_SPREAD = 0.3
+"""The start arm is START's, each joint moved by up to this much (rad), clipped to ARM_BOX."""
+TIME_LIMIT_S = 60.0
+TOLERANCE = 1e-3
+LIMIT_TOLERANCE = 1e-6
+
+
+@dataclass(frozen=True)
+class GoalFamily:
+    """Goal base at distance and bearing from the start base (facing x), at a heading."""
+
+    name: str
+    distance: tuple[float, float]
+    bearing: tuple[float, float]
+    heading: tuple[float, float]
+
+    def sample(self, rng: np.random.Generator) -> tuple[Array, Array]:
+        """(start configuration, goal configuration)."""
+        low, high = ARM_BOX
+        arm_start = np.clip(START[3:] + rng.uniform(-START_SPREAD, START_SPREAD, 5), low, high)
+        distance, bearing = rng.uniform(*self.distance), rng.uniform(*self.bearing)
+        base = [distance * math.cos(bearing), distance * math.sin(bearing),
+                rng.uniform(*self.heading)]  # fmt: skip
+        goal = np.concatenate((base, rng.uniform(low, high)))
+        return np.concatenate((START[:3], arm_start)), goal
+
+
+AHEAD = math.radians(35.0)
+FAMILIES = {
+    "ahead": GoalFamily("ahead", (0.3, 1.2), (-AHEAD, AHEAD), (-AHEAD, AHEAD)),
+    "anywhere": GoalFamily("anywhere", (0.0, 1.2), (-math.pi, math.pi), (-math.pi, math.pi)),
+}
+"""'ahead': the dissertation's kind (goal base 0.3-1.2 m away, within 35 degrees of straight
+ahead, heading within 35 degrees); 'anywhere': within 1.2 m at any bearing and heading."""
+
+
+@dataclass(frozen=True)
+class Attempt:
+    """One closed-loop run towards one goal."""
+
+    converged: bool
+    steps: int
+    joint_overrun: float
+    """Largest excursion of a joint beyond [q_min, q_max] (rad, 0 inside)."""
+    speed_overrun: float
+    """Largest |u_i| beyond the speed bound velocity_max_i (0 inside)."""
+    nonzero: tuple[int, ...]
+    """Nonzero entries of u at every step."""
+
+    @property
+    def within_joint_limits(self) -> bool:
+        return self.converged and self.joint_overrun <= LIMIT_TOLERANCE
+
+    @property
+    def within_all_limits(self) -> bool:
+        return self.within_joint_limits and self.speed_overrun <= LIMIT_TOLERANCE
+
+
+def attempt(law: Law, robot: MobileManipulator, start: Array, goal: Array) -> Attempt:
+    """Run ``law`` from ``start`` to the pose of ``goal`` for at most TIME_LIMIT_S."""
+    task = PoseTask(robot.fkm(goal))
+    run = integrate(law, start, task, DT, int(TIME_LIMIT_S / DT), TOLERANCE)
+    q = np.array(run.configurations)
+    u = run.velocities()
+    joint_overrun = np.maximum(q - robot.q_max, robot.q_min - q).max()
+    speed_overrun = (np.abs(u) - robot.velocity_max).max()
+    return Attempt(run.converged, len(run.outputs), float(max(joint_overrun, 0.0)),
+                   float(max(speed_overrun, 0.0)),
+                   tuple(out.nonzero for out in run.outputs))  # fmt: skip
+
+
+def goals(family: GoalFamily, count: int, seed: int = 1) -> list[tuple[Array, Array]]:
+    rng = np.random.default_rng(seed)
+    return [family.sample(rng) for _ in range(count)]
+
+
+def shares(attempts: Iterable[Attempt]) -> dict[str, float]:
+    """Share of goals reached: at all, inside the joint limits, inside joint and speed limits."""
+    attempts = list(attempts)
+    count = max(len(attempts), 1)
+    return {
+        "reached": sum(a.converged for a in attempts) / count,
+        "within_joint_limits": sum(a.within_joint_limits for a in attempts) / count,
+        "within_joint_and_speed_limits": sum(a.within_all_limits for a in attempts) / count,
+    }
+
+
+def nonzero_histogram(attempts: Iterable[Attempt], dof: int) -> list[int]:
+    """How many control steps had 0, 1, ..., dof nonzero entries of u."""
+    counts = np.zeros(dof + 1, dtype=int)
+    for one in attempts:
+        counts += np.bincount(one.nonzero, minlength=dof + 1)
+    return counts.tolist()
+
+
+LAWS: dict[str, Callable[[MobileManipulator], Law]] = {
+    "lp": lambda robot: LPLaw(robot),
+    "lp 5.29 exactly": lambda robot: LPLaw(robot, EXACT_5_29),
+    "cascade": lambda robot: CascadeLaw(robot),
+}
+"""The laws compared: the default LP, LP 5.29 with no term added to the task, the cascade."""
+EXACT_5_29 = LPParams(velocity_cost=0.0, waist_centring=0.0, base_target=0.0)
+
+
+def _attempt_one(job: tuple[str, Path, Array, Array]) -> Attempt:
+    law_name, robot_file, start, goal = job
+    robot = MobileManipulator.from_yaml(robot_file)
+    return attempt(LAWS[law_name](robot), robot, start, goal)
+
+
+def goal_report(robot_file: Path, count: int, processes: int = 2) -> dict:
+    """For every family and law: the three shares, and the LP's nonzero histograms."""
+    dof = MobileManipulator.from_yaml(robot_file).dof
+    report: dict = {}
+    with multiprocessing.get_context("spawn").Pool(processes) as pool:
+        for family in FAMILIES.values():
+            pairs = goals(family, count)
+            rows = {}
+            for law_name in LAWS:
+                jobs = [(law_name, robot_file, start, goal) for start, goal in pairs]
+                attempts = pool.map(_attempt_one, jobs, chunksize=1)
+                rows[law_name] = shares(attempts)
+                if law_name.startswith("lp"):
+                    rows[law_name]["nonzero_histogram"] = nonzero_histogram(attempts, dof)
+            report[family.name] = {"goals": count, "laws": rows}
+    return report

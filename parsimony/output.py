@@ -1,0 +1,59 @@
+"""Standard output carries a command's result and nothing else.
+
+While a command runs, file descriptor 1 and ``sys.stdout`` point at standard error, so whatever
+a library prints there (HiGHS 1.16 prints a banner from its C++ constructor) reaches the
+terminal as a log line, never the result. The result goes through ``emit``, which writes to the
+original standard output.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+from collections.abc import Iterator
+from typing import TextIO
+
+_result: TextIO | None = None
+
+
+def emit(text: str) -> None:
+    """Write one result line (JSON or a table) to the command's standard output."""
+    stream = _result if _result is not None else sys.stdout
+    stream.write(text + "\n")
+    stream.flush()
+
+
+@contextlib.contextmanager
+def result_only_stdout() -> Iterator[None]:
+    """Send fd 1 and ``sys.stdout`` to standard error; keep the original stdout for ``emit``.
+
+    When ``sys.stdout`` is not file descriptor 1 (a caller captured it), results go there and
+    the descriptors are left alone.
+    """
+    global _result
+    if not _is_descriptor_1(sys.stdout):
+        yield
+        return
+    sys.stdout.flush()
+    saved = os.dup(1)
+    previous_stdout = sys.stdout
+    try:
+        os.dup2(2, 1)
+        _result = os.fdopen(os.dup(saved), "w", encoding="utf-8")
+        sys.stdout = sys.stderr
+        yield
+    finally:
+        sys.stdout = previous_stdout
+        if _result is not None:
+            _result.close()
+            _result = None
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+def _is_descriptor_1(stream: TextIO) -> bool:
+    try:
+        return stream.fileno() == 1
+    except (AttributeError, OSError, ValueError):
+        return False

@@ -1,0 +1,80 @@
+"""Turn the base towards where it should stand for a pose goal: w s |phi' - k angle_to(T)|.
+
+A differential-drive base cannot move sideways, so it must face the place it has to reach
+before it drives there. For a pose goal that place T is not the goal itself but a set-back
+``reach`` behind it, along the yaw psi of the goal's arm plane: T = p_d,xy - reach (cos psi,
+sin psi). The arm plane is perpendicular to the wrist-pitch axis, the end effector's y axis,
+so psi = yaw(r_d j r_d*) - pi/2 with r_d the goal rotation.
+
+The term asks phi' = k wrap(atan2(T - q_xy) - phi). The turn it asks for costs the task
+nothing: phi' = -q1' moves no part of the end effector, and the waist centring term
+(wbc.objectives.waist_centring) takes the waist back afterwards. Its weight ramps from 0 at
+``stop_distance`` from T to w at twice that distance, so the base stops steering as it arrives
+and the task alone places it. Position goals have no arm plane: the term is idle for them.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from wbc import dq
+from wbc.objectives.base import ResidualCost
+from wbc.step_context import StepContext
+
+J_AXIS = np.array([0.0, 0.0, 1.0, 0.0])
+"""The pure quaternion j: the end effector's y axis in its own frame."""
+
+
+def wrap(angle: float) -> float:
+    """The angle in [-pi, pi)."""
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def arm_plane_yaw(goal_pose: np.ndarray) -> float:
+    """psi: yaw of the goal end effector's y axis, less pi/2."""
+    rotation = dq.rotation(goal_pose)
+    y_axis = dq.qmul(dq.qmul(rotation, J_AXIS), dq.qconj(rotation))
+    return math.atan2(y_axis[2], y_axis[1]) - 0.5 * math.pi
+
+
+class BaseTarget:
+    """weight * s * |phi' - gain * wrap(bearing(T) - phi)|, s = clip(d / stop - 1, 0, 1)."""
+
+    name = "base_target"
+
+    def __init__(self, weight: float, gain: float, reach: float, stop_distance: float) -> None:
+        if not (weight >= 0.0 and gain > 0.0 and reach >= 0.0 and stop_distance > 0.0):
+            raise ValueError("base target needs weight >= 0, gain > 0, reach >= 0 and "
+                             "stop_distance > 0")  # fmt: skip
+        self.weight, self.gain = weight, gain
+        self.reach, self.stop_distance = reach, stop_distance
+        self._goal_pose: np.ndarray | None = None
+        self._target = (0.0, 0.0)
+
+    def target(self, goal_pose: np.ndarray) -> tuple[float, float]:
+        """T: the goal's floor position, set back by ``reach`` along its arm plane.
+
+        Kept while the goal pose is the same object (a task's pose is read-only), so a step
+        does not compute it again.
+        """
+        if goal_pose is not self._goal_pose:
+            psi = arm_plane_yaw(goal_pose)
+            position = dq.translation(goal_pose)
+            self._goal_pose = goal_pose
+            self._target = (position[1] - self.reach * math.cos(psi),
+                            position[2] - self.reach * math.sin(psi))  # fmt: skip
+        return self._target
+
+    def cost(self, context: StepContext) -> ResidualCost:
+        row = np.zeros((1, context.robot.dof))
+        row[0, 2] = 1.0
+        if context.goal_pose is None:
+            return ResidualCost(self.name, row, np.zeros(1), 0.0)
+        x, y, phi = context.q[:3].tolist()
+        target_x, target_y = self.target(context.goal_pose)
+        distance = math.hypot(target_x - x, target_y - y)
+        ramp = min(1.0, max(0.0, distance / self.stop_distance - 1.0))
+        turn = wrap(math.atan2(target_y - y, target_x - x) - phi)
+        return ResidualCost(self.name, row, np.array([-self.gain * turn]), self.weight * ramp)

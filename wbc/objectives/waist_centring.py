@@ -1,0 +1,40 @@
+"""Spend the waist/base-yaw self-motion on keeping the waist centred: w |q1' + k q1|.
+
+On this robot the base-yaw column of the whole-body Jacobian equals the waist (q1) column, so
+phi' = -q1' moves no part of the end effector: under the nonholonomic equality it is the only
+instantaneous redundancy. 5.29 leaves it to chance; this term asks for q1' = -k q1, which the
+base's turn can absorb at no cost to the task. The base then turns to face where the arm
+reaches, and the waist keeps its range for the task instead of stalling at its limit.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from wbc.objectives.base import ResidualCost
+from wbc.robot import BASE_DOF
+from wbc.step_context import StepContext
+
+
+class WaistCentring:
+    """weight * f * |q1' + gain q1|, faded by f = min(1, ||e||_1 / fade_error).
+
+    The term competes with the task for the budget of 5.10, which shrinks with e'; near the
+    goal, where the task needs all of it, the fade hands it back (fade_error 0: no fade).
+    """
+
+    name = "waist_centring"
+
+    def __init__(self, weight: float, gain: float, fade_error: float = 0.0) -> None:
+        if not (weight >= 0.0 and gain > 0.0 and fade_error >= 0.0):
+            raise ValueError("waist centring needs weight >= 0, gain > 0 and fade_error >= 0")
+        self.weight, self.gain, self.fade_error = weight, gain, fade_error
+
+    def cost(self, context: StepContext) -> ResidualCost:
+        row = np.zeros((1, context.robot.dof))
+        row[0, BASE_DOF] = 1.0
+        fade = 1.0
+        if self.fade_error > 0.0:
+            fade = min(1.0, float(np.abs(context.error).sum()) / self.fade_error)
+        offset = np.array([self.gain * context.q[BASE_DOF]])
+        return ResidualCost(self.name, row, offset, self.weight * fade)

@@ -1,0 +1,27 @@
+"""What a constraint or an objective term of the LP (5.29) sees at one control step."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from wbc.obstacles import Circle
+from wbc.robot import MobileManipulator
+
+Array = np.ndarray
+
+
+@dataclass(frozen=True)
+class StepContext:
+    """The state of one control step: configuration, task error and its rate, goal, obstacles."""
+
+    robot: MobileManipulator
+    q: Array
+    error: Array
+    error_rate: Array
+    goal_xy: Array
+    """The goal's end-effector position projected on the floor (q_d of 5.25)."""
+    obstacles: tuple[Circle, ...] = ()
+    goal_pose: Array | None = None
+    """The goal's end-effector pose for a pose task; None for a position task."""
