@@ -32,6 +32,8 @@ START_SPREAD = 0.3
 TIME_LIMIT_S = 60.0
 TOLERANCE = 1e-3
 LIMIT_TOLERANCE = 1e-6
+GOAL_SEED = 2
+"""The bench's goals. The secondary objective terms were tuned on seed 1, so it is not used."""
 
 
 @dataclass(frozen=True)
@@ -98,7 +100,7 @@ def attempt(law: Law, robot: MobileManipulator, start: Array, goal: Array) -> At
                    tuple(out.nonzero for out in run.outputs))  # fmt: skip
 
 
-def goals(family: GoalFamily, count: int, seed: int = 1) -> list[tuple[Array, Array]]:
+def goals(family: GoalFamily, count: int, seed: int = GOAL_SEED) -> list[tuple[Array, Array]]:
     rng = np.random.default_rng(seed)
     return [family.sample(rng) for _ in range(count)]
 

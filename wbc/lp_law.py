@@ -68,8 +68,9 @@ class LPParams:
     base_target_gain: float = 2.0
     """k of the base target (1/s)."""
     base_target_reach: float = 0.36
-    """How far behind the goal, along its arm plane, the base should stand (m): the mean
-    horizontal reach of the arm over the box of arm goals of `parsimony bench` (0.36 +- 0.08)."""
+    """How far behind the goal, along the gripper's heading, the base should stand (m): the
+    mean horizontal reach of the arm over the box of arm goals of `parsimony bench`
+    (0.36 +- 0.08)."""
     base_target_stop: float = 0.15
     """Distance from T within which the base target is off; its weight is full at twice (m)."""
     nonholonomic: bool = True

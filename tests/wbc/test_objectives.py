@@ -1,0 +1,114 @@
+"""The secondary objective terms of the LP (wbc/objectives/), alone and inside the law."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from wbc_scenarios import DT, HOME, robot
+
+from wbc import dq
+from wbc.lp_law import LPLaw, LPParams
+from wbc.objectives.base_target import BaseTarget, gripper_heading
+from wbc.objectives.velocity_cost import LeastVelocity
+from wbc.objectives.waist_centring import WaistCentring
+from wbc.step_context import StepContext
+from wbc.task import PoseTask, PositionTask
+
+MODEL = robot()
+WAIST, YAW = 3, 2
+
+
+def context(q: np.ndarray, goal_pose: np.ndarray | None, error: np.ndarray) -> StepContext:
+    return StepContext(MODEL, q, error, -error, np.zeros(2), (), goal_pose)
+
+
+def test_waist_centring_asks_for_q1_rate_minus_k_q1_and_fades_near_the_goal():
+    q = HOME.copy()
+    q[WAIST] = 0.4
+    term = WaistCentring(weight=0.02, gain=1.5, fade_error=0.05)
+    far = term.cost(context(q, None, np.full(8, 0.1)))
+    u = np.zeros(MODEL.dof)
+    u[WAIST] = -1.5 * 0.4
+    assert far.weight == pytest.approx(0.02)
+    assert abs((far.matrix @ u + far.offset)[0]) < 1e-12
+    near = term.cost(context(q, None, np.full(8, 0.1 / 32)))  # ||e||_1 = 0.025
+    assert near.weight == pytest.approx(0.01)
+
+
+def test_the_law_spends_the_self_motion_on_centring_the_waist():
+    """With the waist turned, the LP turns the base and the waist against each other
+    (phi' = -q1' moves no part of the end effector, 4.9): q1 heads back to 0 at no cost to
+    the task residual ||J u + eta e||_1."""
+    goal = HOME.copy()
+    start = goal.copy()
+    start[YAW], start[WAIST] = -0.3, 0.3  # the same end-effector pose as the goal's
+    np.testing.assert_allclose(MODEL.fkm(start), MODEL.fkm(goal), atol=1e-12)
+    task = PoseTask(MODEL.fkm(np.concatenate(([0.02], goal[1:]))))  # 2 cm ahead
+    pose, jacobian = MODEL.kinematics(start)
+    error, _ = task.error(pose, jacobian)
+
+    def residual(params: LPParams) -> tuple[np.ndarray, float]:
+        u = LPLaw(MODEL, params).step(start, task, DT).u
+        return u, float(np.abs(jacobian @ u + params.eta * error).sum())
+
+    centred, centred_residual = residual(LPParams(base_target=0.0))
+    _, plain_residual = residual(LPParams(base_target=0.0, waist_centring=0.0))
+    assert centred[WAIST] < 0.0 < centred[YAW]
+    assert centred_residual == pytest.approx(plain_residual, abs=1e-9)
+
+
+@pytest.mark.parametrize("phi, q1", [(0.0, 0.0), (0.5, -0.3), (-2.0, 1.2), (3.0, 0.4)])
+def test_with_the_wrist_at_zero_the_gripper_heads_along_the_arm_plane(phi, q1):
+    q = np.array([0.3, -0.2, phi, q1, -0.4, 0.1, 0.0, 0.0])
+    psi = gripper_heading(MODEL.fkm(q))
+    assert math.cos(psi - phi - q1) == pytest.approx(1.0, abs=1e-12)
+
+
+def test_base_target_lies_behind_the_goal_along_the_gripper_heading():
+    goal = np.array([1.0, 0.5, 0.3, 0.2, -0.4, 0.1, 0.0, 0.0])
+    pose = MODEL.fkm(goal)
+    term = BaseTarget(weight=0.05, gain=2.0, reach=0.36, stop_distance=0.15)
+    target_x, target_y = term.target(pose)
+    end_effector = dq.translation(pose)[1:3]
+    heading = 0.3 + 0.2
+    np.testing.assert_allclose(end_effector - [target_x, target_y],
+                               0.36 * np.array([math.cos(heading), math.sin(heading)]),
+                               atol=1e-12)  # fmt: skip
+
+
+def test_base_target_turns_towards_the_target_and_stops_near_it():
+    goal = np.array([1.0, 1.0, 0.8, 0.0, -0.4, 0.1, 0.0, 0.6])
+    pose = MODEL.fkm(goal)
+    term = BaseTarget(weight=0.05, gain=2.0, reach=0.36, stop_distance=0.15)
+    far = term.cost(context(HOME, pose, np.ones(8)))
+    target_x, target_y = term.target(pose)
+    bearing = math.atan2(target_y, target_x)  # the base is at the origin facing x
+    assert far.weight == pytest.approx(0.05)
+    assert -far.offset[0] == pytest.approx(2.0 * bearing)
+    at_target = np.concatenate(([target_x, target_y], HOME[2:]))
+    assert term.cost(context(at_target, pose, np.ones(8))).weight == 0.0
+
+
+def test_base_target_is_idle_for_a_position_task():
+    term = BaseTarget(weight=0.05, gain=2.0, reach=0.36, stop_distance=0.15)
+    assert term.cost(context(HOME, None, np.ones(3))).weight == 0.0
+    law = LPLaw(MODEL)
+    out = law.step(HOME, PositionTask(np.array([1.0, 1.0, 0.3])), DT)
+    assert out.ok
+
+
+def test_least_velocity_weighs_every_entry_of_u():
+    cost = LeastVelocity(1e-3).cost(context(HOME, None, np.ones(8)))
+    np.testing.assert_array_equal(cost.weights, np.full(MODEL.dof, 1e-3))
+
+
+@pytest.mark.parametrize(
+    "make", [lambda: WaistCentring(-1.0, 1.0), lambda: WaistCentring(0.02, 0.0),
+             lambda: BaseTarget(0.05, 2.0, -0.1, 0.15), lambda: BaseTarget(0.05, 2.0, 0.36, 0.0),
+             lambda: LeastVelocity(float("nan"))],
+)  # fmt: skip
+def test_invalid_term_parameters_are_refused(make):
+    with pytest.raises(ValueError):
+        make()
