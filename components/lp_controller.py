@@ -38,6 +38,10 @@ class LPController(Controller):
             doc="obstacle constraint: 5.28 (border), 5.19 (conservative) or none",
         ),
         Param("velocity_cost", float, LPParams.velocity_cost, low=0.0, high=1.0, doc="tie-break w"),
+        Param("waist_centring", float, LPParams.waist_centring, low=0.0, high=1.0,
+              doc="weight of |q1' + k q1| (0: off)"),
+        Param("base_target", float, LPParams.base_target, low=0.0, high=1.0,
+              doc="weight of turning the base towards where it should stand (0: off)"),
         *CONTROLLER_PARAMS,
     )
 

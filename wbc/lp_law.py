@@ -26,7 +26,7 @@ from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
 from wbc.step_context import StepContext
 from wbc.task import PoseTask, Task, same_task
-from wbc.validation import require_finite, require_positive
+from wbc.validation import NonFiniteInputError, require_finite, require_positive
 
 Array = np.ndarray
 
@@ -165,7 +165,7 @@ class LPLaw:
         q = require_finite("configuration q", q)
         dt = float(dt)
         if not math.isfinite(dt):
-            require_finite("dt", dt)
+            raise NonFiniteInputError(f"dt must be finite, got {dt}")
         if dt <= 0.0:
             raise ValueError(f"dt must be > 0, got {dt}")
         for index, obstacle in enumerate(obstacles):
