@@ -4,7 +4,8 @@ A profile is validated before anything starts. Every error names the file, the
 field path (``components[1].restart.policy``) and what was expected. Zenoh
 endpoints must be on the loopback interface (or a unix socket) and multicast
 scouting is off, unless the profile says ``allow_remote: true``: running across
-hosts is an explicit choice, never the default.
+hosts is an explicit choice, never the default. ``extends: base.yaml`` starts from
+another profile and says only what differs (components are matched by name).
 """
 
 from __future__ import annotations
@@ -289,16 +290,68 @@ def _check_files_and_modules(path: Path, profile: Profile) -> Profile:
     return profile.model_copy(update={"robot": robot})
 
 
-def load_profile(path: str | Path) -> Profile:
-    """Read and validate a profile; ``robot`` comes back as an absolute path.
-
-    Raises ``ProfileError`` naming the file, the field and what was expected.
+def merge(base: object, override: object) -> object:
+    """``override`` laid over ``base``: mappings merge key by key, ``components`` by name (an
+    entry with a known name merges into it, a new name is appended), anything else is replaced.
     """
-    path = Path(path)
+    if isinstance(base, dict) and isinstance(override, dict):
+        merged = dict(base)
+        for key, value in override.items():
+            if key == "components" and isinstance(value, list) and isinstance(base.get(key), list):
+                merged[key] = _merge_components(base[key], value)
+            else:
+                merged[key] = merge(base[key], value) if key in base else value
+        return merged
+    return override
+
+
+def _merge_components(base: list, override: list) -> list:
+    merged = list(base)
+    names = [entry.get("name") if isinstance(entry, dict) else None for entry in base]
+    for entry in override:
+        name = entry.get("name") if isinstance(entry, dict) else None
+        if name is not None and name in names:
+            index = names.index(name)
+            merged[index] = merge(merged[index], entry)
+        else:
+            merged.append(entry)
+    return merged
+
+
+def read_profile_data(path: Path, chain: tuple[Path, ...] = ()) -> dict:
+    """The profile's mapping, with ``extends: other.yaml`` (relative to the file) resolved.
+
+    A relative ``robot`` path is made absolute against the file that names it.
+    """
     data = _read_yaml(path)
     if not isinstance(data, dict):
         got = type(data).__name__
         raise ProfileError(f"{path}: expected a mapping at the top level, got {got}")
+    if isinstance(data.get("robot"), str):
+        data["robot"] = str((path.parent / data["robot"]).resolve())
+    parent = data.pop("extends", None)
+    if parent is None:
+        return data
+    if not isinstance(parent, str):
+        raise ProfileError(f"{path}: extends: expected the path of a profile, got {parent!r}")
+    base_path = (path.parent / parent).resolve()
+    if base_path in chain or base_path == path.resolve():
+        cycle = " -> ".join(str(p) for p in (*chain, path.resolve(), base_path))
+        raise ProfileError(f"{path}: extends: profiles extend each other in a circle: {cycle}")
+    if not base_path.is_file():
+        raise ProfileError(f"{path}: extends: no profile at {base_path}")
+    base = read_profile_data(base_path, (*chain, path.resolve()))
+    return merge(base, data)  # type: ignore[return-value]
+
+
+def load_profile(path: str | Path) -> Profile:
+    """Read and validate a profile; ``robot`` comes back as an absolute path.
+
+    ``extends: base.yaml`` starts from another profile and overrides what the file says
+    (see ``merge``). Raises ``ProfileError`` naming the file, the field and what was expected.
+    """
+    path = Path(path)
+    data = read_profile_data(path)
     try:
         profile = Profile.model_validate(data)
     except ValidationError as error:

@@ -18,7 +18,7 @@ import yaml
 import zenoh
 from pydantic import BaseModel
 
-from deploy.profile import Profile, load_profile
+from deploy.profile import Profile, load_profile, read_profile_data
 from messages import codec, topics
 
 M = TypeVar("M", bound=BaseModel)
@@ -122,7 +122,8 @@ def system(tmp_path: Path) -> Iterator[System]:
 
 @pytest.fixture
 def deployed(tmp_path: Path) -> Iterator[Callable[[str], System]]:
-    """``deployed(text)``: a profile of ``deploy/`` (its YAML text) with its router open.
+    """``deployed(profile)``: a profile of ``deploy/`` (its path, or its YAML text) with its
+    router open.
 
     The copy's router moves to a free loopback port and its robot path becomes absolute
     (the copy lives in a temporary directory); nothing else changes. The processes
@@ -130,10 +131,13 @@ def deployed(tmp_path: Path) -> Iterator[Callable[[str], System]]:
     """
     with ExitStack() as stack:
 
-        def deploy(text: str) -> System:
-            data: dict[str, Any] = yaml.safe_load(text)
+        def deploy(profile: str | Path) -> System:
+            if isinstance(profile, Path):
+                data: dict[str, Any] = read_profile_data(profile)
+            else:
+                data = yaml.safe_load(profile)
+                data["robot"] = str(DEPLOY / data["robot"])
             data["zenoh"]["router"] = [f"tcp/127.0.0.1:{free_port()}"]
-            data["robot"] = str(DEPLOY / data["robot"])
             path = tmp_path / f"deployed{len(list(tmp_path.glob('*.yaml')))}.yaml"
             path.write_text(yaml.safe_dump(data, sort_keys=False))
             profile = load_profile(path)

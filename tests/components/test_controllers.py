@@ -22,6 +22,7 @@ import yaml
 from components.lp_controller import LPController
 from components.runtime import Node
 from deploy import query
+from deploy.profile import load_profile
 from messages import codec, topics
 from messages.commands import ArmCommand, BaseCommand
 from messages.diagnostics import ControllerDiagnostics
@@ -156,10 +157,11 @@ def operator(deployed: Callable[[str], System]) -> Operator:
 
 
 def test_the_cascade_profile_is_the_lp_profile_with_another_module() -> None:
-    lp = LP_PROFILE.read_text()
-    assert lp.count("module: lp_controller") == 1
-    swapped = lp.replace("module: lp_controller", "module: cascade_controller")
-    assert CASCADE_PROFILE.read_text() == swapped
+    lp, cascade = load_profile(LP_PROFILE), load_profile(CASCADE_PROFILE)
+    assert lp.component("controller").module == "lp_controller"
+    swapped = [spec.model_copy(update={"module": "cascade_controller"})
+               if spec.name == "controller" else spec for spec in lp.components]  # fmt: skip
+    assert cascade == lp.model_copy(update={"components": swapped})
 
 
 def test_the_profile_starts_inside_the_joint_limits_with_the_pose_of_goal_q_as_goal() -> None:
@@ -174,9 +176,9 @@ def test_the_profile_starts_inside_the_joint_limits_with_the_pose_of_goal_q_as_g
 
 @pytest.mark.parametrize(("profile", "law"), [(LP_PROFILE, "lp"), (CASCADE_PROFILE, "cascade")])
 def test_a_profile_with_a_scripted_state_and_goal_makes_finite_optimal_commands(
-    deployed: Callable[[str], System], profile: Path, law: str
+    deployed: Callable[[str | Path], System], profile: Path, law: str
 ) -> None:
-    system = deployed(profile.read_text())
+    system = deployed(profile)
     operator = Operator(system)
     system.start("controller")
     system.start("publisher")

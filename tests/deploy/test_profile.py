@@ -226,3 +226,56 @@ def test_start_order_is_by_role_and_skips_disabled_components(tmp_path: Path) ->
     ]
     profile = load_profile(write(tmp_path, {"namespace": "sim", "components": components}))
     assert [spec.name for spec in profile.start_order()] == ["drv", "est", "ctrl", "tool"]
+
+
+def test_a_profile_extends_another_and_says_only_what_differs(tmp_path: Path) -> None:
+    (tmp_path / "robots").mkdir()
+    (tmp_path / "robots" / "robot.yaml").write_text("links: []\n")
+    base = {
+        "namespace": "sim",
+        "robot": "robots/robot.yaml",
+        "zenoh": {"router": ["tcp/127.0.0.1:7600"]},
+        "components": [
+            {**PUB, "params": {"rate_hz": 50.0, "goal_task": "pose"}},
+            {"name": "ctl", "module": "lp_controller", "role": "controller",
+             "params": {"eta": 0.6}},
+        ],
+    }  # fmt: skip
+    (tmp_path / "base.yaml").write_text(yaml.safe_dump(base))
+    child_dir = tmp_path / "variants"
+    child_dir.mkdir()
+    child = {
+        "extends": "../base.yaml",
+        "zenoh": {"mode": "client"},
+        "components": [
+            {"name": "ctl", "module": "cascade_controller"},
+            {"name": "pub", "params": {"rate_hz": 10.0}},
+            {"name": "extra", "module": "scripted_publisher", "role": "tool", "enabled": False},
+        ],
+    }
+    path = child_dir / "child.yaml"
+    path.write_text(yaml.safe_dump(child))
+    profile = load_profile(path)
+    assert profile.namespace == "sim" and profile.zenoh.mode == "client"
+    assert profile.zenoh.router == ["tcp/127.0.0.1:7600"]
+    assert profile.robot == tmp_path / "robots" / "robot.yaml"  # relative to base.yaml
+    assert [spec.name for spec in profile.components] == ["pub", "ctl", "extra"]
+    assert profile.component("ctl").module == "cascade_controller"
+    assert profile.component("ctl").params == {"eta": 0.6}
+    assert profile.component("pub").params == {"rate_hz": 10.0, "goal_task": "pose"}
+    assert [spec.name for spec in profile.start_order()] == ["ctl", "pub"]
+
+
+def test_extends_that_is_missing_or_circular_is_refused(tmp_path: Path) -> None:
+    assert "extends: no profile at" in refusal(tmp_path, {"extends": "nowhere.yaml"})
+    (tmp_path / "a.yaml").write_text(yaml.safe_dump({"extends": "b.yaml"}))
+    (tmp_path / "b.yaml").write_text(yaml.safe_dump({"extends": "a.yaml"}))
+    with pytest.raises(ProfileError, match="in a circle"):
+        load_profile(tmp_path / "a.yaml")
+
+
+def test_an_invalid_override_names_its_field(tmp_path: Path) -> None:
+    (tmp_path / "base.yaml").write_text(yaml.safe_dump({"namespace": "sim", "components": [PUB]}))
+    message = refusal(tmp_path, {"extends": "base.yaml", "components": [{"name": "pub",
+                                 "restart": {"policy": "sometimes"}}]})  # fmt: skip
+    assert "components[0].restart.policy" in message
