@@ -117,8 +117,14 @@ class Controller(Component):
 
     def on_goal(self, goal: Goal) -> None:
         """Take a goal; a different task resets the law. A goal the law refuses (ValueError,
-        counted in ``errors.control/goal``) drops the current one: no goal, zero commands."""
+        counted in ``errors.control/goal``) drops the current one: no goal, zero commands.
+        The goal's ``eta`` and ``beta`` must lie in the bounds of the parameters they override,
+        as for ``parsimony param set``."""
         try:
+            for name in ("eta", "beta"):
+                value = getattr(goal, name)
+                if value is not None and name in self.node.params:
+                    self.node.params.param(name).check(value)
             task = task_of(goal)
         except ValueError:
             self.goal = self.task = None

@@ -289,6 +289,18 @@ def test_param_set_and_goal_gains_reach_the_next_step(
     assert "eta: expected a float in [0.001, 100.0]" in capsys.readouterr().err
 
 
+def test_a_goal_whose_gains_leave_the_parameter_bounds_is_refused(operator: Operator) -> None:
+    """eta = 1e300 on a goal is checked like `param set`: refused, counted, zero commands."""
+    operator.send_goal()
+    assert operator.step()[0].status == "optimal"
+    operator.send_goal(eta=1e300)
+    diagnostics = operator.step()[0]
+    assert diagnostics.status == "no goal", diagnostics
+    assert operator.counters()["errors.control/goal"] >= 1
+    operator.send_goal(eta=1.5)
+    assert operator.step()[0].parameters["eta"] == 1.5
+
+
 def test_a_robot_description_that_cannot_be_loaded_is_a_configuration_error(
     deployed: Callable[[str], System],
 ) -> None:
