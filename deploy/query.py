@@ -14,6 +14,7 @@ import zenoh
 
 from components.params import ParamValue, decode_value
 from deploy.profile import ZenohSettings, load_profile
+from deploy.zenoh_error import zenoh_error_text
 from messages import codec, topics
 from messages.status import ComponentStatus
 
@@ -53,7 +54,8 @@ class Target:
             return zenoh.open(self.zenoh.client_config())
         except zenoh.ZError as error:
             where = ", ".join(self.zenoh.connect_endpoints)
-            raise QueryError(f"cannot reach a router at {where}: {error}") from error
+            reason = zenoh_error_text(error)
+            raise QueryError(f"cannot reach a router at {where}: {reason}") from error
 
 
 def live_components(

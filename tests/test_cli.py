@@ -89,3 +89,23 @@ def test_demo_reports_every_experiment_and_exits_zero():
     assert rows[("obstacle", "LP border")]["min_obstacle_clearance"] > 0.0
     assert rows[("joint limit", "pinv")]["worst_joint_overrun"] > 0.0
     assert rows[("joint limit", "LP")]["worst_joint_overrun"] == 0.0
+
+
+@pytest.mark.parametrize("duration", ["nan", "inf", "-1", "0", "soon"])
+def test_launch_refuses_a_duration_that_is_not_a_positive_number_of_seconds(duration):
+    result = run_cli("launch", "deploy/controllers.yaml", "--duration", duration)
+    assert result.returncode == 2
+    assert "--duration" in result.stderr and repr(duration) in result.stderr
+
+
+def test_status_of_a_misspelt_profile_says_the_file_does_not_exist():
+    result = run_cli("status", "deploy/controlers.yaml")
+    assert result.returncode == 1
+    assert "deploy/controlers.yaml: no such profile file" in result.stderr
+
+
+def test_zenoh_errors_reach_the_user_as_one_readable_line():
+    result = run_cli("status", "test", "--router", "tcp/127.0.0.1:1", "--timeout", "0.5")
+    assert result.returncode == 1
+    assert "cannot reach a router at tcp/127.0.0.1:1" in result.stderr
+    assert ".rs:" not in result.stderr and len(result.stderr.strip().splitlines()) == 1

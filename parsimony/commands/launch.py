@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 
@@ -10,8 +11,20 @@ import zenoh
 
 from deploy.launcher import Launcher
 from deploy.profile import ProfileError, load_profile
+from deploy.zenoh_error import zenoh_error_text
 
 EXIT_INVALID_PROFILE = 2
+
+
+def positive_seconds(text: str) -> float:
+    """A duration: a finite number of seconds > 0 (``nan``, ``inf`` and ``-1`` are refused)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected seconds, got {text!r}") from None
+    if not math.isfinite(value) or value <= 0.0:
+        raise argparse.ArgumentTypeError(f"expected a finite number of seconds > 0, got {text!r}")
+    return value
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -25,7 +38,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     )
     parser.add_argument("profile", type=Path, help="deploy profile (YAML)")
     parser.add_argument(
-        "--duration", type=float, metavar="S", help="stop everything after S seconds"
+        "--duration", type=positive_seconds, metavar="S", help="stop everything after S seconds"
     )
     return parser
 
@@ -40,5 +53,6 @@ def run(args: argparse.Namespace) -> int:
     try:
         return Launcher(profile, args.profile).run(args.duration)
     except zenoh.ZError as error:
-        print(f"{args.profile}: cannot open the router: {error}", file=sys.stderr)
+        print(f"{args.profile}: cannot open the router: {zenoh_error_text(error)}",
+              file=sys.stderr)  # fmt: skip
         return 1

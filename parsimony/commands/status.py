@@ -52,6 +52,8 @@ def target_of(args: argparse.Namespace) -> Target:
         raise QueryError("name a profile or a namespace, or pass --profile")
     if Path(args.target).is_file():
         return Target.from_profile(args.target)
+    if Path(args.target).suffix:
+        raise QueryError(f"{args.target}: no such profile file (a namespace has no '.')")
     return Target.from_namespace(args.target, args.router)
 
 
