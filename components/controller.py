@@ -61,9 +61,16 @@ FIRST_DT_S = 0.02
 DT_MIN_S, DT_MAX_S = 1e-3, 0.2
 """dt is clamped to this range, whatever the stamps say."""
 
+def robot_loads(path: object) -> None:
+    """``ParamError`` unless ``path`` is empty (the profile's robot) or a robot that loads."""
+    if path:
+        load_robot(Path(str(path)).resolve())
+
+
 CONTROLLER_PARAMS = (
     Param("stale_timeout_s", float, 0.5, low=0.01, high=10.0, doc="command zero after this, s"),
-    Param("robot", str, "", doc="robot description (YAML); empty: the profile's robot"),
+    Param("robot", str, "", doc="robot description (YAML); empty: the profile's robot",
+          can_take=robot_loads),
 )
 """The parameters of every controller, after those of its law."""
 

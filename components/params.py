@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Iterable, Iterator, Mapping
-from dataclasses import dataclass
+from collections.abc import Callable, Iterable, Iterator, Mapping
+from dataclasses import dataclass, field
 
 ParamValue = bool | int | float | str
 """A parameter's value."""
@@ -30,7 +30,7 @@ class ParamError(ValueError):
 class Param:
     """A declared parameter: ``name``, ``type`` (bool, int, float or str), ``default``,
     optional inclusive bounds ``low`` and ``high`` for numbers, optional ``choices``
-    (the only values allowed), and a one-line ``doc``."""
+    (the only values allowed), a one-line ``doc`` and an optional ``can_take`` check."""
 
     name: str
     type: type[bool] | type[int] | type[float] | type[str]
@@ -39,6 +39,9 @@ class Param:
     high: float | None = None
     choices: tuple[ParamValue, ...] | None = None
     doc: str = ""
+    can_take: Callable[[ParamValue], None] | None = field(default=None, compare=False)
+    """Raises ``ParamError`` when a value of the right type could not take effect (a robot
+    file that does not load): such a value is refused when set, not failed on later."""
 
     def __post_init__(self) -> None:
         self.check(self.default)
@@ -72,6 +75,8 @@ class Param:
                 raise ParamError(f"{self.name}: expected {self.expected()}, got {value!r}")
         if self.choices is not None and value not in self.choices:
             raise ParamError(f"{self.name}: expected {self.expected()}, got {value!r}")
+        if self.can_take is not None:
+            self.can_take(value)
         return value
 
     def parse(self, text: str) -> ParamValue:

@@ -289,6 +289,16 @@ def test_param_set_and_goal_gains_reach_the_next_step(
     assert "eta: expected a float in [0.001, 100.0]" in capsys.readouterr().err
 
 
+def test_a_robot_parameter_that_cannot_load_is_refused_and_the_controller_goes_on(
+    operator: Operator, capsys: pytest.CaptureFixture[str]
+) -> None:
+    operator.send_goal()
+    assert operator.step()[0].status == "optimal"
+    assert set_param(operator, "robot", "/etc/passwd") == 1
+    assert "robot: cannot load /etc/passwd" in capsys.readouterr().err
+    assert operator.step()[0].status == "optimal"
+
+
 def test_a_goal_whose_gains_leave_the_parameter_bounds_is_refused(operator: Operator) -> None:
     """eta = 1e300 on a goal is checked like `param set`: refused, counted, zero commands."""
     operator.send_goal()
