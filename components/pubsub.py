@@ -1,38 +1,59 @@
 """Typed publishers and subscriptions of a component (see ``components.runtime``).
 
-A subscription keeps only the newest sample waiting for the handler thread,
-decodes it there with the codec, drops and counts malformed ones
-(``rejected.<topic>``) and counts handler exceptions (``errors.<topic>``).
+A subscription hands its samples to the component's handler thread and decodes them there
+with the codec; it drops and counts malformed ones (``rejected.<topic>``) and counts handler
+exceptions (``errors.<topic>``). Each input chooses what waits for the handler:
+
+- ``latest`` (control): only the newest sample; one that arrives before the previous was
+  handled replaces it (``overwritten.<topic>``);
+- ``queue=N`` (a recorder, an estimator): every sample in arrival order, at most N waiting;
+  past that the oldest is dropped (``overflowed.<topic>``). Nothing is lost uncounted.
 """
 
 from __future__ import annotations
 
+import collections
 import math
 import threading
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Generic, TypeVar
+from typing import Generic, Protocol, TypeVar
 
 import zenoh
 from pydantic import BaseModel
 
+from components.clock import Clock
 from messages import codec, topics
 from messages.header import Header
 
-if TYPE_CHECKING:
-    from components.runtime import Node
-
 M = TypeVar("M", bound=BaseModel)
+
+
+class Host(Protocol):
+    """What publishers and subscriptions need of their component's runtime (a ``Node``)."""
+
+    namespace: str
+    counters: dict[str, int]
+    clock: Clock
+
+    @property
+    def session(self) -> zenoh.Session: ...
+
+    def post(self, event: Callable[[], None]) -> None: ...
+
+    def warn(self, kind: str, message: str, exc_info: bool = False) -> None: ...
 
 
 class Publisher(Generic[M]):
     """Publishes messages of one topic; ``put`` sets the header's ``seq``.
 
-    A message whose header already carries ``next_seq`` is published as it is; any
-    other is copied with the right ``seq`` first.
+    A message whose header already carries ``next_seq`` is published as it is; any other is
+    copied with the right ``seq`` first. A ``verbatim`` publisher (replay) publishes every
+    message as it is, its recorded header unchanged.
     """
 
-    def __init__(self, node: Node, topic: topics.Topic[M]) -> None:
+    def __init__(self, node: Host, topic: topics.Topic[M], verbatim: bool = False) -> None:
         self.topic = topic
+        self.verbatim = verbatim
         self._node = node
         self._publisher = node.session.declare_publisher(topic.key(node.namespace))
         self._seq = 0
@@ -45,12 +66,13 @@ class Publisher(Generic[M]):
         return self._seq
 
     def put(self, message: M) -> None:
-        """Encode and publish ``message``, its header's ``seq`` replaced by this topic's count."""
+        """Encode and publish ``message``, its header's ``seq`` replaced by this topic's count
+        unless the publisher is verbatim."""
         if not isinstance(message, self.topic.type):
             expected = self.topic.type.__name__
             raise TypeError(f"{self.topic.name} carries {expected}, not {type(message).__name__}")
         header = getattr(message, "header", None)
-        if isinstance(header, Header) and header.seq != self._seq:
+        if not self.verbatim and isinstance(header, Header) and header.seq != self._seq:
             stamped = header.model_copy(update={"seq": self._seq})
             message = message.model_copy(update={"header": stamped})
         self._seq += 1
@@ -61,23 +83,32 @@ class Publisher(Generic[M]):
 class Subscription(Generic[M]):
     """The typed input of one topic: ``latest`` valid message and its ``age_s()``.
 
-    Only the newest sample waits for the handler thread: a sample that arrives
-    before the previous one was handled replaces it (``overwritten.<topic>``).
+    ``queue`` None keeps only the newest sample waiting; ``queue`` N keeps every sample in
+    order, at most N waiting (see the module's docstring).
     """
 
     def __init__(
-        self, node: Node, topic: topics.Topic[M], handler: Callable[[M], None] | None
+        self,
+        node: Host,
+        topic: topics.Topic[M],
+        handler: Callable[[M], None] | None,
+        queue: int | None = None,
     ) -> None:
+        if queue is not None and queue < 1:
+            raise ValueError(f"a subscription queue holds at least 1 sample, got {queue}")
         self.topic = topic
         self.latest: M | None = None
         self._node = node
         self._handler = handler
         self._key = topic.key(node.namespace)
         self._lock = threading.Lock()
-        self._pending: tuple[bytes, int] | None = None
+        self._waiting: collections.deque[tuple[bytes, int]] = collections.deque()
+        self._capacity = 1 if queue is None else queue
+        self._dropped = f"{'overwritten' if queue is None else 'overflowed'}.{topic.name}"
         self._received_ns: int | None = None
-        for kind in ("received", "rejected", "errors", "overwritten"):
+        for kind in ("received", "rejected", "errors"):
             node.counters[f"{kind}.{topic.name}"] = 0
+        node.counters[self._dropped] = 0
         self._subscriber = node.session.declare_subscriber(self._key, self._on_sample)
 
     def age_s(self) -> float:
@@ -87,25 +118,29 @@ class Subscription(Generic[M]):
         return (self._node.clock.monotonic_ns() - self._received_ns) / 1e9
 
     def _on_sample(self, sample: zenoh.Sample) -> None:
-        """Zenoh thread: keep the newest payload and wake the handler thread."""
+        """Zenoh thread: keep the payload (dropping the oldest when full), wake the handler."""
         if sample.kind != zenoh.SampleKind.PUT:
             return
         arrival = (sample.payload.to_bytes(), self._node.clock.monotonic_ns())
         with self._lock:
-            was_waiting = self._pending is not None
-            self._pending = arrival
-            if was_waiting:
-                self._node.counters[f"overwritten.{self.topic.name}"] += 1
-        if not was_waiting:
+            was_idle = not self._waiting
+            self._waiting.append(arrival)
+            if len(self._waiting) > self._capacity:
+                self._waiting.popleft()
+                self._node.counters[self._dropped] += 1
+        if was_idle:
             self._node.post(self._deliver)
 
     def _deliver(self) -> None:
-        """Handler thread: decode the waiting payload and call the handler."""
+        """Handler thread: decode the oldest waiting payload and call the handler; come back
+        for the next one after the events already waiting (so timers keep their turn)."""
         with self._lock:
-            pending, self._pending = self._pending, None
-        if pending is None:
-            return
-        payload, arrival_ns = pending
+            if not self._waiting:
+                return
+            payload, arrival_ns = self._waiting.popleft()
+            more = bool(self._waiting)
+        if more:
+            self._node.post(self._deliver)
         try:
             message = codec.decode(payload, self.topic.type, self._key)
         except codec.DecodeError as error:

@@ -123,17 +123,25 @@ class Node:
             raise RuntimeError("the node's session is not open; use `with Node(...) as node`")
         return self._session
 
-    def publisher(self, topic: topics.Topic[M]) -> Publisher[M]:
-        """A typed publisher on ``topic`` in this node's namespace, declared until close."""
-        publisher = Publisher(self, topic)
+    def publisher(self, topic: topics.Topic[M], verbatim: bool = False) -> Publisher[M]:
+        """A typed publisher on ``topic`` in this node's namespace, declared until close;
+        ``verbatim`` publishes headers as given (replay) instead of numbering them."""
+        publisher = Publisher(self, topic, verbatim)
         self._declared.append(publisher)
         return publisher
 
     def subscribe(
-        self, topic: topics.Topic[M], handler: Callable[[M], None] | None = None
+        self,
+        topic: topics.Topic[M],
+        handler: Callable[[M], None] | None = None,
+        queue: int | None = None,
     ) -> Subscription[M]:
-        """Subscribe to ``topic`` until close; ``handler`` (optional) gets each valid message."""
-        subscription = Subscription(self, topic, handler)
+        """Subscribe to ``topic`` until close; ``handler`` (optional) gets each valid message.
+
+        ``queue`` None hands the handler the newest sample only (control inputs); N hands it
+        every sample in order, at most N waiting (see ``components.pubsub``).
+        """
+        subscription = Subscription(self, topic, handler, queue)
         self._declared.append(subscription)
         return subscription
 

@@ -57,6 +57,56 @@ def test_typed_round_trip_between_two_nodes(system: System, wait_until: WaitUnti
     assert listener.counters["rejected.robot/state"] == 0
 
 
+def test_a_verbatim_publisher_keeps_the_recorded_header(
+    system: System, wait_until: WaitUntil
+) -> None:
+    """Replay publishes a recorded message as it was: its seq is not renumbered."""
+    received: list[RobotState] = []
+    with Node(system.profile, "listener") as listener, Node(system.profile, "talker") as talker:
+        listener.subscribe(topics.ROBOT_STATE, received.append)
+        listener.start()
+        publisher = talker.publisher(topics.ROBOT_STATE, verbatim=True)
+        talker.timer(0.02, lambda: publisher.put(robot_state()))
+        talker.start()
+        wait_until(lambda: len(received) >= 2, "two RobotStates")
+    assert {message.header.seq for message in received} == {UNSTAMPED_SEQ}
+
+
+@pytest.mark.parametrize(("queue", "dropped"), [(None, "overwritten"), (4, "overflowed")])
+def test_a_busy_handler_gets_the_newest_or_every_sample_and_drops_are_counted(
+    system: System, wait_until: WaitUntil, queue: int | None, dropped: str
+) -> None:
+    """While the handler is busy, 12 samples arrive. The newest-only input hands it the last;
+    a queue of 4 hands it the last 4 in order. Either way, handled + dropped = sent."""
+    release = threading.Event()
+    handled: list[float] = []
+
+    def on_state(message: RobotState) -> None:
+        handled.append(message.base_pose[0])
+        release.wait(system.deadline_s)
+
+    key = topics.ROBOT_STATE.key("test")
+    with Node(system.profile, "listener") as listener:
+        listener.subscribe(topics.ROBOT_STATE, on_state, queue=queue)
+        listener.start()
+        publisher = system.router.declare_publisher(key)
+        wait_until(lambda: publisher.matching_status.matching, "the subscription to propagate")
+        publisher.put(codec.encode(robot_state(base_x=0.0)))
+        wait_until(lambda: handled == [0.0], "the first sample in the handler")
+        for index in range(1, 12):
+            publisher.put(codec.encode(robot_state(base_x=float(index))))
+        counters = listener.counters
+        sent = 12
+        wait_until(lambda: counters[f"{dropped}.robot/state"] + len(handled) + (queue or 1)
+                   >= sent, "every sample kept or counted")  # fmt: skip
+        release.set()
+        wait_until(lambda: counters[f"{dropped}.robot/state"] + len(handled) == sent,
+                   "the waiting samples handled")  # fmt: skip
+    kept = queue or 1
+    assert handled == [0.0, *[float(i) for i in range(sent - kept, sent)]]
+    assert counters[f"{dropped}.robot/state"] == sent - 1 - kept
+
+
 def test_component_process_publishes_its_params_and_stops_on_sigterm(
     system: System, wait_until: WaitUntil
 ) -> None:
