@@ -38,6 +38,7 @@ import numpy as np
 import yaml
 
 from components.params import Param, ParamError
+from components.pubsub import Input
 from components.runtime import Component, Node
 from messages import topics
 from messages.base import ARM_JOINTS
@@ -99,6 +100,8 @@ class Controller(Component):
     law_name: ClassVar[str]
     law_type: ClassVar[Callable[[MobileManipulator, Any], Law]]
     gains_type: ClassVar[type]
+    reads = (Input(topics.ROBOT_STATE), Input(topics.CONTROL_GOAL), Input(topics.WORLD_OBSTACLES))
+    writes = (topics.BASE_COMMAND, topics.ARM_COMMAND, topics.CONTROL_DIAGNOSTICS)
 
     def __init__(self, node: Node) -> None:
         super().__init__(node)

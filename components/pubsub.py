@@ -16,6 +16,7 @@ import collections
 import math
 import threading
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Generic, Protocol, TypeVar
 
 import zenoh
@@ -41,6 +42,24 @@ class Host(Protocol):
     def post(self, event: Callable[[], None]) -> None: ...
 
     def warn(self, kind: str, message: str, exc_info: bool = False) -> None: ...
+
+
+@dataclass(frozen=True)
+class Input:
+    """A topic a component reads, and what waits for its handler: the newest sample only
+    (``queue`` None) or every sample in order, at most ``queue`` waiting."""
+
+    topic: topics.Topic
+    queue: int | None = None
+
+    def __post_init__(self) -> None:
+        if self.queue is not None and self.queue < 1:
+            raise ValueError(f"{self.topic.name}: a queue holds >= 1 sample, got {self.queue}")
+
+    def describe(self) -> str:
+        """``robot/state (newest)`` or ``robot/state (queue 100)``."""
+        mode = "newest" if self.queue is None else f"queue {self.queue}"
+        return f"{self.topic.name} ({mode})"
 
 
 class Publisher(Generic[M]):
@@ -94,8 +113,7 @@ class Subscription(Generic[M]):
         handler: Callable[[M], None] | None,
         queue: int | None = None,
     ) -> None:
-        if queue is not None and queue < 1:
-            raise ValueError(f"a subscription queue holds at least 1 sample, got {queue}")
+        Input(topic, queue)  # checks the queue
         self.topic = topic
         self.latest: M | None = None
         self._node = node

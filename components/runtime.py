@@ -36,7 +36,7 @@ from pydantic import BaseModel
 
 from components.clock import Clock, SimClock, Timer, Timers, WallClock
 from components.params import Param, ParamError, Parameters, encode_value
-from components.pubsub import Publisher, Subscription
+from components.pubsub import Input, Publisher, Subscription
 from deploy.profile import Profile, ProfileError, load_profile
 from messages import codec, topics
 from messages.header import Header
@@ -88,8 +88,22 @@ class Node:
     makes the component visible and starts handling, leaving closes it all.
     """
 
-    def __init__(self, profile: Profile, name: str, params: Iterable[Param] = ()) -> None:
-        """Raise ``KeyError`` for a name not in the profile, ``ParamError`` for bad params."""
+    def __init__(
+        self,
+        profile: Profile,
+        name: str,
+        params: Iterable[Param] = (),
+        reads: Iterable[Input] | None = None,
+        writes: Iterable[topics.Topic] | None = None,
+    ) -> None:
+        """Raise ``KeyError`` for a name not in the profile, ``ParamError`` for bad params.
+
+        ``reads`` and ``writes`` are the component's declared topics (``Component.reads``,
+        ``Component.writes``): when given, the node refuses any other, and each subscription
+        takes its mode from its declaration. ``None`` (a test's or a tool's node) allows any.
+        """
+        self.reads = None if reads is None else {i.topic.name: i for i in reads}
+        self.writes = None if writes is None else {t.name for t in writes}
         self.profile = profile
         self.spec = profile.component(name)
         self.name = name
@@ -126,6 +140,8 @@ class Node:
     def publisher(self, topic: topics.Topic[M], verbatim: bool = False) -> Publisher[M]:
         """A typed publisher on ``topic`` in this node's namespace, declared until close;
         ``verbatim`` publishes headers as given (replay) instead of numbering them."""
+        if self.writes is not None and topic.name not in self.writes:
+            raise ValueError(f"{self.name} writes {topic.name} without declaring it in `writes`")
         publisher = Publisher(self, topic, verbatim)
         self._declared.append(publisher)
         return publisher
@@ -139,8 +155,13 @@ class Node:
         """Subscribe to ``topic`` until close; ``handler`` (optional) gets each valid message.
 
         ``queue`` None hands the handler the newest sample only (control inputs); N hands it
-        every sample in order, at most N waiting (see ``components.pubsub``).
+        every sample in order, at most N waiting (see ``components.pubsub``). A component
+        declares it in ``reads``, and the node takes it from there.
         """
+        if self.reads is not None and topic is not topics.SIM_CLOCK:
+            if topic.name not in self.reads:
+                raise ValueError(f"{self.name} reads {topic.name} without declaring it in `reads`")
+            queue = self.reads[topic.name].queue
         subscription = Subscription(self, topic, handler, queue)
         self._declared.append(subscription)
         return subscription
@@ -275,13 +296,17 @@ class Node:
 
 
 class Component:
-    """Base of every component: declare ``params``, build publishers, subscriptions and
-    timers on ``self.node`` in ``__init__``, react in handlers.
+    """Base of every component: declare ``params``, ``reads`` and ``writes``, build
+    publishers, subscriptions and timers on ``self.node`` in ``__init__``, react in handlers.
 
     ``__init__`` raises ``ParamError`` for a parameter value it cannot use (a missing
     file, say): the process then exits with ``EXIT_CONFIG_ERROR`` and is not restarted."""
 
     params: ClassVar[tuple[Param, ...]] = ()
+    reads: ClassVar[tuple[Input, ...]] = ()
+    """The topics this component subscribes to, each with its mode (the graph's inputs)."""
+    writes: ClassVar[tuple[topics.Topic, ...]] = ()
+    """The topics this component publishes (the graph's outputs)."""
 
     def __init__(self, node: Node) -> None:
         self.node = node
@@ -330,7 +355,8 @@ def _configure(component_class: type[Component], args: argparse.Namespace) -> No
         log.error("%s: no component named %r (have %s)", args.profile, args.name, names)
         return None
     try:
-        return Node(profile, args.name, component_class.params)
+        return Node(profile, args.name, component_class.params, component_class.reads,
+                    component_class.writes)  # fmt: skip
     except ParamError as error:
         log.error("%s: components[%d].params.%s", args.profile, names.index(args.name), error)
         return None

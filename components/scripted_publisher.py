@@ -26,6 +26,8 @@ WORLD_FRAME = "world"
 class ScriptedPublisher(Component):
     """Publishes ``robot/state`` and ``control/goal`` from parameters every ``1 / rate_hz`` s."""
 
+    writes = (topics.ROBOT_STATE, topics.CONTROL_GOAL)
+
     params = (
         Param("rate_hz", float, 10.0, low=0.1, high=1000.0, doc="publishing rate"),
         Param("base_x", float, 0.0, doc="base position x, m"),

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import zenoh
 
+from deploy.graph import dataflow
 from deploy.launcher import Launcher
 from deploy.profile import ProfileError, load_profile
 from deploy.zenoh_error import zenoh_error_text
@@ -47,9 +48,12 @@ def run(args: argparse.Namespace) -> int:
     """Validate the profile, then launch it until stopped."""
     try:
         profile = load_profile(args.profile)
-    except ProfileError as error:
+        graph = dataflow(profile)
+    except (ProfileError, LookupError) as error:
         print(error, file=sys.stderr)
         return EXIT_INVALID_PROFILE
+    for warning in graph.warnings():
+        print(f"[launch] {warning}", file=sys.stderr)
     try:
         return Launcher(profile, args.profile).run(args.duration)
     except zenoh.ZError as error:

@@ -12,6 +12,7 @@ import pytest
 
 from components import runtime
 from components.params import Param
+from components.pubsub import Input
 from components.runtime import Node
 from deploy import query
 from messages import codec, topics
@@ -223,3 +224,15 @@ def test_repeated_warnings_are_logged_once_then_summarised(
         "bad message at 6 s (3 more since the last report)",
         "handler failed",
     ]
+
+
+def test_a_node_refuses_topics_its_component_did_not_declare(system: System) -> None:
+    reads = (Input(topics.ROBOT_STATE, queue=8),)
+    with Node(system.profile, "listener", reads=reads, writes=(topics.CONTROL_GOAL,)) as node:
+        node.subscribe(topics.ROBOT_STATE)
+        assert "overflowed.robot/state" in node.counters  # the declared mode: a queue
+        node.publisher(topics.CONTROL_GOAL)
+        with pytest.raises(ValueError, match="reads control/goal without declaring it"):
+            node.subscribe(topics.CONTROL_GOAL)
+        with pytest.raises(ValueError, match="writes robot/state without declaring it"):
+            node.publisher(topics.ROBOT_STATE)

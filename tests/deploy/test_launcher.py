@@ -11,6 +11,8 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from tests.deploy.conftest import LaunchFixture, ProfileWriter
 
+ROBOT = Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"
+
 
 def publisher(name: str, role: str = "tool", **fields: object) -> dict[str, object]:
     """A scripted publisher component that restarts quickly."""
@@ -90,6 +92,19 @@ def test_duration_ends_the_launch_cleanly(
     assert launched.process.wait(10.0) == 0
     launched.wait_for(r"\[launch\] stopping \(end of duration\)")
     launched.wait_for(r"\[launch\] pub stopped \(0\)")
+
+
+def test_the_launcher_warns_of_a_topic_read_and_never_written(
+    write_profile: ProfileWriter, launch: LaunchFixture
+) -> None:
+    """A controller alone waits for robot/state that nothing in the profile publishes."""
+    controller = {"name": "ctl", "module": "lp_controller", "role": "controller"}
+    profile = write_profile([controller], robot=str(ROBOT))
+    launched = launch(profile, "--duration", "1.0")
+    launched.wait_for(r"\[launch\] warning: test/robot/state is read by ctl and written by "
+                      r"no component")  # fmt: skip
+    assert launched.process.wait(10.0) == 0
+    assert "test/base/command is read" not in launched.text()
 
 
 def test_components_stop_when_the_launcher_is_killed(

@@ -1,0 +1,52 @@
+"""`parsimony graph PROFILE`: which process publishes and subscribes to which key."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+from deploy.graph import dataflow
+from deploy.profile import ProfileError, load_profile
+from parsimony.output import emit
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Declare `graph` and its arguments."""
+    parser = subparsers.add_parser(
+        "graph",
+        help="print the dataflow of a profile (text, JSON, Graphviz DOT or an image)",
+        description="Derive the dataflow of a profile from what each component declares it "
+        "reads and writes; nothing is started. Warns about topics read and never written.",
+    )
+    parser.add_argument("profile", type=Path, help="deploy profile (YAML)")
+    parser.add_argument("--json", action="store_true", help="print JSON instead of text")
+    parser.add_argument("--dot", type=Path, metavar="FILE", help="also write Graphviz DOT here")
+    parser.add_argument("--png", type=Path, metavar="FILE",
+                        help="also draw it as PNG (needs Graphviz's dot)")  # fmt: skip
+    return parser
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        graph = dataflow(load_profile(args.profile))
+    except (ProfileError, LookupError) as error:
+        print(error, file=sys.stderr)
+        return 2
+    for warning in graph.warnings():
+        print(warning, file=sys.stderr)
+    emit(json.dumps(graph.to_json(), indent=2) if args.json else graph.to_text())
+    if args.dot:
+        args.dot.write_text(graph.to_dot() + "\n")
+    if args.png:
+        dot = shutil.which("dot")
+        if dot is None:
+            print("--png needs Graphviz's dot (apt-get install graphviz); --dot writes the "
+                  "graph without it", file=sys.stderr)  # fmt: skip
+            return 1
+        subprocess.run([dot, "-Tpng", "-o", str(args.png)], input=graph.to_dot(), text=True,
+                       check=True)  # fmt: skip
+    return 0

@@ -1,0 +1,56 @@
+"""The dataflow of a profile, from the components' declarations; nothing is started."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from deploy.graph import dataflow
+from deploy.profile import load_profile
+
+DEPLOY = Path(__file__).resolve().parents[2] / "deploy"
+
+
+def test_the_controllers_profile_wires_the_publisher_to_the_controller() -> None:
+    graph = dataflow(load_profile(DEPLOY / "controllers.yaml"))
+    assert graph.writers("robot/state") == ["publisher"]
+    assert graph.readers("robot/state") == ["controller"]
+    assert graph.writers("control/goal") == ["publisher"]
+    assert graph.writers("base/command") == ["controller"] and graph.readers("base/command") == []
+    assert graph.read_never_written() == ["world/obstacles"]
+    dot = graph.to_dot()
+    assert '"publisher" -> "parsimony/robot/state";' in dot
+    assert '"parsimony/robot/state" -> "controller";' in dot
+    assert '"parsimony/world/obstacles" [shape=ellipse, style=dashed];' in dot
+
+
+def test_a_sim_clock_profile_makes_every_component_read_sim_clock(tmp_path: Path) -> None:
+    profile = load_profile(DEPLOY / "controllers.yaml").model_copy(update={"clock": "sim"})
+    graph = dataflow(profile)
+    assert graph.readers("sim/clock") == ["controller", "publisher"]
+
+
+def test_parsimony_graph_prints_json_alone_and_writes_dot(tmp_path: Path) -> None:
+    dot = tmp_path / "graph.dot"
+    result = subprocess.run(
+        [sys.executable, "-m", "parsimony.cli", "graph", str(DEPLOY / "controllers.yaml"),
+         "--json", "--dot", str(dot)],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    report = json.loads(result.stdout)
+    assert report["topics"]["robot/state"] == {
+        "key": "parsimony/robot/state", "writers": ["publisher"], "readers": ["controller"]}
+    assert "parsimony/world/obstacles is read by controller" in result.stderr
+    assert dot.read_text().startswith('digraph "parsimony" {')
+
+
+def test_a_module_without_one_component_class_is_refused(tmp_path: Path) -> None:
+    path = tmp_path / "profile.yaml"
+    path.write_text("namespace: t\ncomponents:\n  - {name: x, module: params, role: tool}\n")
+    with pytest.raises(LookupError, match="expected one Component subclass"):
+        dataflow(load_profile(path))
