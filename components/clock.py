@@ -30,16 +30,24 @@ class SimClock:
     """The simulator's time: zero until the first ``sim/clock`` message, then its stamp.
 
     ``advance`` is called on the handler thread; reading an int is safe from any thread.
+    ``stalled_s`` measures, on the host's monotonic clock, how long the time has not moved.
     """
 
     simulated = True
 
     def __init__(self) -> None:
         self._stamp_ns = 0
+        self._moved_at_ns = time.monotonic_ns()
 
     def advance(self, stamp_ns: int) -> None:
         """Set the time to ``stamp_ns`` (it may go back when a replay restarts)."""
+        if stamp_ns != self._stamp_ns:
+            self._moved_at_ns = time.monotonic_ns()
         self._stamp_ns = stamp_ns
+
+    def stalled_s(self) -> float:
+        """Host seconds since the simulated time last moved (or since the clock was made)."""
+        return (time.monotonic_ns() - self._moved_at_ns) / 1e9
 
     def now_ns(self) -> int:
         """Simulated time in ns."""
@@ -51,6 +59,9 @@ class SimClock:
 
 
 Clock = WallClock | SimClock
+
+STALL_CHECK_S = 0.05
+"""How often (host seconds) a component on simulated time checks that its clock still moves."""
 
 
 @dataclass
@@ -106,10 +117,13 @@ class Timers:
     def wait_s(self) -> float | None:
         """How long the handler thread may block before a timer is due.
 
-        ``None`` (block until the next event) when there are no timers or the
-        clock is simulated: simulated time only moves with a ``sim/clock`` message.
+        ``None`` (block until the next event) when there are no timers. On a simulated
+        clock, time only moves with a ``sim/clock`` message, so the thread wakes every
+        ``STALL_CHECK_S`` of host time to notice a clock that stopped.
         """
-        if not self._timers or self.clock.simulated:
+        if self.clock.simulated:
+            return STALL_CHECK_S
+        if not self._timers:
             return None
         next_deadline = min(timer.deadline_ns for timer in self._timers)
         return max(0.0, (next_deadline - self.clock.monotonic_ns()) / 1e9)

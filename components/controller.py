@@ -170,6 +170,11 @@ class Controller(Component):
         )
         self.publish_zero(self.node.clock.now_ns(), "stale", reason)
 
+    def clock_stalled(self, stalled_s: float) -> None:
+        """The simulated clock stopped: command zero and say why."""
+        self.publish_zero(self.node.clock.now_ns(), "stale",
+                          f"sim/clock has not moved for {stalled_s:.2f} s")  # fmt: skip
+
     def control(self, state: RobotState, dt: float) -> LawOutput:
         """The law's output for ``state``, or ``Hold`` saying why there is none."""
         age_s = (self.node.clock.now_ns() - state.header.stamp_ns) / 1e9

@@ -109,8 +109,10 @@ class Node:
         self.name = name
         self.namespace = profile.namespace
         self.params = Parameters(params, self.spec.params)
-        self.clock: Clock = SimClock() if profile.clock == "sim" else WallClock()
-        self.counters: dict[str, int] = {}
+        publishes_clock = self.writes is not None and topics.SIM_CLOCK.name in self.writes
+        source = profile.clock_of(self.spec, publishes_clock)
+        self.clock: Clock = SimClock() if source == "sim" else WallClock()
+        self.counters: dict[str, int] = {"clock_stalls": 0}
         self.state = "starting"
         self._timers = Timers(self.clock)
         self._events: queue.SimpleQueue[Callable[[], None] | None] = queue.SimpleQueue()
@@ -119,6 +121,7 @@ class Node:
         self._declared: list[object] = []
         self._thread: threading.Thread | None = None
         self._on_shutdown: Callable[[], None] | None = None
+        self._on_clock_stall: Callable[[float], None] | None = None
 
     def __enter__(self) -> Node:
         self._session = zenoh.open(self.profile.zenoh.component_config())
@@ -204,12 +207,19 @@ class Node:
         """Run ``event`` on the handler thread (callable from any thread)."""
         self._events.put(event)
 
-    def start(self, on_shutdown: Callable[[], None] | None = None) -> None:
+    def start(
+        self,
+        on_shutdown: Callable[[], None] | None = None,
+        on_clock_stall: Callable[[float], None] | None = None,
+    ) -> None:
         """Answer queries, start the handler thread and declare the liveliness token.
 
-        ``on_shutdown`` runs on the handler thread when the node closes.
+        ``on_shutdown`` runs on the handler thread when the node closes; ``on_clock_stall``
+        when a simulated clock has not moved for the profile's ``clock_timeout_s`` (host
+        seconds), with that duration.
         """
         self._on_shutdown = on_shutdown
+        self._on_clock_stall = on_clock_stall
         session = self.session
         status_key = topics.status_key(self.namespace, self.name)
         param_keys = {topics.param_key(self.namespace, self.name, p): p for p in self.params}
@@ -257,8 +267,25 @@ class Node:
                 self._run(event, "errors.events")
             for timer in self._timers.due():
                 self._run(timer.callback, f"errors.timer.{timer.name}")
+            self._check_clock()
         if self._on_shutdown is not None:
             self._run(self._on_shutdown, "errors.shutdown")
+
+    def _check_clock(self) -> None:
+        """On simulated time: say so, once, when the clock stops moving, and when it moves again."""
+        clock = self.clock
+        if not isinstance(clock, SimClock):
+            return
+        stalled_s = clock.stalled_s()
+        if stalled_s >= self.profile.clock_timeout_s and self.state == "running":
+            self.state = "clock stalled"
+            self.count("clock_stalls")
+            log.warning("%s: sim/clock has not moved for %.2f s", self.name, stalled_s)
+            if self._on_clock_stall is not None:
+                self._run(partial(self._on_clock_stall, stalled_s), "errors.clock_stall")
+        elif stalled_s < self.profile.clock_timeout_s and self.state == "clock stalled":
+            self.state = "running"
+            log.info("%s: sim/clock moves again", self.name)
 
     def _run(self, callback: Callable[[], None], counter: str) -> None:
         try:
@@ -313,6 +340,10 @@ class Component:
 
     def shutdown(self) -> None:
         """Runs on the handler thread before the session closes (a driver stops the robot here)."""
+
+    def clock_stalled(self, stalled_s: float) -> None:
+        """Runs on the handler thread when the simulated clock stopped for ``stalled_s`` host
+        seconds (a controller commands zero here)."""
 
 
 class _StopRequested(Exception):
@@ -380,7 +411,7 @@ def main(component_class: type[Component], argv: Sequence[str] | None = None) ->
             except ParamError as error:
                 log.error("%s: %s: %s", args.profile, args.name, error)
                 return EXIT_CONFIG_ERROR
-            node.start(component.shutdown)
+            node.start(component.shutdown, component.clock_stalled)
             _wait_for_stop()
     except _StopRequested as stop:
         log.info("%s stopping on %s", args.name, stop)

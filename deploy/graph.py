@@ -1,8 +1,8 @@
 """The dataflow of a profile, derived from what each component declares it reads and writes.
 
 Every enabled component's module is imported and its ``Component`` subclass asked for
-``reads`` and ``writes`` (``components.runtime.Component``); with ``clock: sim`` every
-component but the clock's publisher also reads ``sim/clock``. Nothing is started.
+``reads`` and ``writes`` (``components.runtime.Component``); a component on simulated time
+also reads ``sim/clock`` (``Profile.clock_of``). Nothing is started.
 """
 
 from __future__ import annotations
@@ -123,7 +123,7 @@ def dataflow(profile: Profile) -> Dataflow:
     for spec in profile.start_order():
         cls = component_class(spec)
         reads = tuple(cls.reads)
-        if profile.clock == "sim" and topics.SIM_CLOCK not in cls.writes:
+        if profile.clock_of(spec, topics.SIM_CLOCK in cls.writes) == "sim":
             reads += (Input(topics.SIM_CLOCK),)
         nodes.append(ComponentNode(spec.name, spec.module, spec.role, reads, tuple(cls.writes)))
     return Dataflow(profile.namespace, tuple(nodes))

@@ -194,6 +194,10 @@ class ComponentSpec(StrictModel):
     params: dict[str, ParamValue] = {}
     restart: RestartPolicy = RestartPolicy()
     enabled: bool = True
+    clock: Literal["wall", "sim"] | None = None
+    """This component's time: the host's, or the simulator's ``sim/clock``; None follows the
+    profile's ``clock``, except for the component that publishes ``sim/clock`` (the simulator,
+    a replayer), which always runs on its own, the host's, time."""
 
     @property
     def module_path(self) -> str:
@@ -208,6 +212,9 @@ class Profile(StrictModel):
     zenoh: ZenohSettings = ZenohSettings()
     robot: Path | None = None
     clock: Literal["wall", "sim"] = "wall"
+    clock_timeout_s: float = Field(default=1.0, gt=0.0)
+    """Host seconds after which a component on ``sim`` time whose clock has not moved says its
+    clock stalled (a controller then commands zero)."""
     components: list[ComponentSpec] = Field(min_length=1)
 
     @model_validator(mode="after")
@@ -228,6 +235,12 @@ class Profile(StrictModel):
             if spec.name == name:
                 return spec
         raise KeyError(f"no component named {name!r} (have {[c.name for c in self.components]})")
+
+    def clock_of(self, spec: ComponentSpec, publishes_clock: bool) -> str:
+        """``"wall"`` or ``"sim"``: the time ``spec`` runs on (see ``ComponentSpec.clock``)."""
+        if spec.clock is not None:
+            return spec.clock
+        return "wall" if publishes_clock else self.clock
 
     def start_order(self) -> list[ComponentSpec]:
         """The enabled components, drivers first, then estimators, controllers, tools."""

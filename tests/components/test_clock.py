@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import time
+
 import pytest
 
-from components.clock import SimClock, Timers, WallClock
+from components.clock import STALL_CHECK_S, SimClock, Timers, WallClock
 
 MS = 1_000_000
 
@@ -14,7 +16,7 @@ def test_timers_fire_on_simulated_time_only() -> None:
     timers = Timers(clock)
     fired: list[int] = []
     timers.add(0.1, lambda: fired.append(clock.now_ns()))
-    assert timers.wait_s() is None
+    assert timers.wait_s() == STALL_CHECK_S  # wakes to notice a clock that stopped
     clock.advance(99 * MS)
     assert timers.due() == []
     clock.advance(100 * MS)
@@ -56,3 +58,14 @@ def test_wall_timers_report_how_long_to_wait() -> None:
 def test_a_period_must_be_positive() -> None:
     with pytest.raises(ValueError, match="must be > 0 s"):
         Timers(WallClock()).add(0.0, lambda: None)
+
+
+def test_a_sim_clock_measures_how_long_it_has_not_moved() -> None:
+    clock = SimClock()
+    clock.advance(5 * MS)
+    time.sleep(0.05)
+    assert clock.stalled_s() >= 0.05
+    clock.advance(5 * MS)  # the same stamp again: still stalled
+    assert clock.stalled_s() >= 0.05
+    clock.advance(6 * MS)
+    assert clock.stalled_s() < 0.05

@@ -343,3 +343,19 @@ def test_the_law_gets_changed_gains_and_only_then(deployed: Callable[[str], Syst
         node.params.set_text("joint_gain", "3.0")
         controller.update_law()
         assert (law.params.eta, law.params.joint_gain) == (1.5, 3.0)
+
+
+def test_on_simulated_time_a_stopped_clock_makes_the_controller_command_zero(
+    deployed: Callable[[str | Path], System], wait_until: Callable[..., None]
+) -> None:
+    text = LP_PROFILE.read_text().replace("namespace: parsimony",
+                                          "namespace: parsimony\nclock: sim\nclock_timeout_s: 0.3")
+    system = deployed(text)
+    diagnostics = system.inbox(topics.CONTROL_DIAGNOSTICS)
+    system.start("controller")
+    clock = system.router.declare_publisher(topics.SIM_CLOCK.key("parsimony"))
+    wait_until(lambda: clock.matching_status.matching, "the controller's clock subscription")
+    for tick in range(1, 11):  # one simulated second, then the simulator stops
+        clock.put(codec.encode(topics.SIM_CLOCK.type(stamp_ns=tick * 100_000_000)))
+    stalled = diagnostics.wait_for(lambda m: "sim/clock has not moved" in m.reason, "stall")
+    assert stalled.status == "stale"

@@ -187,6 +187,33 @@ def test_sim_clock_drives_stamps_and_timers(system: System, wait_until: WaitUnti
         assert node.header("world").stamp_ns == 1_000_000_000
 
 
+def test_a_stopped_sim_clock_is_reported_once_and_its_return_too(
+    system: System, wait_until: WaitUntil
+) -> None:
+    profile = system.profile.model_copy(update={"clock": "sim", "clock_timeout_s": 0.2})
+    stalls: list[float] = []
+    with Node(profile, "listener") as node:
+        node.start(on_clock_stall=stalls.append)
+        clock = system.router.declare_publisher(topics.SIM_CLOCK.key("test"))
+        wait_until(lambda: node.state == "clock stalled", "the stall to be noticed")
+        wait_until(lambda: len(stalls) == 1, "the stall hook")
+        assert stalls[0] >= 0.2 and node.counters["clock_stalls"] == 1
+        assert query.statuses(system.router, "test")["listener"].state == "clock stalled"
+        wait_until(lambda: clock.matching_status.matching, "the clock subscription")
+        clock.put(codec.encode(topics.SIM_CLOCK.type(stamp_ns=10_000_000)))
+        wait_until(lambda: node.state == "running", "the clock to move again")
+        assert len(stalls) == 1
+
+
+def test_the_publisher_of_sim_clock_runs_on_host_time(system: System) -> None:
+    """A simulator or a replayer makes the time the others follow; it does not wait for it."""
+    profile = system.profile.model_copy(update={"clock": "sim"})
+    with Node(profile, "talker", reads=(), writes=(topics.SIM_CLOCK,)) as simulator:
+        assert not simulator.clock.simulated
+    with Node(profile, "listener", reads=(), writes=()) as follower:
+        assert follower.clock.simulated
+
+
 def test_declared_params_take_profile_values_and_reject_unknown_names(
     system: System, wait_until: WaitUntil
 ) -> None:
