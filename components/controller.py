@@ -48,6 +48,7 @@ from messages.goal import Goal
 from messages.obstacles import Obstacles
 from messages.state import RobotState
 from wbc.base_motion import unicycle, wheel_speeds
+from wbc.gains import gain_specs
 from wbc.law_output import Law, LawOutput
 from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
@@ -66,6 +67,16 @@ def robot_loads(path: object) -> None:
     """``ParamError`` unless ``path`` is empty (the profile's robot) or a robot that loads."""
     if path:
         load_robot(Path(str(path)).resolve())
+
+
+def law_params(gains_type: type) -> tuple[Param, ...]:
+    """A law's gains as run-time parameters, each with the bounds, choices and doc its
+    dataclass declares (``wbc.gains``)."""
+    return tuple(
+        Param(spec.name, spec.type, spec.default, low=spec.low, high=spec.high,
+              choices=spec.choices, doc=spec.doc)
+        for spec in gain_specs(gains_type)
+    )  # fmt: skip
 
 
 CONTROLLER_PARAMS = (

@@ -21,32 +21,31 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from wbc.gains import check_gains, gain
 from wbc.law_output import LawOutput, summarise
 from wbc.obstacles import Circle
 from wbc.pinv_law import pinv_velocity
 from wbc.robot import MobileManipulator
 from wbc.task import Task, same_task
-from wbc.validation import require_finite, require_positive
+from wbc.validation import require_finite
 
 Array = np.ndarray
 
 
 @dataclass(frozen=True)
 class CascadeParams:
-    eta: float = 0.6
-    """Outer-loop task gain (1/s)."""
-    offset: float = 0.1
-    """d, the distance of the tracked point ahead of the wheel axle (m)."""
-    k1: float = 2.0
-    k2: float = 2.0
-    """Inner-loop gains on the offset point's position error (1/s)."""
-    max_lead: float = 0.2
-    """How far the reference point may run ahead of the real one (m): beyond it the reference
-    base is pulled back, so a base that cannot follow (stalled, saturated) does not wind the
-    inner loop up."""
+    eta: float = gain(0.6, low=1e-3, high=100.0, doc="outer-loop task gain, 1/s")
+    offset: float = gain(0.1, low=0.01, high=1.0,
+                         doc="d, the tracked point's distance ahead of the wheel axle, m")
+    k1: float = gain(2.0, low=1e-3, high=100.0, doc="inner-loop gain on x1, 1/s")
+    k2: float = gain(2.0, low=1e-3, high=100.0, doc="inner-loop gain on y1, 1/s")
+    max_lead: float = gain(0.2, low=0.01, high=10.0,
+                           doc="how far the reference point may run ahead of the real one, m: "
+                               "beyond it the reference is pulled back, so a base that cannot "
+                               "follow does not wind the inner loop up")
 
     def __post_init__(self) -> None:
-        require_positive(self, "eta", "offset", "k1", "k2", "max_lead")
+        check_gains(self)
 
 
 def offset_point(x: float, y: float, phi: float, d: float) -> tuple[float, float]:

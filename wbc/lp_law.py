@@ -16,6 +16,7 @@ from wbc.constraints.joint_limits import JointLimits
 from wbc.constraints.nonholonomic import Nonholonomic
 from wbc.constraints.obstacle_border import BorderObstacle
 from wbc.constraints.obstacle_conservative import ConservativeObstacle
+from wbc.gains import check_gains, gain
 from wbc.law_output import LawOutput, summarise
 from wbc.linear_program import WarmStartedLP
 from wbc.objectives.base import ObjectiveTerm, ResidualCost
@@ -26,7 +27,7 @@ from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
 from wbc.step_context import StepContext
 from wbc.task import PoseTask, Task, same_task
-from wbc.validation import NonFiniteInputError, require_finite, require_positive
+from wbc.validation import NonFiniteInputError, require_finite
 
 Array = np.ndarray
 
@@ -35,62 +36,50 @@ Array = np.ndarray
 class LPParams:
     """Gains of the LP law; the defaults are those of the pose experiment (section 6.2.1)."""
 
-    eta: float = 0.6
-    """Task gain: the LP seeks J u = -eta e (1/s)."""
-    beta: float = 15.0
-    """Bound gain of 5.10 / 5.7."""
-    joint_gain: float = 1.0
-    """k of 5.14 (1/s)."""
-    safety_factor: float = 0.9
-    """beta_l of 5.14."""
-    error_bound: Literal["derivative", "error"] = "derivative"
-    """5.10 (bound on ||e'||_1) or the original 5.7 (bound on ||e||_1)."""
-    obstacle_mode: Literal["border", "conservative", "off"] = "border"
-    obstacle_gain: float = 2.0
-    """lambda of 5.26 for 'border', the gain on the clearance for 'conservative' (1/s)."""
-    obstacle_margin: float = 0.05
-    """Extra clearance kept around each obstacle and the base body (m)."""
-    obstacle_lookahead: float = 0.1
-    """d: the border constraint acts on the point d ahead of the wheel axle (m)."""
-    velocity_cost: float = 1e-3
-    """w: weight of ||u||_1 added to the objective to break ties between optimal vertices;
-    0 solves 5.29 exactly (see wbc.linear_program and wbc.objectives.velocity_cost)."""
-    waist_centring: float = 0.02
-    """Weight of |q1' + k q1|, spending the waist/base-yaw self-motion on a centred waist
-    (wbc.objectives.waist_centring); 0 switches it off."""
-    waist_gain: float = 1.0
-    """k of the waist centring (1/s)."""
-    waist_fade: float = 0.05
-    """||e||_1 below which the waist centring fades out (0: never)."""
-    base_target: float = 0.05
-    """Weight of |phi' - k angle to T|, turning the base towards where it should stand for a
-    pose goal (wbc.objectives.base_target); 0 switches it off."""
-    base_target_gain: float = 2.0
-    """k of the base target (1/s)."""
-    base_target_reach: float = 0.36
-    """How far behind the goal, along the gripper's heading, the base should stand (m): the
-    mean horizontal reach of the arm over the box of arm goals of `parsimony bench`
-    (0.36 +- 0.08)."""
-    base_target_stop: float = 0.15
-    """Distance from T within which the base target is off; its weight is full at twice (m)."""
-    nonholonomic: bool = True
-    """False models a holonomic base (the first test of section 6.3)."""
+    eta: float = gain(0.6, low=1e-3, high=100.0,
+                      doc="task gain: the LP seeks J u = -eta e, 1/s")
+    beta: float = gain(15.0, low=1e-3, high=1e3, doc="bound gain of 5.10 / 5.7")
+    joint_gain: float = gain(1.0, low=1e-3, high=1e4, doc="k of 5.14, 1/s")
+    safety_factor: float = gain(0.9, low=0.01, high=1.0, doc="beta_l of 5.14")
+    error_bound: Literal["derivative", "error"] = gain(
+        "derivative", choices=("derivative", "error"),
+        doc="5.10 (bound on ||e'||_1) or the original 5.7 (bound on ||e||_1)")
+    obstacle_mode: Literal["border", "conservative", "off"] = gain(
+        "border", choices=("border", "conservative", "off"),
+        doc="obstacle constraint: 5.28 (border), 5.19 (conservative) or none")
+    obstacle_gain: float = gain(2.0, low=1e-3, high=100.0,
+                                doc="lambda of 5.26 (border), gain on the clearance "
+                                    "(conservative), 1/s")
+    obstacle_margin: float = gain(0.05, low=0.0, high=1.0,
+                                  doc="extra clearance round each obstacle and the base, m")
+    obstacle_lookahead: float = gain(0.1, low=0.0, high=1.0,
+                                     doc="d: the border constraint acts on the point d ahead "
+                                         "of the wheel axle, m")
+    velocity_cost: float = gain(1e-3, low=0.0, high=1.0,
+                                doc="w of w ||u||_1, the tie-break between optimal vertices; "
+                                    "0 with the other two weights solves 5.29 exactly "
+                                    "(wbc.objectives.velocity_cost)")
+    waist_centring: float = gain(0.02, low=0.0, high=1.0,
+                                 doc="weight of |q1' + k q1|: the waist/base-yaw self-motion "
+                                     "spent on a centred waist (wbc.objectives.waist_centring)")
+    waist_gain: float = gain(1.0, low=1e-3, high=100.0, doc="k of the waist centring, 1/s")
+    waist_fade: float = gain(0.05, low=0.0, high=10.0,
+                             doc="||e||_1 below which the waist centring fades out (0: never)")
+    base_target: float = gain(0.05, low=0.0, high=1.0,
+                              doc="weight of turning the base towards where it should stand "
+                                  "for a pose goal (wbc.objectives.base_target)")
+    base_target_gain: float = gain(2.0, low=1e-3, high=100.0, doc="k of the base target, 1/s")
+    base_target_reach: float = gain(0.36, low=0.0, high=5.0,
+                                    doc="how far behind the goal, along the gripper's heading, "
+                                        "the base should stand, m: the mean horizontal reach "
+                                        "over the arm goals of `parsimony bench` (0.36 +- 0.08)")
+    base_target_stop: float = gain(0.15, low=1e-3, high=5.0,
+                                   doc="distance from the base target within which it is off "
+                                       "(full weight at twice), m")
+    nonholonomic: bool = gain(True, doc="False models a holonomic base (section 6.3, test 1)")
 
     def __post_init__(self) -> None:
-        require_positive(self, "eta", "beta", "joint_gain", "safety_factor", "obstacle_gain",
-                         "waist_gain", "base_target_gain", "base_target_stop")  # fmt: skip
-        if self.safety_factor > 1.0:
-            raise ValueError(f"LPParams.safety_factor must be <= 1, got {self.safety_factor}")
-        for name in ("velocity_cost", "obstacle_margin", "obstacle_lookahead", "waist_centring",
-                     "waist_fade", "base_target", "base_target_reach"):  # fmt: skip
-            if not np.isfinite(getattr(self, name)) or getattr(self, name) < 0.0:
-                raise ValueError(f"LPParams.{name} must be >= 0, got {getattr(self, name)}")
-        if self.error_bound not in ("derivative", "error"):
-            raise ValueError(f"LPParams.error_bound must be 'derivative' or 'error', got "
-                             f"{self.error_bound!r}")  # fmt: skip
-        if self.obstacle_mode not in ("border", "conservative", "off"):
-            raise ValueError("LPParams.obstacle_mode must be 'border', 'conservative' or 'off', "
-                             f"got {self.obstacle_mode!r}")  # fmt: skip
+        check_gains(self)
 
 
 def default_constraints(params: LPParams) -> list[Constraint]:

@@ -8,11 +8,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from wbc.gains import check_gains, gain
 from wbc.law_output import LawOutput, summarise
 from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
 from wbc.task import Task
-from wbc.validation import require_finite, require_positive
+from wbc.validation import require_finite
 
 Array = np.ndarray
 
@@ -27,11 +28,10 @@ def pinv_velocity(task_jacobian: Array, error: Array, eta: float) -> Array:
 
 @dataclass(frozen=True)
 class PinvParams:
-    eta: float = 0.6
-    """Task gain (1/s)."""
+    eta: float = gain(0.6, low=1e-3, high=100.0, doc="task gain, 1/s")
 
     def __post_init__(self) -> None:
-        require_positive(self, "eta")
+        check_gains(self)
 
 
 @dataclass

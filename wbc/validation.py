@@ -16,11 +16,3 @@ def require_finite(name: str, value: object) -> np.ndarray:
         bad = np.flatnonzero(~np.isfinite(array.ravel())).tolist()
         raise NonFiniteInputError(f"{name} must be finite; entries {bad} are {array.ravel()[bad]}")
     return array
-
-
-def require_positive(params: object, *names: str) -> None:
-    """ValueError naming ``Type.field`` for the first of ``names`` that is not finite and > 0."""
-    for name in names:
-        value = getattr(params, name)
-        if not np.isfinite(value) or value <= 0.0:
-            raise ValueError(f"{type(params).__name__}.{name} must be finite and > 0, got {value}")

@@ -91,3 +91,22 @@ def test_profile_overrides_replace_defaults_and_unknown_names_are_refused() -> N
 def test_reply_values_round_trip_with_their_type(value: object) -> None:
     decoded = decode_value(encode_value(value))
     assert decoded == value and type(decoded) is type(value)
+
+
+@pytest.mark.parametrize("controller", ["lp_controller", "cascade_controller"])
+def test_every_gain_of_a_law_is_a_parameter_with_the_bounds_its_dataclass_declares(controller):
+    import importlib
+
+    from wbc.gains import gain_specs
+
+    module = importlib.import_module(f"components.{controller}")
+    component = next(v for v in vars(module).values()
+                     if isinstance(v, type) and v.__module__ == module.__name__)  # fmt: skip
+    declared = {param.name: param for param in component.params}
+    for spec in gain_specs(component.gains_type):
+        param = declared[spec.name]
+        assert (param.type, param.default, param.low, param.high, param.choices, param.doc) == (
+            spec.type, spec.default, spec.low, spec.high, spec.choices, spec.doc)
+        if spec.high is not None:
+            with pytest.raises(ParamError, match=spec.name):
+                param.check(spec.high * 2 + 1)

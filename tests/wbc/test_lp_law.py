@@ -90,3 +90,12 @@ def test_cascade_reference_does_not_wind_up_when_the_base_cannot_move():
     feedforward = speeds[0]
     assert max(speeds) <= feedforward + max(params.k1, params.k2) * params.max_lead + 1e-9
     assert speeds[-1] == pytest.approx(speeds[100], rel=1e-6)
+
+
+@pytest.mark.parametrize(
+    "field, value", [("eta", "fast"), ("nonholonomic", 1), ("obstacle_gain", True),
+                     ("waist_centring", float("inf"))],
+)  # fmt: skip
+def test_gains_of_the_wrong_type_or_not_finite_are_refused(field, value):
+    with pytest.raises(ValueError, match=f"LPParams.{field}"):
+        LPParams(**{field: value})
