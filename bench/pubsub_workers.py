@@ -16,7 +16,6 @@ from multiprocessing.queues import Queue
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import zenoh
 
 from deploy.profile import ZenohSettings
@@ -27,11 +26,12 @@ from messages.goal import Goal
 from messages.header import Header
 from messages.state import RobotState
 from wbc.robot import MobileManipulator
+from wbc.scenarios import NEAR_START, REACH_GOAL
 
 NAMESPACE = "bench"
 ROBOT = Path(__file__).resolve().parents[1] / "deploy" / "robots" / "little_john.yaml"
-START = np.array([0.07, 0.0, 0.13, 0.03, 0.09, 0.02, 0.03, 0.49])
-GOAL_Q = np.array([0.58, 0.05, -0.16, 0.3, 0.15, -0.66, -0.03, -0.36])
+START = NEAR_START
+GOAL_Q = REACH_GOAL
 WIDTH, HEIGHT = 640, 480
 WAIT_S = 15.0
 """How long anything may take before the bench gives up."""

@@ -15,19 +15,17 @@ from pathlib import Path
 import numpy as np
 
 from parsimony.goal_sets import goal_report
-from parsimony.kinematic_demo import DT, ROBOT_FILE, START
+from parsimony.kinematic_demo import ROBOT_FILE
 from wbc import dq
 from wbc.cascade_law import CascadeLaw, CascadeParams
 from wbc.kinematic_run import integrate
 from wbc.lp_law import LPLaw, LPParams
 from wbc.pinv_law import PinvParams, PseudoinverseLaw
 from wbc.robot import MobileManipulator
+from wbc.scenarios import CONVERGENCE_GOAL, DT, HOME, REACH_GOAL
 from wbc.task import PoseTask
 
-GOAL = np.array([0.58, 0.05, -0.16, 0.3, 0.15, -0.66, -0.03, -0.36])
-CONVERGENCE_GOAL = np.array([0.45, -0.29, -0.12, 0.23, -0.26, 0.14, -0.28, -0.3])
-ARM_GOAL_LOW = np.array([-0.5, -0.8, -0.8, -0.5, -0.8])
-ARM_GOAL_HIGH = np.array([0.5, 0.3, 0.3, 0.5, 0.8])
+GOAL = REACH_GOAL
 
 
 def percentiles(samples_s: list[float]) -> dict[str, float]:
@@ -56,7 +54,7 @@ def step_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str, fl
     The laws take turns, BLOCK steps each, over the same states.
     """
     task = PoseTask(robot.fkm(GOAL))
-    trajectory = integrate(LPLaw(robot), START, task, DT, 3000).configurations
+    trajectory = integrate(LPLaw(robot), HOME, task, DT, 3000).configurations
     laws = {"lp": LPLaw(robot), "classic": PseudoinverseLaw(robot), "cascade": CascadeLaw(robot)}
     samples: dict[str, list[float]] = {name: [] for name in laws}
     position = 0
@@ -85,9 +83,9 @@ def lp_breakdown(robot: MobileManipulator, repeats: int) -> dict[str, float]:
     steps that called HiGHS.
     """
     task = PoseTask(robot.fkm(GOAL))
-    trajectory = integrate(LPLaw(robot), START, task, DT, 3000).configurations
+    trajectory = integrate(LPLaw(robot), HOME, task, DT, 3000).configurations
     law = LPLaw(robot)
-    law.step(START, task, DT)
+    law.step(HOME, task, DT)
     spent = {"kinematics": 0.0, "rows": 0.0, "vertex": 0.0, "highs": 0.0}
 
     def timed(part: str, call: Callable) -> Callable:
@@ -144,7 +142,7 @@ def dqrobotics_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[s
     controller.set_gain(0.6)
     controller.set_damping(0.0)
     goal = DQ(robot.fkm(GOAL))
-    q = START.copy()
+    q = HOME.copy()
     return {
         "kinematics": percentiles(
             time_calls(lambda: (whole_body.fkm(q), whole_body.pose_jacobian(q)), repeats)
@@ -177,7 +175,7 @@ def convergence_test(robot: MobileManipulator, trials: int) -> dict[str, dict[st
         for _ in range(trials):
             law = make_law()
             start = time.perf_counter()
-            run = integrate(law, START, task, DT, 2000)
+            run = integrate(law, HOME, task, DT, 2000)
             durations.append(time.perf_counter() - start)
             iterations.append(len(run.outputs) if run.converged else -1)
         per_iteration = np.array(durations) / np.abs(iterations)

@@ -15,20 +15,18 @@ from pathlib import Path
 
 import numpy as np
 
-from parsimony.kinematic_demo import DT, START
 from wbc.cascade_law import CascadeLaw
 from wbc.kinematic_run import integrate
 from wbc.law_output import Law
 from wbc.lp_law import LPLaw, LPParams
 from wbc.robot import MobileManipulator
+from wbc.scenarios import ARM_BOX, DT, HOME
 from wbc.task import PoseTask
 
 Array = np.ndarray
 
-ARM_BOX = (np.array([-0.5, -0.8, -0.8, -0.5, -0.8]), np.array([0.5, 0.3, 0.3, 0.5, 0.8]))
-"""A moderate box of arm angles (rad), inside the 0.9-scaled joint limits."""
 START_SPREAD = 0.3
-"""The start arm is START's, each joint moved by up to this much (rad), clipped to ARM_BOX."""
+"""The start arm is HOME's, each joint moved by up to this much (rad), clipped to ARM_BOX."""
 TIME_LIMIT_S = 60.0
 TOLERANCE = 1e-3
 LIMIT_TOLERANCE = 1e-6
@@ -48,12 +46,12 @@ class GoalFamily:
     def sample(self, rng: np.random.Generator) -> tuple[Array, Array]:
         """(start configuration, goal configuration)."""
         low, high = ARM_BOX
-        arm_start = np.clip(START[3:] + rng.uniform(-START_SPREAD, START_SPREAD, 5), low, high)
+        arm_start = np.clip(HOME[3:] + rng.uniform(-START_SPREAD, START_SPREAD, 5), low, high)
         distance, bearing = rng.uniform(*self.distance), rng.uniform(*self.bearing)
         base = [distance * math.cos(bearing), distance * math.sin(bearing),
                 rng.uniform(*self.heading)]  # fmt: skip
         goal = np.concatenate((base, rng.uniform(low, high)))
-        return np.concatenate((START[:3], arm_start)), goal
+        return np.concatenate((HOME[:3], arm_start)), goal
 
 
 AHEAD = math.radians(35.0)

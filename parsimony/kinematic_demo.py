@@ -19,15 +19,11 @@ from wbc.lp_law import LPLaw, LPParams
 from wbc.obstacles import Circle
 from wbc.pinv_law import PseudoinverseLaw
 from wbc.robot import MobileManipulator
+from wbc.scenarios import DT, HOME, JOINT_LIMIT_GOAL, OBSTACLE, OBSTACLE_GOAL, REACH_GOAL
 from wbc.task import PoseTask, PositionTask, Task
 
 ROBOT_FILE = Path(__file__).resolve().parents[1] / "deploy" / "robots" / "little_john.yaml"
-DT = 0.02
 STEPS = 4000
-START = np.array([0.0, 0.0, 0.0, 0.0, -0.2, 0.2, 0.0, 0.5])
-OBSTACLE_GOAL = np.concatenate(([1.3, 0.3, 0.2], START[3:]))
-OBSTACLE = Circle(0.56, 0.16, 0.1)
-"""On the path the default LP law's base takes to OBSTACLE_GOAL when nothing is in the way."""
 BORDER_PARAMS = LPParams(obstacle_mode="border", base_target=0.0)
 """The border-following law of 6.2.3 without the base target term, whose straight-line
 heading towards where the base should stand fights the detour round the obstacle."""
@@ -43,9 +39,9 @@ class Experiment:
 
 def experiments(robot: MobileManipulator) -> list[Experiment]:
     """Pose (6.2.1), position (6.2.2), obstacle (6.2.3) and the joint limit of figure 6.10."""
-    reach = robot.fkm(np.array([0.58, 0.05, -0.16, 0.3, 0.15, -0.66, -0.03, -0.36]))
+    reach = robot.fkm(REACH_GOAL)
     beyond_obstacle = robot.fkm(OBSTACLE_GOAL)
-    past_elbow_limit = robot.fkm(np.array([0.3, 0.0, 0.0, 0.0, -0.2, 0.9, 0.0, 0.5]))
+    past_elbow_limit = robot.fkm(JOINT_LIMIT_GOAL)
     return [
         Experiment(
             "pose",
@@ -108,7 +104,7 @@ def run_demo(robot_file: Path = ROBOT_FILE) -> list[dict]:
     rows = []
     for experiment in experiments(robot):
         for law_name, law in experiment.laws.items():
-            run = integrate(law, START, experiment.task, DT, STEPS, obstacles=experiment.obstacles)
+            run = integrate(law, HOME, experiment.task, DT, STEPS, obstacles=experiment.obstacles)
             rows.append(summary_row(experiment, law_name, run, robot))
     return rows
 

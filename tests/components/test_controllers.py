@@ -31,6 +31,7 @@ from messages.header import Header
 from messages.state import RobotState
 from parsimony.commands import param
 from wbc.robot import MobileManipulator
+from wbc.scenarios import NEAR_START, REACH_GOAL
 
 if TYPE_CHECKING:
     from tests.components.conftest import System
@@ -42,10 +43,10 @@ CASCADE_PROFILE = DEPLOY / "controllers_cascade.yaml"
 DEADLINE_S = 10.0
 """Generous limit for anything that involves starting a process on a loaded machine."""
 
-START = (0.07, 0.0, 0.13, 0.03, 0.09, 0.02, 0.03, 0.49)
+START = tuple(NEAR_START.tolist())
 """The configuration the states report: [x, y, phi, q1..q5]."""
 
-GOAL_Q = (0.58, 0.05, -0.16, 0.3, 0.15, -0.66, -0.03, -0.36)
+GOAL_Q = tuple(REACH_GOAL.tolist())
 """The configuration whose end-effector pose is the profile's goal."""
 
 ROBOT = MobileManipulator.from_yaml(DEPLOY / "robots" / "little_john.yaml")

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from wbc_scenarios import DT, STARTS_AND_GOALS, pose_task, position_task, robot
+from wbc_scenarios import pose_task, position_task, robot
 
 from wbc.lp_law import LPLaw
+from wbc.scenarios import DT, STARTS_AND_GOALS
 
 MODEL = robot()
 

@@ -4,20 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from wbc_scenarios import (
-    DT,
-    HOME,
-    STARTS_AND_GOALS,
-    integrate,
-    pose_task,
-    position_task,
-    robot,
-)
+from wbc_scenarios import integrate, pose_task, position_task, robot
 
-from parsimony.kinematic_demo import BORDER_PARAMS, OBSTACLE, OBSTACLE_GOAL
+from parsimony.kinematic_demo import BORDER_PARAMS
 from wbc.cascade_law import CascadeLaw
 from wbc.lp_law import LPLaw, LPParams
 from wbc.pinv_law import PseudoinverseLaw
+from wbc.scenarios import DT, HOME, JOINT_LIMIT_GOAL, OBSTACLE, OBSTACLE_GOAL, STARTS_AND_GOALS
 from wbc.task import PositionTask
 
 MODEL = robot()
@@ -88,9 +81,7 @@ def test_pseudoinverse_law_uses_every_joint_where_the_lp_law_does_not():
 
 def test_joint_limit_kept_by_lp_law_and_passed_by_pseudoinverse_law():
     """Figure 6.10: a goal whose nearest arm pose puts the elbow q3 beyond its limit."""
-    goal = HOME.copy()
-    goal[0], goal[5] = 0.3, 0.9
-    task = pose_task(MODEL, goal)
+    task = pose_task(MODEL, JOINT_LIMIT_GOAL)
     elbow = 5
     pinv = integrate(PseudoinverseLaw(MODEL), HOME, task, steps=2000)
     lp = integrate(LPLaw(MODEL, POSE_PARAMS), HOME, task, steps=2000)

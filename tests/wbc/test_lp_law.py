@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from wbc_scenarios import DT, HOME, STARTS_AND_GOALS, pose_task, robot
+from wbc_scenarios import pose_task, robot
 
 from wbc.lp_law import LPLaw, LPParams
 from wbc.obstacles import Circle
+from wbc.scenarios import DT, HOME, STARTS_AND_GOALS
 from wbc.task import PoseTask
 from wbc.validation import NonFiniteInputError
 

@@ -6,13 +6,14 @@ import math
 
 import numpy as np
 import pytest
-from wbc_scenarios import DT, HOME, robot
+from wbc_scenarios import robot
 
 from wbc import dq
 from wbc.lp_law import LPLaw, LPParams
 from wbc.objectives.base_target import BaseTarget, gripper_heading
 from wbc.objectives.velocity_cost import LeastVelocity
 from wbc.objectives.waist_centring import WaistCentring
+from wbc.scenarios import DT, HOME
 from wbc.step_context import StepContext
 from wbc.task import PoseTask, PositionTask
 
