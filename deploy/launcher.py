@@ -86,6 +86,9 @@ class Launcher:
         self.output = Output(out, err)
         self.children = [Child(spec) for spec in profile.start_order()]
         self._stop_reason: str | None = None
+        self._seen_alive: set[str] = set()
+        """Components whose liveliness token the router has seen at least once."""
+        self._starting_until: float | None = None
 
     def run(self, duration_s: float | None = None) -> int:
         """Run until a stop signal, the duration, or no component is left; return 0 or 1.
@@ -105,6 +108,7 @@ class Launcher:
             try:
                 for child in self.children:
                     self._start(child)
+                self._starting_until = time.monotonic() + self.profile.startup_timeout_s
                 self._supervise(None if duration_s is None else time.monotonic() + duration_s)
             finally:
                 for stop_signal in (signal.SIGINT, signal.SIGTERM):
@@ -124,6 +128,8 @@ class Launcher:
         """Zenoh thread: report a component's token appearing or disappearing."""
         name = topics.component_of_liveliness_key(self.profile.namespace, str(sample.key_expr))
         alive = sample.kind == zenoh.SampleKind.PUT
+        if alive:
+            self._seen_alive.add(name)
         self.output.say(f"{name} {'alive' if alive else 'lost'}")
 
     def _supervise(self, deadline: float | None) -> None:
@@ -139,11 +145,37 @@ class Launcher:
                     self._on_exit(child, code, now)
                 elif child.restart_at is not None and now >= child.restart_at:
                     self._start(child)
+            if self._starting_until is not None:
+                self._check_startup(now)
             if all(child.done for child in self.children):
-                self._stop_reason = "no component left running"
+                self._stop_reason = self._stop_reason or "no component left running"
                 break
             time.sleep(POLL_S)
         self.output.say(f"stopping ({self._stop_reason})")
+
+    def _check_startup(self, now: float) -> None:
+        """Until every component has been alive once: fail the launch when one stops for good
+        before (a configuration error, say), or is not alive when the start-up timeout runs out."""
+        refused = [c.spec.name for c in self.children
+                   if c.done and c.failed and c.spec.name not in self._seen_alive]  # fmt: skip
+        waiting = [c.spec.name for c in self.children
+                   if not c.done and c.spec.name not in self._seen_alive]  # fmt: skip
+        if refused:
+            self._fail_startup(f"{', '.join(refused)} failed during start-up", refused)
+        elif not waiting:
+            self._starting_until = None
+            self.output.say(f"all {len(self.children)} components alive")
+        elif now >= self._starting_until:
+            timeout = self.profile.startup_timeout_s
+            self._fail_startup(f"{', '.join(waiting)} not alive after {timeout:.1f} s "
+                               "(check its zenoh endpoints and its log)", waiting)  # fmt: skip
+
+    def _fail_startup(self, why: str, names: list[str]) -> None:
+        self._starting_until = None
+        for child in self.children:
+            if child.spec.name in names:
+                child.failed = True
+        self._stop_reason = f"start-up failed: {why}"
 
     def _start(self, child: Child) -> None:
         """Start a child's process and the threads that forward its output."""

@@ -212,6 +212,9 @@ class Profile(StrictModel):
     zenoh: ZenohSettings = ZenohSettings()
     robot: Path | None = None
     clock: Literal["wall", "sim"] = "wall"
+    startup_timeout_s: float = Field(default=10.0, gt=0.0)
+    """Seconds the launcher gives every component to become alive (its liveliness token seen
+    by the router) before it fails the launch, naming those that are not."""
     clock_timeout_s: float = Field(default=1.0, gt=0.0)
     """Host seconds after which a component on ``sim`` time whose clock has not moved says its
     clock stalled (a controller then commands zero)."""

@@ -8,6 +8,10 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import yaml
+
+from tests.deploy.conftest import free_port
+
 if TYPE_CHECKING:
     from tests.deploy.conftest import LaunchFixture, ProfileWriter
 
@@ -105,6 +109,34 @@ def test_the_launcher_warns_of_a_topic_read_and_never_written(
                       r"no component")  # fmt: skip
     assert launched.process.wait(10.0) == 0
     assert "test/base/command is read" not in launched.text()
+
+
+def test_a_component_that_never_comes_alive_fails_the_launch_by_name(
+    write_profile: ProfileWriter, launch: LaunchFixture, tmp_path: Path
+) -> None:
+    """Its session connects to a port nobody listens on: it runs, but the router never sees
+    it. Before, the launch ran on and exited 0."""
+    profile = write_profile([publisher("pub")], startup_timeout_s=2.0)
+    data = yaml.safe_load(profile.read_text())
+    data["zenoh"]["connect"] = [f"tcp/127.0.0.1:{free_port()}"]
+    profile.write_text(yaml.safe_dump(data))
+    launched = launch(profile)
+    launched.wait_for(r"\[launch\] stopping \(start-up failed: pub not alive after 2\.0 s")
+    assert launched.process.wait(10.0) == 1
+    assert "[launch] failed: pub" in launched.text()
+
+
+def test_a_configuration_error_at_start_up_fails_the_whole_launch(
+    write_profile: ProfileWriter, launch: LaunchFixture
+) -> None:
+    """One component refuses its parameters (exit 2): the others are stopped, the launch
+    fails, instead of running on without it."""
+    bad = publisher("bad", params={"rate_hz": 0.0})
+    launched = launch(write_profile([publisher("good"), bad]))
+    launched.wait_for(r"\[launch\] bad exited with 2; configuration error, not restarting")
+    launched.wait_for(r"\[launch\] stopping \(start-up failed: bad failed during start-up\)")
+    assert launched.process.wait(10.0) == 1
+    launched.wait_for(r"\[launch\] good stopped")
 
 
 def test_components_stop_when_the_launcher_is_killed(
