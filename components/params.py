@@ -10,13 +10,11 @@ replied as plain text.
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 
-ParamValue = bool | int | float | str
-"""A parameter's value."""
+from messages.process import ParamValue
 
 _TRUE = ("true", "yes", "on", "1")
 _FALSE = ("false", "no", "off", "0")
@@ -137,13 +135,3 @@ class Parameters(Mapping[str, ParamValue]):
         self._values[name] = value
         self.version += 1
         return value
-
-
-def encode_value(value: ParamValue) -> bytes:
-    """A parameter value as a reply payload (JSON)."""
-    return json.dumps(value).encode()
-
-
-def decode_value(payload: bytes) -> ParamValue:
-    """The parameter value in a reply payload."""
-    return json.loads(payload)

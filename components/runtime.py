@@ -35,20 +35,15 @@ import zenoh
 from pydantic import BaseModel
 
 from components.clock import Clock, SimClock, Timer, Timers, WallClock
-from components.params import Param, ParamError, Parameters, encode_value
+from components.params import Param, ParamError, Parameters
 from components.pubsub import Input, Publisher, Subscription
 from deploy.profile import Profile, ProfileError, load_profile
 from messages import codec, topics
 from messages.header import Header
+from messages.process import EXIT_CONFIG_ERROR, LAUNCHER_PID_ENV, encode_value
 from messages.status import ComponentStatus
 
 M = TypeVar("M", bound=BaseModel)
-
-EXIT_CONFIG_ERROR = 2
-"""Exit code of a component refused by its configuration; the launcher never restarts it."""
-
-LAUNCHER_PID_ENV = "PARSIMONY_LAUNCHER_PID"
-"""Set by the launcher; a component whose parent is no longer that pid stops."""
 
 SUMMARY_INTERVAL_S = 5.0
 """Repeated warnings of one kind are summarised at most this often."""

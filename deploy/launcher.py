@@ -8,7 +8,7 @@ stops them in the reverse order: SIGTERM, then SIGKILL after a timeout.
 
 Children run in their own session, so a Ctrl-C reaches the launcher alone and
 the stop order holds; a child whose launcher dies stops by itself
-(``components.runtime.LAUNCHER_PID_ENV``).
+(``messages.process.LAUNCHER_PID_ENV``).
 """
 
 from __future__ import annotations
@@ -25,9 +25,9 @@ from typing import IO
 
 import zenoh
 
-from components.runtime import EXIT_CONFIG_ERROR, LAUNCHER_PID_ENV
 from deploy.profile import ROLES, ComponentSpec, Profile
-from messages import topics
+from messages import process, topics
+from messages.process import EXIT_CONFIG_ERROR, LAUNCHER_PID_ENV
 
 POLL_S = 0.05
 """How often the launcher looks at its children and the clock."""
@@ -180,15 +180,7 @@ class Launcher:
     def _start(self, child: Child) -> None:
         """Start a child's process and the threads that forward its output."""
         spec = child.spec
-        command = [
-            sys.executable,
-            "-m",
-            spec.module_path,
-            "--profile",
-            str(self.profile_path),
-            "--name",
-            spec.name,
-        ]
+        command = process.command(spec.module_path, self.profile_path, spec.name)
         env = dict(os.environ, PYTHONUNBUFFERED="1", **{LAUNCHER_PID_ENV: str(os.getpid())})
         child.process = subprocess.Popen(
             command,

@@ -20,6 +20,8 @@ import yaml
 import zenoh
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from messages.process import ParamValue
+
 COMPONENT_PACKAGE = "components"
 """The package of component modules: ``module: echo`` means ``components.echo``."""
 
@@ -31,9 +33,6 @@ Identifier = Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]*$")]
 
 Namespace = Annotated[str, Field(pattern=r"^[A-Za-z0-9_-]+(/[A-Za-z0-9_-]+)*$")]
 """One or more key-expression chunks without wildcards, e.g. ``sim`` or ``lab/robot1``."""
-
-ParamValue = bool | int | float | str
-"""A value a profile may give a component parameter."""
 
 LOCAL_PROTOCOLS = ("unixsock-stream",)
 """Zenoh link protocols that never leave the host."""

@@ -12,10 +12,10 @@ from pathlib import Path
 
 import zenoh
 
-from components.params import ParamValue, decode_value
 from deploy.profile import ZenohSettings, load_profile
 from deploy.zenoh_error import zenoh_error_text
 from messages import codec, topics
+from messages.process import ParamValue, decode_value
 from messages.status import ComponentStatus
 
 DEFAULT_ROUTER = "tcp/127.0.0.1:7447"

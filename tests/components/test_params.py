@@ -6,7 +6,8 @@ import math
 
 import pytest
 
-from components.params import Param, ParamError, Parameters, decode_value, encode_value
+from components.params import Param, ParamError, Parameters
+from messages.process import decode_value, encode_value
 
 RATE = Param("rate_hz", float, 10.0, low=0.1, high=100.0)
 TASK = Param("task", str, "pose", choices=("pose", "position"))

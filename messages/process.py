@@ -1,0 +1,40 @@
+"""The contract of a component process with whoever starts it and asks it questions.
+
+How it is started (``command``), what its exit codes mean, what the environment tells it, and
+how a parameter's value travels in a query reply. The launcher (``deploy``) and the runtime
+(``components``) both follow it; neither imports the other.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+ParamValue = bool | int | float | str
+"""A parameter's value."""
+
+EXIT_CONFIG_ERROR = 2
+"""Exit code of a component refused by its configuration; the launcher never restarts it."""
+
+LAUNCHER_PID_ENV = "PARSIMONY_LAUNCHER_PID"
+"""Set by the launcher; a component whose parent is no longer that pid stops."""
+
+PARAMS_FILE_ENV = "PARSIMONY_PARAMS_FILE"
+"""Set by the launcher: a JSON file where a component keeps the parameters set while it runs,
+and from which it takes them back when it is started again (a restart keeps them)."""
+
+
+def command(module_path: str, profile: Path, name: str) -> list[str]:
+    """The command line of component ``name`` of ``profile``, running ``module_path``."""
+    return [sys.executable, "-m", module_path, "--profile", str(profile), "--name", name]
+
+
+def encode_value(value: ParamValue) -> bytes:
+    """A parameter value as a reply payload (JSON)."""
+    return json.dumps(value).encode()
+
+
+def decode_value(payload: bytes) -> ParamValue:
+    """The parameter value in a reply payload."""
+    return json.loads(payload)
