@@ -109,6 +109,8 @@ class Parameters(Mapping[str, ParamValue]):
             )
         self._values = {name: param.default for name, param in self.declared.items()}
         self.version = 0
+        self.changed: dict[str, ParamValue] = {}
+        """The values set while the component runs (what a restart must keep)."""
         for name, value in overrides.items():
             self._values[name] = self.declared[name].check(value)
 
@@ -131,7 +133,11 @@ class Parameters(Mapping[str, ParamValue]):
 
     def set_text(self, name: str, text: str) -> ParamValue:
         """Set ``name`` from its text form and return the new value."""
-        value = self.param(name).parse(text)
-        self._values[name] = value
+        return self.set(name, self.param(name).parse(text))
+
+    def set(self, name: str, value: object) -> ParamValue:
+        """Set ``name`` to ``value`` (checked) and return it."""
+        value = self.param(name).check(value)
+        self._values[name] = self.changed[name] = value
         self.version += 1
         return value

@@ -20,6 +20,7 @@ counted as ``errors.<topic>``; the process keeps running either way.
 from __future__ import annotations
 
 import argparse
+import json
 import logging
 import os
 import queue
@@ -29,6 +30,7 @@ import threading
 import time
 from collections.abc import Callable, Iterable, Sequence
 from functools import partial
+from pathlib import Path
 from typing import ClassVar, NoReturn, TypeVar
 
 import zenoh
@@ -40,7 +42,7 @@ from components.pubsub import Input, Publisher, Subscription
 from deploy.profile import Profile, ProfileError, load_profile
 from messages import codec, topics
 from messages.header import Header
-from messages.process import EXIT_CONFIG_ERROR, LAUNCHER_PID_ENV, encode_value
+from messages.process import EXIT_CONFIG_ERROR, LAUNCHER_PID_ENV, PARAMS_FILE_ENV, encode_value
 from messages.status import ComponentStatus
 
 M = TypeVar("M", bound=BaseModel)
@@ -90,12 +92,15 @@ class Node:
         params: Iterable[Param] = (),
         reads: Iterable[Input] | None = None,
         writes: Iterable[topics.Topic] | None = None,
+        kept_params: Path | None = None,
     ) -> None:
         """Raise ``KeyError`` for a name not in the profile, ``ParamError`` for bad params.
 
         ``reads`` and ``writes`` are the component's declared topics (``Component.reads``,
         ``Component.writes``): when given, the node refuses any other, and each subscription
         takes its mode from its declaration. ``None`` (a test's or a tool's node) allows any.
+        ``kept_params`` is a JSON file of the parameters set at run time by an earlier run of
+        this component: they are set again (over the profile's), and later changes written back.
         """
         self.reads = None if reads is None else {i.topic.name: i for i in reads}
         self.writes = None if writes is None else {t.name for t in writes}
@@ -104,6 +109,8 @@ class Node:
         self.name = name
         self.namespace = profile.namespace
         self.params = Parameters(params, self.spec.params)
+        self._kept_params = kept_params
+        self._restore_params()
         publishes_clock = self.writes is not None and topics.SIM_CLOCK.name in self.writes
         source = profile.clock_of(self.spec, publishes_clock)
         self.clock: Clock = SimClock() if source == "sim" else WallClock()
@@ -289,6 +296,31 @@ class Node:
             self.count(counter)
             self.warn(counter, f"{getattr(callback, '__qualname__', callback)} failed", True)
 
+    def _restore_params(self) -> None:
+        """Set again the parameters an earlier run kept; skip (and log) any refused now."""
+        if self._kept_params is None or not self._kept_params.is_file():
+            return
+        try:
+            kept = json.loads(self._kept_params.read_text())
+        except (OSError, ValueError) as error:
+            log.warning("%s: cannot read kept parameters: %s", self._kept_params, error)
+            return
+        for name, value in kept.items():
+            try:
+                self.params.set(name, value)
+            except ParamError as error:
+                log.warning("kept parameter not restored: %s", error)
+        if self.params.changed:
+            log.info("parameters restored from the last run: %s", self.params.changed)
+
+    def _keep_params(self) -> None:
+        """Write the parameters set at run time where the next run of this component finds them."""
+        if self._kept_params is None:
+            return
+        partial_file = self._kept_params.with_suffix(".tmp")
+        partial_file.write_text(json.dumps(self.params.changed))
+        partial_file.replace(self._kept_params)
+
     def _answer_status(self, query: zenoh.Query) -> None:
         with query:
             status = self.status()
@@ -310,6 +342,7 @@ class Node:
                     (name,) = matching.values()
                     value = self.params.set_text(name, query.payload.to_string())
                     log.info("parameter %s set to %r", name, value)
+                    self._keep_params()
             except ParamError as error:
                 query.reply_err(str(error))
                 return
@@ -381,8 +414,9 @@ def _configure(component_class: type[Component], args: argparse.Namespace) -> No
         log.error("%s: no component named %r (have %s)", args.profile, args.name, names)
         return None
     try:
+        kept = os.environ.get(PARAMS_FILE_ENV)
         return Node(profile, args.name, component_class.params, component_class.reads,
-                    component_class.writes)  # fmt: skip
+                    component_class.writes, Path(kept) if kept else None)  # fmt: skip
     except ParamError as error:
         log.error("%s: components[%d].params.%s", args.profile, names.index(args.name), error)
         return None

@@ -14,9 +14,11 @@ the stop order holds; a child whose launcher dies stops by itself
 from __future__ import annotations
 
 import os
+import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from dataclasses import dataclass
@@ -27,7 +29,7 @@ import zenoh
 
 from deploy.profile import ROLES, ComponentSpec, Profile
 from messages import process, topics
-from messages.process import EXIT_CONFIG_ERROR, LAUNCHER_PID_ENV
+from messages.process import EXIT_CONFIG_ERROR, LAUNCHER_PID_ENV, PARAMS_FILE_ENV
 
 POLL_S = 0.05
 """How often the launcher looks at its children and the clock."""
@@ -86,6 +88,9 @@ class Launcher:
         self.output = Output(out, err)
         self.children = [Child(spec) for spec in profile.start_order()]
         self._stop_reason: str | None = None
+        self._kept_params = Path()
+        """A directory of one JSON file per component: the parameters set while it runs, kept
+        for its restart; made by ``run`` and removed when it returns."""
         self._seen_alive: set[str] = set()
         """Components whose liveliness token the router has seen at least once."""
         self._starting_until: float | None = None
@@ -98,6 +103,7 @@ class Launcher:
         for stop_signal in (signal.SIGINT, signal.SIGTERM):
             signal.signal(stop_signal, self._on_signal)
         endpoints = ", ".join(self.profile.zenoh.router)
+        self._kept_params = Path(tempfile.mkdtemp(prefix="parsimony-params-"))
         with zenoh.open(self.profile.zenoh.router_config()) as router:
             self.output.say(f"router listening on {endpoints}, namespace {self.profile.namespace}")
             watcher = router.liveliness().declare_subscriber(
@@ -115,6 +121,7 @@ class Launcher:
                     signal.signal(stop_signal, signal.SIG_IGN)
                 self._stop_all()
                 watcher.undeclare()
+                shutil.rmtree(self._kept_params, ignore_errors=True)
         failed = [child.spec.name for child in self.children if child.failed]
         if failed:
             self.output.say(f"failed: {', '.join(failed)}")
@@ -181,7 +188,10 @@ class Launcher:
         """Start a child's process and the threads that forward its output."""
         spec = child.spec
         command = process.command(spec.module_path, self.profile_path, spec.name)
-        env = dict(os.environ, PYTHONUNBUFFERED="1", **{LAUNCHER_PID_ENV: str(os.getpid())})
+        env = dict(os.environ, PYTHONUNBUFFERED="1", **{
+            LAUNCHER_PID_ENV: str(os.getpid()),
+            PARAMS_FILE_ENV: str(self._kept_params / f"{spec.name}.json"),
+        })  # fmt: skip
         child.process = subprocess.Popen(
             command,
             stdin=subprocess.DEVNULL,

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 import yaml
 
+from deploy import query
 from tests.deploy.conftest import free_port
 
 if TYPE_CHECKING:
@@ -137,6 +138,24 @@ def test_a_configuration_error_at_start_up_fails_the_whole_launch(
     launched.wait_for(r"\[launch\] stopping \(start-up failed: bad failed during start-up\)")
     assert launched.process.wait(10.0) == 1
     launched.wait_for(r"\[launch\] good stopped")
+
+
+def test_a_parameter_set_at_run_time_survives_a_restart(
+    write_profile: ProfileWriter, launch: LaunchFixture
+) -> None:
+    profile = write_profile([publisher("pub")])
+    launched = launch(profile)
+    started, _, match = launched.wait_for(r"\[launch\] started pub \(.*pid (\d+)\)")
+    launched.wait_for(r"\[launch\] pub alive", after=started)
+    target = query.Target.from_profile(profile)
+    with target.open() as session:
+        assert query.set_param(session, "test", "pub", "rate_hz", "7.5") == 7.5
+        os.kill(int(match.group(1)), signal.SIGKILL)
+        restarted, _, _ = launched.wait_for(r"\[launch\] started pub", after=started + 1)
+        launched.wait_for(r"\[launch\] pub alive", after=restarted)
+        assert query.get_param(session, "test", "pub", "rate_hz") == 7.5
+        assert query.get_param(session, "test", "pub", "goal_task") == "position"  # untouched
+    launched.stop()
 
 
 def test_components_stop_when_the_launcher_is_killed(
