@@ -1,8 +1,9 @@
 """Typed publishers and subscriptions of a component (see ``components.runtime``).
 
 A subscription hands its samples to the component's handler thread and decodes them there
-with the codec; it drops and counts malformed ones (``rejected.<topic>``) and counts handler
-exceptions (``errors.<topic>``). Each input chooses what waits for the handler:
+with the codec; it drops and counts malformed ones (``rejected.<topic>``), refuses a payload
+over the topic's ``max_bytes`` on arrival, before any copy or decoding (counted the same), and
+counts handler exceptions (``errors.<topic>``). Each input chooses what waits for the handler:
 
 - ``latest`` (control): only the newest sample; one that arrives before the previous was
   handled replaces it (``overwritten.<topic>``);
@@ -17,6 +18,7 @@ import math
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from typing import Generic, Protocol, TypeVar
 
 import zenoh
@@ -124,6 +126,7 @@ class Subscription(Generic[M]):
         self._capacity = 1 if queue is None else queue
         self._dropped = f"{'overwritten' if queue is None else 'overflowed'}.{topic.name}"
         self._received_ns: int | None = None
+        self._oversized_warning_waiting = False
         for kind in ("received", "rejected", "errors"):
             node.counters[f"{kind}.{topic.name}"] = 0
         node.counters[self._dropped] = 0
@@ -139,6 +142,10 @@ class Subscription(Generic[M]):
         """Zenoh thread: keep the payload (dropping the oldest when full), wake the handler."""
         if sample.kind != zenoh.SampleKind.PUT:
             return
+        size = len(sample.payload)
+        if size > self.topic.max_bytes:
+            self._refuse_oversized(size)
+            return
         arrival = (sample.payload.to_bytes(), self._node.clock.monotonic_ns())
         with self._lock:
             was_idle = not self._waiting
@@ -148,6 +155,22 @@ class Subscription(Generic[M]):
                 self._node.counters[self._dropped] += 1
         if was_idle:
             self._node.post(self._deliver)
+
+    def _refuse_oversized(self, size: int) -> None:
+        """Zenoh thread: count a payload over the topic's ``max_bytes``, never decoding it; the
+        warning is logged by the handler thread, one at a time whatever the flood."""
+        with self._lock:
+            self._node.counters[f"rejected.{self.topic.name}"] += 1
+            warn = not self._oversized_warning_waiting
+            self._oversized_warning_waiting = True
+        if warn:
+            self._node.post(partial(self._warn_oversized, size))
+
+    def _warn_oversized(self, size: int) -> None:
+        with self._lock:
+            self._oversized_warning_waiting = False
+        self._node.warn(f"rejected.{self.topic.name}", f"dropped a {size}-byte message on "
+                        f"{self._key}: over {self.topic.max_bytes} bytes")  # fmt: skip
 
     def _deliver(self) -> None:
         """Handler thread: decode the oldest waiting payload and call the handler; come back

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pydantic import Field
+
 from messages.base import Message, NonNegative, UnitDualQuaternion
 from messages.header import Header
 
@@ -15,8 +17,12 @@ class MarkerDetection(Message):
     reprojection_error: NonNegative
 
 
+MAX_MARKERS = 1024
+"""The most markers one image's detections may hold (the ArUco 4x4 dictionaries have 1000)."""
+
+
 class MarkerDetections(Message):
-    """Every marker found in one image (possibly none)."""
+    """Every marker found in one image (possibly none, at most ``MAX_MARKERS``)."""
 
     header: Header
-    markers: tuple[MarkerDetection, ...] = ()
+    markers: tuple[MarkerDetection, ...] = Field(default=(), max_length=MAX_MARKERS)

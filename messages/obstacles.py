@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pydantic import Field
+
 from messages.base import Finite, Message, Positive
 from messages.header import Header
 
@@ -14,8 +16,12 @@ class Circle(Message):
     radius: Positive
 
 
+MAX_CIRCLES = 256
+"""The most obstacles one message may carry: each costs the LP a row and a step time."""
+
+
 class Obstacles(Message):
-    """Every obstacle known, in the header's frame."""
+    """Every obstacle known, in the header's frame (at most ``MAX_CIRCLES``)."""
 
     header: Header
-    circles: tuple[Circle, ...] = ()
+    circles: tuple[Circle, ...] = Field(default=(), max_length=MAX_CIRCLES)

@@ -46,18 +46,21 @@ class KeyExpressionError(ValueError):
 @dataclass(frozen=True)
 class Topic(Generic[M]):
     """A topic: its ``name`` in this table (what profiles refer to), the
-    ``suffix`` its key ends with, and the message ``type`` it carries."""
+    ``suffix`` its key ends with, the message ``type`` it carries, and the largest payload
+    (``max_bytes``) a subscriber takes: a larger one is refused before it is decoded."""
 
     name: str
     suffix: str
     type: type[M]
+    max_bytes: int = 64 * 1024
 
     def key(self, namespace: str) -> str:
         """This topic's key under ``namespace``: ``"<namespace>/<suffix>"``."""
         return f"{check_namespace(namespace)}/{self.suffix}"
 
 
-CAMERA_IMAGE = Topic("camera/image", "camera/image", CameraFrame)
+CAMERA_IMAGE = Topic("camera/image", "camera/image", CameraFrame, max_bytes=16 * 1024 * 1024)
+"""Up to 16 MiB: a 1920 x 1080 bgr8 frame is 6.2 MB."""
 VISION_MARKERS = Topic("vision/markers", "vision/markers", MarkerDetections)
 BASE_ODOMETRY = Topic("base/odometry", "base/odometry", BaseOdometry)
 ARM_JOINT_STATES = Topic("arm/joint_states", "arm/joint_states", JointStates)

@@ -360,3 +360,35 @@ def test_on_simulated_time_a_stopped_clock_makes_the_controller_command_zero(
         clock.put(codec.encode(topics.SIM_CLOCK.type(stamp_ns=tick * 100_000_000)))
     stalled = diagnostics.wait_for(lambda m: "sim/clock has not moved" in m.reason, "stall")
     assert stalled.status == "stale"
+
+
+def test_a_flood_of_huge_obstacle_messages_never_silences_the_controller(
+    operator: Operator,
+) -> None:
+    """10 MB payloads, and a valid message of 100,000 circles, arrive on world/obstacles for
+    2 s: each is refused on arrival, counted, and the stale timer keeps commanding zero with
+    no gap longer than the stale timeout (0.5 s)."""
+    from messages.obstacles import Circle as CircleMessage
+    from messages.obstacles import Obstacles
+
+    obstacles = operator.system.router.declare_publisher(
+        topics.WORLD_OBSTACLES.key(operator.namespace))
+    header = Header(stamp_ns=operator.stamp(), frame="world", seq=0, source="test")
+    circles = (CircleMessage(x=1.0, y=0.0, radius=0.1),) * 100_000
+    many = codec.encode(Obstacles.model_construct(header=header, circles=circles))
+    huge = b"\x93" + bytes(10_000_000)
+    flood_start = time.time_ns()
+    sent = 0
+    while time.time_ns() - flood_start < 2_000_000_000:
+        obstacles.put(huge if sent % 2 else many)
+        sent += 1
+    flood_end = time.time_ns()
+    stamps = sorted(m.header.stamp_ns for m in operator.diagnostics.messages
+                    if flood_start <= m.header.stamp_ns <= flood_end)  # fmt: skip
+    gaps = np.diff([flood_start, *stamps, flood_end]) / 1e9
+    assert gaps.max() <= 0.5, f"silent for {gaps.max():.2f} s during the flood"
+    assert all(m.status == "stale" for m in operator.diagnostics.messages)
+    deadline = time.monotonic() + DEADLINE_S
+    while operator.counters()["rejected.world/obstacles"] < sent // 2:
+        assert time.monotonic() < deadline, operator.counters()
+    assert operator.counters()["received.world/obstacles"] == 0
