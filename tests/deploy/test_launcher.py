@@ -63,29 +63,27 @@ def test_killed_component_is_back_within_2_s_until_restarts_run_out(
     assert "[launch] failed: pub" in launched.text()
 
 
-def test_sigint_stops_in_reverse_role_order_and_exit_code_reports_failures(
+def test_sigint_stops_in_reverse_role_order(
     write_profile: ProfileWriter, launch: LaunchFixture
 ) -> None:
+    """Started drivers first, stopped tools first; a clean stop exits 0. (A failure's exit
+    code is checked by the restart and start-up tests.)"""
     profile = write_profile(
         [
             publisher("arm", role="tool"),
             publisher("lp", role="controller"),
-            publisher("bad", role="estimator", params={"rate_hz": -3.0}),
+            publisher("est", role="estimator"),
             publisher("base", role="driver"),
         ]
     )
     launched = launch(profile)
-    launched.wait_for(r"\[bad\] ERROR .*components\[2\]\.params\.rate_hz: expected a float")
-    launched.wait_for(r"\[launch\] bad exited with 2; configuration error, not restarting")
-    for name in ("arm", "lp", "base"):
-        launched.wait_for(rf"\[launch\] {name} alive")
+    launched.wait_for(r"\[launch\] all 4 components alive")
 
-    assert launched.stop(signal.SIGINT) == 1
+    assert launched.stop(signal.SIGINT) == 0
     text = launched.text()
-    starts = [text.index(f"[launch] started {name} ") for name in ("base", "bad", "lp", "arm")]
-    stops = [text.index(f"[launch] {name} stopped (0)") for name in ("arm", "lp", "base")]
+    starts = [text.index(f"[launch] started {name} ") for name in ("base", "est", "lp", "arm")]
+    stops = [text.index(f"[launch] {name} stopped (0)") for name in ("arm", "lp", "est", "base")]
     assert starts == sorted(starts) and stops == sorted(stops)
-    assert "[launch] failed: bad" in text
     assert "INFO arm stopping on SIGTERM" in text
 
 
