@@ -28,6 +28,7 @@ from typing import IO
 import zenoh
 
 from deploy.profile import ROLES, ComponentSpec, Profile
+from deploy.query import statuses
 from messages import process, topics
 from messages.process import EXIT_CONFIG_ERROR, LAUNCHER_PID_ENV, PARAMS_FILE_ENV
 
@@ -71,6 +72,10 @@ class Child:
     restart_at: float | None = None
     done: bool = False
     failed: bool = False
+    alive: bool = False
+    """Whether the current process's liveliness token is present."""
+    answered_at: float = 0.0
+    """When it last answered a status query, or came alive (the watchdog's reference)."""
 
 
 class Launcher:
@@ -115,6 +120,7 @@ class Launcher:
                 for child in self.children:
                     self._start(child)
                 self._starting_until = time.monotonic() + self.profile.startup_timeout_s
+                threading.Thread(target=self._watch, args=(router,), daemon=True).start()
                 self._supervise(None if duration_s is None else time.monotonic() + duration_s)
             finally:
                 for stop_signal in (signal.SIGINT, signal.SIGTERM):
@@ -137,6 +143,9 @@ class Launcher:
         alive = sample.kind == zenoh.SampleKind.PUT
         if alive:
             self._seen_alive.add(name)
+        for child in self.children:
+            if child.spec.name == name:
+                child.alive, child.answered_at = alive, time.monotonic()
         self.output.say(f"{name} {'alive' if alive else 'lost'}")
 
     def _supervise(self, deadline: float | None) -> None:
@@ -154,11 +163,39 @@ class Launcher:
                     self._start(child)
             if self._starting_until is not None:
                 self._check_startup(now)
+            self._kill_hung(now)
             if all(child.done for child in self.children):
                 self._stop_reason = self._stop_reason or "no component left running"
                 break
             time.sleep(POLL_S)
         self.output.say(f"stopping ({self._stop_reason})")
+
+    def _watch(self, router: zenoh.Session) -> None:
+        """Watchdog thread: ask every component for its status, twice per ``watchdog_s``; an
+        answer proves its handler thread runs."""
+        period = self.profile.watchdog_s / 2.0
+        while self._stop_reason is None:
+            started = time.monotonic()
+            try:
+                answered = statuses(router, self.profile.namespace, period)
+            except zenoh.ZError:
+                answered = {}
+            now = time.monotonic()
+            for child in self.children:
+                if child.spec.name in answered:
+                    child.answered_at = now
+            time.sleep(max(0.0, period - (now - started)))
+
+    def _kill_hung(self, now: float) -> None:
+        """Kill a component seen alive that answered no status query for ``watchdog_s``; its
+        exit is then handled like any other (restart by policy)."""
+        for child in self.children:
+            silent_s = now - child.answered_at
+            if child.process is not None and child.alive and silent_s > self.profile.watchdog_s:
+                self.output.say(f"{child.spec.name} hung: no status answer for {silent_s:.1f} s; "
+                                "killing it")  # fmt: skip
+                child.process.kill()
+                child.answered_at = now
 
     def _check_startup(self, now: float) -> None:
         """Until every component has been alive once: fail the launch when one stops for good
@@ -204,6 +241,7 @@ class Launcher:
         )
         child.started_at = time.monotonic()
         child.restart_at = None
+        child.alive = False
         for pipe, stream in (
             (child.process.stdout, self.output.out),
             (child.process.stderr, self.output.err),

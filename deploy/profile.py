@@ -214,6 +214,9 @@ class Profile(StrictModel):
     startup_timeout_s: float = Field(default=10.0, gt=0.0)
     """Seconds the launcher gives every component to become alive (its liveliness token seen
     by the router) before it fails the launch, naming those that are not."""
+    watchdog_s: float = Field(default=3.0, gt=0.0)
+    """A component alive but answering no status query for this long (a stopped process, a
+    handler that never returns) is hung: the launcher kills it and restarts it by its policy."""
     clock_timeout_s: float = Field(default=1.0, gt=0.0)
     """Host seconds after which a component on ``sim`` time whose clock has not moved says its
     clock stalled (a controller then commands zero)."""

@@ -156,6 +156,24 @@ def test_a_parameter_set_at_run_time_survives_a_restart(
     launched.stop()
 
 
+def test_a_hung_component_is_killed_and_restarted_by_the_watchdog(
+    write_profile: ProfileWriter, launch: LaunchFixture
+) -> None:
+    """SIGSTOP leaves the process and its session up but answering nothing: before, it was
+    reported lost only after the ~10 s session lease and never restarted."""
+    launched = launch(write_profile([publisher("pub")], watchdog_s=1.0))
+    started, _, match = launched.wait_for(r"\[launch\] started pub \(.*pid (\d+)\)")
+    launched.wait_for(r"\[launch\] pub alive", after=started)
+    stopped_at = time.monotonic()
+    os.kill(int(match.group(1)), signal.SIGSTOP)
+    hung, hung_at, _ = launched.wait_for(r"\[launch\] pub hung: no status answer for")
+    assert hung_at - stopped_at < 3.0
+    launched.wait_for(r"\[launch\] pub exited with -9; restart 1/5", after=hung)
+    restarted, _, _ = launched.wait_for(r"\[launch\] started pub", after=hung)
+    launched.wait_for(r"\[launch\] pub alive", after=restarted)
+    assert launched.stop() == 0
+
+
 def test_components_stop_when_the_launcher_is_killed(
     write_profile: ProfileWriter, launch: LaunchFixture
 ) -> None:
