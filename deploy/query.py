@@ -108,6 +108,34 @@ def set_param(
     return _param_query(session, namespace, component, name, text, timeout_s)
 
 
+def all_params(
+    session: zenoh.Session, namespace: str, component: str, timeout_s: float = DEFAULT_TIMEOUT_S
+) -> dict[str, ParamValue]:
+    """Every parameter of a running component and its value, by name."""
+    prefix = topics.param_key(namespace, component, "x")[:-1]
+    values = {}
+    for reply in session.get(topics.param_selector(namespace, component), timeout=timeout_s):
+        if reply.ok is not None:
+            name = str(reply.ok.key_expr).removeprefix(prefix)
+            values[name] = decode_value(reply.ok.payload.to_bytes())
+    if not values:
+        raise QueryError(f"no reply from {component!r} in namespace {namespace!r} within "
+                         f"{timeout_s} s (is it running?)")  # fmt: skip
+    return dict(sorted(values.items()))
+
+
+def status_of(
+    session: zenoh.Session, namespace: str, component: str, timeout_s: float = DEFAULT_TIMEOUT_S
+) -> ComponentStatus:
+    """One running component's status."""
+    key = topics.status_key(namespace, component)
+    for reply in session.get(key, timeout=timeout_s):
+        if reply.ok is not None:
+            return codec.decode(reply.ok.payload.to_bytes(), topics.STATUS_TYPE, key)
+    raise QueryError(f"no status from {component!r} in namespace {namespace!r} within "
+                     f"{timeout_s} s (is it running?)")  # fmt: skip
+
+
 def _param_query(
     session: zenoh.Session,
     namespace: str,

@@ -1,35 +1,31 @@
-"""`parsimony param get|set`: read or change a parameter of a running component."""
+"""`parsimony param get|set|list|describe|dump|load`: the parameters of a running component."""
 
 from __future__ import annotations
 
 import argparse
 import json
-import os
-import sys
+from pathlib import Path
 
+import yaml
+
+from deploy.graph import component_class
 from deploy.profile import ProfileError
-from deploy.query import DEFAULT_TIMEOUT_S, QueryError, Target, get_param, set_param
+from deploy.query import QueryError, all_params, get_param, set_param
 from parsimony.output import emit
+from parsimony.target_options import PROFILE_ENV, fail, profile_and_target, target_options
 
-PROFILE_ENV = "PARSIMONY_PROFILE"
-"""The profile used when `--profile` is not given."""
+__all__ = ["PROFILE_ENV", "add_parser", "run"]
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    """Declare `param get` and `param set`."""
+    """Declare `param` and its actions."""
     parser = subparsers.add_parser(
         "param",
-        help="read or change a parameter of a running component",
-        description="Read or change a declared parameter of a running component. "
-        "Prints the value it has afterwards; exits 1 with the component's error otherwise.",
+        help="read, change, describe, dump or load the parameters of a running component",
+        description="Read or change the declared parameters of a running component. A value "
+        "the component refuses exits 1 with its error.",
     )
-    common = argparse.ArgumentParser(add_help=False)
-    common.add_argument(
-        "--profile",
-        default=os.environ.get(PROFILE_ENV),
-        help=f"the deploy profile of the running system (default: ${PROFILE_ENV})",
-    )
-    common.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="S")
+    common = target_options()
     actions = parser.add_subparsers(dest="action", required=True)
     get = actions.add_parser("get", parents=[common], help="print a parameter's value")
     get.add_argument("component")
@@ -38,27 +34,75 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     put.add_argument("component")
     put.add_argument("name")
     put.add_argument("value", help="the new value as text: 0.5, 3, true, pose")
+    listing = actions.add_parser("list", parents=[common], help="every parameter and its value")
+    listing.add_argument("component")
+    describe = actions.add_parser(
+        "describe", parents=[common], help="type, default, bounds, choices and doc of each")
+    describe.add_argument("component")
+    describe.add_argument("name", nargs="?")
+    dump = actions.add_parser("dump", parents=[common], help="the values as YAML, to load back")
+    dump.add_argument("component")
+    load = actions.add_parser("load", parents=[common], help="set every value of a YAML file")
+    load.add_argument("component")
+    load.add_argument("file", type=Path)
     return parser
 
 
+def as_text(value: object) -> str:
+    """A value as `param set` takes it: true, 0.5, pose."""
+    return json.dumps(value) if isinstance(value, bool | int | float) else str(value)
+
+
+def describe(args: argparse.Namespace) -> list[dict]:
+    """The declarations of the component's parameters, from its class."""
+    profile, _ = profile_and_target(args)
+    params = component_class(profile.component(args.component)).params
+    rows = [
+        {"name": p.name, "type": p.type.__name__, "default": p.default, "low": p.low,
+         "high": p.high, "choices": list(p.choices) if p.choices else None, "doc": p.doc}
+        for p in params if args.name in (None, p.name)
+    ]  # fmt: skip
+    if not rows:
+        raise QueryError(f"{args.component} declares no parameter {args.name!r}")
+    return rows
+
+
 def run(args: argparse.Namespace) -> int:
-    """Get or set the parameter and print `component.name = value`."""
-    if args.profile is None:
-        print(f"no profile: pass --profile or set {PROFILE_ENV}", file=sys.stderr)
-        return 2
+    """Carry out the action and print its result."""
     try:
-        target = Target.from_profile(args.profile)
+        if args.action == "describe":
+            rows = describe(args)
+            emit(json.dumps(rows, indent=2) if args.json else "\n".join(
+                f"{r['name']}: {r['type']} = {r['default']!r}"
+                + (f" in [{r['low']}, {r['high']}]" if r["low"] is not None
+                   or r["high"] is not None else "")
+                + (f" one of {r['choices']}" if r["choices"] else "") + f"  {r['doc']}"
+                for r in rows))  # fmt: skip
+            return 0
+        profile, target = profile_and_target(args)
         with target.open() as session:
-            if args.action == "set":
-                value = set_param(
-                    session, target.namespace, args.component, args.name, args.value, args.timeout
-                )
+            ns, component = target.namespace, args.component
+            if args.action == "get":
+                values = {args.name: get_param(session, ns, component, args.name, args.timeout)}
+            elif args.action == "set":
+                values = {args.name: set_param(session, ns, component, args.name, args.value,
+                                               args.timeout)}  # fmt: skip
+            elif args.action == "load":
+                wanted = yaml.safe_load(args.file.read_text())
+                if not isinstance(wanted, dict):
+                    raise QueryError(f"{args.file}: expected a mapping of parameter: value")
+                values = {
+                    name: set_param(session, ns, component, name, as_text(value), args.timeout)
+                    for name, value in wanted.items()
+                }
             else:
-                value = get_param(
-                    session, target.namespace, args.component, args.name, args.timeout
-                )
-    except (ProfileError, QueryError, ValueError) as error:
-        print(error, file=sys.stderr)
-        return 1
-    emit(f"{args.component}.{args.name} = {json.dumps(value)}")
+                values = all_params(session, ns, component, args.timeout)
+    except (ProfileError, QueryError, KeyError, LookupError, OSError, ValueError) as error:
+        return fail(error)
+    if args.json:
+        emit(json.dumps(values, indent=2))
+    elif args.action == "dump":
+        emit(yaml.safe_dump(values, sort_keys=False).rstrip())
+    else:
+        emit("\n".join(f"{args.component}.{name} = {json.dumps(v)}" for name, v in values.items()))
     return 0

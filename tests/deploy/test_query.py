@@ -10,6 +10,7 @@ import time
 from pathlib import Path
 
 import pytest
+import yaml
 
 from deploy import query
 from parsimony.commands import param, status
@@ -104,3 +105,84 @@ def test_param_errors_are_reported(
 ) -> None:
     assert command(param, "param", *argv, "--profile", str(running_pub)) == 1
     assert error in capsys.readouterr().err
+
+
+def cli(*argv: str) -> subprocess.CompletedProcess[str]:
+    """`parsimony ARGV` as a user runs it: a process, stdout its result alone."""
+    return subprocess.run([sys.executable, "-m", "parsimony.cli", *argv], capture_output=True,
+                          text=True, timeout=60)  # fmt: skip
+
+
+def test_topic_echo_prints_each_decoded_message_as_a_json_line(running_pub: Path) -> None:
+    result = cli("topic", "echo", "robot/state", "--count", "3", "--profile", str(running_pub))
+    assert result.returncode == 0, result.stderr
+    lines = [json.loads(line) for line in result.stdout.splitlines()]
+    assert len(lines) == 3 and {line["header"]["source"] for line in lines} == {"pub"}
+    seqs = [line["header"]["seq"] for line in lines]
+    assert seqs == sorted(seqs) and len(lines[0]["arm_joints"]) == 5
+
+
+def test_topic_hz_measures_the_rate_of_a_live_topic(running_pub: Path) -> None:
+    result = cli("topic", "hz", "robot/state", "--window", "1.0", "--json",
+                 "--profile", str(running_pub))  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    report = json.loads(result.stdout)
+    assert report["messages"] > 5 and report["rate_hz"] > 5.0
+    assert report["period_min_s"] <= report["period_median_s"] <= report["period_max_s"]
+
+
+def test_topic_list_info_and_pub(running_pub: Path) -> None:
+    rows = json.loads(cli("topic", "list", "--json", "--profile", str(running_pub)).stdout)
+    state = next(row for row in rows if row["topic"] == "robot/state")
+    assert state["key"] == "test/robot/state" and state["writers"] == ["pub"]
+    info = json.loads(cli("topic", "info", "control/goal", "--profile", str(running_pub)).stdout)
+    assert info["type"] == "Goal" and "task" in info["schema"]["properties"]
+    with query.Target.from_profile(running_pub).open() as session:
+        received: list[bytes] = []
+        session.declare_subscriber("test/world/obstacles",
+                                   lambda sample: received.append(sample.payload.to_bytes()))
+        result = cli("topic", "pub", "world/obstacles", '{"circles": [{"x": 2, "y": 0, '
+                     '"radius": 0.1}]}', "--profile", str(running_pub))  # fmt: skip
+        assert result.returncode == 0, result.stderr
+        assert json.loads(result.stdout)["published"] == 1
+        deadline = time.monotonic() + 10.0
+        while not received:
+            assert time.monotonic() < deadline, "the published message did not arrive"
+            time.sleep(0.01)
+    bad = cli("topic", "pub", "control/goal", '{"task": "pose"}', "--profile", str(running_pub))
+    assert bad.returncode == 1 and "a pose task needs a pose" in bad.stderr
+
+
+def test_param_list_describe_dump_and_load(running_pub: Path, tmp_path: Path) -> None:
+    profile = str(running_pub)
+    values = json.loads(cli("param", "list", "pub", "--json", "--profile", profile).stdout)
+    assert {"rate_hz", "goal_task", "goal_z", "q5"} <= values.keys()
+    with query.Target.from_profile(running_pub).open() as session:
+        assert values["rate_hz"] == query.get_param(session, "test", "pub", "rate_hz")
+    described = json.loads(cli("param", "describe", "pub", "rate_hz", "--json",
+                               "--profile", profile).stdout)  # fmt: skip
+    assert described == [{"name": "rate_hz", "type": "float", "default": 10.0, "low": 0.1,
+                          "high": 1000.0, "choices": None, "doc": "publishing rate"}]
+    dump = cli("param", "dump", "pub", "--profile", profile)
+    assert dump.returncode == 0 and yaml.safe_load(dump.stdout) == values
+    saved = tmp_path / "pub.yaml"
+    saved.write_text(yaml.safe_dump({**values, "goal_z": values["goal_z"] + 0.25}))
+    loaded = cli("param", "load", "pub", str(saved), "--profile", profile)
+    assert loaded.returncode == 0, loaded.stderr
+    now = json.loads(cli("param", "list", "pub", "--json", "--profile", profile).stdout)
+    assert now == {**values, "goal_z": values["goal_z"] + 0.25}
+    saved.write_text("rate_hz: -1\n")
+    refused = cli("param", "load", "pub", str(saved), "--profile", profile)
+    assert refused.returncode == 1
+    assert "rate_hz: expected a float in [0.1, 1000.0]" in refused.stderr
+
+
+def test_node_info_shows_what_a_component_reads_writes_and_counts(running_pub: Path) -> None:
+    wait_for_first_message(running_pub)
+    result = cli("node", "info", "pub", "--json", "--profile", str(running_pub))
+    assert result.returncode == 0, result.stderr
+    info = json.loads(result.stdout)
+    assert info["module"] == "components.scripted_publisher" and info["state"] == "running"
+    assert info["reads"] == [] and info["writes"] == ["robot/state", "control/goal"]
+    assert info["counters"]["published.robot/state"] > 0
+    assert info["parameters"]["rate_hz"] > 0

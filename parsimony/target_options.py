@@ -1,0 +1,39 @@
+"""The options every command that talks to a running system shares: the profile, a timeout."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+from deploy.profile import Profile, ProfileError, load_profile
+from deploy.query import DEFAULT_TIMEOUT_S, Target
+
+PROFILE_ENV = "PARSIMONY_PROFILE"
+"""The profile used when `--profile` is not given."""
+
+
+def target_options() -> argparse.ArgumentParser:
+    """A parent parser with ``--profile``, ``--timeout`` and ``--json``."""
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument(
+        "--profile",
+        default=os.environ.get(PROFILE_ENV),
+        help=f"the deploy profile of the running system (default: ${PROFILE_ENV})",
+    )
+    common.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="S")
+    common.add_argument("--json", action="store_true", help="print JSON")
+    return common
+
+
+def profile_and_target(args: argparse.Namespace) -> tuple[Profile, Target]:
+    """The profile named by the options and how to reach its system (``ProfileError``)."""
+    if args.profile is None:
+        raise ProfileError(f"no profile: pass --profile or set {PROFILE_ENV}")
+    profile = load_profile(args.profile)
+    return profile, Target(profile.namespace, profile.zenoh)
+
+
+def fail(error: Exception) -> int:
+    print(error, file=sys.stderr)
+    return 1
