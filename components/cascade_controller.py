@@ -8,7 +8,7 @@ the law is the controller shell of ``components.controller``. A goal's
 from __future__ import annotations
 
 from components.controller import CONTROLLER_PARAMS, Controller, law_params
-from components.runtime import run_component
+from components.process_entry import run_component
 from wbc.cascade_law import CascadeLaw, CascadeParams
 
 

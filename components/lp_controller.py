@@ -8,7 +8,7 @@ run-time parameter with the bounds the dataclass declares.
 from __future__ import annotations
 
 from components.controller import CONTROLLER_PARAMS, Controller, law_params
-from components.runtime import run_component
+from components.process_entry import run_component
 from wbc.lp_law import LPLaw, LPParams
 
 

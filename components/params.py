@@ -10,11 +10,16 @@ replied as plain text.
 
 from __future__ import annotations
 
+import json
+import logging
 import math
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from messages.process import ParamValue
+
+log = logging.getLogger("components")
 
 _TRUE = ("true", "yes", "on", "1")
 _FALSE = ("false", "no", "off", "0")
@@ -141,3 +146,28 @@ class Parameters(Mapping[str, ParamValue]):
         self._values[name] = self.changed[name] = value
         self.version += 1
         return value
+
+
+def restore_params(params: Parameters, path: Path) -> None:
+    """Set again the parameters an earlier run kept in ``path``; skip (and log) any refused now."""
+    if not path.is_file():
+        return
+    try:
+        kept = json.loads(path.read_text())
+    except (OSError, ValueError) as error:
+        log.warning("%s: cannot read kept parameters: %s", path, error)
+        return
+    for name, value in kept.items():
+        try:
+            params.set(name, value)
+        except ParamError as error:
+            log.warning("kept parameter not restored: %s", error)
+    if params.changed:
+        log.info("parameters restored from the last run: %s", params.changed)
+
+
+def keep_params(params: Parameters, path: Path) -> None:
+    """Write the parameters set at run time to ``path``, where the next run finds them."""
+    partial_file = path.with_suffix(".tmp")
+    partial_file.write_text(json.dumps(params.changed))
+    partial_file.replace(path)

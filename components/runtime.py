@@ -3,7 +3,7 @@
 A component module defines a ``Component`` subclass and ends with::
 
     if __name__ == "__main__":
-        run_component(MyComponent)
+        run_component(MyComponent)  # components.process_entry
 
 It runs as ``python -m components.<module> --profile PATH --name NAME``. The
 ``Node`` gives it a Zenoh session opened from the profile, typed publishers
@@ -19,63 +19,34 @@ counted as ``errors.<topic>``; the process keeps running either way.
 
 from __future__ import annotations
 
-import argparse
-import json
 import logging
 import os
 import queue
-import signal
-import sys
 import threading
-import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable
 from functools import partial
 from pathlib import Path
-from typing import ClassVar, NoReturn, TypeVar
+from typing import ClassVar, TypeVar
 
 import zenoh
 from pydantic import BaseModel
 
 from components.clock import Clock, SimClock, Timer, Timers, WallClock
-from components.params import Param, ParamError, Parameters
+from components.params import Param, ParamError, Parameters, keep_params, restore_params
 from components.pubsub import Input, Publisher, Subscription
-from deploy.profile import Profile, ProfileError, load_profile
+from components.rate_limited_log import RateLimitedLog
+from deploy.profile import Profile
 from messages import codec, topics
 from messages.header import Header
-from messages.process import EXIT_CONFIG_ERROR, LAUNCHER_PID_ENV, PARAMS_FILE_ENV, encode_value
+from messages.process import encode_value
 from messages.status import ComponentStatus
 
 M = TypeVar("M", bound=BaseModel)
-
-SUMMARY_INTERVAL_S = 5.0
-"""Repeated warnings of one kind are summarised at most this often."""
 
 STOP_TIMEOUT_S = 2.0
 """How long closing waits for the handler thread to finish its current event."""
 
 log = logging.getLogger("components")
-
-
-class RateLimitedLog:
-    """Logs the first warning of a kind, then at most one summary per interval."""
-
-    def __init__(self, logger: logging.Logger, interval_s: float = SUMMARY_INTERVAL_S) -> None:
-        self._logger = logger
-        self._interval_ns = round(interval_s * 1e9)
-        self._last_ns: dict[str, int] = {}
-        self._suppressed: dict[str, int] = {}
-
-    def warning(self, kind: str, message: str, exc_info: bool = False) -> None:
-        """Log ``message`` unless a ``kind`` warning was logged less than an interval ago."""
-        now = time.monotonic_ns()
-        last = self._last_ns.get(kind)
-        if last is not None and now - last < self._interval_ns:
-            self._suppressed[kind] = self._suppressed.get(kind, 0) + 1
-            return
-        self._last_ns[kind] = now
-        suppressed = self._suppressed.pop(kind, 0)
-        suffix = f" ({suppressed} more since the last report)" if suppressed else ""
-        self._logger.warning("%s%s", message, suffix, exc_info=exc_info)
 
 
 class Node:
@@ -110,7 +81,8 @@ class Node:
         self.namespace = profile.namespace
         self.params = Parameters(params, self.spec.params)
         self._kept_params = kept_params
-        self._restore_params()
+        if kept_params is not None:
+            restore_params(self.params, kept_params)
         publishes_clock = self.writes is not None and topics.SIM_CLOCK.name in self.writes
         source = profile.clock_of(self.spec, publishes_clock)
         self.clock: Clock = SimClock() if source == "sim" else WallClock()
@@ -296,31 +268,6 @@ class Node:
             self.count(counter)
             self.warn(counter, f"{getattr(callback, '__qualname__', callback)} failed", True)
 
-    def _restore_params(self) -> None:
-        """Set again the parameters an earlier run kept; skip (and log) any refused now."""
-        if self._kept_params is None or not self._kept_params.is_file():
-            return
-        try:
-            kept = json.loads(self._kept_params.read_text())
-        except (OSError, ValueError) as error:
-            log.warning("%s: cannot read kept parameters: %s", self._kept_params, error)
-            return
-        for name, value in kept.items():
-            try:
-                self.params.set(name, value)
-            except ParamError as error:
-                log.warning("kept parameter not restored: %s", error)
-        if self.params.changed:
-            log.info("parameters restored from the last run: %s", self.params.changed)
-
-    def _keep_params(self) -> None:
-        """Write the parameters set at run time where the next run of this component finds them."""
-        if self._kept_params is None:
-            return
-        partial_file = self._kept_params.with_suffix(".tmp")
-        partial_file.write_text(json.dumps(self.params.changed))
-        partial_file.replace(self._kept_params)
-
     def _answer_status(self, query: zenoh.Query) -> None:
         with query:
             status = self.status()
@@ -342,7 +289,8 @@ class Node:
                     (name,) = matching.values()
                     value = self.params.set_text(name, query.payload.to_string())
                     log.info("parameter %s set to %r", name, value)
-                    self._keep_params()
+                    if self._kept_params is not None:
+                        keep_params(self.params, self._kept_params)
             except ParamError as error:
                 query.reply_err(str(error))
                 return
@@ -372,84 +320,3 @@ class Component:
     def clock_stalled(self, stalled_s: float) -> None:
         """Runs on the handler thread when the simulated clock stopped for ``stalled_s`` host
         seconds (a controller commands zero here)."""
-
-
-class _StopRequested(Exception):
-    """Raised in the main thread by SIGINT or SIGTERM."""
-
-
-def _on_stop_signal(signum: int, _frame: object) -> None:
-    for stop_signal in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(stop_signal, signal.SIG_IGN)
-    raise _StopRequested(signal.Signals(signum).name)
-
-
-def _wait_for_stop() -> None:
-    """Sleep until a stop signal, or until the launcher that started us is gone."""
-    launcher = os.environ.get(LAUNCHER_PID_ENV)
-    while True:
-        time.sleep(1.0)
-        if launcher is not None and os.getppid() != int(launcher):
-            log.warning("launcher (pid %s) is gone; stopping", launcher)
-            return
-
-
-def _parse_args(component_class: type[Component], argv: Sequence[str] | None) -> argparse.Namespace:
-    parser = argparse.ArgumentParser(description=component_class.__doc__)
-    parser.add_argument("--profile", required=True, help="the deploy profile (YAML)")
-    parser.add_argument("--name", required=True, help="this component's name in the profile")
-    parser.add_argument("--log-level", default="INFO", help="DEBUG, INFO, WARNING or ERROR")
-    return parser.parse_args(argv)
-
-
-def _configure(component_class: type[Component], args: argparse.Namespace) -> Node | None:
-    """The component's node, or ``None`` after logging why the configuration is refused."""
-    try:
-        profile = load_profile(args.profile)
-    except ProfileError as error:
-        log.error("%s", error)
-        return None
-    names = [spec.name for spec in profile.components]
-    if args.name not in names:
-        log.error("%s: no component named %r (have %s)", args.profile, args.name, names)
-        return None
-    try:
-        kept = os.environ.get(PARAMS_FILE_ENV)
-        return Node(profile, args.name, component_class.params, component_class.reads,
-                    component_class.writes, Path(kept) if kept else None)  # fmt: skip
-    except ParamError as error:
-        log.error("%s: components[%d].params.%s", args.profile, names.index(args.name), error)
-        return None
-
-
-def main(component_class: type[Component], argv: Sequence[str] | None = None) -> int:
-    """Run ``component_class`` until SIGINT or SIGTERM; return the exit code."""
-    args = _parse_args(component_class, argv)
-    logging.basicConfig(
-        level=args.log_level.upper(), stream=sys.stderr, format="%(levelname)s %(message)s"
-    )
-    for stop_signal in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(stop_signal, _on_stop_signal)
-    try:
-        node = _configure(component_class, args)
-        if node is None:
-            return EXIT_CONFIG_ERROR
-        with node:
-            try:
-                component = component_class(node)
-            except ParamError as error:
-                log.error("%s: %s: %s", args.profile, args.name, error)
-                return EXIT_CONFIG_ERROR
-            node.start(component.shutdown, component.clock_stalled)
-            _wait_for_stop()
-    except _StopRequested as stop:
-        log.info("%s stopping on %s", args.name, stop)
-    except zenoh.ZError as error:
-        log.error("%s: Zenoh failed: %s", args.name, error)
-        return 1
-    return 0
-
-
-def run_component(component_class: type[Component]) -> NoReturn:
-    """The entry point of every component module: run it and exit with its code."""
-    sys.exit(main(component_class))

@@ -13,7 +13,8 @@ with ``parsimony param set`` apply from the next message (``rate_hz`` from the n
 from __future__ import annotations
 
 from components.params import Param
-from components.runtime import Component, Node, run_component
+from components.process_entry import run_component
+from components.runtime import Component, Node
 from messages import topics
 from messages.base import IDENTITY_POSE
 from messages.goal import Goal

@@ -10,9 +10,10 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from components import runtime
+from components import rate_limited_log
 from components.params import Param
 from components.pubsub import Input
+from components.rate_limited_log import RateLimitedLog
 from components.runtime import Node
 from deploy import query
 from messages import codec, topics
@@ -240,8 +241,8 @@ def test_repeated_warnings_are_logged_once_then_summarised(
     monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
 ) -> None:
     now = [0]
-    monkeypatch.setattr(runtime.time, "monotonic_ns", lambda: now[0])
-    warnings = runtime.RateLimitedLog(logging.getLogger("test"), interval_s=5.0)
+    monkeypatch.setattr(rate_limited_log.time, "monotonic_ns", lambda: now[0])
+    warnings = RateLimitedLog(logging.getLogger("test"), interval_s=5.0)
     for step_s in (0, 1, 2, 3, 6, 7):
         now[0] = step_s * 1_000_000_000
         warnings.warning("rejected.robot/state", f"bad message at {step_s} s")
