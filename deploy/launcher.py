@@ -6,6 +6,12 @@ It opens the router the components connect to, starts the enabled components
 reports liveliness changes, and on SIGINT, SIGTERM or the end of the duration
 stops them in the reverse order: SIGTERM, then SIGKILL after a timeout.
 
+The launch fails at start-up when a component is not alive within the profile's
+``startup_timeout_s`` or stops for good before it ever was (a configuration error). A
+watchdog asks every component for its status; one alive but silent for ``watchdog_s`` is
+killed and restarted by its policy. Parameters set while a component runs are kept in a file
+per component (``messages.process.PARAMS_FILE_ENV``) that its next start reads.
+
 Children run in their own session, so a Ctrl-C reaches the launcher alone and
 the stop order holds; a child whose launcher dies stops by itself
 (``messages.process.LAUNCHER_PID_ENV``).
