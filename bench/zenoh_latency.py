@@ -50,6 +50,7 @@ from bench.pubsub_workers import (
 from deploy import query
 from deploy.profile import ZenohSettings
 from messages import topics
+from parsimony.output import emit, result_only_stdout
 
 SETTLE_S = 1.0
 """How long the subscriber may stay silent after the last publication before we count."""
@@ -225,6 +226,7 @@ def free_port() -> int:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--mode", choices=("peer", "client"), default=ZenohSettings().mode)
+    parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     args = parser.parse_args(argv)
     settings = ZenohSettings(router=[f"tcp/127.0.0.1:{free_port()}"], mode=args.mode)
     started = time.monotonic()
@@ -236,14 +238,19 @@ def main(argv: list[str] | None = None) -> int:
             results.append(loop)
         finally:
             bench.close()
-    print(format_table(results))
-    print("lp_controller counters:", " ".join(f"{k}={v}" for k, v in sorted(counters.items())))
     report = {"bench": "zenoh_latency", "mode": settings.mode, "cpus": os.cpu_count()}
     report |= {"duration_s": round(time.monotonic() - started, 1)}
     report |= {"results": [asdict(r) for r in results], "controller_counters": counters}
-    print(json.dumps(report))
+    if args.json:
+        emit(json.dumps(report))
+    else:
+        emit(format_table(results))
+        emit("lp_controller counters: "
+             + " ".join(f"{k}={v}" for k, v in sorted(counters.items())))  # fmt: skip
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    with result_only_stdout():  # what a library prints goes to stderr, not the result
+        code = main()
+    sys.exit(code)
