@@ -98,7 +98,7 @@ class Node:
         self._on_clock_stall: Callable[[float], None] | None = None
 
     def __enter__(self) -> Node:
-        self._session = zenoh.open(self.profile.zenoh.component_config())
+        self._session = zenoh.open(self.profile.zenoh.component_config(self.name))
         clock = self.clock
         if isinstance(clock, SimClock):
             self.subscribe(topics.SIM_CLOCK, lambda tick: clock.advance(tick.stamp_ns))

@@ -115,7 +115,7 @@ class Launcher:
             signal.signal(stop_signal, self._on_signal)
         endpoints = ", ".join(self.profile.zenoh.router)
         self._kept_params = Path(tempfile.mkdtemp(prefix="parsimony-params-"))
-        with zenoh.open(self.profile.zenoh.router_config()) as router:
+        with zenoh.open(self.profile.zenoh.router_config(self.profile.namespace)) as router:
             self.output.say(f"router listening on {endpoints}, namespace {self.profile.namespace}")
             watcher = router.liveliness().declare_subscriber(
                 topics.liveliness_selector(self.profile.namespace),

@@ -20,6 +20,7 @@ import yaml
 import zenoh
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from deploy.access import AccessSettings, insert
 from messages.process import ParamValue
 
 COMPONENT_PACKAGE = "components"
@@ -109,9 +110,14 @@ class ZenohSettings(StrictModel):
     listen: list[str] = ["tcp/127.0.0.1:0"]
     multicast_scouting: bool = False
     allow_remote: bool = False
+    access: AccessSettings | None = None
+    """Authentication and per-topic write rights (``deploy.access``); needs client mode."""
 
     @model_validator(mode="after")
     def _local_unless_allowed(self) -> ZenohSettings:
+        if self.access is not None and self.mode != "client":
+            raise ValueError("access: the router's rules only see what passes through it; "
+                             "set mode: client")  # fmt: skip
         if self.allow_remote:
             return self
         if self.multicast_scouting:
@@ -131,18 +137,25 @@ class ZenohSettings(StrictModel):
         """Where component and tool sessions connect."""
         return self.router if self.connect is None else self.connect
 
-    def router_config(self) -> zenoh.Config:
-        """The config of the launcher's router session."""
-        return self._config("router", listen=self.router, connect=[])
+    def router_config(self, namespace: str = "") -> zenoh.Config:
+        """The config of the launcher's router session (its access rules act on ``namespace``)."""
+        config = self._config("router", listen=self.router, connect=[])
+        if self.access is not None:
+            insert(config, self.access.router_json(namespace))
+        return config
 
-    def client_config(self) -> zenoh.Config:
-        """The config of a client session, as used by tools such as ``parsimony status``."""
-        return self._config("client", listen=[], connect=self.connect_endpoints)
+    def client_config(self, user: str | None = None) -> zenoh.Config:
+        """The config of a client session: a tool's such as ``parsimony status`` (``user``
+        None), or a client-mode component's."""
+        config = self._config("client", listen=[], connect=self.connect_endpoints)
+        if self.access is not None:
+            insert(config, self.access.session_json(user))
+        return config
 
-    def component_config(self) -> zenoh.Config:
-        """The config of a component's session, in the profile's ``mode``."""
+    def component_config(self, name: str | None = None) -> zenoh.Config:
+        """The config of component ``name``'s session, in the profile's ``mode``."""
         if self.mode == "client":
-            return self.client_config()
+            return self.client_config(name)
         return self._config("peer", listen=self.listen, connect=self.connect_endpoints)
 
     def _config(self, mode: str, listen: list[str], connect: list[str]) -> zenoh.Config:
@@ -221,6 +234,18 @@ class Profile(StrictModel):
     """Host seconds after which a component on ``sim`` time whose clock has not moved says its
     clock stalled (a controller then commands zero)."""
     components: list[ComponentSpec] = Field(min_length=1)
+
+    @model_validator(mode="after")
+    def _components_have_credentials(self) -> Profile:
+        access = self.zenoh.access
+        if access is not None:
+            users = access.users()
+            for index, spec in enumerate(self.components):
+                if spec.name not in users:
+                    raise ValueError(f"components[{index}].name: {spec.name!r} has no line in "
+                                     f"{access.credentials}; each component authenticates "
+                                     "as its name")  # fmt: skip
+        return self
 
     @model_validator(mode="after")
     def _unique_names(self) -> Profile:
@@ -347,6 +372,9 @@ def read_profile_data(path: Path, chain: tuple[Path, ...] = ()) -> dict:
         raise ProfileError(f"{path}: expected a mapping at the top level, got {got}")
     if isinstance(data.get("robot"), str):
         data["robot"] = str((path.parent / data["robot"]).resolve())
+    access = data.get("zenoh", {}).get("access") if isinstance(data.get("zenoh"), dict) else None
+    if isinstance(access, dict) and isinstance(access.get("credentials"), str):
+        access["credentials"] = str((path.parent / access["credentials"]).resolve())
     parent = data.pop("extends", None)
     if parent is None:
         return data

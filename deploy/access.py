@@ -1,0 +1,108 @@
+"""Who may connect and who may publish what: Zenoh user/password authentication and ACL.
+
+A profile that says ``zenoh.access`` names a credentials file (``user:password`` per line,
+the router's dictionary) and, per topic, the users who may write it::
+
+    zenoh:
+      mode: client
+      access:
+        credentials: credentials.txt
+        writers:
+          control/goal: [operator]
+
+A session without a user and password of the file is refused by the router. Every component
+authenticates as its own name; tools as ``$PARSIMONY_USER`` (default ``operator``). A put on a
+listed topic from any other user is dropped by the router's access control. The rules act in
+the router, so the profile must run in ``client`` mode (peers would link directly, past them).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+from pydantic import BaseModel, ConfigDict, model_validator
+
+from messages import topics
+
+USER_ENV = "PARSIMONY_USER"
+"""The user a tool (``parsimony status``, ``topic``, ``param`` ...) authenticates as."""
+DEFAULT_TOOL_USER = "operator"
+
+
+def read_credentials(path: Path) -> dict[str, str]:
+    """``user -> password`` from a file of ``user:password`` lines (blank lines and # skipped)."""
+    users = {}
+    for number, line in enumerate(path.read_text().splitlines(), start=1):
+        line = line.strip()
+        if not line or line.startswith("#"):
+            continue
+        user, colon, password = line.partition(":")
+        if not colon or not user or not password:
+            raise ValueError(f"{path}:{number}: expected user:password")
+        users[user] = password
+    return users
+
+
+class AccessSettings(BaseModel):
+    """The credentials file and, per topic of the table, the users who may write it."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    credentials: Path
+    writers: dict[str, list[str]] = {}
+
+    @model_validator(mode="after")
+    def _known_topics_and_users(self) -> AccessSettings:
+        try:
+            users = read_credentials(self.credentials)
+        except OSError as error:
+            raise ValueError(f"credentials: cannot read {self.credentials}: "
+                             f"{error.strerror}") from error  # fmt: skip
+        for topic, writers in self.writers.items():
+            if topic not in topics.TOPICS:
+                raise ValueError(f"writers.{topic}: not a topic of the table "
+                                 f"({', '.join(topics.TOPICS)})")  # fmt: skip
+            unknown = sorted(set(writers) - set(users))
+            if unknown:
+                raise ValueError(f"writers.{topic}: {unknown} not in {self.credentials}")
+        return self
+
+    def users(self) -> dict[str, str]:
+        return read_credentials(self.credentials)
+
+    def router_json(self, namespace: str) -> dict[str, Any]:
+        """The router's authentication and access control: every user outside a topic's
+        writers is denied puts on its key."""
+        users = set(self.users())
+        rules, subjects, policies = [], [], []
+        for index, (topic, writers) in enumerate(sorted(self.writers.items())):
+            others = sorted(users - set(writers))
+            if not others:
+                continue
+            rules.append({"id": f"no-put-{index}", "permission": "deny", "flows": ["ingress"],
+                          "messages": ["put", "delete"],
+                          "key_exprs": [topics.TOPICS[topic].key(namespace)]})  # fmt: skip
+            subjects.append({"id": f"not-writers-{index}", "usernames": others})
+            policies.append({"rules": [f"no-put-{index}"], "subjects": [f"not-writers-{index}"]})
+        return {
+            "transport/auth/usrpwd": {"dictionary_file": str(self.credentials)},
+            "access_control": {"enabled": True, "default_permission": "allow", "rules": rules,
+                               "subjects": subjects, "policies": policies},
+        }  # fmt: skip
+
+    def session_json(self, user: str | None) -> dict[str, Any]:
+        """A session's credentials: ``user`` (a tool's: ``$PARSIMONY_USER``) and its password."""
+        user = user or os.environ.get(USER_ENV, DEFAULT_TOOL_USER)
+        users = self.users()
+        if user not in users:
+            raise ValueError(f"user {user!r} has no line in {self.credentials}")
+        return {"transport/auth/usrpwd": {"user": user, "password": users[user]}}
+
+
+def insert(config: Any, entries: dict[str, Any]) -> None:
+    """Insert each ``path: value`` into a ``zenoh.Config``."""
+    for path, value in entries.items():
+        config.insert_json5(path, json.dumps(value))
