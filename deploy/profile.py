@@ -11,7 +11,6 @@ another profile and says only what differs (components are matched by name).
 from __future__ import annotations
 
 import importlib.util
-import ipaddress
 import json
 from pathlib import Path
 from typing import Annotated, Literal
@@ -21,8 +20,10 @@ import zenoh
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from deploy.access import AccessSettings, insert
+from deploy.endpoints import endpoint_problem
 from messages.process import ParamValue
 
+TLS_FILES = ("root_ca_certificate", "listen_certificate", "listen_private_key")
 COMPONENT_PACKAGE = "components"
 """The package of component modules: ``module: echo`` means ``components.echo``."""
 
@@ -35,12 +36,6 @@ Identifier = Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]*$")]
 Namespace = Annotated[str, Field(pattern=r"^[A-Za-z0-9_-]+(/[A-Za-z0-9_-]+)*$")]
 """One or more key-expression chunks without wildcards, e.g. ``sim`` or ``lab/robot1``."""
 
-LOCAL_PROTOCOLS = ("unixsock-stream",)
-"""Zenoh link protocols that never leave the host."""
-IP_PROTOCOLS = ("tcp", "udp", "tls", "quic", "ws")
-"""Zenoh link protocols addressed by ``host:port``."""
-
-
 class ProfileError(Exception):
     """A profile that cannot be used; the message says where and what was expected."""
 
@@ -51,40 +46,16 @@ class StrictModel(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
 
-def endpoint_problem(endpoint: str, needs_port: bool = False) -> str | None:
-    """Why a Zenoh endpoint is not provably on this host, or None when it is.
+class TlsSettings(StrictModel):
+    """TLS for the ``tls/...`` endpoints: the CA every session trusts, and the certificate
+    and key a router listening on TLS presents (paths relative to the profile)."""
 
-    An endpoint is ``<protocol>/<address>[?<metadata>][#<config>]``. Local means a unix socket,
-    or an IP protocol on a literal loopback address (127.0.0.0/8, ::1) with a port, and no
-    metadata or config: an option such as ``#iface=eth0`` could bind it elsewhere, and a name
-    such as ``localhost`` resolves through files and services outside the profile.
-    ``needs_port``: port 0 (any free port) is refused, as for a router others connect to.
-    """
-    protocol, slash, address = endpoint.partition("/")
-    if not slash or not address:
-        return "expected <protocol>/<address>, e.g. tcp/127.0.0.1:7447"
-    if "?" in address or "#" in address:
-        return "metadata (?...) and options (#...) are not allowed on a local endpoint"
-    if protocol in LOCAL_PROTOCOLS:
-        return None
-    if protocol not in IP_PROTOCOLS:
-        return f"unknown protocol {protocol!r} (expected one of {', '.join(IP_PROTOCOLS)} or " \
-               f"{', '.join(LOCAL_PROTOCOLS)})"
-    host, colon, port = address.rpartition(":")
-    if not colon or not port.isdigit() or not 0 <= int(port) <= 65535:
-        return "expected host:port with a port from 0 to 65535"
-    if needs_port and int(port) == 0:
-        return "port 0 picks a free port nobody knows; give the port others connect to"
-    try:
-        loopback = ipaddress.ip_address(host.removeprefix("[").removesuffix("]")).is_loopback
-    except ValueError:
-        return f"{host!r} is not a literal IP address (write 127.0.0.1 or [::1])"
-    return None if loopback else f"{host} is not on the loopback interface"
+    root_ca_certificate: Path
+    listen_certificate: Path | None = None
+    listen_private_key: Path | None = None
 
-
-def is_local_endpoint(endpoint: str) -> bool:
-    """Whether a Zenoh endpoint (``tcp/127.0.0.1:7447``, ``unixsock-stream//tmp/s``) is local."""
-    return endpoint_problem(endpoint) is None
+    def json(self) -> dict[str, str]:
+        return {name: str(value) for name, value in self.model_dump().items() if value}
 
 
 class ZenohSettings(StrictModel):
@@ -112,6 +83,10 @@ class ZenohSettings(StrictModel):
     allow_remote: bool = False
     access: AccessSettings | None = None
     """Authentication and per-topic write rights (``deploy.access``); needs client mode."""
+    uplinks: list[str] = []
+    """Routers on other hosts that the launcher's router connects to (a lab of several
+    computers); remote, so they need ``allow_remote``."""
+    tls: TlsSettings | None = None
 
     @model_validator(mode="after")
     def _local_unless_allowed(self) -> ZenohSettings:
@@ -122,7 +97,7 @@ class ZenohSettings(StrictModel):
             return self
         if self.multicast_scouting:
             raise ValueError("multicast_scouting: reaches other hosts; it needs allow_remote: true")
-        for field in ("router", "connect", "listen"):
+        for field in ("router", "connect", "listen", "uplinks"):
             for index, endpoint in enumerate(getattr(self, field) or ()):
                 problem = endpoint_problem(endpoint, needs_port=field != "listen")
                 if problem is not None:
@@ -139,7 +114,7 @@ class ZenohSettings(StrictModel):
 
     def router_config(self, namespace: str = "") -> zenoh.Config:
         """The config of the launcher's router session (its access rules act on ``namespace``)."""
-        config = self._config("router", listen=self.router, connect=[])
+        config = self._config("router", listen=self.router, connect=self.uplinks)
         if self.access is not None:
             insert(config, self.access.router_json(namespace))
         return config
@@ -166,6 +141,8 @@ class ZenohSettings(StrictModel):
         config.insert_json5("scouting/multicast/enabled", json.dumps(self.multicast_scouting))
         gossip = self.allow_remote or (self.mode == "peer" and mode != "client")
         config.insert_json5("scouting/gossip/enabled", json.dumps(gossip))
+        if self.tls is not None:
+            config.insert_json5("transport/link/tls", json.dumps(self.tls.json()))
         return config
 
 
@@ -372,9 +349,12 @@ def read_profile_data(path: Path, chain: tuple[Path, ...] = ()) -> dict:
         raise ProfileError(f"{path}: expected a mapping at the top level, got {got}")
     if isinstance(data.get("robot"), str):
         data["robot"] = str((path.parent / data["robot"]).resolve())
-    access = data.get("zenoh", {}).get("access") if isinstance(data.get("zenoh"), dict) else None
-    if isinstance(access, dict) and isinstance(access.get("credentials"), str):
-        access["credentials"] = str((path.parent / access["credentials"]).resolve())
+    settings = data.get("zenoh") if isinstance(data.get("zenoh"), dict) else {}
+    for section, names in (("access", ("credentials",)), ("tls", TLS_FILES)):
+        files = settings.get(section)
+        for name in names if isinstance(files, dict) else ():
+            if isinstance(files.get(name), str):
+                files[name] = str((path.parent / files[name]).resolve())
     parent = data.pop("extends", None)
     if parent is None:
         return data

@@ -12,7 +12,8 @@ import pytest
 import yaml
 import zenoh
 
-from deploy.profile import ProfileError, ZenohSettings, is_local_endpoint, load_profile
+from deploy.endpoints import is_local_endpoint
+from deploy.profile import ProfileError, ZenohSettings, load_profile
 
 PUB = {"name": "pub", "module": "scripted_publisher", "role": "tool"}
 
