@@ -18,13 +18,13 @@ from typing import Any
 
 import zenoh
 
-from deploy.profile import ZenohSettings
 from messages import codec, topics
 from messages.base import IDENTITY_POSE
 from messages.camera import CameraFrame, CameraIntrinsics
 from messages.goal import Goal
 from messages.header import Header
 from messages.state import RobotState
+from profiles.profile import ZenohSettings
 from wbc.robot import MobileManipulator
 from wbc.scenarios import NEAR_START, REACH_GOAL
 

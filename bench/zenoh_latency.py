@@ -48,9 +48,9 @@ from bench.pubsub_workers import (
     subscriber_main,
 )
 from deploy import query
-from deploy.profile import ZenohSettings
 from messages import topics
 from parsimony.output import emit, result_only_stdout
+from profiles.profile import ZenohSettings
 
 SETTLE_S = 1.0
 """How long the subscriber may stay silent after the last publication before we count."""

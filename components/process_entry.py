@@ -22,8 +22,8 @@ import zenoh
 
 from components.params import ParamError
 from components.runtime import Component, Node
-from deploy.profile import ProfileError, load_profile
 from messages.process import EXIT_CONFIG_ERROR, LAUNCHER_PID_ENV, PARAMS_FILE_ENV
+from profiles.profile import ProfileError, load_profile
 
 log = logging.getLogger("components")
 

@@ -35,11 +35,11 @@ from components.clock import Clock, SimClock, Timer, Timers, WallClock
 from components.params import Param, ParamError, Parameters, keep_params, restore_params
 from components.pubsub import Input, Publisher, Subscription
 from components.rate_limited_log import RateLimitedLog
-from deploy.profile import Profile
 from messages import codec, topics
 from messages.header import Header
 from messages.process import encode_value
 from messages.status import ComponentStatus
+from profiles.profile import Profile
 
 M = TypeVar("M", bound=BaseModel)
 

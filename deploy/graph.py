@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 from components.pubsub import Input
 from components.runtime import Component
-from deploy.profile import ComponentSpec, Profile
 from messages import topics
+from profiles.profile import ComponentSpec, Profile
 
 
 @dataclass(frozen=True)

@@ -33,10 +33,10 @@ from typing import IO
 
 import zenoh
 
-from deploy.profile import ROLES, ComponentSpec, Profile
 from deploy.query import statuses
 from messages import process, topics
 from messages.process import EXIT_CONFIG_ERROR, LAUNCHER_PID_ENV, PARAMS_FILE_ENV
+from profiles.profile import ROLES, ComponentSpec, Profile
 
 POLL_S = 0.05
 """How often the launcher looks at its children and the clock."""

@@ -12,11 +12,11 @@ from pathlib import Path
 
 import zenoh
 
-from deploy.profile import ZenohSettings, load_profile
 from deploy.zenoh_error import zenoh_error_text
 from messages import codec, topics
 from messages.process import ParamValue, decode_value
 from messages.status import ComponentStatus
+from profiles.profile import ZenohSettings, load_profile
 
 DEFAULT_ROUTER = "tcp/127.0.0.1:7447"
 """Where tools look for the router when given a namespace and no endpoint."""

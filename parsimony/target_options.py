@@ -6,8 +6,8 @@ import argparse
 import os
 import sys
 
-from deploy.profile import Profile, ProfileError, load_profile
 from deploy.query import DEFAULT_TIMEOUT_S, Target
+from profiles.profile import Profile, ProfileError, load_profile
 
 PROFILE_ENV = "PARSIMONY_PROFILE"
 """The profile used when `--profile` is not given."""

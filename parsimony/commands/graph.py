@@ -10,8 +10,8 @@ import sys
 from pathlib import Path
 
 from deploy.graph import dataflow
-from deploy.profile import ProfileError, load_profile
 from parsimony.output import emit
+from profiles.profile import ProfileError, load_profile
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

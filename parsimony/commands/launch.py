@@ -11,8 +11,8 @@ import zenoh
 
 from deploy.graph import dataflow
 from deploy.launcher import Launcher
-from deploy.profile import ProfileError, load_profile
 from deploy.zenoh_error import zenoh_error_text
+from profiles.profile import ProfileError, load_profile
 
 EXIT_INVALID_PROFILE = 2
 

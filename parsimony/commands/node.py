@@ -6,10 +6,10 @@ import argparse
 import json
 
 from deploy.graph import component_class
-from deploy.profile import ProfileError
 from deploy.query import QueryError, status_of
 from parsimony.output import emit
 from parsimony.target_options import fail, profile_and_target, target_options
+from profiles.profile import ProfileError
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

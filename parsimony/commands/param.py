@@ -9,10 +9,10 @@ from pathlib import Path
 import yaml
 
 from deploy.graph import component_class
-from deploy.profile import ProfileError
 from deploy.query import QueryError, all_params, get_param, set_param
 from parsimony.output import emit
 from parsimony.target_options import PROFILE_ENV, fail, profile_and_target, target_options
+from profiles.profile import ProfileError
 
 __all__ = ["PROFILE_ENV", "add_parser", "run"]
 

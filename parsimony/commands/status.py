@@ -7,7 +7,6 @@ import json
 import sys
 from pathlib import Path
 
-from deploy.profile import ProfileError
 from deploy.query import (
     DEFAULT_ROUTER,
     DEFAULT_TIMEOUT_S,
@@ -18,6 +17,7 @@ from deploy.query import (
 )
 from messages.status import ComponentStatus
 from parsimony.output import emit
+from profiles.profile import ProfileError
 
 COLUMNS = ("NAME", "MODULE", "STATE", "PID", "COUNTERS (non-zero)")
 

@@ -15,12 +15,12 @@ import zenoh
 from pydantic import BaseModel, ValidationError
 
 from deploy.graph import dataflow
-from deploy.profile import ProfileError
 from deploy.query import QueryError
 from messages import codec, topics
 from messages.header import Header
 from parsimony.output import emit
 from parsimony.target_options import fail, profile_and_target, target_options
+from profiles.profile import ProfileError
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

@@ -18,8 +18,8 @@ import yaml
 import zenoh
 from pydantic import BaseModel
 
-from deploy.profile import Profile, load_profile, read_profile_data
 from messages import codec, topics
+from profiles.profile import Profile, load_profile, read_profile_data
 
 M = TypeVar("M", bound=BaseModel)
 

@@ -22,7 +22,6 @@ import yaml
 from components.lp_controller import LPController
 from components.runtime import Node
 from deploy import query
-from deploy.profile import load_profile
 from messages import codec, topics
 from messages.commands import ArmCommand, BaseCommand
 from messages.diagnostics import ControllerDiagnostics
@@ -30,6 +29,7 @@ from messages.goal import Goal
 from messages.header import Header
 from messages.state import RobotState
 from parsimony.commands import param
+from profiles.profile import load_profile
 from wbc.robot import MobileManipulator
 from wbc.scenarios import NEAR_START, REACH_GOAL
 

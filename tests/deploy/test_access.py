@@ -12,10 +12,10 @@ import yaml
 import zenoh
 
 from deploy import query
-from deploy.profile import ProfileError, ZenohSettings, load_profile
 from messages import codec, topics
 from messages.goal import Goal
 from messages.header import Header
+from profiles.profile import ProfileError, ZenohSettings, load_profile
 from tests.deploy.conftest import free_port
 
 if TYPE_CHECKING:

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from deploy.graph import dataflow
-from deploy.profile import load_profile
+from profiles.profile import load_profile
 
 DEPLOY = Path(__file__).resolve().parents[2] / "deploy"
 

@@ -12,8 +12,8 @@ import pytest
 import yaml
 import zenoh
 
-from deploy.endpoints import is_local_endpoint
-from deploy.profile import ProfileError, ZenohSettings, load_profile
+from profiles.endpoints import is_local_endpoint
+from profiles.profile import ProfileError, ZenohSettings, load_profile
 
 PUB = {"name": "pub", "module": "scripted_publisher", "role": "tool"}
 

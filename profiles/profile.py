@@ -19,9 +19,9 @@ import yaml
 import zenoh
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from deploy.access import AccessSettings, insert
-from deploy.endpoints import endpoint_problem
 from messages.process import ParamValue
+from profiles.access import AccessSettings, insert
+from profiles.endpoints import endpoint_problem
 
 TLS_FILES = ("root_ca_certificate", "listen_certificate", "listen_private_key")
 COMPONENT_PACKAGE = "components"
@@ -82,7 +82,7 @@ class ZenohSettings(StrictModel):
     multicast_scouting: bool = False
     allow_remote: bool = False
     access: AccessSettings | None = None
-    """Authentication and per-topic write rights (``deploy.access``); needs client mode."""
+    """Authentication and per-topic write rights (``profiles.access``); needs client mode."""
     uplinks: list[str] = []
     """Routers on other hosts that the launcher's router connects to (a lab of several
     computers); remote, so they need ``allow_remote``."""
