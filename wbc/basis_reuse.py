@@ -13,8 +13,8 @@ return this same vertex after 0 iterations.
 
 Between two control steps the optimal basis rarely changes (0 simplex iterations at the median
 step of the bench trajectory), and a HiGHS run() costs about 90 us even then (model checks, a
-new factorisation, and per-run reads of the CPU topology in sysfs), against about 25 us for
-this test in NumPy, measured on the LP step of `parsimony bench`.
+new factorisation, and per-run reads of the CPU topology in sysfs), against about 40 us for
+this test in NumPy (the ``vertex`` part of the LP step in `parsimony bench`).
 """
 
 from __future__ import annotations
