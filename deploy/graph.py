@@ -78,10 +78,11 @@ class Dataflow:
     def to_dot(self) -> str:
         """The graph in Graphviz's DOT language: components as boxes, keys as ellipses."""
         lines = [f'digraph "{self.namespace}" {{', "  rankdir=LR;"]
+        unwritten = self.read_never_written()
         for c in self.components:
             lines.append(f'  "{c.name}" [shape=box, label="{c.name}\\n{c.module}"];')
         for name in self.topics():
-            style = ", style=dashed" if name in self.read_never_written() else ""
+            style = ", style=dashed" if name in unwritten else ""
             lines.append(f'  "{self.key(name)}" [shape=ellipse{style}];')
             lines += [f'  "{w}" -> "{self.key(name)}";' for w in self.writers(name)]
             lines += [f'  "{self.key(name)}" -> "{r}";' for r in self.readers(name)]

@@ -11,10 +11,8 @@ import yaml
 from deploy.graph import component_class
 from deploy.query import QueryError, all_params, get_param, set_param
 from parsimony.output import emit
-from parsimony.target_options import PROFILE_ENV, fail, profile_and_target, target_options
+from parsimony.target_options import fail, profile_and_target, target_options
 from profiles.profile import ProfileError
-
-__all__ = ["PROFILE_ENV", "add_parser", "run"]
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

@@ -14,6 +14,7 @@ import yaml
 
 from deploy import query
 from parsimony.commands import param, status
+from parsimony.target_options import PROFILE_ENV
 
 
 def command(module: object, *argv: str) -> int:
@@ -80,7 +81,7 @@ def test_param_set_then_get_changes_the_running_component(
         command(param, "param", "set", "pub", "rate_hz", "25", "--profile", str(running_pub)) == 0
     )
     assert capsys.readouterr().out.strip() == "pub.rate_hz = 25.0"
-    monkeypatch.setenv(param.PROFILE_ENV, str(running_pub))
+    monkeypatch.setenv(PROFILE_ENV, str(running_pub))
     assert command(param, "param", "get", "pub", "rate_hz") == 0
     assert capsys.readouterr().out.strip() == "pub.rate_hz = 25.0"
     assert command(param, "param", "set", "pub", "goal_task", "pose") == 0
