@@ -23,6 +23,7 @@ from messages.base import IDENTITY_POSE
 from messages.camera import CameraFrame, CameraIntrinsics
 from messages.goal import Goal
 from messages.header import Header
+from messages.obstacles import Circle, Obstacles
 from messages.state import RobotState
 from profiles.profile import ZenohSettings
 from wbc.robot import MobileManipulator
@@ -33,6 +34,8 @@ ROBOT = Path(__file__).resolve().parents[1] / "deploy" / "robots" / "little_john
 START = NEAR_START
 GOAL_Q = REACH_GOAL
 WIDTH, HEIGHT = 640, 480
+FLOOD_CIRCLES = 4
+"""Circles in each ``world/obstacles`` message of the flood."""
 WAIT_S = 15.0
 """How long anything may take before the bench gives up."""
 
@@ -56,6 +59,9 @@ def message(kind: str, index: int, count: int, image: bytes) -> tuple[topics.Top
             intrinsics=intrinsics,
         )  # fmt: skip
         return topics.CAMERA_IMAGE, frame
+    if kind == "obstacles":
+        circles = tuple(Circle(x=0.5 + 0.01 * i, y=0.2, radius=0.1) for i in range(FLOOD_CIRCLES))
+        return topics.WORLD_OBSTACLES, Obstacles(header=header, circles=circles)
     if kind == "goal":
         pose = tuple(MobileManipulator.from_yaml(ROBOT).fkm(GOAL_Q).tolist())
         return topics.CONTROL_GOAL, Goal(header=header, task="pose", pose=pose)
@@ -78,6 +84,9 @@ def publisher_main(settings: ZenohSettings, commands: Queue, results: Queue) -> 
         publishers: dict[str, zenoh.Publisher] = {}
         results.put("ready")
         while (phase := commands.get()) is not None:
+            if phase.kind == "obstacles":
+                results.put(flood(session, phase))
+                continue
             stamps, start = [], time.perf_counter()
             for index in range(phase.count):
                 if phase.rate_hz > 0:
@@ -94,6 +103,23 @@ def publisher_main(settings: ZenohSettings, commands: Queue, results: Queue) -> 
                 publishers[topic.name].put(codec.encode(payload))
                 stamps.append(payload.header.stamp_ns)
             results.put((stamps, time.perf_counter() - start))
+
+
+def flood(session: zenoh.Session, phase: Phase) -> tuple[list[int], float]:
+    """Publish ``phase.count`` obstacle messages, encoded beforehand, as fast as the
+    subscribers take them: the publisher blocks rather than drop (``CongestionControl.BLOCK``),
+    so the rate measures the slowest subscriber, not the publisher's encoding."""
+    messages = [message(phase.kind, index, phase.count, b"")[1] for index in range(phase.count)]
+    payloads = [codec.encode(m) for m in messages]
+    key = topics.WORLD_OBSTACLES.key(NAMESPACE)
+    publisher = session.declare_publisher(key, congestion_control=zenoh.CongestionControl.BLOCK)
+    try:
+        start = time.perf_counter()
+        for payload in payloads:
+            publisher.put(payload)
+        return [m.header.stamp_ns for m in messages], time.perf_counter() - start
+    finally:
+        publisher.undeclare()
 
 
 def subscriber_main(settings: ZenohSettings, commands: Queue, results: Queue) -> None:

@@ -15,14 +15,19 @@ subscriber takes ``time.time_ns()`` once it has decoded it (one machine, one clo
 3. The loop through an ``lp_controller`` process: states at 50 Hz from the publisher,
    ``arm/command`` at the subscriber. A command carries the stamp of the state it
    answers, so its age on arrival is the state-in to command-out latency.
+4. A flood of ``world/obstacles``, as fast as the publisher can, into the same process
+   (a newest-sample input: how many its handler decodes per second, how many were replaced
+   before it could) and into a node with a queue input (every sample decoded, in order).
+   Figures from the components' own counters.
 
-Prints a table, then one JSON line. Runs in about 30 s.
+Prints a table, or ``--json``. Runs in about 30 s.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import multiprocessing as mp
 import os
 import signal
@@ -47,10 +52,11 @@ from bench.pubsub_workers import (
     publisher_main,
     subscriber_main,
 )
+from components.runtime import Node
 from deploy import query
 from messages import topics
 from parsimony.output import emit, result_only_stdout
-from profiles.profile import ZenohSettings
+from profiles.profile import ZenohSettings, load_profile
 
 SETTLE_S = 1.0
 """How long the subscriber may stay silent after the last publication before we count."""
@@ -159,12 +165,22 @@ def controller_loop(
     with tempfile.TemporaryDirectory() as directory:
         profile = Path(directory) / "bench.yaml"
         component = {"name": "controller", "module": "lp_controller", "role": "controller"}
+        sink = {"name": "sink", "module": "scripted_publisher", "role": "tool"}  # never run
         data = {"namespace": NAMESPACE, "zenoh": {"router": settings.router, "mode": settings.mode}}
-        data |= {"robot": str(ROBOT), "components": [component]}
+        data |= {"robot": str(ROBOT), "components": [component, sink]}
         profile.write_text(yaml.safe_dump(data))
         command = [sys.executable, "-m", "components.lp_controller", "--profile", str(profile)]
         process = subprocess.Popen([*command, "--name", "controller", "--log-level", "WARNING"])
+        sink_node = Node(load_profile(profile), "sink")
         try:
+            sink_node.__enter__()
+            arrivals: list[int] = []
+            sink_node.subscribe(
+                topics.WORLD_OBSTACLES,
+                lambda _: arrivals.append(time.perf_counter_ns()),
+                FLOOD.count,
+            )
+            sink_node.start()
             deadline = time.monotonic() + WAIT_S
             while "controller" not in query.live_components(router, NAMESPACE, 0.2):
                 if time.monotonic() > deadline or process.poll() is not None:
@@ -177,7 +193,9 @@ def controller_loop(
             arm = bench.collect(topics.ARM_COMMAND, sent)
             diagnostics = bench.collect(topics.CONTROL_DIAGNOSTICS, sent)
             counters = query.statuses(router, NAMESPACE)["controller"].counters
+            flood = decode_rate(bench, router, sink_node, arrivals)
         finally:
+            sink_node.close()
             process.send_signal(signal.SIGTERM)
             try:
                 process.wait(WAIT_S)
@@ -186,7 +204,59 @@ def controller_loop(
                 process.wait()
     name = "state -> lp_controller -> arm/command @50 Hz"
     counters = {name: count for name, count in counters.items() if count}
-    return summary(name, sent, duration_s, arm, diagnostics), counters
+    return summary(name, sent, duration_s, arm, diagnostics), counters, flood
+
+
+FLOOD = Phase("obstacles", 20_000, 0.0)
+"""The flood of ``decode_rate``."""
+
+
+def decode_rate(
+    bench: Bench, router: zenoh.Session, sink: Node, decoded_ns: list[int]
+) -> dict[str, dict[str, int]]:
+    """Flood ``world/obstacles`` into the controller (newest-sample input) and into ``sink``,
+    a node of this process with a queue input as large as the flood whose handler appends
+    to ``decoded_ns`` the time it got each message. Wait until the counters of both account
+    for every message sent (decoded, replaced or refused).
+
+    Decoded per second: for the queue input, from its first decoded message to its last;
+    for the controller, whose newest-sample input decodes only while the flood lasts, over
+    the flood's duration."""
+    topic = topics.WORLD_OBSTACLES.name
+    kinds = ("received", "overwritten", "overflowed", "rejected")
+
+    def counts() -> dict[str, dict[str, int]]:
+        controller = query.statuses(router, NAMESPACE)["controller"].counters
+        return {
+            name: {kind: counters.get(f"{kind}.{topic}", 0) for kind in kinds}
+            for name, counters in (("lp_controller", controller), ("queue input", sink.counters))
+        }
+
+    before, done_s = counts(), {}
+    decoded_ns.clear()
+    started = time.monotonic()
+    sent, sent_s = bench.publish(FLOOD)
+    deadline = time.monotonic() + WAIT_S
+    while True:
+        now, elapsed_s = counts(), time.monotonic() - started
+        handled = {
+            name: {kind: now[name][kind] - before[name][kind] for kind in kinds} for name in now
+        }
+        for name, figures in handled.items():
+            if name not in done_s and sum(figures.values()) >= len(sent):
+                done_s[name] = elapsed_s
+        if len(done_s) == len(now) or time.monotonic() > deadline:
+            break
+        time.sleep(0.01)  # polling the counters, not waiting for an event
+    report = {}
+    for name, figures in handled.items():
+        lost = len(sent) - sum(figures.values())
+        report[name] = {"sent": len(sent), "sent_hz": round(len(sent) / sent_s), **figures}
+        report[name]["lost"] = lost
+    span_s = (decoded_ns[-1] - decoded_ns[0]) / 1e9 if len(decoded_ns) > 1 else math.inf
+    report["queue input"]["decoded_hz"] = round((len(decoded_ns) - 1) / span_s)
+    report["lp_controller"]["decoded_hz"] = round(report["lp_controller"]["received"] / sent_s)
+    return report
 
 
 def rate(count: int, span_ns: float) -> float:
@@ -234,19 +304,23 @@ def main(argv: list[str] | None = None) -> int:
         bench = Bench(settings)
         try:
             results = [bench.measure(*measurement) for measurement in TRANSPORT]
-            loop, counters = controller_loop(bench, settings, router)
+            loop, counters, flood = controller_loop(bench, settings, router)
             results.append(loop)
         finally:
             bench.close()
     report = {"bench": "zenoh_latency", "mode": settings.mode, "cpus": os.cpu_count()}
     report |= {"duration_s": round(time.monotonic() - started, 1)}
     report |= {"results": [asdict(r) for r in results], "controller_counters": counters}
+    report |= {"flood": flood}
     if args.json:
         emit(json.dumps(report))
     else:
         emit(format_table(results))
         emit("lp_controller counters: "
              + " ".join(f"{k}={v}" for k, v in sorted(counters.items())))  # fmt: skip
+        for name, figures in flood.items():
+            emit(f"world/obstacles flood into the {name}: "
+                 + " ".join(f"{k}={v}" for k, v in figures.items()))  # fmt: skip
     return 0
 
 
