@@ -52,7 +52,7 @@ from wbc.gains import gain_specs
 from wbc.law_output import Law, LawOutput
 from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
-from wbc.task import PoseTask, PositionTask, Task, same_task
+from wbc.task import MEASUREMENT_TOLERANCE, PoseTask, PositionTask, Task, same_task
 
 STALE_CHECK_PERIOD_S = 0.1
 """How often the controller checks that states still arrive."""
@@ -62,6 +62,7 @@ FIRST_DT_S = 0.02
 
 DT_MIN_S, DT_MAX_S = 1e-3, 0.2
 """dt is clamped to this range, whatever the stamps say."""
+
 
 def robot_loads(path: object) -> None:
     """``ParamError`` unless ``path`` is empty (the profile's robot) or a robot that loads."""
@@ -81,8 +82,13 @@ def law_params(gains_type: type) -> tuple[Param, ...]:
 
 CONTROLLER_PARAMS = (
     Param("stale_timeout_s", float, 0.5, low=0.01, high=10.0, doc="command zero after this, s"),
-    Param("robot", str, "", doc="robot description (YAML); empty: the profile's robot",
-          can_take=robot_loads),
+    Param(
+        "robot",
+        str,
+        "",
+        doc="robot description (YAML); empty: the profile's robot",
+        can_take=robot_loads,
+    ),
 )
 """The parameters of every controller, after those of its law."""
 
@@ -137,7 +143,8 @@ class Controller(Component):
         node.timer(STALE_CHECK_PERIOD_S, self.check_inputs_arrive)
 
     def on_goal(self, goal: Goal) -> None:
-        """Take a goal; a different task resets the law. A goal the law refuses (ValueError,
+        """Take a goal; a different task (another kind, or a goal moved by over
+        ``MEASUREMENT_TOLERANCE``) resets the law. A goal the law refuses (ValueError,
         counted in ``errors.control/goal``) drops the current one: no goal, zero commands.
         The goal's ``eta`` and ``beta`` must lie in the bounds of the parameters they override,
         as for ``parsimony param set``."""
@@ -150,7 +157,7 @@ class Controller(Component):
         except ValueError:
             self.goal = self.task = None
             raise
-        if self.task is None or not same_task(self.task, task):
+        if self.task is None or not same_task(self.task, task, MEASUREMENT_TOLERANCE):
             self.law.reset()
         self.goal, self.task = goal, task
 

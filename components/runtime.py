@@ -135,6 +135,9 @@ class Node:
         every sample in order, at most N waiting (see ``components.pubsub``). A component
         declares it in ``reads``, and the node takes it from there.
         """
+        if topic.ground_truth and self.spec.role in ("estimator", "controller"):
+            raise ValueError(f"{self.name} is an {self.spec.role}: it may not read the ground "
+                             f"truth on {topic.name}")  # fmt: skip
         if self.reads is not None and topic is not topics.SIM_CLOCK:
             if topic.name not in self.reads:
                 raise ValueError(f"{self.name} reads {topic.name} without declaring it in `reads`")

@@ -14,6 +14,7 @@ class RobotState(Message):
     world frame. ``valid`` is false until the estimator has a fix (then the
     pose fields are best guesses; ``base.IDENTITY_POSE`` stands for an
     unknown end effector); ``age_s`` is how old the newest fused measurement is, in s.
+    ``degraded`` says the base pose is carried by odometry alone: the camera lost its marker.
     """
 
     header: Header
@@ -22,6 +23,7 @@ class RobotState(Message):
     end_effector: UnitDualQuaternion
     valid: bool
     age_s: NonNegative
+    degraded: bool = False
 
     def configuration(self) -> list[float]:
         """The whole-body configuration ``q = [x, y, phi, q1, ..., q5]``."""

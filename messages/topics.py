@@ -32,6 +32,7 @@ from messages.obstacles import Obstacles
 from messages.odometry import BaseOdometry
 from messages.state import RobotState
 from messages.status import ComponentStatus
+from messages.truth import SimTruth
 
 M = TypeVar("M", bound=BaseModel)
 
@@ -47,12 +48,15 @@ class KeyExpressionError(ValueError):
 class Topic(Generic[M]):
     """A topic: its ``name`` in this table (what profiles refer to), the
     ``suffix`` its key ends with, the message ``type`` it carries, and the largest payload
-    (``max_bytes``) a subscriber takes: a larger one is refused before it is decoded."""
+    (``max_bytes``) a subscriber takes: a larger one is refused before it is decoded.
+    A ``ground_truth`` topic (the simulator's) is for tests and reports: no estimator or
+    controller may read it."""
 
     name: str
     suffix: str
     type: type[M]
     max_bytes: int = 64 * 1024
+    ground_truth: bool = False
 
     def key(self, namespace: str) -> str:
         """This topic's key under ``namespace``: ``"<namespace>/<suffix>"``."""
@@ -71,6 +75,7 @@ BASE_COMMAND = Topic("base/command", "base/command", BaseCommand)
 ARM_COMMAND = Topic("arm/command", "arm/command", ArmCommand)
 CONTROL_DIAGNOSTICS = Topic("control/diagnostics", "control/diagnostics", ControllerDiagnostics)
 SIM_CLOCK = Topic("sim/clock", "sim/clock", Clock)
+SIM_TRUTH = Topic("sim/truth", "sim/truth", SimTruth, ground_truth=True)
 
 TOPICS: Mapping[str, Topic] = MappingProxyType(
     {
@@ -87,6 +92,7 @@ TOPICS: Mapping[str, Topic] = MappingProxyType(
             ARM_COMMAND,
             CONTROL_DIAGNOSTICS,
             SIM_CLOCK,
+            SIM_TRUTH,
         )
     }
 )

@@ -22,6 +22,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from messages.process import ParamValue
 from profiles.access import AccessSettings, insert
 from profiles.endpoints import endpoint_problem
+from profiles.scene import Scene
 
 TLS_FILES = ("root_ca_certificate", "listen_certificate", "listen_private_key")
 COMPONENT_PACKAGE = "components"
@@ -200,6 +201,8 @@ class Profile(StrictModel):
     namespace: Namespace
     zenoh: ZenohSettings = ZenohSettings()
     robot: Path | None = None
+    scene: Scene | None = None
+    """The markers and camera of the workspace, for the components that see them."""
     clock: Literal["wall", "sim"] = "wall"
     startup_timeout_s: float = Field(default=10.0, gt=0.0)
     """Seconds the launcher gives every component to become alive (its liveliness token seen

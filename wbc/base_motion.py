@@ -37,3 +37,16 @@ def wheel_speeds(forward: float, angular: float, base: BaseDescription) -> BaseV
     fastest = max(abs(left), abs(right))
     scale = 1.0 if fastest <= base.wheel_speed_max else base.wheel_speed_max / fastest
     return BaseVelocity(forward * scale, angular * scale, left * scale, right * scale, scale)
+
+
+def dead_reckoning(
+    x: float, y: float, phi: float, d_left: float, d_right: float, wheel_base: float
+) -> tuple[float, float, float]:
+    """The pose after the wheels roll ``d_left`` and ``d_right`` (m) along a circular arc:
+    ds = (d_r + d_l)/2, dphi = (d_r - d_l)/b, and the chord of the arc,
+    x += ds sinc(dphi/2) cos(phi + dphi/2), y += ds sinc(dphi/2) sin(phi + dphi/2)."""
+    ds, dphi = 0.5 * (d_right + d_left), (d_right - d_left) / wheel_base
+    half = 0.5 * dphi
+    chord = ds * (math.sin(half) / half if abs(half) > 1e-9 else 1.0 - half * half / 6.0)
+    heading = phi + half
+    return x + chord * math.cos(heading), y + chord * math.sin(heading), phi + dphi

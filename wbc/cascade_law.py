@@ -26,7 +26,7 @@ from wbc.law_output import LawOutput, summarise
 from wbc.obstacles import Circle
 from wbc.pinv_law import pinv_velocity
 from wbc.robot import MobileManipulator
-from wbc.task import Task, same_task
+from wbc.task import MEASUREMENT_TOLERANCE, Task, same_task
 from wbc.validation import require_finite
 
 Array = np.ndarray
@@ -35,14 +35,19 @@ Array = np.ndarray
 @dataclass(frozen=True)
 class CascadeParams:
     eta: float = gain(0.6, low=1e-3, high=100.0, doc="outer-loop task gain, 1/s")
-    offset: float = gain(0.1, low=0.01, high=1.0,
-                         doc="d, the tracked point's distance ahead of the wheel axle, m")
+    offset: float = gain(
+        0.1, low=0.01, high=1.0, doc="d, the tracked point's distance ahead of the wheel axle, m"
+    )
     k1: float = gain(2.0, low=1e-3, high=100.0, doc="inner-loop gain on x1, 1/s")
     k2: float = gain(2.0, low=1e-3, high=100.0, doc="inner-loop gain on y1, 1/s")
-    max_lead: float = gain(0.2, low=0.01, high=10.0,
-                           doc="how far the reference point may run ahead of the real one, m: "
-                               "beyond it the reference is pulled back, so a base that cannot "
-                               "follow does not wind the inner loop up")
+    max_lead: float = gain(
+        0.2,
+        low=0.01,
+        high=10.0,
+        doc="how far the reference point may run ahead of the real one, m: "
+        "beyond it the reference is pulled back, so a base that cannot "
+        "follow does not wind the inner loop up",
+    )
 
     def __post_init__(self) -> None:
         check_gains(self)
@@ -70,16 +75,18 @@ class CascadeLaw:
         self._reference = None
         self._task = None
 
-    def step(
-        self, q: Array, task: Task, dt: float, obstacles: Sequence[Circle] = ()
-    ) -> LawOutput:
+    def step(self, q: Array, task: Task, dt: float, obstacles: Sequence[Circle] = ()) -> LawOutput:
         """One step; the reference base advances by the outer loop's u_b over ``dt``."""
         start = time.perf_counter()
         q = require_finite("configuration q", q)
         dt = float(require_finite("dt", dt))
         if dt <= 0.0:
             raise ValueError(f"dt must be > 0, got {dt}")
-        if self._reference is None or self._task is None or not same_task(self._task, task):
+        if (
+            self._reference is None
+            or self._task is None
+            or not same_task(self._task, task, MEASUREMENT_TOLERANCE)
+        ):
             self._reference = q[:3].copy()
         self._task = task
 

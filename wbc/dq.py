@@ -117,6 +117,14 @@ def norm(x: Array) -> Array:
     return out
 
 
+def normalize(x: Array) -> Array:
+    """The unit dual quaternion nearest x: P' = P/|P|, D' = D/|P| - (P'.D/|P|) P', so that
+    |P'| = 1 and P'.D' = 0 (removes the drift of long products of measured poses)."""
+    scale = float(np.linalg.norm(x[:4]))
+    p, d = x[:4] / scale, x[4:] / scale
+    return from_parts(p, d - float(np.dot(p, d)) * p)
+
+
 def is_unit(x: Array, tol: float = 1e-9) -> bool:
     """True when x* x = 1, i.e. x represents a rigid motion."""
     return bool(np.allclose(mul(conj(x), x), ONE, atol=tol))

@@ -73,9 +73,12 @@ class ControlEffort:
 
 def control_effort(run: Run) -> ControlEffort:
     """Table 6.1's metrics of a run's velocities."""
-    velocity = run.velocities()
-    acceleration = np.diff(velocity, axis=0) / run.dt
-    dt = run.dt
+    return effort_of(run.velocities(), run.dt)
+
+
+def effort_of(velocity: Array, dt: float) -> ControlEffort:
+    """Table 6.1's metrics of velocities u (one row per step, ``dt`` apart)."""
+    acceleration = np.diff(velocity, axis=0) / dt
     return ControlEffort(
         velocity_l1=float(np.abs(velocity).sum() * dt),
         velocity_l2=float(np.sqrt((velocity**2).sum() * dt)),

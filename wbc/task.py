@@ -67,12 +67,18 @@ class PositionTask:
 Task = PoseTask | PositionTask
 
 
-def same_task(a: Task, b: Task) -> bool:
-    """True when a and b are the same kind of task with the same goal."""
+MEASUREMENT_TOLERANCE = 0.02
+"""Goals whose coefficients differ by less than this are one task measured twice (a goal the
+camera measures each frame): laws keep their state across them."""
+
+
+def same_task(a: Task, b: Task, tolerance: float = 0.0) -> bool:
+    """True when a and b are the same kind of task with goals no further apart than
+    ``tolerance`` in any coefficient (0: the same goal)."""
     if a is b:
         return True
     if type(a) is not type(b):
         return False
     goal_a = a.pose if isinstance(a, PoseTask) else a.position
     goal_b = b.pose if isinstance(b, PoseTask) else b.position
-    return bool(np.array_equal(goal_a, goal_b))
+    return bool(np.max(np.abs(goal_a - goal_b)) <= tolerance)

@@ -23,6 +23,7 @@ from messages import (
     RobotState,
 )
 from messages.base import Message
+from messages.truth import SimTruth
 
 HEADER = Header(stamp_ns=1_700_000_000_123_456_789, frame="world", seq=7, source="test")
 
@@ -113,4 +114,12 @@ EXAMPLES: tuple[Message, ...] = (
         parameters={"eta": 5.0, "steps": 3, "law": "lp", "warm_start": True},
     ),
     Clock(stamp_ns=123_000_000),
+    SimTruth(
+        header=HEADER,
+        base_pose=(1.0, 2.0, 0.3),
+        arm_joints=(0.1, -0.2, 0.3, -0.4, 0.5),
+        end_effector=QUARTER_TURN_SHIFTED,
+        contacts=2,
+        in_contact=False,
+    ),
 )

@@ -60,6 +60,7 @@ def test_the_table_holds_every_topic_of_the_design() -> None:
         "arm/command": "ArmCommand",
         "control/diagnostics": "ControllerDiagnostics",
         "sim/clock": "Clock",
+        "sim/truth": "SimTruth",
     }
 
 

@@ -1,0 +1,377 @@
+"""The 2D simulator as a process: the pymunk world of ``sim2d.world`` and its ceiling camera.
+
+It consumes ``base/command`` and ``arm/command`` and publishes what the drivers and the
+camera publish on the real robot, every ``step_s`` of simulated time::
+
+    sim/clock          t
+    arm/joint_states   the servo angles and speeds
+    base/odometry      the wheel encoder counts (noise and slip from the parameters), the
+                       distances and the dead-reckoned pose from them, as the Create driver does
+    camera/image       a 640x480 mono8 frame of the scene's markers at the camera's rate
+    sim/truth          the real pose, joints, end effector and contacts (tests and reports only)
+
+It stops the robot when no command has arrived for ``command_timeout_s`` of simulated time.
+
+Time: ``real_time_factor`` 1 runs as fast as the wall clock, 2 twice as fast, 0 as fast as it
+can. With ``lockstep`` each step waits until the loop has answered it, acknowledged by stamps:
+a camera frame stamped t by ``vision/markers`` (the tracker) and ``world/obstacles`` (the
+estimator, which publishes both each frame) stamped t, then the sensors of t by
+``base/command`` and ``arm/command`` stamped t (the controller answers the state of t with
+commands of t). Only then does t advance, so a run does not depend on the machine's load. An
+answer missing for ``ack_timeout_s`` host seconds is counted (``lockstep_timeouts``) and the
+step goes on. The simulator starts when ``paused`` is set false (a profile may start it so).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from components.params import Param, ParamError
+from components.process_entry import run_component
+from components.pubsub import Input
+from components.runtime import Component, Node
+from messages import topics
+from messages.base import ARM_JOINTS
+from messages.camera import CameraFrame, CameraIntrinsics
+from messages.clock import Clock
+from messages.commands import ArmCommand, BaseCommand
+from messages.joints import JointStates
+from messages.odometry import BaseOdometry
+from messages.truth import SimTruth
+from profiles.scene import Scene
+from sim2d.camera import ImageNoise, PinholeCamera, PlacedMarker, ceiling_pose, render
+from sim2d.world import World, WorldSettings, wheel_distance_per_count
+from wbc.base_motion import dead_reckoning
+from wbc.obstacles import Circle
+from wbc.planar import planar_pose
+from wbc.robot import MobileManipulator
+
+JOINT_NAMES = tuple(f"q{i}" for i in range(1, ARM_JOINTS + 1))
+LOCKSTEP_CHECK_S = 0.05
+"""How often the simulator looks for an answer that is overdue (host seconds)."""
+
+
+def floats(text: str, name: str, count: int | None = None, group: int = 1) -> list[tuple]:
+    """``"1, 2; 3, 4"`` as [(1, 2), (3, 4)] (``group`` numbers each), or ``ParamError``."""
+    groups = [g for g in str(text).split(";") if g.strip()]
+    try:
+        values = [tuple(float(v) for v in g.split(",")) for g in groups]
+    except ValueError as error:
+        raise ParamError(f"{name}: {error}") from error
+    if any(len(v) != group or not all(math.isfinite(x) for x in v) for v in values):
+        raise ParamError(f"{name}: expected groups of {group} finite numbers, got {text!r}")
+    if count is not None and len(values) != count:
+        raise ParamError(f"{name}: expected {count} group(s), got {len(values)}")
+    return values
+
+
+def parses(name: str, count: int | None, group: int):
+    """A ``can_take`` check: the text parses as ``floats(text, name, count, group)``."""
+    return lambda text: floats(str(text), name, count, group)
+
+
+@dataclass
+class Awaited:
+    """The answers a lockstep step waits for: the stamps that must reach ``stamp_ns``."""
+
+    stamp_ns: int
+    topics: tuple[str, ...]
+    deadline: float
+
+
+class Simulator(Component):
+    """sim2d: world, encoders, servos and ceiling camera (see the module docstring)."""
+
+    reads = (
+        Input(topics.BASE_COMMAND),
+        Input(topics.ARM_COMMAND),
+        Input(topics.VISION_MARKERS),
+        Input(topics.WORLD_OBSTACLES),
+    )
+    writes = (
+        topics.SIM_CLOCK,
+        topics.ARM_JOINT_STATES,
+        topics.BASE_ODOMETRY,
+        topics.CAMERA_IMAGE,
+        topics.SIM_TRUTH,
+    )
+    params = (
+        Param("step_s", float, 0.01, low=1e-4, high=0.1, doc="simulated time per step, s"),
+        Param("real_time_factor", float, 1.0, low=0.0, high=1000.0,
+              doc="simulated s per wall s; 0: as fast as possible"),
+        Param("lockstep", bool, False, doc="advance only when the loop answered each step"),
+        Param("ack_timeout_s", float, 2.0, low=0.01, high=60.0,
+              doc="host s a lockstep step waits for an answer"),
+        Param("paused", bool, False, doc="hold the simulation (set false to start)"),
+        Param("command_timeout_s", float, 0.5, low=0.01, high=10.0,
+              doc="stop the robot after this long without a command, s (simulated)"),
+        Param("seed", int, 0, low=0, high=2**31, doc="noise seed"),
+        Param("start", str, "0, 0, 0, 0, -0.2, 0.2, 0, 0.5", doc="q0 = x, y, phi, q1..q5",
+              can_take=parses("start", 1, 8)),
+        Param("obstacles", str, "", doc="obstacle circles 'x, y, radius; ...', m",
+              can_take=parses("obstacles", None, 3)),
+        Param("goal_marker", str, "0.6, 0.0, 0.0", doc="the bin marker F2: x, y, yaw",
+              can_take=parses("goal_marker", 1, 3)),
+        Param("hide_base_marker", str, "", doc="sim seconds 'from, to' the base marker is hidden",
+              can_take=parses("hide_base_marker", None, 2)),
+        Param("camera", bool, True, doc="render camera frames"),
+        Param("image_noise", float, 2.0, low=0.0, high=50.0, doc="pixel noise std, grey levels"),
+        Param("image_blur_px", float, 0.6, low=0.0, high=5.0, doc="Gaussian blur sigma, px"),
+        Param("encoder_noise_counts", float, 0.0, low=0.0, high=100.0,
+              doc="encoder noise std per step, counts"),
+        Param("wheel_slip", float, 0.0, low=0.0, high=0.5, doc="wheel slip std, fraction"),
+        Param("wheel_acceleration_max", float, 1.0, low=0.01, high=100.0, doc="m/s^2"),
+    )  # fmt: skip
+
+    def __init__(self, node: Node) -> None:
+        super().__init__(node)
+        p = node.params
+        if node.profile.robot is None:
+            raise ParamError("the simulator needs the profile's `robot`")
+        if node.profile.scene is None:
+            raise ParamError("the simulator needs the profile's `scene` (markers and camera)")
+        self.robot = MobileManipulator.from_yaml(node.profile.robot)
+        self.scene: Scene = node.profile.scene
+        self.obstacles = [Circle(*c) for c in floats(p["obstacles"], "obstacles", None, 3)]
+        settings = WorldSettings(
+            wheel_acceleration_max=p["wheel_acceleration_max"],
+            encoder_noise_counts=p["encoder_noise_counts"],
+            wheel_slip=p["wheel_slip"],
+        )
+        start = np.array(floats(p["start"], "start", 1, 8)[0])
+        self.world = World(self.robot, start, self.obstacles, settings, seed=p["seed"])
+        self.rng = np.random.default_rng(p["seed"] + 1)
+        self.step_ns = round(p["step_s"] * 1e9)
+        self.now_ns = 0
+        self.camera = self._camera()
+        self.frame_period_ns = round(1e9 / self.scene.camera.rate_hz)
+        self.next_frame_ns = 0
+        self.metres_per_count = wheel_distance_per_count(self.robot.base, settings.counts_per_turn)
+        self.odometry_pose = (0.0, 0.0, 0.0)
+        self.last_counts = self.world.encoder_counts
+        self.last_command_ns: int | None = None
+        self.awaited: Awaited | None = None
+        self.answered: dict[str, int] = {}
+        node.counters["lockstep_timeouts"] = 0
+        node.counters["contacts"] = 0
+        self.publishers = {t.name: node.publisher(t) for t in self.writes}
+        for topic in self.reads:
+            node.subscribe(topic.topic, self._answer_handler(topic.topic.name))
+        self.base_command = self.arm_command = None
+        self._queued = False
+        if p["real_time_factor"] > 0:
+            node.timer(p["step_s"] / p["real_time_factor"], self._paced_tick)
+        node.timer(LOCKSTEP_CHECK_S, self._check_overdue)
+
+    # -- the loop -------------------------------------------------------------------------
+
+    def _paced_tick(self) -> None:
+        """Timer at the real-time factor's pace: step unless paused or an answer is awaited."""
+        if self.awaited is None and not self.node.params["paused"]:
+            self.step()
+
+    def _kick(self) -> None:
+        """As fast as possible (factor 0): queue the next step unless one is queued, the
+        simulation is paused or an answer is awaited."""
+        p = self.node.params
+        if p["real_time_factor"] or p["paused"] or self.awaited is not None or self._queued:
+            return
+        self._queued = True
+        self.node.post(self._free_tick)
+
+    def _free_tick(self) -> None:
+        """One step, then the next after the events already waiting (commands, queries)."""
+        self._queued = False
+        if self.awaited is None and not self.node.params["paused"]:
+            self.step()
+        self._kick()
+
+    def step(self) -> None:
+        """Advance one step; publish the clock, and the camera frame when one is due."""
+        self._apply_commands()
+        self.world.step(self.step_ns / 1e9)
+        self.now_ns += self.step_ns
+        self.publishers["sim/clock"].put(Clock(stamp_ns=self.now_ns))
+        if self.camera is not None and self.now_ns >= self.next_frame_ns:
+            self.next_frame_ns += self.frame_period_ns
+            self._publish_frame()
+            if self.node.params["lockstep"]:
+                self._await(("vision/markers", "world/obstacles"))
+                return
+        self._publish_sensors()
+
+    def _publish_sensors(self) -> None:
+        self._publish_joints()
+        self._publish_odometry()
+        self._publish_truth()
+        if self.node.params["lockstep"]:
+            self._await(("base/command", "arm/command"))
+
+    def _await(self, names: tuple[str, ...]) -> None:
+        deadline = time.monotonic() + self.node.params["ack_timeout_s"]
+        self.awaited = Awaited(self.now_ns, names, deadline)
+
+    def _answer_handler(self, name: str):
+        def on_answer(message) -> None:
+            if name in ("base/command", "arm/command"):
+                self._take_command(name, message)
+            stamp = message.header.stamp_ns
+            self.answered[name] = max(self.answered.get(name, -1), stamp)
+            self._check_answered()
+
+        return on_answer
+
+    def _check_answered(self) -> None:
+        awaited = self.awaited
+        if awaited is None:
+            return
+        if all(self.answered.get(name, -1) >= awaited.stamp_ns for name in awaited.topics):
+            self._proceed()
+
+    def _proceed(self) -> None:
+        """The awaited answers are in (or overdue): go on with the step or the next one."""
+        awaited, self.awaited = self.awaited, None
+        if awaited is not None and "vision/markers" in awaited.topics:
+            self._publish_sensors()
+        self._kick()
+
+    def _check_overdue(self) -> None:
+        awaited = self.awaited
+        if awaited is not None and time.monotonic() > awaited.deadline:
+            missing = [n for n in awaited.topics if self.answered.get(n, -1) < awaited.stamp_ns]
+            self.node.count("lockstep_timeouts")
+            self.node.warn("lockstep_timeouts", f"no answer on {', '.join(missing)} for "
+                           f"t={awaited.stamp_ns / 1e9:.3f} s; going on")  # fmt: skip
+            self._proceed()
+        self._kick()  # also starts a run once ``paused`` is set false
+
+    # -- commands in, sensors out ---------------------------------------------------------
+
+    def _take_command(self, name: str, message: BaseCommand | ArmCommand) -> None:
+        if name == "base/command":
+            self.base_command = message
+        else:
+            self.arm_command = message
+        self.last_command_ns = self.now_ns
+
+    def _apply_commands(self) -> None:
+        timeout_ns = self.node.params["command_timeout_s"] * 1e9
+        if self.last_command_ns is None or self.now_ns - self.last_command_ns > timeout_ns:
+            self.world.stop()
+            return
+        base, arm = self.base_command, self.arm_command
+        left, right = (base.left_wheel, base.right_wheel) if base else (0.0, 0.0)
+        joints = arm.joint_velocities if arm else (0.0,) * ARM_JOINTS
+        self.world.command(left, right, joints)
+
+    def _header(self, frame: str, publisher: str):
+        return self.node.header(frame, self.now_ns, self.publishers[publisher].next_seq)
+
+    def _publish_joints(self) -> None:
+        q = self.world.q
+        self.publishers["arm/joint_states"].put(
+            JointStates(
+                header=self._header("arm", "arm/joint_states"),
+                names=JOINT_NAMES,
+                positions=tuple(q[3:].tolist()),
+                velocities=tuple(self.world.joint_velocities.tolist()),
+            )
+        )
+
+    def _publish_odometry(self) -> None:
+        counts = self.world.encoder_counts
+        d_left, d_right = ((c - c0) * self.metres_per_count
+                           for c, c0 in zip(counts, self.last_counts, strict=True))  # fmt: skip
+        self.last_counts = counts
+        self.odometry_pose = dead_reckoning(*self.odometry_pose, d_left, d_right,
+                                            self.robot.base.wheel_base)  # fmt: skip
+        left, right = self.world.wheel_speeds
+        x, y, phi = self.odometry_pose
+        self.publishers["base/odometry"].put(
+            BaseOdometry(
+                header=self._header("odom", "base/odometry"),
+                left_encoder=counts[0],
+                right_encoder=counts[1],
+                left_distance=counts[0] * self.metres_per_count,
+                right_distance=counts[1] * self.metres_per_count,
+                x=x,
+                y=y,
+                phi=phi,
+                forward_velocity=0.5 * (left + right),
+                angular_velocity=(right - left) / self.robot.base.wheel_base,
+            )
+        )
+
+    def _publish_truth(self) -> None:
+        q = self.world.q
+        self.node.counters["contacts"] = self.world.contacts
+        self.publishers["sim/truth"].put(
+            SimTruth(
+                header=self._header("world", "sim/truth"),
+                base_pose=tuple(q[:3].tolist()),
+                arm_joints=tuple(q[3:].tolist()),
+                end_effector=tuple(self.world.end_effector.tolist()),
+                contacts=self.world.contacts,
+                in_contact=self.world.in_contact,
+            )
+        )
+
+    # -- the camera -----------------------------------------------------------------------
+
+    def _camera(self) -> PinholeCamera | None:
+        if not self.node.params["camera"]:
+            return None
+        c = self.scene.camera
+        return PinholeCamera(ceiling_pose(*c.position), width=c.width, height=c.height,
+                             fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy)  # fmt: skip
+
+    def placed_markers(self) -> list[PlacedMarker]:
+        """Every marker visible now, where it is in the world."""
+        scene, q = self.scene, self.world.q
+        reference = planar_pose(*scene.reference_pose, scene.reference.height_m)
+        markers = [PlacedMarker(scene.reference.id, scene.reference.size_m, reference)]
+        if not self._base_marker_hidden():
+            ox, oy = scene.base.offset
+            c, s = math.cos(q[2]), math.sin(q[2])
+            x, y = q[0] + c * ox - s * oy, q[1] + s * ox + c * oy
+            pose = planar_pose(x, y, q[2], scene.base.height_m)
+            markers.append(PlacedMarker(scene.base.id, scene.base.size_m, pose))
+        gx, gy, gyaw = floats(self.node.params["goal_marker"], "goal_marker", 1, 3)[0]
+        goal_pose = planar_pose(gx, gy, gyaw, scene.goal.height_m)
+        markers.append(PlacedMarker(scene.goal.id, scene.goal.size_m, goal_pose))
+        for marker_id, circle in zip(scene.obstacles.ids, self.obstacles, strict=False):
+            pose = planar_pose(circle.x, circle.y, 0.0, scene.obstacles.height_m)
+            markers.append(PlacedMarker(marker_id, scene.obstacles.size_m, pose))
+        return markers
+
+    def _base_marker_hidden(self) -> bool:
+        windows = floats(self.node.params["hide_base_marker"], "hide_base_marker", None, 2)
+        t = self.now_ns / 1e9
+        return any(start <= t < end for start, end in windows)
+
+    def _publish_frame(self) -> None:
+        camera, scene, q = self.camera, self.scene, self.world.q
+        base_top = scene.base.height_m
+        discs = [(q[0], q[1], base_top, self.robot.base.body_radius, 70)]
+        discs += [(o.x, o.y, scene.obstacles.height_m, o.radius, 200) for o in self.obstacles]
+        noise = ImageNoise(self.node.params["image_noise"], self.node.params["image_blur_px"])
+        image = render(camera, self.placed_markers(), scene.dictionary_id, noise, self.rng, discs)
+        c = scene.camera
+        self.publishers["camera/image"].put(
+            CameraFrame(
+                header=self._header("camera", "camera/image"),
+                encoding="mono8",
+                width=c.width,
+                height=c.height,
+                data=image.tobytes(),
+                intrinsics=CameraIntrinsics(fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy),
+            )
+        )
+
+
+if __name__ == "__main__":
+    run_component(Simulator)

@@ -1,0 +1,157 @@
+"""The vision tracker: ArUco markers in each camera frame, a pose per marker (section 6.1.1).
+
+Input: ``camera/image`` (the simulator's, or a camera component's), or with ``device`` set a
+``cv2.VideoCapture`` (a device index such as ``0``, a URL or a video file) read at the
+scene's camera rate, with the intrinsics of the ``calibration`` YAML file (``fx fy cx cy``
+and optional ``distortion``).
+
+Output: ``vision/markers``, every scene marker found, its pose in the camera frame and the
+fit's reprojection error, stamped with the frame's stamp (an empty list when none is found:
+``frames_without_markers`` counts them). Corners are refined to sub-pixel. The reference
+marker F0 is fitted by the square-marker method (``solvePnP`` IPPE) and low-pass filtered
+(eq. 6.1): it gives the floor plane. Every other marker lies flat at a known height above
+that floor, so its pose comes from the plane instead: the ray through its centre meets the
+plane, the yaw comes from its edges. Before F0 is seen, every marker gets the square fit.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from components.params import Param, ParamError
+from components.process_entry import run_component
+from components.pubsub import Input
+from components.runtime import Component, Node
+from messages import topics
+from messages.camera import CameraFrame
+from messages.markers import MarkerDetection, MarkerDetections
+from profiles.scene import Scene
+from vision.markers import Intrinsics, MarkerDetector, plane_of, plane_pose, square_pose
+from wbc.pose_filter import PoseFilter
+
+
+class VisionTracker(Component):
+    """camera/image (or a capture device) in, vision/markers out."""
+
+    reads = (Input(topics.CAMERA_IMAGE),)
+    writes = (topics.VISION_MARKERS,)
+    params = (
+        Param("device", str, "", doc="cv2.VideoCapture source; empty: the camera/image topic"),
+        Param("calibration", str, "", doc="intrinsics YAML of the capture device"),
+        Param("reference_samples", int, 100, low=1, high=100000,
+              doc="eq. 6.1 samples of the floor reference F0"),
+        Param("plane_fit", bool, True, doc="fit markers on their known plane (else IPPE only)"),
+    )  # fmt: skip
+
+    def __init__(self, node: Node) -> None:
+        super().__init__(node)
+        if node.profile.scene is None:
+            raise ParamError("the vision tracker needs the profile's `scene` (markers)")
+        self.scene: Scene = node.profile.scene
+        self.markers = self.scene.markers()
+        self.detector = MarkerDetector(self.scene.dictionary_id)
+        self.reference = PoseFilter(node.params["reference_samples"])
+        self.output = node.publisher(topics.VISION_MARKERS)
+        node.counters["frames"] = 0
+        node.counters["frames_without_markers"] = 0
+        node.counters["unknown_markers"] = 0
+        self.capture = None
+        if node.params["device"]:
+            self.capture, self.intrinsics = self._open_device()
+            node.timer(1.0 / self.scene.camera.rate_hz, self._read_device)
+        else:
+            node.subscribe(topics.CAMERA_IMAGE, self.on_frame)
+
+    def on_frame(self, frame: CameraFrame) -> None:
+        """One image from the topic: detect, fit, publish."""
+        channels = len(frame.data) // (frame.width * frame.height)
+        image = np.frombuffer(frame.data, np.uint8).reshape(frame.height, frame.width, channels)
+        if channels == 3:
+            image = image.mean(axis=2).astype(np.uint8)
+        i = frame.intrinsics
+        intrinsics = Intrinsics(i.fx, i.fy, i.cx, i.cy, tuple(i.distortion))
+        self.track(image.reshape(frame.height, frame.width), intrinsics, frame.header.stamp_ns)
+
+    def track(self, image: np.ndarray, intrinsics: Intrinsics, stamp_ns: int) -> None:
+        """Publish the markers of ``image`` with the stamp of the frame."""
+        self.node.count("frames")
+        found = []
+        detections = {d.id: d for d in self.detector.detect(image)}
+        reference = detections.get(self.scene.reference.id)
+        reference_pose = None
+        if reference is not None:
+            pose, error = square_pose(reference, self.scene.reference.size_m, intrinsics)
+            reference_pose = self.reference.update(pose)
+            found.append((reference.id, pose, error))
+        elif self.reference.pose is not None:
+            reference_pose = self.reference.pose
+        for marker_id, detection in detections.items():
+            marker = self.markers.get(marker_id)
+            if marker is None:
+                self.node.count("unknown_markers")
+                continue
+            if marker_id == self.scene.reference.id:
+                continue
+            if reference_pose is not None and self.node.params["plane_fit"]:
+                height = marker.height_m - self.scene.reference.height_m
+                normal, offset = plane_of(reference_pose, height)
+                pose, error = plane_pose(detection, marker.size_m, intrinsics, normal, offset)
+            else:
+                pose, error = square_pose(detection, marker.size_m, intrinsics)
+            found.append((marker_id, pose, error))
+        if not found:
+            self.node.count("frames_without_markers")
+        self.output.put(
+            MarkerDetections(
+                header=self.node.header("camera", stamp_ns, self.output.next_seq),
+                markers=tuple(
+                    MarkerDetection(id=i, pose=tuple(p.tolist()), reprojection_error=float(e))
+                    for i, p, e in sorted(found, key=lambda item: item[0])
+                ),
+            )
+        )
+
+    # -- a real camera ---------------------------------------------------------------------
+
+    def _open_device(self):
+        import cv2
+
+        source = str(self.node.params["device"])
+        capture = cv2.VideoCapture(int(source) if source.isdigit() else source)
+        if not capture.isOpened():
+            raise ParamError(f"device: cannot open {source!r}")
+        return capture, load_calibration(Path(str(self.node.params["calibration"])))
+
+    def _read_device(self) -> None:
+        import cv2
+
+        ok, image = self.capture.read()
+        if not ok:
+            self.node.count("capture_failures")
+            self.node.warn("capture_failures", f"no frame from {self.node.params['device']}")
+            return
+        if image.ndim == 3:
+            image = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
+        self.track(image, self.intrinsics, self.node.clock.now_ns())
+
+    def shutdown(self) -> None:
+        if self.capture is not None:
+            self.capture.release()
+
+
+def load_calibration(path: Path) -> Intrinsics:
+    """``fx fy cx cy`` (px) and optional ``distortion`` from a YAML file, or ``ParamError``."""
+    try:
+        data = yaml.safe_load(path.read_text())
+        distortion = tuple(float(v) for v in data.get("distortion", ()))
+        return Intrinsics(float(data["fx"]), float(data["fy"]), float(data["cx"]),
+                          float(data["cy"]), distortion)  # fmt: skip
+    except (OSError, yaml.YAMLError, KeyError, TypeError, ValueError, AttributeError) as error:
+        raise ParamError(f"calibration: cannot read intrinsics from {path}: {error}") from error
+
+
+if __name__ == "__main__":
+    run_component(VisionTracker)

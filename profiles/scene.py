@@ -1,0 +1,116 @@
+"""The fiducial markers of a workspace and the ceiling camera that watches them (section 6.1.1).
+
+Declared once in a profile's ``scene`` section and read by every component that needs them:
+the simulator draws them, the vision tracker measures them, the state estimator gives them
+their roles::
+
+    F0  reference   fixed on the floor; the world frame of every estimate (eq. 6.2)
+    F1  base        on the base's top plate, at ``offset`` (x, y) in the base frame
+    F2  goal        the trash bin; the goal is x_d = x_2^0 x_d^2 (eq. 6.3), x_d^2 = ``goal.offset``
+    F3  obstacles   one marker on top of each obstacle, a circle of ``radius`` around it
+
+Every marker lies flat, its face up, ``height`` metres above the floor (the plane the tracker
+intersects its ray with). Sizes are the black square's side, m.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Marker(_Strict):
+    """One marker: its ArUco ``id``, side ``size_m`` and the height of its face, m."""
+
+    id: int = Field(ge=0)
+    size_m: Positive
+    height_m: NonNegative = 0.0
+
+
+class BaseMarker(Marker):
+    """F1: ``offset`` is the marker centre in the base frame, m (its x axis along the base's)."""
+
+    offset: tuple[Finite, Finite] = (0.0, 0.0)
+
+
+class GoalMarker(Marker):
+    """F2: ``offset`` is x_d^2 of eq. 6.3 as (x, y, z, yaw, pitch, roll), m and rad, in F2."""
+
+    offset: tuple[Finite, Finite, Finite, Finite, Finite, Finite] = (0.0,) * 6
+
+
+class ObstacleMarkers(_Strict):
+    """F3: the ids of the obstacle markers, their size and height, and each obstacle's radius."""
+
+    ids: tuple[int, ...] = ()
+    size_m: Positive = 0.15
+    height_m: NonNegative = 0.0
+    radius_m: Positive = 0.1
+
+    def marker(self, marker_id: int) -> Marker:
+        return Marker(id=marker_id, size_m=self.size_m, height_m=self.height_m)
+
+
+class Camera(_Strict):
+    """The ceiling camera: pinhole intrinsics (px) and frame rate. ``position`` (x, y, height)
+    places the simulated one above the world; a real one is found through F0."""
+
+    width: int = Field(default=640, gt=0)
+    height: int = Field(default=480, gt=0)
+    fx: Positive = 600.0
+    fy: Positive = 600.0
+    cx: Finite = 319.5
+    cy: Finite = 239.5
+    rate_hz: Positive = 30.0
+    position: tuple[Finite, Finite, Positive] = (0.6, 0.15, 2.5)
+
+
+class Scene(_Strict):
+    """The markers and the camera of one workspace (see the module docstring)."""
+
+    dictionary: str = "DICT_4X4_50"
+    camera: Camera = Camera()
+    reference: Marker
+    reference_pose: tuple[Finite, Finite, Finite] = (0.0, 0.0, 0.0)
+    """Where the simulator puts F0 on its floor: (x, y, yaw) in its own world frame."""
+    base: BaseMarker
+    goal: GoalMarker
+    obstacles: ObstacleMarkers = ObstacleMarkers()
+
+    @field_validator("dictionary")
+    @classmethod
+    def _known_dictionary(cls, name: str) -> str:
+        import cv2  # only profiles with a scene pay for it
+
+        if not name.startswith("DICT_") or not hasattr(cv2.aruco, name):
+            raise ValueError(f"not an OpenCV ArUco dictionary: {name!r} (e.g. 'DICT_4X4_50')")
+        return name
+
+    @model_validator(mode="after")
+    def _ids_unique(self) -> Scene:
+        ids = [self.reference.id, self.base.id, self.goal.id, *self.obstacles.ids]
+        for marker_id in ids:
+            if ids.count(marker_id) > 1:
+                raise ValueError(f"obstacles.ids: marker id {marker_id} is used twice")
+        return self
+
+    @property
+    def dictionary_id(self) -> int:
+        """The OpenCV predefined dictionary id."""
+        import cv2
+
+        return int(getattr(cv2.aruco, self.dictionary))
+
+    def markers(self) -> dict[int, Marker]:
+        """Every marker of the scene by id."""
+        obstacles = (self.obstacles.marker(i) for i in self.obstacles.ids)
+        return {m.id: m for m in (self.reference, self.base, self.goal, *obstacles)}

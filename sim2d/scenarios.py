@@ -1,0 +1,70 @@
+"""The simulated set-ups of the chapter 6 experiments: where the robot starts, where the trash
+bin (marker F2) stands and where the obstacles are, in the simulator's world frame.
+
+The dissertation's set-up (``seed`` None) starts at ``wbc.scenarios.HOME``. The bin stands
+under the pose of ``REACH_GOAL`` (pose and position experiments, 6.2.1 and 6.2.2), or
+``OBSTACLE_SHIFT`` further, past ``wbc.scenarios.OBSTACLE`` (6.2.3); the goal is then
+x_d = x_2 x_d^2 with the scene's offset x_d^2 (eq. 6.3). A seed draws the start and the bin
+from ``START_RANGE`` and ``BIN_RANGE`` around them: the goal stays a pose the arm reaches
+above some base pose (the bin only moves and turns on the floor), inside the joint limits.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from wbc.obstacles import Circle
+from wbc.planar import planar_of
+from wbc.robot import MobileManipulator
+from wbc.scenarios import HOME, OBSTACLE, REACH_GOAL
+
+NAMES = ("pose", "position", "obstacle")
+"""The experiments of section 6.2."""
+
+OBSTACLE_SHIFT = (0.75, 0.25)
+"""Where the obstacle experiment's bin stands from the pose experiment's, m: past the obstacle."""
+
+START_RANGE = np.array([0.05, 0.05, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1])
+"""A seeded start is HOME + U(-range, range), per coordinate (m, m, rad, rad...)."""
+
+BIN_RANGE = np.array([0.1, 0.1, 0.2])
+"""A seeded bin is the set-up's + U(-range, range) in (x, y, yaw) (m, m, rad)."""
+
+
+@dataclass(frozen=True)
+class SimScenario:
+    """One experiment's set-up: the task, the start q, the bin (x, y, yaw) and obstacles."""
+
+    name: str
+    task: str
+    start: tuple[float, ...]
+    bin: tuple[float, float, float]
+    obstacles: tuple[Circle, ...]
+
+    def sim_params(self) -> dict[str, str]:
+        """The simulator's parameters that place this set-up."""
+        return {
+            "start": ", ".join(f"{v:.6f}" for v in self.start),
+            "goal_marker": ", ".join(f"{v:.6f}" for v in self.bin),
+            "obstacles": "; ".join(f"{c.x}, {c.y}, {c.radius}" for c in self.obstacles),
+        }
+
+
+def scenario(name: str, robot: MobileManipulator, seed: int | None = None) -> SimScenario:
+    """The set-up of experiment ``name`` (one of ``NAMES``); a ``seed`` draws a variant."""
+    if name not in NAMES:
+        raise ValueError(f"no experiment {name!r}; choose one of {', '.join(NAMES)}")
+    x, y, yaw = planar_of(robot.fkm(REACH_GOAL))
+    obstacles: tuple[Circle, ...] = ()
+    if name == "obstacle":
+        x, y = x + OBSTACLE_SHIFT[0], y + OBSTACLE_SHIFT[1]
+        obstacles = (OBSTACLE,)
+    start, bin_pose = HOME.copy(), np.array([x, y, yaw])
+    if seed is not None:
+        rng = np.random.default_rng(seed)
+        start = start + rng.uniform(-START_RANGE, START_RANGE)
+        bin_pose = bin_pose + rng.uniform(-BIN_RANGE, BIN_RANGE)
+    task = "position" if name == "position" else "pose"
+    return SimScenario(name, task, tuple(start.tolist()), tuple(bin_pose.tolist()), obstacles)

@@ -1,0 +1,40 @@
+"""Poses in the floor plane as unit dual quaternions, and back.
+
+A planar pose (x, y, phi) at height z is x = r + eps (1/2) p r with r = cos(phi/2) + k sin(phi/2)
+and p = x i + y j + z k (3.15). Going back keeps the yaw of r's rotation of the x axis, so a
+pose slightly tilted out of the plane (a measured one) still gives its heading.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from wbc import dq
+
+
+def planar_pose(x: float, y: float, phi: float, z: float = 0.0) -> np.ndarray:
+    """The unit dual quaternion of a rotation phi about z and a translation (x, y, z)."""
+    return dq.pose(dq.rotation_quaternion(phi, dq.K_[1:]), np.array([x, y, z]))
+
+
+def planar_of(pose: np.ndarray) -> tuple[float, float, float]:
+    """(x, y, phi) of a pose: its translation's x and y, and the heading atan2 of the rotated
+    x axis r i r* projected on the plane."""
+    p = dq.translation(pose)
+    r = dq.rotation(pose)
+    axis = dq.qmul(dq.qmul(r, dq.I_), dq.qconj(r))
+    return float(p[1]), float(p[2]), math.atan2(axis[2], axis[1])
+
+
+def height_of(pose: np.ndarray) -> float:
+    """The z of a pose's translation."""
+    return float(dq.translation(pose)[3])
+
+
+def tilt_of(pose: np.ndarray) -> float:
+    """The angle between a pose's z axis and the vertical, rad."""
+    r = dq.rotation(pose)
+    axis = dq.qmul(dq.qmul(r, dq.K_), dq.qconj(r))
+    return math.acos(max(-1.0, min(1.0, float(axis[3]))))
