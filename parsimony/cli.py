@@ -8,7 +8,7 @@ import sys
 
 from parsimony.output import result_only_stdout
 
-COMMANDS = ("demo", "bench", "launch", "status", "param", "node", "topic", "graph", "schema")
+COMMANDS = ("demo", "experiment", "bench", "launch", "status", "param", "node", "topic", "graph", "schema")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -28,6 +28,13 @@ BORDER_PARAMS = LPParams(obstacle_mode="border", base_target=0.0)
 """The border-following law of 6.2.3 without the base target term, whose straight-line
 heading towards where the base should stand fights the detour round the obstacle."""
 
+LP_PARAMS = {
+    "pose": LPParams(eta=0.6, beta=15.0),
+    "position": LPParams(eta=1.0, beta=10.0),
+    "obstacle": BORDER_PARAMS,
+}
+"""The LP law's gains in each experiment of section 6.2 (6.2.1 gives eta 0.6 and beta 15)."""
+
 
 @dataclass(frozen=True)
 class Experiment:
@@ -46,18 +53,18 @@ def experiments(robot: MobileManipulator) -> list[Experiment]:
         Experiment(
             "pose",
             PoseTask(reach),
-            {"LP": LPLaw(robot, LPParams(eta=0.6, beta=15.0)), "cascade": CascadeLaw(robot)},
+            {"LP": LPLaw(robot, LP_PARAMS["pose"]), "cascade": CascadeLaw(robot)},
         ),
         Experiment(
             "position",
             PositionTask(dq.translation(reach)[1:]),
-            {"LP": LPLaw(robot, LPParams(eta=1.0, beta=10.0)), "cascade": CascadeLaw(robot)},
+            {"LP": LPLaw(robot, LP_PARAMS["position"]), "cascade": CascadeLaw(robot)},
         ),
         Experiment(
             "obstacle",
             PoseTask(beyond_obstacle),
             {
-                "LP border": LPLaw(robot, BORDER_PARAMS),
+                "LP border": LPLaw(robot, LP_PARAMS["obstacle"]),
                 "LP conservative": LPLaw(robot, LPParams(obstacle_mode="conservative")),
             },
             (OBSTACLE,),

@@ -1,0 +1,72 @@
+"""`parsimony experiment`: a chapter 6 experiment on the whole simulated loop (see
+parsimony.experiment)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from deploy.query import QueryError
+from parsimony.experiment import PROFILES, TIME_LIMIT_S, Options, dumps, run_experiment
+from parsimony.output import emit
+from profiles.profile import ProfileError
+from sim2d.scenarios import NAMES
+
+EXIT_NOT_CONVERGED = 1
+EXIT_USAGE = 2
+
+
+def seconds_window(text: str) -> tuple[float, float]:
+    """``FROM,TO`` in simulated seconds, FROM < TO."""
+    try:
+        start, end = (float(v) for v in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected FROM,TO in seconds, got {text!r}") from None
+    if not 0.0 <= start < end:
+        raise argparse.ArgumentTypeError(f"expected 0 <= FROM < TO, got {text!r}")
+    return start, end
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    parser = subparsers.add_parser(
+        "experiment",
+        help="run a chapter 6 experiment on the simulated loop and write its report",
+        description="Launch the simulation profile headless with the experiment's set-up, "
+        "run until the goal is reached or the time limit passes, write OUT/report.json. "
+        "Exits 0 when it converged, 1 when not, 2 on a usage or configuration error.",
+    )
+    parser.add_argument("name", choices=NAMES, help="the experiment of section 6.2")
+    parser.add_argument("--controller", choices=tuple(PROFILES), default="lp")
+    parser.add_argument("--out", type=Path, required=True, help="directory of the report")
+    parser.add_argument("--seed", type=int, help="draw the start and the bin from the ranges")
+    parser.add_argument("--profile", type=Path, help="simulation profile to extend")
+    parser.add_argument("--realtime", action="store_true",
+                        help="run at the wall clock's pace instead of in lockstep")  # fmt: skip
+    parser.add_argument("--time-limit", type=float, default=TIME_LIMIT_S, metavar="S",
+                        help="simulated seconds before giving up")  # fmt: skip
+    parser.add_argument("--hide-base-marker", type=seconds_window, metavar="FROM,TO",
+                        help="hide the base marker from the camera in this window (sim s)")  # fmt: skip
+    parser.add_argument("--json", action="store_true", help="print the report as JSON")
+    return parser
+
+
+def run(args: argparse.Namespace) -> int:
+    options = Options(
+        name=args.name, controller=args.controller, out=args.out, seed=args.seed,
+        profile=args.profile, realtime=args.realtime, time_limit_s=args.time_limit,
+        hide_base_marker=args.hide_base_marker,
+    )  # fmt: skip
+    try:
+        report = run_experiment(options)
+    except (ProfileError, OSError, QueryError, RuntimeError) as error:
+        print(f"experiment: {error}", file=sys.stderr)
+        return EXIT_USAGE
+    if args.json:
+        emit(dumps(report))
+    else:
+        summary = {k: report[k] for k in ("converged", "final_error", "sim_time_s",
+                                          "wall_time_s", "real_time_factor", "contacts")}  # fmt: skip
+        emit(" ".join(f"{k}={v}" for k, v in summary.items()))
+    print(f"[experiment] report: {args.out / 'report.json'}", file=sys.stderr)
+    return 0 if report["converged"] else EXIT_NOT_CONVERGED

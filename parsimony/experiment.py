@@ -1,0 +1,382 @@
+"""`parsimony experiment`: one chapter 6 experiment on the whole simulated loop.
+
+It writes a profile that extends the simulation profile with the experiment's set-up
+(``sim2d.scenarios``), the law and its gains, launches it (``parsimony launch``, its logs in
+``DIR/launch.log``), unpauses the simulator once every component is alive, follows the run
+on Zenoh, stops when the controller's error has stayed under ``CONVERGED_ERROR`` for
+``HOLD_S`` of simulated time or the time limit passes, and writes ``DIR/report.json``.
+
+By default the simulator runs in lockstep as fast as the loop answers; ``realtime`` runs it
+at the wall clock's pace instead, as ``make demo`` does.
+
+The report judges the run against the simulator's ground truth, which no component of the
+loop reads: the true end-effector error, the estimator's error in steady state (the last
+``HOLD_S`` s), contacts, joints at their hard stops, obstacle clearance, and the control
+effort of table 6.1 of the commands sent.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+import zenoh
+
+from deploy import query
+from messages import codec, topics
+from parsimony.kinematic_demo import LP_PARAMS
+from profiles.profile import Profile, load_profile
+from sim2d.scenarios import SimScenario, scenario
+from wbc import dq
+from wbc.kinematic_run import effort_of
+from wbc.lp_law import LPParams
+from wbc.planar import planar_pose
+from wbc.robot import MobileManipulator
+
+DEPLOY = Path(__file__).resolve().parents[1] / "deploy"
+PROFILES = {"lp": DEPLOY / "sim.yaml", "cascade": DEPLOY / "sim_cascade.yaml"}
+"""The profile each controller runs in unless ``--profile`` names another."""
+MODULES = {"lp": "lp_controller", "cascade": "cascade_controller"}
+
+CONVERGED_ERROR = 0.01
+"""The controller's error norm ||e|| under which the goal counts as reached."""
+HOLD_S = 2.0
+"""Simulated seconds the error must stay under ``CONVERGED_ERROR``; also the steady state."""
+TIME_LIMIT_S = 60.0
+"""Simulated seconds after which a run that has not converged stops."""
+STARTUP_S = 60.0
+"""Host seconds the components may take to come up."""
+LISTENED = ("sim/truth", "robot/state", "control/diagnostics", "base/command", "arm/command")
+
+
+@dataclass(frozen=True)
+class Options:
+    name: str
+    controller: str = "lp"
+    out: Path = Path("runs/experiment")
+    seed: int | None = None
+    profile: Path | None = None
+    realtime: bool = False
+    time_limit_s: float = TIME_LIMIT_S
+    hide_base_marker: tuple[float, float] | None = None
+
+
+def free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def law_overrides(options: Options) -> dict[str, Any]:
+    """The LP gains of the experiment that differ from the law's defaults (the cascade's
+    defaults are the dissertation's)."""
+    if options.controller != "lp":
+        return {}
+    wanted, default = LP_PARAMS[options.name], LPParams()
+    return {
+        f.name: getattr(wanted, f.name)
+        for f in dataclasses.fields(LPParams)
+        if getattr(wanted, f.name) != getattr(default, f.name)
+    }
+
+
+def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict[str, Any]:
+    """A profile extending ``base`` with the set-up, the law, lockstep or real time, its own
+    namespace and router port (so it never meets another running system)."""
+    simulator: dict[str, Any] = {**setup.sim_params(), "paused": True, "seed": options.seed or 0}
+    simulator |= {"lockstep": not options.realtime,
+                  "real_time_factor": 1.0 if options.realtime else 0.0}  # fmt: skip
+    if options.hide_base_marker is not None:
+        simulator["hide_base_marker"] = ", ".join(str(v) for v in options.hide_base_marker)
+    controller = {"module": MODULES[options.controller], "params": law_overrides(options)}
+    return {
+        "extends": str(base.resolve()),
+        "namespace": f"experiment{os.getpid()}",
+        "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
+        "components": [
+            {"name": "simulator", "params": simulator},
+            {"name": "state_estimator", "params": {"task": setup.task}},
+            {"name": "controller", **controller},
+        ],
+    }
+
+
+class Recorder:
+    """Every message of ``LISTENED`` in the namespace, decoded, in arrival order."""
+
+    def __init__(self, session: zenoh.Session, namespace: str) -> None:
+        self.messages: dict[str, list] = {name: [] for name in LISTENED}
+        self._lock = threading.Lock()
+        self._subscribers = [
+            session.declare_subscriber(topics.TOPICS[name].key(namespace), self._taker(name))
+            for name in LISTENED
+        ]
+
+    def _taker(self, name: str):
+        topic = topics.TOPICS[name]
+
+        def take(sample: zenoh.Sample) -> None:
+            message = codec.decode(sample.payload.to_bytes(), topic.type)
+            with self._lock:
+                self.messages[name].append(message)
+
+        return take
+
+    def snapshot(self) -> dict[str, list]:
+        with self._lock:
+            return {name: list(values) for name, values in self.messages.items()}
+
+
+def converged_at(diagnostics: list) -> float | None:
+    """The simulated time since which every step's error stayed under ``CONVERGED_ERROR``."""
+    since = None
+    for d in diagnostics:
+        small = d.status == "optimal" and d.error_norm is not None
+        small = small and d.error_norm < CONVERGED_ERROR
+        if not small:
+            since = None
+        elif since is None:
+            since = d.header.stamp_ns / 1e9
+    return since
+
+
+def progress_line(messages: dict[str, list], wall_s: float) -> str:
+    diagnostics = messages["control/diagnostics"]
+    if not diagnostics:
+        return f"[experiment] wall {wall_s:5.1f} s  waiting for the first control step"
+    d = diagnostics[-1]
+    t = d.header.stamp_ns / 1e9
+    error = "-" if d.error_norm is None else f"{d.error_norm:.4f}"
+    return (f"[experiment] sim {t:6.2f} s  wall {wall_s:5.1f} s  error {error}  "
+            f"nonzero {d.nonzero}  {d.status}")  # fmt: skip
+
+
+def run_experiment(options: Options) -> dict[str, Any]:
+    """Run one experiment; return its report (also written to ``out/report.json``)."""
+    base = options.profile or PROFILES[options.controller]
+    base_profile = load_profile(base)
+    robot = MobileManipulator.from_yaml(base_profile.robot)
+    setup = scenario(options.name, robot, options.seed)
+    options.out.mkdir(parents=True, exist_ok=True)
+    profile_path = options.out / "profile.yaml"
+    profile_path.write_text(yaml.safe_dump(experiment_profile(options, base, setup)))
+    profile = load_profile(profile_path)
+    log = (options.out / "launch.log").open("w")
+    launcher = subprocess.Popen(
+        [sys.executable, "-m", "parsimony.cli", "launch", str(profile_path)],
+        stdout=log, stderr=subprocess.STDOUT,
+    )  # fmt: skip
+    started = time.monotonic()
+    try:
+        with connect(profile, launcher) as session:
+            recorder = Recorder(session, profile.namespace)
+            wait_alive(session, profile, launcher)
+            query.set_param(session, profile.namespace, "simulator", "paused", "false")
+            started = time.monotonic()
+            messages = follow(recorder, options, started)
+            counters = simulator_counters(session, profile.namespace)
+    finally:
+        launcher.send_signal(signal.SIGINT)
+        try:
+            launcher.wait(20)
+        except subprocess.TimeoutExpired:
+            launcher.kill()
+            launcher.wait()
+        log.close()
+    wall_s = time.monotonic() - started
+    report = build_report(options, setup, profile, robot, messages, wall_s, counters)
+    (options.out / "report.json").write_text(dumps(report))
+    return report
+
+
+def connect(profile: Profile, launcher: subprocess.Popen) -> zenoh.Session:
+    """A client session to the launch's router, once the router listens."""
+    deadline = time.monotonic() + STARTUP_S
+    while True:
+        try:
+            return query.Target(profile.namespace, profile.zenoh).open()
+        except query.QueryError:
+            if launcher.poll() is not None or time.monotonic() > deadline:
+                raise
+            time.sleep(0.2)  # the launcher opens its router first thing
+
+
+def wait_alive(session: zenoh.Session, profile: Profile, launcher: subprocess.Popen) -> None:
+    wanted = {spec.name for spec in profile.components if spec.enabled}
+    deadline = time.monotonic() + STARTUP_S
+    while not wanted <= set(query.live_components(session, profile.namespace, 0.5)):
+        if launcher.poll() is not None:
+            raise RuntimeError(f"the launch stopped (exit {launcher.returncode}); see its log")
+        if time.monotonic() > deadline:
+            raise RuntimeError(f"the components did not all come up in {STARTUP_S:.0f} s")
+        time.sleep(0.2)  # polling the router for liveliness tokens
+
+
+def follow(recorder: Recorder, options: Options, started: float) -> dict[str, list]:
+    """Print progress until the run converges or its time is up; return what was received."""
+    last_print = 0.0
+    wall_limit = max(120.0, options.time_limit_s * (3.0 if options.realtime else 10.0))
+    while True:
+        time.sleep(0.2)  # progress is sampled, the data itself is all kept by the recorder
+        messages = recorder.snapshot()
+        wall = time.monotonic() - started
+        if wall - last_print >= 1.0:
+            print(progress_line(messages, wall), file=sys.stderr, flush=True)
+            last_print = wall
+        diagnostics = messages["control/diagnostics"]
+        sim_s = diagnostics[-1].header.stamp_ns / 1e9 if diagnostics else 0.0
+        since = converged_at(diagnostics)
+        if since is not None and sim_s - since >= HOLD_S:
+            return messages
+        if sim_s >= options.time_limit_s or wall > wall_limit:
+            return messages
+
+
+def simulator_counters(session: zenoh.Session, namespace: str) -> dict[str, int]:
+    status = query.statuses(session, namespace).get("simulator")
+    return dict(status.counters) if status is not None else {}
+
+
+def true_goal(setup: SimScenario, profile: Profile) -> np.ndarray:
+    """x_d in the simulator's world: the bin marker's pose times the scene's offset (eq. 6.3)."""
+    from components.state_estimator import goal_offset
+
+    scene = profile.scene
+    bin_pose = planar_pose(*setup.bin[:2], setup.bin[2], scene.goal.height_m)
+    return dq.normalize(dq.mul(bin_pose, goal_offset(scene.goal.offset)))
+
+
+def to_reference(pose: tuple[float, float, float], reference: tuple[float, ...]):
+    """A world (x, y, phi) in the frame of F0 placed at ``reference`` (x0, y0, yaw0)."""
+    x0, y0, yaw0 = reference
+    c, s = math.cos(yaw0), math.sin(yaw0)
+    dx, dy = pose[0] - x0, pose[1] - y0
+    return c * dx + s * dy, -s * dx + c * dy, pose[2] - yaw0
+
+
+def wrap(angle: float) -> float:
+    return math.atan2(math.sin(angle), math.cos(angle))
+
+
+def build_report(
+    options: Options, setup: SimScenario, profile: Profile, robot: MobileManipulator,
+    messages: dict[str, list], wall_s: float, counters: dict[str, int],
+) -> dict[str, Any]:  # fmt: skip
+    truth, states = messages["sim/truth"], messages["robot/state"]
+    diagnostics = messages["control/diagnostics"]
+    sim_s = truth[-1].header.stamp_ns / 1e9 if truth else 0.0
+    since = converged_at(diagnostics)
+    end_s = diagnostics[-1].header.stamp_ns / 1e9 if diagnostics else 0.0
+    converged = since is not None and end_s - since >= HOLD_S
+    goal = true_goal(setup, profile)
+    final_error = None
+    if truth:
+        x = np.array(truth[-1].end_effector)
+        if setup.task == "pose":
+            final_error = float(np.linalg.norm(x - dq.nearest_equivalent(goal, x)))
+        else:
+            final_error = float(np.linalg.norm(dq.translation(x) - dq.translation(goal)))
+    steps = [d for d in diagnostics if d.status == "optimal"]
+    solve = np.array([d.solve_time_us for d in steps]) if steps else np.zeros(1)
+    return {
+        "experiment": options.name,
+        "controller": options.controller,
+        "seed": options.seed,
+        "mode": "realtime" if options.realtime else "lockstep",
+        "converged": converged,
+        "final_error": final_error,
+        "final_error_estimated": diagnostics[-1].error_norm if diagnostics else None,
+        "sim_time_s": round(sim_s, 3),
+        "wall_time_s": round(wall_s, 3),
+        "real_time_factor": round(sim_s / wall_s, 2) if wall_s > 0 else None,
+        "iterations": len(diagnostics),
+        "contacts": truth[-1].contacts if truth else 0,
+        "joint_limit_violations": joints_at_stops(truth, robot),
+        "min_obstacle_clearance_m": clearance(truth, setup, robot),
+        "estimator_error": estimator_error(truth, states, profile, end_s - HOLD_S),
+        "nonzero_entries": dict(sorted(Counter(d.nonzero for d in steps).items())),
+        "effort": effort(messages, truth),
+        "step_time_us": {"median": round(float(np.median(solve)), 1),
+                         "p99": round(float(np.percentile(solve, 99)), 1)},  # fmt: skip
+        "lockstep_timeouts": counters.get("lockstep_timeouts", 0),
+        "scenario": dataclasses.asdict(setup) | {"obstacles": setup.sim_params()["obstacles"]},
+    }
+
+
+def joints_at_stops(truth: list, robot: MobileManipulator) -> int:
+    """Ground-truth samples with an arm joint at (or past) its limit: the simulated servo's
+    hard stop. The LP's joint constraint (5.14) keeps them inside."""
+    if not truth:
+        return 0
+    arm = np.array([t.arm_joints for t in truth])
+    low, high = robot.q_min[3:], robot.q_max[3:]
+    return int(np.any((arm <= low + 1e-9) | (arm >= high - 1e-9), axis=1).sum())
+
+
+def clearance(truth: list, setup: SimScenario, robot: MobileManipulator) -> float | None:
+    """The least distance between the base's disc and an obstacle, m (None without obstacles)."""
+    if not truth or not setup.obstacles:
+        return None
+    base = np.array([t.base_pose[:2] for t in truth])
+    gaps = [np.hypot(base[:, 0] - o.x, base[:, 1] - o.y) - o.radius - robot.base.body_radius
+            for o in setup.obstacles]  # fmt: skip
+    return round(float(np.min(gaps)), 4)
+
+
+def estimator_error(truth: list, states: list, profile: Profile, since_s: float) -> dict:
+    """The largest base position and heading error of the estimate against the truth, both in
+    F0's frame, over the states stamped after ``since_s`` (the steady state)."""
+    by_stamp = {t.header.stamp_ns: t for t in truth}
+    position, angle = [], []
+    for state in states:
+        t = by_stamp.get(state.header.stamp_ns)
+        if t is None or not state.valid or state.header.stamp_ns / 1e9 < since_s:
+            continue
+        x, y, phi = to_reference(t.base_pose, profile.scene.reference_pose)
+        position.append(math.hypot(state.base_pose[0] - x, state.base_pose[1] - y))
+        angle.append(abs(wrap(state.base_pose[2] - phi)))
+    if not position:
+        return {"position_m": None, "angle_rad": None, "samples": 0}
+    return {"position_m": round(max(position), 5), "angle_rad": round(max(angle), 5),
+            "samples": len(position)}  # fmt: skip
+
+
+def effort(messages: dict[str, list], truth: list) -> dict[str, float]:
+    """Table 6.1's four metrics of the commanded u = [x', y', phi', q'] (x' = v cos phi,
+    y' = v sin phi with the true heading at the command's stamp)."""
+    heading = {t.header.stamp_ns: t.base_pose[2] for t in truth}
+    arm = {a.header.stamp_ns: a.joint_velocities for a in messages["arm/command"]}
+    rows, stamps = [], []
+    for b in messages["base/command"]:
+        stamp = b.header.stamp_ns
+        if stamp not in arm or stamp not in heading:
+            continue
+        phi = heading[stamp]
+        v, w = b.forward_velocity, b.angular_velocity
+        rows.append([v * math.cos(phi), v * math.sin(phi), w, *arm[stamp]])
+        stamps.append(stamp)
+    if len(rows) < 2:
+        return {f"metric{i}": 0.0 for i in range(1, 5)}
+    dt = float(np.median(np.diff(stamps))) / 1e9
+    e = effort_of(np.array(rows), dt)
+    values = (e.velocity_l1, e.velocity_l2, e.acceleration_l1, e.acceleration_l2)
+    return {f"metric{i}": round(v, 4) for i, v in enumerate(values, start=1)}
+
+
+def dumps(report: dict) -> str:
+    import json
+
+    return json.dumps(report, indent=2)
