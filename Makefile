@@ -16,8 +16,9 @@ $(STAMP): $(LOCK) pyproject.toml
 	$(VENV)/bin/python -m pip install --quiet --no-deps --no-build-isolation -e .
 	touch $(STAMP)
 
+# The pose experiment of section 6.2.1 on the whole simulated loop, in real time.
 demo: $(STAMP)
-	$(VENV)/bin/parsimony demo
+	$(VENV)/bin/parsimony experiment pose --controller lp --realtime --out runs/demo
 
 test: $(STAMP)
 	$(VENV)/bin/ruff check .

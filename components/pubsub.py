@@ -130,7 +130,11 @@ class Subscription(Generic[M]):
         for kind in ("received", "rejected", "errors"):
             node.counters[f"{kind}.{topic.name}"] = 0
         node.counters[self._dropped] = 0
-        self._subscriber = node.session.declare_subscriber(self._key, self._on_sample)
+        # indirect=False: called on the Zenoh thread that received the sample, so the samples of
+        # one publisher's session reach the handler in the order they were put, across topics
+        # (zenoh-python's default runs each subscriber's callback on a thread of its own).
+        on_sample = zenoh.handlers.Callback(self._on_sample, indirect=False)
+        self._subscriber = node.session.declare_subscriber(self._key, on_sample)
 
     def age_s(self) -> float:
         """Seconds on the component clock since ``latest`` arrived; ``inf`` before the first."""

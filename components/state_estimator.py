@@ -78,7 +78,7 @@ class StateEstimator(Component):
         Param("reference_samples", int, 100, low=1, high=100000, doc="eq. 6.1 samples of F0"),
         Param("static_samples", int, 30, low=1, high=100000,
               doc="eq. 6.1 samples of the goal and obstacle markers"),
-        Param("base_samples", int, 3, low=1, high=1000,
+        Param("base_samples", int, 20, low=1, high=1000,
               doc="a camera fix corrects the base by 1/base_samples"),
         Param("marker_timeout_s", float, 0.5, low=0.01, high=60.0,
               doc="the state is degraded when F1 has not been seen for this long, s"),
@@ -101,11 +101,12 @@ class StateEstimator(Component):
         self.odometry: tuple[float, float, float] | None = None
         self.odometry_ns: int | None = None
         self.joints: tuple[float, ...] | None = None
+        self.joints_ns = -1
         self.last_stamps: dict[str, int] = {}
         self.state = node.publisher(topics.ROBOT_STATE)
         self.goal = node.publisher(topics.CONTROL_GOAL)
         self.obstacles = node.publisher(topics.WORLD_OBSTACLES)
-        for name in ("base_fixes", "duplicates", "degraded_states"):
+        for name in ("base_fixes", "duplicates", "degraded_states", "joints_behind"):
             node.counters[name] = 0
         node.subscribe(topics.VISION_MARKERS, self.on_markers)
         node.subscribe(topics.BASE_ODOMETRY, self.on_odometry)
@@ -193,12 +194,15 @@ class StateEstimator(Component):
         if len(message.positions) != ARM_JOINTS:
             raise ValueError(f"expected {ARM_JOINTS} joints, got {len(message.positions)}")
         self.joints = tuple(message.positions)
+        self.joints_ns = message.header.stamp_ns
 
     def on_odometry(self, message: BaseOdometry) -> None:
         """Move the base by the odometry's motion in the base frame; publish the state."""
         stamp = message.header.stamp_ns
         if not self._fresh("odometry", stamp):
             return
+        if self.joints_ns < stamp:
+            self.node.count("joints_behind")
         current = (message.x, message.y, message.phi)
         if self.odometry is not None and self.base is not None:
             ox, oy, ophi = self.odometry

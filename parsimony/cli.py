@@ -8,7 +8,9 @@ import sys
 
 from parsimony.output import result_only_stdout
 
-COMMANDS = ("demo", "experiment", "bench", "launch", "status", "param", "node", "topic", "graph", "schema")
+COMMANDS = (
+    "demo", "experiment", "bench", "launch", "status", "param", "node", "topic", "graph", "schema",
+)  # fmt: skip
 
 
 def build_parser() -> argparse.ArgumentParser:

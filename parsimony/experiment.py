@@ -18,10 +18,12 @@ effort of table 6.1 of the commands sent.
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import math
 import os
 import signal
 import socket
+import struct
 import subprocess
 import sys
 import threading
@@ -197,8 +199,10 @@ def run_experiment(options: Options) -> dict[str, Any]:
             launcher.wait()
         log.close()
     wall_s = time.monotonic() - started
+    messages = until(messages, end_of_run(messages["control/diagnostics"], options.time_limit_s))
     report = build_report(options, setup, profile, robot, messages, wall_s, counters)
     (options.out / "report.json").write_text(dumps(report))
+    write_commands(options.out / "commands.csv", messages)
     return report
 
 
@@ -248,6 +252,20 @@ def follow(recorder: Recorder, options: Options, started: float) -> dict[str, li
 def simulator_counters(session: zenoh.Session, namespace: str) -> dict[str, int]:
     status = query.statuses(session, namespace).get("simulator")
     return dict(status.counters) if status is not None else {}
+
+
+def end_of_run(diagnostics: list, time_limit_s: float) -> int:
+    """The stamp (ns) a run ends at: ``HOLD_S`` after it converged, else the time limit; a
+    simulated time, so that two lockstep runs of one set-up report the same steps."""
+    since = converged_at(diagnostics)
+    if since is not None and diagnostics[-1].header.stamp_ns / 1e9 - since >= HOLD_S:
+        return round((since + HOLD_S) * 1e9)
+    return round(time_limit_s * 1e9)
+
+
+def until(messages: dict[str, list], end_ns: int) -> dict[str, list]:
+    """The messages stamped up to ``end_ns``."""
+    return {n: [m for m in ms if m.header.stamp_ns <= end_ns] for n, ms in messages.items()}
 
 
 def true_goal(setup: SimScenario, profile: Profile) -> np.ndarray:
@@ -312,6 +330,10 @@ def build_report(
         "step_time_us": {"median": round(float(np.median(solve)), 1),
                          "p99": round(float(np.percentile(solve, 99)), 1)},  # fmt: skip
         "lockstep_timeouts": counters.get("lockstep_timeouts", 0),
+        "controller_statuses": dict(sorted(Counter(d.status for d in diagnostics).items())),
+        "degraded_states": sum(s.degraded for s in states),
+        "invalid_states": sum(not s.valid for s in states),
+        "commands_digest": commands_digest(messages),
         "scenario": dataclasses.asdict(setup) | {"obstacles": setup.sim_params()["obstacles"]},
     }
 
@@ -374,6 +396,30 @@ def effort(messages: dict[str, list], truth: list) -> dict[str, float]:
     e = effort_of(np.array(rows), dt)
     values = (e.velocity_l1, e.velocity_l2, e.acceleration_l1, e.acceleration_l2)
     return {f"metric{i}": round(v, 4) for i, v in enumerate(values, start=1)}
+
+
+def write_commands(path: Path, messages: dict[str, list]) -> None:
+    """Every command pair the controller sent, one row per stamp (s, m/s, rad/s)."""
+    arm = {a.header.stamp_ns: a.joint_velocities for a in messages["arm/command"]}
+    lines = ["stamp_s,forward,angular," + ",".join(f"q{i}_dot" for i in range(1, 6))]
+    for b in sorted(messages["base/command"], key=lambda c: c.header.stamp_ns):
+        joints = arm.get(b.header.stamp_ns)
+        if joints is not None:
+            values = (b.forward_velocity, b.angular_velocity, *joints)
+            lines.append(f"{b.header.stamp_ns / 1e9:.3f}," + ",".join(repr(v) for v in values))
+    path.write_text("\n".join(lines) + "\n")
+
+
+def commands_digest(messages: dict[str, list]) -> str:
+    """SHA-256 of every command's stamp and values in stamp order: two runs that sent the same
+    commands have the same digest."""
+    digest = hashlib.sha256()
+    for name in ("base/command", "arm/command"):
+        for command in sorted(messages[name], key=lambda c: c.header.stamp_ns):
+            values = command.model_dump(exclude={"header"})
+            digest.update(struct.pack("<q", command.header.stamp_ns))
+            digest.update(repr(sorted(values.items())).encode())
+    return digest.hexdigest()
 
 
 def dumps(report: dict) -> str:

@@ -46,7 +46,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("--time-limit", type=float, default=TIME_LIMIT_S, metavar="S",
                         help="simulated seconds before giving up")  # fmt: skip
     parser.add_argument("--hide-base-marker", type=seconds_window, metavar="FROM,TO",
-                        help="hide the base marker from the camera in this window (sim s)")  # fmt: skip
+                        help="hide the base marker from the camera then (sim s)")  # fmt: skip
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
     return parser
 
@@ -65,8 +65,9 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         emit(dumps(report))
     else:
-        summary = {k: report[k] for k in ("converged", "final_error", "sim_time_s",
-                                          "wall_time_s", "real_time_factor", "contacts")}  # fmt: skip
+        keys = ("converged", "final_error", "sim_time_s", "wall_time_s", "real_time_factor",
+                "contacts")  # fmt: skip
+        summary = {k: report[k] for k in keys}
         emit(" ".join(f"{k}={v}" for k, v in summary.items()))
     print(f"[experiment] report: {args.out / 'report.json'}", file=sys.stderr)
     return 0 if report["converged"] else EXIT_NOT_CONVERGED
