@@ -199,8 +199,9 @@ def run_experiment(options: Options) -> dict[str, Any]:
             launcher.wait()
         log.close()
     wall_s = time.monotonic() - started
-    messages = until(messages, end_of_run(messages["control/diagnostics"], options.time_limit_s))
-    report = build_report(options, setup, profile, robot, messages, wall_s, counters)
+    end_ns, converged = end_of_run(messages["control/diagnostics"], options.time_limit_s)
+    messages = until(messages, end_ns)
+    report = build_report(options, setup, profile, robot, messages, wall_s, counters, converged)
     (options.out / "report.json").write_text(dumps(report))
     write_commands(options.out / "commands.csv", messages)
     return report
@@ -254,13 +255,14 @@ def simulator_counters(session: zenoh.Session, namespace: str) -> dict[str, int]
     return dict(status.counters) if status is not None else {}
 
 
-def end_of_run(diagnostics: list, time_limit_s: float) -> int:
-    """The stamp (ns) a run ends at: ``HOLD_S`` after it converged, else the time limit; a
-    simulated time, so that two lockstep runs of one set-up report the same steps."""
+def end_of_run(diagnostics: list, time_limit_s: float) -> tuple[int, bool]:
+    """The stamp (ns) a run ends at, ``HOLD_S`` after it converged, else the time limit (a
+    simulated time: two lockstep runs of one set-up report the same steps); and whether it
+    converged."""
     since = converged_at(diagnostics)
     if since is not None and diagnostics[-1].header.stamp_ns / 1e9 - since >= HOLD_S:
-        return round((since + HOLD_S) * 1e9)
-    return round(time_limit_s * 1e9)
+        return round((since + HOLD_S) * 1e9), True
+    return round(time_limit_s * 1e9), False
 
 
 def until(messages: dict[str, list], end_ns: int) -> dict[str, list]:
@@ -291,14 +293,12 @@ def wrap(angle: float) -> float:
 
 def build_report(
     options: Options, setup: SimScenario, profile: Profile, robot: MobileManipulator,
-    messages: dict[str, list], wall_s: float, counters: dict[str, int],
+    messages: dict[str, list], wall_s: float, counters: dict[str, int], converged: bool,
 ) -> dict[str, Any]:  # fmt: skip
     truth, states = messages["sim/truth"], messages["robot/state"]
     diagnostics = messages["control/diagnostics"]
     sim_s = truth[-1].header.stamp_ns / 1e9 if truth else 0.0
-    since = converged_at(diagnostics)
     end_s = diagnostics[-1].header.stamp_ns / 1e9 if diagnostics else 0.0
-    converged = since is not None and end_s - since >= HOLD_S
     goal = true_goal(setup, profile)
     final_error = None
     if truth:

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
@@ -86,21 +86,27 @@ class Scene(_Strict):
     goal: GoalMarker
     obstacles: ObstacleMarkers = ObstacleMarkers()
 
-    @field_validator("dictionary")
-    @classmethod
-    def _known_dictionary(cls, name: str) -> str:
+    @model_validator(mode="after")
+    def _known_dictionary(self) -> Scene:
         import cv2  # only profiles with a scene pay for it
 
-        if not name.startswith("DICT_") or not hasattr(cv2.aruco, name):
-            raise ValueError(f"not an OpenCV ArUco dictionary: {name!r} (e.g. 'DICT_4X4_50')")
-        return name
+        if not self.dictionary.startswith("DICT_") or not hasattr(cv2.aruco, self.dictionary):
+            raise ValueError(f"dictionary: not an OpenCV ArUco dictionary: {self.dictionary!r} "
+                             "(e.g. 'DICT_4X4_50')")  # fmt: skip
+        return self
 
     @model_validator(mode="after")
     def _ids_unique(self) -> Scene:
-        ids = [self.reference.id, self.base.id, self.goal.id, *self.obstacles.ids]
-        for marker_id in ids:
-            if ids.count(marker_id) > 1:
-                raise ValueError(f"obstacles.ids: marker id {marker_id} is used twice")
+        """Each marker id once; the error names the later of two markers that share one."""
+        fields = [("reference.id", self.reference.id), ("base.id", self.base.id),
+                  ("goal.id", self.goal.id)]  # fmt: skip
+        fields += [(f"obstacles.ids[{i}]", marker_id) for i, marker_id in
+                   enumerate(self.obstacles.ids)]  # fmt: skip
+        seen: dict[int, str] = {}
+        for field, marker_id in fields:
+            if marker_id in seen:
+                raise ValueError(f"{field}: marker id {marker_id} is already {seen[marker_id]}")
+            seen[marker_id] = field
         return self
 
     @property

@@ -1,0 +1,132 @@
+"""The ``scene`` section of a profile (profiles/scene.py): markers, camera, refusals by field."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+import pytest
+import yaml
+
+from profiles.profile import ProfileError, load_profile
+from profiles.scene import BaseMarker, GoalMarker, Marker, Scene
+
+REPO = Path(__file__).resolve().parents[2]
+PUB = {"name": "pub", "module": "scripted_publisher", "role": "tool"}
+SCENE = {
+    "reference": {"id": 0, "size_m": 0.3},
+    "base": {"id": 1, "size_m": 0.12, "height_m": 0.09, "offset": [-0.08, 0.0]},
+    "goal": {"id": 2, "size_m": 0.15},
+    "obstacles": {"ids": [3, 4], "size_m": 0.1, "height_m": 0.3},
+}
+
+
+def write(tmp_path: Path, scene: object) -> Path:
+    path = tmp_path / "profile.yaml"
+    path.write_text(yaml.safe_dump({"namespace": "sim", "components": [PUB], "scene": scene}))
+    return path
+
+
+def refusal(tmp_path: Path, scene: object) -> str:
+    with pytest.raises(ProfileError) as error:
+        load_profile(write(tmp_path, scene))
+    message = str(error.value)
+    assert message.startswith(f"{tmp_path / 'profile.yaml'}: invalid profile"), message
+    return message
+
+
+def test_the_sim_profile_has_its_scene() -> None:
+    scene = load_profile(REPO / "deploy/sim.yaml").scene
+    assert isinstance(scene, Scene)
+    assert (scene.reference.id, scene.base.id, scene.goal.id) == (0, 1, 2)
+    assert scene.obstacles.ids == (3,)
+    assert scene.camera.position == (0.8, 0.15, 2.5)
+    assert scene.dictionary_id == cv2.aruco.DICT_4X4_50
+
+
+def test_a_profile_without_a_scene_has_none(tmp_path: Path) -> None:
+    path = tmp_path / "profile.yaml"
+    path.write_text(yaml.safe_dump({"namespace": "sim", "components": [PUB]}))
+    assert load_profile(path).scene is None
+
+
+def test_a_scene_gets_defaults_for_what_it_leaves_out(tmp_path: Path) -> None:
+    minimal = {key: SCENE[key] for key in ("reference", "base", "goal")}
+    scene = load_profile(write(tmp_path, minimal)).scene
+    assert scene is not None
+    assert scene.dictionary == "DICT_4X4_50" and scene.obstacles.ids == ()
+    assert (scene.camera.width, scene.camera.height) == (640, 480)
+    assert scene.goal.offset == (0.0,) * 6 and scene.reference_pose == (0.0, 0.0, 0.0)
+
+
+def test_markers_maps_every_id_to_its_size_and_height(tmp_path: Path) -> None:
+    scene = load_profile(write(tmp_path, SCENE)).scene
+    assert scene is not None
+    markers = scene.markers()
+    assert sorted(markers) == [0, 1, 2, 3, 4]
+    sizes = {i: (m.size_m, m.height_m) for i, m in markers.items()}
+    assert sizes == {0: (0.3, 0.0), 1: (0.12, 0.09), 2: (0.15, 0.0), 3: (0.1, 0.3), 4: (0.1, 0.3)}
+    assert isinstance(markers[1], BaseMarker) and markers[1].offset == (-0.08, 0.0)
+    assert isinstance(markers[2], GoalMarker)
+    assert all(isinstance(m, Marker) and m.id == i for i, m in markers.items())
+
+
+def test_the_dictionary_id_is_opencvs() -> None:
+    scene = Scene.model_validate(SCENE)
+    assert scene.dictionary_id == cv2.aruco.DICT_4X4_50
+    other = Scene.model_validate({**SCENE, "dictionary": "DICT_5X5_100"})
+    assert other.dictionary_id == cv2.aruco.DICT_5X5_100 != cv2.aruco.DICT_4X4_50
+
+
+@pytest.mark.parametrize(
+    ("change", "field", "expected"),
+    [
+        ({"obstacles": {"ids": [3, 3]}}, "scene.obstacles.ids[1]", "obstacles.ids[0]"),
+        ({"obstacles": {"ids": [3, 1]}}, "scene.obstacles.ids[1]", "already base.id"),
+        ({"goal": {"id": 2, "size_m": -0.15}}, "scene.goal.size_m", "greater than 0"),
+        ({"reference": {"id": 0, "size_m": 0.0}}, "scene.reference.size_m", "greater than 0"),
+        (
+            {"base": {"id": 1, "size_m": 0.1, "height_m": -1}},
+            "scene.base.height_m",
+            "greater than or equal to 0",
+        ),
+        ({"reference": {"id": -1, "size_m": 0.3}}, "scene.reference.id", "greater than or equal"),
+        ({"colour": "red"}, "scene.colour", "Extra inputs are not permitted"),
+        ({"camera": {"lens": "wide"}}, "scene.camera.lens", "Extra inputs are not permitted"),
+        (
+            {"goal": {"id": 2, "size_m": 0.1, "offset": [0, 0, 1]}},
+            "scene.goal.offset[3]",
+            "Field required",
+        ),
+        ({"camera": {"position": [0, 0, -2.5]}}, "scene.camera.position[2]", "greater than 0"),
+    ],
+)
+def test_invalid_scenes_name_the_field(
+    tmp_path: Path, change: dict[str, object], field: str, expected: str
+) -> None:
+    message = refusal(tmp_path, {**SCENE, **change})
+    assert f"  {field}" in message and expected in message, message
+
+
+def test_a_missing_marker_is_named(tmp_path: Path) -> None:
+    scene = {key: SCENE[key] for key in ("reference", "goal")}
+    assert "  scene.base: Field required" in refusal(tmp_path, scene)
+
+
+def test_an_unknown_dictionary_is_refused(tmp_path: Path) -> None:
+    message = refusal(tmp_path, {**SCENE, "dictionary": "DICT_9X9_7"})
+    assert "scene.dictionary" in message
+    assert "not an OpenCV ArUco dictionary: 'DICT_9X9_7'" in message
+
+
+def test_an_unknown_dictionary_is_reported_as_field_colon_message(tmp_path: Path) -> None:
+    """Like every other refusal: '  <field path>: <what was wrong>'."""
+    message = refusal(tmp_path, {**SCENE, "dictionary": "DICT_9X9_7"})
+    assert "  scene.dictionary: not an OpenCV ArUco dictionary" in message, message
+
+
+def test_a_repeated_id_outside_the_obstacles_names_the_marker_that_repeats(tmp_path: Path) -> None:
+    message = refusal(tmp_path, {**SCENE, "goal": {"id": 0, "size_m": 0.15}})
+    assert "marker id 0 is already reference.id" in message
+    assert "scene.obstacles" not in message, message
+    assert "  scene.goal.id" in message, message

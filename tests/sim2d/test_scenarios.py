@@ -1,0 +1,170 @@
+"""The simulated set-ups of section 6.2 (sim2d/scenarios.py) against deploy/sim.yaml's scene."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from components.state_estimator import goal_offset
+from profiles.profile import load_profile
+from profiles.scene import Scene
+from sim2d.camera import PinholeCamera, ceiling_pose
+from sim2d.scenarios import (
+    BIN_RANGE,
+    NAMES,
+    OBSTACLE_SHIFT,
+    START_RANGE,
+    SimScenario,
+    scenario,
+)
+from wbc import dq
+from wbc.planar import planar_of, planar_pose
+from wbc.robot import BASE_DOF, MobileManipulator
+from wbc.scenarios import HOME, OBSTACLE, REACH_GOAL
+
+REPO = Path(__file__).resolve().parents[2]
+ROBOT = MobileManipulator.from_yaml(REPO / "deploy/robots/little_john.yaml")
+SCENE = load_profile(REPO / "deploy/sim.yaml").scene
+SEEDS = range(50)
+DEFAULT_BIN = np.array(planar_of(ROBOT.fkm(REACH_GOAL)))
+
+
+def scene() -> Scene:
+    assert SCENE is not None
+    return SCENE
+
+
+def test_the_default_goal_is_the_dissertations_reach_goal() -> None:
+    """x_d = x_2 x_d^2 (eq. 6.3) on the default bin is fkm(REACH_GOAL), up to sign."""
+    setup = scenario("pose", ROBOT)
+    goal = scene().goal
+    bin_pose = planar_pose(*setup.bin, goal.height_m)
+    x_d = dq.mul(bin_pose, goal_offset(goal.offset))
+    expected = ROBOT.fkm(REACH_GOAL)
+    error = min(np.max(np.abs(x_d - expected)), np.max(np.abs(x_d + expected)))
+    assert error < 1e-5, (x_d, expected)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_the_default_set_up_starts_at_home(name: str) -> None:
+    setup = scenario(name, ROBOT)
+    assert setup.name == name
+    assert np.array_equal(setup.start, HOME)
+
+
+def test_the_pose_set_up_puts_the_bin_under_the_reach_goal_without_obstacles() -> None:
+    setup = scenario("pose", ROBOT)
+    assert setup.task == "pose" and setup.obstacles == ()
+    assert np.allclose(setup.bin, DEFAULT_BIN, atol=1e-12)
+
+
+def test_the_position_set_up_has_the_position_task() -> None:
+    setup = scenario("position", ROBOT)
+    assert setup.task == "position" and setup.obstacles == ()
+    assert np.allclose(setup.bin, DEFAULT_BIN, atol=1e-12)
+
+
+def test_the_obstacle_set_up_shifts_the_bin_past_the_obstacle() -> None:
+    setup = scenario("obstacle", ROBOT)
+    assert setup.task == "pose"
+    assert setup.obstacles == (OBSTACLE,)
+    shifted = DEFAULT_BIN + [OBSTACLE_SHIFT[0], OBSTACLE_SHIFT[1], 0.0]
+    assert np.allclose(setup.bin, shifted, atol=1e-12)
+
+
+def test_an_unknown_experiment_is_refused() -> None:
+    with pytest.raises(ValueError, match="no experiment 'dance'; choose one of pose, position"):
+        scenario("dance", ROBOT)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_seeded_set_ups_stay_in_their_ranges_and_the_joint_limits(name: str) -> None:
+    default = scenario(name, ROBOT)
+    for seed in SEEDS:
+        setup = scenario(name, ROBOT, seed)
+        start, bin_pose = np.array(setup.start), np.array(setup.bin)
+        assert np.all(np.abs(start - HOME) <= START_RANGE)
+        assert np.all(np.abs(bin_pose - default.bin) <= BIN_RANGE)
+        arm = start[BASE_DOF:]
+        assert np.all(arm >= ROBOT.q_min[BASE_DOF:]) and np.all(arm <= ROBOT.q_max[BASE_DOF:])
+        assert setup.obstacles == default.obstacles and setup.task == default.task
+
+
+def test_seeds_repeat_and_differ() -> None:
+    assert scenario("pose", ROBOT, 3) == scenario("pose", ROBOT, 3)
+    draws = {scenario("pose", ROBOT, seed).start for seed in SEEDS}
+    bins = {scenario("pose", ROBOT, seed).bin for seed in SEEDS}
+    assert len(draws) == len(bins) == len(SEEDS)
+    assert scenario("pose", ROBOT, 0).start != tuple(HOME.tolist())
+
+
+def groups(text: str) -> list[tuple[float, ...]]:
+    """'1, 2; 3, 4' as [(1, 2), (3, 4)]."""
+    return [tuple(float(v) for v in g.split(",")) for g in text.split(";") if g.strip()]
+
+
+@pytest.mark.parametrize(("name", "seed"), [("pose", None), ("obstacle", None), ("obstacle", 7)])
+def test_sim_params_parse_back_to_the_set_up(name: str, seed: int | None) -> None:
+    setup = scenario(name, ROBOT, seed)
+    params = setup.sim_params()
+    assert set(params) == {"start", "goal_marker", "obstacles"}
+    (start,) = groups(params["start"])
+    (bin_pose,) = groups(params["goal_marker"])
+    assert start == pytest.approx(setup.start, abs=5e-7)
+    assert bin_pose == pytest.approx(setup.bin, abs=5e-7)
+    obstacles = groups(params["obstacles"])
+    assert obstacles == [(c.x, c.y, c.radius) for c in setup.obstacles]
+
+
+def test_several_obstacles_are_separated_by_semicolons() -> None:
+    setup = SimScenario("obstacle", "pose", tuple(HOME), (1.0, 0.0, 0.0), (OBSTACLE, OBSTACLE))
+    one = (OBSTACLE.x, OBSTACLE.y, OBSTACLE.radius)
+    assert groups(setup.sim_params()["obstacles"]) == [one, one]
+
+
+def camera() -> PinholeCamera:
+    c = scene().camera
+    return PinholeCamera(ceiling_pose(*c.position), width=c.width, height=c.height,
+                         fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy)  # fmt: skip
+
+
+def markers(setup: SimScenario) -> list[tuple[str, float, float, float, float]]:
+    """(what, x, y, height, size) of every marker: F0, F1 on the base at its start, F2, F3."""
+    s = scene()
+    x, y, phi = setup.start[:3]
+    ox, oy = s.base.offset
+    c, s_ = math.cos(phi), math.sin(phi)
+    base = (x + c * ox - s_ * oy, y + s_ * ox + c * oy)
+    found = [
+        ("reference", *s.reference_pose[:2], s.reference.height_m, s.reference.size_m),
+        ("base", *base, s.base.height_m, s.base.size_m),
+        ("bin", *setup.bin[:2], s.goal.height_m, s.goal.size_m),
+    ]
+    found += [("obstacle", c.x, c.y, s.obstacles.height_m, s.obstacles.size_m)
+              for c in setup.obstacles]  # fmt: skip
+    return found
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_every_marker_is_in_the_image_with_half_a_marker_to_spare(name: str) -> None:
+    view = camera()
+    assert (view.width, view.height) == (640, 480)
+    depth = scene().camera.position[2]
+    for seed in (None, *SEEDS):
+        for what, x, y, z, size in markers(scenario(name, ROBOT, seed)):
+            ((u, v),) = view.project(np.array([[x, y, z]]))
+            half = 0.5 * size * view.fx / (depth - z)
+            assert half < u < view.width - 1 - half, (name, seed, what, u)
+            assert half < v < view.height - 1 - half, (name, seed, what, v)
+
+
+def test_the_camera_sees_the_world_as_the_check_assumes() -> None:
+    """The scene camera's centre pixel is straight below it, world +x to the right."""
+    view = camera()
+    x, y, _ = scene().camera.position
+    centre, right = view.project(np.array([[x, y, 0.0], [x + 0.1, y, 0.0]]))
+    assert centre == pytest.approx((view.cx, view.cy))
+    assert right[0] > centre[0] and right[1] == pytest.approx(centre[1])

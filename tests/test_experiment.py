@@ -1,0 +1,156 @@
+"""`parsimony experiment` on the whole simulated loop: real processes, real Zenoh on loopback,
+real pymunk, real OpenCV detection of rendered ArUco markers, real HiGHS. Each run is judged
+by the report against the simulator's ground truth, which no component of the loop reads."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from deploy import query
+
+ONE_DEGREE = math.radians(1.0)
+
+
+def experiment(out: Path, *arguments: str) -> tuple[int, dict]:
+    """Run `parsimony experiment ... --json`; its exit status and the report on its stdout."""
+    command = [sys.executable, "-m", "parsimony.cli", "experiment", *arguments, "--json"]
+    done = subprocess.run([*command, "--out", str(out)], capture_output=True, text=True,
+                          timeout=300)  # fmt: skip
+    assert done.stdout.strip(), done.stderr[-2000:]
+    report = json.loads(done.stdout)
+    assert report == json.loads((out / "report.json").read_text())
+    return done.returncode, report
+
+
+def assert_sound(report: dict) -> None:
+    """What every converged run of the LP must show."""
+    assert report["converged"], report
+    assert report["contacts"] == 0
+    assert report["joint_limit_violations"] == 0
+    assert report["final_error"] < 0.02
+    error = report["estimator_error"]
+    assert error["samples"] > 100
+    assert error["position_m"] < 0.01 and error["angle_rad"] < ONE_DEGREE, error
+
+
+def test_pose_experiment_with_the_lp_reaches_the_goal_seen_by_the_camera(tmp_path: Path) -> None:
+    code, report = experiment(tmp_path, "pose", "--controller", "lp", "--seed", "1")
+    assert code == 0
+    assert_sound(report)
+    assert report["mode"] == "lockstep" and report["lockstep_timeouts"] == 0
+    # Section 5.7: 6 task DOF + the nonholonomic equality, plus one per active constraint.
+    histogram = {int(k): v for k, v in report["nonzero_entries"].items()}
+    most = max(histogram, key=histogram.get)
+    assert most in (7, 8), histogram
+    assert max(histogram) <= 9, histogram
+    for key in ("metric1", "metric2", "metric3", "metric4"):
+        assert report["effort"][key] > 0.0
+    assert report["step_time_us"]["median"] > 0.0
+    assert report["iterations"] == sum(report["controller_statuses"].values())
+
+
+def test_two_lockstep_runs_of_one_seed_send_bit_identical_commands(tmp_path: Path) -> None:
+    _, first = experiment(tmp_path / "a", "position", "--seed", "3")
+    _, second = experiment(tmp_path / "b", "position", "--seed", "3")
+    assert first["commands_digest"] == second["commands_digest"]
+    a = (tmp_path / "a" / "commands.csv").read_text()
+    assert a == (tmp_path / "b" / "commands.csv").read_text()
+    assert len(a.splitlines()) > 100
+    _, other = experiment(tmp_path / "c", "position", "--seed", "4")
+    assert other["commands_digest"] != first["commands_digest"]
+
+
+def test_obstacle_experiment_with_the_lp_goes_round_the_obstacle(tmp_path: Path) -> None:
+    code, report = experiment(tmp_path, "obstacle", "--controller", "lp")
+    assert code == 0
+    assert_sound(report)
+    assert report["min_obstacle_clearance_m"] > 0.0
+
+
+def test_position_experiment_with_the_cascade_converges(tmp_path: Path) -> None:
+    code, report = experiment(tmp_path, "position", "--controller", "cascade", "--seed", "2")
+    assert code == 0 and report["converged"]
+    assert report["contacts"] == 0
+
+
+def test_hidden_base_marker_degrades_the_state_and_the_run_still_converges(
+    tmp_path: Path,
+) -> None:
+    code, report = experiment(tmp_path, "pose", "--hide-base-marker", "1,4")
+    assert code == 0
+    assert_sound(report)
+    assert report["degraded_states"] > 100  # about 2.5 s of 100 Hz states after the timeout
+
+
+def connect(target: query.Target, deadline: float):
+    """A session to the experiment's router once it listens."""
+    while True:
+        try:
+            return target.open()
+        except query.QueryError:
+            assert time.monotonic() < deadline
+            time.sleep(0.1)  # the launcher opens its router after the experiment starts it
+
+
+def kill_during_run(tmp_path: Path, component: str) -> tuple[int, dict, str]:
+    """Start an experiment, SIGKILL ``component`` once the controller has run 200 steps, and
+    return the exit status, the report and the launch log."""
+    command = [sys.executable, "-m", "parsimony.cli", "experiment", "pose", "--json"]
+    process = subprocess.Popen([*command, "--out", str(tmp_path)], stdout=subprocess.PIPE,
+                               stderr=subprocess.DEVNULL, text=True)  # fmt: skip
+    try:
+        deadline = time.monotonic() + 120
+        while not (tmp_path / "profile.yaml").exists():
+            assert time.monotonic() < deadline and process.poll() is None
+            time.sleep(0.1)  # the experiment writes its profile before it launches
+        target = query.Target.from_profile(tmp_path / "profile.yaml")
+        with connect(target, deadline) as session:
+            while True:
+                assert time.monotonic() < deadline and process.poll() is None
+                found = query.statuses(session, target.namespace, 0.5)
+                steps = found.get("controller")
+                if steps and steps.counters.get("published.arm/command", 0) > 200:
+                    break
+            os.kill(found[component].pid, signal.SIGKILL)
+        stdout, _ = process.communicate(timeout=300)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    return process.returncode, json.loads(stdout), (tmp_path / "launch.log").read_text()
+
+
+def test_a_killed_estimator_stops_the_robot_is_restarted_and_the_run_converges(
+    tmp_path: Path,
+) -> None:
+    code, report, log = kill_during_run(tmp_path, "state_estimator")
+    assert code == 0 and report["converged"], report
+    assert "state_estimator exited with -9; restart 1/" in log, log[-3000:]
+    assert log.count("started state_estimator") == 2
+    assert report["controller_statuses"].get("stale", 0) > 0  # zeros while no state came
+    assert report["contacts"] == 0
+
+
+def test_a_killed_vision_tracker_is_restarted_and_the_run_converges(tmp_path: Path) -> None:
+    code, report, log = kill_during_run(tmp_path, "vision_tracker")
+    assert code == 0 and report["converged"], report
+    assert "vision_tracker exited with -9; restart 1/" in log, log[-3000:]
+    assert log.count("started vision_tracker") == 2
+    assert report["lockstep_timeouts"] >= 1  # the frame the dead tracker never answered
+
+
+@pytest.mark.parametrize("bad", [["pose", "--seed", "x"], ["jump"], ["pose"]])
+def test_usage_errors_exit_2(bad: list[str], tmp_path: Path) -> None:
+    extra = [] if bad == ["pose"] else ["--out", str(tmp_path)]
+    command = [sys.executable, "-m", "parsimony.cli", "experiment", *bad, *extra]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2
+    assert done.stdout == ""
