@@ -24,6 +24,7 @@ step goes on. The simulator starts when ``paused`` is set false (a profile may s
 
 from __future__ import annotations
 
+import collections
 import math
 import time
 from dataclasses import dataclass
@@ -80,7 +81,12 @@ class Awaited:
 
     stamp_ns: int
     topics: tuple[str, ...]
+    since: float
     deadline: float
+
+
+LATENCY_WINDOW = 2000
+"""How many recent answer times the latency counters summarise."""
 
 
 class Simulator(Component):
@@ -156,6 +162,7 @@ class Simulator(Component):
         self.last_command_ns: int | None = None
         self.awaited: Awaited | None = None
         self.answered: dict[str, int] = {}
+        self.latencies: dict[str, collections.deque] = {}
         node.counters["lockstep_timeouts"] = 0
         node.counters["contacts"] = 0
         self.publishers = {t.name: node.publisher(t) for t in self.writes}
@@ -212,8 +219,8 @@ class Simulator(Component):
             self._await(("base/command", "arm/command"))
 
     def _await(self, names: tuple[str, ...]) -> None:
-        deadline = time.monotonic() + self.node.params["ack_timeout_s"]
-        self.awaited = Awaited(self.now_ns, names, deadline)
+        now = time.monotonic()
+        self.awaited = Awaited(self.now_ns, names, now, now + self.node.params["ack_timeout_s"])
 
     def _answer_handler(self, name: str):
         def on_answer(message) -> None:
@@ -230,7 +237,20 @@ class Simulator(Component):
         if awaited is None:
             return
         if all(self.answered.get(name, -1) >= awaited.stamp_ns for name in awaited.topics):
+            kind = "frame" if "vision/markers" in awaited.topics else "loop"
+            self._note_latency(kind, time.monotonic() - awaited.since)
             self._proceed()
+
+    def _note_latency(self, kind: str, seconds: float) -> None:
+        """Host time from publishing to the last answer: ``frame`` (camera frame to markers
+        and obstacles) or ``loop`` (sensors to commands, through estimator and controller);
+        median and p99 of the recent ones as counters, in us."""
+        recent = self.latencies.setdefault(kind, collections.deque(maxlen=LATENCY_WINDOW))
+        recent.append(seconds * 1e6)
+        if len(recent) % 50 == 0 or len(recent) < 50:
+            ordered = sorted(recent)
+            self.node.counters[f"{kind}_us_median"] = round(ordered[len(ordered) // 2])
+            self.node.counters[f"{kind}_us_p99"] = round(ordered[int(len(ordered) * 0.99)])
 
     def _proceed(self) -> None:
         """The awaited answers are in (or overdue): go on with the step or the next one."""

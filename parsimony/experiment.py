@@ -330,6 +330,8 @@ def build_report(
         "step_time_us": {"median": round(float(np.median(solve)), 1),
                          "p99": round(float(np.percentile(solve, 99)), 1)},  # fmt: skip
         "lockstep_timeouts": counters.get("lockstep_timeouts", 0),
+        "answer_time_us": {name: counters[name] for name in sorted(counters)
+                           if name.startswith(("frame_us", "loop_us"))},  # fmt: skip
         "controller_statuses": dict(sorted(Counter(d.status for d in diagnostics).items())),
         "degraded_states": sum(s.degraded for s in states),
         "invalid_states": sum(not s.valid for s in states),
