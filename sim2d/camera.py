@@ -33,11 +33,6 @@ DISC_VERTICES = 96
 _MIN_DEPTH_M = 1e-3
 
 
-def rotation_matrix(r: np.ndarray) -> np.ndarray:
-    """R with R v = Im(r v r*) for a unit quaternion r: the lower 3x3 of H+(r) H-(r*) (3.6)."""
-    return (dq.hamiplus4(r) @ dq.haminus4(dq.qconj(r)))[1:, 1:]
-
-
 def _read_only(x: np.ndarray) -> np.ndarray:
     out = np.array(x, dtype=float)
     out.flags.writeable = False
@@ -67,7 +62,7 @@ class PinholeCamera:
 
     def to_camera(self, points_world: np.ndarray) -> np.ndarray:
         """p_c = R_c^T (p_w - t_c) for (N, 3) world points, m."""
-        rotation = rotation_matrix(dq.rotation(self.pose))
+        rotation = dq.rotation_matrix(dq.rotation(self.pose))
         origin = dq.translation(self.pose)[1:]
         return (np.asarray(points_world, float).reshape(-1, 3) - origin) @ rotation
 
@@ -124,7 +119,7 @@ def _square(side: float) -> np.ndarray:
 
 def _plane_to_world(pose: np.ndarray, xy: np.ndarray) -> np.ndarray:
     """p_w = R [x, y, 0] + t for points (x, y) of the frame's z = 0 plane."""
-    rotation = rotation_matrix(dq.rotation(pose))
+    rotation = dq.rotation_matrix(dq.rotation(pose))
     return xy @ rotation[:, :2].T + dq.translation(pose)[1:]
 
 
@@ -152,7 +147,7 @@ def _draw_marker(
     quiet_side = marker.size_m * (modules + 2 * QUIET_ZONE_MODULES) / modules
     outline_c = camera.to_camera(_plane_to_world(marker.pose, _square(quiet_side)))
     centre_c = camera.to_camera(dq.translation(marker.pose)[1:])[0]
-    rotation_c = rotation_matrix(dq.rotation(camera.pose)).T @ rotation_matrix(
+    rotation_c = dq.rotation_matrix(dq.rotation(camera.pose)).T @ dq.rotation_matrix(
         dq.rotation(marker.pose)
     )
     facing = float(rotation_c[:, 2] @ centre_c) < 0.0

@@ -77,42 +77,15 @@ def square_corners(size_m: float) -> np.ndarray:
     return np.array([[-h, h, 0.0], [h, h, 0.0], [h, -h, 0.0], [-h, -h, 0.0]])
 
 
-def _rotation_matrix(r: np.ndarray) -> np.ndarray:
-    """R with R v = Im(r v r*): the lower 3x3 of H+(r) H-(r*) (3.6)."""
-    return (dq.hamiplus4(r) @ dq.haminus4(dq.qconj(r)))[1:, 1:]
-
-
-def _quaternion(rotation: np.ndarray) -> np.ndarray:
-    """The unit quaternion r (r_1 >= 0) of a rotation matrix, by Shepperd's method."""
-    m = rotation
-    trace = np.trace(m)
-    squares = np.array([1.0 + trace, 1.0 + 2.0 * m[0, 0] - trace, 1.0 + 2.0 * m[1, 1] - trace])
-    squares = np.append(squares, 1.0 + 2.0 * m[2, 2] - trace)  # 4 r_k^2, k = 1..4
-    k = int(np.argmax(squares))
-    pivot = 0.5 * np.sqrt(squares[k])  # |r_k|
-    # 4 r_1 r_i = (m_kj - m_jk) terms, 4 r_i r_j = (m_ij + m_ji): the off-diagonal identities.
-    others = np.array(
-        [
-            [m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]],
-            [m[2, 1] - m[1, 2], m[0, 1] + m[1, 0], m[0, 2] + m[2, 0]],
-            [m[0, 2] - m[2, 0], m[0, 1] + m[1, 0], m[1, 2] + m[2, 1]],
-            [m[1, 0] - m[0, 1], m[0, 2] + m[2, 0], m[1, 2] + m[2, 1]],
-        ]
-    )[k] / (4.0 * pivot)
-    r = np.insert(others, k, pivot)
-    r = r / np.linalg.norm(r)
-    return -r if r[0] < 0.0 else r
-
-
 def _pose(rotation: np.ndarray, translation: np.ndarray) -> np.ndarray:
-    return dq.pose(_quaternion(rotation), translation)
+    return dq.pose(dq.quaternion_of_matrix(rotation), translation)
 
 
 def _reprojection_rms(
     pose_c: np.ndarray, detection: Detection, size_m: float, intrinsics: Intrinsics
 ) -> float:
     """sqrt(mean_k |pi(R c_k + t) - u_k|^2), px, with pi the distorted projection."""
-    rvec, _ = cv2.Rodrigues(_rotation_matrix(dq.rotation(pose_c)))
+    rvec, _ = cv2.Rodrigues(dq.rotation_matrix(dq.rotation(pose_c)))
     tvec = dq.translation(pose_c)[1:]
     projected, _ = cv2.projectPoints(
         square_corners(size_m), rvec, tvec, intrinsics.matrix(), intrinsics.distortion_array()
@@ -202,6 +175,6 @@ def plane_of(reference_pose_c: np.ndarray, height_m: float) -> tuple[np.ndarray,
 
     n = R z (the reference's z in the camera frame) and d = n.(t + h n) = n.t + h.
     """
-    normal = _rotation_matrix(dq.rotation(reference_pose_c))[:, 2]
+    normal = dq.rotation_matrix(dq.rotation(reference_pose_c))[:, 2]
     origin = dq.translation(reference_pose_c)[1:]
     return normal, float(normal @ origin + height_m)

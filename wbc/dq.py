@@ -137,6 +137,33 @@ def rotation_quaternion(angle: float, axis: Array) -> Array:
     return np.concatenate(([math.cos(half)], math.sin(half) * axis / np.linalg.norm(axis)))
 
 
+def rotation_matrix(r: np.ndarray) -> np.ndarray:
+    """R with R v = Im(r v r*): the lower 3x3 of H+(r) H-(r*) (3.6)."""
+    return (hamiplus4(r) @ haminus4(qconj(r)))[1:, 1:]
+
+
+def quaternion_of_matrix(rotation: np.ndarray) -> np.ndarray:
+    """The unit quaternion r (r_1 >= 0) of a rotation matrix, by Shepperd's method."""
+    m = rotation
+    trace = np.trace(m)
+    squares = np.array([1.0 + trace, 1.0 + 2.0 * m[0, 0] - trace, 1.0 + 2.0 * m[1, 1] - trace])
+    squares = np.append(squares, 1.0 + 2.0 * m[2, 2] - trace)  # 4 r_k^2, k = 1..4
+    k = int(np.argmax(squares))
+    pivot = 0.5 * np.sqrt(squares[k])  # |r_k|
+    # 4 r_1 r_i = (m_kj - m_jk) terms, 4 r_i r_j = (m_ij + m_ji): the off-diagonal identities.
+    others = np.array(
+        [
+            [m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]],
+            [m[2, 1] - m[1, 2], m[0, 1] + m[1, 0], m[0, 2] + m[2, 0]],
+            [m[0, 2] - m[2, 0], m[0, 1] + m[1, 0], m[1, 2] + m[2, 1]],
+            [m[1, 0] - m[0, 1], m[0, 2] + m[2, 0], m[1, 2] + m[2, 1]],
+        ]
+    )[k] / (4.0 * pivot)
+    r = np.insert(others, k, pivot)
+    r = r / np.linalg.norm(r)
+    return -r if r[0] < 0.0 else r
+
+
 def pose(rotation: Array, translation: Array) -> Array:
     """Unit dual quaternion x = r + eps (1/2) p r of rotation r and translation p (3.15).
 

@@ -318,3 +318,15 @@ def test_power_matches_dqrobotics(x: np.ndarray, exponent: float) -> None:
 @given(general_dqs.filter(lambda x: np.linalg.norm(x[:4]) > 1e-2))
 def test_norm_matches_dqrobotics(x: np.ndarray) -> None:
     assert_close(dq.norm(x), vec8(dqrobotics.norm(DQ(x))), 1e-10)
+
+
+def test_rotation_matrix_and_its_quaternion_round_trip() -> None:
+    rng = np.random.default_rng(7)
+    for _ in range(200):
+        r = dq.rotation_quaternion(rng.uniform(-math.pi, math.pi), rng.normal(size=3))
+        matrix = dq.rotation_matrix(r)
+        v = rng.normal(size=3)
+        rotated = dq.qmul(dq.qmul(r, np.concatenate(([0.0], v))), dq.qconj(r))[1:]
+        np.testing.assert_allclose(matrix @ v, rotated, atol=1e-12)
+        back = dq.quaternion_of_matrix(matrix)
+        np.testing.assert_allclose(back, r if r[0] >= 0 else -r, atol=1e-12)
