@@ -115,3 +115,19 @@ def test_a_device_that_does_not_open_is_a_configuration_error(deployed, tmp_path
     process = system.start("vision_tracker")
     assert process.wait(system.deadline_s) == 2
     assert "device: cannot open" in process.stderr.read()
+
+
+def test_no_estimator_or_controller_may_read_the_ground_truth(deployed) -> None:
+    from components.runtime import Node
+
+    system = deployed(DEPLOY / "sim.yaml")
+    for name in ("state_estimator", "controller"):
+        with Node(system.profile, name) as node:
+            try:
+                node.subscribe(topics.SIM_TRUTH)
+            except ValueError as error:
+                assert "may not read the ground truth" in str(error)
+            else:
+                raise AssertionError(f"{name} subscribed to sim/truth")
+    with Node(system.profile, "simulator") as node:  # a driver (or a tool) may
+        node.subscribe(topics.SIM_TRUTH)

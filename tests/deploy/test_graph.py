@@ -28,6 +28,26 @@ def test_the_controllers_profile_wires_the_publisher_to_the_controller() -> None
     assert '"parsimony/world/obstacles" [shape=ellipse, style=dashed];' in dot
 
 
+@pytest.mark.parametrize("name", ["sim.yaml", "sim_cascade.yaml"])
+def test_the_sim_profiles_close_the_loop_of_the_design(name: str) -> None:
+    """simulator -> tracker -> estimator -> controller -> simulator, every topic read is
+    written, and the ground truth reaches no estimator or controller."""
+    profile = load_profile(DEPLOY / name)
+    graph = dataflow(profile)
+    assert graph.writers("camera/image") == ["simulator"]
+    assert graph.readers("camera/image") == ["vision_tracker"]
+    assert graph.readers("vision/markers") == ["simulator", "state_estimator"]
+    assert graph.writers("robot/state") == ["state_estimator"]
+    assert graph.readers("robot/state") == ["controller"]
+    assert graph.readers("arm/command") == ["simulator"]
+    assert graph.read_never_written() == []
+    roles = {spec.name: spec.role for spec in profile.components}
+    assert all(roles[r] not in ("estimator", "controller") for r in graph.readers("sim/truth"))
+    assert profile.component("controller").module == (
+        "lp_controller" if name == "sim.yaml" else "cascade_controller"
+    )
+
+
 def test_a_sim_clock_profile_makes_every_component_read_sim_clock(tmp_path: Path) -> None:
     profile = load_profile(DEPLOY / "controllers.yaml").model_copy(update={"clock": "sim"})
     graph = dataflow(profile)
