@@ -116,21 +116,3 @@ def test_a_device_that_does_not_open_is_a_configuration_error(deployed, tmp_path
     assert process.wait(system.deadline_s) == 2
     assert "device: cannot open" in process.stderr.read()
 
-
-def test_no_estimator_or_controller_may_read_the_ground_truth(deployed) -> None:
-    from components.lp_controller import LPController
-    from components.runtime import Node
-    from components.simulator import Simulator
-    from components.state_estimator import StateEstimator
-
-    system = deployed(DEPLOY / "sim.yaml")
-    for name, component in (("state_estimator", StateEstimator), ("controller", LPController)):
-        with Node(system.profile, name, component.params) as node:
-            try:
-                node.subscribe(topics.SIM_TRUTH)
-            except ValueError as error:
-                assert "may not read the ground truth" in str(error)
-            else:
-                raise AssertionError(f"{name} subscribed to sim/truth")
-    with Node(system.profile, "simulator", Simulator.params) as node:  # a driver may
-        node.subscribe(topics.SIM_TRUTH)
