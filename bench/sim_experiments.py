@@ -48,7 +48,8 @@ def run_seeds(name: str, controller: str, seeds: int, directory: Path) -> dict:
         print(f"[bench] {name} {controller} seed {seed}: converged={reports[-1]['converged']}",
               file=sys.stderr, flush=True)  # fmt: skip
     estimator = [r["estimator_error"] for r in reports if r["estimator_error"]["samples"]]
-    answer = [r["answer_time_us"] for r in reports]
+    answer = [r["durations_us"].get("simulator", {}) for r in reports]
+    handlers = [r["durations_us"].get("state_estimator", {}) for r in reports]
     return {
         "experiment": name,
         "law": controller,
@@ -59,9 +60,16 @@ def run_seeds(name: str, controller: str, seeds: int, directory: Path) -> dict:
         "estimator_position_mm": round(max(e["position_m"] for e in estimator) * 1e3, 2),
         "estimator_angle_deg": round(float(np.degrees(max(e["angle_rad"] for e in estimator))), 2),
         "real_time_factor": round(statistics.median(r["real_time_factor"] for r in reports), 2),
+        "tracker_frame_us": round(statistics.median(
+            r["durations_us"].get("vision_tracker", {}).get("handler.camera/image_us_median", 0)
+            for r in reports)),
         "step_us_median": round(statistics.median(r["step_time_us"]["median"] for r in reports)),
         "loop_us_median": round(statistics.median(a.get("loop_us_median", 0) for a in answer)),
         "frame_us_median": round(statistics.median(a.get("frame_us_median", 0) for a in answer)),
+        "estimator_odometry_us": round(statistics.median(
+            e.get("handler.base/odometry_us_median", 0) for e in handlers)),
+        "estimator_markers_us": round(statistics.median(
+            e.get("handler.vision/markers_us_median", 0) for e in handlers)),
     }
 
 

@@ -3,7 +3,9 @@
 A subscription hands its samples to the component's handler thread and decodes them there
 with the codec; it drops and counts malformed ones (``rejected.<topic>``), refuses a payload
 over the topic's ``max_bytes`` on arrival, before any copy or decoding (counted the same), and
-counts handler exceptions (``errors.<topic>``). Each input chooses what waits for the handler:
+counts handler exceptions (``errors.<topic>``); ``handler.<topic>_us_median`` and ``_us_p99``
+say how long its handler takes (``components.durations``). Each input chooses what waits for
+the handler:
 
 - ``latest`` (control): only the newest sample; one that arrives before the previous was
   handled replaces it (``overwritten.<topic>``);
@@ -16,6 +18,7 @@ from __future__ import annotations
 import collections
 import math
 import threading
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
@@ -25,6 +28,7 @@ import zenoh
 from pydantic import BaseModel
 
 from components.clock import Clock
+from components.durations import Durations
 from messages import codec, topics
 from messages.header import Header
 
@@ -130,6 +134,7 @@ class Subscription(Generic[M]):
         for kind in ("received", "rejected", "errors"):
             node.counters[f"{kind}.{topic.name}"] = 0
         node.counters[self._dropped] = 0
+        self._handler_time = Durations(node.counters, f"handler.{topic.name}")
         # indirect=False: called on the Zenoh thread that received the sample, so the samples of
         # one publisher's session reach the handler in the order they were put, across topics
         # (zenoh-python's default runs each subscriber's callback on a thread of its own).
@@ -196,8 +201,10 @@ class Subscription(Generic[M]):
         self.latest, self._received_ns = message, arrival_ns
         if self._handler is None:
             return
+        started = time.perf_counter()
         try:
             self._handler(message)
+            self._handler_time.note(time.perf_counter() - started)
         except Exception:
             self._node.counters[f"errors.{self.topic.name}"] += 1
             self._node.warn(f"errors.{self.topic.name}", f"handler of {self._key} failed", True)

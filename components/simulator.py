@@ -24,13 +24,13 @@ step goes on. The simulator starts when ``paused`` is set false (a profile may s
 
 from __future__ import annotations
 
-import collections
 import math
 import time
 from dataclasses import dataclass
 
 import numpy as np
 
+from components.durations import Durations
 from components.params import Param, ParamError
 from components.process_entry import run_component
 from components.pubsub import Input
@@ -83,10 +83,6 @@ class Awaited:
     topics: tuple[str, ...]
     since: float
     deadline: float
-
-
-LATENCY_WINDOW = 2000
-"""How many recent answer times the latency counters summarise."""
 
 
 class Simulator(Component):
@@ -162,7 +158,7 @@ class Simulator(Component):
         self.last_command_ns: int | None = None
         self.awaited: Awaited | None = None
         self.answered: dict[str, int] = {}
-        self.latencies: dict[str, collections.deque] = {}
+        self.answer_times = {k: Durations(node.counters, k) for k in ("frame", "loop")}
         node.counters["lockstep_timeouts"] = 0
         node.counters["contacts"] = 0
         self.publishers = {t.name: node.publisher(t) for t in self.writes}
@@ -237,20 +233,11 @@ class Simulator(Component):
         if awaited is None:
             return
         if all(self.answered.get(name, -1) >= awaited.stamp_ns for name in awaited.topics):
+            # Host time from publishing to the last answer: a camera frame to the tracker's
+            # markers and the estimator's obstacles, or the sensors to the controller's commands.
             kind = "frame" if "vision/markers" in awaited.topics else "loop"
-            self._note_latency(kind, time.monotonic() - awaited.since)
+            self.answer_times[kind].note(time.monotonic() - awaited.since)
             self._proceed()
-
-    def _note_latency(self, kind: str, seconds: float) -> None:
-        """Host time from publishing to the last answer: ``frame`` (camera frame to markers
-        and obstacles) or ``loop`` (sensors to commands, through estimator and controller);
-        median and p99 of the recent ones as counters, in us."""
-        recent = self.latencies.setdefault(kind, collections.deque(maxlen=LATENCY_WINDOW))
-        recent.append(seconds * 1e6)
-        if len(recent) % 50 == 0 or len(recent) < 50:
-            ordered = sorted(recent)
-            self.node.counters[f"{kind}_us_median"] = round(ordered[len(ordered) // 2])
-            self.node.counters[f"{kind}_us_p99"] = round(ordered[int(len(ordered) * 0.99)])
 
     def _proceed(self) -> None:
         """The awaited answers are in (or overdue): go on with the step or the next one."""

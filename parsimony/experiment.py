@@ -189,7 +189,7 @@ def run_experiment(options: Options) -> dict[str, Any]:
             query.set_param(session, profile.namespace, "simulator", "paused", "false")
             started = time.monotonic()
             messages = follow(recorder, options, started)
-            counters = simulator_counters(session, profile.namespace)
+            counters = component_counters(session, profile.namespace)
     finally:
         launcher.send_signal(signal.SIGINT)
         try:
@@ -250,9 +250,18 @@ def follow(recorder: Recorder, options: Options, started: float) -> dict[str, li
             return messages
 
 
-def simulator_counters(session: zenoh.Session, namespace: str) -> dict[str, int]:
-    status = query.statuses(session, namespace).get("simulator")
-    return dict(status.counters) if status is not None else {}
+def component_counters(session: zenoh.Session, namespace: str) -> dict[str, dict[str, int]]:
+    """Every component's counters at the end of the run."""
+    return {name: dict(s.counters) for name, s in query.statuses(session, namespace).items()}
+
+
+def durations(counters: dict[str, dict[str, int]]) -> dict[str, dict[str, int]]:
+    """The ``*_us_median`` and ``*_us_p99`` counters of each component: its handlers' times
+    and the simulator's answer times (``components.durations``)."""
+    return {
+        name: {k: v for k, v in sorted(found.items()) if k.endswith(("_us_median", "_us_p99"))}
+        for name, found in sorted(counters.items())
+    }
 
 
 def end_of_run(diagnostics: list, time_limit_s: float) -> tuple[int, bool]:
@@ -293,7 +302,8 @@ def wrap(angle: float) -> float:
 
 def build_report(
     options: Options, setup: SimScenario, profile: Profile, robot: MobileManipulator,
-    messages: dict[str, list], wall_s: float, counters: dict[str, int], converged: bool,
+    messages: dict[str, list], wall_s: float, counters: dict[str, dict[str, int]],
+    converged: bool,
 ) -> dict[str, Any]:  # fmt: skip
     truth, states = messages["sim/truth"], messages["robot/state"]
     diagnostics = messages["control/diagnostics"]
@@ -329,9 +339,8 @@ def build_report(
         "effort": effort(messages, truth),
         "step_time_us": {"median": round(float(np.median(solve)), 1),
                          "p99": round(float(np.percentile(solve, 99)), 1)},  # fmt: skip
-        "lockstep_timeouts": counters.get("lockstep_timeouts", 0),
-        "answer_time_us": {name: counters[name] for name in sorted(counters)
-                           if name.startswith(("frame_us", "loop_us"))},  # fmt: skip
+        "lockstep_timeouts": counters.get("simulator", {}).get("lockstep_timeouts", 0),
+        "durations_us": durations(counters),
         "controller_statuses": dict(sorted(Counter(d.status for d in diagnostics).items())),
         "degraded_states": sum(s.degraded for s in states),
         "invalid_states": sum(not s.valid for s in states),
