@@ -8,10 +8,12 @@ and optional ``distortion``).
 Output: ``vision/markers``, every scene marker found, its pose in the camera frame and the
 fit's reprojection error, stamped with the frame's stamp (an empty list when none is found:
 ``frames_without_markers`` counts them). Corners are refined to sub-pixel. The reference
-marker F0 is fitted by the square-marker method (``solvePnP`` IPPE) and low-pass filtered
-(eq. 6.1): it gives the floor plane. Every other marker lies flat at a known height above
-that floor, so its pose comes from the plane instead: the ray through its centre meets the
-plane, the yaw comes from its edges. Before F0 is seen, every marker gets the square fit.
+marker F0 is fitted by the square-marker method (``solvePnP`` IPPE; a fit tilted away from the
+filtered one, IPPE's other solution, is left out) and low-pass filtered (eq. 6.1): that gives
+the floor plane, on which F0's own position and yaw are then measured like the others'.
+Every other marker lies flat at a known height above that floor, so its pose comes from the
+plane instead: the ray through its centre meets the plane, the yaw comes from its edges.
+Before F0 is seen, every marker gets the square fit.
 """
 
 from __future__ import annotations
@@ -30,7 +32,13 @@ from messages.camera import CameraFrame
 from messages.markers import MarkerDetection, MarkerDetections
 from profiles.scene import Scene
 from vision.markers import Intrinsics, MarkerDetector, plane_of, plane_pose, square_pose
+from wbc import dq
 from wbc.pose_filter import PoseFilter
+
+FLIP_DEG = 3.0
+"""A square fit of F0 tilted this far from the filtered one is IPPE's wrong solution."""
+FLIP_MIN_SAMPLES = 10
+"""Fits filtered before the tilt check applies."""
 
 
 class VisionTracker(Component):
@@ -58,6 +66,7 @@ class VisionTracker(Component):
         node.counters["frames"] = 0
         node.counters["frames_without_markers"] = 0
         node.counters["unknown_markers"] = 0
+        node.counters["reference_flips"] = 0
         self.capture = None
         if node.params["device"]:
             self.capture, self.intrinsics = self._open_device()
@@ -84,7 +93,14 @@ class VisionTracker(Component):
         reference_pose = None
         if reference is not None:
             pose, error = square_pose(reference, self.scene.reference.size_m, intrinsics)
-            reference_pose = self.reference.update(pose)
+            if self._consistent(pose):
+                self.reference.update(pose)
+            reference_pose = self.reference.pose
+            if self.node.params["plane_fit"]:
+                # The floor plane from the filtered fits; F0's position and yaw on it.
+                normal, offset = plane_of(reference_pose, 0.0)
+                pose, error = plane_pose(reference, self.scene.reference.size_m, intrinsics,
+                                         normal, offset)  # fmt: skip
             found.append((reference.id, pose, error))
         elif self.reference.pose is not None:
             reference_pose = self.reference.pose
@@ -113,6 +129,19 @@ class VisionTracker(Component):
                 ),
             )
         )
+
+    def _consistent(self, pose: np.ndarray) -> bool:
+        """False for a square fit of F0 whose face normal is over ``FLIP_DEG`` from the
+        filtered one: IPPE's other solution (the two-fold ambiguity of a planar square),
+        counted as ``reference_flips`` and left out of the filter."""
+        if self.reference.pose is None or self.reference.count < FLIP_MIN_SAMPLES:
+            return True
+        normal = dq.rotation_matrix(dq.rotation(pose))[:, 2]
+        filtered = dq.rotation_matrix(dq.rotation(self.reference.pose))[:, 2]
+        if float(np.dot(normal, filtered)) >= np.cos(np.radians(FLIP_DEG)):
+            return True
+        self.node.count("reference_flips")
+        return False
 
     # -- a real camera ---------------------------------------------------------------------
 
