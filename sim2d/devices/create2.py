@@ -1,0 +1,222 @@
+"""An emulated iRobot Create 2 on a pseudo-terminal: a driver opens ``port`` (or the symlink)
+with pyserial as it would the robot's USB serial cable, and the emulator answers as the robot.
+
+The OI modes: Off until Start (128), which sets Passive (and stops the wheels); Safe (131) and
+Full (132) from any started mode. Drive Direct (145) acts in Safe and Full only, clamps each
+wheel to +-500 mm/s and sets the backend's wheel speeds (m/s) until the next command: the real
+robot has no command timeout. Stream (148 n ids) sends a frame of the requested packets every
+15 ms, encoders (43, 44) as counts mod 2^16; Pause/Resume Stream (150 0|1). Commands other than
+Start are ignored while Off. Bytes that start no known command are counted and skipped; packets
+other than the encoders are counted and left out of the frames. Safe mode's cliff and wheel-drop
+reflexes are not emulated.
+
+The backend is the world the robot drives in (``sim2d`` or a test double); the emulator calls it
+from its two threads under one lock, so the backend need not be thread-safe.
+"""
+
+from __future__ import annotations
+
+import enum
+import os
+import select
+import threading
+import time
+import tty
+from pathlib import Path
+from typing import Protocol
+
+from protocols import create_oi as oi
+
+READ_TIMEOUT_S = 0.02
+"""Longest wait of the reader thread for input, hence of ``stop`` for it."""
+
+_ENCODERS = (oi.LEFT_ENCODER, oi.RIGHT_ENCODER)
+
+
+class WheelBackend(Protocol):
+    def set_wheel_speeds(self, left: float, right: float) -> None:
+        """Commanded wheel speeds, m/s."""
+
+    def encoder_counts(self) -> tuple[int, int]:
+        """Cumulative (left, right) encoder counts, unwrapped."""
+
+
+class Mode(enum.Enum):
+    OFF = "off"
+    PASSIVE = "passive"
+    SAFE = "safe"
+    FULL = "full"
+
+
+_FIXED_DATA_LENGTHS: dict[int, int] = {
+    oi.START: 0,
+    oi.SAFE: 0,
+    oi.FULL: 0,
+    oi.DRIVE_DIRECT: 4,
+    oi.PAUSE_RESUME_STREAM: 1,
+}
+"""Data bytes after each opcode the emulator knows, but Stream's, which carries 1 + n."""
+_DRIVING_MODES = (Mode.SAFE, Mode.FULL)
+
+
+def _data_length(pending: bytes) -> int | None:
+    """Data bytes of the command ``pending`` begins with a known opcode; None while unknown."""
+    if pending[0] == oi.STREAM:
+        return 1 + pending[1] if len(pending) >= 2 else None
+    return _FIXED_DATA_LENGTHS[pending[0]]
+
+
+class Create2Emulator:
+    """The robot end of a pty. ``port`` is the slave's path, which a driver opens; ``mode`` the
+    OI mode; ``counters`` counts commands executed and ignored, bad bytes (no known opcode),
+    unsupported stream packets, frames sent and output bytes dropped while nobody read."""
+
+    def __init__(self, backend: WheelBackend, link: Path | None = None) -> None:
+        self._backend = backend
+        self._link = link
+        self._master, self._slave = os.openpty()
+        tty.setraw(self._slave)
+        os.set_blocking(self._master, False)
+        self.port = os.ttyname(self._slave)
+        if link is not None:
+            if link.is_symlink() or link.exists():
+                link.unlink()
+            link.symlink_to(self.port)
+        self.counters: dict[str, int] = dict.fromkeys(
+            (
+                "commands",
+                "ignored_commands",
+                "bad_bytes",
+                "unsupported_packets",
+                "frames_sent",
+                "bytes_dropped",
+            ),
+            0,
+        )
+        self.mode = Mode.OFF
+        self._pending = bytearray()
+        self._stream_ids: list[int] = []
+        self._streaming = False
+        self._lock = threading.Lock()
+        self._stopping = threading.Event()
+        self._threads = [
+            threading.Thread(target=self._read_loop, name="create2-reader", daemon=True),
+            threading.Thread(target=self._stream_loop, name="create2-stream", daemon=True),
+        ]
+        self._closed = False
+
+    def __enter__(self) -> Create2Emulator:
+        self.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    def start(self) -> None:
+        for thread in self._threads:
+            thread.start()
+
+    def stop(self) -> None:
+        """Stop both threads, close the pty and remove the link; safe to call twice."""
+        if self._closed:
+            return
+        self._closed = True
+        self._stopping.set()
+        for thread in self._threads:
+            if thread.is_alive():
+                thread.join()
+        os.close(self._master)
+        os.close(self._slave)
+        if self._link is not None and self._link.is_symlink():
+            if os.readlink(self._link) == self.port:
+                self._link.unlink()
+
+    def _read_loop(self) -> None:
+        while not self._stopping.is_set():
+            readable, _, _ = select.select([self._master], [], [], READ_TIMEOUT_S)
+            if not readable:
+                continue
+            try:
+                data = os.read(self._master, 4096)
+            except (BlockingIOError, InterruptedError):
+                continue
+            with self._lock:
+                for byte in data:
+                    self._receive(byte)
+
+    def _receive(self, byte: int) -> None:
+        """One byte from the driver: complete the pending command and execute it."""
+        if not self._pending and byte != oi.STREAM and byte not in _FIXED_DATA_LENGTHS:
+            self.counters["bad_bytes"] += 1
+            return
+        self._pending.append(byte)
+        needed = _data_length(self._pending)
+        if needed is None or len(self._pending) < 1 + needed:
+            return
+        command = bytes(self._pending)
+        self._pending.clear()
+        self._execute(command[0], command[1:])
+
+    def _execute(self, opcode: int, data: bytes) -> None:
+        if not self._accepts(opcode):
+            self.counters["ignored_commands"] += 1
+            return
+        self.counters["commands"] += 1
+        if opcode == oi.START:
+            if self.mode in _DRIVING_MODES:
+                self._backend.set_wheel_speeds(0.0, 0.0)
+            self.mode = Mode.PASSIVE
+        elif opcode == oi.SAFE:
+            self.mode = Mode.SAFE
+        elif opcode == oi.FULL:
+            self.mode = Mode.FULL
+        elif opcode == oi.DRIVE_DIRECT:
+            self._drive_direct(data)
+        elif opcode == oi.STREAM:
+            self._request_stream(data[1:])
+        elif opcode == oi.PAUSE_RESUME_STREAM:
+            self._streaming = data[0] != 0 and bool(self._stream_ids)
+
+    def _accepts(self, opcode: int) -> bool:
+        """Off accepts only Start; Drive Direct needs Safe or Full."""
+        if self.mode is Mode.OFF:
+            return opcode == oi.START
+        return opcode != oi.DRIVE_DIRECT or self.mode in _DRIVING_MODES
+
+    def _drive_direct(self, data: bytes) -> None:
+        right, left = (oi.clamp_wheel_speed(v) for v in oi.parse_drive_direct(data))
+        self._backend.set_wheel_speeds(left / 1000.0, right / 1000.0)
+
+    def _request_stream(self, packet_ids: bytes) -> None:
+        supported = [i for i in packet_ids if i in _ENCODERS]
+        self.counters["unsupported_packets"] += len(packet_ids) - len(supported)
+        self._stream_ids = supported
+        self._streaming = bool(supported)
+
+    def _stream_loop(self) -> None:
+        """A frame every STREAM_PERIOD_S on an absolute schedule; after a stall (more than one
+        period late) the schedule restarts from now instead of sending a burst."""
+        deadline = time.monotonic()
+        while not self._stopping.wait(max(0.0, deadline - time.monotonic())):
+            deadline += oi.STREAM_PERIOD_S
+            if time.monotonic() > deadline:
+                deadline = time.monotonic() + oi.STREAM_PERIOD_S
+            with self._lock:
+                frame = self._frame() if self._streaming else None
+            if frame is not None:
+                self._send(frame)
+
+    def _frame(self) -> bytes:
+        counts = dict(zip(_ENCODERS, self._backend.encoder_counts(), strict=True))
+        return oi.stream_frame({i: oi.packet_data(i, counts[i]) for i in self._stream_ids})
+
+    def _send(self, frame: bytes) -> None:
+        """Write to the master without blocking: when no driver reads, the pty buffer fills and
+        the rest of the frame is dropped (counted), as a robot's bytes go nowhere unplugged."""
+        try:
+            written = os.write(self._master, frame)
+        except BlockingIOError:
+            written = 0
+        self.counters["bytes_dropped"] += len(frame) - written
+        if written == len(frame):
+            self.counters["frames_sent"] += 1
