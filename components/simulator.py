@@ -120,6 +120,8 @@ class Simulator(Component):
               can_take=parses("goal_marker", 1, 3)),
         Param("hide_base_marker", str, "", doc="sim seconds 'from, to' the base marker is hidden",
               can_take=parses("hide_base_marker", None, 2)),
+        Param("host_epoch", bool, False,
+              doc="simulated time starts at the host's clock, to match drivers on host time"),
         Param("camera", bool, True, doc="render camera frames"),
         Param("image_noise", float, 2.0, low=0.0, high=50.0, doc="pixel noise std, grey levels"),
         Param("image_blur_px", float, 0.6, low=0.0, high=5.0, doc="Gaussian blur sigma, px"),
@@ -148,10 +150,10 @@ class Simulator(Component):
         self.world = World(self.robot, start, self.obstacles, settings, seed=p["seed"])
         self.rng = np.random.default_rng(p["seed"] + 1)
         self.step_ns = round(p["step_s"] * 1e9)
-        self.now_ns = 0
+        self.now_ns = time.time_ns() if p["host_epoch"] else 0
         self.camera = self._camera()
         self.frame_period_ns = round(1e9 / self.scene.camera.rate_hz)
-        self.next_frame_ns = 0
+        self.next_frame_ns = self.now_ns
         self.metres_per_count = wheel_distance_per_count(self.robot.base, settings.counts_per_turn)
         self.odometry_pose = (0.0, 0.0, 0.0)
         self.last_counts = self.world.encoder_counts
