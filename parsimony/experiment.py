@@ -17,6 +17,7 @@ effort of table 6.1 of the commands sent.
 
 from __future__ import annotations
 
+import bisect
 import dataclasses
 import hashlib
 import math
@@ -104,15 +105,24 @@ def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict
     if options.hide_base_marker is not None:
         simulator["hide_base_marker"] = ", ".join(str(v) for v in options.hide_base_marker)
     controller = {"module": MODULES[options.controller], "params": law_overrides(options)}
+    components = [
+        {"name": "simulator", "params": simulator},
+        {"name": "state_estimator", "params": {"task": setup.task}},
+        {"name": "controller", **controller},
+    ]
+    base_profile = load_profile(base)
+    if base_profile.component("simulator").module == "emulated_robot":
+        # The emulated devices' ports live in the run's directory: runs never share one.
+        devices = options.out.resolve() / "devices"
+        links = {"base_driver": devices / "create2", "arm_driver": devices / "servos"}
+        simulator |= {"create_link": str(links["base_driver"]),
+                      "servo_link": str(links["arm_driver"]), "host_epoch": True}  # fmt: skip
+        components += [{"name": n, "params": {"port": str(p)}} for n, p in links.items()]
     return {
         "extends": str(base.resolve()),
         "namespace": f"experiment{os.getpid()}",
         "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
-        "components": [
-            {"name": "simulator", "params": simulator},
-            {"name": "state_estimator", "params": {"task": setup.task}},
-            {"name": "controller", **controller},
-        ],
+        "components": components,
     }
 
 
@@ -160,7 +170,7 @@ def progress_line(messages: dict[str, list], wall_s: float) -> str:
     if not diagnostics:
         return f"[experiment] wall {wall_s:5.1f} s  waiting for the first control step"
     d = diagnostics[-1]
-    t = d.header.stamp_ns / 1e9
+    t = d.header.stamp_ns / 1e9 - min(origin_s(messages), d.header.stamp_ns / 1e9)
     error = "-" if d.error_norm is None else f"{d.error_norm:.4f}"
     return (f"[experiment] sim {t:6.2f} s  wall {wall_s:5.1f} s  error {error}  "
             f"nonzero {d.nonzero}  {d.status}")  # fmt: skip
@@ -199,7 +209,8 @@ def run_experiment(options: Options) -> dict[str, Any]:
             launcher.wait()
         log.close()
     wall_s = time.monotonic() - started
-    end_ns, converged = end_of_run(messages["control/diagnostics"], options.time_limit_s)
+    end_ns, converged = end_of_run(messages["control/diagnostics"], options.time_limit_s,
+                                   origin_s(messages))  # fmt: skip
     messages = until(messages, end_ns)
     report = build_report(options, setup, profile, robot, messages, wall_s, counters, converged)
     (options.out / "report.json").write_text(dumps(report))
@@ -242,11 +253,11 @@ def follow(recorder: Recorder, options: Options, started: float) -> dict[str, li
             print(progress_line(messages, wall), file=sys.stderr, flush=True)
             last_print = wall
         diagnostics = messages["control/diagnostics"]
-        sim_s = diagnostics[-1].header.stamp_ns / 1e9 if diagnostics else 0.0
+        now_s = diagnostics[-1].header.stamp_ns / 1e9 if diagnostics else 0.0
         since = converged_at(diagnostics)
-        if since is not None and sim_s - since >= HOLD_S:
+        if since is not None and now_s - since >= HOLD_S:
             return messages
-        if sim_s >= options.time_limit_s or wall > wall_limit:
+        if now_s - origin_s(messages) >= options.time_limit_s or wall > wall_limit:
             return messages
 
 
@@ -264,14 +275,21 @@ def durations(counters: dict[str, dict[str, int]]) -> dict[str, dict[str, int]]:
     }
 
 
-def end_of_run(diagnostics: list, time_limit_s: float) -> tuple[int, bool]:
+def origin_s(messages: dict[str, list]) -> float:
+    """The simulated time the run started at: its first ground truth (0 in lockstep, the host's
+    clock when the simulator keeps host time), s."""
+    truth = messages["sim/truth"]
+    return truth[0].header.stamp_ns / 1e9 if truth else math.inf
+
+
+def end_of_run(diagnostics: list, time_limit_s: float, origin: float) -> tuple[int, bool]:
     """The stamp (ns) a run ends at, ``HOLD_S`` after it converged, else the time limit (a
     simulated time: two lockstep runs of one set-up report the same steps); and whether it
     converged."""
     since = converged_at(diagnostics)
     if since is not None and diagnostics[-1].header.stamp_ns / 1e9 - since >= HOLD_S:
         return round((since + HOLD_S) * 1e9), True
-    return round(time_limit_s * 1e9), False
+    return round((origin + time_limit_s) * 1e9), False
 
 
 def until(messages: dict[str, list], end_ns: int) -> dict[str, list]:
@@ -307,7 +325,7 @@ def build_report(
 ) -> dict[str, Any]:  # fmt: skip
     truth, states = messages["sim/truth"], messages["robot/state"]
     diagnostics = messages["control/diagnostics"]
-    sim_s = truth[-1].header.stamp_ns / 1e9 if truth else 0.0
+    sim_s = (truth[-1].header.stamp_ns - truth[0].header.stamp_ns) / 1e9 if truth else 0.0
     end_s = diagnostics[-1].header.stamp_ns / 1e9 if diagnostics else 0.0
     goal = true_goal(setup, profile)
     final_error = None
@@ -369,13 +387,30 @@ def clearance(truth: list, setup: SimScenario, robot: MobileManipulator) -> floa
     return round(float(np.min(gaps)), 4)
 
 
+class Truth:
+    """The ground truth nearest a stamp (the same stamp in lockstep; on host time, as with
+    emulated devices, the simulator's step nearest the driver's reading)."""
+
+    def __init__(self, truth: list) -> None:
+        self.samples = sorted(truth, key=lambda t: t.header.stamp_ns)
+        self.stamps = [t.header.stamp_ns for t in self.samples]
+
+    def at(self, stamp_ns: int, within_ns: int = 20_000_000):
+        index = bisect.bisect_left(self.stamps, stamp_ns)
+        near = [i for i in (index - 1, index) if 0 <= i < len(self.stamps)]
+        if not near:
+            return None
+        best = min(near, key=lambda i: abs(self.stamps[i] - stamp_ns))
+        return self.samples[best] if abs(self.stamps[best] - stamp_ns) <= within_ns else None
+
+
 def estimator_error(truth: list, states: list, profile: Profile, since_s: float) -> dict:
     """The largest base position and heading error of the estimate against the truth, both in
     F0's frame, over the states stamped after ``since_s`` (the steady state)."""
-    by_stamp = {t.header.stamp_ns: t for t in truth}
+    nearest = Truth(truth)
     position, angle = [], []
     for state in states:
-        t = by_stamp.get(state.header.stamp_ns)
+        t = nearest.at(state.header.stamp_ns)
         if t is None or not state.valid or state.header.stamp_ns / 1e9 < since_s:
             continue
         x, y, phi = to_reference(t.base_pose, profile.scene.reference_pose)
@@ -390,14 +425,15 @@ def estimator_error(truth: list, states: list, profile: Profile, since_s: float)
 def effort(messages: dict[str, list], truth: list) -> dict[str, float]:
     """Table 6.1's four metrics of the commanded u = [x', y', phi', q'] (x' = v cos phi,
     y' = v sin phi with the true heading at the command's stamp)."""
-    heading = {t.header.stamp_ns: t.base_pose[2] for t in truth}
+    nearest = Truth(truth)
     arm = {a.header.stamp_ns: a.joint_velocities for a in messages["arm/command"]}
     rows, stamps = [], []
     for b in messages["base/command"]:
         stamp = b.header.stamp_ns
-        if stamp not in arm or stamp not in heading:
+        t = nearest.at(stamp)
+        if stamp not in arm or t is None:
             continue
-        phi = heading[stamp]
+        phi = t.base_pose[2]
         v, w = b.forward_velocity, b.angular_velocity
         rows.append([v * math.cos(phi), v * math.sin(phi), w, *arm[stamp]])
         stamps.append(stamp)
