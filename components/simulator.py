@@ -121,7 +121,7 @@ class Simulator(Component):
         Param("hide_base_marker", str, "", doc="sim seconds 'from, to' the base marker is hidden",
               can_take=parses("hide_base_marker", None, 2)),
         Param("host_epoch", bool, False,
-              doc="simulated time starts at the host's clock, to match drivers on host time"),
+              doc="stamp with the host's clock, to match drivers on host time (real time)"),
         Param("camera", bool, True, doc="render camera frames"),
         Param("image_noise", float, 2.0, low=0.0, high=50.0, doc="pixel noise std, grey levels"),
         Param("image_blur_px", float, 0.6, low=0.0, high=5.0, doc="Gaussian blur sigma, px"),
@@ -199,7 +199,9 @@ class Simulator(Component):
         """Advance one step; publish the clock, and the camera frame when one is due."""
         self._apply_commands()
         self.world.step(self.step_ns / 1e9)
-        self.now_ns += self.step_ns
+        # On host time the stamps are the host's: the paced steps lag it under load.
+        host = self.node.params["host_epoch"]
+        self.now_ns = time.time_ns() if host else self.now_ns + self.step_ns
         self.publishers["sim/clock"].put(Clock(stamp_ns=self.now_ns))
         if self.camera is not None and self.now_ns >= self.next_frame_ns:
             self.next_frame_ns += self.frame_period_ns

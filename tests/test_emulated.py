@@ -1,0 +1,148 @@
+"""The hardware profile against emulated devices: the same drivers, tracker, estimator and
+controller as on the real robot, the Create and the servos emulated byte for byte on
+pseudo-terminals and moving the simulated world. Real processes, real Zenoh on loopback."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+import zenoh
+
+from deploy import query
+from messages import codec, topics
+from profiles.profile import load_profile, read_profile_data
+
+DEPLOY = Path(__file__).resolve().parents[1] / "deploy"
+
+
+def components(path: Path) -> dict[str, dict]:
+    return {c["name"]: c for c in read_profile_data(path)["components"]}
+
+
+def test_emulated_differs_from_hardware_by_device_paths_and_camera_source_only() -> None:
+    hardware, emulated = components(DEPLOY / "hardware.yaml"), components(DEPLOY / "emulated.yaml")
+    changed = {
+        name: {key for key in set(spec) | set(hardware[name])
+               if spec.get(key) != hardware[name].get(key)}
+        for name, spec in emulated.items()
+    }  # fmt: skip
+    assert changed.pop("simulator") == {"enabled", "module", "params"}  # the emulated robot
+    for driver in ("base_driver", "arm_driver"):
+        params = (emulated[driver]["params"], hardware[driver]["params"])
+        assert {k for k in params[0] if params[0][k] != params[1].get(k)} == {"port"}
+    camera = (emulated["vision_tracker"]["params"], hardware["vision_tracker"]["params"])
+    assert {k for k in camera[0] if camera[0][k] != camera[1].get(k)} <= {"device", "calibration"}
+    assert {name for name, keys in changed.items() if keys} == {
+        "base_driver", "arm_driver", "vision_tracker"
+    }
+    sim = components(DEPLOY / "sim.yaml")
+    assert set(hardware) - set(sim) == {"base_driver", "arm_driver"}
+    assert hardware["simulator"]["enabled"] is False
+    for unchanged in ("state_estimator", "controller"):
+        assert hardware[unchanged]["module"] == sim[unchanged]["module"]
+    assert load_profile(DEPLOY / "emulated.yaml").clock == "wall"
+
+
+@pytest.mark.parametrize("seed", ["1", "2"])
+def test_the_pose_experiment_converges_through_the_emulated_devices(
+    tmp_path: Path, seed: str
+) -> None:
+    command = [sys.executable, "-m", "parsimony.cli", "experiment", "pose", "--profile",
+               str(DEPLOY / "emulated.yaml"), "--realtime", "--seed", seed, "--json",
+               "--out", str(tmp_path)]  # fmt: skip
+    done = subprocess.run(command, capture_output=True, text=True, timeout=300)
+    report = json.loads(done.stdout)
+    assert done.returncode == 0 and report["converged"], report
+    assert report["contacts"] == 0
+    assert report["joint_limit_violations"] == 0
+    assert report["final_error"] < 0.02
+    assert report["estimator_error"]["position_m"] < 0.02
+
+
+def test_a_killed_controller_leaves_the_robot_stopped_by_its_drivers(tmp_path: Path) -> None:
+    """The Create keeps its last Drive command for ever; the base driver's timeout stops it."""
+    data = {
+        "extends": str(DEPLOY / "emulated.yaml"),
+        "namespace": "killtest",
+        "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
+        "components": [
+            {"name": "simulator", "params": {"create_link": str(tmp_path / "create2"),
+                                             "servo_link": str(tmp_path / "servos")}},
+            {"name": "base_driver", "params": {"port": str(tmp_path / "create2")}},
+            {"name": "arm_driver", "params": {"port": str(tmp_path / "servos")}},
+            {"name": "controller", "restart": {"policy": "never"}},
+        ],
+    }  # fmt: skip
+    path = tmp_path / "profile.yaml"
+    path.write_text(yaml.safe_dump(data))
+    profile = load_profile(path)
+    launcher = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "launch", str(path)],
+                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
+    truth: list = []
+    try:
+        target = query.Target(profile.namespace, profile.zenoh)
+        session = open_session(target)
+        key = topics.SIM_TRUTH.key(profile.namespace)
+        session.declare_subscriber(
+            key, lambda s: truth.append(codec.decode(s.payload.to_bytes(), topics.SIM_TRUTH.type))
+        )
+        deadline = time.monotonic() + 60
+        while not moving(truth):
+            assert time.monotonic() < deadline and launcher.poll() is None, "never moved"
+            time.sleep(0.1)
+        controller = query.statuses(session, profile.namespace)["controller"]
+        os.kill(controller.pid, signal.SIGKILL)
+        killed_ns = time.time_ns()  # the simulator keeps host time (host_epoch)
+        time.sleep(1.5)
+        after = [t for t in truth if t.header.stamp_ns > killed_ns]
+        # Command timeout 0.2 s, then the wheels decelerate at 1 m/s^2 from under 0.25 m/s.
+        settled = [t for t in after if t.header.stamp_ns > killed_ns + 600_000_000]
+        assert len(settled) > 50
+        xs = [t.base_pose[0] for t in settled]
+        ys = [t.base_pose[1] for t in settled]
+        assert max(xs) - min(xs) < 1e-4 and max(ys) - min(ys) < 1e-4, (xs[0], xs[-1])
+        arm = [t.arm_joints for t in settled]
+        assert max(abs(a - b) for a, b in zip(arm[0], arm[-1], strict=True)) < 0.01
+        counters = query.statuses(session, profile.namespace)["base_driver"].counters
+        assert counters["stops"] >= 1
+        session.close()
+    finally:
+        launcher.send_signal(signal.SIGINT)
+        try:
+            launcher.wait(30)
+        except subprocess.TimeoutExpired:
+            launcher.kill()
+
+
+def moving(truth: list) -> bool:
+    """The base has moved over 2 cm and is still moving."""
+    if len(truth) < 20:
+        return False
+    first, before, last = truth[0].base_pose, truth[-20].base_pose, truth[-1].base_pose
+    return abs(last[0] - first[0]) > 0.02 and abs(last[0] - before[0]) > 1e-4
+
+
+def open_session(target: query.Target) -> zenoh.Session:
+    deadline = time.monotonic() + 30
+    while True:
+        try:
+            return target.open()
+        except query.QueryError:
+            assert time.monotonic() < deadline
+            time.sleep(0.1)  # the launcher opens its router first thing
+
+
+def free_port() -> int:
+    import socket
+
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
