@@ -1,0 +1,125 @@
+"""Serial round trips on the emulated devices, through the clients the drivers use.
+
+Run as ``python -m bench.serial_devices [--json]``. On the AX-18A chain emulator at 1 Mbps
+(return delay 500 us, the servos' default), with ROBOTIS's dynamixel-sdk: one servo's
+present position and speed (a 4-byte read), the Sync Write of five goals and speeds, and the
+joint-state rate one read per servo allows. On the Create 2 emulator, with pyserial: a Drive
+Direct written until the wheels take it, and the mean period of the encoder stream.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from collections.abc import Sequence
+
+import numpy as np
+import serial
+from dynamixel_sdk import COMM_SUCCESS, GroupSyncWrite, PacketHandler, PortHandler
+
+from parsimony.output import emit, result_only_stdout
+from protocols import create_oi
+from protocols import dynamixel_v1 as dxl
+from sim2d.devices.ax_servos import AXChainEmulator
+from sim2d.devices.create2 import Create2Emulator
+
+SAMPLES = 300
+
+
+class StillArm:
+    def joint_positions(self) -> Sequence[float]:
+        return (0.0, -0.2, 0.2, 0.0, 0.5)
+
+    def set_joint_velocities(self, velocities: Sequence[float]) -> None:
+        pass
+
+
+class Wheels:
+    """Notes when the wheels were last told a speed."""
+
+    def __init__(self) -> None:
+        self.told_ns = 0
+
+    def set_wheel_speeds(self, left: float, right: float) -> None:
+        self.told_ns = time.perf_counter_ns()
+
+    def encoder_counts(self) -> tuple[int, int]:
+        return 0, 0
+
+
+def figures(values_us: list[float]) -> dict[str, float]:
+    return {"median_us": round(float(np.median(values_us)), 1),
+            "p99_us": round(float(np.percentile(values_us, 99)), 1)}  # fmt: skip
+
+
+def servo_bus() -> dict:
+    with AXChainEmulator(StillArm()) as chain:
+        port, packet = PortHandler(chain.port), PacketHandler(1.0)
+        port.openPort()
+        port.setBaudRate(1_000_000)
+        reads, writes = [], []
+        for index in range(SAMPLES):
+            servo = 1 + index % 5
+            start = time.perf_counter()
+            _, result, _ = packet.readTxRx(port, servo, dxl.Address.PRESENT_POSITION, 4)
+            reads.append((time.perf_counter() - start) * 1e6)
+            if result != COMM_SUCCESS:
+                raise RuntimeError(packet.getTxRxResult(result))
+            group = GroupSyncWrite(port, packet, dxl.Address.GOAL_POSITION, 4)
+            for servo_id in range(1, 6):
+                group.addParam(servo_id, [0, 2, 100, 0])
+            start = time.perf_counter()
+            group.txPacket()
+            writes.append((time.perf_counter() - start) * 1e6)
+        port.closePort()
+    cycle_us = 5 * float(np.median(reads)) + float(np.median(writes))
+    return {"read_one_servo": figures(reads), "sync_write_five": figures(writes),
+            "joint_state_rate_hz": round(1e6 / cycle_us, 1)}  # fmt: skip
+
+
+def create_link() -> dict:
+    wheels = Wheels()
+    with Create2Emulator(wheels) as create:
+        client = serial.Serial(create.port, create_oi.BAUD, timeout=0.1)
+        client.write(bytes([create_oi.START, create_oi.SAFE]))
+        time.sleep(0.05)
+        latencies = []
+        for index in range(SAMPLES // 3):
+            before = wheels.told_ns
+            start = time.perf_counter_ns()
+            client.write(create_oi.drive_direct(100 + index % 2, 100))
+            while wheels.told_ns == before:
+                time.sleep(0)  # the emulator's reader thread takes it
+            latencies.append((wheels.told_ns - start) / 1e3)
+        client.write(create_oi.stream_request([create_oi.LEFT_ENCODER, create_oi.RIGHT_ENCODER]))
+        parser, stamps = create_oi.StreamParser(), []
+        while len(stamps) < 100:
+            for _ in parser.feed(client.read(64)):
+                stamps.append(time.perf_counter())
+        client.close()
+    # Frames arrive in bursts when the reader is late: the mean period over 100 frames.
+    period_ms = (stamps[-1] - stamps[0]) * 1e3 / (len(stamps) - 1)
+    return {"drive_direct_to_wheels": figures(latencies),
+            "stream_period_ms": round(period_ms, 2)}  # fmt: skip
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--json", action="store_true", help="print JSON instead of lines")
+    args = parser.parse_args(argv)
+    report = {"bench": "serial_devices", "servos": servo_bus(), "create": create_link()}
+    if args.json:
+        emit(json.dumps(report))
+    else:
+        for device in ("servos", "create"):
+            for name, value in report[device].items():
+                emit(f"{device:7} {name:24} {value}")
+    return 0
+
+
+if __name__ == "__main__":
+    with result_only_stdout():
+        code = main()
+    sys.exit(code)
