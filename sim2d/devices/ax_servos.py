@@ -30,13 +30,13 @@ import os
 import select
 import threading
 import time
-import tty
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Protocol
 
 from protocols import dynamixel_v1 as dxl
 from protocols.dynamixel_v1 import Address, Instruction, StatusError
+from sim2d.devices.pty_link import PtyLink
 
 READ_TIMEOUT_S = 0.02
 """Longest wait of the reader thread for input, hence of ``stop`` for it."""
@@ -257,21 +257,14 @@ class AXChainEmulator:
         return_delay_us: float = 500.0,
     ) -> None:
         self._backend = backend
-        self._link = link
         positions = backend.joint_positions()
         self.servos = [
             AXServo(servo_id, return_delay_us, position)
             for servo_id, position in zip(ids, positions, strict=True)
         ]
         self._previous_positions: list[float] = list(positions)
-        self._master, self._slave = os.openpty()
-        tty.setraw(self._slave)
-        os.set_blocking(self._master, False)
-        self.port = os.ttyname(self._slave)
-        if link is not None:
-            if link.is_symlink() or link.exists():
-                link.unlink()
-            link.symlink_to(self.port)
+        self._pty = PtyLink(link)
+        self.port = self._pty.port
         self.counters: dict[str, int] = dict.fromkeys(
             (
                 "packets",
@@ -308,11 +301,7 @@ class AXChainEmulator:
         self._stopping.set()
         if self._thread.is_alive():
             self._thread.join()
-        os.close(self._master)
-        os.close(self._slave)
-        if self._link is not None and self._link.is_symlink():
-            if os.readlink(self._link) == self.port:
-                self._link.unlink()
+        self._pty.close()
 
     def fail(self, servo_id: int, silent: bool = True) -> None:
         """Fault injection (see ``AXServo.fail``)."""
@@ -347,11 +336,11 @@ class AXChainEmulator:
 
     def _read_loop(self) -> None:
         while not self._stopping.is_set():
-            readable, _, _ = select.select([self._master], [], [], READ_TIMEOUT_S)
+            readable, _, _ = select.select([self._pty.master], [], [], READ_TIMEOUT_S)
             if not readable:
                 continue
             try:
-                data = os.read(self._master, 4096)
+                data = os.read(self._pty.master, 4096)
             except (BlockingIOError, InterruptedError):
                 continue
             for packet in self._parser.feed(data):
@@ -394,7 +383,7 @@ class AXChainEmulator:
         """Write to the master without blocking: when no driver reads, the pty buffer fills and
         the rest of the packet is dropped (counted), as a servo's bytes go nowhere unplugged."""
         try:
-            written = os.write(self._master, packet)
+            written = os.write(self._pty.master, packet)
         except BlockingIOError:
             written = 0
         self.counters["bytes_dropped"] += len(packet) - written

@@ -21,11 +21,11 @@ import os
 import select
 import threading
 import time
-import tty
 from pathlib import Path
 from typing import Protocol
 
 from protocols import create_oi as oi
+from sim2d.devices.pty_link import PtyLink
 
 READ_TIMEOUT_S = 0.02
 """Longest wait of the reader thread for input, hence of ``stop`` for it."""
@@ -73,15 +73,8 @@ class Create2Emulator:
 
     def __init__(self, backend: WheelBackend, link: Path | None = None) -> None:
         self._backend = backend
-        self._link = link
-        self._master, self._slave = os.openpty()
-        tty.setraw(self._slave)
-        os.set_blocking(self._master, False)
-        self.port = os.ttyname(self._slave)
-        if link is not None:
-            if link.is_symlink() or link.exists():
-                link.unlink()
-            link.symlink_to(self.port)
+        self._pty = PtyLink(link)
+        self.port = self._pty.port
         self.counters: dict[str, int] = dict.fromkeys(
             (
                 "commands",
@@ -125,19 +118,15 @@ class Create2Emulator:
         for thread in self._threads:
             if thread.is_alive():
                 thread.join()
-        os.close(self._master)
-        os.close(self._slave)
-        if self._link is not None and self._link.is_symlink():
-            if os.readlink(self._link) == self.port:
-                self._link.unlink()
+        self._pty.close()
 
     def _read_loop(self) -> None:
         while not self._stopping.is_set():
-            readable, _, _ = select.select([self._master], [], [], READ_TIMEOUT_S)
+            readable, _, _ = select.select([self._pty.master], [], [], READ_TIMEOUT_S)
             if not readable:
                 continue
             try:
-                data = os.read(self._master, 4096)
+                data = os.read(self._pty.master, 4096)
             except (BlockingIOError, InterruptedError):
                 continue
             with self._lock:
@@ -214,7 +203,7 @@ class Create2Emulator:
         """Write to the master without blocking: when no driver reads, the pty buffer fills and
         the rest of the frame is dropped (counted), as a robot's bytes go nowhere unplugged."""
         try:
-            written = os.write(self._master, frame)
+            written = os.write(self._pty.master, frame)
         except BlockingIOError:
             written = 0
         self.counters["bytes_dropped"] += len(frame) - written
