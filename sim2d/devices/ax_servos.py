@@ -26,9 +26,6 @@ against the emulator, only against whoever else steps it.
 from __future__ import annotations
 
 import math
-import os
-import select
-import threading
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -36,10 +33,8 @@ from typing import Protocol
 
 from protocols import dynamixel_v1 as dxl
 from protocols.dynamixel_v1 import Address, Instruction, StatusError
-from sim2d.devices.pty_link import PtyLink
+from sim2d.devices.pty_link import SerialDevice
 
-READ_TIMEOUT_S = 0.02
-"""Longest wait of the reader thread for input, hence of ``stop`` for it."""
 MODEL_NUMBER = 18
 MAX_SPEED_RAD_S = 97.0 * 2.0 * math.pi / 60.0
 """The AX-18A's no-load speed at 12 V, 97 rpm: Moving Speed 0 and anything above it."""
@@ -248,7 +243,7 @@ class AXServo:
         return StatusError(0)
 
 
-class AXChainEmulator:
+class AXChainEmulator(SerialDevice):
     def __init__(
         self,
         backend: ServoBackend,
@@ -263,45 +258,18 @@ class AXChainEmulator:
             for servo_id, position in zip(ids, positions, strict=True)
         ]
         self._previous_positions: list[float] = list(positions)
-        self._pty = PtyLink(link)
-        self.port = self._pty.port
-        self.counters: dict[str, int] = dict.fromkeys(
+        super().__init__(
+            link,
             (
                 "packets",
                 "bad_checksums",
                 "skipped_bytes",
                 "unanswered",
                 "status_sent",
-                "bytes_dropped",
                 "handler_errors",
             ),
-            0,
         )
         self._parser = dxl.PacketParser()
-        self._lock = threading.Lock()
-        self._stopping = threading.Event()
-        self._thread = threading.Thread(target=self._read_loop, name="ax-reader", daemon=True)
-        self._closed = False
-
-    def __enter__(self) -> AXChainEmulator:
-        self.start()
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.stop()
-
-    def start(self) -> None:
-        self._thread.start()
-
-    def stop(self) -> None:
-        """Stop the reader, close the pty and remove the link; safe to call twice."""
-        if self._closed:
-            return
-        self._closed = True
-        self._stopping.set()
-        if self._thread.is_alive():
-            self._thread.join()
-        self._pty.close()
 
     def fail(self, servo_id: int, silent: bool = True) -> None:
         """Fault injection (see ``AXServo.fail``)."""
@@ -334,19 +302,11 @@ class AXChainEmulator:
     def _servo(self, servo_id: int) -> AXServo | None:
         return next((servo for servo in self.servos if servo.id == servo_id), None)
 
-    def _read_loop(self) -> None:
-        while not self._stopping.is_set():
-            readable, _, _ = select.select([self._pty.master], [], [], READ_TIMEOUT_S)
-            if not readable:
-                continue
-            try:
-                data = os.read(self._pty.master, 4096)
-            except (BlockingIOError, InterruptedError):
-                continue
-            for packet in self._parser.feed(data):
-                self._handle_guarded(packet)
-            self.counters["bad_checksums"] = self._parser.bad_checksums
-            self.counters["skipped_bytes"] = self._parser.skipped_bytes
+    def receive(self, data: bytes) -> None:
+        for packet in self._parser.feed(data):
+            self._handle_guarded(packet)
+        self.counters["bad_checksums"] = self._parser.bad_checksums
+        self.counters["skipped_bytes"] = self._parser.skipped_bytes
 
     def _handle_guarded(self, packet: dxl.Packet) -> None:
         """A fault in handling one packet is counted, not fatal: a bus keeps going."""
@@ -380,12 +340,5 @@ class AXChainEmulator:
         self._send(dxl.status_packet(answer_id, *answer))
 
     def _send(self, packet: bytes) -> None:
-        """Write to the master without blocking: when no driver reads, the pty buffer fills and
-        the rest of the packet is dropped (counted), as a servo's bytes go nowhere unplugged."""
-        try:
-            written = os.write(self._pty.master, packet)
-        except BlockingIOError:
-            written = 0
-        self.counters["bytes_dropped"] += len(packet) - written
-        if written == len(packet):
+        if self.send(packet):
             self.counters["status_sent"] += 1

@@ -17,18 +17,13 @@ from its two threads under one lock, so the backend need not be thread-safe.
 from __future__ import annotations
 
 import enum
-import os
-import select
 import threading
 import time
 from pathlib import Path
 from typing import Protocol
 
 from protocols import create_oi as oi
-from sim2d.devices.pty_link import PtyLink
-
-READ_TIMEOUT_S = 0.02
-"""Longest wait of the reader thread for input, hence of ``stop`` for it."""
+from sim2d.devices.pty_link import SerialDevice
 
 _ENCODERS = (oi.LEFT_ENCODER, oi.RIGHT_ENCODER)
 
@@ -66,72 +61,35 @@ def _data_length(pending: bytes) -> int | None:
     return _FIXED_DATA_LENGTHS[pending[0]]
 
 
-class Create2Emulator:
+class Create2Emulator(SerialDevice):
     """The robot end of a pty. ``port`` is the slave's path, which a driver opens; ``mode`` the
     OI mode; ``counters`` counts commands executed and ignored, bad bytes (no known opcode),
     unsupported stream packets, frames sent and output bytes dropped while nobody read."""
 
     def __init__(self, backend: WheelBackend, link: Path | None = None) -> None:
         self._backend = backend
-        self._pty = PtyLink(link)
-        self.port = self._pty.port
-        self.counters: dict[str, int] = dict.fromkeys(
+        super().__init__(
+            link,
             (
                 "commands",
                 "ignored_commands",
                 "bad_bytes",
                 "unsupported_packets",
                 "frames_sent",
-                "bytes_dropped",
             ),
-            0,
         )
         self.mode = Mode.OFF
         self._pending = bytearray()
         self._stream_ids: list[int] = []
         self._streaming = False
-        self._lock = threading.Lock()
-        self._stopping = threading.Event()
-        self._threads = [
-            threading.Thread(target=self._read_loop, name="create2-reader", daemon=True),
-            threading.Thread(target=self._stream_loop, name="create2-stream", daemon=True),
-        ]
-        self._closed = False
+        self._threads.append(
+            threading.Thread(target=self._stream_loop, name="create2-stream", daemon=True)
+        )
 
-    def __enter__(self) -> Create2Emulator:
-        self.start()
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.stop()
-
-    def start(self) -> None:
-        for thread in self._threads:
-            thread.start()
-
-    def stop(self) -> None:
-        """Stop both threads, close the pty and remove the link; safe to call twice."""
-        if self._closed:
-            return
-        self._closed = True
-        self._stopping.set()
-        for thread in self._threads:
-            if thread.is_alive():
-                thread.join()
-        self._pty.close()
-
-    def _read_loop(self) -> None:
-        while not self._stopping.is_set():
-            readable, _, _ = select.select([self._pty.master], [], [], READ_TIMEOUT_S)
-            if not readable:
-                continue
-            try:
-                data = os.read(self._pty.master, 4096)
-            except (BlockingIOError, InterruptedError):
-                continue
-            with self._lock:
-                for byte in data:
-                    self._receive(byte)
+    def receive(self, data: bytes) -> None:
+        with self._lock:
+            for byte in data:
+                self._receive(byte)
 
     def _receive(self, byte: int) -> None:
         """One byte from the driver: complete the pending command and execute it."""
@@ -200,12 +158,5 @@ class Create2Emulator:
         return oi.stream_frame({i: oi.packet_data(i, counts[i]) for i in self._stream_ids})
 
     def _send(self, frame: bytes) -> None:
-        """Write to the master without blocking: when no driver reads, the pty buffer fills and
-        the rest of the frame is dropped (counted), as a robot's bytes go nowhere unplugged."""
-        try:
-            written = os.write(self._pty.master, frame)
-        except BlockingIOError:
-            written = 0
-        self.counters["bytes_dropped"] += len(frame) - written
-        if written == len(frame):
+        if self.send(frame):
             self.counters["frames_sent"] += 1

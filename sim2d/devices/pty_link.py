@@ -8,8 +8,14 @@ a fixed name for a profile.
 from __future__ import annotations
 
 import os
+import select
+import threading
 import tty
 from pathlib import Path
+from typing import Self
+
+READ_TIMEOUT_S = 0.02
+"""How long a reader waits for bytes before it looks whether it should stop."""
 
 
 class PtyLink:
@@ -33,3 +39,68 @@ class PtyLink:
         if self.link is not None and self.link.is_symlink():
             if os.readlink(self.link) == self.port:
                 self.link.unlink()
+
+
+class SerialDevice:
+    """An emulated device on a ``PtyLink``: a reader thread hands each chunk the driver wrote
+    to ``receive``; ``send`` writes without blocking (when no driver reads, the pty's buffer
+    fills and the rest is dropped and counted, as a device's bytes go nowhere unplugged).
+    Subclasses add their threads to ``_threads`` and their counters to ``counters``."""
+
+    name = "device"
+
+    def __init__(self, link: Path | None, counters: tuple[str, ...]) -> None:
+        self._pty = PtyLink(link)
+        self.port = self._pty.port
+        self.counters: dict[str, int] = dict.fromkeys((*counters, "bytes_dropped"), 0)
+        self._lock = threading.Lock()
+        self._stopping = threading.Event()
+        self._closed = False
+        reader = threading.Thread(target=self._read_loop, name=f"{self.name}-reader", daemon=True)
+        self._threads = [reader]
+
+    def __enter__(self) -> Self:
+        self.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    def start(self) -> None:
+        for thread in self._threads:
+            thread.start()
+
+    def stop(self) -> None:
+        """Stop the threads, close the pty and remove the link; safe to call twice."""
+        if self._closed:
+            return
+        self._closed = True
+        self._stopping.set()
+        for thread in self._threads:
+            if thread.is_alive():
+                thread.join()
+        self._pty.close()
+
+    def receive(self, data: bytes) -> None:
+        """Bytes the driver wrote (reader thread)."""
+        raise NotImplementedError
+
+    def send(self, data: bytes) -> bool:
+        """Write ``data`` to the driver; False when some of it was dropped."""
+        try:
+            written = os.write(self._pty.master, data)
+        except BlockingIOError:
+            written = 0
+        self.counters["bytes_dropped"] += len(data) - written
+        return written == len(data)
+
+    def _read_loop(self) -> None:
+        while not self._stopping.is_set():
+            readable, _, _ = select.select([self._pty.master], [], [], READ_TIMEOUT_S)
+            if not readable:
+                continue
+            try:
+                data = os.read(self._pty.master, 4096)
+            except (BlockingIOError, InterruptedError):
+                continue
+            self.receive(data)
