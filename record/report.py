@@ -1,0 +1,341 @@
+"""The figures and the control-effort table of section 6.2, from recorded sessions.
+
+A session maps a topic name (``messages.topics``) to the messages recorded on it. It needs
+``robot/state``, ``control/goal``, ``base/command``, ``arm/command`` and
+``control/diagnostics``; ``world/obstacles`` and ``sim/truth`` are drawn when present.
+Commands and diagnostics carry the stamp of the state they answer, so the control input
+u = [x', y', phi', q1'..q5'] of a stamp joins the base and arm commands of that stamp with
+x' = v cos(phi), y' = v sin(phi), phi' = omega, phi the heading of the nearest state.
+Times are in s from the session's first command.
+
+``write_report`` draws one or two sessions (e.g. the LP and the cascade law) side by side:
+
+    control_inputs.png     u over time (figs. 6.6, 6.11)
+    nonzero_entries.png    nonzero entries of u per iteration, and the practical count (6.7, 6.8)
+    error.png              e = x - x_d of the end effector, or p - p_d for a position task (6.9)
+    joints.png             q1..q5 against their limits, dashed green (6.10)
+    end_effector_path.png  x-y of the end effector and the goal (6.14)
+    base_path.png          x-y of the base and the obstacles
+    effort.json, effort.md the four metrics of table 6.1 (``wbc.kinematic_run.effort_of``)
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle
+
+from messages.goal import Goal
+from messages.topics import (
+    ARM_COMMAND,
+    BASE_COMMAND,
+    CONTROL_DIAGNOSTICS,
+    CONTROL_GOAL,
+    ROBOT_STATE,
+    SIM_TRUTH,
+    WORLD_OBSTACLES,
+    Topic,
+)
+from wbc import dq
+from wbc.kinematic_run import effort_of
+from wbc.robot import MobileManipulator
+
+Array = np.ndarray
+Session = Mapping[str, Sequence[Any]]
+
+METRICS: Mapping[str, tuple[str, str]] = {
+    "metric1": ("velocity_l1", r"$\int \lVert\dot{q}\rVert_1\,dt$"),
+    "metric2": ("velocity_l2", r"$\sqrt{\int \lVert\dot{q}\rVert_2^2\,dt}$"),
+    "metric3": ("acceleration_l1", r"$\int \lVert\ddot{q}\rVert_1\,dt$"),
+    "metric4": ("acceleration_l2", r"$\sqrt{\int \lVert\ddot{q}\rVert_2^2\,dt}$"),
+}
+"""Table 6.1's metrics: the ``ControlEffort`` field each reports, and its formula."""
+
+INPUT_NAMES = ("x'", "y'", "phi'", "q1'", "q2'", "q3'", "q4'", "q5'")
+"""The entries of u, in order."""
+
+
+def control_inputs(session: Session) -> tuple[Array, Array]:
+    """(t, u): times in s from the first command, and one row u = [x', y', phi', q1'..q5']
+    per stamp that has both a base and an arm command."""
+    stamps, u = _commands(session)
+    return (stamps - stamps[0]) * 1e-9, u
+
+
+def effort(session: Session) -> dict[str, float]:
+    """Table 6.1's metrics of the session's control inputs, as ``metric1`` .. ``metric4``."""
+    return _effort(*_commands(session))
+
+
+def write_report(
+    sessions: Sequence[tuple[str, Session]], robot: MobileManipulator, out: Path
+) -> dict:
+    """Write the figures and effort table of one or two (label, session) pairs into ``out``.
+
+    Every session is checked before anything is written; a missing or empty topic raises
+    ``ValueError`` naming it. Returns ``{"figures": [paths], "effort": {label: metrics}}``.
+    """
+    labels = [label for label, _ in sessions]
+    if not 1 <= len(sessions) <= 2:
+        raise ValueError(f"a report compares one or two sessions, got {len(sessions)}")
+    if len(set(labels)) != len(labels):
+        raise ValueError(f"session labels must differ, got {labels}")
+    recordings = [_recording(label, session) for label, session in sessions]
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    figures = []
+    for name, draw in _FIGURES.items():
+        figure = draw(recordings, robot)
+        figure.savefig(out / name, dpi=100)
+        figures.append(out / name)
+    efforts = {rec.label: _effort(rec.stamps_ns, rec.u) for rec in recordings}
+    (out / "effort.json").write_text(json.dumps(efforts, indent=2) + "\n")
+    (out / "effort.md").write_text(_effort_table(efforts))
+    return {"figures": figures, "effort": efforts}
+
+
+@dataclass(frozen=True)
+class _Recording:
+    """One session's messages, checked and sorted by stamp, with its control inputs."""
+
+    label: str
+    stamps_ns: Array
+    u: Array
+    states: list
+    goals: list
+    diagnostics: list
+    obstacles: list
+    truth: list
+
+    def seconds(self, messages: Sequence[Any]) -> Array:
+        """The stamps of ``messages`` in s from the first command."""
+        stamps = np.array([m.header.stamp_ns for m in messages], dtype=np.int64)
+        return (stamps - self.stamps_ns[0]) * 1e-9
+
+    def command_seconds(self) -> Array:
+        """The stamps of the rows of ``u`` in s from the first."""
+        return (self.stamps_ns - self.stamps_ns[0]) * 1e-9
+
+
+def _recording(label: str, session: Session) -> _Recording:
+    stamps, u = _commands(session)
+    return _Recording(
+        label=label,
+        stamps_ns=stamps,
+        u=u,
+        states=_messages(session, ROBOT_STATE),
+        goals=_messages(session, CONTROL_GOAL),
+        diagnostics=_messages(session, CONTROL_DIAGNOSTICS),
+        obstacles=_messages(session, WORLD_OBSTACLES, required=False),
+        truth=_messages(session, SIM_TRUTH, required=False),
+    )
+
+
+def _messages(session: Session, topic: Topic, required: bool = True) -> list:
+    """The messages on ``topic`` sorted by stamp; none is an error when ``required``."""
+    messages = session.get(topic.name) or []
+    if required and not messages:
+        raise ValueError(f"the session has no messages on topic {topic.name!r}")
+    wrong = [type(m).__name__ for m in messages if not isinstance(m, topic.type)]
+    if wrong:
+        raise ValueError(f"topic {topic.name!r} carries {topic.type.__name__}, got {wrong[0]}")
+    return sorted(messages, key=lambda m: m.header.stamp_ns)
+
+
+def _commands(session: Session) -> tuple[Array, Array]:
+    """(stamps in ns, u rows) of the stamps that have a base and an arm command."""
+    base = {m.header.stamp_ns: m for m in _messages(session, BASE_COMMAND)}
+    arm = {m.header.stamp_ns: m for m in _messages(session, ARM_COMMAND)}
+    stamps = np.array(sorted(base.keys() & arm.keys()), dtype=np.int64)
+    if stamps.size == 0:
+        raise ValueError(
+            f"no {BASE_COMMAND.name!r} message shares a stamp with {ARM_COMMAND.name!r}"
+        )
+    states = _messages(session, ROBOT_STATE)
+    state_stamps = np.array([s.header.stamp_ns for s in states], dtype=np.int64)
+    phi = np.array([states[i].base_pose[2] for i in _nearest(state_stamps, stamps)])
+    v = np.array([base[s].forward_velocity for s in stamps])
+    omega = np.array([base[s].angular_velocity for s in stamps])
+    joints = np.array([arm[s].joint_velocities for s in stamps])
+    u = np.column_stack((v * np.cos(phi), v * np.sin(phi), omega, joints))
+    return stamps, u
+
+
+def _nearest(sorted_stamps: Array, stamps: Array) -> Array:
+    """The index into ``sorted_stamps`` of the one nearest each of ``stamps``."""
+    if len(sorted_stamps) == 1:
+        return np.zeros(len(stamps), dtype=int)
+    after = np.clip(np.searchsorted(sorted_stamps, stamps), 1, len(sorted_stamps) - 1)
+    before = after - 1
+    nearer_before = stamps - sorted_stamps[before] <= sorted_stamps[after] - stamps
+    return np.where(nearer_before, before, after)
+
+
+def _effort(stamps_ns: Array, u: Array) -> dict[str, float]:
+    """``effort_of`` u with dt the median command period."""
+    if len(stamps_ns) < 2:
+        raise ValueError(f"the control effort needs two commands or more, got {len(stamps_ns)}")
+    dt = float(np.median(np.diff(stamps_ns))) * 1e-9
+    metrics = effort_of(u, dt)
+    return {name: getattr(metrics, field) for name, (field, _) in METRICS.items()}
+
+
+def _effort_table(efforts: Mapping[str, Mapping[str, float]]) -> str:
+    labels = [label.replace("|", r"\|") for label in efforts]
+    lines = [
+        "Control effort (table 6.1)",
+        "",
+        "| | Metric | " + " | ".join(labels) + " |",
+        "| :-: | :-- |" + " --: |" * len(labels),
+    ]
+    for number, (name, (_, formula)) in enumerate(METRICS.items(), start=1):
+        values = " | ".join(f"{metrics[name]:.4g}" for metrics in efforts.values())
+        lines.append(f"| {number} | {formula} | {values} |")
+    return "\n".join(lines) + "\n"
+
+
+def _panels(recordings: Sequence[_Recording], rows: int, height: float, **share: Any) -> tuple:
+    """A figure with ``rows`` panels per session, sessions side by side, labels as titles."""
+    figure = Figure(figsize=(6.0 * len(recordings), height), layout="constrained")
+    axes = figure.subplots(rows, len(recordings), squeeze=False, **share)
+    for ax, rec in zip(axes[0], recordings, strict=True):
+        ax.set_title(rec.label)
+    return figure, axes
+
+
+def _control_inputs_figure(recordings: Sequence[_Recording], _: MobileManipulator) -> Figure:
+    figure, axes = _panels(recordings, 1, 4.0, sharey=True)
+    for ax, rec in zip(axes[0], recordings, strict=True):
+        t = rec.command_seconds()
+        for column, name in enumerate(INPUT_NAMES):
+            ax.plot(t, rec.u[:, column], label=name, linewidth=1.0)
+        ax.set(xlabel="t (s)", ylabel="u (m/s, rad/s)")
+        ax.legend(ncols=4, fontsize="small")
+    return figure
+
+
+def _nonzero_figure(recordings: Sequence[_Recording], _: MobileManipulator) -> Figure:
+    figure, axes = _panels(recordings, 2, 5.0, sharex="col", sharey=True)
+    for column, rec in enumerate(recordings):
+        iteration = np.arange(len(rec.diagnostics))
+        counts = (
+            ("nonzero entries", [d.nonzero for d in rec.diagnostics]),
+            ("practical nonzero entries", [d.practical_nonzero for d in rec.diagnostics]),
+        )
+        for ax, (name, count) in zip(axes[:, column], counts, strict=True):
+            ax.step(iteration, count, where="post")
+            ax.set(ylabel=name, ylim=(-0.5, rec.u.shape[1] + 0.5))
+        axes[-1, column].set_xlabel("iteration")
+    return figure
+
+
+def _error_figure(recordings: Sequence[_Recording], _: MobileManipulator) -> Figure:
+    figure, axes = _panels(recordings, 1, 4.0, sharey=True)
+    for ax, rec in zip(axes[0], recordings, strict=True):
+        t, error, names = _task_error(rec)
+        for column, name in enumerate(names):
+            ax.plot(t, error[:, column], label=name, linewidth=1.0)
+        ax.set(xlabel="t (s)", ylabel="error")
+        ax.legend(ncols=4, fontsize="small")
+    return figure
+
+
+def _task_error(rec: _Recording) -> tuple[Array, Array, tuple[str, ...]]:
+    """(t, rows of e, names) of the states with a goal in force: the 8 coefficients of
+    x - x_d when every goal is a pose, else the translation error p - p_d."""
+    goal_stamps = np.array([g.header.stamp_ns for g in rec.goals], dtype=np.int64)
+    pose_only = all(g.task == "pose" for g in rec.goals)
+    used, rows = [], []
+    for state in rec.states:
+        index = int(np.searchsorted(goal_stamps, state.header.stamp_ns, side="right")) - 1
+        if index < 0:
+            continue
+        x, goal = np.array(state.end_effector), rec.goals[index]
+        if pose_only:
+            rows.append(x - dq.nearest_equivalent(np.array(goal.pose), x))
+        else:
+            rows.append(dq.translation(x)[1:] - _goal_position(goal))
+        used.append(state)
+    if not rows:
+        raise ValueError(f"no {ROBOT_STATE.name!r} message comes after the first goal")
+    names = tuple(f"e{i}" for i in range(1, 9)) if pose_only else ("e_x", "e_y", "e_z")
+    return rec.seconds(used), np.array(rows), names
+
+
+def _goal_position(goal: Goal) -> Array:
+    if goal.task == "pose":
+        return dq.translation(np.array(goal.pose))[1:]
+    return np.array(goal.position)
+
+
+def _joints_figure(recordings: Sequence[_Recording], robot: MobileManipulator) -> Figure:
+    joints = robot.arm_dof
+    figure, axes = _panels(recordings, joints, 2.0 * joints, sharex="col", sharey="row")
+    for column, rec in enumerate(recordings):
+        t = rec.seconds(rec.states)
+        q = np.array([s.arm_joints for s in rec.states])
+        for joint, ax in enumerate(axes[:, column]):
+            ax.plot(t, q[:, joint], linewidth=1.0)
+            for limit in (robot.q_min[3 + joint], robot.q_max[3 + joint]):
+                ax.axhline(limit, color="green", linestyle="--", linewidth=1.0)
+            ax.set_ylabel(f"q{joint + 1} (rad)")
+        axes[-1, column].set_xlabel("t (s)")
+    return figure
+
+
+def _end_effector_path_figure(recordings: Sequence[_Recording], _: MobileManipulator) -> Figure:
+    figure, axes = _panels(recordings, 1, 5.0)
+    for ax, rec in zip(axes[0], recordings, strict=True):
+        _path(ax, [dq.translation(np.array(s.end_effector))[1:3] for s in rec.states], "estimate")
+        if rec.truth:
+            truth = [dq.translation(np.array(s.end_effector))[1:3] for s in rec.truth]
+            _path(ax, truth, "truth", linestyle="--")
+        goals = np.array([_goal_position(g)[:2] for g in rec.goals])
+        ax.plot(goals[:, 0], goals[:, 1], "*", color="green", markersize=12, label="goal")
+        ax.legend(fontsize="small")
+    return figure
+
+
+def _base_path_figure(recordings: Sequence[_Recording], robot: MobileManipulator) -> Figure:
+    figure, axes = _panels(recordings, 1, 5.0)
+    for ax, rec in zip(axes[0], recordings, strict=True):
+        _path(ax, [s.base_pose[:2] for s in rec.states], "estimate")
+        if rec.truth:
+            _path(ax, [s.base_pose[:2] for s in rec.truth], "truth", linestyle="--")
+        x, y = rec.states[-1].base_pose[:2]
+        body = Circle((x, y), robot.base.body_radius, fill=False, color="gray", label="base body")
+        ax.add_patch(body)
+        circles = {(c.x, c.y, c.radius) for message in rec.obstacles for c in message.circles}
+        for index, (cx, cy, radius) in enumerate(sorted(circles)):
+            label = "obstacle" if index == 0 else None
+            ax.add_patch(Circle((cx, cy), radius, color="red", alpha=0.4, label=label))
+        ax.autoscale_view()
+        ax.legend(fontsize="small")
+    return figure
+
+
+def _path(ax: Axes, points: Sequence[Sequence[float]], label: str, **style: Any) -> None:
+    """A path in the x-y plane from a circle at its start to a square at its end."""
+    xy = np.array(points, dtype=float)
+    (line,) = ax.plot(xy[:, 0], xy[:, 1], label=label, linewidth=1.2, **style)
+    ax.plot(*xy[0], "o", color=line.get_color())
+    ax.plot(*xy[-1], "s", color=line.get_color())
+    ax.set(xlabel="x (m)", ylabel="y (m)", aspect="equal", adjustable="datalim")
+
+
+_FIGURES: Mapping[str, Callable[[Sequence[_Recording], MobileManipulator], Figure]] = {
+    "control_inputs.png": _control_inputs_figure,
+    "nonzero_entries.png": _nonzero_figure,
+    "error.png": _error_figure,
+    "joints.png": _joints_figure,
+    "end_effector_path.png": _end_effector_path_figure,
+    "base_path.png": _base_path_figure,
+}
+"""Every figure of the report, by file name."""

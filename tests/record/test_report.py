@@ -1,0 +1,213 @@
+"""record.report on sessions made of real kinematic runs of the LP and the cascade law."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from messages.commands import ArmCommand, BaseCommand
+from messages.diagnostics import ControllerDiagnostics
+from messages.goal import Goal
+from messages.header import Header
+from messages.obstacles import Circle, Obstacles
+from messages.state import RobotState
+from messages.topics import (
+    ARM_COMMAND,
+    BASE_COMMAND,
+    CONTROL_DIAGNOSTICS,
+    CONTROL_GOAL,
+    ROBOT_STATE,
+    SIM_TRUTH,
+    WORLD_OBSTACLES,
+)
+from messages.truth import SimTruth
+from record.report import control_inputs, write_report
+from wbc import dq, scenarios
+from wbc.base_motion import unicycle, wheel_speeds
+from wbc.cascade_law import CascadeLaw
+from wbc.kinematic_run import Run, effort_of, integrate
+from wbc.lp_law import LPLaw, LPParams
+from wbc.robot import MobileManipulator
+from wbc.task import PoseTask
+
+ROBOT = MobileManipulator.from_yaml(
+    Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"
+)
+DT = scenarios.DT
+DT_NS = round(DT * 1e9)
+START_NS = 1_000_000_000
+FIGURES = (
+    "control_inputs.png",
+    "nonzero_entries.png",
+    "error.png",
+    "joints.png",
+    "end_effector_path.png",
+    "base_path.png",
+)
+REQUIRED = (ROBOT_STATE, CONTROL_GOAL, BASE_COMMAND, ARM_COMMAND, CONTROL_DIAGNOSTICS)
+
+
+def header(stamp_ns: int, frame: str, seq: int) -> Header:
+    return Header(stamp_ns=stamp_ns, frame=frame, seq=seq, source="test")
+
+
+def session_of(run: Run, law: str, task: PoseTask) -> dict[str, list]:
+    """The messages a controller and a state estimator would publish over ``run``: each step's
+    state, and the commands and diagnostics answering it with the state's stamp."""
+    session: dict[str, list] = {
+        CONTROL_GOAL.name: [
+            Goal(header=header(START_NS, "world", 0), task="pose", pose=tuple(task.pose))
+        ]
+    }
+    for topic in (ROBOT_STATE, BASE_COMMAND, ARM_COMMAND, CONTROL_DIAGNOSTICS):
+        session[topic.name] = []
+    for seq, (q, out) in enumerate(zip(run.configurations, run.outputs, strict=True)):
+        stamp = START_NS + seq * DT_NS
+        base = wheel_speeds(*unicycle(out.u[0], out.u[1], out.u[2], q[2]), ROBOT.base)
+        session[ROBOT_STATE.name].append(
+            RobotState(
+                header=header(stamp, "world", seq),
+                base_pose=tuple(q[:3]),
+                arm_joints=tuple(q[3:]),
+                end_effector=tuple(ROBOT.fkm(q)),
+                valid=True,
+                age_s=0.0,
+            )
+        )
+        session[BASE_COMMAND.name].append(
+            BaseCommand(
+                header=header(stamp, "base", seq),
+                forward_velocity=base.forward,
+                angular_velocity=base.angular,
+                left_wheel=base.left_wheel,
+                right_wheel=base.right_wheel,
+            )
+        )
+        session[ARM_COMMAND.name].append(
+            ArmCommand(header=header(stamp, "arm", seq), joint_velocities=tuple(out.u[3:]))
+        )
+        session[CONTROL_DIAGNOSTICS.name].append(
+            ControllerDiagnostics(
+                header=header(stamp, "world", seq),
+                law=law,
+                status=out.status,
+                nonzero=out.nonzero,
+                practical_nonzero=out.practical_nonzero,
+                solve_time_us=out.solve_time_s * 1e6,
+                error_norm=out.error_norm,
+            )
+        )
+    return session
+
+
+@pytest.fixture(scope="module")
+def runs() -> dict[str, tuple[Run, dict[str, list]]]:
+    task = PoseTask(ROBOT.fkm(scenarios.REACH_GOAL))
+    laws = {"LP": LPLaw(ROBOT, LPParams()), "cascade": CascadeLaw(ROBOT)}
+    result = {}
+    for label, law in laws.items():
+        run = integrate(law, scenarios.HOME, task, DT, 1500)
+        assert run.converged
+        result[label] = (run, session_of(run, label, task))
+    return result
+
+
+@pytest.fixture(scope="module")
+def report(runs, tmp_path_factory) -> tuple[Path, dict]:
+    out = tmp_path_factory.mktemp("report")
+    sessions = [(label, session) for label, (_, session) in runs.items()]
+    return out, write_report(sessions, ROBOT, out)
+
+
+def test_every_figure_is_a_png_of_reasonable_size(report):
+    out, result = report
+    assert [path.name for path in result["figures"]] == list(FIGURES)
+    for name in FIGURES:
+        data = (out / name).read_bytes()
+        assert data.startswith(b"\x89PNG\r\n\x1a\n"), name
+        assert 10_000 < len(data) < 2_000_000, (name, len(data))
+
+
+def test_control_inputs_are_the_laws_u(runs):
+    for run, session in runs.values():
+        t, u = control_inputs(session)
+        np.testing.assert_allclose(t, DT * np.arange(len(run.outputs)), atol=1e-12)
+        np.testing.assert_allclose(u, run.velocities(), atol=1e-12)
+
+
+def test_effort_json_is_effort_of_the_control_inputs(report, runs):
+    out, result = report
+    written = json.loads((out / "effort.json").read_text())
+    assert written == result["effort"]
+    for label, (_, session) in runs.items():
+        metrics = effort_of(control_inputs(session)[1], DT)
+        expected = [
+            metrics.velocity_l1,
+            metrics.velocity_l2,
+            metrics.acceleration_l1,
+            metrics.acceleration_l2,
+        ]
+        got = [written[label][f"metric{i}"] for i in range(1, 5)]
+        np.testing.assert_allclose(got, expected, rtol=1e-9)
+
+
+def test_effort_table_has_a_row_per_metric_and_a_column_per_law(report):
+    out, _ = report
+    lines = (out / "effort.md").read_text().splitlines()
+    table = [line for line in lines if line.startswith("|")]
+    assert "LP" in table[0] and "cascade" in table[0]
+    rows = table[2:]
+    assert [row.split("|")[1].strip() for row in rows] == ["1", "2", "3", "4"]
+    assert all(len(row.strip("|").split("|")) == 4 for row in rows)
+
+
+def test_lp_spends_less_of_the_1_norm_than_the_cascade(report):
+    # Table 6.1 also has the pseudoinverse below LP in metric 2; in this run the cascade law
+    # takes 722 steps to LP's 529 and spends more in every metric, so only metric 1 is checked.
+    _, result = report
+    assert result["effort"]["LP"]["metric1"] < result["effort"]["cascade"]["metric1"]
+
+
+@pytest.mark.parametrize("topic", [topic.name for topic in REQUIRED])
+@pytest.mark.parametrize("empty", [False, True])
+def test_a_missing_or_empty_topic_is_named(runs, tmp_path, topic, empty):
+    session = dict(runs["LP"][1])
+    if empty:
+        session[topic] = []
+    else:
+        del session[topic]
+    with pytest.raises(ValueError, match=topic):
+        write_report([("LP", session)], ROBOT, tmp_path / "out")
+    assert not (tmp_path / "out").exists()
+
+
+def test_obstacles_truth_and_a_position_goal_render(runs, tmp_path):
+    recorded = runs["LP"][1]
+    session = dict(recorded)
+    obstacle = scenarios.OBSTACLE
+    circle = Circle(x=obstacle.x, y=obstacle.y, radius=obstacle.radius)
+    session[WORLD_OBSTACLES.name] = [
+        Obstacles(header=header(START_NS, "world", 0), circles=(circle,))
+    ]
+    session[SIM_TRUTH.name] = [
+        SimTruth(
+            header=state.header,
+            base_pose=state.base_pose,
+            arm_joints=state.arm_joints,
+            end_effector=state.end_effector,
+            contacts=0,
+            in_contact=False,
+        )
+        for state in recorded[ROBOT_STATE.name]
+    ]
+    position = dq.translation(ROBOT.fkm(scenarios.REACH_GOAL))[1:]
+    session[CONTROL_GOAL.name] = [
+        Goal(header=header(START_NS, "world", 0), task="position", position=tuple(position))
+    ]
+    result = write_report([("LP", session)], ROBOT, tmp_path)
+    assert (tmp_path / "base_path.png").read_bytes().startswith(b"\x89PNG")
+    assert len(result["figures"]) == len(FIGURES)
+    assert list(result["effort"]) == ["LP"]
