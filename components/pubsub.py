@@ -181,6 +181,11 @@ class Subscription(Generic[M]):
         self._node.warn(f"rejected.{self.topic.name}", f"dropped a {size}-byte message on "
                         f"{self._key}: over {self.topic.max_bytes} bytes")  # fmt: skip
 
+    def drain(self) -> None:
+        """Handler thread: deliver every sample still waiting (a recorder closing its file)."""
+        while self._waiting:
+            self._deliver()
+
     def _deliver(self) -> None:
         """Handler thread: decode the oldest waiting payload and call the handler; come back
         for the next one after the events already waiting (so timers keep their turn)."""

@@ -10,6 +10,7 @@ from parsimony.output import result_only_stdout
 
 COMMANDS = (
     "demo", "experiment", "bench", "launch", "status", "param", "node", "topic", "graph", "schema",
+    "record", "info", "replay", "report",
 )  # fmt: skip
 
 

@@ -41,7 +41,9 @@ import zenoh
 from deploy import query
 from messages import codec, topics
 from parsimony.kinematic_demo import LP_PARAMS
+from parsimony.sessions import load_session
 from profiles.profile import Profile, load_profile
+from record.report import write_report
 from sim2d.scenarios import SimScenario, scenario
 from wbc import dq
 from wbc.kinematic_run import effort_of
@@ -62,6 +64,8 @@ TIME_LIMIT_S = 60.0
 """Simulated seconds after which a run that has not converged stops."""
 STARTUP_S = 60.0
 """Host seconds the components may take to come up."""
+SESSION_FILE = "session.mcap"
+"""The recording of a run, beside its report."""
 LISTENED = ("sim/truth", "robot/state", "control/diagnostics", "base/command", "arm/command")
 
 
@@ -105,7 +109,10 @@ def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict
     if options.hide_base_marker is not None:
         simulator["hide_base_marker"] = ", ".join(str(v) for v in options.hide_base_marker)
     controller = {"module": MODULES[options.controller], "params": law_overrides(options)}
+    recorder = {"name": "recorder", "module": "recorder", "role": "tool",
+                "params": {"path": str((options.out / SESSION_FILE).resolve())}}  # fmt: skip
     components = [
+        recorder,
         {"name": "simulator", "params": simulator},
         {"name": "state_estimator", "params": {"task": setup.task}},
         {"name": "controller", **controller},
@@ -215,6 +222,9 @@ def run_experiment(options: Options) -> dict[str, Any]:
     report = build_report(options, setup, profile, robot, messages, wall_s, counters, converged)
     (options.out / "report.json").write_text(dumps(report))
     write_commands(options.out / "commands.csv", messages)
+    session = load_session(options.out / SESSION_FILE)
+    figures = write_report([(options.controller, session)], robot, options.out)["figures"]
+    report["figures"] = [str(path) for path in figures]
     return report
 
 

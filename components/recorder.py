@@ -1,0 +1,80 @@
+"""The recorder: every message of the namespace into an MCAP session file.
+
+Each topic of the table is read with a queue (``queue`` samples waiting at most), so no
+sample is dropped unless the writer falls that far behind, and then the loss is counted
+(``overflowed.<topic>``). Each message is written on the channel of its key with the
+project's schema, log time from its stamp (``record.session_file``), and beside it in
+Foxglove's well-known schemas (``record.foxglove_views``: images as ``foxglove.RawImage``,
+frames as ``foxglove.FrameTransforms``, obstacles as ``foxglove.SceneUpdate``), so that
+Foxglove's 3D, Image and Plot panels open the file as it is. ``keys`` limits the recording to
+topics whose names match one of its comma-separated ``fnmatch`` patterns.
+
+The current chunk is flushed every ``flush_s`` (SIGKILL loses at most that much); a clean stop
+writes the file's footer and index.
+"""
+
+from __future__ import annotations
+
+import fnmatch
+from pathlib import Path
+
+from components.params import Param, ParamError
+from components.process_entry import run_component
+from components.pubsub import Input
+from components.runtime import Component, Node
+from messages import topics
+from record.foxglove_views import views_of
+from record.session_file import SessionWriter, stamp_of
+
+QUEUE = 10_000
+"""Samples of one topic that may wait for the writer."""
+
+
+class Recorder(Component):
+    """Every topic in, one MCAP file out."""
+
+    reads = tuple(Input(topic, queue=QUEUE) for topic in topics.TOPICS.values())
+    writes = ()
+    params = (
+        Param("path", str, "session.mcap", doc="the MCAP file to write"),
+        Param("keys", str, "*", doc="comma-separated patterns of the topic names to record"),
+        Param("flush_s", float, 1.0, low=0.05, high=60.0, doc="chunk flush period, s"),
+        Param("views", bool, True, doc="also write Foxglove's well-known schemas"),
+    )
+
+    def __init__(self, node: Node) -> None:
+        super().__init__(node)
+        path = Path(str(node.params["path"]))
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            self.writer = SessionWriter(path)
+        except OSError as error:
+            raise ParamError(f"path: cannot write {path}: {error}") from error
+        patterns = [p.strip() for p in str(node.params["keys"]).split(",") if p.strip()]
+        node.counters["written"] = 0
+        self.inputs = [
+            node.subscribe(topic, self._writer_of(topic.name, topic.key(node.namespace)))
+            for topic in topics.TOPICS.values()
+            if any(fnmatch.fnmatch(topic.name, pattern) for pattern in patterns)
+        ]
+        node.timer(node.params["flush_s"], self.writer.flush)
+
+    def _writer_of(self, name: str, key: str):
+        def write(message) -> None:
+            self.writer.write(key, message)
+            if self.node.params["views"]:
+                for view in views_of(name, key, message):
+                    self.writer.write_raw(*view.channel(key), stamp_of(message))
+            self.node.counters["written"] += 1
+
+        return write
+
+    def shutdown(self) -> None:
+        """Write what still waits, then the footer: the file is whole."""
+        for subscription in self.inputs:
+            subscription.drain()
+        self.writer.close()
+
+
+if __name__ == "__main__":
+    run_component(Recorder)

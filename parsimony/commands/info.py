@@ -1,0 +1,41 @@
+"""`parsimony info FILE`: what a recorded session holds (see record.session_file.info)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from parsimony.output import emit
+from record.session_file import info
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    parser = subparsers.add_parser(
+        "info", help="channels, counts, rates, duration and schemas of a recording",
+        description="Reads every complete chunk, so a file whose recorder was killed works too.",
+    )  # fmt: skip
+    parser.add_argument("file", type=Path, help="MCAP session")
+    parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    return parser
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        found = info(args.file)
+    except OSError as error:
+        print(f"info: {error}", file=sys.stderr)
+        return 2
+    if args.json:
+        emit(json.dumps(found, indent=2))
+        return 0
+    rows = [("channel", "schema", "schema_bytes", "messages", "rate_hz")]
+    rows += [(c["key"], c["schema"], str(c["schema_bytes"]), str(c["messages"]),
+              str(c["rate_hz"])) for c in found["channels"]]  # fmt: skip
+    widths = [max(len(row[i]) for row in rows) for i in range(len(rows[0]))]
+    emit(f"{found['path']}: {found['messages']} messages, {found['bytes']} bytes, "
+         f"{found['duration_s']} s from {found['start_ns']} to {found['end_ns']} ns")  # fmt: skip
+    emit("\n".join("  ".join(cell.ljust(w) for cell, w in zip(row, widths, strict=True))
+                   for row in rows))  # fmt: skip
+    return 0

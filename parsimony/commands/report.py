@@ -1,0 +1,58 @@
+"""`parsimony report FILE [FILE2] --out DIR`: the chapter 6 figures and table 6.1 of recorded
+sessions (see record.report)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from parsimony.output import emit
+from parsimony.sessions import load_session
+from record.report import write_report
+from wbc.robot import MobileManipulator
+
+ROBOT = Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    parser = subparsers.add_parser(
+        "report", help="figures like 6.6 to 6.14 and table 6.1 of one or two recordings",
+        description="Write PNG figures (control inputs, nonzero entries, the error's eight "
+        "coefficients, joints against their limits, end-effector and base paths) and the four "
+        "effort metrics of table 6.1 (JSON and Markdown) into DIR; two files side by side.",
+    )  # fmt: skip
+    parser.add_argument("files", type=Path, nargs="+", metavar="FILE", help="MCAP sessions")
+    parser.add_argument("--labels", help="comma-separated labels (default: the law's name)")
+    parser.add_argument("--out", type=Path, required=True, help="directory of the figures")
+    parser.add_argument("--robot", type=Path, default=ROBOT, help="robot description")
+    parser.add_argument("--json", action="store_true", help="print the result as JSON")
+    return parser
+
+
+def run(args: argparse.Namespace) -> int:
+    if len(args.files) > 2:
+        print("report: one or two files", file=sys.stderr)
+        return 2
+    sessions = []
+    try:
+        for index, path in enumerate(args.files):
+            session = load_session(path)
+            sessions.append((label_of(args.labels, index, session, path), session))
+        args.out.mkdir(parents=True, exist_ok=True)
+        result = write_report(sessions, MobileManipulator.from_yaml(args.robot), args.out)
+    except (OSError, ValueError) as error:
+        print(f"report: {error}", file=sys.stderr)
+        return 2
+    result = {**result, "figures": [str(p) for p in result["figures"]]}
+    emit(json.dumps(result, indent=2) if args.json else "\n".join(result["figures"]))
+    return 0
+
+
+def label_of(labels: str | None, index: int, session: dict, path: Path) -> str:
+    """The user's label, else the law that made the recording, else the file's name."""
+    if labels:
+        return labels.split(",")[index].strip()
+    diagnostics = session.get("control/diagnostics") or []
+    return diagnostics[0].law if diagnostics else path.stem
