@@ -1,106 +1,165 @@
-"""The project's messages in Foxglove's well-known schemas, so that Foxglove's Image, 3D and
-Plot panels open a recording (or a live view) with no plugin.
+"""The project's messages in Foxglove's well-known schemas, so that Foxglove's Image and 3D
+panels open a recording (or a live view) with no plugin:
 
-    CameraFrame            -> foxglove.RawImage        (the same bytes: lossless)
-    RobotState, SimTruth   -> foxglove.FrameTransforms world -> <prefix>base, <prefix>end_effector
-    Goal (pose)            -> foxglove.FrameTransforms world -> goal
-    MarkerDetections       -> foxglove.FrameTransforms camera -> marker_<id>
-    Obstacles              -> foxglove.SceneUpdate     one cylinder per circle
+    CameraFrame            -> foxglove.RawImage         frame "camera", the same bytes (lossless)
+    RobotState             -> foxglove.FrameTransforms  world -> estimate/base,
+                                                        world -> estimate/end_effector
+    SimTruth               -> foxglove.FrameTransforms  world -> truth/base, truth/end_effector
+    MarkerDetections       -> foxglove.FrameTransforms  camera -> marker_<id>
+    Goal (pose task)       -> foxglove.FrameTransforms  world -> goal
+    Obstacles              -> foxglove.SceneUpdate      one cylinder per circle, frame "world"
 
-Each view goes on the channel ``<key>/foxglove``, protobuf-encoded by foxglove-sdk.
+The base transform is the planar pose (x, y, phi): translation (x, y, 0), rotation phi about z.
+A pose dual quaternion x gives translation(x) and rotation(x) (``wbc.dq``). Each view is
+protobuf, encoded by foxglove-sdk with its schema, and goes on the channel
+``<key>/foxglove`` (``View.channel``).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from foxglove import messages as fox
 
-from messages.camera import CHANNELS
+from messages import topics
+from messages.camera import CHANNELS, CameraFrame
+from messages.goal import Goal
+from messages.markers import MarkerDetections
+from messages.obstacles import Obstacles
+from messages.state import RobotState
+from messages.truth import SimTruth
 from wbc import dq
 
+CHANNEL_SUFFIX = "foxglove"
+"""A view of the message on key K goes on the channel ``K/foxglove``."""
 OBSTACLE_HEIGHT_M = 0.3
-"""How tall the 3D panel draws an obstacle."""
-SUFFIX = "foxglove"
+"""How tall the 3D panel draws an obstacle, m."""
+OBSTACLE_COLOR = fox.Color(r=0.8, g=0.2, b=0.2, a=0.8)
 
 
 @dataclass(frozen=True)
 class View:
     """One message in a well-known schema, ready for an MCAP channel or a live server."""
 
+    channel_suffix: str
     schema_name: str
     schema_encoding: str
     schema_data: bytes
     message_encoding: str
     data: bytes
-    message: object
 
     def channel(self, key: str) -> tuple[str, str, str, bytes, str, bytes]:
-        """The arguments of ``SessionWriter.write_raw`` before the log time."""
-        return (f"{key}/{SUFFIX}", self.schema_name, self.schema_encoding, self.schema_data,
-                "protobuf", self.data)  # fmt: skip
+        """The arguments of ``SessionWriter.write_raw`` before the log time, for the view of
+        the message on ``key``."""
+        return (f"{key}/{self.channel_suffix}", self.schema_name, self.schema_encoding,
+                self.schema_data, self.message_encoding, self.data)  # fmt: skip
 
 
-def _view(message) -> View:
+def view(message: Any) -> View:
+    """A foxglove-sdk message as a ``View``: its protobuf schema and bytes."""
     schema = type(message).get_schema()
-    return View(schema.name, schema.encoding, bytes(schema.data), "protobuf",
-                bytes(message.encode()), message)  # fmt: skip
+    return View(CHANNEL_SUFFIX, schema.name, schema.encoding, bytes(schema.data), "protobuf",
+                bytes(message.encode()))  # fmt: skip
 
 
-def _time(stamp_ns: int) -> fox.Timestamp:
+def timestamp(stamp_ns: int) -> fox.Timestamp:
     return fox.Timestamp(stamp_ns // 1_000_000_000, stamp_ns % 1_000_000_000)
 
 
-def _planar(parent: str, child: str, x: float, y: float, phi: float, stamp_ns: int):
+def planar_transform(
+    parent: str, child: str, base_pose: tuple[float, ...], stamp_ns: int
+) -> fox.FrameTransform:
+    """The transform of a planar pose (x, y, phi): translation (x, y, 0), phi about z."""
+    x, y, phi = base_pose
     return fox.FrameTransform(
-        timestamp=_time(stamp_ns), parent_frame_id=parent, child_frame_id=child,
+        timestamp=timestamp(stamp_ns), parent_frame_id=parent, child_frame_id=child,
         translation=fox.Vector3(x=x, y=y, z=0.0),
         rotation=fox.Quaternion(x=0.0, y=0.0, z=math.sin(phi / 2), w=math.cos(phi / 2)),
     )  # fmt: skip
 
 
-def _pose(parent: str, child: str, pose: tuple[float, ...], stamp_ns: int):
-    x = np.array(pose)
-    t, r = dq.translation(x)[1:], dq.rotation(x)
+def pose_transform(
+    parent: str, child: str, pose: tuple[float, ...], stamp_ns: int
+) -> fox.FrameTransform:
+    """The transform of a unit dual quaternion: its translation and rotation."""
+    x = np.asarray(pose, dtype=float)
+    t, r = dq.translation(x), dq.rotation(x)
     return fox.FrameTransform(
-        timestamp=_time(stamp_ns), parent_frame_id=parent, child_frame_id=child,
-        translation=fox.Vector3(x=float(t[0]), y=float(t[1]), z=float(t[2])),
+        timestamp=timestamp(stamp_ns), parent_frame_id=parent, child_frame_id=child,
+        translation=fox.Vector3(x=float(t[1]), y=float(t[2]), z=float(t[3])),
         rotation=fox.Quaternion(w=float(r[0]), x=float(r[1]), y=float(r[2]), z=float(r[3])),
     )  # fmt: skip
 
 
-def views_of(topic_name: str, key: str, message) -> list[View]:
-    """The well-known views of one message of ``topic_name`` (none for most topics)."""
-    stamp = getattr(getattr(message, "header", None), "stamp_ns", 0)
-    if topic_name == "camera/image":
-        return [_view(fox.RawImage(
-            timestamp=_time(stamp), frame_id="camera", width=message.width,
-            height=message.height, encoding=message.encoding,
-            step=message.width * CHANNELS[message.encoding], data=message.data,
-        ))]  # fmt: skip
-    if topic_name in ("robot/state", "sim/truth"):
-        prefix = "truth/" if topic_name == "sim/truth" else "estimate/"
-        return [_view(fox.FrameTransforms(transforms=[
-            _planar("world", prefix + "base", *message.base_pose, stamp),
-            _pose("world", prefix + "end_effector", message.end_effector, stamp),
+def image_views(frame: CameraFrame) -> list[View]:
+    return [view(fox.RawImage(
+        timestamp=timestamp(frame.header.stamp_ns), frame_id="camera", width=frame.width,
+        height=frame.height, encoding=frame.encoding,
+        step=frame.width * CHANNELS[frame.encoding], data=frame.data,
+    ))]  # fmt: skip
+
+
+def robot_views(prefix: str) -> Callable[[RobotState | SimTruth], list[View]]:
+    """Views of a robot's state, its frames named ``<prefix>base`` and ``<prefix>end_effector``."""
+
+    def views(state: RobotState | SimTruth) -> list[View]:
+        stamp = state.header.stamp_ns
+        return [view(fox.FrameTransforms(transforms=[
+            planar_transform("world", prefix + "base", state.base_pose, stamp),
+            pose_transform("world", prefix + "end_effector", state.end_effector, stamp),
         ]))]  # fmt: skip
-    if topic_name == "control/goal" and message.pose is not None:
-        return [_view(fox.FrameTransforms(transforms=[_pose("world", "goal", message.pose,
-                                                            stamp)]))]  # fmt: skip
-    if topic_name == "vision/markers":
-        transforms = [_pose("camera", f"marker_{m.id}", m.pose, stamp) for m in message.markers]
-        return [_view(fox.FrameTransforms(transforms=transforms))] if transforms else []
-    if topic_name == "world/obstacles":
-        entities = [fox.SceneEntity(
-            timestamp=_time(stamp), frame_id="world", id=f"obstacle_{index}",
-            cylinders=[fox.CylinderPrimitive(
-                pose=fox.Pose(position=fox.Vector3(x=c.x, y=c.y, z=OBSTACLE_HEIGHT_M / 2),
-                              orientation=fox.Quaternion(w=1.0)),
-                size=fox.Vector3(x=2 * c.radius, y=2 * c.radius, z=OBSTACLE_HEIGHT_M),
-                bottom_scale=1.0, top_scale=1.0, color=fox.Color(r=0.8, g=0.2, b=0.2, a=0.8),
-            )],
-        ) for index, c in enumerate(message.circles)]  # fmt: skip
-        return [_view(fox.SceneUpdate(entities=entities))]
-    return []
+
+    return views
+
+
+def marker_views(detections: MarkerDetections) -> list[View]:
+    stamp = detections.header.stamp_ns
+    transforms = [pose_transform("camera", f"marker_{m.id}", m.pose, stamp)
+                  for m in detections.markers]  # fmt: skip
+    return [view(fox.FrameTransforms(transforms=transforms))] if transforms else []
+
+
+def goal_views(goal: Goal) -> list[View]:
+    if goal.pose is None:
+        return []
+    transform = pose_transform("world", "goal", goal.pose, goal.header.stamp_ns)
+    return [view(fox.FrameTransforms(transforms=[transform]))]
+
+
+def obstacle_views(obstacles: Obstacles) -> list[View]:
+    """Every obstacle as a cylinder standing on the floor; the update first deletes all the
+    entities of the previous one, so obstacles that are gone disappear."""
+    stamp = timestamp(obstacles.header.stamp_ns)
+    entities = [fox.SceneEntity(
+        timestamp=stamp, frame_id="world", id=f"obstacle_{index}",
+        cylinders=[fox.CylinderPrimitive(
+            pose=fox.Pose(position=fox.Vector3(x=c.x, y=c.y, z=OBSTACLE_HEIGHT_M / 2),
+                          orientation=fox.Quaternion(w=1.0)),
+            size=fox.Vector3(x=2 * c.radius, y=2 * c.radius, z=OBSTACLE_HEIGHT_M),
+            bottom_scale=1.0, top_scale=1.0, color=OBSTACLE_COLOR,
+        )],
+    ) for index, c in enumerate(obstacles.circles)]  # fmt: skip
+    deletion = fox.SceneEntityDeletion(timestamp=stamp, type=fox.SceneEntityDeletionType.All)
+    return [view(fox.SceneUpdate(deletions=[deletion], entities=entities))]
+
+
+VIEWS: dict[str, Callable[[Any], list[View]]] = {
+    topics.CAMERA_IMAGE.name: image_views,
+    topics.ROBOT_STATE.name: robot_views("estimate/"),
+    topics.SIM_TRUTH.name: robot_views("truth/"),
+    topics.VISION_MARKERS.name: marker_views,
+    topics.CONTROL_GOAL.name: goal_views,
+    topics.WORLD_OBSTACLES.name: obstacle_views,
+}
+"""Topic name -> the views of one of its messages; topics not named here have none."""
+
+
+def views_of(topic_name: str, key: str, message: Any) -> list[View]:
+    """The well-known views of one message of ``topic_name``; each goes on
+    ``view.channel(key)``, beside the channel ``key`` the message itself is on."""
+    make = VIEWS.get(topic_name)
+    return make(message) if make is not None else []

@@ -1,11 +1,16 @@
-"""Sessions as MCAP files: one channel per key expression, each message with its schema.
+"""Sessions as MCAP files: one channel per key expression, every channel with its schema.
 
-The project's messages are written as JSON (schema encoding ``jsonschema``, the type's JSON
-Schema; ``bytes`` fields base64), so Foxglove plots them as they are, and read back into their
-pydantic types exactly (Python's JSON floats round-trip bit for bit). Other channels (the
-Foxglove views) are written raw. Chunks are zstd-compressed; ``flush`` closes the current one,
-so a writer killed by SIGKILL loses at most what came since. A file without a footer reads
-back by its complete chunks (``read_session``, ``info``) and ``recover`` makes it whole.
+The project's messages go in as JSON (message encoding ``json``, schema encoding
+``jsonschema``, schema name the type's name, schema data its JSON Schema, ``bytes`` fields as
+base64 strings marked ``"contentEncoding": "base64"``), so Foxglove plots them as they are, and
+come back into their pydantic types exactly: Python writes a float as its shortest repr, which
+reads back bit for bit. Other channels (the Foxglove views) are written as given
+(``write_raw``). Chunks are zstd-compressed; ``flush`` closes the current one and pushes it to
+the file, so a writer killed by SIGKILL loses only what came after its last flush.
+
+A file without a footer (its writer was killed) is read record by record with the streaming
+reader up to its last complete chunk: ``read_session`` and ``info`` work on it as they are, and
+``recover`` writes a whole file (footer, indexes, statistics) from it.
 """
 
 from __future__ import annotations
@@ -19,22 +24,30 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
-from mcap.exceptions import McapError
-from mcap.reader import NonSeekingReader
+from mcap.exceptions import EndOfFile, McapError
+from mcap.records import Channel, Footer, Message, Schema
+from mcap.stream_reader import StreamReader
 from mcap.writer import CompressionType, Writer
 from pydantic import BaseModel
 
 from messages import topics
 from messages.schema import json_schema
 
-PROJECT_ENCODING = "json"
+MESSAGE_ENCODING = "json"
 """The message encoding of the project's own channels."""
+SCHEMA_ENCODING = "jsonschema"
+"""The schema encoding of the project's own channels."""
+LIBRARY = "parsimony"
+"""What the MCAP header names as the writer."""
+SEQUENCE_MODULUS = 2**32
+"""MCAP's message sequence is a uint32 per channel; it wraps."""
 
 
 @dataclass(frozen=True)
 class Recorded:
-    """One message read back: its key, its topic's name (None for another channel), its log
-    time and the decoded message (None for a channel that is not the project's)."""
+    """One message read back: the channel's key, its topic's name in ``topics.TOPICS`` and the
+    decoded message, or ``None`` and ``None`` for a channel that is not one of the project's
+    (a Foxglove view), and the log time in ns."""
 
     key: str
     topic_name: str | None
@@ -43,48 +56,57 @@ class Recorded:
 
 
 def stamp_of(message: BaseModel) -> int:
-    """A message's stamp: its header's (a Clock has only ``stamp_ns``)."""
+    """A message's stamp in ns: its header's (a ``Clock`` has only ``stamp_ns``)."""
     header = getattr(message, "header", None)
     return header.stamp_ns if header is not None else message.stamp_ns
 
 
+@functools.cache
+def bytes_fields(message_type: type[BaseModel]) -> tuple[str, ...]:
+    """The top-level ``bytes`` fields of a type: written as base64 strings."""
+    return tuple(n for n, f in message_type.model_fields.items() if f.annotation is bytes)
+
+
 def to_json(message: BaseModel) -> bytes:
-    """The message as JSON, ``bytes`` fields as base64 strings."""
-    return json.dumps(message.model_dump(mode="python"), default=_bytes_as_text).encode()
-
-
-def _bytes_as_text(value: object) -> str:
-    if isinstance(value, bytes):
-        return base64.b64encode(value).decode()
-    raise TypeError(f"cannot write {type(value).__name__} as JSON")
+    """``message`` as compact JSON, its ``bytes`` fields base64 (nested bytes are refused)."""
+    fields = message.model_dump()
+    for name in bytes_fields(type(message)):
+        fields[name] = base64.b64encode(fields[name]).decode("ascii")
+    return json.dumps(fields, allow_nan=False, separators=(",", ":")).encode()
 
 
 def from_json(data: bytes, message_type: type[BaseModel]) -> BaseModel:
-    """The message of ``to_json``, exactly: base64 strings back into its ``bytes`` fields."""
+    """The message ``to_json`` wrote, exactly (``model_validate`` of the decoded JSON)."""
     fields = json.loads(data)
-    for name, field in message_type.model_fields.items():
-        if field.annotation is bytes and isinstance(fields.get(name), str):
-            fields[name] = base64.b64decode(fields[name])
+    for name in bytes_fields(message_type):
+        if isinstance(fields.get(name), str):
+            fields[name] = base64.b64decode(fields[name], validate=True)
     return message_type.model_validate(fields)
 
 
 @functools.cache
-def schema_bytes(message_type: type[BaseModel]) -> bytes:
-    """The JSON Schema of a message type, once per type (pydantic takes a millisecond)."""
-    return json.dumps(json_schema(message_type)).encode()
+def schema_of(message_type: type[BaseModel]) -> bytes:
+    """The JSON Schema of a type as written in the file, base64 fields marked as such."""
+    schema = json_schema(message_type)
+    properties = dict(schema["properties"])
+    for name in bytes_fields(message_type):
+        properties[name] = {**properties[name], "contentEncoding": "base64"}
+    return json.dumps({**schema, "properties": properties}).encode()
 
 
 class SessionWriter:
-    """An MCAP file being written (a context manager; ``close`` writes the footer)."""
+    """An MCAP file being written: a context manager, ``close`` writes the footer.
+
+    ``chunk_size`` is the uncompressed size (bytes) at which a chunk is closed on its own.
+    """
 
     def __init__(self, path: Path, chunk_size: int = 1024 * 1024) -> None:
-        self._file: IO[bytes] = Path(path).open("wb")
-        self._writer = Writer(self._file, chunk_size=chunk_size,
-                              compression=CompressionType.ZSTD)  # fmt: skip
-        self._writer.start(profile="", library="parsimony")
-        self._schemas: dict[tuple[str, str], int] = {}
+        self._file = Path(path).open("wb")
+        self._writer = Writer(self._file, chunk_size=chunk_size, compression=CompressionType.ZSTD)
+        self._writer.start(library=LIBRARY)
+        self._schemas: dict[tuple[str, str, bytes], int] = {}
         self._channels: dict[str, int] = {}
-        self._sequence = 0
+        self._sequences: dict[int, int] = {}
         self._closed = False
 
     def __enter__(self) -> SessionWriter:
@@ -94,87 +116,166 @@ class SessionWriter:
         self.close()
 
     def write(self, key: str, message: BaseModel, log_time_ns: int | None = None) -> None:
-        """``message`` on the channel of ``key``, logged at its stamp unless given."""
+        """``message`` as JSON on the channel ``key``, logged at its stamp unless given."""
         message_type = type(message)
-        schema = schema_bytes(message_type)
-        self.write_raw(key, message_type.__name__, "jsonschema", schema, PROJECT_ENCODING,
-                       to_json(message), stamp_of(message) if log_time_ns is None
-                       else log_time_ns)  # fmt: skip
+        log_time = stamp_of(message) if log_time_ns is None else log_time_ns
+        self.write_raw(key, message_type.__name__, SCHEMA_ENCODING, schema_of(message_type),
+                       MESSAGE_ENCODING, to_json(message), log_time)  # fmt: skip
 
-    def write_raw(self, key: str, schema_name: str, schema_encoding: str, schema_data: bytes,
-                  message_encoding: str, data: bytes, log_time_ns: int) -> None:  # fmt: skip
-        """Any message on the channel ``key`` (created with its schema on first use)."""
+    def write_raw(
+        self,
+        key: str,
+        schema_name: str,
+        schema_encoding: str,
+        schema_data: bytes,
+        message_encoding: str,
+        data: bytes,
+        log_time_ns: int,
+    ) -> None:
+        """``data`` on the channel ``key``, which is created with this schema on first use
+        (later calls' schema arguments are then not looked at); published now."""
         channel = self._channels.get(key)
         if channel is None:
-            schema = self._schemas.get((schema_name, schema_encoding))
-            if schema is None:
-                schema = self._writer.register_schema(schema_name, schema_encoding, schema_data)
-                self._schemas[(schema_name, schema_encoding)] = schema
-            channel = self._writer.register_channel(key, message_encoding, schema)
+            schema = (schema_name, schema_encoding, bytes(schema_data))
+            if schema not in self._schemas:
+                self._schemas[schema] = self._writer.register_schema(*schema)
+            channel = self._writer.register_channel(key, message_encoding, self._schemas[schema])
             self._channels[key] = channel
-        self._sequence += 1
-        self._writer.add_message(channel, log_time_ns, data, time.time_ns(), self._sequence)
+            self._sequences[channel] = 0
+        sequence = self._sequences[channel]
+        self._sequences[channel] = (sequence + 1) % SEQUENCE_MODULUS
+        self._writer.add_message(channel, log_time_ns, data, time.time_ns(), sequence)
 
     def flush(self) -> None:
-        """Close the current chunk and push it to the file: a kill loses nothing before."""
+        """Close the current chunk and push it to the file (no fsync): a kill loses nothing
+        written before."""
         if not self._closed:
             self._writer.flush()
 
     def close(self) -> None:
+        """Write the last chunk, the indexes and the footer; later calls do nothing."""
         if not self._closed:
             self._closed = True
             self._writer.finish()
             self._file.close()
 
 
-def _records(path: Path) -> Iterator[tuple[Any, Any, Any]]:
-    """(schema, channel, message) of every complete chunk, in file order; stops quietly where a
-    file without a footer ends."""
-    with Path(path).open("rb") as stream:
-        reader = NonSeekingReader(stream)
-        try:
-            yield from reader.iter_messages(log_time_order=False)
-        except (McapError, EOFError, ValueError, AssertionError):  # the cut at the end
-            return
+class _ExactReads:
+    """A binary file whose ``read(n)`` gives ``n`` bytes or raises ``EndOfFile``.
+
+    mcap's reader passes short reads on, so the cut of a file without a footer would surface
+    as a struct, zstd or UTF-8 error depending on where it fell; through this it is always
+    ``EndOfFile``, and every other fault stays an error.
+    """
+
+    def __init__(self, stream: IO[bytes]) -> None:
+        self._stream = stream
+
+    def read(self, length: int) -> bytes:
+        data = self._stream.read(length)
+        if len(data) < length:
+            raise EndOfFile()
+        return data
+
+
+class _Scan:
+    """``(schema or None, channel, message)`` of every complete chunk of a file, in file order.
+
+    Reading stops quietly where a file without a footer was cut (``EndOfFile``); any other
+    fault is raised. After iterating, ``complete`` says whether the footer was there.
+    """
+
+    def __init__(self, path: Path) -> None:
+        self.path = Path(path)
+        self.complete = False
+
+    def __iter__(self) -> Iterator[tuple[Schema | None, Channel, Message]]:
+        schemas: dict[int, Schema] = {}
+        channels: dict[int, Channel] = {}
+        with self.path.open("rb") as stream:
+            try:
+                for record in StreamReader(_ExactReads(stream)).records:
+                    if isinstance(record, Schema):
+                        schemas[record.id] = record
+                    elif isinstance(record, Channel):
+                        if record.schema_id != 0 and record.schema_id not in schemas:
+                            raise McapError(f"{self.path}: channel {record.topic!r} has no "
+                                            f"schema record {record.schema_id}")  # fmt: skip
+                        channels[record.id] = record
+                    elif isinstance(record, Message):
+                        channel = channels.get(record.channel_id)
+                        if channel is None:
+                            raise McapError(f"{self.path}: message on unknown channel "
+                                            f"{record.channel_id}")  # fmt: skip
+                        yield schemas.get(channel.schema_id), channel, record
+                    elif isinstance(record, Footer):
+                        self.complete = True
+            except EndOfFile:
+                return
+
+
+@functools.cache
+def _topic_of(key: str, schema_name: str) -> topics.Topic | None:
+    """The topic a project channel carries: its key ends with the suffix, the type matches."""
+    for topic in topics.TOPICS.values():
+        ends = key == topic.suffix or key.endswith("/" + topic.suffix)
+        if ends and topic.type.__name__ == schema_name:
+            return topic
+    return None
+
+
+def _project_topic(schema: Schema | None, channel: Channel) -> topics.Topic | None:
+    if schema is None or channel.message_encoding != MESSAGE_ENCODING:
+        return None
+    return _topic_of(channel.topic, schema.name)
 
 
 def read_session(path: Path) -> Iterator[Recorded]:
-    """Every message of a session file, its project's messages decoded, in log-time order."""
-    by_suffix = {topic.suffix: topic for topic in topics.TOPICS.values()}
-    found = []
-    for schema, channel, message in _records(path):
-        topic = None
-        if channel.message_encoding == PROJECT_ENCODING and schema is not None:
-            topic = next((t for suffix, t in by_suffix.items() if channel.topic.endswith(
-                "/" + suffix) and t.type.__name__ == schema.name), None)  # fmt: skip
+    """Every message of a session file (all its complete chunks if it has no footer), in
+    log-time order (stable: ties keep file order). The project's messages are decoded into
+    their types; other channels' messages (the Foxglove views) come with ``topic_name`` and
+    ``message`` None. Decoding is lazy, so a caller that skips images never builds them."""
+    found = sorted(_Scan(path), key=lambda record: record[2].log_time)
+    for schema, channel, message in found:
+        topic = _project_topic(schema, channel)
         decoded = from_json(message.data, topic.type) if topic is not None else None
         name = topic.name if topic is not None else None
-        found.append(Recorded(channel.topic, name, message.log_time, decoded))
-    found.sort(key=lambda r: r.log_time_ns)
-    yield from found
+        yield Recorded(channel.topic, name, message.log_time, decoded)
 
 
 def info(path: Path) -> dict[str, Any]:
-    """Channels (key, schema name and size, count, first and last log time, rate) and totals."""
-    channels: dict[str, dict[str, Any]] = {}
-    for schema, channel, message in _records(path):
-        entry = channels.setdefault(channel.topic, {
-            "key": channel.topic, "schema": schema.name if schema else "",
-            "schema_bytes": len(schema.data) if schema else 0,
-            "encoding": channel.message_encoding, "messages": 0, "bytes": 0,
-            "start_ns": message.log_time, "end_ns": message.log_time,
-        })  # fmt: skip
+    """What a session file holds: totals (messages, file bytes, start, end and duration,
+    ``complete``: whether the footer is there) and, per channel, its key, schema name,
+    encoding and size in bytes, message count and bytes, first and last log time and mean
+    rate (Hz, (count - 1) / span)."""
+    scan = _Scan(path)
+    channels: dict[int, dict[str, Any]] = {}
+    for schema, channel, message in scan:
+        entry = channels.get(channel.id)
+        if entry is None:
+            entry = channels[channel.id] = {
+                "key": channel.topic,
+                "schema": schema.name if schema is not None else "",
+                "schema_encoding": schema.encoding if schema is not None else "",
+                "schema_bytes": len(schema.data) if schema is not None else 0,
+                "encoding": channel.message_encoding,
+                "messages": 0,
+                "bytes": 0,
+                "start_ns": message.log_time,
+                "end_ns": message.log_time,
+            }
         entry["messages"] += 1
         entry["bytes"] += len(message.data)
         entry["start_ns"] = min(entry["start_ns"], message.log_time)
         entry["end_ns"] = max(entry["end_ns"], message.log_time)
     for entry in channels.values():
-        span = (entry["end_ns"] - entry["start_ns"]) / 1e9
-        entry["rate_hz"] = round((entry["messages"] - 1) / span, 2) if span > 0 else 0.0
+        span_s = (entry["end_ns"] - entry["start_ns"]) / 1e9
+        entry["rate_hz"] = round((entry["messages"] - 1) / span_s, 2) if span_s > 0 else 0.0
     start = min((c["start_ns"] for c in channels.values()), default=0)
     end = max((c["end_ns"] for c in channels.values()), default=0)
     return {
         "path": str(path),
+        "complete": scan.complete,
         "messages": sum(c["messages"] for c in channels.values()),
         "bytes": Path(path).stat().st_size,
         "start_ns": start,
@@ -185,13 +286,29 @@ def info(path: Path) -> dict[str, Any]:
 
 
 def recover(source: Path, target: Path) -> int:
-    """A whole file (footer, index) at ``target`` of what survives in ``source``; the number of
-    messages saved."""
+    """Write at ``target`` a whole file (footer, indexes, statistics) of every message that
+    survives in ``source`` (a file without a footer, or a whole one), schemas, channels,
+    times and sequence numbers unchanged, in file order; return the number of messages."""
+    if Path(source).resolve() == Path(target).resolve():
+        raise ValueError(f"recover: {source} would be overwritten while it is read")
+    schema_ids: dict[int, int] = {0: 0}
+    channel_ids: dict[int, int] = {}
     saved = 0
-    with SessionWriter(target) as writer:
-        for schema, channel, message in _records(source):
-            writer.write_raw(channel.topic, schema.name if schema else "",
-                             schema.encoding if schema else "", schema.data if schema else b"",
-                             channel.message_encoding, message.data, message.log_time)  # fmt: skip
+    with Path(target).open("wb") as stream:
+        writer = Writer(stream, compression=CompressionType.ZSTD)
+        writer.start(library=LIBRARY)
+        for schema, channel, message in _Scan(source):
+            if schema is not None and schema.id not in schema_ids:
+                schema_ids[schema.id] = writer.register_schema(
+                    schema.name, schema.encoding, schema.data
+                )
+            if channel.id not in channel_ids:
+                channel_ids[channel.id] = writer.register_channel(
+                    channel.topic, channel.message_encoding, schema_ids[channel.schema_id],
+                    channel.metadata,
+                )  # fmt: skip
+            writer.add_message(channel_ids[channel.id], message.log_time, message.data,
+                               message.publish_time, message.sequence)  # fmt: skip
             saved += 1
+        writer.finish()
     return saved

@@ -70,4 +70,7 @@ def run(args: argparse.Namespace) -> int:
         summary = {k: report[k] for k in keys}
         emit(" ".join(f"{k}={v}" for k, v in summary.items()))
     print(f"[experiment] report: {args.out / 'report.json'}", file=sys.stderr)
+    print(f"[experiment] figures: {', '.join(report.get('figures', []))}", file=sys.stderr)
+    print(f"[experiment] recording: {args.out / 'session.mcap'} (parsimony info, replay, "
+          "report; Foxglove opens it)", file=sys.stderr)  # fmt: skip
     return 0 if report["converged"] else EXIT_NOT_CONVERGED

@@ -1,0 +1,266 @@
+"""record.foxglove_views: each view decoded with nothing but its own schema (the protobuf
+FileDescriptorSet written beside it; a small wire-format reader below, protobuf itself is not
+installed) carries the message's data."""
+
+from __future__ import annotations
+
+import math
+import random
+import struct
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from foxglove import messages as fox
+from mcap.reader import make_reader
+
+from messages import topics
+from messages.camera import CameraFrame
+from messages.commands import BaseCommand
+from messages.goal import Goal
+from messages.header import Header
+from messages.markers import MarkerDetection, MarkerDetections
+from messages.obstacles import Circle, Obstacles
+from messages.state import RobotState
+from messages.truth import SimTruth
+from record.foxglove_views import OBSTACLE_HEIGHT_M, View, views_of
+from record.session_file import SessionWriter, stamp_of
+from wbc import dq
+
+STAMP_NS = 1_700_000_000_123_456_789
+HEADER = Header(stamp_ns=STAMP_NS, frame="world", seq=3, source="test")
+KEY = "sim/robot/state"
+
+# ---- protobuf wire format, read with the schema's own descriptors -------------------------
+
+REPEATED = 3
+MESSAGE, STRING = 11, 9
+FIXED_WIDTH = {1: "<d", 2: "<f", 6: "<Q", 7: "<I", 15: "<i", 16: "<q"}
+"""struct formats of the fixed-width scalar types (double, float, fixed64, fixed32, sfixed)."""
+
+
+def wire_fields(data: bytes) -> list[tuple[int, int, Any]]:
+    """(field number, wire type, raw value) of every field of one protobuf message."""
+    fields, at = [], 0
+
+    def varint() -> int:
+        nonlocal at
+        value = shift = 0
+        while True:
+            byte = data[at]
+            at += 1
+            value |= (byte & 0x7F) << shift
+            shift += 7
+            if byte < 0x80:
+                return value
+
+    while at < len(data):
+        tag = varint()
+        number, wire = tag >> 3, tag & 7
+        if wire == 0:
+            value = varint()
+        elif wire == 1:
+            value, at = data[at : at + 8], at + 8
+        elif wire == 2:
+            length = varint()
+            value, at = data[at : at + length], at + length
+        elif wire == 5:
+            value, at = data[at : at + 4], at + 4
+        else:
+            raise AssertionError(f"wire type {wire}")
+        fields.append((number, wire, value))
+    return fields
+
+
+def descriptors(file_descriptor_set: bytes) -> dict[str, dict[int, tuple[str, int, int, str]]]:
+    """Full message name -> field number -> (name, label, type, type name)."""
+    found = {}
+
+    def add(prefix: str, descriptor: bytes) -> None:
+        parts = wire_fields(descriptor)
+        name = f"{prefix}.{next(v.decode() for n, _, v in parts if n == 1)}"
+        fields = {}
+        for number, _, value in parts:
+            if number == 2:  # FieldDescriptorProto: name 1, number 3, label 4, type 5, type 6
+                field = {n: v for n, _, v in wire_fields(value)}
+                fields[field[3]] = (field[1].decode(), field[4], field[5],
+                                    field.get(6, b"").decode())  # fmt: skip
+            elif number == 3:  # a nested DescriptorProto
+                add(name, value)
+        found[name] = fields
+
+    for number, _, file in wire_fields(file_descriptor_set):
+        assert number == 1
+        parts = wire_fields(file)
+        package = next((v.decode() for n, _, v in parts if n == 2), "")
+        for n, _, value in parts:
+            if n == 4:
+                add(f".{package}" if package else "", value)
+    return found
+
+
+def decode(view: View) -> dict[str, Any]:
+    """The view's message as a dict, read with its schema (absent fields are proto3 zeros)."""
+    assert (view.schema_encoding, view.message_encoding) == ("protobuf", "protobuf")
+    types = descriptors(view.schema_data)
+
+    def read(type_name: str, data: bytes) -> dict[str, Any]:
+        out: dict[str, Any] = {}
+        for number, _, raw in wire_fields(data):
+            name, label, kind, nested = types[type_name][number]
+            if kind == MESSAGE:
+                value = read(nested, raw)
+            elif kind == STRING:
+                value = raw.decode()
+            elif kind in FIXED_WIDTH:
+                value = struct.unpack(FIXED_WIDTH[kind], raw)[0]
+            else:
+                value = raw  # bytes, or the integer of a varint
+            if label == REPEATED:
+                out.setdefault(name, []).append(value)
+            else:
+                out[name] = value
+        return out
+
+    return read(f".{view.schema_name}", view.data)
+
+
+def vector(message: dict[str, Any], names: str) -> list[float]:
+    return [message.get(n, 0.0) for n in names]
+
+
+# ---- the views ------------------------------------------------------------------------------
+
+
+def pose_dq(angle_z: float, translation: tuple[float, float, float]) -> tuple[float, ...]:
+    """The unit dual quaternion r + eps t r / 2 of a rotation about z, then a translation."""
+    r = np.array([math.cos(angle_z / 2), 0.0, 0.0, math.sin(angle_z / 2)])
+    t = np.array([0.0, *translation])
+    return tuple(float(v) for v in (*r, *(0.5 * dq.qmul(t, r))))
+
+
+@pytest.mark.parametrize("encoding", ["mono8", "bgr8", "rgb8"])
+def test_an_image_is_a_raw_image_with_the_same_bytes(encoding: str) -> None:
+    width, height, channels = 32, 24, 1 if encoding == "mono8" else 3
+    pixels = random.Random(encoding).randbytes(width * height * channels)
+    frame = CameraFrame.model_validate({
+        "header": HEADER, "encoding": encoding, "width": width, "height": height,
+        "data": pixels, "intrinsics": {"fx": 40.0, "fy": 40.0, "cx": 15.5, "cy": 11.5},
+    })  # fmt: skip
+    (view,) = views_of(topics.CAMERA_IMAGE.name, "sim/camera/image", frame)
+    assert view.schema_name == "foxglove.RawImage"
+    assert view.schema_data == fox.RawImage.get_schema().data
+    image = decode(view)
+    assert image["data"] == pixels
+    assert (image["width"], image["height"], image["encoding"]) == (width, height, encoding)
+    assert (image["step"], image["frame_id"]) == (width * channels, "camera")
+    assert (image["timestamp"]["seconds"], image["timestamp"]["nanos"]) == (
+        1_700_000_000,
+        123_456_789,
+    )
+
+
+def transforms_of(view: View) -> dict[str, dict[str, Any]]:
+    assert view.schema_name == "foxglove.FrameTransforms"
+    return {t["child_frame_id"]: t for t in decode(view)["transforms"]}
+
+
+@pytest.mark.parametrize(("message_type", "prefix"), [(RobotState, "estimate/"),
+                                                      (SimTruth, "truth/")])  # fmt: skip
+def test_a_robot_state_gives_the_base_and_end_effector_frames(message_type, prefix) -> None:
+    fields = {"header": HEADER, "base_pose": (1.5, -2.0, 0.6),
+              "arm_joints": (0.1, -0.2, 0.3, -0.4, 0.5),
+              "end_effector": pose_dq(math.pi / 2, (0.7, 0.2, 0.45))}  # fmt: skip
+    if message_type is RobotState:
+        fields |= {"valid": True, "age_s": 0.01}
+    else:
+        fields |= {"contacts": 0, "in_contact": False}
+    topic = topics.ROBOT_STATE if message_type is RobotState else topics.SIM_TRUTH
+    (view,) = views_of(topic.name, KEY, message_type(**fields))
+    frames = transforms_of(view)
+    assert set(frames) == {prefix + "base", prefix + "end_effector"}
+    base, hand = frames[prefix + "base"], frames[prefix + "end_effector"]
+    assert base["parent_frame_id"] == hand["parent_frame_id"] == "world"
+    assert vector(base["translation"], "xyz") == [1.5, -2.0, 0.0]
+    assert vector(base["rotation"], "xyzw") == pytest.approx([0, 0, math.sin(0.3),
+                                                              math.cos(0.3)])  # fmt: skip
+    assert vector(hand["translation"], "xyz") == pytest.approx([0.7, 0.2, 0.45], abs=1e-12)
+    half = math.sqrt(0.5)
+    assert vector(hand["rotation"], "xyzw") == pytest.approx([0, 0, half, half], abs=1e-12)
+
+
+def test_markers_are_frames_of_the_camera() -> None:
+    detections = MarkerDetections(header=HEADER, markers=(
+        MarkerDetection(id=3, pose=pose_dq(0.0, (0.1, 0.2, 2.5)), reprojection_error=0.3),
+        MarkerDetection(id=7, pose=pose_dq(math.pi, (-0.4, 0.0, 2.4)), reprojection_error=0.5),
+    ))  # fmt: skip
+    (view,) = views_of(topics.VISION_MARKERS.name, "sim/vision/markers", detections)
+    frames = transforms_of(view)
+    assert set(frames) == {"marker_3", "marker_7"}
+    assert {f["parent_frame_id"] for f in frames.values()} == {"camera"}
+    assert vector(frames["marker_7"]["translation"], "xyz") == pytest.approx([-0.4, 0, 2.4])
+    assert vector(frames["marker_7"]["rotation"], "xyzw") == pytest.approx([0, 0, 1, 0], abs=1e-12)
+    empty = MarkerDetections(header=HEADER)
+    assert views_of(topics.VISION_MARKERS.name, "sim/vision/markers", empty) == []
+
+
+def test_a_pose_goal_is_a_frame_and_a_position_goal_has_no_view() -> None:
+    goal = Goal(header=HEADER, task="pose", pose=pose_dq(0.5, (0.3, -0.1, 0.6)))
+    (view,) = views_of(topics.CONTROL_GOAL.name, "sim/control/goal", goal)
+    frame = transforms_of(view)["goal"]
+    assert frame["parent_frame_id"] == "world"
+    assert vector(frame["translation"], "xyz") == pytest.approx([0.3, -0.1, 0.6])
+    position = Goal(header=HEADER, task="position", position=(0.3, -0.1, 0.6))
+    assert views_of(topics.CONTROL_GOAL.name, "sim/control/goal", position) == []
+
+
+def test_obstacles_are_one_cylinder_each_and_replace_the_previous_ones() -> None:
+    circles = (Circle(x=1.0, y=1.5, radius=0.3), Circle(x=-2.0, y=0.5, radius=0.25))
+    (view,) = views_of(topics.WORLD_OBSTACLES.name, "sim/world/obstacles",
+                       Obstacles(header=HEADER, circles=circles))  # fmt: skip
+    assert view.schema_name == "foxglove.SceneUpdate"
+    update = decode(view)
+    assert [d.get("type") for d in update["deletions"]] == [1]  # ALL
+    entities = update["entities"]
+    assert len(entities) == len(circles)
+    for entity, circle in zip(entities, circles, strict=True):
+        assert entity["frame_id"] == "world"
+        (cylinder,) = entity["cylinders"]
+        assert vector(cylinder["size"], "xyz") == [2 * circle.radius, 2 * circle.radius,
+                                                   OBSTACLE_HEIGHT_M]  # fmt: skip
+        position = cylinder["pose"]["position"]
+        assert vector(position, "xyz") == [circle.x, circle.y, OBSTACLE_HEIGHT_M / 2]
+    (none,) = views_of(topics.WORLD_OBSTACLES.name, "sim/world/obstacles",
+                       Obstacles(header=HEADER))  # fmt: skip
+    assert "entities" not in decode(none)
+
+
+def test_topics_without_a_well_known_schema_have_no_view() -> None:
+    command = BaseCommand(header=HEADER, forward_velocity=0.1, angular_velocity=0.2,
+                          left_wheel=0.07, right_wheel=0.13)  # fmt: skip
+    assert views_of(topics.BASE_COMMAND.name, "sim/base/command", command) == []
+
+
+def test_views_go_beside_their_message_in_a_session_file(tmp_path: Path) -> None:
+    state = RobotState(
+        header=HEADER,
+        base_pose=(1.0, 2.0, 0.0),
+        arm_joints=(0.0, 0.0, 0.0, 0.0, 0.0),
+        end_effector=pose_dq(0.0, (0.5, 0.0, 0.4)),
+        valid=True,
+        age_s=0.0,
+    )
+    path = tmp_path / "session.mcap"
+    with SessionWriter(path) as writer:
+        writer.write(KEY, state)
+        for view in views_of(topics.ROBOT_STATE.name, KEY, state):
+            writer.write_raw(*view.channel(KEY), stamp_of(state))
+    with path.open("rb") as stream:
+        read = {c.topic: (s, m) for s, c, m in make_reader(stream).iter_messages()}
+    schema, message = read[f"{KEY}/foxglove"]
+    assert (schema.name, schema.encoding) == ("foxglove.FrameTransforms", "protobuf")
+    assert message.log_time == STAMP_NS
+    stored = View("foxglove", schema.name, schema.encoding, schema.data, "protobuf", message.data)
+    hand = transforms_of(stored)["estimate/end_effector"]
+    assert vector(hand["translation"], "xyz") == pytest.approx([0.5, 0.0, 0.4])

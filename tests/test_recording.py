@@ -1,0 +1,154 @@
+"""Recording on real processes: an experiment's MCAP session read back by the `mcap` package,
+`parsimony info`, a recorder killed with SIGKILL, replay into Zenoh, and the report of two laws."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+import zenoh
+from mcap.reader import make_reader
+
+from deploy import query
+from messages import codec, topics
+from parsimony.sessions import load_session
+from record.session_file import info, read_session, recover
+
+
+def parsimony(*arguments: str, timeout: float = 300) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "parsimony.cli", *arguments],
+                          capture_output=True, text=True, timeout=timeout)  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """The pose experiment of one seed with each law, recorded."""
+    found = {}
+    for law in ("lp", "cascade"):
+        out = tmp_path_factory.mktemp(law)
+        done = parsimony("experiment", "pose", "--controller", law, "--seed", "6",
+                         "--out", str(out))  # fmt: skip
+        assert done.returncode == 0, done.stderr[-2000:]
+        found[law] = out
+    return found
+
+
+def test_a_recorded_experiment_reads_back_with_every_channel_schema(runs) -> None:
+    path = runs["lp"] / "session.mcap"
+    with path.open("rb") as stream:
+        reader = make_reader(stream)
+        summary = reader.get_summary()
+        counted = sum(1 for _ in reader.iter_messages())
+    assert counted == summary.statistics.message_count > 1000
+    assert all(channel.schema_id in summary.schemas for channel in summary.channels.values())
+    names = {schema.name for schema in summary.schemas.values()}
+    assert {"RobotState", "CameraFrame", "foxglove.RawImage", "foxglove.FrameTransforms",
+            "foxglove.SceneUpdate"} <= names
+    shown = json.loads(parsimony("info", str(path), "--json").stdout)
+    assert shown["messages"] == counted
+    by_key = {c["key"]: c for c in shown["channels"]}
+    # What the controller published is all there: its own count, in its recorded status.
+    session = load_session(path)
+    diagnostics = session["control/diagnostics"]
+    assert [d.header.seq for d in diagnostics] == list(range(len(diagnostics)))
+    state_key = next(k for k in by_key if k.endswith("/robot/state"))
+    assert by_key[state_key]["messages"] == len(session["robot/state"])
+    assert abs(by_key[state_key]["rate_hz"] - 100.0) < 1.0
+
+
+def test_the_report_of_two_laws_shows_the_norms_they_minimise(runs, tmp_path: Path) -> None:
+    files = [str(runs[law] / "session.mcap") for law in ("lp", "cascade")]
+    done = parsimony("report", *files, "--out", str(tmp_path), "--json")
+    assert done.returncode == 0, done.stderr
+    result = json.loads(done.stdout)
+    for figure in result["figures"]:
+        assert Path(figure).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    effort = result["effort"]
+    assert set(effort) == {"lp", "cascade"}
+    # Table 6.1: the LP minimises the 1-norm of u, the cascade (pseudoinverse) the 2-norm.
+    assert effort["lp"]["metric1"] < effort["cascade"]["metric1"], effort
+    assert "| 1 |" in (tmp_path / "effort.md").read_text()
+
+
+def test_a_recorder_killed_with_sigkill_leaves_all_but_the_last_second(tmp_path: Path) -> None:
+    """The experiment records; its recorder is killed mid-run, the file still reads."""
+    command = [sys.executable, "-m", "parsimony.cli", "experiment", "pose", "--realtime",
+               "--out", str(tmp_path)]  # fmt: skip
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 120
+        while not (tmp_path / "profile.yaml").exists():
+            assert time.monotonic() < deadline
+            time.sleep(0.1)  # the experiment writes its profile before it launches
+        target = query.Target.from_profile(tmp_path / "profile.yaml")
+        while True:
+            try:
+                session = target.open()
+                break
+            except query.QueryError:
+                assert time.monotonic() < deadline
+                time.sleep(0.1)  # the router opens first thing
+        with session:
+            while True:
+                assert time.monotonic() < deadline
+                found = query.statuses(session, target.namespace, 0.5)
+                if found.get("recorder") and found["recorder"].counters["written"] > 2000:
+                    break
+            written = found["recorder"].counters["written"]
+            os.kill(found["recorder"].pid, signal.SIGKILL)
+            killed = time.monotonic()
+    finally:
+        process.wait(300)
+    assert time.monotonic() - killed < 300
+    path = tmp_path / "session.mcap"
+    recorded = list(read_session(path))
+    project = [r for r in recorded if r.topic_name is not None]
+    # Written when polled: all of it that was flushed (a chunk a second) reads back.
+    assert len(project) >= written * 0.5 > 500
+    assert info(path)["messages"] == len(recorded)
+    whole = tmp_path / "recovered.mcap"
+    assert recover(path, whole) == len(recorded)
+    with whole.open("rb") as stream:
+        assert sum(1 for _ in make_reader(stream).iter_messages()) == len(recorded)
+
+
+def test_replay_republishes_the_sensors_with_headers_as_recorded(runs, tmp_path: Path) -> None:
+    path = runs["lp"] / "session.mcap"
+    profile = tmp_path / "replay.yaml"
+    port = free_port()
+    component = {"name": "x", "module": "scripted_publisher", "role": "tool"}
+    zenoh_settings = {"router": [f"tcp/127.0.0.1:{port}"]}
+    profile.write_text(yaml.safe_dump(
+        {"namespace": "replayed", "zenoh": zenoh_settings, "components": [component]}))
+    from profiles.profile import load_profile
+
+    loaded = load_profile(profile)
+    received: list = []
+    with zenoh.open(loaded.zenoh.router_config()) as router:
+        key = topics.BASE_ODOMETRY.key("replayed")
+        router.declare_subscriber(key, lambda s: received.append(
+            codec.decode(s.payload.to_bytes(), topics.BASE_ODOMETRY.type)))  # fmt: skip
+        done = parsimony("replay", str(path), "--profile", str(profile), "--sensors",
+                         "--rate", "4", "--duration", "3")  # fmt: skip
+        assert done.returncode == 0, done.stderr
+        time.sleep(0.5)  # the last samples in flight
+    recorded = [m for m in load_session(path)["base/odometry"]
+                if m.header.stamp_ns <= load_session(path)["base/odometry"][0].header.stamp_ns
+                + 3_000_000_000]  # fmt: skip
+    assert len(received) >= 0.95 * len(recorded)
+    assert [m.header for m in received[:50]] == [m.header for m in recorded[:50]]
+
+
+def free_port() -> int:
+    import socket
+
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
