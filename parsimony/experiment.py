@@ -223,7 +223,8 @@ def run_experiment(options: Options) -> dict[str, Any]:
     (options.out / "report.json").write_text(dumps(report))
     write_commands(options.out / "commands.csv", messages)
     session = load_session(options.out / SESSION_FILE)
-    figures = write_report([(options.controller, session)], robot, options.out)["figures"]
+    figures = write_report([(options.controller, session)], robot, options.out,
+                           profile.scene.reference_pose)["figures"]  # fmt: skip
     report["figures"] = [str(path) for path in figures]
     return report
 

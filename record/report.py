@@ -22,6 +22,7 @@ Times are in s from the session's first command.
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -45,6 +46,7 @@ from messages.topics import (
 )
 from wbc import dq
 from wbc.kinematic_run import effort_of
+from wbc.planar import planar_pose
 from wbc.robot import MobileManipulator
 
 Array = np.ndarray
@@ -75,9 +77,16 @@ def effort(session: Session) -> dict[str, float]:
 
 
 def write_report(
-    sessions: Sequence[tuple[str, Session]], robot: MobileManipulator, out: Path
+    sessions: Sequence[tuple[str, Session]],
+    robot: MobileManipulator,
+    out: Path,
+    truth_frame: tuple[float, float, float] | None = None,
 ) -> dict:
     """Write the figures and effort table of one or two (label, session) pairs into ``out``.
+
+    The estimates are in the frame of the reference marker F0; the simulator's truth is in its
+    own world. ``truth_frame`` is F0's (x, y, yaw) there (the scene's ``reference_pose``): the
+    truth is drawn in F0's frame beside the estimate; None draws no truth.
 
     Every session is checked before anything is written; a missing or empty topic raises
     ``ValueError`` naming it. Returns ``{"figures": [paths], "effort": {label: metrics}}``.
@@ -87,7 +96,7 @@ def write_report(
         raise ValueError(f"a report compares one or two sessions, got {len(sessions)}")
     if len(set(labels)) != len(labels):
         raise ValueError(f"session labels must differ, got {labels}")
-    recordings = [_recording(label, session) for label, session in sessions]
+    recordings = [_recording(label, session, truth_frame) for label, session in sessions]
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     figures = []
@@ -124,8 +133,21 @@ class _Recording:
         return (self.stamps_ns - self.stamps_ns[0]) * 1e-9
 
 
-def _recording(label: str, session: Session) -> _Recording:
+def _in_frame(truth: Any, frame: tuple[float, float, float]) -> Any:
+    """A SimTruth seen from ``frame`` (x0, y0, yaw0): p' = R(-yaw0)(p - p0), x' = F* x."""
+    x0, y0, yaw0 = frame
+    c, s = math.cos(yaw0), math.sin(yaw0)
+    x, y, phi = truth.base_pose
+    base = (c * (x - x0) + s * (y - y0), -s * (x - x0) + c * (y - y0), phi - yaw0)
+    pose = dq.normalize(dq.mul(dq.conj(planar_pose(x0, y0, yaw0)), np.array(truth.end_effector)))
+    return truth.model_copy(update={"base_pose": base, "end_effector": tuple(pose.tolist())})
+
+
+def _recording(
+    label: str, session: Session, truth_frame: tuple[float, float, float] | None
+) -> _Recording:
     stamps, u = _commands(session)
+    truth = _messages(session, SIM_TRUTH, required=False) if truth_frame is not None else []
     return _Recording(
         label=label,
         stamps_ns=stamps,
@@ -134,7 +156,7 @@ def _recording(label: str, session: Session) -> _Recording:
         goals=_messages(session, CONTROL_GOAL),
         diagnostics=_messages(session, CONTROL_DIAGNOSTICS),
         obstacles=_messages(session, WORLD_OBSTACLES, required=False),
-        truth=_messages(session, SIM_TRUTH, required=False),
+        truth=[_in_frame(t, truth_frame) for t in truth],
     )
 
 

@@ -10,6 +10,7 @@ from pathlib import Path
 
 from parsimony.output import emit
 from parsimony.sessions import load_session
+from profiles.profile import ProfileError, load_profile
 from record.report import write_report
 from wbc.robot import MobileManipulator
 
@@ -27,6 +28,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("--labels", help="comma-separated labels (default: the law's name)")
     parser.add_argument("--out", type=Path, required=True, help="directory of the figures")
     parser.add_argument("--robot", type=Path, default=ROBOT, help="robot description")
+    parser.add_argument("--profile", type=Path,
+                        help="the recorded profile: truth drawn in F0's frame")  # fmt: skip
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
     return parser
 
@@ -41,8 +44,12 @@ def run(args: argparse.Namespace) -> int:
             session = load_session(path)
             sessions.append((label_of(args.labels, index, session, path), session))
         args.out.mkdir(parents=True, exist_ok=True)
-        result = write_report(sessions, MobileManipulator.from_yaml(args.robot), args.out)
-    except (OSError, ValueError) as error:
+        frame = None
+        if args.profile is not None:
+            scene = load_profile(args.profile).scene
+            frame = scene.reference_pose if scene is not None else None
+        result = write_report(sessions, MobileManipulator.from_yaml(args.robot), args.out, frame)
+    except (OSError, ValueError, ProfileError) as error:
         print(f"report: {error}", file=sys.stderr)
         return 2
     result = {**result, "figures": [str(p) for p in result["figures"]]}
