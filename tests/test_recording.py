@@ -152,3 +152,23 @@ def free_port() -> int:
     with socket.socket() as probe:
         probe.bind(("127.0.0.1", 0))
         return probe.getsockname()[1]
+
+
+def test_rerun_of_the_recorded_law_reproduces_its_commands(runs, tmp_path: Path) -> None:
+    """The LP run offline on the recorded states, goals and obstacles gives back the commands
+    the live controller sent (the order of a goal and a state of one stamp may differ: at most
+    a small difference, and most steps exactly)."""
+    out = tmp_path / "rerun.mcap"
+    done = parsimony("rerun", str(runs["lp"] / "session.mcap"), "--controller", "lp",
+                     "-o", str(out))  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    recorded = {m.header.stamp_ns: m.joint_velocities
+                for m in load_session(runs["lp"] / "session.mcap")["arm/command"]}  # fmt: skip
+    rerun = {m.header.stamp_ns: m.joint_velocities for m in load_session(out)["arm/command"]}
+    common = set(recorded) & set(rerun)
+    assert len(common) > 0.9 * len(recorded)
+    gaps = [max(abs(a - b) for a, b in zip(recorded[s], rerun[s], strict=True)) for s in common]
+    assert max(gaps) < 1e-3
+    assert sum(gap == 0.0 for gap in gaps) > 0.8 * len(gaps)
+    keys = {c["key"] for c in info(out)["channels"]}
+    assert any(key.endswith("/arm/command/recorded") for key in keys)
