@@ -44,6 +44,7 @@ from parsimony.kinematic_demo import LP_PARAMS
 from parsimony.sessions import load_session
 from profiles.profile import Profile, load_profile
 from record.report import write_report
+from record.session_file import info, recover
 from sim2d.scenarios import SimScenario, scenario
 from wbc import dq
 from wbc.kinematic_run import effort_of
@@ -222,6 +223,7 @@ def run_experiment(options: Options) -> dict[str, Any]:
     report = build_report(options, setup, profile, robot, messages, wall_s, counters, converged)
     (options.out / "report.json").write_text(dumps(report))
     write_commands(options.out / "commands.csv", messages)
+    whole_recording(options.out / SESSION_FILE)
     session = load_session(options.out / SESSION_FILE)
     figures = write_report([(options.controller, session)], robot, options.out,
                            profile.scene.reference_pose)["figures"]  # fmt: skip
@@ -239,6 +241,18 @@ def connect(profile: Profile, launcher: subprocess.Popen) -> zenoh.Session:
             if launcher.poll() is not None or time.monotonic() > deadline:
                 raise
             time.sleep(0.2)  # the launcher opens its router first thing
+
+
+def whole_recording(path: Path) -> None:
+    """Make ``path`` whole if its recorder was stopped before it wrote the footer (killed after
+    the launcher's stop timeout on a loaded machine): every complete chunk is kept."""
+    if not info(path)["complete"]:
+        partial = path.with_suffix(".partial.mcap")
+        path.rename(partial)
+        saved = recover(partial, path)
+        partial.unlink()
+        print(f"[experiment] the recording had no footer: {saved} messages kept",
+              file=sys.stderr)  # fmt: skip
 
 
 def wait_alive(session: zenoh.Session, profile: Profile, launcher: subprocess.Popen) -> None:
