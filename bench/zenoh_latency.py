@@ -31,7 +31,6 @@ import math
 import multiprocessing as mp
 import os
 import signal
-import socket
 import subprocess
 import sys
 import tempfile
@@ -56,6 +55,7 @@ from components.runtime import Node
 from deploy import query
 from messages import topics
 from parsimony.output import emit, result_only_stdout
+from profiles.endpoints import free_port
 from profiles.profile import ZenohSettings, load_profile
 
 SETTLE_S = 1.0
@@ -286,11 +286,6 @@ def format_table(results: list[Result]) -> str:
         for row in rows
     )
 
-
-def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
 
 
 def main(argv: list[str] | None = None) -> int:

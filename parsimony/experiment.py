@@ -23,7 +23,6 @@ import hashlib
 import math
 import os
 import signal
-import socket
 import struct
 import subprocess
 import sys
@@ -42,6 +41,7 @@ from deploy import query
 from messages import codec, topics
 from parsimony.kinematic_demo import LP_PARAMS
 from parsimony.sessions import load_session
+from profiles.endpoints import free_port
 from profiles.profile import Profile, load_profile
 from record.report import write_report
 from record.session_file import info, recover
@@ -81,11 +81,6 @@ class Options:
     time_limit_s: float = TIME_LIMIT_S
     hide_base_marker: tuple[float, float] | None = None
 
-
-def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
 
 
 def law_overrides(options: Options) -> dict[str, Any]:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ipaddress
+import socket
 
 LOCAL_PROTOCOLS = ("unixsock-stream",)
 """Zenoh link protocols that never leave the host."""
@@ -44,3 +45,10 @@ def endpoint_problem(endpoint: str, needs_port: bool = False) -> str | None:
 def is_local_endpoint(endpoint: str) -> bool:
     """Whether a Zenoh endpoint (``tcp/127.0.0.1:7447``, ``unixsock-stream//tmp/s``) is local."""
     return endpoint_problem(endpoint) is None
+
+
+def free_port() -> int:
+    """A TCP port on 127.0.0.1 that nothing listens on right now (for a router's endpoint)."""
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]

@@ -18,6 +18,7 @@ import zenoh
 
 from deploy import query
 from messages import codec, topics
+from profiles.endpoints import free_port
 from profiles.profile import load_profile, read_profile_data
 
 DEPLOY = Path(__file__).resolve().parents[1] / "deploy"
@@ -139,10 +140,3 @@ def open_session(target: query.Target) -> zenoh.Session:
             assert time.monotonic() < deadline
             time.sleep(0.1)  # the launcher opens its router first thing
 
-
-def free_port() -> int:
-    import socket
-
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]

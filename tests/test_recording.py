@@ -19,6 +19,7 @@ from mcap.reader import make_reader
 from deploy import query
 from messages import codec, topics
 from parsimony.sessions import load_session
+from profiles.endpoints import free_port
 from record.session_file import info, read_session, recover
 
 
@@ -148,13 +149,6 @@ def test_replay_republishes_the_sensors_with_headers_as_recorded(runs, tmp_path:
     assert len(received) >= 0.95 * len(recorded)
     assert [m.header for m in received[:50]] == [m.header for m in recorded[:50]]
 
-
-def free_port() -> int:
-    import socket
-
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
 
 
 def test_rerun_of_the_recorded_law_reproduces_its_commands(runs, tmp_path: Path) -> None:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import socket
 import subprocess
 import sys
 import threading
@@ -19,6 +18,7 @@ import zenoh
 from pydantic import BaseModel
 
 from messages import codec, topics
+from profiles.endpoints import free_port
 from profiles.profile import Profile, load_profile, read_profile_data
 
 M = TypeVar("M", bound=BaseModel)
@@ -29,12 +29,6 @@ DEADLINE_S = 10.0
 DEPLOY = Path(__file__).resolve().parents[2] / "deploy"
 """The directory of the project's profiles and robot descriptions."""
 
-
-def free_port() -> int:
-    """A TCP port on 127.0.0.1 that nothing listens on right now."""
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
 
 
 def _wait_until(condition: Callable[[], bool], what: str, timeout_s: float = DEADLINE_S) -> None:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import re
 import signal
-import socket
 import subprocess
 import sys
 import threading
@@ -15,6 +14,8 @@ from typing import Any
 
 import pytest
 import yaml
+
+from profiles.endpoints import free_port
 
 DEADLINE_S = 10.0
 """Generous limit for anything that starts processes on a loaded machine."""
@@ -28,12 +29,6 @@ LAUNCH = (
 )
 """`parsimony launch` through its own module, independent of the other subcommands."""
 
-
-def free_port() -> int:
-    """A TCP port on 127.0.0.1 that nothing listens on right now."""
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
 
 
 def profile_file(directory: Path, components: list[dict[str, Any]], **top_level: Any) -> Path:
