@@ -216,13 +216,13 @@ def run_experiment(options: Options) -> dict[str, Any]:
                                    origin_s(messages))  # fmt: skip
     messages = until(messages, end_ns)
     report = build_report(options, setup, profile, robot, messages, wall_s, counters, converged)
-    (options.out / "report.json").write_text(dumps(report))
     write_commands(options.out / "commands.csv", messages)
     whole_recording(options.out / SESSION_FILE)
     session = load_session(options.out / SESSION_FILE)
     figures = write_report([(options.controller, session)], robot, options.out,
                            profile.scene.reference_pose)["figures"]  # fmt: skip
     report["figures"] = [str(path) for path in figures]
+    (options.out / "report.json").write_text(dumps(report))
     return report
 
 
