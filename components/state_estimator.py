@@ -41,26 +41,12 @@ from messages.odometry import BaseOdometry
 from messages.state import RobotState
 from profiles.scene import Scene
 from wbc import dq
-from wbc.planar import planar_of
+from wbc.planar import offset_pose, planar_of, wrap
 from wbc.pose_filter import PoseFilter
 from wbc.robot import MobileManipulator
 
 WORLD_FRAME = "world"
 TIMEOUT_CHECK_S = 0.1
-
-
-def goal_offset(offset: tuple[float, ...]) -> np.ndarray:
-    """x_d^2 from (x, y, z, yaw, pitch, roll): the rotation Rz(yaw) Ry(pitch) Rx(roll)."""
-    x, y, z, yaw, pitch, roll = offset
-    r = dq.qmul(dq.qmul(dq.rotation_quaternion(yaw, dq.K_[1:]),
-                        dq.rotation_quaternion(pitch, dq.J_[1:])),
-                dq.rotation_quaternion(roll, dq.I_[1:]))  # fmt: skip
-    return dq.pose(r, np.array([x, y, z]))
-
-
-def wrap(angle: float) -> float:
-    """``angle`` in (-pi, pi]."""
-    return math.atan2(math.sin(angle), math.cos(angle))
 
 
 class StateEstimator(Component):
@@ -92,7 +78,7 @@ class StateEstimator(Component):
             raise ParamError("the state estimator needs the profile's `robot` and `scene`")
         self.robot = MobileManipulator.from_yaml(node.profile.robot)
         self.scene: Scene = node.profile.scene
-        self.offset = goal_offset(self.scene.goal.offset)
+        self.offset = offset_pose(*self.scene.goal.offset)
         p = node.params
         self.reference = PoseFilter(p["reference_samples"])
         self.statics: dict[int, PoseFilter] = {}

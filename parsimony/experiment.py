@@ -49,7 +49,7 @@ from sim2d.scenarios import SimScenario, scenario
 from wbc import dq
 from wbc.kinematic_run import effort_of
 from wbc.lp_law import LPParams
-from wbc.planar import planar_pose
+from wbc.planar import in_frame, offset_pose, planar_pose, wrap
 from wbc.robot import MobileManipulator
 
 DEPLOY = Path(__file__).resolve().parents[1] / "deploy"
@@ -319,23 +319,9 @@ def until(messages: dict[str, list], end_ns: int) -> dict[str, list]:
 
 def true_goal(setup: SimScenario, profile: Profile) -> np.ndarray:
     """x_d in the simulator's world: the bin marker's pose times the scene's offset (eq. 6.3)."""
-    from components.state_estimator import goal_offset
-
     scene = profile.scene
     bin_pose = planar_pose(*setup.bin[:2], setup.bin[2], scene.goal.height_m)
-    return dq.normalize(dq.mul(bin_pose, goal_offset(scene.goal.offset)))
-
-
-def to_reference(pose: tuple[float, float, float], reference: tuple[float, ...]):
-    """A world (x, y, phi) in the frame of F0 placed at ``reference`` (x0, y0, yaw0)."""
-    x0, y0, yaw0 = reference
-    c, s = math.cos(yaw0), math.sin(yaw0)
-    dx, dy = pose[0] - x0, pose[1] - y0
-    return c * dx + s * dy, -s * dx + c * dy, pose[2] - yaw0
-
-
-def wrap(angle: float) -> float:
-    return math.atan2(math.sin(angle), math.cos(angle))
+    return dq.normalize(dq.mul(bin_pose, offset_pose(*scene.goal.offset)))
 
 
 def build_report(
@@ -433,7 +419,7 @@ def estimator_error(truth: list, states: list, profile: Profile, since_s: float)
         t = nearest.at(state.header.stamp_ns)
         if t is None or not state.valid or state.header.stamp_ns / 1e9 < since_s:
             continue
-        x, y, phi = to_reference(t.base_pose, profile.scene.reference_pose)
+        x, y, phi = in_frame(*t.base_pose, profile.scene.reference_pose)
         position.append(math.hypot(state.base_pose[0] - x, state.base_pose[1] - y))
         angle.append(abs(wrap(state.base_pose[2] - phi)))
     if not position:

@@ -22,7 +22,6 @@ Times are in s from the session's first command.
 from __future__ import annotations
 
 import json
-import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,7 +45,7 @@ from messages.topics import (
 )
 from wbc import dq
 from wbc.kinematic_run import effort_of
-from wbc.planar import planar_pose
+from wbc.planar import in_frame, planar_pose
 from wbc.robot import MobileManipulator
 
 Array = np.ndarray
@@ -135,11 +134,8 @@ class _Recording:
 
 def _in_frame(truth: Any, frame: tuple[float, float, float]) -> Any:
     """A SimTruth seen from ``frame`` (x0, y0, yaw0): p' = R(-yaw0)(p - p0), x' = F* x."""
-    x0, y0, yaw0 = frame
-    c, s = math.cos(yaw0), math.sin(yaw0)
-    x, y, phi = truth.base_pose
-    base = (c * (x - x0) + s * (y - y0), -s * (x - x0) + c * (y - y0), phi - yaw0)
-    pose = dq.normalize(dq.mul(dq.conj(planar_pose(x0, y0, yaw0)), np.array(truth.end_effector)))
+    base = in_frame(*truth.base_pose, frame)
+    pose = dq.normalize(dq.mul(dq.conj(planar_pose(*frame)), np.array(truth.end_effector)))
     return truth.model_copy(update={"base_pose": base, "end_effector": tuple(pose.tolist())})
 
 

@@ -38,3 +38,25 @@ def tilt_of(pose: np.ndarray) -> float:
     r = dq.rotation(pose)
     axis = dq.qmul(dq.qmul(r, dq.K_), dq.qconj(r))
     return math.acos(max(-1.0, min(1.0, float(axis[3]))))
+
+
+def wrap(angle: float) -> float:
+    """The angle in [-pi, pi)."""
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def in_frame(
+    x: float, y: float, phi: float, frame: tuple[float, float, float]
+) -> tuple[float, float, float]:
+    """(x, y, phi) seen from a frame at (x0, y0, yaw0): R(-yaw0) ((x, y) - (x0, y0)), phi - yaw0."""
+    x0, y0, yaw0 = frame
+    c, s = math.cos(yaw0), math.sin(yaw0)
+    return c * (x - x0) + s * (y - y0), -s * (x - x0) + c * (y - y0), phi - yaw0
+
+
+def offset_pose(x: float, y: float, z: float, yaw: float, pitch: float, roll: float) -> np.ndarray:
+    """The pose of a translation (x, y, z) and the rotation Rz(yaw) Ry(pitch) Rx(roll)."""
+    r = dq.qmul(dq.qmul(dq.rotation_quaternion(yaw, dq.K_[1:]),
+                        dq.rotation_quaternion(pitch, dq.J_[1:])),
+                dq.rotation_quaternion(roll, dq.I_[1:]))  # fmt: skip
+    return dq.pose(r, np.array([x, y, z]))

@@ -8,7 +8,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from components.state_estimator import goal_offset
 from profiles.profile import load_profile
 from profiles.scene import Scene
 from sim2d.camera import PinholeCamera, ceiling_pose
@@ -21,7 +20,7 @@ from sim2d.scenarios import (
     scenario,
 )
 from wbc import dq
-from wbc.planar import planar_of, planar_pose
+from wbc.planar import offset_pose, planar_of, planar_pose
 from wbc.robot import BASE_DOF, MobileManipulator
 from wbc.scenarios import HOME, OBSTACLE, REACH_GOAL
 
@@ -42,7 +41,7 @@ def test_the_default_goal_is_the_dissertations_reach_goal() -> None:
     setup = scenario("pose", ROBOT)
     goal = scene().goal
     bin_pose = planar_pose(*setup.bin, goal.height_m)
-    x_d = dq.mul(bin_pose, goal_offset(goal.offset))
+    x_d = dq.mul(bin_pose, offset_pose(*goal.offset))
     expected = ROBOT.fkm(REACH_GOAL)
     error = min(np.max(np.abs(x_d - expected)), np.max(np.abs(x_d + expected)))
     assert error < 1e-5, (x_d, expected)

@@ -24,15 +24,11 @@ import numpy as np
 
 from wbc import dq
 from wbc.objectives.base import ResidualCost
+from wbc.planar import wrap
 from wbc.step_context import StepContext
 
 J_AXIS = np.array([0.0, 0.0, 1.0, 0.0])
 """The pure quaternion j: the end effector's y axis in its own frame."""
-
-
-def wrap(angle: float) -> float:
-    """The angle in [-pi, pi)."""
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
 def gripper_heading(goal_pose: np.ndarray) -> float:
