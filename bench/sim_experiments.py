@@ -24,7 +24,12 @@ import numpy as np
 from parsimony.experiment import PROFILES, Options, run_experiment
 from parsimony.output import emit, result_only_stdout
 from profiles.profile import load_profile
-from sim2d.camera import ImageNoise, PinholeCamera, PlacedMarker, ceiling_pose, render
+from sim2d.camera import (
+    ImageNoise,
+    PlacedMarker,
+    ceiling_camera,
+    render,
+)
 from sim2d.scenarios import NAMES, scenario
 from vision.markers import Intrinsics, MarkerDetector, plane_of, plane_pose, square_pose
 from wbc.planar import planar_pose
@@ -79,8 +84,7 @@ def vision_speed() -> dict:
     scene, c = profile.scene, profile.scene.camera
     robot = MobileManipulator.from_yaml(profile.robot)
     setup = scenario("obstacle", robot)
-    camera = PinholeCamera(ceiling_pose(*c.position), width=c.width, height=c.height,
-                           fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy)  # fmt: skip
+    camera = ceiling_camera(c)
     reference = planar_pose(*scene.reference_pose)
     markers = [
         PlacedMarker(scene.reference.id, scene.reference.size_m, reference),

@@ -44,7 +44,13 @@ from messages.joints import JointStates
 from messages.odometry import BaseOdometry
 from messages.truth import SimTruth
 from profiles.scene import Scene
-from sim2d.camera import ImageNoise, PinholeCamera, PlacedMarker, ceiling_pose, render
+from sim2d.camera import (
+    ImageNoise,
+    PinholeCamera,
+    PlacedMarker,
+    ceiling_camera,
+    render,
+)
 from sim2d.world import World, WorldSettings, wheel_distance_per_count
 from wbc.base_motion import dead_reckoning
 from wbc.obstacles import Circle
@@ -336,9 +342,7 @@ class Simulator(Component):
     def _camera(self) -> PinholeCamera | None:
         if not self.node.params["camera"]:
             return None
-        c = self.scene.camera
-        return PinholeCamera(ceiling_pose(*c.position), width=c.width, height=c.height,
-                             fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy)  # fmt: skip
+        return ceiling_camera(self.scene.camera)
 
     def placed_markers(self) -> list[PlacedMarker]:
         """Every marker visible now, where it is in the world."""

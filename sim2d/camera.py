@@ -79,6 +79,14 @@ def ceiling_pose(x: float, y: float, height: float) -> np.ndarray:
     return dq.pose(dq.rotation_quaternion(math.pi, [1.0, 0.0, 0.0]), [x, y, height])
 
 
+def ceiling_camera(settings) -> PinholeCamera:
+    """The camera of a profile's scene (``profiles.scene.Camera``): its intrinsics, above
+    ``position`` (x, y, height) looking straight down."""
+    c = settings
+    return PinholeCamera(ceiling_pose(*c.position), width=c.width, height=c.height,
+                         fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy)  # fmt: skip
+
+
 @dataclass(frozen=True, eq=False)
 class PlacedMarker:
     """An ArUco marker of side ``size_m`` (black square incl. its border) placed at ``pose``.

@@ -16,7 +16,13 @@ from messages import codec, topics
 from messages.camera import CameraFrame, CameraIntrinsics
 from messages.header import Header
 from profiles.profile import read_profile_data
-from sim2d.camera import ImageNoise, PinholeCamera, PlacedMarker, ceiling_pose, render
+from sim2d.camera import (
+    ImageNoise,
+    PinholeCamera,
+    PlacedMarker,
+    ceiling_camera,
+    render,
+)
 from wbc import dq
 from wbc.planar import planar_pose
 
@@ -29,8 +35,7 @@ DEPLOY = Path(__file__).resolve().parents[2] / "deploy"
 def scene_image(system: System, seed: int = 0) -> tuple[np.ndarray, PinholeCamera, list]:
     """A frame of the profile's scene: F0 where the profile puts it, the base and bin markers."""
     scene, c = system.profile.scene, system.profile.scene.camera
-    camera = PinholeCamera(ceiling_pose(*c.position), width=c.width, height=c.height,
-                           fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy)  # fmt: skip
+    camera = ceiling_camera(c)
     markers = [
         PlacedMarker(scene.reference.id, scene.reference.size_m,
                      planar_pose(*scene.reference_pose, scene.reference.height_m)),

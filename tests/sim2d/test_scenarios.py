@@ -10,7 +10,7 @@ import pytest
 
 from profiles.profile import load_profile
 from profiles.scene import Scene
-from sim2d.camera import PinholeCamera, ceiling_pose
+from sim2d.camera import PinholeCamera, ceiling_camera
 from sim2d.scenarios import (
     BIN_RANGE,
     NAMES,
@@ -125,9 +125,7 @@ def test_several_obstacles_are_separated_by_semicolons() -> None:
 
 
 def camera() -> PinholeCamera:
-    c = scene().camera
-    return PinholeCamera(ceiling_pose(*c.position), width=c.width, height=c.height,
-                         fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy)  # fmt: skip
+    return ceiling_camera(scene().camera)
 
 
 def markers(setup: SimScenario) -> list[tuple[str, float, float, float, float]]:
