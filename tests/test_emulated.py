@@ -14,10 +14,10 @@ from pathlib import Path
 
 import pytest
 import yaml
-import zenoh
 
 from deploy import query
 from messages import codec, topics
+from parsimony.experiment import connect
 from profiles.endpoints import free_port
 from profiles.profile import load_profile, read_profile_data
 
@@ -89,8 +89,7 @@ def test_a_killed_controller_leaves_the_robot_stopped_by_its_drivers(tmp_path: P
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
     truth: list = []
     try:
-        target = query.Target(profile.namespace, profile.zenoh)
-        session = open_session(target)
+        session = connect(profile, launcher)
         key = topics.SIM_TRUTH.key(profile.namespace)
         session.declare_subscriber(
             key, lambda s: truth.append(codec.decode(s.payload.to_bytes(), topics.SIM_TRUTH.type))
@@ -129,14 +128,3 @@ def moving(truth: list) -> bool:
         return False
     first, before, last = truth[0].base_pose, truth[-20].base_pose, truth[-1].base_pose
     return abs(last[0] - first[0]) > 0.02 and abs(last[0] - before[0]) > 1e-4
-
-
-def open_session(target: query.Target) -> zenoh.Session:
-    deadline = time.monotonic() + 30
-    while True:
-        try:
-            return target.open()
-        except query.QueryError:
-            assert time.monotonic() < deadline
-            time.sleep(0.1)  # the launcher opens its router first thing
-

@@ -16,6 +16,8 @@ from pathlib import Path
 import pytest
 
 from deploy import query
+from parsimony.experiment import connect
+from profiles.profile import load_profile
 
 ONE_DEGREE = math.radians(1.0)
 
@@ -91,16 +93,6 @@ def test_hidden_base_marker_degrades_the_state_and_the_run_still_converges(
     assert report["degraded_states"] > 100  # about 2.5 s of 100 Hz states after the timeout
 
 
-def connect(target: query.Target, deadline: float):
-    """A session to the experiment's router once it listens."""
-    while True:
-        try:
-            return target.open()
-        except query.QueryError:
-            assert time.monotonic() < deadline
-            time.sleep(0.1)  # the launcher opens its router after the experiment starts it
-
-
 def kill_during_run(tmp_path: Path, component: str) -> tuple[int, dict, str]:
     """Start an experiment, SIGKILL ``component`` once the controller has run 200 steps, and
     return the exit status, the report and the launch log."""
@@ -113,7 +105,7 @@ def kill_during_run(tmp_path: Path, component: str) -> tuple[int, dict, str]:
             assert time.monotonic() < deadline and process.poll() is None
             time.sleep(0.1)  # the experiment writes its profile before it launches
         target = query.Target.from_profile(tmp_path / "profile.yaml")
-        with connect(target, deadline) as session:
+        with connect(load_profile(tmp_path / "profile.yaml"), process) as session:
             while True:
                 assert time.monotonic() < deadline and process.poll() is None
                 found = query.statuses(session, target.namespace, 0.5)

@@ -18,8 +18,10 @@ from mcap.reader import make_reader
 
 from deploy import query
 from messages import codec, topics
+from parsimony.experiment import connect
 from parsimony.sessions import load_session
 from profiles.endpoints import free_port
+from profiles.profile import load_profile
 from record.session_file import info, read_session, recover
 
 
@@ -89,14 +91,7 @@ def test_a_recorder_killed_with_sigkill_leaves_all_but_the_last_second(tmp_path:
             assert time.monotonic() < deadline
             time.sleep(0.1)  # the experiment writes its profile before it launches
         target = query.Target.from_profile(tmp_path / "profile.yaml")
-        while True:
-            try:
-                session = target.open()
-                break
-            except query.QueryError:
-                assert time.monotonic() < deadline
-                time.sleep(0.1)  # the router opens first thing
-        with session:
+        with connect(load_profile(tmp_path / "profile.yaml"), process) as session:
             while True:
                 assert time.monotonic() < deadline
                 found = query.statuses(session, target.namespace, 0.5)
@@ -131,8 +126,6 @@ def test_replay_republishes_the_sensors_with_headers_as_recorded(runs, tmp_path:
     zenoh_settings = {"router": [f"tcp/127.0.0.1:{port}"]}
     profile.write_text(yaml.safe_dump(
         {"namespace": "replayed", "zenoh": zenoh_settings, "components": [component]}))
-    from profiles.profile import load_profile
-
     loaded = load_profile(profile)
     received: list = []
     with zenoh.open(loaded.zenoh.router_config()) as router:
