@@ -91,7 +91,7 @@ class CascadeLaw:
         self._task = task
 
         pose, jacobian = self.robot.kinematics(q)
-        error, task_jacobian = task.error(pose, jacobian)
+        error, task_jacobian = task.error(pose, jacobian, q)
         reference_u = pinv_velocity(task_jacobian, error, self.params.eta)
         x_r, y_r, phi_r = self._reference
         xr_dot, yr_dot, phir_dot = reference_u[:3]

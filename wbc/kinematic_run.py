@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
@@ -22,6 +23,8 @@ class Run:
     tolerance: float = 1e-3
     configurations: list[Array] = field(default_factory=list)
     outputs: list[LawOutput] = field(default_factory=list)
+    reached: bool | None = None
+    """Set by a supervised run: its supervisor's verdict (the last task may not be the goal's)."""
 
     @property
     def final_error(self) -> float:
@@ -29,6 +32,8 @@ class Run:
 
     @property
     def converged(self) -> bool:
+        if self.reached is not None:
+            return self.reached
         return bool(self.outputs) and self.outputs[-1].error_norm < self.tolerance
 
     def velocities(self) -> Array:
@@ -54,6 +59,46 @@ def integrate(
         if out.error_norm < tolerance:
             break
         q = q + out.u * dt
+    return run
+
+
+class Supervisor(Protocol):
+    """What hands a law its task step by step (wbc.staging_supervisor)."""
+
+    @property
+    def reached(self) -> bool: ...
+
+    def update(self, q: Array, t: float) -> Task | None: ...
+
+
+def integrate_supervised(
+    law: Law,
+    supervisor: Supervisor,
+    q0: Array,
+    dt: float,
+    steps: int,
+    obstacles: Sequence[Circle] = (),
+) -> Run:
+    """As ``integrate``, with the task of each step from ``supervisor``, until it reports the
+    goal reached, gives no task (the robot stops) or ``steps`` run out. The law is reset
+    whenever the task changes."""
+    run = Run(dt=dt)
+    q = np.array(q0, dtype=float)
+    task = None
+    for k in range(steps):
+        current = supervisor.update(q, k * dt)
+        if current is None:
+            break
+        if current is not task:
+            law.reset()
+            task = current
+        out = law.step(q, task, dt, obstacles)
+        run.configurations.append(q.copy())
+        run.outputs.append(out)
+        if supervisor.reached:
+            break
+        q = q + out.u * dt
+    run.reached = supervisor.reached
     return run
 
 

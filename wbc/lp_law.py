@@ -165,7 +165,7 @@ class LPLaw:
             self.objectives = default_objectives(self.params)
 
         pose, jacobian = self.robot.kinematics(q)
-        error, task_jacobian = task.error(pose, jacobian)
+        error, task_jacobian = task.error(pose, jacobian, q)
         if self._last is not None and same_task(self._last[0], task):
             error_rate = (error - self._last[1]) / dt
         else:

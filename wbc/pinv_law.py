@@ -54,6 +54,6 @@ class PseudoinverseLaw:
         start = time.perf_counter()
         q = require_finite("configuration q", q)
         pose, jacobian = self.robot.kinematics(q)
-        error, task_jacobian = task.error(pose, jacobian)
+        error, task_jacobian = task.error(pose, jacobian, q)
         u = pinv_velocity(task_jacobian, error, self.params.eta)
         return summarise(u, "optimal", None, (), error, start)

@@ -7,6 +7,7 @@ e = p - p_d with the rows of the translation Jacobian J_p (4.18) for i, j and k.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
@@ -36,7 +37,11 @@ class PoseTask:
         position.flags.writeable = False
         object.__setattr__(self, "goal_position", position)
 
-    def error(self, pose: Array, jacobian: Array) -> tuple[Array, Array]:
+    @property
+    def coefficients(self) -> Array:
+        return self.pose
+
+    def error(self, pose: Array, jacobian: Array, q: Array | None = None) -> tuple[Array, Array]:
         """(vec8(x - x_d), J), x_d taken with the sign nearer to x (x_d and -x_d are one pose)."""
         return pose - dq.nearest_equivalent(self.pose, pose), jacobian
 
@@ -59,12 +64,32 @@ class PositionTask:
     def goal_position(self) -> Array:
         return self.position
 
-    def error(self, pose: Array, jacobian: Array) -> tuple[Array, Array]:
+    @property
+    def coefficients(self) -> Array:
+        return self.position
+
+    def error(self, pose: Array, jacobian: Array, q: Array | None = None) -> tuple[Array, Array]:
         """(p - p_d, rows i, j, k of J_p) (4.18)."""
         return dq.translation(pose)[1:] - self.position, translation_jacobian(pose, jacobian)[1:]
 
 
-Task = PoseTask | PositionTask
+class Task(Protocol):
+    """What every law drives to zero: e and its Jacobian at the pose x, Jacobian J and
+    configuration q (end-effector tasks use x and J; base and joint tasks use q)."""
+
+    dof: int
+
+    @property
+    def goal_position(self) -> Array:
+        """Where the task leads, (x, y, z): its projection on the floor is the q_d of 5.25."""
+        ...
+
+    @property
+    def coefficients(self) -> Array:
+        """The goal's numbers: two tasks of one kind are one task when these agree."""
+        ...
+
+    def error(self, pose: Array, jacobian: Array, q: Array) -> tuple[Array, Array]: ...
 
 
 MEASUREMENT_TOLERANCE = 0.02
@@ -79,6 +104,4 @@ def same_task(a: Task, b: Task, tolerance: float = 0.0) -> bool:
         return True
     if type(a) is not type(b):
         return False
-    goal_a = a.pose if isinstance(a, PoseTask) else a.position
-    goal_b = b.pose if isinstance(b, PoseTask) else b.position
-    return bool(np.max(np.abs(goal_a - goal_b)) <= tolerance)
+    return bool(np.max(np.abs(a.coefficients - b.coefficients)) <= tolerance)

@@ -1,0 +1,150 @@
+"""The staging supervisor's parts: drive tasks, conditioning, candidates, and whole runs."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from wbc_scenarios import robot
+
+from parsimony.goal_sets import FAMILIES, goals
+from wbc import dq
+from wbc.conditioning import smallest_singular_value
+from wbc.drive_tasks import HeadingTask, PointTask, offset_point
+from wbc.kinematic_run import integrate, integrate_supervised
+from wbc.lp_law import LPLaw
+from wbc.obstacles import Circle
+from wbc.planar import planar_pose
+from wbc.scenarios import DT, HOME
+from wbc.staging import StagingParams, arm_box, candidates
+from wbc.staging_supervisor import Phase, StagingSupervisor
+from wbc.task import PoseTask
+
+MODEL = robot()
+STEPS = int(60.0 / DT)
+
+
+def finite_difference(task, q: np.ndarray, step: float = 1e-6) -> np.ndarray:
+    pose, jacobian = MODEL.kinematics(q)
+    columns = []
+    for i in range(q.size):
+        dq_ = np.zeros_like(q)
+        dq_[i] = step
+        plus = task.error(*MODEL.kinematics(q + dq_), q + dq_)[0]
+        minus = task.error(*MODEL.kinematics(q - dq_), q - dq_)[0]
+        columns.append((plus - minus) / (2 * step))
+    return np.column_stack(columns)
+
+
+@pytest.mark.parametrize("task", [
+    PointTask(np.array([0.4, -0.2]), np.array([0.1, -0.3, 0.2, 0.0, 0.4])),
+    HeadingTask(2.0, np.array([0.1, -0.3, 0.2, 0.0, 0.4]), np.array([0.0, 0.0])),
+])  # fmt: skip
+def test_drive_task_jacobians_are_the_derivatives_of_their_errors(task) -> None:
+    q = np.array([0.3, -0.1, 0.7, 0.2, -0.4, 0.1, 0.3, -0.2])
+    _, jacobian = task.error(*MODEL.kinematics(q), q)
+    np.testing.assert_allclose(jacobian, finite_difference(task, q), atol=1e-8)
+
+
+def test_a_point_task_drives_the_point_ahead_of_the_axle_and_the_arm_there() -> None:
+    task = PointTask(np.array([-0.5, 0.6]), np.array([0.2, -0.5, 0.1, 0.3, 0.2]))
+    run = integrate(LPLaw(MODEL), HOME, task, DT, STEPS, tolerance=1e-3)
+    q = run.configurations[-1]
+    assert run.converged
+    np.testing.assert_allclose(offset_point(q, task.lookahead), task.point, atol=2e-3)
+    np.testing.assert_allclose(q[3:], task.arm, atol=2e-3)
+    for q_k, out in zip(run.configurations, run.outputs, strict=True):
+        assert out.status == "optimal"
+        assert abs(out.u[0] * math.sin(q_k[2]) - out.u[1] * math.cos(q_k[2])) < 1e-9
+
+
+def test_a_heading_task_turns_the_base_in_place() -> None:
+    task = HeadingTask(-2.5, HOME[3:], HOME[:2])
+    run = integrate(LPLaw(MODEL), HOME, task, DT, STEPS, tolerance=1e-3)
+    q = run.configurations[-1]
+    assert run.converged
+    assert abs(q[2] - -2.5) < 2e-3
+    assert np.hypot(*q[:2]) < 1e-9
+
+
+def test_conditioning_vanishes_where_the_arm_loses_a_direction() -> None:
+    # The wrist rolled a quarter turn puts the wrist pitch axis parallel to the shoulder's and
+    # the elbow's: the three then move the gripper in the arm's plane, as the base's forward
+    # motion does, and nothing turns it about the vertical without swinging it sideways.
+    rolled = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, math.pi / 2, 0.0])
+    assert smallest_singular_value(MODEL, rolled) < 1e-9
+    assert smallest_singular_value(MODEL, HOME) > 0.01
+
+
+def test_every_candidate_reaches_the_goal_pose_inside_the_shrunk_joint_box() -> None:
+    params = StagingParams()
+    low, high = arm_box(MODEL, params.safety_factor, params.joint_margins[-1])
+    for start, goal in goals(FAMILIES["anywhere"], 5, seed=7):
+        found = candidates(MODEL, start, MODEL.fkm(goal), params=params)
+        assert found
+        assert [c.score for c in found] == sorted(c.score for c in found)
+        for c in found:
+            x = MODEL.fkm(c.q)
+            np.testing.assert_allclose(x, dq.nearest_equivalent(MODEL.fkm(goal), x), atol=1e-5)
+            assert c.q[3] == 0.0
+            assert np.all(c.q[4:] >= low[1:] - 1e-9) and np.all(c.q[4:] <= high[1:] + 1e-9)
+
+
+def test_candidates_keep_the_base_clear_of_obstacles() -> None:
+    start, goal = goals(FAMILIES["anywhere"], 1, seed=3)[0]
+    free = candidates(MODEL, start, MODEL.fkm(goal))
+    blocker = Circle(*free[0].base[:2], 0.1)
+    found = candidates(MODEL, start, MODEL.fkm(goal), [blocker])
+    clearance = blocker.radius + MODEL.base.body_radius
+    assert all(math.hypot(*(c.base[:2] - free[0].base[:2])) >= clearance for c in found)
+
+
+def test_a_goal_behind_the_robot_is_reached_through_lp_steps_within_the_limits() -> None:
+    goal = MODEL.fkm(np.array([-0.7, 0.3, math.pi - 0.4, 0.2, -0.3, -0.4, 0.2, 0.3]))
+    supervisor = StagingSupervisor(MODEL, goal)
+    run = integrate_supervised(LPLaw(MODEL), supervisor, HOME, DT, STEPS)
+    assert run.converged and supervisor.phase is Phase.REACHED
+    assert [e.detail for e in supervisor.events if e.kind == "phase"][-1] == "pose"
+    q = np.array(run.configurations)
+    assert np.all(q >= MODEL.q_min - 1e-9) and np.all(q <= MODEL.q_max + 1e-9)
+    u = run.velocities()
+    assert np.all(np.abs(u) <= MODEL.velocity_max + 1e-9)
+    assert all(out.status == "optimal" for out in run.outputs)
+    x = MODEL.fkm(run.configurations[-1])
+    assert np.linalg.norm(x - dq.nearest_equivalent(goal, x)) < 1e-3
+
+
+def test_a_goal_no_configuration_reaches_is_reported_at_once_and_gives_no_task() -> None:
+    floating = planar_pose(0.5, 0.0, 0.0, 2.0)
+    supervisor = StagingSupervisor(MODEL, floating)
+    assert supervisor.update(HOME, 0.0) is None
+    assert supervisor.phase is Phase.UNREACHABLE
+    assert "no whole-body configuration" in supervisor.reason
+
+
+def test_a_walled_off_goal_is_given_up_after_the_bounded_re_plans_and_the_robot_stops() -> None:
+    goal_q = np.array([2.0, 0.0, 0.0, 0.0, -0.3, -0.4, 0.2, 0.3])
+    goal = MODEL.fkm(goal_q)
+    # A ring of posts 0.9 m round the goal, too close together for the base to pass.
+    ring = [Circle(2.0 + 0.9 * math.cos(a), 0.9 * math.sin(a), 0.08)
+            for a in np.linspace(0.0, 2.0 * math.pi, 30, endpoint=False)]  # fmt: skip
+    supervisor = StagingSupervisor(MODEL, goal, ring)
+    run = integrate_supervised(LPLaw(MODEL), supervisor, HOME, DT, STEPS, ring)
+    assert supervisor.phase is Phase.UNREACHABLE and not run.converged
+    assert supervisor.replans == supervisor.params.max_replans
+    assert "stalled" in supervisor.reason
+    assert sum(e.kind == "stall" for e in supervisor.events) == supervisor.params.max_replans + 1
+    assert len(run.outputs) < STEPS
+
+
+def test_the_pose_task_alone_is_what_runs_once_the_base_stands_at_its_candidate() -> None:
+    goal = MODEL.fkm(np.array([0.6, 0.1, 0.2, 0.0, -0.3, -0.4, 0.2, 0.3]))
+    supervisor = StagingSupervisor(MODEL, goal)
+    first = supervisor.update(HOME, 0.0)
+    assert supervisor.candidate is not None
+    at_candidate = supervisor.candidate.q
+    supervisor = StagingSupervisor(MODEL, goal)
+    task = supervisor.update(at_candidate, 0.0)
+    assert isinstance(task, PoseTask) and supervisor.phase in (Phase.POSE, Phase.REACHED)
+    assert not isinstance(first, PoseTask)

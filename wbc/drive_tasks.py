@@ -1,0 +1,116 @@
+"""Tasks on the base and the arm's joints, for the legs of a staging plan (wbc.staging).
+
+A differential-drive base cannot steer its wheel axle's centre, but it can steer a point
+ahead of it: p = (x + d cos phi, y + d sin phi) moves as
+
+    p' = [cos phi, sin phi] v + d [-sin phi, cos phi] phi'
+
+for forward speed v, a map that is invertible for d > 0. ``PointTask`` drives p to a point
+with e = [p - p_d, q_a - q_a,d] (7 rows: the base's two and the five joints'), which the
+robot's 7 velocities (v, phi', q1'..q5') meet exactly. ``HeadingTask`` turns the base in
+place, e = [wrap(phi - phi_d), q_a - q_a,d]: with its six rows the forward speed stays free
+and the least-velocity term keeps it at zero. Each Jacobian is the derivative of its error
+with respect to q = [x, y, phi, q1..q5].
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from wbc.planar import wrap
+from wbc.robot import BASE_DOF
+from wbc.validation import require_finite
+
+Array = np.ndarray
+
+ARM_DOF = 5
+
+
+def _frozen(name: str, values: Array, size: int) -> Array:
+    array = require_finite(name, values).astype(float).copy()
+    if array.shape != (size,):
+        raise ValueError(f"{name} must have shape ({size},), got {array.shape}")
+    array.flags.writeable = False
+    return array
+
+
+def _arm_rows(q: Array, arm: Array) -> tuple[Array, Array]:
+    """q_a - q_a,d and its Jacobian [0 I]."""
+    rows = np.zeros((ARM_DOF, BASE_DOF + ARM_DOF))
+    rows[:, BASE_DOF:] = np.eye(ARM_DOF)
+    return q[BASE_DOF:] - arm, rows
+
+
+def offset_point(q: Array, lookahead: float) -> Array:
+    """p = (x + d cos phi, y + d sin phi): the point ``lookahead`` d ahead of the axle."""
+    phi = float(q[2])
+    return np.array([q[0] + lookahead * math.cos(phi), q[1] + lookahead * math.sin(phi)])
+
+
+@dataclass(frozen=True)
+class PointTask:
+    """Drive the point ``lookahead`` ahead of the axle to ``point`` (x, y) with the arm going
+    to ``arm`` (5 joint angles): e = [p - p_d, q_a - q_a,d]."""
+
+    point: Array
+    arm: Array
+    lookahead: float = 0.1
+    dof = 7
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "point", _frozen("drive point", self.point, 2))
+        object.__setattr__(self, "arm", _frozen("arm configuration", self.arm, ARM_DOF))
+        if not self.lookahead > 0.0:
+            raise ValueError(f"lookahead must be > 0, got {self.lookahead}")
+
+    @property
+    def goal_position(self) -> Array:
+        return np.array([self.point[0], self.point[1], 0.0])
+
+    @property
+    def coefficients(self) -> Array:
+        return np.concatenate((self.point, self.arm))
+
+    def error(self, pose: Array, jacobian: Array, q: Array) -> tuple[Array, Array]:
+        phi = float(q[2])
+        point_rows = np.zeros((2, BASE_DOF + ARM_DOF))
+        point_rows[0, 0] = point_rows[1, 1] = 1.0
+        point_rows[0, 2] = -self.lookahead * math.sin(phi)
+        point_rows[1, 2] = self.lookahead * math.cos(phi)
+        arm_error, arm_rows = _arm_rows(q, self.arm)
+        error = np.concatenate((offset_point(q, self.lookahead) - self.point, arm_error))
+        return error, np.vstack((point_rows, arm_rows))
+
+
+@dataclass(frozen=True)
+class HeadingTask:
+    """Turn the base to ``heading`` (rad) where it stands, ``position`` (x, y), with the arm
+    going to ``arm``: e = [wrap(phi - phi_d), q_a - q_a,d]."""
+
+    heading: float
+    arm: Array
+    position: Array
+    dof = 6
+
+    def __post_init__(self) -> None:
+        require_finite("heading", np.array([self.heading]))
+        object.__setattr__(self, "arm", _frozen("arm configuration", self.arm, ARM_DOF))
+        object.__setattr__(self, "position", _frozen("turning position", self.position, 2))
+
+    @property
+    def goal_position(self) -> Array:
+        return np.array([self.position[0], self.position[1], 0.0])
+
+    @property
+    def coefficients(self) -> Array:
+        return np.concatenate(([self.heading], self.arm))
+
+    def error(self, pose: Array, jacobian: Array, q: Array) -> tuple[Array, Array]:
+        heading_row = np.zeros((1, BASE_DOF + ARM_DOF))
+        heading_row[0, 2] = 1.0
+        arm_error, arm_rows = _arm_rows(q, self.arm)
+        error = np.concatenate(([wrap(float(q[2]) - self.heading)], arm_error))
+        return error, np.vstack((heading_row, arm_rows))

@@ -1,0 +1,217 @@
+"""Above the local law: drive to a staging candidate by LP sub-tasks, then run the pose task.
+
+For a pose goal x_d the supervisor takes the best candidate q_c of wbc.staging and hands the
+law one task per phase, every command still one LP step:
+
+    drive     PointTask: the point d ahead of the axle to the staging point's (a final leg
+              behind q_c's base, on its heading), the arm to q_c's arm
+    turn      HeadingTask: the base to q_c's heading where it stands, the arm held at q_c's
+    approach  PointTask: the straight final leg to q_c's base
+    pose      PoseTask(x_d): the ordinary LP pose task, which starts with room on every joint
+
+A phase ends when its error is within its tolerance; phases already met are skipped. A phase
+stalls when ||e|| falls by less than ``stall_reduction`` of itself over ``stall_window_s``:
+the supervisor then re-plans from where the robot is, with the best candidate not yet tried,
+at most ``max_replans`` times; after that, or when no candidate exists, the goal is
+unreachable, the reason is kept, and the supervisor gives no task (the robot stops).
+"""
+
+from __future__ import annotations
+
+import collections
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from enum import StrEnum
+
+import numpy as np
+
+from wbc.drive_tasks import HeadingTask, PointTask
+from wbc.obstacles import Circle
+from wbc.planar import wrap
+from wbc.robot import MobileManipulator
+from wbc.staging import Candidate, StagingParams, candidates, same_configuration
+from wbc.task import PoseTask, Task
+
+Array = np.ndarray
+
+
+NEAR_HEADING = 0.3
+"""A base within a final leg of its candidate and this close to its heading (rad) goes
+straight to the approach."""
+
+
+class Phase(StrEnum):
+    DRIVE = "drive"
+    TURN = "turn"
+    APPROACH = "approach"
+    POSE = "pose"
+    REACHED = "reached"
+    UNREACHABLE = "unreachable"
+
+
+@dataclass(frozen=True)
+class SupervisorParams:
+    lookahead: float = 0.1
+    """d: the drive legs steer the point this far ahead of the axle, m."""
+    leg_tolerance: float = 0.03
+    """A drive leg ends with its point this close to the target, m."""
+    turn_tolerance: float = 0.05
+    """The turn ends with the heading this close, rad."""
+    arm_tolerance: float = 0.05
+    """The approach ends with every arm joint this close to the candidate's, rad."""
+    pose_tolerance: float = 1e-3
+    """The goal is reached when ||vec8(x - x_d)|| is below this."""
+    stall_window_s: float = 2.0
+    stall_reduction: float = 0.03
+    max_replans: int = 3
+
+
+@dataclass(frozen=True)
+class Event:
+    """Something the supervisor did, for its diagnostics."""
+
+    t: float
+    kind: str
+    """'plan', 'phase', 'stall', 'replan', 'reached' or 'unreachable'."""
+    detail: str
+
+
+@dataclass
+class StagingSupervisor:
+    """The phases of the module docstring for one goal; ``update`` once per control step."""
+
+    robot: MobileManipulator
+    goal_pose: Array
+    obstacles: Sequence[Circle] = ()
+    params: SupervisorParams = field(default_factory=SupervisorParams)
+    staging: StagingParams = field(default_factory=StagingParams)
+    phase: Phase = field(default=Phase.POSE, init=False)
+    candidate: Candidate | None = field(default=None, init=False)
+    replans: int = field(default=0, init=False)
+    reason: str = field(default="", init=False)
+    events: list[Event] = field(default_factory=list, init=False)
+    planning_s: list[float] = field(default_factory=list, init=False)
+    tried: list[Candidate] = field(default_factory=list, init=False)
+    """The candidates driven to so far, the current one last."""
+    _task: Task | None = field(default=None, init=False)
+    _history: collections.deque = field(default_factory=collections.deque, init=False)
+    _pose_task: PoseTask = field(init=False)
+    _planned: bool = field(default=False, init=False)
+
+    def __post_init__(self) -> None:
+        self._pose_task = PoseTask(np.asarray(self.goal_pose, dtype=float))
+
+    @property
+    def reached(self) -> bool:
+        return self.phase is Phase.REACHED
+
+    @property
+    def task(self) -> Task | None:
+        """The task of the current phase; None when the goal is unreachable."""
+        return self._task
+
+    def update(self, q: Array, t: float) -> Task | None:
+        """Advance the phases at configuration q and time t (s); the task to step now."""
+        if not self._planned:
+            self._planned = True
+            self._plan(q, t)
+        for _ in range(len(Phase)):
+            if self._task is None:
+                return None
+            error = self._error(q)
+            if self.phase is Phase.REACHED or not self._met(error):
+                break
+            self._advance(t)
+        if self.phase is not Phase.REACHED and self._stalled(t, float(np.linalg.norm(error))):
+            self.events.append(Event(t, "stall", f"{self.phase} error {np.linalg.norm(error):.3g}"))
+            self._replan(q, t)
+        return self._task
+
+    def _plan(self, q: Array, t: float) -> None:
+        start = time.perf_counter()
+        found = candidates(self.robot, q, self._pose_task.pose, self.obstacles, self.staging)
+        self.planning_s.append(time.perf_counter() - start)
+        fresh = [c for c in found if not any(same_configuration(c.q, o.q) for o in self.tried)]
+        if not fresh:
+            self._give_up(t, "no whole-body configuration inside the joint box reaches the goal"
+                          if not found else "every staging candidate was tried")  # fmt: skip
+            return
+        self.candidate = fresh[0]
+        self.tried.append(fresh[0])
+        base = ", ".join(f"{v:.2f}" for v in fresh[0].base)
+        self.events.append(Event(t, "plan", f"candidate {len(self.tried)} of {len(found)}: "
+                                 f"base ({base}) score {fresh[0].score:.2f} "
+                                 f"sigma {fresh[0].sigma:.3f}"))  # fmt: skip
+        near = (math.hypot(*(fresh[0].base[:2] - q[:2])) < self.staging.final_leg
+                and abs(wrap(fresh[0].base[2] - q[2])) < NEAR_HEADING)  # fmt: skip
+        self._enter(Phase.APPROACH if near else Phase.DRIVE, t)
+
+    def _replan(self, q: Array, t: float) -> None:
+        if self.replans >= self.params.max_replans:
+            self._give_up(t, f"stalled in {self.phase} after {self.replans} re-plans")
+            return
+        self.replans += 1
+        self.events.append(Event(t, "replan", f"re-plan {self.replans}"))
+        self._plan(q, t)
+
+    def _give_up(self, t: float, reason: str) -> None:
+        self.reason = reason
+        self.phase, self._task = Phase.UNREACHABLE, None
+        self.events.append(Event(t, "unreachable", reason))
+
+    def _advance(self, t: float) -> None:
+        order = [Phase.DRIVE, Phase.TURN, Phase.APPROACH, Phase.POSE, Phase.REACHED]
+        self._enter(order[order.index(self.phase) + 1], t)
+
+    def _enter(self, phase: Phase, t: float) -> None:
+        self.phase = phase
+        self._history.clear()
+        candidate, d = self.candidate, self.params.lookahead
+        assert candidate is not None
+        x, y, phi = candidate.base
+        heading = np.array([math.cos(phi), math.sin(phi)])
+        if phase is Phase.DRIVE:
+            point = candidate.staging_point(self.staging.final_leg) + d * heading
+            self._task = PointTask(point, candidate.arm, d)
+        elif phase is Phase.TURN:
+            position = candidate.staging_point(self.staging.final_leg)
+            self._task = HeadingTask(float(phi), candidate.arm, position)
+        elif phase is Phase.APPROACH:
+            self._task = PointTask(np.array([x, y]) + d * heading, candidate.arm, d)
+        elif phase is Phase.POSE:
+            self._task = self._pose_task
+        else:
+            self.events.append(Event(t, "reached", "pose goal reached"))
+            return
+        self.events.append(Event(t, "phase", str(phase)))
+
+    def _error(self, q: Array) -> Array:
+        pose, jacobian = self.robot.kinematics(q)
+        assert self._task is not None
+        return self._task.error(pose, jacobian, q)[0]
+
+    def _met(self, error: Array) -> bool:
+        p = self.params
+        if self.phase is Phase.DRIVE:
+            return bool(np.linalg.norm(error[:2]) < p.leg_tolerance)
+        if self.phase is Phase.TURN:
+            return bool(abs(error[0]) < p.turn_tolerance)
+        if self.phase is Phase.APPROACH:
+            return bool(np.linalg.norm(error[:2]) < p.leg_tolerance
+                        and np.max(np.abs(error[2:])) < p.arm_tolerance)  # fmt: skip
+        if self.phase is Phase.POSE:
+            return bool(np.linalg.norm(error) < p.pose_tolerance)
+        return False
+
+    def _stalled(self, t: float, norm: float) -> bool:
+        """||e|| fell by less than stall_reduction of itself over the last stall window."""
+        history = self._history
+        history.append((t, norm))
+        window = self.params.stall_window_s
+        if t - history[0][0] < window:
+            return False
+        while len(history) > 1 and t - history[1][0] >= window:
+            history.popleft()
+        return norm > (1.0 - self.params.stall_reduction) * history[0][1]
