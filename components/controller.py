@@ -48,6 +48,7 @@ from messages.goal import Goal
 from messages.obstacles import Obstacles
 from messages.state import RobotState
 from wbc.base_motion import unicycle, wheel_speeds
+from wbc.drive_tasks import HeadingTask, PointTask
 from wbc.gains import gain_specs
 from wbc.law_output import Law, LawOutput
 from wbc.obstacles import Circle
@@ -107,7 +108,11 @@ def task_of(goal: Goal) -> Task:
     """The ``wbc`` task a goal asks for."""
     if goal.task == "pose":
         return PoseTask(np.array(goal.pose))
-    return PositionTask(np.array(goal.position))
+    if goal.task == "position":
+        return PositionTask(np.array(goal.position))
+    if goal.task == "point":
+        return PointTask(np.array(goal.point), np.array(goal.arm), float(goal.lookahead))
+    return HeadingTask(float(goal.heading), np.array(goal.arm), np.array(goal.point))
 
 
 class Controller(Component):

@@ -32,6 +32,7 @@ from messages.obstacles import Obstacles
 from messages.odometry import BaseOdometry
 from messages.state import RobotState
 from messages.status import ComponentStatus
+from messages.supervisor import SupervisorStatus
 from messages.truth import SimTruth
 
 M = TypeVar("M", bound=BaseModel)
@@ -71,6 +72,9 @@ ARM_JOINT_STATES = Topic("arm/joint_states", "arm/joint_states", JointStates)
 ROBOT_STATE = Topic("robot/state", "robot/state", RobotState)
 WORLD_OBSTACLES = Topic("world/obstacles", "world/obstacles", Obstacles)
 CONTROL_GOAL = Topic("control/goal", "control/goal", Goal)
+GOAL_REQUEST = Topic("goal/request", "goal/request", Goal)
+"""The operator's goal, for a supervisor that turns it into control/goal phase by phase."""
+SUPERVISOR_STATUS = Topic("supervisor/status", "supervisor/status", SupervisorStatus)
 BASE_COMMAND = Topic("base/command", "base/command", BaseCommand)
 ARM_COMMAND = Topic("arm/command", "arm/command", ArmCommand)
 CONTROL_DIAGNOSTICS = Topic("control/diagnostics", "control/diagnostics", ControllerDiagnostics)
@@ -88,6 +92,8 @@ TOPICS: Mapping[str, Topic] = MappingProxyType(
             ROBOT_STATE,
             WORLD_OBSTACLES,
             CONTROL_GOAL,
+            GOAL_REQUEST,
+            SUPERVISOR_STATUS,
             BASE_COMMAND,
             ARM_COMMAND,
             CONTROL_DIAGNOSTICS,
@@ -101,7 +107,9 @@ TOPICS: Mapping[str, Topic] = MappingProxyType(
 STATUS_TYPE = ComponentStatus
 """The message type published on ``status_key(namespace, component)``."""
 
-MESSAGE_TYPES: tuple[type[BaseModel], ...] = (*(t.type for t in TOPICS.values()), STATUS_TYPE)
+MESSAGE_TYPES: tuple[type[BaseModel], ...] = tuple(
+    dict.fromkeys((*(t.type for t in TOPICS.values()), STATUS_TYPE))
+)
 """Every type that travels on its own on the wire (nested models excluded)."""
 
 _BY_SUFFIX: Mapping[str, Topic] = MappingProxyType({t.suffix: t for t in TOPICS.values()})

@@ -23,6 +23,7 @@ from messages import (
     RobotState,
 )
 from messages.base import Message
+from messages.supervisor import SupervisorStatus
 from messages.truth import SimTruth
 
 HEADER = Header(stamp_ns=1_700_000_000_123_456_789, frame="world", seq=7, source="test")
@@ -63,6 +64,12 @@ STATE = RobotState(
 POSE_GOAL = Goal(header=HEADER, task="pose", pose=QUARTER_TURN_SHIFTED, eta=5.0, beta=2.0)
 
 POSITION_GOAL = Goal(header=HEADER, task="position", position=(0.5, -0.25, 0.4), eta=1.5, beta=3)
+
+POINT_GOAL = Goal(header=HEADER, task="point", point=(0.4, -0.2),
+                  arm=(0.0, -0.3, 0.2, 0.0, 0.4), lookahead=0.1)  # fmt: skip
+
+HEADING_GOAL = Goal(header=HEADER, task="heading", heading=-2.5, point=(0.3, 0.1),
+                    arm=(0.0, -0.3, 0.2, 0.0, 0.4))  # fmt: skip
 
 EXAMPLES: tuple[Message, ...] = (
     IMAGE,
@@ -121,5 +128,11 @@ EXAMPLES: tuple[Message, ...] = (
         end_effector=QUARTER_TURN_SHIFTED,
         contacts=2,
         in_contact=False,
+    ),
+    POINT_GOAL,
+    HEADING_GOAL,
+    SupervisorStatus(
+        header=HEADER, phase="turn", candidate=2, candidate_base=(0.4, -0.1, 3.0), plans=2,
+        replans=1, stalls=1, error_norm=0.3, last_event="re-plan 1", planning_ms=61.5,
     ),
 )

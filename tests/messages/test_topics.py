@@ -56,6 +56,8 @@ def test_the_table_holds_every_topic_of_the_design() -> None:
         "robot/state": "RobotState",
         "world/obstacles": "Obstacles",
         "control/goal": "Goal",
+        "goal/request": "Goal",
+        "supervisor/status": "SupervisorStatus",
         "base/command": "BaseCommand",
         "arm/command": "ArmCommand",
         "control/diagnostics": "ControllerDiagnostics",

@@ -1,0 +1,35 @@
+"""What the staging supervisor is doing for the operator's goal."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import Field
+
+from messages.base import Finite, Message, NonNegative
+from messages.header import Header
+
+
+class SupervisorStatus(Message):
+    """The phase of the current goal (``wbc.staging_supervisor``), published as it changes and
+    with every control-rate tick that follows.
+
+    ``phase`` is ``drive``, ``turn``, ``approach``, ``pose``, ``reached`` or ``unreachable``
+    (``idle`` before any goal); ``candidate`` numbers the staging candidate being driven to
+    (1 the best), ``candidate_base`` is its base pose (x, y, phi); ``plans``, ``replans`` and
+    ``stalls`` count since the goal came; ``reason`` says why a goal is unreachable;
+    ``last_event`` is the latest thing the supervisor did, in words; ``planning_ms`` is the
+    time of the last plan.
+    """
+
+    header: Header
+    phase: Literal["idle", "drive", "turn", "approach", "pose", "reached", "unreachable"]
+    candidate: int = Field(ge=0)
+    candidate_base: tuple[Finite, Finite, Finite] | None = None
+    plans: int = Field(ge=0)
+    replans: int = Field(ge=0)
+    stalls: int = Field(ge=0)
+    error_norm: NonNegative | None = None
+    reason: str = ""
+    last_event: str = ""
+    planning_ms: NonNegative | None = None
