@@ -119,7 +119,7 @@ class Node:
         ``verbatim`` publishes headers as given (replay) instead of numbering them."""
         if self.writes is not None and topic.name not in self.writes:
             raise ValueError(f"{self.name} writes {topic.name} without declaring it in `writes`")
-        publisher = Publisher(self, topic, verbatim)
+        publisher = Publisher(self, self.spec.topic(topic), verbatim)
         self._declared.append(publisher)
         return publisher
 
@@ -135,14 +135,15 @@ class Node:
         every sample in order, at most N waiting (see ``components.pubsub``). A component
         declares it in ``reads``, and the node takes it from there.
         """
-        if topic.ground_truth and self.spec.role in ("estimator", "controller"):
+        actual = self.spec.topic(topic)
+        if actual.ground_truth and self.spec.role in ("estimator", "controller"):
             raise ValueError(f"{self.name} is an {self.spec.role}: it may not read the ground "
-                             f"truth on {topic.name}")  # fmt: skip
+                             f"truth on {actual.name}")  # fmt: skip
         if self.reads is not None and topic is not topics.SIM_CLOCK:
             if topic.name not in self.reads:
                 raise ValueError(f"{self.name} reads {topic.name} without declaring it in `reads`")
             queue = self.reads[topic.name].queue
-        subscription = Subscription(self, topic, handler, queue)
+        subscription = Subscription(self, actual, handler, queue)
         self._declared.append(subscription)
         return subscription
 

@@ -2,7 +2,8 @@
 
 Every enabled component's module is imported and its ``Component`` subclass asked for
 ``reads`` and ``writes`` (``components.runtime.Component``); a component on simulated time
-also reads ``sim/clock`` (``Profile.clock_of``). Nothing is started.
+also reads ``sim/clock`` (``Profile.clock_of``); a profile's ``remap`` renames what a
+component reads and writes (``ComponentSpec.topic``). Nothing is started.
 """
 
 from __future__ import annotations
@@ -123,8 +124,9 @@ def dataflow(profile: Profile) -> Dataflow:
     nodes = []
     for spec in profile.start_order():
         cls = component_class(spec)
-        reads = tuple(cls.reads)
+        reads = tuple(Input(spec.topic(i.topic), i.queue) for i in cls.reads)
         if profile.clock_of(spec, topics.SIM_CLOCK in cls.writes) == "sim":
             reads += (Input(topics.SIM_CLOCK),)
-        nodes.append(ComponentNode(spec.name, spec.module, spec.role, reads, tuple(cls.writes)))
+        writes = tuple(spec.topic(t) for t in cls.writes)
+        nodes.append(ComponentNode(spec.name, spec.module, spec.role, reads, writes))
     return Dataflow(profile.namespace, tuple(nodes))

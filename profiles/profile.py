@@ -19,6 +19,7 @@ import yaml
 import zenoh
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from messages import topics
 from messages.process import ParamValue
 from profiles.access import AccessSettings, insert
 from profiles.endpoints import endpoint_problem
@@ -188,6 +189,25 @@ class ComponentSpec(StrictModel):
     """This component's time: the host's, or the simulator's ``sim/clock``; None follows the
     profile's ``clock``, except for the component that publishes ``sim/clock`` (the simulator,
     a replayer), which always runs on its own, the host's, time."""
+    remap: dict[str, str] = {}
+    """Topic name -> topic name: the component reads or writes the second where its code says
+    the first (as ROS 2 remaps a node's topics). Both must carry the same message type."""
+
+    @model_validator(mode="after")
+    def _remaps_keep_the_message_type(self) -> ComponentSpec:
+        for old, new in self.remap.items():
+            for name in (old, new):
+                if name not in topics.TOPICS:
+                    raise ValueError(f"remap: {name!r} is not a topic (have "
+                                     f"{', '.join(topics.TOPICS)})")  # fmt: skip
+            if topics.TOPICS[old].type is not topics.TOPICS[new].type:
+                raise ValueError(f"remap: {old} carries {topics.TOPICS[old].type.__name__} and "
+                                 f"{new} {topics.TOPICS[new].type.__name__}")  # fmt: skip
+        return self
+
+    def topic(self, topic: topics.Topic) -> topics.Topic:
+        """The topic this component really uses where its code names ``topic``."""
+        return topics.TOPICS[self.remap.get(topic.name, topic.name)]
 
     @property
     def module_path(self) -> str:

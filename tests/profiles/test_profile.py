@@ -280,3 +280,21 @@ def test_an_invalid_override_names_its_field(tmp_path: Path) -> None:
     message = refusal(tmp_path, {"extends": "base.yaml", "components": [{"name": "pub",
                                  "restart": {"policy": "sometimes"}}]})  # fmt: skip
     assert "components[0].restart.policy" in message
+
+
+@pytest.mark.parametrize(("remap", "complaint"), [
+    ({"control/goal": "robot/state"}, "control/goal carries Goal and robot/state RobotState"),
+    ({"control/goal": "goal/requests"}, "'goal/requests' is not a topic"),
+])  # fmt: skip
+def test_a_remap_must_name_topics_of_one_message_type(
+    tmp_path: Path, remap: dict[str, str], complaint: str
+) -> None:
+    path = tmp_path / "remap.yaml"
+    path.write_text(yaml.safe_dump({
+        "namespace": "remap",
+        "components": [{"name": "estimator", "module": "state_estimator", "role": "estimator",
+                        "remap": remap}],
+    }))  # fmt: skip
+    with pytest.raises(ProfileError, match=r"components\[0\]\.remap: ") as error:
+        load_profile(path)
+    assert complaint in str(error.value)
