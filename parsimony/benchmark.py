@@ -240,11 +240,16 @@ def format_report(report: dict) -> str:
         )
     for family, result in report.get("goals", {}).items():
         lines.append(f"{family} goals ({result['goals']}): share reached   "
-                     "overall  in joint limits  in joint+speed limits")  # fmt: skip
+                     "overall  in joint limits  in joint+speed limits  median s to converge")
         for law, row in result["laws"].items():
             lines.append(f"  {law:<32} {row['reached']:9.2f} {row['within_joint_limits']:16.2f}"
-                         f" {row['within_joint_and_speed_limits']:22.2f}")  # fmt: skip
+                         f" {row['within_joint_and_speed_limits']:22.2f}"
+                         f" {row['median_time_to_converge_s']:21.1f}")  # fmt: skip
         for law, row in result["laws"].items():
+            if "plans_per_run" in row:
+                lines.append(f"  {law}: {row['plans_per_run']:.2f} plans per run, a plan takes "
+                             f"{row['plan_median_ms']:.0f} ms median, "
+                             f"{row['plan_p99_ms']:.0f} ms p99")  # fmt: skip
             if "nonzero_histogram" in row:
                 lines.append(f"  {law} steps by nonzero count 0..8: {row['nonzero_histogram']}")
     return "\n".join(lines)

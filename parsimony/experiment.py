@@ -42,7 +42,7 @@ from messages import codec, topics
 from parsimony.kinematic_demo import LP_PARAMS
 from parsimony.sessions import load_session
 from profiles.endpoints import free_port
-from profiles.profile import Profile, load_profile
+from profiles.profile import Profile, ProfileError, load_profile
 from record.report import write_report
 from record.session_file import info, recover
 from sim2d.scenarios import SimScenario, scenario
@@ -55,6 +55,8 @@ from wbc.robot import MobileManipulator
 DEPLOY = Path(__file__).resolve().parents[1] / "deploy"
 PROFILES = {"lp": DEPLOY / "sim.yaml", "cascade": DEPLOY / "sim_cascade.yaml"}
 """The profile each controller runs in unless ``--profile`` names another."""
+SUPERVISED = {"anywhere": DEPLOY / "sim_supervised.yaml"}
+"""Experiments whose LP runs under the staging supervisor (components/supervisor.py)."""
 MODULES = {"lp": "lp_controller", "cascade": "cascade_controller"}
 
 CONVERGED_ERROR = 0.01
@@ -67,7 +69,8 @@ STARTUP_S = 60.0
 """Host seconds the components may take to come up."""
 SESSION_FILE = "session.mcap"
 """The recording of a run, beside its report."""
-LISTENED = ("sim/truth", "robot/state", "control/diagnostics", "base/command", "arm/command")
+LISTENED = ("sim/truth", "robot/state", "control/diagnostics", "base/command", "arm/command",
+            "supervisor/status")  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -155,16 +158,35 @@ class Recorder:
             return {name: list(values) for name, values in self.messages.items()}
 
 
-def converged_at(diagnostics: list) -> float | None:
-    """The simulated time since which every step's error stayed under ``CONVERGED_ERROR``."""
+def converged_at(diagnostics: list, statuses: list) -> float | None:
+    """The simulated time since which every step's error stayed under ``CONVERGED_ERROR``;
+    under a supervisor (``statuses`` of supervisor/status), only the steps of its last pose
+    phase count: a drive leg's error is not the goal's."""
+    pose_since = pose_phase_since(statuses)
+    if pose_since is None:
+        return None
     since = None
     for d in diagnostics:
+        if d.header.stamp_ns / 1e9 < pose_since:
+            continue
         small = d.status == "optimal" and d.error_norm is not None
         small = small and d.error_norm < CONVERGED_ERROR
         if not small:
             since = None
         elif since is None:
             since = d.header.stamp_ns / 1e9
+    return since
+
+
+def pose_phase_since(statuses: list) -> float | None:
+    """When the supervisor's last run of pose (or reached) phases began; 0 with no supervisor,
+    None while it is in another phase."""
+    since = 0.0
+    for status in statuses:
+        if status.phase not in ("pose", "reached"):
+            since = None
+        elif since is None or since == 0.0:
+            since = status.header.stamp_ns / 1e9
     return since
 
 
@@ -181,7 +203,10 @@ def progress_line(messages: dict[str, list], wall_s: float) -> str:
 
 def run_experiment(options: Options) -> dict[str, Any]:
     """Run one experiment; return its report (also written to ``out/report.json``)."""
-    base = options.profile or PROFILES[options.controller]
+    if options.name in SUPERVISED and options.controller != "lp":
+        raise ProfileError(f"the {options.name} experiment runs the LP under the staging "
+                           "supervisor; the cascade cannot follow its drive tasks")  # fmt: skip
+    base = options.profile or SUPERVISED.get(options.name) or PROFILES[options.controller]
     base_profile = load_profile(base)
     robot = MobileManipulator.from_yaml(base_profile.robot)
     setup = scenario(options.name, robot, options.seed)
@@ -212,8 +237,7 @@ def run_experiment(options: Options) -> dict[str, Any]:
             launcher.wait()
         log.close()
     wall_s = time.monotonic() - started
-    end_ns, converged = end_of_run(messages["control/diagnostics"], options.time_limit_s,
-                                   origin_s(messages))  # fmt: skip
+    end_ns, converged = end_of_run(messages, options.time_limit_s, origin_s(messages))
     messages = until(messages, end_ns)
     report = build_report(options, setup, profile, robot, messages, wall_s, counters, converged)
     write_commands(options.out / "commands.csv", messages)
@@ -274,7 +298,7 @@ def follow(recorder: Recorder, options: Options, started: float) -> dict[str, li
             last_print = wall
         diagnostics = messages["control/diagnostics"]
         now_s = diagnostics[-1].header.stamp_ns / 1e9 if diagnostics else 0.0
-        since = converged_at(diagnostics)
+        since = converged_at(diagnostics, messages["supervisor/status"])
         if since is not None and now_s - since >= HOLD_S:
             return messages
         if now_s - origin_s(messages) >= options.time_limit_s or wall > wall_limit:
@@ -302,11 +326,13 @@ def origin_s(messages: dict[str, list]) -> float:
     return truth[0].header.stamp_ns / 1e9 if truth else math.inf
 
 
-def end_of_run(diagnostics: list, time_limit_s: float, origin: float) -> tuple[int, bool]:
+def end_of_run(messages: dict[str, list], time_limit_s: float, origin: float
+               ) -> tuple[int, bool]:  # fmt: skip
     """The stamp (ns) a run ends at, ``HOLD_S`` after it converged, else the time limit (a
     simulated time: two lockstep runs of one set-up report the same steps); and whether it
     converged."""
-    since = converged_at(diagnostics)
+    diagnostics = messages["control/diagnostics"]
+    since = converged_at(diagnostics, messages["supervisor/status"])
     if since is not None and diagnostics[-1].header.stamp_ns / 1e9 - since >= HOLD_S:
         return round((since + HOLD_S) * 1e9), True
     return round((origin + time_limit_s) * 1e9), False
@@ -356,6 +382,7 @@ def build_report(
         "real_time_factor": round(sim_s / wall_s, 2) if wall_s > 0 else None,
         "iterations": len(diagnostics),
         "contacts": truth[-1].contacts if truth else 0,
+        "supervisor": supervisor_summary(messages["supervisor/status"]),
         "joint_limit_violations": joints_at_stops(truth, robot),
         "min_obstacle_clearance_m": clearance(truth, setup, robot),
         "estimator_error": estimator_error(truth, states, profile, end_s - HOLD_S),
@@ -371,6 +398,21 @@ def build_report(
         "commands_digest": commands_digest(messages),
         "scenario": dataclasses.asdict(setup) | {"obstacles": setup.sim_params()["obstacles"]},
     }
+
+
+def supervisor_summary(statuses: list) -> dict[str, Any] | None:
+    """The staging supervisor's last word: phase, plans, re-plans, stalls, reason; and when
+    each phase began (simulated s). None when the run had no supervisor."""
+    if not statuses:
+        return None
+    last = statuses[-1]
+    began: list[tuple[str, float]] = []
+    for status in statuses:
+        if not began or began[-1][0] != status.phase:
+            began.append((status.phase, status.header.stamp_ns / 1e9))
+    return {"phase": last.phase, "plans": last.plans, "replans": last.replans,
+            "stalls": last.stalls, "reason": last.reason, "candidate_base": last.candidate_base,
+            "phases": [{"phase": p, "from_s": t} for p, t in began]}  # fmt: skip
 
 
 def joints_at_stops(truth: list, robot: MobileManipulator) -> int:

@@ -16,11 +16,12 @@ from pathlib import Path
 import numpy as np
 
 from wbc.cascade_law import CascadeLaw
-from wbc.kinematic_run import integrate
+from wbc.kinematic_run import integrate, integrate_supervised
 from wbc.law_output import Law
 from wbc.lp_law import LPLaw, LPParams
 from wbc.robot import MobileManipulator
 from wbc.scenarios import ARM_BOX, DT, HOME
+from wbc.staging_supervisor import StagingSupervisor, SupervisorParams
 from wbc.task import PoseTask
 
 Array = np.ndarray
@@ -75,6 +76,13 @@ class Attempt:
     """Largest |u_i| beyond the speed bound velocity_max_i (0 inside)."""
     nonzero: tuple[int, ...]
     """Nonzero entries of u at every step."""
+    planning_s: tuple[float, ...] = ()
+    """How long each staging plan took (supervised runs only)."""
+
+    @property
+    def seconds(self) -> float:
+        """Time the run took, s: to convergence when it converged."""
+        return self.steps * DT
 
     @property
     def within_joint_limits(self) -> bool:
@@ -85,17 +93,26 @@ class Attempt:
         return self.within_joint_limits and self.speed_overrun <= LIMIT_TOLERANCE
 
 
-def attempt(law: Law, robot: MobileManipulator, start: Array, goal: Array) -> Attempt:
-    """Run ``law`` from ``start`` to the pose of ``goal`` for at most TIME_LIMIT_S."""
-    task = PoseTask(robot.fkm(goal))
-    run = integrate(law, start, task, DT, int(TIME_LIMIT_S / DT), TOLERANCE)
-    q = np.array(run.configurations)
-    u = run.velocities()
+def attempt(law: Law, robot: MobileManipulator, start: Array, goal: Array,
+            supervised: bool = False) -> Attempt:  # fmt: skip
+    """Run ``law`` from ``start`` to the pose of ``goal`` for at most TIME_LIMIT_S, alone or
+    with the staging supervisor handing it its tasks."""
+    steps = int(TIME_LIMIT_S / DT)
+    planning: tuple[float, ...] = ()
+    if supervised:
+        params = SupervisorParams(pose_tolerance=TOLERANCE)
+        supervisor = StagingSupervisor(robot, robot.fkm(goal), params=params)
+        run = integrate_supervised(law, supervisor, start, DT, steps)
+        planning = tuple(supervisor.planning_s)
+    else:
+        run = integrate(law, start, PoseTask(robot.fkm(goal)), DT, steps, TOLERANCE)
+    q = np.array([start, *run.configurations])  # a supervisor may stop before any step
+    u = np.vstack((np.zeros(robot.dof), run.velocities().reshape(-1, robot.dof)))
     joint_overrun = np.maximum(q - robot.q_max, robot.q_min - q).max()
     speed_overrun = (np.abs(u) - robot.velocity_max).max()
     return Attempt(run.converged, len(run.outputs), float(max(joint_overrun, 0.0)),
                    float(max(speed_overrun, 0.0)),
-                   tuple(out.nonzero for out in run.outputs))  # fmt: skip
+                   tuple(out.nonzero for out in run.outputs), planning)  # fmt: skip
 
 
 def goals(family: GoalFamily, count: int, seed: int = GOAL_SEED) -> list[tuple[Array, Array]]:
@@ -104,13 +121,27 @@ def goals(family: GoalFamily, count: int, seed: int = GOAL_SEED) -> list[tuple[A
 
 
 def shares(attempts: Iterable[Attempt]) -> dict[str, float]:
-    """Share of goals reached: at all, inside the joint limits, inside joint and speed limits."""
+    """Share of goals reached: at all, inside the joint limits, inside joint and speed limits;
+    and the median time to converge of the goals reached (s)."""
     attempts = list(attempts)
     count = max(len(attempts), 1)
+    times = [a.seconds for a in attempts if a.converged]
     return {
         "reached": sum(a.converged for a in attempts) / count,
         "within_joint_limits": sum(a.within_joint_limits for a in attempts) / count,
         "within_joint_and_speed_limits": sum(a.within_all_limits for a in attempts) / count,
+        "median_time_to_converge_s": float(np.median(times)) if times else math.nan,
+    }
+
+
+def planning(attempts: Iterable[Attempt]) -> dict[str, float]:
+    """Plans per run (mean) and the time of one plan (median, p99, ms)."""
+    attempts = list(attempts)
+    times = np.array([t for a in attempts for t in a.planning_s]) * 1e3
+    return {
+        "plans_per_run": len(times) / max(len(attempts), 1),
+        "plan_median_ms": float(np.median(times)) if times.size else math.nan,
+        "plan_p99_ms": float(np.percentile(times, 99)) if times.size else math.nan,
     }
 
 
@@ -122,19 +153,22 @@ def nonzero_histogram(attempts: Iterable[Attempt], dof: int) -> list[int]:
     return counts.tolist()
 
 
+SUPERVISED = "lp + staging supervisor"
 LAWS: dict[str, Callable[[MobileManipulator], Law]] = {
     "lp": lambda robot: LPLaw(robot),
     "lp 5.29 exactly": lambda robot: LPLaw(robot, EXACT_5_29),
+    SUPERVISED: lambda robot: LPLaw(robot),
     "cascade": lambda robot: CascadeLaw(robot),
 }
-"""The laws compared: the default LP, LP 5.29 with no term added to the task, the cascade."""
+"""The laws compared: the default LP, LP 5.29 with no term added to the task, the default LP
+under the staging supervisor (wbc.staging_supervisor), the cascade."""
 EXACT_5_29 = LPParams(velocity_cost=0.0, waist_centring=0.0, base_target=0.0)
 
 
 def _attempt_one(job: tuple[str, Path, Array, Array]) -> Attempt:
     law_name, robot_file, start, goal = job
     robot = MobileManipulator.from_yaml(robot_file)
-    return attempt(LAWS[law_name](robot), robot, start, goal)
+    return attempt(LAWS[law_name](robot), robot, start, goal, law_name == SUPERVISED)
 
 
 def goal_report(robot_file: Path, count: int, processes: int = 2) -> dict:
@@ -149,6 +183,8 @@ def goal_report(robot_file: Path, count: int, processes: int = 2) -> dict:
                 jobs = [(law_name, robot_file, start, goal) for start, goal in pairs]
                 attempts = pool.map(_attempt_one, jobs, chunksize=1)
                 rows[law_name] = shares(attempts)
+                if law_name == SUPERVISED:
+                    rows[law_name].update(planning(attempts))
                 if law_name.startswith("lp"):
                     rows[law_name]["nonzero_histogram"] = nonzero_histogram(attempts, dof)
             report[family.name] = {"goals": count, "laws": rows}

@@ -32,6 +32,7 @@ LP_PARAMS = {
     "pose": LPParams(eta=0.6, beta=15.0),
     "position": LPParams(eta=1.0, beta=10.0),
     "obstacle": BORDER_PARAMS,
+    "anywhere": BORDER_PARAMS,
 }
 """The LP law's gains in each experiment of section 6.2 (6.2.1 gives eta 0.6 and beta 15)."""
 

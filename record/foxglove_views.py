@@ -6,7 +6,7 @@ panels open a recording (or a live view) with no plugin:
                                                         world -> estimate/end_effector
     SimTruth               -> foxglove.FrameTransforms  world -> truth/base, truth/end_effector
     MarkerDetections       -> foxglove.FrameTransforms  camera -> marker_<id>
-    Goal (pose task)       -> foxglove.FrameTransforms  world -> goal
+    Goal (pose task)       -> foxglove.FrameTransforms  world -> goal (control/goal, goal/request)
     Obstacles              -> foxglove.SceneUpdate      one cylinder per circle, frame "world"
 
 The base transform is the planar pose (x, y, phi): translation (x, y, 0), rotation phi about z.
@@ -153,6 +153,7 @@ VIEWS: dict[str, Callable[[Any], list[View]]] = {
     topics.SIM_TRUTH.name: robot_views("truth/"),
     topics.VISION_MARKERS.name: marker_views,
     topics.CONTROL_GOAL.name: goal_views,
+    topics.GOAL_REQUEST.name: goal_views,
     topics.WORLD_OBSTACLES.name: obstacle_views,
 }
 """Topic name -> the views of one of its messages; topics not named here have none."""

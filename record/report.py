@@ -2,7 +2,9 @@
 
 A session maps a topic name (``messages.topics``) to the messages recorded on it. It needs
 ``robot/state``, ``control/goal``, ``base/command``, ``arm/command`` and
-``control/diagnostics``; ``world/obstacles`` and ``sim/truth`` are drawn when present.
+``control/diagnostics``; ``world/obstacles`` and ``sim/truth`` are drawn when present. The goal
+is the operator's, ``goal/request``, when a staging supervisor stood between it and
+``control/goal`` (whose drive legs are not the goal), else ``control/goal``.
 Commands and diagnostics carry the stamp of the state they answer, so the control input
 u = [x', y', phi', q1'..q5'] of a stamp joins the base and arm commands of that stamp with
 x' = v cos(phi), y' = v sin(phi), phi' = omega, phi the heading of the nearest state.
@@ -38,6 +40,7 @@ from messages.topics import (
     BASE_COMMAND,
     CONTROL_DIAGNOSTICS,
     CONTROL_GOAL,
+    GOAL_REQUEST,
     ROBOT_STATE,
     SIM_TRUTH,
     WORLD_OBSTACLES,
@@ -149,7 +152,7 @@ def _recording(
         stamps_ns=stamps,
         u=u,
         states=_messages(session, ROBOT_STATE),
-        goals=_messages(session, CONTROL_GOAL),
+        goals=_messages(session, GOAL_REQUEST, required=False) or _messages(session, CONTROL_GOAL),
         diagnostics=_messages(session, CONTROL_DIAGNOSTICS),
         obstacles=_messages(session, WORLD_OBSTACLES, required=False),
         truth=[_in_frame(t, truth_frame) for t in truth],

@@ -20,8 +20,17 @@ from wbc.planar import planar_of
 from wbc.robot import MobileManipulator
 from wbc.scenarios import HOME, OBSTACLE, REACH_GOAL
 
-NAMES = ("pose", "position", "obstacle")
-"""The experiments of section 6.2."""
+NAMES = ("pose", "position", "obstacle", "anywhere")
+"""The experiments of section 6.2, and 'anywhere': a pose goal behind the robot, past an
+obstacle, which the LP law reaches only under the staging supervisor (deploy/sim_supervised)."""
+
+ANYWHERE_START = (1.3, 0.2, 0.0)
+"""The base of 'anywhere' (x, y, phi): at the far side of the camera's view, facing away."""
+ANYWHERE_BIN = (0.35, 0.0)
+"""The bin of 'anywhere' (x, y), behind the robot; it faces the other way from the pose
+experiment's bin, so the gripper must point back along -x."""
+ANYWHERE_OBSTACLE = Circle(0.8, -0.3, 0.1)
+"""Beside the way back."""
 
 OBSTACLE_SHIFT = (0.75, 0.25)
 """Where the obstacle experiment's bin stands from the pose experiment's, m: past the obstacle."""
@@ -58,10 +67,15 @@ def scenario(name: str, robot: MobileManipulator, seed: int | None = None) -> Si
         raise ValueError(f"no experiment {name!r}; choose one of {', '.join(NAMES)}")
     x, y, yaw = planar_of(robot.fkm(REACH_GOAL))
     obstacles: tuple[Circle, ...] = ()
+    start = HOME.copy()
     if name == "obstacle":
         x, y = x + OBSTACLE_SHIFT[0], y + OBSTACLE_SHIFT[1]
         obstacles = (OBSTACLE,)
-    start, bin_pose = HOME.copy(), np.array([x, y, yaw])
+    if name == "anywhere":
+        (x, y), yaw = ANYWHERE_BIN, yaw + np.pi
+        start[:3] = ANYWHERE_START
+        obstacles = (ANYWHERE_OBSTACLE,)
+    bin_pose = np.array([x, y, yaw])
     if seed is not None:
         rng = np.random.default_rng(seed)
         start = start + rng.uniform(-START_RANGE, START_RANGE)

@@ -93,10 +93,11 @@ def test_hidden_base_marker_degrades_the_state_and_the_run_still_converges(
     assert report["degraded_states"] > 100  # about 2.5 s of 100 Hz states after the timeout
 
 
-def kill_during_run(tmp_path: Path, component: str) -> tuple[int, dict, str]:
-    """Start an experiment, SIGKILL ``component`` once the controller has run 200 steps, and
-    return the exit status, the report and the launch log."""
-    command = [sys.executable, "-m", "parsimony.cli", "experiment", "pose", "--json"]
+def kill_during_run(tmp_path: Path, component: str, name: str = "pose"
+                    ) -> tuple[int, dict, str]:  # fmt: skip
+    """Start experiment ``name``, SIGKILL ``component`` once the controller has run 200 steps,
+    and return the exit status, the report and the launch log."""
+    command = [sys.executable, "-m", "parsimony.cli", "experiment", name, "--json"]
     process = subprocess.Popen([*command, "--out", str(tmp_path)], stdout=subprocess.PIPE,
                                stderr=subprocess.DEVNULL, text=True)  # fmt: skip
     try:
@@ -146,3 +147,33 @@ def test_usage_errors_exit_2(bad: list[str], tmp_path: Path) -> None:
     done = subprocess.run(command, capture_output=True, text=True, timeout=60)
     assert done.returncode == 2
     assert done.stdout == ""
+
+
+def assert_behind(report: dict) -> None:
+    """The goal (above the bin) lay behind the robot at the start: more than 90 degrees off
+    its heading."""
+    x, y, phi = report["scenario"]["start"][:3]
+    goal_x, goal_y = report["scenario"]["bin"][:2]
+    bearing = math.atan2(goal_y - y, goal_x - x) - phi
+    assert abs(math.remainder(bearing, 2 * math.pi)) > math.pi / 2, report
+
+
+def test_a_goal_behind_the_robot_is_reached_under_the_staging_supervisor(tmp_path: Path) -> None:
+    code, report = experiment(tmp_path, "anywhere")
+    assert code == 0
+    assert_sound(report)
+    assert_behind(report)
+    supervisor = report["supervisor"]
+    assert [p["phase"] for p in supervisor["phases"]] == [
+        "drive", "turn", "approach", "pose", "reached"]  # fmt: skip
+    assert supervisor["plans"] == 1 and supervisor["replans"] == 0
+    assert report["min_obstacle_clearance_m"] > 0.0
+
+
+def test_a_killed_supervisor_is_restarted_and_the_run_still_converges(tmp_path: Path) -> None:
+    code, report, log = kill_during_run(tmp_path, "supervisor", "anywhere")
+    assert code == 0 and report["converged"], report
+    assert "supervisor exited with -9; restart 1/" in log, log[-3000:]
+    assert log.count("started supervisor") == 2
+    assert_sound(report)
+    assert report["supervisor"]["phases"][-1]["phase"] == "reached"

@@ -74,3 +74,18 @@ def test_a_module_without_one_component_class_is_refused(tmp_path: Path) -> None
     path.write_text("namespace: t\ncomponents:\n  - {name: x, module: params, role: tool}\n")
     with pytest.raises(LookupError, match="expected one Component subclass"):
         dataflow(load_profile(path))
+
+
+def test_the_supervised_profile_puts_the_supervisor_between_the_goal_and_the_controller() -> None:
+    """The estimator's goal is remapped to goal/request; only the supervisor writes the
+    controller's goal; the controller and the rest of the loop are as in sim.yaml."""
+    graph = dataflow(load_profile(DEPLOY / "sim_supervised.yaml"))
+    assert graph.writers("goal/request") == ["state_estimator"]
+    assert graph.readers("goal/request") == ["supervisor"]
+    assert graph.writers("control/goal") == ["supervisor"]
+    assert graph.readers("control/goal") == ["controller"]
+    assert graph.readers("robot/state") == ["controller", "supervisor"]
+    assert graph.read_never_written() == []
+    plain = dataflow(load_profile(DEPLOY / "sim.yaml"))
+    assert plain.writers("control/goal") == ["state_estimator"]
+    assert "goal/request" not in plain.topics()

@@ -1,0 +1,158 @@
+"""The staging supervisor: the operator's goal in, the controller's goal out, phase by phase.
+
+It reads the goal the operator (or the state estimator, remapped) gives on ``goal/request``,
+the robot state and the obstacles, and for a pose goal runs ``wbc.staging_supervisor``: it
+plans where the base should stand and publishes on ``control/goal`` the task of each phase
+(drive, turn, approach, then the pose task itself), with every robot state, so that the
+controller, which alone commands the robot, steps the LP on it. Planning runs in this process,
+off the control loop: the controller keeps stepping meanwhile. A goal that no candidate
+reaches leaves no task: the supervisor then publishes a ``point`` goal that holds the base and
+arm where they stand, so the robot stops, and says why on ``supervisor/status``. Position
+goals pass through unchanged. A goal moved by more than ``MEASUREMENT_TOLERANCE`` is a new
+goal and is planned afresh; a restarted supervisor plans again from where the robot is.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+
+from components.controller import load_robot
+from components.params import Param, ParamError
+from components.process_entry import run_component
+from components.pubsub import Input
+from components.runtime import Component, Node
+from messages import topics
+from messages.goal import Goal
+from messages.obstacles import Obstacles
+from messages.state import RobotState
+from messages.supervisor import SupervisorStatus
+from wbc.drive_tasks import HeadingTask, PointTask, offset_point
+from wbc.obstacles import Circle
+from wbc.staging_supervisor import StagingSupervisor, SupervisorParams
+from wbc.task import MEASUREMENT_TOLERANCE, PoseTask, Task, same_task
+
+log = logging.getLogger("components.supervisor")
+
+DEFAULTS = SupervisorParams()
+
+
+class Supervisor(Component):
+    """goal/request + robot/state -> control/goal, supervisor/status."""
+
+    reads = (Input(topics.GOAL_REQUEST), Input(topics.ROBOT_STATE), Input(topics.WORLD_OBSTACLES))
+    writes = (topics.CONTROL_GOAL, topics.SUPERVISOR_STATUS)
+    params = (
+        Param("stall_window_s", float, DEFAULTS.stall_window_s, low=0.1, high=60.0,
+              doc="a phase stalls when its error falls by less than stall_reduction over this"),
+        Param("stall_reduction", float, DEFAULTS.stall_reduction, low=0.0, high=0.9,
+              doc="share of the error a phase must shed per stall window"),
+        Param("max_replans", int, DEFAULTS.max_replans, low=0, high=20,
+              doc="re-plans after stalls before the goal is reported unreachable"),
+        Param("pose_tolerance", float, 5e-3, low=1e-5, high=0.5,
+              doc="||vec8(x - x_d)|| under which the pose goal counts as reached"),
+    )  # fmt: skip
+
+    def __init__(self, node: Node) -> None:
+        super().__init__(node)
+        if node.profile.robot is None:
+            raise ParamError("robot: the profile names no robot description")
+        self.robot = load_robot(node.profile.robot)
+        self.goal_out = node.publisher(topics.CONTROL_GOAL)
+        self.status_out = node.publisher(topics.SUPERVISOR_STATUS)
+        self.request: Goal | None = None
+        self.supervisor: StagingSupervisor | None = None
+        self.obstacles: tuple[Circle, ...] = ()
+        self._events_reported = 0
+        self._hold: PointTask | None = None
+        """Where the robot stopped when its goal was found unreachable."""
+        for name in ("plans", "replans", "stalls", "unreachable"):
+            node.counters[name] = 0
+        node.subscribe(topics.GOAL_REQUEST, self.on_request)
+        node.subscribe(topics.WORLD_OBSTACLES, self.on_obstacles)
+        node.subscribe(topics.ROBOT_STATE, self.on_state)
+
+    def on_obstacles(self, message: Obstacles) -> None:
+        self.obstacles = tuple(Circle(c.x, c.y, c.radius) for c in message.circles)
+
+    def on_request(self, goal: Goal) -> None:
+        """A new goal replaces the supervisor; the same goal measured again keeps it."""
+        if self.request is not None and goal.task == self.request.task == "pose":
+            if same_task(PoseTask(np.array(self.request.pose)), PoseTask(np.array(goal.pose)),
+                         MEASUREMENT_TOLERANCE):  # fmt: skip
+                return
+        self.request, self.supervisor, self._events_reported = goal, None, 0
+        self._hold = None
+
+    def on_state(self, state: RobotState) -> None:
+        """Advance the phases and publish the controller's goal and the status."""
+        request = self.request
+        if request is None or not state.valid:
+            return
+        if request.task != "pose":
+            self.goal_out.put(request.model_copy(update={"header": self.node.header()}))
+            return
+        q = np.array(state.configuration())
+        t = state.header.stamp_ns / 1e9
+        if self.supervisor is None:
+            self.supervisor = StagingSupervisor(self.robot, np.array(request.pose),
+                                                self.obstacles, self._params())  # fmt: skip
+        supervisor = self.supervisor
+        task = supervisor.update(q, t)
+        self._report_events(supervisor)
+        if task is None:
+            if self._hold is None:
+                self._hold = PointTask(offset_point(q, DEFAULTS.lookahead), q[3:],
+                                       DEFAULTS.lookahead)  # fmt: skip
+            task = self._hold
+        self.goal_out.put(self._goal_of(task, request, state.header.stamp_ns))
+        self.status_out.put(self._status(supervisor, state.header.stamp_ns))
+
+    def _params(self) -> SupervisorParams:
+        p = self.node.params
+        return SupervisorParams(stall_window_s=p["stall_window_s"],
+                                stall_reduction=p["stall_reduction"],
+                                max_replans=p["max_replans"],
+                                pose_tolerance=p["pose_tolerance"])  # fmt: skip
+
+    def _goal_of(self, task: Task, request: Goal, stamp_ns: int) -> Goal:
+        header = self.node.header(stamp_ns=stamp_ns)
+        if isinstance(task, PoseTask):
+            return request.model_copy(update={"header": header})
+        if isinstance(task, PointTask):
+            return Goal(header=header, task="point", point=tuple(task.point.tolist()),
+                        arm=tuple(task.arm.tolist()), lookahead=task.lookahead)  # fmt: skip
+        assert isinstance(task, HeadingTask)
+        return Goal(header=header, task="heading", heading=task.heading,
+                    arm=tuple(task.arm.tolist()), point=tuple(task.position.tolist()))  # fmt: skip
+
+    def _report_events(self, supervisor: StagingSupervisor) -> None:
+        for event in supervisor.events[self._events_reported:]:
+            counter = {"plan": "plans", "replan": "replans", "stall": "stalls",
+                       "unreachable": "unreachable"}.get(event.kind)  # fmt: skip
+            if counter:
+                self.node.count(counter)
+            level = logging.WARNING if event.kind in ("stall", "unreachable") else logging.INFO
+            log.log(level, "%s at %.2f s: %s", event.kind, event.t, event.detail)
+        self._events_reported = len(supervisor.events)
+
+    def _status(self, supervisor: StagingSupervisor, stamp_ns: int) -> SupervisorStatus:
+        candidate = supervisor.candidate
+        last = supervisor.events[-1].detail if supervisor.events else ""
+        return SupervisorStatus(
+            header=self.node.header(stamp_ns=stamp_ns),
+            phase=str(supervisor.phase),
+            candidate=len(supervisor.tried),
+            candidate_base=None if candidate is None else tuple(candidate.base.tolist()),
+            plans=len(supervisor.planning_s),
+            replans=supervisor.replans,
+            stalls=sum(e.kind == "stall" for e in supervisor.events),
+            reason=supervisor.reason,
+            last_event=last,
+            planning_ms=supervisor.planning_s[-1] * 1e3 if supervisor.planning_s else None,
+        )
+
+
+if __name__ == "__main__":
+    run_component(Supervisor)
