@@ -246,6 +246,9 @@ def format_report(report: dict) -> str:
                          f" {row['within_joint_and_speed_limits']:22.2f}"
                          f" {row['median_time_to_converge_s']:21.1f}")  # fmt: skip
         for law, row in result["laws"].items():
+            if law.startswith("lp"):
+                lines.append(f"  {law}: every command an optimal LP solution in "
+                             f"{row['every_step_optimal']:.2f} of the runs")
             if "plans_per_run" in row:
                 lines.append(f"  {law}: {row['plans_per_run']:.2f} plans per run, a plan takes "
                              f"{row['plan_median_ms']:.0f} ms median, "

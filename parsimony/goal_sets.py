@@ -78,6 +78,8 @@ class Attempt:
     """Nonzero entries of u at every step."""
     planning_s: tuple[float, ...] = ()
     """How long each staging plan took (supervised runs only)."""
+    every_step_optimal: bool = True
+    """Every command was an optimal solution of its step's program."""
 
     @property
     def seconds(self) -> float:
@@ -112,7 +114,8 @@ def attempt(law: Law, robot: MobileManipulator, start: Array, goal: Array,
     speed_overrun = (np.abs(u) - robot.velocity_max).max()
     return Attempt(run.converged, len(run.outputs), float(max(joint_overrun, 0.0)),
                    float(max(speed_overrun, 0.0)),
-                   tuple(out.nonzero for out in run.outputs), planning)  # fmt: skip
+                   tuple(out.nonzero for out in run.outputs), planning,
+                   all(out.ok for out in run.outputs))  # fmt: skip
 
 
 def goals(family: GoalFamily, count: int, seed: int = GOAL_SEED) -> list[tuple[Array, Array]]:
@@ -131,6 +134,7 @@ def shares(attempts: Iterable[Attempt]) -> dict[str, float]:
         "within_joint_limits": sum(a.within_joint_limits for a in attempts) / count,
         "within_joint_and_speed_limits": sum(a.within_all_limits for a in attempts) / count,
         "median_time_to_converge_s": float(np.median(times)) if times else math.nan,
+        "every_step_optimal": sum(a.every_step_optimal for a in attempts) / count,
     }
 
 
