@@ -142,7 +142,7 @@ class Supervisor(Component):
         last = supervisor.events[-1].detail if supervisor.events else ""
         return SupervisorStatus(
             header=self.node.header(stamp_ns=stamp_ns),
-            phase=str(supervisor.phase),
+            phase=supervisor.phase.value,
             candidate=len(supervisor.tried),
             candidate_base=None if candidate is None else tuple(candidate.base.tolist()),
             plans=len(supervisor.planning_s),

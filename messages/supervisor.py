@@ -8,14 +8,17 @@ from pydantic import Field
 
 from messages.base import Finite, Message, NonNegative
 from messages.header import Header
+from wbc.staging_supervisor import Phase
+
+PhaseName = Literal[("idle", *(phase.value for phase in Phase))]  # type: ignore[valid-type]
+"""``idle`` before any goal, then one of ``wbc.staging_supervisor.Phase``."""
 
 
 class SupervisorStatus(Message):
     """The phase of the current goal (``wbc.staging_supervisor``), published as it changes and
     with every control-rate tick that follows.
 
-    ``phase`` is ``drive``, ``turn``, ``approach``, ``pose``, ``reached`` or ``unreachable``
-    (``idle`` before any goal); ``candidate`` numbers the staging candidate being driven to
+    ``phase`` is a ``PhaseName``; ``candidate`` numbers the staging candidate being driven to
     (1 the best), ``candidate_base`` is its base pose (x, y, phi); ``plans``, ``replans`` and
     ``stalls`` count since the goal came; ``reason`` says why a goal is unreachable;
     ``last_event`` is the latest thing the supervisor did, in words; ``planning_ms`` is the
@@ -23,7 +26,7 @@ class SupervisorStatus(Message):
     """
 
     header: Header
-    phase: Literal["idle", "drive", "turn", "approach", "pose", "reached", "unreachable"]
+    phase: PhaseName
     candidate: int = Field(ge=0)
     candidate_base: tuple[Finite, Finite, Finite] | None = None
     plans: int = Field(ge=0)

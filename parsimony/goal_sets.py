@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from parsimony.kinematic_demo import SUPERVISED_PARAMS
 from wbc.cascade_law import CascadeLaw
 from wbc.kinematic_run import integrate, integrate_supervised
 from wbc.law_output import Law
@@ -161,11 +162,11 @@ SUPERVISED = "lp + staging supervisor"
 LAWS: dict[str, Callable[[MobileManipulator], Law]] = {
     "lp": lambda robot: LPLaw(robot),
     "lp 5.29 exactly": lambda robot: LPLaw(robot, EXACT_5_29),
-    SUPERVISED: lambda robot: LPLaw(robot),
+    SUPERVISED: lambda robot: LPLaw(robot, SUPERVISED_PARAMS),
     "cascade": lambda robot: CascadeLaw(robot),
 }
-"""The laws compared: the default LP, LP 5.29 with no term added to the task, the default LP
-under the staging supervisor (wbc.staging_supervisor), the cascade."""
+"""The laws compared: the default LP, LP 5.29 with no term added to the task, the LP under the
+staging supervisor (wbc.staging_supervisor) with its gains, the cascade."""
 EXACT_5_29 = LPParams(velocity_cost=0.0, waist_centring=0.0, base_target=0.0)
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import subprocess
 import sys
@@ -10,7 +11,9 @@ from pathlib import Path
 import pytest
 
 from deploy.graph import dataflow
+from parsimony.kinematic_demo import SUPERVISED_PARAMS
 from profiles.profile import load_profile
+from wbc.lp_law import LPParams
 
 DEPLOY = Path(__file__).resolve().parents[2] / "deploy"
 
@@ -89,3 +92,10 @@ def test_the_supervised_profile_puts_the_supervisor_between_the_goal_and_the_con
     plain = dataflow(load_profile(DEPLOY / "sim.yaml"))
     assert plain.writers("control/goal") == ["state_estimator"]
     assert "goal/request" not in plain.topics()
+
+
+def test_the_supervised_profile_gives_the_controller_the_gains_of_the_kinematic_bench() -> None:
+    wanted = {f.name: getattr(SUPERVISED_PARAMS, f.name) for f in dataclasses.fields(LPParams)
+              if getattr(SUPERVISED_PARAMS, f.name) != getattr(LPParams(), f.name)}  # fmt: skip
+    controller = load_profile(DEPLOY / "sim_supervised.yaml").component("controller")
+    assert {k: v for k, v in controller.params.items() if k in wanted} == wanted
