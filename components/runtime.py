@@ -43,8 +43,9 @@ from profiles.profile import Profile
 
 M = TypeVar("M", bound=BaseModel)
 
-STOP_TIMEOUT_S = 2.0
-"""How long closing waits for the handler thread to finish its current event."""
+STOP_MARGIN_S = 1.0
+"""The handler thread gets the profile's ``stop_timeout_s`` less this to finish (after which
+the launcher kills the process) before the session closes anyway."""
 
 log = logging.getLogger("components")
 
@@ -225,9 +226,10 @@ class Node:
         self.state = "stopping"
         if self._thread is not None:
             self._events.put(None)
-            self._thread.join(STOP_TIMEOUT_S)
+            patience_s = max(0.5, self.spec.stop_timeout_s - STOP_MARGIN_S)
+            self._thread.join(patience_s)
             if self._thread.is_alive():
-                log.warning("handler thread busy after %.1f s; closing anyway", STOP_TIMEOUT_S)
+                log.warning("handler thread busy after %.1f s; closing anyway", patience_s)
         if self._session is not None:
             self._session.close()
         self._declared.clear()

@@ -4,7 +4,7 @@ It opens the router the components connect to, starts the enabled components
 (drivers, estimators, controllers, tools), prefixes every line they print with
 ``[name]``, restarts the ones that exit according to their restart policy,
 reports liveliness changes, and on SIGINT, SIGTERM or the end of the duration
-stops them in the reverse order: SIGTERM, then SIGKILL after a timeout.
+stops them in the reverse order: SIGTERM, then SIGKILL after each one's ``stop_timeout_s``.
 
 The launch fails at start-up when a component is not alive within the profile's
 ``startup_timeout_s`` or stops for good before it ever was (a configuration error). A
@@ -40,9 +40,6 @@ from profiles.profile import ROLES, ComponentSpec, Profile
 
 POLL_S = 0.05
 """How often the launcher looks at its children and the clock."""
-
-STOP_TIMEOUT_S = 5.0
-"""How long a role's components get to exit after SIGTERM before SIGKILL."""
 
 CLEAN_STOP_CODES = (0, -signal.SIGTERM)
 """Exit codes that count as a clean stop after SIGTERM."""
@@ -298,9 +295,9 @@ class Launcher:
             group = [c for c in self.children if c.spec.role == role and c.process is not None]
             for child in group:
                 child.process.send_signal(signal.SIGTERM)
-            deadline = time.monotonic() + STOP_TIMEOUT_S
+            stopped_at = time.monotonic()
             for child in group:
-                self._reap(child, child.process, deadline)
+                self._reap(child, child.process, stopped_at + child.spec.stop_timeout_s)
 
     def _reap(self, child: Child, process: subprocess.Popen[str], deadline: float) -> None:
         """Wait for a child sent SIGTERM until ``deadline``, then kill it."""
@@ -309,7 +306,8 @@ class Launcher:
         except subprocess.TimeoutExpired:
             process.kill()
             process.wait()
-            self.output.say(f"{child.spec.name} did not stop in {STOP_TIMEOUT_S:.0f} s; killed")
+            self.output.say(f"{child.spec.name} did not stop in {child.spec.stop_timeout_s:g} s; "
+                            "killed")  # fmt: skip
             child.failed = True
         else:
             child.failed = child.failed or code not in CLEAN_STOP_CODES

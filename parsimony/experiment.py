@@ -67,6 +67,9 @@ TIME_LIMIT_S = 60.0
 """Simulated seconds after which a run that has not converged stops."""
 STARTUP_S = 60.0
 """Host seconds the components may take to come up."""
+RECORDER_STOP_S = 60.0
+"""Host seconds the recorder may take at the end to write what still waits for it (a lockstep
+run faster than real time on a loaded machine leaves a backlog of camera frames)."""
 SESSION_FILE = "session.mcap"
 """The recording of a run, beside its report."""
 LISTENED = ("sim/truth", "robot/state", "control/diagnostics", "base/command", "arm/command",
@@ -109,6 +112,7 @@ def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict
         simulator["hide_base_marker"] = ", ".join(str(v) for v in options.hide_base_marker)
     controller = {"module": MODULES[options.controller], "params": law_overrides(options)}
     recorder = {"name": "recorder", "module": "recorder", "role": "tool",
+                "stop_timeout_s": RECORDER_STOP_S,
                 "params": {"path": str((options.out / SESSION_FILE).resolve())}}  # fmt: skip
     components = [
         recorder,
@@ -231,7 +235,7 @@ def run_experiment(options: Options) -> dict[str, Any]:
     finally:
         launcher.send_signal(signal.SIGINT)
         try:
-            launcher.wait(20)
+            launcher.wait(RECORDER_STOP_S + 20.0)
         except subprocess.TimeoutExpired:
             launcher.kill()
             launcher.wait()

@@ -189,6 +189,9 @@ class ComponentSpec(StrictModel):
     """This component's time: the host's, or the simulator's ``sim/clock``; None follows the
     profile's ``clock``, except for the component that publishes ``sim/clock`` (the simulator,
     a replayer), which always runs on its own, the host's, time."""
+    stop_timeout_s: float = Field(default=5.0, gt=0.0)
+    """Seconds this component gets to exit after SIGTERM before SIGKILL (a recorder may need
+    longer, to write what still waits)."""
     remap: dict[str, str] = {}
     """Topic name -> topic name: the component reads or writes the second where its code says
     the first (as ROS 2 remaps a node's topics). Both must carry the same message type."""

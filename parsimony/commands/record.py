@@ -12,6 +12,7 @@ from pathlib import Path
 
 import yaml
 
+from parsimony.experiment import RECORDER_STOP_S
 from parsimony.output import emit
 from profiles.profile import ProfileError, load_profile
 from record.session_file import recover
@@ -50,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
         profile.write_text(yaml.safe_dump({
             "extends": str(args.profile.resolve()),
             "components": [{"name": "recorder", "module": "recorder", "role": "tool",
-                            "params": params}],
+                            "stop_timeout_s": RECORDER_STOP_S, "params": params}],
         }))  # fmt: skip
         command = [sys.executable, "-m", "components.recorder", "--profile", str(profile),
                    "--name", "recorder"]  # fmt: skip
