@@ -213,7 +213,7 @@ class Simulator(Component):
             self.next_frame_ns += self.frame_period_ns
             self._publish_frame()
             if self.node.params["lockstep"]:
-                self._await(("vision/markers", "world/obstacles"))
+                self._await(tuple(topic.name for topic in topics.FRAME_ANSWERS))
                 return
         self._publish_sensors()
 

@@ -104,6 +104,11 @@ TOPICS: Mapping[str, Topic] = MappingProxyType(
 )
 """Every topic, by name."""
 
+FRAME_ANSWERS = (VISION_MARKERS, WORLD_OBSTACLES)
+"""In lockstep, what answers a camera frame: the tracker's markers and the estimator's
+obstacles, stamped with the frame's stamp (the simulator waits for them; so does a lockstep
+replay)."""
+
 STATUS_TYPE = ComponentStatus
 """The message type published on ``status_key(namespace, component)``."""
 
