@@ -20,7 +20,7 @@ from wbc.cascade_law import CascadeLaw
 from wbc.kinematic_run import integrate, integrate_supervised
 from wbc.law_output import Law
 from wbc.lp_law import LPLaw, LPParams
-from wbc.robot import MobileManipulator
+from wbc.robot import BASE_DOF, MobileManipulator
 from wbc.scenarios import ARM_BOX, DT, HOME
 from wbc.staging_supervisor import StagingSupervisor, SupervisorParams
 from wbc.task import PoseTask
@@ -38,17 +38,27 @@ GOAL_SEED = 2
 
 @dataclass(frozen=True)
 class GoalFamily:
-    """Goal base at distance and bearing from the start base (facing x), at a heading."""
+    """Goal base at distance and bearing from the start base (facing x), at a heading; the
+    arm's start near HOME and its goal in ARM_BOX, or, with ``joint_box`` b, both anywhere in
+    b [q-, q+] (the LP's joint box for b = its safety factor)."""
 
     name: str
     distance: tuple[float, float]
     bearing: tuple[float, float]
     heading: tuple[float, float]
+    joint_box: float | None = None
 
-    def sample(self, rng: np.random.Generator) -> tuple[Array, Array]:
+    def sample(self, rng: np.random.Generator, robot: MobileManipulator
+               ) -> tuple[Array, Array]:  # fmt: skip
         """(start configuration, goal configuration)."""
-        low, high = ARM_BOX
-        arm_start = np.clip(HOME[3:] + rng.uniform(-START_SPREAD, START_SPREAD, 5), low, high)
+        if self.joint_box is None:
+            low, high = ARM_BOX
+            spread = rng.uniform(-START_SPREAD, START_SPREAD, 5)
+            arm_start = np.clip(HOME[3:] + spread, low, high)
+        else:
+            low = self.joint_box * robot.q_min[BASE_DOF:]
+            high = self.joint_box * robot.q_max[BASE_DOF:]
+            arm_start = rng.uniform(low, high)
         distance, bearing = rng.uniform(*self.distance), rng.uniform(*self.bearing)
         base = [distance * math.cos(bearing), distance * math.sin(bearing),
                 rng.uniform(*self.heading)]  # fmt: skip
@@ -59,10 +69,12 @@ class GoalFamily:
 AHEAD = math.radians(35.0)
 FAMILIES = {
     "ahead": GoalFamily("ahead", (0.3, 1.2), (-AHEAD, AHEAD), (-AHEAD, AHEAD)),
-    "anywhere": GoalFamily("anywhere", (0.0, 1.2), (-math.pi, math.pi), (-math.pi, math.pi)),
+    "anywhere": GoalFamily("anywhere", (0.0, 1.2), (-math.pi, math.pi), (-math.pi, math.pi),
+                           LPParams().safety_factor),
 }
 """'ahead': the dissertation's kind (goal base 0.3-1.2 m away, within 35 degrees of straight
-ahead, heading within 35 degrees); 'anywhere': within 1.2 m at any bearing and heading."""
+ahead, heading within 35 degrees); 'anywhere': within 1.2 m at any bearing and heading, the
+arm's start and goal anywhere in the LP's joint box."""
 
 
 @dataclass(frozen=True)
@@ -119,9 +131,10 @@ def attempt(law: Law, robot: MobileManipulator, start: Array, goal: Array,
                    all(out.ok for out in run.outputs))  # fmt: skip
 
 
-def goals(family: GoalFamily, count: int, seed: int = GOAL_SEED) -> list[tuple[Array, Array]]:
+def goals(family: GoalFamily, count: int, robot: MobileManipulator, seed: int = GOAL_SEED
+          ) -> list[tuple[Array, Array]]:  # fmt: skip
     rng = np.random.default_rng(seed)
-    return [family.sample(rng) for _ in range(count)]
+    return [family.sample(rng, robot) for _ in range(count)]
 
 
 def shares(attempts: Iterable[Attempt]) -> dict[str, float]:
@@ -178,11 +191,11 @@ def _attempt_one(job: tuple[str, Path, Array, Array]) -> Attempt:
 
 def goal_report(robot_file: Path, count: int, processes: int = 2) -> dict:
     """For every family and law: the three shares, and the LP's nonzero histograms."""
-    dof = MobileManipulator.from_yaml(robot_file).dof
+    robot = MobileManipulator.from_yaml(robot_file)
     report: dict = {}
     with multiprocessing.get_context("spawn").Pool(processes) as pool:
         for family in FAMILIES.values():
-            pairs = goals(family, count)
+            pairs = goals(family, count, robot)
             rows = {}
             for law_name in LAWS:
                 jobs = [(law_name, robot_file, start, goal) for start, goal in pairs]
@@ -191,6 +204,6 @@ def goal_report(robot_file: Path, count: int, processes: int = 2) -> dict:
                 if law_name == SUPERVISED:
                     rows[law_name].update(planning(attempts))
                 if law_name.startswith("lp"):
-                    rows[law_name]["nonzero_histogram"] = nonzero_histogram(attempts, dof)
+                    rows[law_name]["nonzero_histogram"] = nonzero_histogram(attempts, robot.dof)
             report[family.name] = {"goals": count, "laws": rows}
     return report

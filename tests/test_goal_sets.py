@@ -24,7 +24,7 @@ HELD_OUT_SEED = 3
 
 
 def test_default_lp_reaches_goals_ahead_inside_its_joint_and_speed_limits():
-    pairs = goals(FAMILIES["ahead"], 20, HELD_OUT_SEED)
+    pairs = goals(FAMILIES["ahead"], 20, ROBOT, HELD_OUT_SEED)
     attempts = [attempt(LAWS["lp"](ROBOT), ROBOT, start, goal) for start, goal in pairs]
     result = shares(attempts)
     assert result["within_joint_and_speed_limits"] >= 0.85, result
@@ -33,8 +33,8 @@ def test_default_lp_reaches_goals_ahead_inside_its_joint_and_speed_limits():
 
 def test_the_staging_supervisor_reaches_goals_anywhere_inside_the_limits():
     """Goals at any bearing and heading within 1.2 m, on a set the planner was not tuned on;
-    the default LP alone reaches about half of such goals."""
-    pairs = goals(FAMILIES["anywhere"], 8, HELD_OUT_SEED)
+    the default LP alone reaches about one in eight of such goals."""
+    pairs = goals(FAMILIES["anywhere"], 8, ROBOT, HELD_OUT_SEED)
     attempts = [attempt(LAWS[SUPERVISED](ROBOT), ROBOT, start, goal, supervised=True)
                 for start, goal in pairs]  # fmt: skip
     result = shares(attempts)
@@ -45,7 +45,7 @@ def test_the_staging_supervisor_reaches_goals_anywhere_inside_the_limits():
 
 def test_goals_are_reachable_configurations_of_their_family():
     family = FAMILIES["ahead"]
-    for start, goal in goals(family, 50, HELD_OUT_SEED):
+    for start, goal in goals(family, 50, ROBOT, HELD_OUT_SEED):
         assert start[:3].tolist() == [0.0, 0.0, 0.0]
         distance = float(goal[:2] @ goal[:2]) ** 0.5
         assert family.distance[0] <= distance <= family.distance[1]

@@ -80,7 +80,7 @@ def test_conditioning_vanishes_where_the_arm_loses_a_direction() -> None:
 def test_every_candidate_reaches_the_goal_pose_inside_the_shrunk_joint_box() -> None:
     params = StagingParams()
     low, high = arm_box(MODEL, params.safety_factor, params.joint_margins[-1])
-    for start, goal in goals(FAMILIES["anywhere"], 5, seed=7):
+    for start, goal in goals(FAMILIES["anywhere"], 5, MODEL, seed=7):
         found = candidates(MODEL, start, MODEL.fkm(goal), params=params)
         assert found
         assert [c.score for c in found] == sorted(c.score for c in found)
@@ -92,7 +92,7 @@ def test_every_candidate_reaches_the_goal_pose_inside_the_shrunk_joint_box() -> 
 
 
 def test_candidates_keep_the_base_clear_of_obstacles() -> None:
-    start, goal = goals(FAMILIES["anywhere"], 1, seed=3)[0]
+    start, goal = goals(FAMILIES["anywhere"], 1, MODEL, seed=3)[0]
     free = candidates(MODEL, start, MODEL.fkm(goal))
     blocker = Circle(*free[0].base[:2], 0.1)
     found = candidates(MODEL, start, MODEL.fkm(goal), [blocker])
