@@ -1,0 +1,130 @@
+"""A Foxglove live view of a running namespace: foxglove-sdk's WebSocket server, on 127.0.0.1
+only, carrying every message of the namespace's topics as it arrives.
+
+Each message goes out as a recording holds it (``record.session_file``): on the channel of its
+key as JSON with the project's JSON Schema, and beside it each of its well-known views
+(``record.foxglove_views``: ``foxglove.RawImage``, ``foxglove.FrameTransforms``,
+``foxglove.SceneUpdate``) on ``<key>/foxglove``, logged at the message's stamp. A channel is
+created, and advertised to the clients, on its first message. A sample that does not decode is
+dropped, counted (``malformed``) and logged, at most once per key every few seconds.
+"""
+
+from __future__ import annotations
+
+import fnmatch
+import logging
+import threading
+from collections.abc import Sequence
+from functools import partial
+
+import foxglove
+import zenoh
+
+from components.rate_limited_log import RateLimitedLog
+from messages import codec, topics
+from record.foxglove_views import views_of
+from record.session_file import MESSAGE_ENCODING, SCHEMA_ENCODING, schema_of, stamp_of, to_json
+
+HOST = "127.0.0.1"
+"""The only address the server listens on."""
+DEFAULT_PORT = 8765
+"""Foxglove's usual WebSocket port."""
+
+log = logging.getLogger(__name__)
+
+
+def topics_matching(patterns: Sequence[str]) -> list[topics.Topic]:
+    """The topics whose names match one of the ``fnmatch`` patterns; ``ValueError`` if none."""
+    chosen = [topic for topic in topics.TOPICS.values()
+              if any(fnmatch.fnmatch(topic.name, pattern) for pattern in patterns)]  # fmt: skip
+    if not chosen:
+        raise ValueError(f"keys: {' '.join(patterns)} matches no topic (the topics: "
+                         f"{', '.join(topics.TOPICS)})")  # fmt: skip
+    return chosen
+
+
+class LiveView:
+    """The topics ``chosen`` of ``namespace``, read on ``session``, served on ``HOST:port``
+    (0: any free port; ``address`` says which). A context manager: ``close`` stops the server
+    and the subscriptions. ``shown`` counts the messages logged, ``malformed`` those dropped."""
+
+    def __init__(
+        self,
+        session: zenoh.Session,
+        namespace: str,
+        chosen: Sequence[topics.Topic],
+        port: int = DEFAULT_PORT,
+    ) -> None:
+        self._context = foxglove.Context()
+        try:
+            self._server = foxglove.start_server(name=f"parsimony {namespace}", host=HOST,
+                                                 port=port, context=self._context)  # fmt: skip
+        except RuntimeError as error:
+            raise OSError(f"port: cannot listen on {HOST}:{port}: {error}") from error
+        self._channels: dict[tuple[str, str], foxglove.Channel] = {}
+        self._lock = threading.Lock()
+        self._warnings = RateLimitedLog(log)
+        self.shown = 0
+        self.malformed = 0
+        self._subscribers = [
+            session.declare_subscriber(topic.key(namespace), partial(self._on_sample, topic))
+            for topic in chosen
+        ]
+
+    @property
+    def address(self) -> str:
+        """The WebSocket address a Foxglove client opens."""
+        return f"ws://{HOST}:{self._server.port}"
+
+    def __enter__(self) -> LiveView:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Stop reading, then stop the server (its clients are disconnected)."""
+        for subscriber in self._subscribers:
+            subscriber.undeclare()
+        self._subscribers = []
+        self._server.stop()
+
+    def _on_sample(self, topic: topics.Topic, sample: zenoh.Sample) -> None:
+        key = str(sample.key_expr)
+        try:
+            message = codec.decode(sample.payload.to_bytes(), topic.type, key)
+        except codec.DecodeError as error:
+            with self._lock:
+                self.malformed += 1
+                self._warnings.warning(key, f"view: malformed sample dropped: {error}")
+            return
+        stamp = stamp_of(message)
+        message_type = type(message)
+        self._log(key, message_type.__name__, SCHEMA_ENCODING, schema_of(message_type),
+                  MESSAGE_ENCODING, to_json(message), stamp)  # fmt: skip
+        for view in views_of(topic.name, key, message):
+            self._log(*view.channel(key), stamp)
+        with self._lock:
+            self.shown += 1
+
+    def _log(
+        self,
+        channel_name: str,
+        schema_name: str,
+        schema_encoding: str,
+        schema_data: bytes,
+        message_encoding: str,
+        data: bytes,
+        log_time_ns: int,
+    ) -> None:
+        """``data`` on the channel of this name and schema, created on first use."""
+        with self._lock:
+            channel = self._channels.get((channel_name, schema_name))
+            if channel is None:
+                schema = foxglove.Schema(name=schema_name, encoding=schema_encoding,
+                                         data=schema_data)  # fmt: skip
+                channel = foxglove.Channel(channel_name, schema=schema,
+                                           message_encoding=message_encoding,
+                                           context=self._context)  # fmt: skip
+                self._channels[(channel_name, schema_name)] = channel
+        channel.log(data, log_time=log_time_ns)
