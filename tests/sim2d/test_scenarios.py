@@ -12,6 +12,8 @@ from profiles.profile import load_profile
 from profiles.scene import Scene
 from sim2d.camera import PinholeCamera, ceiling_camera
 from sim2d.scenarios import (
+    ANYWHERE_OBSTACLE,
+    ANYWHERE_START,
     BIN_RANGE,
     NAMES,
     OBSTACLE_SHIFT,
@@ -49,9 +51,21 @@ def test_the_default_goal_is_the_dissertations_reach_goal() -> None:
 
 @pytest.mark.parametrize("name", NAMES)
 def test_the_default_set_up_starts_at_home(name: str) -> None:
+    """Every set-up starts with HOME's arm; all but 'anywhere' at HOME's base too."""
     setup = scenario(name, ROBOT)
     assert setup.name == name
-    assert np.array_equal(setup.start, HOME)
+    home = HOME.copy()
+    if name == "anywhere":
+        home[:BASE_DOF] = ANYWHERE_START
+    assert np.array_equal(setup.start, home)
+
+
+def test_the_anywhere_set_up_puts_the_goal_behind_the_robot_past_an_obstacle() -> None:
+    setup = scenario("anywhere", ROBOT)
+    x, y, phi = setup.start[:BASE_DOF]
+    bearing = math.atan2(setup.bin[1] - y, setup.bin[0] - x) - phi
+    assert abs(math.remainder(bearing, 2 * math.pi)) > 0.9 * math.pi
+    assert setup.task == "pose" and setup.obstacles == (ANYWHERE_OBSTACLE,)
 
 
 def test_the_pose_set_up_puts_the_bin_under_the_reach_goal_without_obstacles() -> None:
@@ -85,7 +99,7 @@ def test_seeded_set_ups_stay_in_their_ranges_and_the_joint_limits(name: str) -> 
     for seed in SEEDS:
         setup = scenario(name, ROBOT, seed)
         start, bin_pose = np.array(setup.start), np.array(setup.bin)
-        assert np.all(np.abs(start - HOME) <= START_RANGE)
+        assert np.all(np.abs(start - default.start) <= START_RANGE)
         assert np.all(np.abs(bin_pose - default.bin) <= BIN_RANGE)
         arm = start[BASE_DOF:]
         assert np.all(arm >= ROBOT.q_min[BASE_DOF:]) and np.all(arm <= ROBOT.q_max[BASE_DOF:])
