@@ -60,6 +60,8 @@ from wbc.robot import MobileManipulator
 JOINT_NAMES = tuple(f"q{i}" for i in range(1, ARM_JOINTS + 1))
 LOCKSTEP_CHECK_S = 0.05
 """How often the simulator looks for an answer that is overdue (host seconds)."""
+PAUSED_CLOCK_S = 0.1
+"""How often a paused simulator publishes its clock (host seconds)."""
 
 
 def floats(text: str, name: str, count: int | None = None, group: int = 1) -> list[tuple]:
@@ -177,8 +179,16 @@ class Simulator(Component):
         if p["real_time_factor"] > 0:
             node.timer(p["step_s"] / p["real_time_factor"], self._paced_tick)
         node.timer(LOCKSTEP_CHECK_S, self._check_overdue)
+        node.timer(PAUSED_CLOCK_S, self._paused_clock)
 
     # -- the loop -------------------------------------------------------------------------
+
+    def _paused_clock(self) -> None:
+        """While paused, publish the clock where it stands: whoever starts the run can see that
+        every reader of the simulator's topics is reached before the first step (a reader
+        reached only later misses the first camera frame)."""
+        if self.node.params["paused"]:
+            self.publishers["sim/clock"].put(Clock(stamp_ns=self.now_ns))
 
     def _paced_tick(self) -> None:
         """Timer at the real-time factor's pace: step unless paused or an answer is awaited."""

@@ -228,6 +228,7 @@ def run_experiment(options: Options) -> dict[str, Any]:
         with connect(profile, launcher) as session:
             recorder = Recorder(session, profile.namespace)
             wait_alive(session, profile, launcher)
+            wait_reached(session, profile, launcher)
             query.set_param(session, profile.namespace, "simulator", "paused", "false")
             started = time.monotonic()
             messages = follow(recorder, options, started)
@@ -287,6 +288,24 @@ def wait_alive(session: zenoh.Session, profile: Profile, launcher: subprocess.Po
         if time.monotonic() > deadline:
             raise RuntimeError(f"the components did not all come up in {STARTUP_S:.0f} s")
         time.sleep(0.2)  # polling the router for liveliness tokens
+
+
+def wait_reached(session: zenoh.Session, profile: Profile, launcher: subprocess.Popen) -> None:
+    """Wait until every component that reads ``sim/clock`` has received the paused simulator's
+    clock: a component's liveliness does not prove that the simulator's data reaches it yet,
+    and one reached late would miss the first steps (the recorder, the first camera frame)."""
+    deadline = time.monotonic() + STARTUP_S
+    while True:
+        found = query.statuses(session, profile.namespace, 0.5)
+        waiting = [name for name, status in found.items()
+                   if status.counters.get("received.sim/clock", 1) == 0]  # fmt: skip
+        if not waiting:
+            return
+        if launcher.poll() is not None:
+            raise RuntimeError(f"the launch stopped (exit {launcher.returncode}); see its log")
+        if time.monotonic() > deadline:
+            raise RuntimeError(f"{', '.join(waiting)} never received the simulator's clock")
+        time.sleep(0.1)  # polling the components' counters
 
 
 def follow(recorder: Recorder, options: Options, started: float) -> dict[str, list]:
