@@ -6,7 +6,8 @@ key as JSON with the project's JSON Schema, and beside it each of its well-known
 (``record.foxglove_views``: ``foxglove.RawImage``, ``foxglove.FrameTransforms``,
 ``foxglove.SceneUpdate``) on ``<key>/foxglove``, logged at the message's stamp. A channel is
 created, and advertised to the clients, on its first message. A sample that does not decode is
-dropped, counted (``malformed``) and logged, at most once per key every few seconds.
+dropped, counted (``malformed``) and said (``parsimony view`` logs it at most once per key every
+few seconds).
 """
 
 from __future__ import annotations
@@ -14,13 +15,12 @@ from __future__ import annotations
 import fnmatch
 import logging
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from functools import partial
 
 import foxglove
 import zenoh
 
-from components.rate_limited_log import RateLimitedLog
 from messages import codec, topics
 from record.foxglove_views import views_of
 from record.session_file import MESSAGE_ENCODING, SCHEMA_ENCODING, schema_of, stamp_of, to_json
@@ -46,7 +46,8 @@ def topics_matching(patterns: Sequence[str]) -> list[topics.Topic]:
 class LiveView:
     """The topics ``chosen`` of ``namespace``, read on ``session``, served on ``HOST:port``
     (0: any free port; ``address`` says which). A context manager: ``close`` stops the server
-    and the subscriptions. ``shown`` counts the messages logged, ``malformed`` those dropped."""
+    and the subscriptions. ``shown`` counts the messages logged, ``malformed`` those dropped;
+    ``warn(key, text)`` says why a sample was dropped (default: a log warning each time)."""
 
     def __init__(
         self,
@@ -54,6 +55,7 @@ class LiveView:
         namespace: str,
         chosen: Sequence[topics.Topic],
         port: int = DEFAULT_PORT,
+        warn: Callable[[str, str], None] | None = None,
     ) -> None:
         self._context = foxglove.Context()
         try:
@@ -63,7 +65,7 @@ class LiveView:
             raise OSError(f"port: cannot listen on {HOST}:{port}: {error}") from error
         self._channels: dict[tuple[str, str], foxglove.Channel] = {}
         self._lock = threading.Lock()
-        self._warnings = RateLimitedLog(log)
+        self._warn = warn or (lambda _key, message: log.warning("%s", message))
         self.shown = 0
         self.malformed = 0
         self._subscribers = [
@@ -96,7 +98,7 @@ class LiveView:
         except codec.DecodeError as error:
             with self._lock:
                 self.malformed += 1
-                self._warnings.warning(key, f"view: malformed sample dropped: {error}")
+                self._warn(key, f"view: malformed sample dropped: {error}")
             return
         stamp = stamp_of(message)
         message_type = type(message)

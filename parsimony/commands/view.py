@@ -5,10 +5,12 @@ A replay into the profile's namespace is watched the same way."""
 from __future__ import annotations
 
 import argparse
+import logging
 import signal
 import sys
 from pathlib import Path
 
+from components.rate_limited_log import RateLimitedLog
 from deploy.query import QueryError, Target
 from profiles.profile import ProfileError
 from record.live_view import DEFAULT_PORT, LiveView, topics_matching
@@ -48,10 +50,12 @@ def run(args: argparse.Namespace) -> int:
         return 2
     previous = signal.signal(signal.SIGTERM, _interrupt)
     try:
-        with target.open() as session, LiveView(session, target.namespace, chosen,
-                                                args.port) as view:  # fmt: skip
-            print(f"view: {target.namespace} live at {view.address}", file=sys.stderr, flush=True)
+        warnings = RateLimitedLog(logging.getLogger("parsimony.view"))
+        with target.open() as session, LiveView(session, target.namespace, chosen, args.port,
+                                                warnings.warning) as view:  # fmt: skip
             try:
+                print(f"view: {target.namespace} live at {view.address}", file=sys.stderr,
+                      flush=True)  # fmt: skip
                 while True:
                     signal.pause()
             except KeyboardInterrupt:

@@ -47,6 +47,8 @@ FRAMES_VIEW = f"{NAMESPACE}/robot/state/foxglove"
 STATE_JSON = f"{NAMESPACE}/robot/state"
 MESSAGE_DATA = 0x01
 """The opcode of a binary message-data frame: then u32 subscription id, u64 log time."""
+UNKNOWN_CHANNEL = "Unknown channel ID: "
+"""How the server's status message starts when it refuses a subscription."""
 
 
 def header(seq: int) -> Header:
@@ -161,15 +163,25 @@ async def watch(address: str, wanted: set[str]) -> tuple[dict, dict[str, tuple[i
             if message["op"] == "advertise":
                 channels |= {channel["topic"]: channel for channel in message["channels"]}
         topic_of = dict(enumerate(sorted(wanted), start=1))
-        await client.send(json.dumps({"op": "subscribe", "subscriptions": [
-            {"id": sid, "channelId": channels[topic]["id"]} for sid, topic in topic_of.items()
-        ]}))  # fmt: skip
+
+        async def subscribe(chosen: dict[int, str]) -> None:
+            await client.send(json.dumps({"op": "subscribe", "subscriptions": [
+                {"id": sid, "channelId": channels[topic]["id"]} for sid, topic in chosen.items()
+            ]}))  # fmt: skip
+
+        await subscribe(topic_of)
         first: dict[str, tuple[int, bytes]] = {}
         while set(first) != wanted:
             message = await client.recv()
             if isinstance(message, bytes) and message[0] == MESSAGE_DATA:
                 subscription, log_time = struct.unpack_from("<IQ", message, 1)
                 first.setdefault(topic_of[subscription], (log_time, message[13:]))
+            elif isinstance(message, str) and UNKNOWN_CHANNEL in message:
+                # foxglove-sdk 0.30 sends an advertisement before it records the channel as
+                # advertised to this client: a subscription that follows at once can be refused.
+                unknown = int(json.loads(message)["message"].removeprefix(UNKNOWN_CHANNEL))
+                await subscribe({sid: topic for sid, topic in topic_of.items()
+                                 if channels[topic]["id"] == unknown})  # fmt: skip
         return channels, first
 
 
