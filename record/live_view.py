@@ -23,7 +23,7 @@ import zenoh
 
 from messages import codec, topics
 from record.foxglove_views import views_of
-from record.session_file import MESSAGE_ENCODING, SCHEMA_ENCODING, schema_of, stamp_of, to_json
+from record.session_file import json_channel, stamp_of
 
 HOST = "127.0.0.1"
 """The only address the server listens on."""
@@ -101,9 +101,7 @@ class LiveView:
                 self._warn(key, f"view: malformed sample dropped: {error}")
             return
         stamp = stamp_of(message)
-        message_type = type(message)
-        self._log(key, message_type.__name__, SCHEMA_ENCODING, schema_of(message_type),
-                  MESSAGE_ENCODING, to_json(message), stamp)  # fmt: skip
+        self._log(key, *json_channel(message), stamp)
         for view in views_of(topic.name, key, message):
             self._log(*view.channel(key), stamp)
         with self._lock:

@@ -90,6 +90,14 @@ BYTES_MARKER = "\u0000bytes\u0000"
 _ENCODED_MARKER = json.dumps(BYTES_MARKER).encode()
 
 
+def json_channel(message: BaseModel) -> tuple[str, str, bytes, str, bytes]:
+    """(schema name, schema encoding, schema data, message encoding, data) of a project
+    message on its own channel: its type's name and JSON Schema, and the message as JSON."""
+    message_type = type(message)
+    return (message_type.__name__, SCHEMA_ENCODING, schema_of(message_type), MESSAGE_ENCODING,
+            to_json(message))  # fmt: skip
+
+
 def from_json(data: bytes, message_type: type[BaseModel]) -> BaseModel:
     """The message ``to_json`` wrote, exactly (``model_validate`` of the decoded JSON)."""
     fields = json.loads(data)
@@ -132,10 +140,8 @@ class SessionWriter:
 
     def write(self, key: str, message: BaseModel, log_time_ns: int | None = None) -> None:
         """``message`` as JSON on the channel ``key``, logged at its stamp unless given."""
-        message_type = type(message)
         log_time = stamp_of(message) if log_time_ns is None else log_time_ns
-        self.write_raw(key, message_type.__name__, SCHEMA_ENCODING, schema_of(message_type),
-                       MESSAGE_ENCODING, to_json(message), log_time)  # fmt: skip
+        self.write_raw(key, *json_channel(message), log_time)
 
     def write_raw(
         self,
