@@ -45,6 +45,7 @@ from messages.base import ARM_JOINTS
 from messages.commands import ArmCommand, BaseCommand
 from messages.diagnostics import ControllerDiagnostics
 from messages.goal import Goal
+from messages.header import Header
 from messages.obstacles import Obstacles
 from messages.state import RobotState
 from wbc.base_motion import unicycle, wheel_speeds
@@ -113,6 +114,21 @@ def task_of(goal: Goal) -> Task:
     if goal.task == "point":
         return PointTask(np.array(goal.point), np.array(goal.arm), float(goal.lookahead))
     return HeadingTask(float(goal.heading), np.array(goal.arm), np.array(goal.point))
+
+
+def goal_of(task: Task, header: Header) -> Goal:
+    """The goal that asks for ``task`` (``task_of`` of it gives the task back)."""
+    if isinstance(task, PoseTask):
+        return Goal(header=header, task="pose", pose=tuple(task.pose.tolist()))
+    if isinstance(task, PositionTask):
+        return Goal(header=header, task="position", position=tuple(task.position.tolist()))
+    if isinstance(task, PointTask):
+        return Goal(header=header, task="point", point=tuple(task.point.tolist()),
+                    arm=tuple(task.arm.tolist()), lookahead=task.lookahead)  # fmt: skip
+    if isinstance(task, HeadingTask):
+        return Goal(header=header, task="heading", heading=task.heading,
+                    arm=tuple(task.arm.tolist()), point=tuple(task.position.tolist()))  # fmt: skip
+    raise TypeError(f"no goal asks for a {type(task).__name__}")
 
 
 class Controller(Component):

@@ -18,7 +18,7 @@ import logging
 
 import numpy as np
 
-from components.controller import load_robot
+from components.controller import goal_of, load_robot
 from components.params import Param, ParamError
 from components.process_entry import run_component
 from components.pubsub import Input
@@ -28,7 +28,7 @@ from messages.goal import Goal
 from messages.obstacles import Obstacles
 from messages.state import RobotState
 from messages.supervisor import SupervisorStatus
-from wbc.drive_tasks import HeadingTask, PointTask, offset_point
+from wbc.drive_tasks import PointTask, offset_point
 from wbc.obstacles import Circle
 from wbc.staging_supervisor import StagingSupervisor, SupervisorParams
 from wbc.task import MEASUREMENT_TOLERANCE, PoseTask, Task, same_task
@@ -36,6 +36,8 @@ from wbc.task import MEASUREMENT_TOLERANCE, PoseTask, Task, same_task
 log = logging.getLogger("components.supervisor")
 
 DEFAULTS = SupervisorParams()
+COUNTED = {"plan": "plans", "replan": "replans", "stall": "stalls", "unreachable": "unreachable"}
+"""The supervisor's events that are counted, and their counters."""
 
 
 class Supervisor(Component):
@@ -51,7 +53,8 @@ class Supervisor(Component):
         Param("max_replans", int, DEFAULTS.max_replans, low=0, high=20,
               doc="re-plans after stalls before the goal is reported unreachable"),
         Param("pose_tolerance", float, 5e-3, low=1e-5, high=0.5,
-              doc="||vec8(x - x_d)|| under which the pose goal counts as reached"),
+              doc="||vec8(x - x_d)|| under which the pose goal counts as reached (looser "
+                  "than the kinematic bench's: a measured pose jitters)"),
     )  # fmt: skip
 
     def __init__(self, node: Node) -> None:
@@ -67,7 +70,7 @@ class Supervisor(Component):
         self._events_reported = 0
         self._hold: PointTask | None = None
         """Where the robot stopped when its goal was found unreachable."""
-        for name in ("plans", "replans", "stalls", "unreachable"):
+        for name in COUNTED.values():
             node.counters[name] = 0
         node.subscribe(topics.GOAL_REQUEST, self.on_request)
         node.subscribe(topics.WORLD_OBSTACLES, self.on_obstacles)
@@ -117,20 +120,16 @@ class Supervisor(Component):
                                 pose_tolerance=p["pose_tolerance"])  # fmt: skip
 
     def _goal_of(self, task: Task, request: Goal, stamp_ns: int) -> Goal:
+        """The controller's goal for ``task``: the operator's own for the pose task (with its
+        gains), else the phase's."""
         header = self.node.header(stamp_ns=stamp_ns)
         if isinstance(task, PoseTask):
             return request.model_copy(update={"header": header})
-        if isinstance(task, PointTask):
-            return Goal(header=header, task="point", point=tuple(task.point.tolist()),
-                        arm=tuple(task.arm.tolist()), lookahead=task.lookahead)  # fmt: skip
-        assert isinstance(task, HeadingTask)
-        return Goal(header=header, task="heading", heading=task.heading,
-                    arm=tuple(task.arm.tolist()), point=tuple(task.position.tolist()))  # fmt: skip
+        return goal_of(task, header)
 
     def _report_events(self, supervisor: StagingSupervisor) -> None:
         for event in supervisor.events[self._events_reported:]:
-            counter = {"plan": "plans", "replan": "replans", "stall": "stalls",
-                       "unreachable": "unreachable"}.get(event.kind)  # fmt: skip
+            counter = COUNTED.get(event.kind)
             if counter:
                 self.node.count(counter)
             level = logging.WARNING if event.kind in ("stall", "unreachable") else logging.INFO

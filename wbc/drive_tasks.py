@@ -22,19 +22,12 @@ import numpy as np
 
 from wbc.planar import wrap
 from wbc.robot import BASE_DOF
+from wbc.task import frozen_vector
 from wbc.validation import require_finite
 
 Array = np.ndarray
 
 ARM_DOF = 5
-
-
-def _frozen(name: str, values: Array, size: int) -> Array:
-    array = require_finite(name, values).astype(float).copy()
-    if array.shape != (size,):
-        raise ValueError(f"{name} must have shape ({size},), got {array.shape}")
-    array.flags.writeable = False
-    return array
 
 
 def _arm_rows(q: Array, arm: Array) -> tuple[Array, Array]:
@@ -61,8 +54,8 @@ class PointTask:
     dof = 7
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "point", _frozen("drive point", self.point, 2))
-        object.__setattr__(self, "arm", _frozen("arm configuration", self.arm, ARM_DOF))
+        object.__setattr__(self, "point", frozen_vector("drive point", self.point, 2))
+        object.__setattr__(self, "arm", frozen_vector("arm configuration", self.arm, ARM_DOF))
         if not self.lookahead > 0.0:
             raise ValueError(f"lookahead must be > 0, got {self.lookahead}")
 
@@ -97,8 +90,8 @@ class HeadingTask:
 
     def __post_init__(self) -> None:
         require_finite("heading", np.array([self.heading]))
-        object.__setattr__(self, "arm", _frozen("arm configuration", self.arm, ARM_DOF))
-        object.__setattr__(self, "position", _frozen("turning position", self.position, 2))
+        object.__setattr__(self, "arm", frozen_vector("arm configuration", self.arm, ARM_DOF))
+        object.__setattr__(self, "position", frozen_vector("turning position", self.position, 2))
 
     @property
     def goal_position(self) -> Array:

@@ -30,6 +30,7 @@ from scipy.optimize import least_squares
 
 from wbc import dq
 from wbc.conditioning import smallest_singular_value
+from wbc.lp_law import LPParams
 from wbc.objectives.base_target import gripper_heading
 from wbc.obstacles import Circle
 from wbc.planar import wrap
@@ -45,8 +46,8 @@ FREE = [0, 1, 2, 4, 5, 6, 7]
 class StagingParams:
     """How candidates are searched for and ranked."""
 
-    safety_factor: float = 0.9
-    """b_l of the LP's joint limits (LPParams.safety_factor)."""
+    safety_factor: float = LPParams().safety_factor
+    """b_l of the LP's joint limits."""
     joint_margins: tuple[float, ...] = (0.15, 0.05)
     """Each arm joint of a candidate stays this far inside b_l [q-, q+], rad: the first margin
     that gives any candidate is kept."""
@@ -59,8 +60,8 @@ class StagingParams:
     sigma_floor: float = 0.03
     conditioning_weight: float = 1.0
     """m of travel a singular candidate is worth (scaled down to 0 at sigma_floor)."""
-    clearance: float = 0.05
-    """Extra distance between the base's body and an obstacle, m."""
+    clearance: float = LPParams().obstacle_margin
+    """Extra distance between the base's body and an obstacle, m: the LP's margin."""
     final_leg: float = 0.4
     """The straight drive into the candidate's pose starts this far behind it, m."""
     seed: int = 0
@@ -85,9 +86,14 @@ class Candidate:
         return self.q[BASE_DOF:]
 
     def staging_point(self, final_leg: float) -> Array:
-        """Where the final straight leg starts: ``final_leg`` behind the base, on its heading."""
-        x, y, phi = self.base
-        return np.array([x - final_leg * math.cos(phi), y - final_leg * math.sin(phi)])
+        return staging_point(self.base, final_leg)
+
+
+def staging_point(base: Array, final_leg: float) -> Array:
+    """Where the final straight leg into a base pose (x, y, phi) starts: ``final_leg`` behind
+    it, on its heading."""
+    x, y, phi = base
+    return np.array([x - final_leg * math.cos(phi), y - final_leg * math.sin(phi)])
 
 
 def arm_box(robot: MobileManipulator, safety_factor: float, margin: float
@@ -174,7 +180,7 @@ def same_configuration(a: Array, b: Array) -> bool:
 
 def _scored(robot: MobileManipulator, q_now: Array, q: Array, params: StagingParams) -> Candidate:
     travel = float(math.hypot(q[0] - q_now[0], q[1] - q_now[1]))
-    staging = Candidate(q, 0.0, 0.0, 0.0, 0.0).staging_point(params.final_leg)
+    staging = staging_point(q[:BASE_DOF], params.final_leg)
     bearing = math.atan2(staging[1] - q_now[1], staging[0] - q_now[0])
     # The base may drive its first leg backwards: turning is counted modulo a half turn.
     face = abs(wrap(2.0 * (bearing - q_now[2]))) / 2.0

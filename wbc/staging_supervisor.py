@@ -45,6 +45,8 @@ straight to the approach."""
 
 
 class Phase(StrEnum):
+    """The phases in the order they run (``_advance`` follows it); UNREACHABLE can end any."""
+
     DRIVE = "drive"
     TURN = "turn"
     APPROACH = "approach"
@@ -108,7 +110,6 @@ class StagingSupervisor:
     _task: Task | None = field(default=None, init=False)
     _history: collections.deque = field(default_factory=collections.deque, init=False)
     _pose_task: PoseTask = field(init=False)
-    _planned: bool = field(default=False, init=False)
 
     def __post_init__(self) -> None:
         self._pose_task = PoseTask(np.asarray(self.goal_pose, dtype=float))
@@ -117,15 +118,9 @@ class StagingSupervisor:
     def reached(self) -> bool:
         return self.phase is Phase.REACHED
 
-    @property
-    def task(self) -> Task | None:
-        """The task of the current phase; None when the goal is unreachable."""
-        return self._task
-
     def update(self, q: Array, t: float) -> Task | None:
         """Advance the phases at configuration q and time t (s); the task to step now."""
-        if not self._planned:
-            self._planned = True
+        if not self.planning_s:  # the first update plans
             self._plan(q, t)
         for _ in range(len(Phase)):
             if self._task is None:
@@ -134,8 +129,9 @@ class StagingSupervisor:
             if self.phase is Phase.REACHED or not self._met(error):
                 break
             self._advance(t)
-        if self.phase is not Phase.REACHED and self._stalled(t, float(np.linalg.norm(error))):
-            self.events.append(Event(t, "stall", f"{self.phase} error {np.linalg.norm(error):.3g}"))
+        norm = float(np.linalg.norm(error))
+        if self.phase is not Phase.REACHED and self._stalled(t, norm):
+            self.events.append(Event(t, "stall", f"{self.phase} error {norm:.3g}"))
             self._replan(q, t)
         return self._task
 
@@ -172,7 +168,8 @@ class StagingSupervisor:
         self.events.append(Event(t, "unreachable", reason))
 
     def _advance(self, t: float) -> None:
-        order = [Phase.DRIVE, Phase.TURN, Phase.APPROACH, Phase.ALIGN, Phase.POSE, Phase.REACHED]
+        """Enter the phase declared after this one (``Phase`` lists them in order)."""
+        order = list(Phase)
         self._enter(order[order.index(self.phase) + 1], t)
 
     def _enter(self, phase: Phase, t: float) -> None:

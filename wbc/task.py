@@ -18,6 +18,16 @@ from wbc.validation import require_finite
 Array = np.ndarray
 
 
+def frozen_vector(name: str, values: object, size: int) -> Array:
+    """A read-only copy of ``values`` as a finite float vector of ``size`` entries, or an error
+    naming ``name``: a task's goal cannot change under it."""
+    array = require_finite(name, values).copy()
+    if array.shape != (size,):
+        raise ValueError(f"{name} must have shape ({size},), got {array.shape}")
+    array.flags.writeable = False
+    return array
+
+
 @dataclass(frozen=True)
 class PoseTask:
     """Drive the end-effector pose to the unit dual quaternion ``pose`` (6 DOF)."""
@@ -54,11 +64,7 @@ class PositionTask:
     dof = 3
 
     def __post_init__(self) -> None:
-        position = require_finite("goal position", self.position).copy()
-        if position.shape != (3,):
-            raise ValueError(f"goal position must have shape (3,), got {position.shape}")
-        position.flags.writeable = False
-        object.__setattr__(self, "position", position)
+        object.__setattr__(self, "position", frozen_vector("goal position", self.position, 3))
 
     @property
     def goal_position(self) -> Array:

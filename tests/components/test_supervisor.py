@@ -6,15 +6,21 @@ import time
 from collections.abc import Callable
 
 import numpy as np
-from conftest import DEADLINE_S, System
+import pytest
+from conftest import DEADLINE_S, DEPLOY, System
 
+from components.controller import goal_of, task_of
 from messages import codec, topics
 from messages.goal import Goal
 from messages.header import Header
 from messages.state import RobotState
+from wbc.drive_tasks import HeadingTask, PointTask
 from wbc.planar import planar_pose
 from wbc.robot import MobileManipulator
 from wbc.scenarios import HOME, REACH_GOAL
+from wbc.task import PoseTask, PositionTask, same_task
+
+MODEL = MobileManipulator.from_yaml(DEPLOY / "robots" / "little_john.yaml")
 
 PROFILE = """
 namespace: supervised
@@ -86,3 +92,15 @@ def test_an_unreachable_goal_is_reported_and_the_robot_is_held_where_it_stands(
     assert hold.task == "point"
     np.testing.assert_allclose(hold.arm, HOME[3:])
     np.testing.assert_allclose(hold.point, HOME[:2] + [hold.lookahead, 0.0])
+
+
+@pytest.mark.parametrize("task", [
+    PoseTask(MODEL.fkm(REACH_GOAL)),
+    PositionTask(np.array([0.5, -0.2, 0.3])),
+    PointTask(np.array([0.4, -0.2]), np.array([0.0, -0.3, 0.2, 0.0, 0.4]), 0.03),
+    HeadingTask(-2.5, np.array([0.0, -0.3, 0.2, 0.0, 0.4]), np.array([0.3, 0.1])),
+])  # fmt: skip
+def test_the_goal_of_every_task_kind_asks_for_that_task(task) -> None:
+    header = Header(stamp_ns=1, frame="world", seq=0, source="test")
+    back = task_of(codec.decode(codec.encode(goal_of(task, header)), Goal))
+    assert type(back) is type(task) and same_task(back, task)
