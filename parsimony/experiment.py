@@ -29,6 +29,7 @@ import sys
 import threading
 import time
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -51,6 +52,7 @@ from wbc.kinematic_run import effort_of
 from wbc.lp_law import LPParams
 from wbc.planar import in_frame, offset_pose, planar_pose, wrap
 from wbc.robot import MobileManipulator
+from wbc.staging_supervisor import Phase
 
 DEPLOY = Path(__file__).resolve().parents[1] / "deploy"
 PROFILES = {"lp": DEPLOY / "sim.yaml", "cascade": DEPLOY / "sim_cascade.yaml"}
@@ -185,11 +187,13 @@ def converged_at(diagnostics: list, statuses: list) -> float | None:
 def pose_phase_since(statuses: list) -> float | None:
     """When the supervisor's last run of pose (or reached) phases began; 0 with no supervisor,
     None while it is in another phase."""
-    since = 0.0
+    if not statuses:
+        return 0.0
+    since = None
     for status in statuses:
-        if status.phase not in ("pose", "reached"):
+        if status.phase not in (Phase.POSE, Phase.REACHED):
             since = None
-        elif since is None or since == 0.0:
+        elif since is None:
             since = status.header.stamp_ns / 1e9
     return since
 
@@ -280,32 +284,38 @@ def whole_recording(path: Path) -> None:
 
 
 def wait_alive(session: zenoh.Session, profile: Profile, launcher: subprocess.Popen) -> None:
+    """Wait until every enabled component of the profile is alive."""
     wanted = {spec.name for spec in profile.components if spec.enabled}
-    deadline = time.monotonic() + STARTUP_S
-    while not wanted <= set(query.live_components(session, profile.namespace, 0.5)):
-        if launcher.poll() is not None:
-            raise RuntimeError(f"the launch stopped (exit {launcher.returncode}); see its log")
-        if time.monotonic() > deadline:
-            raise RuntimeError(f"the components did not all come up in {STARTUP_S:.0f} s")
-        time.sleep(0.2)  # polling the router for liveliness tokens
+
+    def missing() -> list[str]:
+        return sorted(wanted - set(query.live_components(session, profile.namespace, 0.5)))
+
+    wait_launch(launcher, missing, "did not come up")
 
 
 def wait_reached(session: zenoh.Session, profile: Profile, launcher: subprocess.Popen) -> None:
     """Wait until every component that reads ``sim/clock`` has received the paused simulator's
     clock: a component's liveliness does not prove that the simulator's data reaches it yet,
     and one reached late would miss the first steps (the recorder, the first camera frame)."""
-    deadline = time.monotonic() + STARTUP_S
-    while True:
+
+    def missing() -> list[str]:
         found = query.statuses(session, profile.namespace, 0.5)
-        waiting = [name for name, status in found.items()
-                   if status.counters.get("received.sim/clock", 1) == 0]  # fmt: skip
-        if not waiting:
-            return
+        return [name for name, status in found.items()
+                if status.counters.get("received.sim/clock", 1) == 0]  # fmt: skip
+
+    wait_launch(launcher, missing, "never received the simulator's clock")
+
+
+def wait_launch(launcher: subprocess.Popen, missing: Callable[[], list[str]], what: str) -> None:
+    """Poll ``missing()``, the components still waited for, until it is empty; fail, naming
+    them, when the launch stops or after ``STARTUP_S``."""
+    deadline = time.monotonic() + STARTUP_S
+    while waiting := missing():
         if launcher.poll() is not None:
             raise RuntimeError(f"the launch stopped (exit {launcher.returncode}); see its log")
         if time.monotonic() > deadline:
-            raise RuntimeError(f"{', '.join(waiting)} never received the simulator's clock")
-        time.sleep(0.1)  # polling the components' counters
+            raise RuntimeError(f"{', '.join(waiting)} {what} in {STARTUP_S:.0f} s")
+        time.sleep(0.1)  # polling the router (liveliness tokens, the components' counters)
 
 
 def follow(recorder: Recorder, options: Options, started: float) -> dict[str, list]:
