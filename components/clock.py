@@ -30,7 +30,8 @@ class SimClock:
     """The simulator's time: zero until the first ``sim/clock`` message, then its stamp.
 
     ``advance`` is called on the handler thread; reading an int is safe from any thread.
-    ``stalled_s`` measures, on the host's monotonic clock, how long the time has not moved.
+    ``stalled_s`` measures, on the host's monotonic clock, how long the time has not moved
+    (a paused simulator's clock does not stall).
     """
 
     simulated = True
@@ -39,9 +40,10 @@ class SimClock:
         self._stamp_ns = 0
         self._moved_at_ns = time.monotonic_ns()
 
-    def advance(self, stamp_ns: int) -> None:
-        """Set the time to ``stamp_ns`` (it may go back when a replay restarts)."""
-        if stamp_ns != self._stamp_ns:
+    def advance(self, stamp_ns: int, paused: bool = False) -> None:
+        """Set the time to ``stamp_ns`` (it may go back when a replay restarts). A paused
+        simulator holds its time on purpose: its clock does not count as stalled."""
+        if stamp_ns != self._stamp_ns or paused:
             self._moved_at_ns = time.monotonic_ns()
         self._stamp_ns = stamp_ns
 

@@ -102,7 +102,7 @@ class Node:
         self._session = zenoh.open(self.profile.zenoh.component_config(self.name))
         clock = self.clock
         if isinstance(clock, SimClock):
-            self.subscribe(topics.SIM_CLOCK, lambda tick: clock.advance(tick.stamp_ns))
+            self.subscribe(topics.SIM_CLOCK, lambda tick: clock.advance(tick.stamp_ns, tick.paused))
         return self
 
     def __exit__(self, *_exc: object) -> None:

@@ -184,11 +184,12 @@ class Simulator(Component):
     # -- the loop -------------------------------------------------------------------------
 
     def _paused_clock(self) -> None:
-        """While paused, publish the clock where it stands: whoever starts the run can see that
-        every reader of the simulator's topics is reached before the first step (a reader
-        reached only later misses the first camera frame)."""
+        """While paused, publish the clock where it stands, marked paused: the components on
+        simulated time do not take the held time for a stalled simulator, and whoever starts
+        the run can see that every reader of the simulator's topics is reached before the first
+        step (a reader reached only later misses the first camera frame)."""
         if self.node.params["paused"]:
-            self.publishers["sim/clock"].put(Clock(stamp_ns=self.now_ns))
+            self.publishers["sim/clock"].put(Clock(stamp_ns=self.now_ns, paused=True))
 
     def _paced_tick(self) -> None:
         """Timer at the real-time factor's pace: step unless paused or an answer is awaited."""

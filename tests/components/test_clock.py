@@ -69,3 +69,14 @@ def test_a_sim_clock_measures_how_long_it_has_not_moved() -> None:
     assert clock.stalled_s() >= 0.05
     clock.advance(6 * MS)
     assert clock.stalled_s() < 0.05
+
+
+def test_a_paused_simulators_held_time_is_not_a_stall() -> None:
+    clock = SimClock()
+    clock.advance(5 * MS)
+    time.sleep(0.05)
+    clock.advance(5 * MS, paused=True)  # the same stamp, held on purpose
+    assert clock.stalled_s() < 0.05
+    time.sleep(0.05)
+    clock.advance(5 * MS)  # no longer paused, and not moving
+    assert clock.stalled_s() >= 0.05
