@@ -337,8 +337,4 @@ class AXChainEmulator(SerialDevice):
             self.counters["unanswered"] += 1
             return
         time.sleep(delay)
-        self._send(dxl.status_packet(answer_id, *answer))
-
-    def _send(self, packet: bytes) -> None:
-        if self.send(packet):
-            self.counters["status_sent"] += 1
+        self.send(dxl.status_packet(answer_id, *answer), "status_sent")

@@ -151,12 +151,8 @@ class Create2Emulator(SerialDevice):
             with self._lock:
                 frame = self._frame() if self._streaming else None
             if frame is not None:
-                self._send(frame)
+                self.send(frame, "frames_sent")
 
     def _frame(self) -> bytes:
         counts = dict(zip(_ENCODERS, self._backend.encoder_counts(), strict=True))
         return oi.stream_frame({i: oi.packet_data(i, counts[i]) for i in self._stream_ids})
-
-    def _send(self, frame: bytes) -> None:
-        if self.send(frame):
-            self.counters["frames_sent"] += 1

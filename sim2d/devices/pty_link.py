@@ -85,13 +85,19 @@ class SerialDevice:
         """Bytes the driver wrote (reader thread)."""
         raise NotImplementedError
 
-    def send(self, data: bytes) -> bool:
-        """Write ``data`` to the driver; False when some of it was dropped."""
+    def send(self, data: bytes, counter: str | None = None) -> bool:
+        """Write ``data`` to the driver; False when some of it was dropped. ``counter`` counts
+        it as sent: before the write, so that a driver that has read it also sees it counted,
+        and taken back when bytes were dropped."""
+        if counter is not None:
+            self.counters[counter] += 1
         try:
             written = os.write(self._pty.master, data)
         except BlockingIOError:
             written = 0
         self.counters["bytes_dropped"] += len(data) - written
+        if counter is not None and written != len(data):
+            self.counters[counter] -= 1
         return written == len(data)
 
     def _read_loop(self) -> None:
