@@ -21,7 +21,8 @@ from __future__ import annotations
 
 import math
 import struct
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
+from typing import NamedTuple
 
 START = 128
 SAFE = 131
@@ -116,27 +117,49 @@ def _packet_length(packet_id: int) -> int:
         ) from None
 
 
+class StreamFrame(NamedTuple):
+    """A decoded stream frame: packet id -> unsigned value, and how many frames the parser
+    refused since the previous good one (each one stream period the robot went on moving)."""
+
+    packets: dict[int, int]
+    lost: int
+
+
 class StreamParser:
     """Splits a byte stream into stream frames and decodes their packets.
 
-    ``feed`` returns one dict (packet id -> unsigned value) per complete frame whose checksum
-    holds and whose body is a sequence of packets of ``PACKET_LENGTHS``. It never raises.
+    ``feed`` returns one ``StreamFrame`` per complete frame whose checksum holds and whose body
+    is a sequence of packets of ``PACKET_LENGTHS``. It never raises.
     Counters: ``resyncs`` bytes skipped while looking for a header 19, ``bad_checksums`` frames
     whose checksum failed, ``bad_frames`` frames with a good checksum but an unknown packet id
     or a body that does not split into whole packets. After a bad frame the parser drops only
     its 19 and looks for the next one, so a 19 inside garbage costs one frame, not a lock.
+
+    Given the ``packet_ids`` a driver asked for (``stream_request``), a frame must carry
+    exactly those, in that order: a 19 whose n is not their length is dropped at once, so a
+    stray ``19 255`` costs the bytes up to the next frame instead of 258 bytes of waiting, and
+    a frame of other packets is a bad frame.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, packet_ids: Sequence[int] | None = None) -> None:
         self._buffer = bytearray()
+        self._ids = None if packet_ids is None else tuple(packet_ids)
+        self._body_length = (
+            None if self._ids is None else sum(1 + _packet_length(i) for i in self._ids)
+        )
         self.resyncs = 0
         self.bad_checksums = 0
         self.bad_frames = 0
+        self._refused_at_last_frame = 0
 
-    def feed(self, data: bytes) -> list[dict[int, int]]:
+    def feed(self, data: bytes) -> list[StreamFrame]:
         self._buffer += data
-        frames: list[dict[int, int]] = []
+        frames: list[StreamFrame] = []
         while self._skip_to_header() and len(self._buffer) >= 2:
+            if self._body_length is not None and self._buffer[1] != self._body_length:
+                self.resyncs += 1
+                del self._buffer[0]
+                continue
             end = self._buffer[1] + 3
             if len(self._buffer) < end:
                 break
@@ -145,7 +168,9 @@ class StreamParser:
             if packets is None:
                 del self._buffer[0]
             else:
-                frames.append(packets)
+                refused = self.bad_checksums + self.bad_frames
+                frames.append(StreamFrame(packets, refused - self._refused_at_last_frame))
+                self._refused_at_last_frame = refused
                 del self._buffer[:end]
         return frames
 
@@ -171,6 +196,9 @@ class StreamParser:
                 return None
             packets[body[i]] = int.from_bytes(body[i + 1 : i + 1 + length], "big")
             i += 1 + length
+        if self._ids is not None and tuple(packets) != self._ids:
+            self.bad_frames += 1
+            return None
         return packets
 
 

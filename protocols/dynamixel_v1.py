@@ -85,6 +85,9 @@ POSITION_UNITS_PER_RAD = 1024 / math.radians(300.0)
 SPEED_MAX = 1023
 SPEED_RAD_S_PER_UNIT = 0.111 * 2.0 * math.pi / 60.0
 """0.111 rpm per unit."""
+_HALF_SPAN = POSITION_MAX / POSITION_UNITS_PER_RAD
+"""An angle bound wider than the servo's travel, so that rounding never meets a huge float."""
+_SPEED_SPAN = SPEED_MAX * SPEED_RAD_S_PER_UNIT
 DIRECTION_BIT = 0x400
 """Bit 10 of Present Speed and Present Load: set for clockwise (negative)."""
 
@@ -110,6 +113,38 @@ class Packet:
     @property
     def error(self) -> StatusError:
         return StatusError(self.code & 0x7F)
+
+
+class StatusFault(enum.StrEnum):
+    """What is wrong with the answer to an instruction that expects a status packet."""
+
+    SILENT = "silent"
+    """No byte came back before the timeout."""
+    TRUNCATED = "truncated"
+    """Fewer bytes came back than the packet's length says."""
+    CHECKSUM = "checksum"
+    WRONG_ID = "wrong_id"
+    """A whole status packet, from another servo."""
+    WRONG_LENGTH = "wrong_length"
+    """A whole status packet of this servo that carries other than the parameters asked for."""
+
+
+def status_fault(answer: bytes, servo_id: int, params: int) -> StatusFault | None:
+    """What is wrong with ``answer``, the bytes from ``FF FF`` on that came back from
+    ``servo_id`` for an instruction asking for ``params`` parameter bytes; None when it is
+    that servo's whole status packet with a good checksum."""
+    if not answer:
+        return StatusFault.SILENT
+    if len(answer) < 6 or answer[:2] != HEADER or len(answer) < answer[3] + 4:
+        return StatusFault.TRUNCATED
+    packet = answer[: answer[3] + 4]
+    if checksum(packet[2:-1]) != packet[-1]:
+        return StatusFault.CHECKSUM
+    if packet[2] != servo_id:
+        return StatusFault.WRONG_ID
+    if packet[3] - _MIN_LENGTH != params:
+        return StatusFault.WRONG_LENGTH
+    return None
 
 
 def checksum(body: Iterable[int]) -> int:
@@ -215,9 +250,17 @@ class PacketParser:
 
 
 def position_units(angle_rad: float) -> int:
-    """Goal Position of a joint angle (rad, 0 at the centre), clamped to 0..1023."""
-    units = round(POSITION_CENTER + angle_rad * POSITION_UNITS_PER_RAD)
+    """Goal Position of a joint angle (rad, 0 at the centre), clamped to 0..1023; ValueError
+    for a non-finite angle."""
+    if not math.isfinite(angle_rad):
+        raise ValueError(f"no position for a non-finite angle {angle_rad}")
+    units = round(position_of_angle(min(max(angle_rad, -_HALF_SPAN), _HALF_SPAN)))
     return min(max(units, 0), POSITION_MAX)
+
+
+def position_of_angle(angle_rad: float) -> float:
+    """512 + angle * 1024 / 300 degrees: the Goal Position of an angle, before rounding."""
+    return POSITION_CENTER + angle_rad * POSITION_UNITS_PER_RAD
 
 
 def angle_of_units(units: int) -> float:
@@ -225,10 +268,13 @@ def angle_of_units(units: int) -> float:
     return (units - POSITION_CENTER) / POSITION_UNITS_PER_RAD
 
 
-def speed_units(rad_s: float) -> int:
-    """Moving Speed of a speed magnitude (rad/s), 1..1023: never 0, which means full speed."""
-    units = round(abs(rad_s) / SPEED_RAD_S_PER_UNIT)
-    return min(max(units, 1), SPEED_MAX)
+def moving_speed(rad_s: float) -> int | None:
+    """Moving Speed of a speed magnitude: round(|rad_s| / 0.0116), at most 1023; None when
+    that is 0, for Moving Speed 0 means full speed: a joint that slow must hold. ValueError
+    for a non-finite speed."""
+    if not math.isfinite(rad_s):
+        raise ValueError(f"no moving speed for a non-finite speed {rad_s}")
+    return round(min(abs(rad_s), _SPEED_SPAN) / SPEED_RAD_S_PER_UNIT) or None
 
 
 def signed_speed_units(rad_s: float) -> int:

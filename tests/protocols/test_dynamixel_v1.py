@@ -113,13 +113,44 @@ def test_position_units_clamp_and_round_trip() -> None:
         assert dxl.position_units(dxl.angle_of_units(units)) == units
 
 
-def test_speed_units() -> None:
+def test_position_units_refuse_a_non_finite_angle_and_never_overflow() -> None:
+    for angle in (math.nan, math.inf, -math.inf):
+        with pytest.raises(ValueError, match="non-finite"):
+            dxl.position_units(angle)
+    assert dxl.position_units(1e308) == 1023 and dxl.position_units(-1e308) == 0
+
+
+def test_moving_speed() -> None:
     one_rpm = 2.0 * math.pi / 60.0
-    assert dxl.speed_units(0.111 * 300 * one_rpm) == 300
-    assert dxl.speed_units(-0.111 * 300 * one_rpm) == 300
-    assert dxl.speed_units(0.0) == 1, "0 would mean full speed"
-    assert dxl.speed_units(100.0) == 1023
+    assert dxl.moving_speed(0.111 * 300 * one_rpm) == 300
+    assert dxl.moving_speed(-0.111 * 300 * one_rpm) == 300
     assert dxl.rad_s_of_speed_units(300) == pytest.approx(0.111 * 300 * one_rpm)
+    # Moving Speed 0 means full speed: a speed that rounds to it is no speed at all.
+    for still in (0.0, -0.0, 0.4 * dxl.SPEED_RAD_S_PER_UNIT):
+        assert dxl.moving_speed(still) is None
+    assert dxl.moving_speed(0.6 * dxl.SPEED_RAD_S_PER_UNIT) == 1
+    for fast in (100.0, 1e3, -1e300, 1e308):
+        assert dxl.moving_speed(fast) == 1023
+    for bad in (math.nan, math.inf):
+        with pytest.raises(ValueError, match="non-finite"):
+            dxl.moving_speed(bad)
+
+
+READ_ANSWER = dxl.status_packet(3, 0, bytes([0x00, 0x02, 0x10, 0x00]))
+
+
+@pytest.mark.parametrize(("answer", "fault"), [
+    (READ_ANSWER, None),
+    (b"", dxl.StatusFault.SILENT),
+    (READ_ANSWER[:5], dxl.StatusFault.TRUNCATED),
+    (READ_ANSWER[:-2], dxl.StatusFault.TRUNCATED),
+    (READ_ANSWER[:-1] + bytes([READ_ANSWER[-1] ^ 0x5A]), dxl.StatusFault.CHECKSUM),
+    (dxl.status_packet(4, 0, READ_ANSWER[5:-1]), dxl.StatusFault.WRONG_ID),
+    (dxl.status_packet(3, 0, READ_ANSWER[5:-2]), dxl.StatusFault.WRONG_LENGTH),
+    (dxl.status_packet(3, 0, READ_ANSWER[5:-1] + b"\x00"), dxl.StatusFault.WRONG_LENGTH),
+])  # fmt: skip
+def test_each_fault_of_a_status_packet_is_named(answer: bytes, fault) -> None:
+    assert dxl.status_fault(answer, 3, 4) == fault
 
 
 def test_present_speed_direction_bit() -> None:
