@@ -95,12 +95,39 @@ class Timer:
         return False
 
 
+@dataclass
+class Alarm:
+    """A callback due once, ``after_s`` from when it was last ``set`` on a clock's monotonic
+    time; ``set`` again moves the deadline, ``cancel`` clears it (a command timeout)."""
+
+    clock: Clock
+    callback: Callable[[], None]
+    deadline_ns: int | None = None
+
+    @property
+    def name(self) -> str:
+        return getattr(self.callback, "__qualname__", repr(self.callback))
+
+    def set(self, after_s: float) -> None:
+        self.deadline_ns = self.clock.monotonic_ns() + max(0, round(after_s * 1e9))
+
+    def cancel(self) -> None:
+        self.deadline_ns = None
+
+    def reschedule(self, now_ns: int) -> bool:
+        """Whether the alarm is due; a due alarm is cleared."""
+        if self.deadline_ns is None or self.deadline_ns > now_ns:
+            return False
+        self.deadline_ns = None
+        return True
+
+
 class Timers:
-    """The timers of one component, fired by its handler thread."""
+    """The timers and alarms of one component, fired by its handler thread."""
 
     def __init__(self, clock: Clock) -> None:
         self.clock = clock
-        self._timers: list[Timer] = []
+        self._timers: list[Timer | Alarm] = []
 
     def add(self, period_s: float, callback: Callable[[], None]) -> Timer:
         """Call ``callback`` every ``period_s`` seconds of the clock, first after one period."""
@@ -111,21 +138,27 @@ class Timers:
         self._timers.append(timer)
         return timer
 
-    def due(self) -> list[Timer]:
-        """The timers whose deadline has passed, each moved to its next deadline."""
+    def alarm(self, callback: Callable[[], None]) -> Alarm:
+        """An alarm that calls ``callback`` once per ``Alarm.set``."""
+        alarm = Alarm(self.clock, callback)
+        self._timers.append(alarm)
+        return alarm
+
+    def due(self) -> list[Timer | Alarm]:
+        """The timers and alarms whose deadline has passed, each moved to its next deadline."""
         now = self.clock.monotonic_ns()
         return [timer for timer in self._timers if timer.reschedule(now)]
 
     def wait_s(self) -> float | None:
         """How long the handler thread may block before a timer is due.
 
-        ``None`` (block until the next event) when there are no timers. On a simulated
-        clock, time only moves with a ``sim/clock`` message, so the thread wakes every
-        ``STALL_CHECK_S`` of host time to notice a clock that stopped.
+        ``None`` (block until the next event) when nothing is due. On a simulated clock, time
+        only moves with a ``sim/clock`` message, so the thread wakes every ``STALL_CHECK_S`` of
+        host time to notice a clock that stopped.
         """
         if self.clock.simulated:
             return STALL_CHECK_S
-        if not self._timers:
+        deadlines = [t.deadline_ns for t in self._timers if t.deadline_ns is not None]
+        if not deadlines:
             return None
-        next_deadline = min(timer.deadline_ns for timer in self._timers)
-        return max(0.0, (next_deadline - self.clock.monotonic_ns()) / 1e9)
+        return max(0.0, (min(deadlines) - self.clock.monotonic_ns()) / 1e9)

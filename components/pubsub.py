@@ -3,9 +3,10 @@
 A subscription hands its samples to the component's handler thread and decodes them there
 with the codec; it drops and counts malformed ones (``rejected.<topic>``), refuses a payload
 over the topic's ``max_bytes`` on arrival, before any copy or decoding (counted the same), and
-counts handler exceptions (``errors.<topic>``); ``handler.<topic>_us_median`` and ``_us_p99``
-say how long its handler takes (``components.durations``). Each input chooses what waits for
-the handler:
+counts handler exceptions (``errors.<topic>``); a refusal is logged once per failing check and
+handed to the component's ``on_reject``, if it gave one; ``handler.<topic>_us_median`` and
+``_us_p99`` say how long its handler takes (``components.durations``). Each input chooses what
+waits for the handler:
 
 - ``latest`` (control): only the newest sample; one that arrives before the previous was
   handled replaces it (``overwritten.<topic>``);
@@ -118,12 +119,14 @@ class Subscription(Generic[M]):
         topic: topics.Topic[M],
         handler: Callable[[M], None] | None,
         queue: int | None = None,
+        on_reject: Callable[[str], None] | None = None,
     ) -> None:
         Input(topic, queue)  # checks the queue
         self.topic = topic
         self.latest: M | None = None
         self._node = node
         self._handler = handler
+        self._on_reject = on_reject
         self._key = topic.key(node.namespace)
         self._lock = threading.Lock()
         self._waiting: collections.deque[tuple[bytes, int]] = collections.deque()
@@ -178,8 +181,20 @@ class Subscription(Generic[M]):
     def _warn_oversized(self, size: int) -> None:
         with self._lock:
             self._oversized_warning_waiting = False
-        self._node.warn(f"rejected.{self.topic.name}", f"dropped a {size}-byte message on "
-                        f"{self._key}: over {self.topic.max_bytes} bytes")  # fmt: skip
+        self._reject("size", f"dropped a {size}-byte message on {self._key}: over "
+                     f"{self.topic.max_bytes} bytes")  # fmt: skip
+
+    def _reject(self, check: str, reason: str) -> None:
+        """Handler thread: log a refusal, rate-limited per topic and check (so that each
+        failing check is heard), and tell the component."""
+        self._node.warn(f"rejected.{self.topic.name}.{check}", reason)
+        if self._on_reject is not None:
+            try:
+                self._on_reject(reason)
+            except Exception:
+                self._node.counters[f"errors.{self.topic.name}"] += 1
+                self._node.warn(f"errors.{self.topic.name}", f"refusal handler of {self._key} "
+                                "failed", True)  # fmt: skip
 
     def drain(self) -> None:
         """Handler thread: deliver every sample still waiting (a recorder closing its file)."""
@@ -200,7 +215,7 @@ class Subscription(Generic[M]):
             message = codec.decode(payload, self.topic.type, self._key)
         except codec.DecodeError as error:
             self._node.counters[f"rejected.{self.topic.name}"] += 1
-            self._node.warn(f"rejected.{self.topic.name}", f"dropped a malformed message: {error}")
+            self._reject(error.field or "message", f"dropped a malformed message: {error}")
             return
         self._node.counters[f"received.{self.topic.name}"] += 1
         self.latest, self._received_ns = message, arrival_ns

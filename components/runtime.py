@@ -31,7 +31,7 @@ from typing import ClassVar, TypeVar
 import zenoh
 from pydantic import BaseModel
 
-from components.clock import Clock, SimClock, Timer, Timers, WallClock
+from components.clock import Alarm, Clock, SimClock, Timer, Timers, WallClock
 from components.params import Param, ParamError, Parameters, keep_params, restore_params
 from components.pubsub import Input, Publisher, Subscription
 from components.rate_limited_log import RateLimitedLog
@@ -129,8 +129,10 @@ class Node:
         topic: topics.Topic[M],
         handler: Callable[[M], None] | None = None,
         queue: int | None = None,
+        on_reject: Callable[[str], None] | None = None,
     ) -> Subscription[M]:
-        """Subscribe to ``topic`` until close; ``handler`` (optional) gets each valid message.
+        """Subscribe to ``topic`` until close; ``handler`` (optional) gets each valid message,
+        ``on_reject`` (optional) the reason of each refused one.
 
         ``queue`` None hands the handler the newest sample only (control inputs); N hands it
         every sample in order, at most N waiting (see ``components.pubsub``). A component
@@ -144,7 +146,7 @@ class Node:
             if topic.name not in self.reads:
                 raise ValueError(f"{self.name} reads {topic.name} without declaring it in `reads`")
             queue = self.reads[topic.name].queue
-        subscription = Subscription(self, actual, handler, queue)
+        subscription = Subscription(self, actual, handler, queue, on_reject)
         self._declared.append(subscription)
         return subscription
 
@@ -153,6 +155,13 @@ class Node:
         timer = self._timers.add(period_s, callback)
         self.counters[f"errors.timer.{timer.name}"] = 0
         return timer
+
+    def alarm(self, callback: Callable[[], None]) -> Alarm:
+        """An alarm that calls ``callback`` on the handler thread once, ``after_s`` of the
+        component clock from each ``alarm.set(after_s)``."""
+        alarm = self._timers.alarm(callback)
+        self.counters[f"errors.timer.{alarm.name}"] = 0
+        return alarm
 
     def header(self, frame: str = "", stamp_ns: int | None = None, seq: int = 0) -> Header:
         """A header from this component, stamped now unless ``stamp_ns`` is given.

@@ -80,3 +80,31 @@ def test_a_paused_simulators_held_time_is_not_a_stall() -> None:
     time.sleep(0.05)
     clock.advance(5 * MS)  # no longer paused, and not moving
     assert clock.stalled_s() >= 0.05
+
+
+def test_an_alarm_fires_once_after_its_last_set_and_not_after_a_cancel() -> None:
+    clock = SimClock()
+    timers = Timers(clock)
+    alarm = timers.alarm(lambda: None)
+    clock.advance(1000 * MS)
+    assert timers.due() == []  # never set
+    alarm.set(0.2)
+    clock.advance(1150 * MS)
+    alarm.set(0.2)  # a command came: the deadline moves on
+    clock.advance(1300 * MS)
+    assert timers.due() == []
+    clock.advance(1350 * MS)
+    assert timers.due() == [alarm]
+    clock.advance(2000 * MS)
+    assert timers.due() == []  # once
+    alarm.set(0.1)
+    alarm.cancel()
+    clock.advance(3000 * MS)
+    assert timers.due() == []
+
+
+def test_a_wall_alarm_is_what_the_handler_thread_waits_for() -> None:
+    timers = Timers(WallClock())
+    timers.add(60.0, lambda: None)
+    timers.alarm(lambda: None).set(0.2)
+    assert 0.0 < timers.wait_s() <= 0.2
