@@ -3,16 +3,24 @@
 Every 1/``rate_hz`` s it reads each servo's present position, speed and load on its own (bulk
 and sync read do not exist for AX servos in protocol 1.0) and publishes ``arm/joint_states``.
 
-A velocity command becomes, per joint, a goal position ahead of the present one in the
-direction of motion (``lookahead_s`` of the commanded speed, at least ``min_step`` units),
-clamped to the robot's joint limits, with the moving speed of the commanded speed (about 0.111
-rpm per unit). A moving speed of 0 means full speed to the servo, so a joint commanded to stop
-holds: its goal is its present position. All five goals and speeds go in one Sync Write. With
-no command for ``command_timeout_s`` the arm holds.
+A velocity command is checked (every entry finite, else the arm holds) and each joint's speed
+clamped to the robot's velocity limit. It becomes, per joint, a goal position ahead of the
+present one in the direction of motion (``lookahead_s`` of the commanded speed, at least
+``min_step`` units) with the moving speed of the commanded speed (about 0.111 rpm per unit).
+A joint whose speed rounds to Moving Speed 0 (which would mean full speed) holds: its goal is
+the position it had when it stopped, kept while it stays stopped, so it does not creep. All
+five goals and speeds go in one Sync Write, and every goal written lies inside the robot
+description's joint limits. With no command for ``command_timeout_s`` the arm holds.
 
-Status-packet error bits are counted by name (``servo_error.<bit>``) and logged; a servo that
-stops answering is counted (``servo_timeouts``), the arm holds, no joint state is published
-until every servo answers again, and the component's state says ``servo <id> silent``.
+Each answer is checked (``protocols.dynamixel_v1.status_fault``): a servo that is silent, or
+answers a truncated packet, a bad checksum, another servo's id or the wrong length, is counted
+by that name (``servo_faults.<name>``); a reading outside the joint limits (by more than
+``limit_margin``) is counted (``out_of_limits``) and never published. Either way no joint state
+is published, the arm holds at the last good readings and refuses commands until every servo
+answers again with a reading inside its limits, and the component's state says why
+(``holding: servo 3 silent``); then every goal is set where its joint is and torque is enabled
+again on every servo. Status-packet error
+bits are counted by name (``servo_error.<bit>``) and logged.
 """
 
 from __future__ import annotations
@@ -30,11 +38,15 @@ from messages.base import ARM_JOINTS
 from messages.commands import ArmCommand
 from messages.joints import JointStates
 from protocols import dynamixel_v1 as dxl
-from wbc.robot import MobileManipulator
+from wbc.robot import BASE_DOF, MobileManipulator
 
 JOINT_NAMES = tuple(f"q{i}" for i in range(1, ARM_JOINTS + 1))
 ERROR_BITS = {int(bit): bit.name.lower() for bit in dxl.StatusError}
 """The status-packet error bits of protocol 1.0, by the name they are counted under."""
+READ_BYTES = 4
+"""Present Position and Present Speed, from address 36."""
+HOLD_SPEED = 1
+"""The Moving Speed of a held joint: the slowest there is (0 would mean full speed)."""
 
 
 def ids_of(text: object) -> tuple[int, ...]:
@@ -63,6 +75,8 @@ class ArmDriver(Component):
         Param("lookahead_s", float, 0.25, low=0.01, high=5.0,
               doc="a goal is this many seconds of motion ahead"),
         Param("min_step", int, 8, low=1, high=100, doc="least goal step ahead, units"),
+        Param("limit_margin", float, 0.02, low=0.0, high=0.5,
+              doc="a reading this far outside a joint limit is refused, rad"),
     )  # fmt: skip
 
     def __init__(self, node: Node) -> None:
@@ -70,19 +84,32 @@ class ArmDriver(Component):
         if node.profile.robot is None:
             raise ParamError("the arm driver needs the profile's `robot`")
         robot = MobileManipulator.from_yaml(node.profile.robot)
-        self.low, self.high = robot.q_min[3:], robot.q_max[3:]
+        self.low, self.high = robot.q_min[BASE_DOF:], robot.q_max[BASE_DOF:]
+        self.speed_max = robot.velocity_max[BASE_DOF:]
+        self.goal_low = [max(0, math.ceil(dxl.position_of_angle(q))) for q in self.low]
+        self.goal_high = [min(dxl.POSITION_MAX, math.floor(dxl.position_of_angle(q)))
+                          for q in self.high]  # fmt: skip
+        """The Goal Positions inside the joint limits (every goal written lies in them)."""
         self.ids = ids_of(node.params["ids"])
         self.port = PortHandler(str(node.params["port"]))
         self.packet = PacketHandler(1.0)
         self.connected = False
-        for name in ("servo_timeouts", "sync_writes", "holds", "reads"):
+        for name in ("sync_writes", "holds", "reads", "out_of_limits", "non_finite_commands",
+                     "speed_limited", "refused_commands", "port_errors"):  # fmt: skip
             node.counters[name] = 0
+        for fault in dxl.StatusFault:
+            node.counters[f"servo_faults.{fault}"] = 0
         for name in ERROR_BITS.values():
             node.counters[f"servo_error.{name}"] = 0
         self.present: list[float | None] = [None] * ARM_JOINTS
-        self.last_command_ns: int | None = None
+        """The last good reading of each joint (inside its limits)."""
+        self.held: list[int | None] = [None] * ARM_JOINTS
+        """The goal a stopped joint holds, units; None while it moves."""
+        self.fault = ""
+        """Why the arm holds whatever it is told; empty when every servo answers well."""
         self.holding = True
         self.output = node.publisher(topics.ARM_JOINT_STATES)
+        self.timeout = node.alarm(self.hold)
         self._connect()  # a port that is not there yet is opened by the timer when it is
         node.subscribe(topics.ARM_COMMAND, self.on_command)
         node.timer(1.0 / node.params["rate_hz"], self.read_joints)
@@ -98,100 +125,178 @@ class ArmDriver(Component):
             return
         self.connected = True
         self.node.state = "running"
-        for servo in self.ids:
-            torque = self.packet.write1ByteTxRx(self.port, servo, dxl.Address.TORQUE_ENABLE, 1)
-            self._check(servo, *torque)
+        self._enable_torque()
 
-    def _check(self, servo: int, result: int, error: int) -> bool:
-        """Count a failed exchange or the error bits of a status packet; True when it went
-        through (error bits included: the servo answered)."""
-        if result != COMM_SUCCESS:
-            self.node.count("servo_timeouts")
-            self.node.warn(f"servo_timeout.{servo}",
-                           f"servo {servo}: {self.packet.getTxRxResult(result)}")  # fmt: skip
-            return False
+    def _enable_torque(self) -> None:
+        """Torque on for every servo (a servo that browned out comes back with it off)."""
+        for servo in self.ids:
+            result, error = self.packet.write1ByteTxRx(
+                self.port, servo, dxl.Address.TORQUE_ENABLE, 1
+            )
+            if result == COMM_SUCCESS:
+                self._count_error_bits(servo, error)
+
+    def _lost(self, error: Exception) -> None:
+        self.node.count("port_errors")
+        self.node.warn("port_errors", f"lost {self.node.params['port']}: {error}")
+        self.connected = False
+        self.node.state = "no port"
+        try:
+            self.port.closePort()
+        except OSError:
+            pass
+
+    def _read(self, servo: int) -> tuple[bytes, dxl.StatusFault | None]:
+        """One servo's Present Position and Speed: the answer's parameters, or what is wrong."""
+        result = self.packet.readTx(self.port, servo, dxl.Address.PRESENT_POSITION, READ_BYTES)
+        answer = b""
+        if result == COMM_SUCCESS:
+            rx, _ = self.packet.rxPacket(self.port)
+            answer = bytes(rx)
+        fault = dxl.status_fault(answer, servo, READ_BYTES)
+        if fault is not None:
+            self.node.count(f"servo_faults.{fault}")
+            self.node.warn(f"servo_faults.{fault}.{servo}", f"servo {servo}: {fault} answer")
+            return b"", fault
+        self._count_error_bits(servo, answer[4])
+        return answer[5 : 5 + READ_BYTES], None
+
+    def _count_error_bits(self, servo: int, error: int) -> None:
         for bit, name in ERROR_BITS.items():
             if error & bit:
                 self.node.count(f"servo_error.{name}")
                 self.node.warn(f"servo_error.{name}", f"servo {servo} reports {name}")
-        return True
 
     def read_joints(self) -> None:
-        """Timer: each servo's present position and speed; publish when all answered."""
+        """Timer: each servo's present position and speed; publish when all answered well,
+        else hold and say why."""
         if not self.connected:
             self._connect()
             return
-        positions, velocities, silent = [], [], []
-        for index, servo in enumerate(self.ids):
-            data, result, error = self.packet.readTxRx(
-                self.port, servo, dxl.Address.PRESENT_POSITION, 4
-            )
-            if not self._check(servo, result, error):
-                silent.append(servo)
-                continue
-            self.node.count("reads")
-            position = dxl.angle_of_units(data[0] | data[1] << 8)
-            self.present[index] = position
-            positions.append(position)
-            velocities.append(dxl.rad_s_of_speed_units(data[2] | data[3] << 8))
-        if silent:
-            self.node.state = "servo " + ", ".join(map(str, silent)) + " silent"
-            self.hold()
+        readings, faults = [], []
+        try:
+            for index, servo in enumerate(self.ids):
+                data, fault = self._read(servo)
+                if fault is not None:
+                    faults.append(f"servo {servo} {fault}")
+                    continue
+                position = dxl.angle_of_units(data[0] | data[1] << 8)
+                low, high = self.low[index], self.high[index]
+                margin = self.node.params["limit_margin"]
+                if not low - margin <= position <= high + margin:
+                    self.node.count("out_of_limits")
+                    faults.append(f"servo {servo} reads {position:.3f} rad, outside its "
+                                  f"limits [{low:.3f}, {high:.3f}]")  # fmt: skip
+                    continue
+                self.present[index] = position
+                readings.append((position, dxl.rad_s_of_speed_units(data[2] | data[3] << 8)))
+        except (OSError, TypeError) as error:  # the port went away under the SDK
+            self._lost(error)
             return
-        if self.node.state.startswith("servo"):
-            self.node.state = "running"
-        now = self.node.clock.monotonic_ns()
-        timeout_ns = self.node.params["command_timeout_s"] * 1e9
-        if not self.holding and (self.last_command_ns is None
-                                 or now - self.last_command_ns > timeout_ns):  # fmt: skip
-            self.hold()
+        self.node.count("reads", len(readings))
+        if faults:
+            self._hold_for("; ".join(faults))
+            return
+        if self.fault:
+            self._recover()
         self.output.put(
             JointStates(
                 header=self.node.header("arm", None, self.output.next_seq),
                 names=JOINT_NAMES,
-                positions=tuple(positions),
-                velocities=tuple(velocities),
+                positions=tuple(p for p, _ in readings),
+                velocities=tuple(v for _, v in readings),
             )
         )
+
+    def _recover(self) -> None:
+        """Every servo answers again: goals where the joints are now, then torque on."""
+        self.node.warn("holding", f"every servo answers again (was: {self.fault})")
+        self.fault = ""
+        self.node.state = "running"
+        self.held = [None] * ARM_JOINTS
+        self.hold()
+        self._enable_torque()
+
+    def _hold_for(self, why: str) -> None:
+        if why != self.fault:
+            self.node.warn("holding", f"arm holding: {why}")
+        self.fault = why
+        self.node.state = f"holding: {why}"
+        self.hold()
 
     def on_command(self, command: ArmCommand) -> None:
         """Goals ahead of the present positions at the commanded speeds, in one Sync Write."""
         velocities = command.joint_velocities
         if len(velocities) != ARM_JOINTS or not all(math.isfinite(v) for v in velocities):
-            raise ValueError(f"expected {ARM_JOINTS} finite joint velocities, got {velocities}")
-        if not self.connected or any(p is None for p in self.present):
-            return  # no position read yet: nothing to aim from
+            self.node.count("non_finite_commands")
+            self.node.warn("non_finite_commands", f"expected {ARM_JOINTS} finite joint "
+                           f"velocities, got {velocities}; holding")  # fmt: skip
+            self.hold()
+            return
+        if self.fault or not self.connected or any(p is None for p in self.present):
+            self.node.count("refused_commands")
+            return  # holding, or no position read yet to aim from
         goals, speeds = [], []
-        lookahead, min_step = self.node.params["lookahead_s"], self.node.params["min_step"]
         for index, velocity in enumerate(velocities):
-            present = self.present[index]
-            units = dxl.speed_units(abs(velocity))
-            if units == 0:  # too slow to command: hold (0 would mean full speed)
-                goals.append(dxl.position_units(present))
-                speeds.append(1)
-                continue
-            step = max(abs(velocity) * lookahead, min_step / dxl.POSITION_UNITS_PER_RAD)
-            goal = present + math.copysign(step, velocity)
-            goal = min(max(goal, self.low[index]), self.high[index])
-            goals.append(dxl.position_units(goal))
-            speeds.append(units)
-        self.last_command_ns = self.node.clock.monotonic_ns()
+            limit = self.speed_max[index]
+            if abs(velocity) > limit:
+                self.node.count("speed_limited")
+                velocity = math.copysign(limit, velocity)
+            goal, speed = self._goal(index, velocity)
+            goals.append(goal)
+            speeds.append(speed)
         self.holding = False
         self._sync_write(goals, speeds)
+        self.timeout.set(self.node.params["command_timeout_s"])
+
+    def _goal(self, index: int, velocity: float) -> tuple[int, int]:
+        """Joint ``index``'s goal (units) and Moving Speed for a finite ``velocity`` (rad/s)."""
+        speed = dxl.moving_speed(velocity)
+        if speed is None:
+            return self._held(index), HOLD_SPEED
+        self.held[index] = None
+        present = self.present[index]
+        assert present is not None
+        step = max(abs(velocity) * self.node.params["lookahead_s"],
+                   self.node.params["min_step"] / dxl.POSITION_UNITS_PER_RAD)  # fmt: skip
+        return self._inside_limits(index, present + math.copysign(step, velocity)), speed
+
+    def _held(self, index: int) -> int:
+        """The goal joint ``index`` holds: where it was when it stopped."""
+        if self.held[index] is None:
+            present = self.present[index]
+            assert present is not None
+            self.held[index] = self._inside_limits(index, present)
+        return self.held[index]
+
+    def _inside_limits(self, index: int, angle: float) -> int:
+        """The Goal Position of ``angle`` (finite), clamped to the joint's limits in units."""
+        units = dxl.position_units(angle)
+        return min(max(units, self.goal_low[index]), self.goal_high[index])
 
     def hold(self) -> None:
-        """Every servo's goal at its present position, slowly: the arm stops where it is."""
-        if any(p is None for p in self.present):
+        """Every joint's goal where it stopped, slowly: the arm stops where it is. Written again
+        at each call, so a lost Sync Write is made good."""
+        if not self.connected or any(p is None for p in self.present):
             return
-        self.holding = True
-        self.node.count("holds")
-        self._sync_write([dxl.position_units(p) for p in self.present], [1] * ARM_JOINTS)
+        if not self.holding:
+            self.holding = True
+            self.node.count("holds")
+        self.timeout.cancel()
+        self._sync_write([self._held(i) for i in range(ARM_JOINTS)], [HOLD_SPEED] * ARM_JOINTS)
 
     def _sync_write(self, goals: list[int], speeds: list[int]) -> None:
         group = GroupSyncWrite(self.port, self.packet, dxl.Address.GOAL_POSITION, 4)
-        for servo, goal, speed in zip(self.ids, goals, speeds, strict=True):
+        for index, (servo, goal, speed) in enumerate(zip(self.ids, goals, speeds, strict=True)):
+            if not (self.goal_low[index] <= goal <= self.goal_high[index]
+                    and 1 <= speed <= dxl.SPEED_MAX):  # fmt: skip
+                raise ValueError(f"servo {servo}: goal {goal} or speed {speed} out of range")
             group.addParam(servo, [goal & 0xFF, goal >> 8, speed & 0xFF, speed >> 8])
-        result = group.txPacket()
+        try:
+            result = group.txPacket()
+        except (OSError, TypeError) as error:
+            self._lost(error)
+            return
         if result != COMM_SUCCESS:
             self.node.warn("sync_write", f"sync write: {self.packet.getTxRxResult(result)}")
         self.node.count("sync_writes")

@@ -11,6 +11,9 @@ RESET restores the defaults (id 1). Broadcast packets get no answer; a bad check
 CHECKSUM bit, an unknown or malformed instruction the INSTRUCTION bit, a read or write past
 the table the RANGE bit. Status Return Level is obeyed (0: PING only, 1: PING and READ). The
 answer leaves after the servo's Return Delay (2 us per unit), slept as the real servo waits.
+Faults are injected per servo: ``fail`` (silent, or an overload shutdown), ``recover`` (a
+silent servo answers again) and ``corrupt`` (its status packets truncated, with a bad checksum,
+another id or a parameter short).
 
 Motion: ``update(dt)``, called every simulator step, drives each torque-enabled servo towards
 its Goal Position at its Moving Speed (0: full speed) capped at the AX-18A's 97 rpm, ending
@@ -79,6 +82,24 @@ class ServoBackend(Protocol):
         """Joint velocity commands (rad/s), one per servo in id order."""
 
 
+class IntegratingJoints:
+    """The plainest world for the servos: joints that move at the velocities they command,
+    ``step(dt)`` at a time (tests and benchmarks without the simulator)."""
+
+    def __init__(self, angles: Sequence[float]) -> None:
+        self.angles = list(angles)
+        self.velocities = [0.0] * len(self.angles)
+
+    def joint_positions(self) -> Sequence[float]:
+        return tuple(self.angles)
+
+    def set_joint_velocities(self, velocities: Sequence[float]) -> None:
+        self.velocities = list(velocities)
+
+    def step(self, dt: float) -> None:
+        self.angles = [q + v * dt for q, v in zip(self.angles, self.velocities, strict=True)]
+
+
 def default_table(servo_id: int) -> bytearray:
     table = bytearray(TABLE_BYTES)
     for address, value in _DEFAULTS.items():
@@ -97,6 +118,8 @@ class AXServo:
         )
         self.silent = False
         self.overloaded = False
+        self.corruption: dxl.StatusFault | None = None
+        """How this servo's status packets are spoiled on their way out (fault injection)."""
         self._registered: tuple[int, bytes] | None = None
         self._set_word(Address.GOAL_POSITION, dxl.position_units(position_rad))
         self.sense_position(position_rad)
@@ -110,7 +133,8 @@ class AXServo:
     def return_delay_s(self) -> float:
         return self.table[Address.RETURN_DELAY] * dxl.RETURN_DELAY_US_PER_UNIT * 1e-6
 
-    def _word(self, address: int) -> int:
+    def word(self, address: int) -> int:
+        """The control table's word at ``address`` (low byte first)."""
         return int.from_bytes(self.table[address : address + 2], "little")
 
     def _set_word(self, address: int, value: int) -> None:
@@ -122,7 +146,7 @@ class AXServo:
         position = dxl.position_units(position_rad)
         self._set_word(Address.PRESENT_POSITION, position)
         away = (
-            abs(self._word(Address.GOAL_POSITION) - position)
+            abs(self.word(Address.GOAL_POSITION) - position)
             > self.table[Address.CW_COMPLIANCE_MARGIN]
         )
         self.table[Address.MOVING] = away and self._driven()
@@ -138,10 +162,10 @@ class AXServo:
         torque off or after an overload shutdown."""
         if not self._driven():
             return 0.0
-        speed_units = self._word(Address.MOVING_SPEED) & dxl.SPEED_MAX
+        speed_units = self.word(Address.MOVING_SPEED) & dxl.SPEED_MAX
         speed = dxl.rad_s_of_speed_units(speed_units) if speed_units else MAX_SPEED_RAD_S
         speed = min(speed, MAX_SPEED_RAD_S)
-        error = dxl.angle_of_units(self._word(Address.GOAL_POSITION)) - position_rad
+        error = dxl.angle_of_units(self.word(Address.GOAL_POSITION)) - position_rad
         return min(max(error / dt, -speed), speed)
 
     def fail(self, silent: bool) -> None:
@@ -210,8 +234,8 @@ class AXServo:
         return StatusError(0)
 
     def _clamp_goal(self) -> StatusError:
-        goal = self._word(Address.GOAL_POSITION)
-        low, high = self._word(Address.CW_ANGLE_LIMIT), self._word(Address.CCW_ANGLE_LIMIT)
+        goal = self.word(Address.GOAL_POSITION)
+        low, high = self.word(Address.CW_ANGLE_LIMIT), self.word(Address.CCW_ANGLE_LIMIT)
         clamped = min(max(goal, low), high)
         self._set_word(Address.GOAL_POSITION, clamped)
         return StatusError.ANGLE_LIMIT if clamped != goal else StatusError(0)
@@ -266,6 +290,7 @@ class AXChainEmulator(SerialDevice):
                 "skipped_bytes",
                 "unanswered",
                 "status_sent",
+                "sync_writes",
                 "handler_errors",
             ),
         )
@@ -274,10 +299,27 @@ class AXChainEmulator(SerialDevice):
     def fail(self, servo_id: int, silent: bool = True) -> None:
         """Fault injection (see ``AXServo.fail``)."""
         with self._lock:
-            servo = self._servo(servo_id)
-            if servo is None:
-                raise KeyError(f"no servo {servo_id} on the chain, ids {self._ids()}")
-            servo.fail(silent)
+            self._named(servo_id).fail(silent)
+
+    def recover(self, servo_id: int) -> None:
+        """A silent servo answers again, its torque off as after a brown-out."""
+        with self._lock:
+            self._named(servo_id).silent = False
+
+    def corrupt(self, servo_id: int, fault: dxl.StatusFault | None) -> None:
+        """Spoil every status packet of ``servo_id`` as ``fault`` says (TRUNCATED: its first
+        five bytes; CHECKSUM: the checksum inverted; WRONG_ID: the next id's; WRONG_LENGTH:
+        one parameter short); None sends them whole again."""
+        if fault is dxl.StatusFault.SILENT:
+            raise ValueError("a silent servo is fail(id), not a corrupt answer")
+        with self._lock:
+            self._named(servo_id).corruption = fault
+
+    def _named(self, servo_id: int) -> AXServo:
+        servo = self._servo(servo_id)
+        if servo is None:
+            raise KeyError(f"no servo {servo_id} on the chain, ids {self._ids()}")
+        return servo
 
     def update(self, dt: float) -> None:
         """One simulator step of dt seconds: measure each joint's motion since the last step,
@@ -321,6 +363,8 @@ class AXChainEmulator(SerialDevice):
             if packet.id == dxl.BROADCAST_ID:
                 for servo in self.servos:
                     servo.execute(packet)
+                if packet.instruction == Instruction.SYNC_WRITE:
+                    self.counters["sync_writes"] += 1
                 return
             servo = self._servo(packet.id)
             if servo is None:
@@ -333,8 +377,22 @@ class AXChainEmulator(SerialDevice):
             answer_id = servo.id
             answer = servo.execute(packet)
             delay = servo.return_delay_s
+            corruption = servo.corruption
         if answer is None:
             self.counters["unanswered"] += 1
             return
         time.sleep(delay)
-        self.send(dxl.status_packet(answer_id, *answer), "status_sent")
+        self.send(spoiled(dxl.status_packet(answer_id, *answer), corruption), "status_sent")
+
+
+def spoiled(packet: bytes, fault: dxl.StatusFault | None) -> bytes:
+    """A status packet as ``fault`` spoils it (see ``AXChainEmulator.corrupt``)."""
+    if fault is dxl.StatusFault.TRUNCATED:
+        return packet[:5]
+    if fault is dxl.StatusFault.CHECKSUM:
+        return packet[:-1] + bytes([packet[-1] ^ 0xFF])
+    if fault is dxl.StatusFault.WRONG_ID:
+        return dxl.status_packet((packet[2] + 1) % dxl.BROADCAST_ID, packet[4], packet[5:-1])
+    if fault is dxl.StatusFault.WRONG_LENGTH:
+        return dxl.status_packet(packet[2], packet[4], packet[5:-2])
+    return packet

@@ -4,7 +4,7 @@ dynamixel-sdk, and by pyserial for the bytes the SDK never sends."""
 from __future__ import annotations
 
 import random
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -20,7 +20,7 @@ from dynamixel_sdk import (
 
 from protocols import dynamixel_v1 as dxl
 from protocols.dynamixel_v1 import Address, Instruction, StatusError
-from sim2d.devices.ax_servos import MODEL_NUMBER, AXChainEmulator
+from sim2d.devices.ax_servos import MODEL_NUMBER, AXChainEmulator, IntegratingJoints
 
 IDS = (1, 2, 3, 4, 5)
 START_ANGLES = (0.0, 0.4, -0.6, 1.2, -1.0)
@@ -28,30 +28,13 @@ DT = 0.01
 QUIET_S = 0.03
 
 
-class IntegratingArm:
-    """The world for the emulator: five joints that move at the commanded velocities."""
-
-    def __init__(self, angles: Sequence[float]) -> None:
-        self.angles = list(angles)
-        self.velocities = [0.0] * len(angles)
-
-    def joint_positions(self) -> Sequence[float]:
-        return tuple(self.angles)
-
-    def set_joint_velocities(self, velocities: Sequence[float]) -> None:
-        self.velocities = list(velocities)
-
-    def step(self, dt: float) -> None:
-        self.angles = [q + v * dt for q, v in zip(self.angles, self.velocities, strict=True)]
+@pytest.fixture
+def arm() -> IntegratingJoints:
+    return IntegratingJoints(START_ANGLES)
 
 
 @pytest.fixture
-def arm() -> IntegratingArm:
-    return IntegratingArm(START_ANGLES)
-
-
-@pytest.fixture
-def emulator(arm: IntegratingArm) -> Iterator[AXChainEmulator]:
+def emulator(arm: IntegratingJoints) -> Iterator[AXChainEmulator]:
     with AXChainEmulator(arm, IDS) as chain:
         yield chain
     assert chain.counters["handler_errors"] == 0
@@ -71,7 +54,7 @@ def packet() -> PacketHandler:
     return PacketHandler(1.0)
 
 
-def simulate(emulator: AXChainEmulator, arm: IntegratingArm, steps: int) -> None:
+def simulate(emulator: AXChainEmulator, arm: IntegratingJoints, steps: int) -> None:
     for _ in range(steps):
         emulator.update(DT)
         arm.step(DT)
@@ -85,7 +68,7 @@ def test_every_servo_answers_a_ping_with_the_ax18a_model(
 
 
 def test_present_position_is_the_backend_angle(
-    port: PortHandler, packet: PacketHandler, arm: IntegratingArm
+    port: PortHandler, packet: PacketHandler, arm: IntegratingJoints
 ) -> None:
     arm.angles[3] = -0.25
     for servo_id, angle in zip(IDS, arm.angles, strict=True):
@@ -95,7 +78,7 @@ def test_present_position_is_the_backend_angle(
 
 
 def test_sync_write_moves_every_joint_to_its_goal(
-    port: PortHandler, packet: PacketHandler, emulator: AXChainEmulator, arm: IntegratingArm
+    port: PortHandler, packet: PacketHandler, emulator: AXChainEmulator, arm: IntegratingJoints
 ) -> None:
     for servo_id in IDS:
         assert packet.write1ByteTxRx(port, servo_id, Address.TORQUE_ENABLE, 1) == (
@@ -127,7 +110,7 @@ def test_sync_write_moves_every_joint_to_its_goal(
 
 
 def test_joints_stay_put_with_torque_off(
-    port: PortHandler, packet: PacketHandler, emulator: AXChainEmulator, arm: IntegratingArm
+    port: PortHandler, packet: PacketHandler, emulator: AXChainEmulator, arm: IntegratingJoints
 ) -> None:
     assert packet.write2ByteTxRx(port, 1, Address.GOAL_POSITION, 900) == (COMM_SUCCESS, 0)
     simulate(emulator, arm, 20)
@@ -144,7 +127,7 @@ def test_a_silent_servo_times_out_while_the_others_answer(
 
 
 def test_an_overloaded_servo_answers_with_the_overload_bit(
-    port: PortHandler, packet: PacketHandler, emulator: AXChainEmulator, arm: IntegratingArm
+    port: PortHandler, packet: PacketHandler, emulator: AXChainEmulator, arm: IntegratingJoints
 ) -> None:
     emulator.fail(2, silent=False)
     assert packet.write1ByteTxRx(port, 2, Address.TORQUE_ENABLE, 1) == (
@@ -223,7 +206,7 @@ def test_the_emulator_survives_garbage(raw: serial.Serial, emulator: AXChainEmul
     assert emulator.counters["skipped_bytes"] > 0
 
 
-def test_the_link_names_the_port(arm: IntegratingArm, tmp_path: Path) -> None:
+def test_the_link_names_the_port(arm: IntegratingJoints, tmp_path: Path) -> None:
     link = tmp_path / "ttyAX"
     with AXChainEmulator(arm, IDS, link=link) as chain:
         assert link.resolve() == Path(chain.port).resolve()

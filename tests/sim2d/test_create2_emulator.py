@@ -80,7 +80,7 @@ def timed_frames(
     while len(frames) < count and time.monotonic() < deadline:
         data = port.read(max(1, port.in_waiting))
         now = time.monotonic()
-        frames += [(now, frame) for frame in parser.feed(data)]
+        frames += [(now, frame.packets) for frame in parser.feed(data)]
     assert len(frames) >= count, f"{len(frames)} of {count} frames in {timeout_s} s"
     return frames[:count]
 
