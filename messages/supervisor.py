@@ -8,10 +8,10 @@ from pydantic import Field
 
 from messages.base import Finite, Message, NonNegative
 from messages.header import Header
-from wbc.staging_supervisor import Phase
+from wbc.supervisor_phase import Phase
 
 PhaseName = Literal[("idle", *(phase.value for phase in Phase))]  # type: ignore[valid-type]
-"""``idle`` before any goal, then one of ``wbc.staging_supervisor.Phase``."""
+"""``idle`` before any goal, then one of ``wbc.supervisor_phase.Phase``."""
 
 
 class SupervisorStatus(Message):
@@ -22,7 +22,9 @@ class SupervisorStatus(Message):
     (1 the best), ``candidate_base`` is its base pose (x, y, phi); ``plans``, ``replans`` and
     ``stalls`` count since the goal came; ``reason`` says why a goal is unreachable;
     ``last_event`` is the latest thing the supervisor did, in words; ``planning_ms`` is the
-    time of the last plan.
+    time of the last plan; ``refusals`` counts the requests refused as malformed since the
+    supervisor started, ``last_refusal`` says why the latest was (a refused request leaves
+    the current goal as it is).
     """
 
     header: Header
@@ -36,3 +38,5 @@ class SupervisorStatus(Message):
     reason: str = ""
     last_event: str = ""
     planning_ms: NonNegative | None = None
+    refusals: int = Field(default=0, ge=0)
+    last_refusal: str = ""

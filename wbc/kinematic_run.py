@@ -68,7 +68,7 @@ class Supervisor(Protocol):
     @property
     def reached(self) -> bool: ...
 
-    def update(self, q: Array, t: float) -> Task | None: ...
+    def step(self, q: Array, t: float) -> Task | None: ...
 
 
 def integrate_supervised(
@@ -86,7 +86,7 @@ def integrate_supervised(
     q = np.array(q0, dtype=float)
     task = None
     for k in range(steps):
-        current = supervisor.update(q, k * dt)
+        current = supervisor.step(q, k * dt)
         if current is None:
             break
         if current is not task:

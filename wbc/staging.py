@@ -22,6 +22,7 @@ there (face the staging point, then turn to phi_c) and sigma_6 the conditioning 
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -64,6 +65,13 @@ class StagingParams:
     """Extra distance between the base's body and an obstacle, m: the LP's margin."""
     final_leg: float = 0.4
     """The straight drive into the candidate's pose starts this far behind it, m."""
+    max_distance: float = 10.0
+    """A goal farther than this from the base is refused, m: a staging plan drives straight,
+    and the search's residual loses its precision far from the origin (a goal 100 m away
+    took 2.1 s to fail)."""
+    budget_s: float = 2.0
+    """CPU seconds of the planning thread a search may take (its own work, whatever else
+    the machine does): no new start is tried past it. Plans take 0.05 s median, 0.2 s p99."""
     seed: int = 0
 
 
@@ -133,21 +141,69 @@ def clear_of(obstacles: Sequence[Circle], point: Array, body_radius: float) -> b
                for c in obstacles)  # fmt: skip
 
 
-def candidates(robot: MobileManipulator, q_now: Array, goal_pose: Array,
-               obstacles: Sequence[Circle] = (),
-               params: StagingParams = StagingParams()) -> list[Candidate]:  # fmt: skip
-    """Every distinct configuration of the goal pose the search finds, best score first,
-    with the widest joint margin that gives any."""
+@dataclass(frozen=True)
+class Plan:
+    """What a search found: the candidates, best score first, or why there is none."""
+
+    candidates: tuple[Candidate, ...]
+    reason: str
+    """Why there is no candidate; empty when there are."""
+    elapsed_s: float
+
+
+def plan(robot: MobileManipulator, q_now: Array, goal_pose: Array,
+         obstacles: Sequence[Circle] = (), params: StagingParams = StagingParams()
+         ) -> Plan:  # fmt: skip
+    """Every distinct configuration of the goal pose the search finds, with the widest joint
+    margin that gives any; with none, the reason: the goal refused at once (``refusal``), the
+    CPU budget spent, every configuration found too near an obstacle, or none found. Pure
+    but for the clocks: callable from any thread."""
+    started = time.perf_counter()
+
+    def done(found: Sequence[Candidate], reason: str = "") -> Plan:
+        return Plan(tuple(found), reason, time.perf_counter() - started)
+
+    refused = refusal(q_now, goal_pose, obstacles, params)
+    if refused:
+        return done((), refused)
+    budget_end = time.thread_time() + params.budget_s
+    blocked = 0
     for margin in params.joint_margins:
-        found = _search(robot, q_now, goal_pose, obstacles, params, margin)
+        found, near_obstacles, finished = _search(robot, q_now, goal_pose, obstacles, params,
+                                                  margin, budget_end)  # fmt: skip
         if found:
-            return found
-    return []
+            return done(found)
+        blocked += near_obstacles
+        if not finished:
+            return done((), "no whole-body configuration found within the planning budget "
+                        f"of {params.budget_s:g} s of CPU time")  # fmt: skip
+    if blocked:
+        return done((), f"every whole-body configuration found that reaches the goal ({blocked}) "
+                    f"brings the base within {params.clearance:g} m of an obstacle")  # fmt: skip
+    return done((), "no whole-body configuration inside the joint box reaches the goal")
+
+
+def refusal(q_now: Array, goal_pose: Array, obstacles: Sequence[Circle],
+            params: StagingParams) -> str:  # fmt: skip
+    """Why a goal is refused before any search, or empty: its gripper inside an obstacle's
+    circle, or farther than ``max_distance`` from the base."""
+    x, y = dq.translation(goal_pose)[1:3]
+    for index, c in enumerate(obstacles, start=1):
+        if math.hypot(x - c.x, y - c.y) < c.radius:
+            return (f"the goal ({x:.2f}, {y:.2f}) lies inside obstacle {index} at "
+                    f"({c.x:.2f}, {c.y:.2f}), radius {c.radius:g} m")  # fmt: skip
+    distance = math.hypot(x - q_now[0], y - q_now[1])
+    if distance > params.max_distance:
+        return (f"the goal is {distance:.1f} m from the base, farther than the "
+                f"{params.max_distance:g} m a plan may cover")  # fmt: skip
+    return ""
 
 
 def _search(robot: MobileManipulator, q_now: Array, goal_pose: Array,
-            obstacles: Sequence[Circle], params: StagingParams, margin: float
-            ) -> list[Candidate]:  # fmt: skip
+            obstacles: Sequence[Circle], params: StagingParams, margin: float,
+            budget_end: float) -> tuple[list[Candidate], int, bool]:  # fmt: skip
+    """The candidates of one margin, how many were left out near obstacles, and whether every
+    start was tried before the CPU budget ran out."""
     rng = np.random.default_rng(params.seed)
     low, high = arm_box(robot, params.safety_factor, margin)
     inf = np.full(BASE_DOF, np.inf)
@@ -156,7 +212,10 @@ def _search(robot: MobileManipulator, q_now: Array, goal_pose: Array,
     goal_xy = dq.translation(goal_pose)[1:3]
     body = robot.base.body_radius + params.clearance
     found: list[Candidate] = []
+    blocked = 0
     for index in range(params.starts):
+        if time.thread_time() > budget_end:
+            return sorted(found, key=lambda c: c.score), blocked, False
         yaw = psi + (math.pi if index % 4 == 3 else rng.uniform(-0.5, 0.5))
         reach = params.reaches[index % len(params.reaches)]
         start = np.concatenate((goal_xy - reach * np.array([math.cos(yaw), math.sin(yaw)]),
@@ -169,7 +228,9 @@ def _search(robot: MobileManipulator, q_now: Array, goal_pose: Array,
             obstacles, candidate.staging_point(params.final_leg), body
         ):
             found.append(candidate)
-    return sorted(found, key=lambda c: c.score)
+        else:
+            blocked += 1
+    return sorted(found, key=lambda c: c.score), blocked, True
 
 
 def same_configuration(a: Array, b: Array) -> bool:

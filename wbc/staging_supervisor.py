@@ -3,6 +3,8 @@
 For a pose goal x_d the supervisor takes the best candidate q_c of wbc.staging and hands the
 law one task per phase, every command still one LP step:
 
+    planning  no task: the caller holds the robot while the plan of ``pending`` runs, on
+              any thread (``PlanRequest.run``), and hands it back (``take``)
     drive     PointTask: the point d ahead of the axle to the staging point's (a final leg
               behind q_c's base, on its heading), the arm to q_c's arm
     turn      HeadingTask: the base to q_c's heading where it stands, the arm held at q_c's
@@ -16,16 +18,15 @@ stalls when ||e|| falls by less than ``stall_reduction`` of itself over ``stall_
 the supervisor then re-plans from where the robot is, with the best candidate not yet tried,
 at most ``max_replans`` times; after that, or when no candidate exists, the goal is
 unreachable, the reason is kept, and the supervisor gives no task (the robot stops).
+``step`` plans in line, for a caller with no other thread (the kinematic loop).
 """
 
 from __future__ import annotations
 
 import collections
 import math
-import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from enum import StrEnum
 
 import numpy as np
 
@@ -33,7 +34,8 @@ from wbc.drive_tasks import HeadingTask, PointTask
 from wbc.obstacles import Circle
 from wbc.planar import wrap
 from wbc.robot import MobileManipulator
-from wbc.staging import Candidate, StagingParams, candidates, same_configuration
+from wbc.staging import Candidate, Plan, StagingParams, plan, same_configuration
+from wbc.supervisor_phase import Phase
 from wbc.task import PoseTask, Task
 
 Array = np.ndarray
@@ -42,18 +44,6 @@ Array = np.ndarray
 NEAR_HEADING = 0.3
 """A base within a final leg of its candidate and this close to its heading (rad) goes
 straight to the approach."""
-
-
-class Phase(StrEnum):
-    """The phases in the order they run (``_advance`` follows it); UNREACHABLE can end any."""
-
-    DRIVE = "drive"
-    TURN = "turn"
-    APPROACH = "approach"
-    ALIGN = "align"
-    POSE = "pose"
-    REACHED = "reached"
-    UNREACHABLE = "unreachable"
 
 
 @dataclass(frozen=True)
@@ -90,6 +80,22 @@ class Event:
     detail: str
 
 
+@dataclass(frozen=True)
+class PlanRequest:
+    """A plan the supervisor waits for, from configuration ``q`` at time ``t``: everything it
+    needs is frozen here, so ``run`` may go on another thread while the caller holds."""
+
+    robot: MobileManipulator
+    q: Array
+    goal_pose: Array
+    obstacles: tuple[Circle, ...]
+    staging: StagingParams
+    t: float
+
+    def run(self) -> Plan:
+        return plan(self.robot, self.q, self.goal_pose, self.obstacles, self.staging)
+
+
 @dataclass
 class StagingSupervisor:
     """The phases of the module docstring for one goal; ``update`` once per control step."""
@@ -99,7 +105,7 @@ class StagingSupervisor:
     obstacles: Sequence[Circle] = ()
     params: SupervisorParams = field(default_factory=SupervisorParams)
     staging: StagingParams = field(default_factory=StagingParams)
-    phase: Phase = field(default=Phase.POSE, init=False)
+    phase: Phase = field(default=Phase.PLANNING, init=False)
     candidate: Candidate | None = field(default=None, init=False)
     replans: int = field(default=0, init=False)
     reason: str = field(default="", init=False)
@@ -107,6 +113,8 @@ class StagingSupervisor:
     planning_s: list[float] = field(default_factory=list, init=False)
     tried: list[Candidate] = field(default_factory=list, init=False)
     """The candidates driven to so far, the current one last."""
+    pending: PlanRequest | None = field(default=None, init=False)
+    """The plan to run and ``take`` while the phase is PLANNING."""
     _task: Task | None = field(default=None, init=False)
     _history: collections.deque = field(default_factory=collections.deque, init=False)
     _pose_task: PoseTask = field(init=False)
@@ -119,9 +127,14 @@ class StagingSupervisor:
         return self.phase is Phase.REACHED
 
     def update(self, q: Array, t: float) -> Task | None:
-        """Advance the phases at configuration q and time t (s); the task to step now."""
-        if not self.planning_s:  # the first update plans
-            self._plan(q, t)
+        """Advance the phases at configuration q and time t (s); the task to step now, None
+        while planning (the caller holds the robot) or once the goal is unreachable."""
+        if self.phase is Phase.PLANNING:
+            if self.pending is None:
+                self.pending = PlanRequest(self.robot, np.array(q, dtype=float),
+                                           self._pose_task.pose, tuple(self.obstacles),
+                                           self.staging, t)  # fmt: skip
+            return None
         for _ in range(len(Phase)):
             if self._task is None:
                 return None
@@ -135,21 +148,32 @@ class StagingSupervisor:
             self._replan(q, t)
         return self._task
 
-    def _plan(self, q: Array, t: float) -> None:
-        start = time.perf_counter()
-        found = candidates(self.robot, q, self._pose_task.pose, self.obstacles, self.staging)
-        self.planning_s.append(time.perf_counter() - start)
-        fresh = [c for c in found if not any(same_configuration(c.q, o.q) for o in self.tried)]
+    def step(self, q: Array, t: float) -> Task | None:
+        """``update``, with any plan it asks for run in line."""
+        task = self.update(q, t)
+        if self.pending is not None:
+            self.take(self.pending.run(), t)
+            task = self.update(q, t)
+        return task
+
+    def take(self, found: Plan, t: float) -> None:
+        """The plan of ``pending``: drive to its best candidate not tried yet, or give up."""
+        request, self.pending = self.pending, None
+        if request is None or self.phase is not Phase.PLANNING:
+            return
+        self.planning_s.append(found.elapsed_s)
+        fresh = [c for c in found.candidates
+                 if not any(same_configuration(c.q, o.q) for o in self.tried)]  # fmt: skip
         if not fresh:
-            self._give_up(t, "no whole-body configuration inside the joint box reaches the goal"
-                          if not found else "every staging candidate was tried")  # fmt: skip
+            self._give_up(t, found.reason or "every staging candidate was tried")
             return
         self.candidate = fresh[0]
         self.tried.append(fresh[0])
         base = ", ".join(f"{v:.2f}" for v in fresh[0].base)
-        self.events.append(Event(t, "plan", f"candidate {len(self.tried)} of {len(found)}: "
-                                 f"base ({base}) score {fresh[0].score:.2f} "
-                                 f"sigma {fresh[0].sigma:.3f}"))  # fmt: skip
+        self.events.append(Event(t, "plan", f"candidate {len(self.tried)} of "
+                                 f"{len(found.candidates)}: base ({base}) score "
+                                 f"{fresh[0].score:.2f} sigma {fresh[0].sigma:.3f}"))  # fmt: skip
+        q = request.q
         near = (math.hypot(*(fresh[0].base[:2] - q[:2])) < self.staging.final_leg
                 and abs(wrap(fresh[0].base[2] - q[2])) < NEAR_HEADING)  # fmt: skip
         self._enter(Phase.APPROACH if near else Phase.DRIVE, t)
@@ -160,7 +184,8 @@ class StagingSupervisor:
             return
         self.replans += 1
         self.events.append(Event(t, "replan", f"re-plan {self.replans}"))
-        self._plan(q, t)
+        self.phase, self._task = Phase.PLANNING, None
+        self.update(q, t)
 
     def _give_up(self, t: float, reason: str) -> None:
         self.reason = reason

@@ -2,18 +2,24 @@
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 
+import msgpack
 import numpy as np
 import pytest
 from conftest import DEADLINE_S, DEPLOY, System
+from driver_harness import status as component_status
 
 from components.controller import goal_of, task_of
 from messages import codec, topics
 from messages.goal import Goal
 from messages.header import Header
+from messages.obstacles import Circle, Obstacles
 from messages.state import RobotState
+from messages.supervisor import SupervisorStatus
+from wbc import dq
 from wbc.drive_tasks import HeadingTask, PointTask
 from wbc.planar import planar_pose
 from wbc.robot import MobileManipulator
@@ -37,8 +43,10 @@ class Operator:
     def __init__(self, system: System) -> None:
         namespace = system.profile.namespace
         self.robot = MobileManipulator.from_yaml(system.profile.robot)
+        self.system = system
         self.request = system.router.declare_publisher(topics.GOAL_REQUEST.key(namespace))
         self.state = system.router.declare_publisher(topics.ROBOT_STATE.key(namespace))
+        self.obstacles = system.router.declare_publisher(topics.WORLD_OBSTACLES.key(namespace))
         self.goals = system.inbox(topics.CONTROL_GOAL)
         self.statuses = system.inbox(topics.SUPERVISOR_STATUS)
         deadline = time.monotonic() + DEADLINE_S
@@ -47,8 +55,12 @@ class Operator:
             time.sleep(0.005)
 
     def ask(self, pose: np.ndarray) -> None:
-        header = Header(stamp_ns=time.time_ns(), frame="world", seq=0, source="test")
-        self.request.put(codec.encode(Goal(header=header, task="pose", pose=tuple(pose))))
+        self.request.put(codec.encode(Goal(header=header(), task="pose", pose=tuple(pose))))
+
+    def ask_raw(self, fields: dict) -> None:
+        """A request as its bytes, whatever its fields hold (a NaN, a pose of norm 2...)."""
+        fields = {"header": header().model_dump(), "task": "pose", **fields}
+        self.request.put(msgpack.packb([codec.FORMAT_TAG, "Goal", fields], use_bin_type=True))
 
     def send_state(self, q: np.ndarray) -> None:
         header = Header(stamp_ns=time.time_ns(), frame="world", seq=0, source="test")
@@ -58,40 +70,127 @@ class Operator:
         self.state.put(codec.encode(state))
 
 
+def header() -> Header:
+    return Header(stamp_ns=time.time_ns(), frame="world", seq=0, source="test")
+
+
 def supervised(deployed: Callable[[str], System]) -> Operator:
     system = deployed(PROFILE)
     system.start("supervisor")
     return Operator(system)
 
 
-def test_a_goal_behind_the_robot_becomes_a_drive_leg_for_the_controller(
+def test_a_goal_behind_the_robot_is_planned_off_the_handler_thread_then_driven_to(
     deployed: Callable[[str], System],
 ) -> None:
+    """While the plan runs the controller is told to hold where the robot stands, and the
+    status says so: both come from the state that asked for the plan, before it returned."""
     operator = supervised(deployed)
+    operator.send_state(HOME)
+    operator.statuses.wait_for(lambda s: s.phase == "idle", "the idle status")
     behind = operator.robot.fkm(np.concatenate(([-0.8, 0.2, 3.0], REACH_GOAL[3:])))
     operator.ask(behind)
     operator.send_state(HOME)
-    goal = operator.goals.wait_for(lambda g: True, "the controller's goal")
-    status = operator.statuses.wait_for(lambda s: True, "a status")
-    assert goal.task == "point" and goal.arm is not None and goal.lookahead is not None
+    first = operator.goals.wait_for(lambda g: True, "the controller's first goal")
+    planning = operator.statuses.wait_for(lambda s: s.phase != "idle", "a status of the goal")
+    assert planning.phase == "planning" and planning.plans == 0
+    assert first.task == "point" and first.arm is not None and first.lookahead is not None
+    np.testing.assert_allclose(first.arm, HOME[3:])
+    np.testing.assert_allclose(first.point, HOME[:2] + [first.lookahead, 0.0])
+
+    status = operator.statuses.wait_for(lambda s: s.phase not in ("idle", "planning"),
+                                        "the plan's first phase, as soon as it is made")
+    operator.send_state(HOME)
     assert status.phase == "drive" and status.plans == 1 and status.candidate == 1
     assert status.candidate_base is not None and status.candidate_base[0] < -0.3
     assert status.planning_ms is not None and status.planning_ms > 0.0
+    drive = operator.goals.wait_for(lambda g: g.point is not None
+                                    and not np.allclose(g.point, first.point), "the drive leg")
+    assert drive.task == "point"
+
+
+def unreachable(operator: Operator, pose: np.ndarray) -> SupervisorStatus:
+    operator.ask(pose)
+
+    def said() -> bool:
+        operator.send_state(HOME)
+        time.sleep(0.02)
+        return any(s.phase == "unreachable" for s in operator.statuses.messages)
+
+    deadline = time.monotonic() + DEADLINE_S
+    while not said():
+        assert time.monotonic() < deadline, "the goal was never reported unreachable"
+    return next(s for s in operator.statuses.messages if s.phase == "unreachable")
 
 
 def test_an_unreachable_goal_is_reported_and_the_robot_is_held_where_it_stands(
     deployed: Callable[[str], System],
 ) -> None:
     operator = supervised(deployed)
-    operator.ask(planar_pose(0.5, 0.0, 0.0, 2.0))  # 2 m above the floor
-    for _ in range(2):
-        operator.send_state(HOME)
-    status = operator.statuses.wait_for(lambda s: s.phase == "unreachable", "unreachable")
+    status = unreachable(operator, planar_pose(0.5, 0.0, 0.0, 2.0))  # 2 m above the floor
     assert "no whole-body configuration" in status.reason
-    hold = operator.goals.wait_for(lambda g: True, "the controller's goal")
+    hold = operator.goals.messages[-1]
     assert hold.task == "point"
     np.testing.assert_allclose(hold.arm, HOME[3:])
     np.testing.assert_allclose(hold.point, HOME[:2] + [hold.lookahead, 0.0])
+
+
+def test_a_goal_too_far_to_plan_is_refused_at_once_and_the_supervisor_keeps_answering(
+    deployed: Callable[[str], System],
+) -> None:
+    """A goal 100 m away took 2.1 s to fail, and over 3 s in the running system: the
+    launcher's watchdog killed the supervisor and the goal was forgotten."""
+    operator = supervised(deployed)
+    status = unreachable(operator, planar_pose(100.0, 0.0, 0.0, 0.3))
+    assert "farther than the 10 m a plan may cover" in status.reason
+    assert status.planning_ms is not None and status.planning_ms < 100.0
+    assert operator.goals.messages[-1].task == "point"
+    answer = component_status(operator.system, "supervisor")
+    assert answer is not None and answer.counters["unreachable"] == 1
+
+
+def test_a_goal_inside_an_obstacle_is_refused_for_that_reason(
+    deployed: Callable[[str], System],
+) -> None:
+    operator = supervised(deployed)
+    goal = operator.robot.fkm(REACH_GOAL)
+    x, y = dq.translation(goal)[1:3]
+    obstacles = Obstacles(header=header(), circles=(Circle(x=x + 0.02, y=y, radius=0.1),))
+    deadline = time.monotonic() + DEADLINE_S
+    while component_status(operator.system, "supervisor").counters[
+        "received.world/obstacles"
+    ] == 0:  # fmt: skip
+        assert time.monotonic() < deadline, "the supervisor never took the obstacles"
+        operator.obstacles.put(codec.encode(obstacles))
+    status = unreachable(operator, goal)
+    assert "lies inside obstacle 1" in status.reason, status.reason
+
+
+@pytest.mark.parametrize(("fields", "blamed"), [
+    ({"pose": (math.nan, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)}, "pose"),
+    ({"pose": (2.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)}, "pose"),
+    ({"pose": (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)}, "pose"),
+    ({"pose": (1.0, 0.0, 0.0, 0.0, 0.3, 0.0, 0.0, 0.0)}, "pose"),
+    ({"pose": (0.0,) * 8}, "pose"),
+    ({"pose": (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), "eta": -1.0}, "eta"),
+])  # fmt: skip
+def test_a_refused_request_is_on_the_status_with_its_reason_and_the_goal_stays(
+    deployed: Callable[[str], System], fields: dict, blamed: str
+) -> None:
+    operator = supervised(deployed)
+    goal = operator.robot.fkm(REACH_GOAL)
+    operator.ask(goal)
+    operator.send_state(REACH_GOAL)
+    operator.statuses.wait_for(lambda s: s.phase not in ("idle", "planning"), "the goal taken")
+    operator.ask_raw(fields)
+    refused = operator.statuses.wait_for(lambda s: s.refusals == 1, "the refusal")
+    assert f"Goal.{blamed}" in refused.last_refusal, refused.last_refusal
+    assert refused.phase not in ("idle", "planning", "unreachable"), refused
+    count = len(operator.statuses.messages)
+    operator.send_state(REACH_GOAL)
+    after = operator.statuses.wait_for(lambda s: operator.statuses.messages.index(s) >= count,
+                                       "a status after the refusal")  # fmt: skip
+    assert after.phase == refused.phase and after.refusals == 1
 
 
 @pytest.mark.parametrize("task", [

@@ -17,7 +17,7 @@ from wbc.lp_law import LPLaw
 from wbc.obstacles import Circle
 from wbc.planar import planar_pose
 from wbc.scenarios import DT, HOME
-from wbc.staging import StagingParams, arm_box, candidates
+from wbc.staging import StagingParams, arm_box, plan
 from wbc.staging_supervisor import Phase, StagingSupervisor
 from wbc.task import PoseTask
 
@@ -81,7 +81,7 @@ def test_every_candidate_reaches_the_goal_pose_inside_the_shrunk_joint_box() -> 
     params = StagingParams()
     low, high = arm_box(MODEL, params.safety_factor, params.joint_margins[-1])
     for start, goal in goals(FAMILIES["anywhere"], 5, MODEL, seed=7):
-        found = candidates(MODEL, start, MODEL.fkm(goal), params=params)
+        found = plan(MODEL, start, MODEL.fkm(goal), params=params).candidates
         assert found
         assert [c.score for c in found] == sorted(c.score for c in found)
         for c in found:
@@ -93,9 +93,9 @@ def test_every_candidate_reaches_the_goal_pose_inside_the_shrunk_joint_box() -> 
 
 def test_candidates_keep_the_base_clear_of_obstacles() -> None:
     start, goal = goals(FAMILIES["anywhere"], 1, MODEL, seed=3)[0]
-    free = candidates(MODEL, start, MODEL.fkm(goal))
+    free = plan(MODEL, start, MODEL.fkm(goal)).candidates
     blocker = Circle(*free[0].base[:2], 0.1)
-    found = candidates(MODEL, start, MODEL.fkm(goal), [blocker])
+    found = plan(MODEL, start, MODEL.fkm(goal), [blocker]).candidates
     clearance = blocker.radius + MODEL.base.body_radius
     assert all(math.hypot(*(c.base[:2] - free[0].base[:2])) >= clearance for c in found)
 
@@ -118,7 +118,7 @@ def test_a_goal_behind_the_robot_is_reached_through_lp_steps_within_the_limits()
 def test_a_goal_no_configuration_reaches_is_reported_at_once_and_gives_no_task() -> None:
     floating = planar_pose(0.5, 0.0, 0.0, 2.0)
     supervisor = StagingSupervisor(MODEL, floating)
-    assert supervisor.update(HOME, 0.0) is None
+    assert supervisor.step(HOME, 0.0) is None
     assert supervisor.phase is Phase.UNREACHABLE
     assert "no whole-body configuration" in supervisor.reason
 
@@ -141,10 +141,48 @@ def test_a_walled_off_goal_is_given_up_after_the_bounded_re_plans_and_the_robot_
 def test_the_pose_task_alone_is_what_runs_once_the_base_stands_at_its_candidate() -> None:
     goal = MODEL.fkm(np.array([0.6, 0.1, 0.2, 0.0, -0.3, -0.4, 0.2, 0.3]))
     supervisor = StagingSupervisor(MODEL, goal)
-    first = supervisor.update(HOME, 0.0)
+    first = supervisor.step(HOME, 0.0)
     assert supervisor.candidate is not None
     at_candidate = supervisor.candidate.q
     supervisor = StagingSupervisor(MODEL, goal)
-    task = supervisor.update(at_candidate, 0.0)
+    task = supervisor.step(at_candidate, 0.0)
     assert isinstance(task, PoseTask) and supervisor.phase in (Phase.POSE, Phase.REACHED)
     assert not isinstance(first, PoseTask)
+
+
+def test_a_goal_inside_an_obstacle_or_too_far_is_refused_before_any_search() -> None:
+    goal = MODEL.fkm(np.array([0.6, 0.1, 0.2, 0.0, -0.3, -0.4, 0.2, 0.3]))
+    x, y = dq.translation(goal)[1:3]
+    inside = plan(MODEL, HOME, goal, [Circle(x + 0.05, y, 0.1)])
+    assert not inside.candidates and "lies inside obstacle 1" in inside.reason
+    far = plan(MODEL, HOME, planar_pose(100.0, 0.0, 0.0, 0.3))
+    assert not far.candidates and "farther than the 10 m" in far.reason
+
+
+def test_a_search_stops_at_its_cpu_budget_and_says_so() -> None:
+    goal = MODEL.fkm(np.array([0.6, 0.1, 0.2, 0.0, -0.3, -0.4, 0.2, 0.3]))
+    spent = plan(MODEL, HOME, goal, params=StagingParams(budget_s=0.0))
+    assert not spent.candidates and "planning budget" in spent.reason
+
+
+def test_candidates_all_blocked_by_obstacles_are_named_as_such() -> None:
+    goal_q = np.array([2.0, 0.0, 0.0, 0.0, -0.3, -0.4, 0.2, 0.3])
+    goal = MODEL.fkm(goal_q)
+    x, y = dq.translation(goal)[1:3]
+    # A wide disc round the goal, the gripper's own spot left out: no base can stand near it.
+    ring = [Circle(x + 0.6 * math.cos(a), y + 0.6 * math.sin(a), 0.45)
+            for a in np.linspace(0.0, 2.0 * math.pi, 12, endpoint=False)]  # fmt: skip
+    blocked = plan(MODEL, HOME, goal, ring)
+    assert not blocked.candidates and "of an obstacle" in blocked.reason, blocked.reason
+
+
+def test_a_supervisor_waits_for_its_plan_and_holds_meanwhile() -> None:
+    goal = MODEL.fkm(np.array([0.6, 0.1, 0.2, 0.0, -0.3, -0.4, 0.2, 0.3]))
+    supervisor = StagingSupervisor(MODEL, goal)
+    assert supervisor.update(HOME, 0.0) is None and supervisor.phase is Phase.PLANNING
+    request = supervisor.pending
+    assert request is not None and supervisor.update(HOME, 0.02) is None
+    assert supervisor.pending is request  # one plan asked for, not one per step
+    supervisor.take(request.run(), 0.04)
+    assert supervisor.pending is None and supervisor.phase is not Phase.PLANNING
+    assert supervisor.update(HOME, 0.06) is not None
