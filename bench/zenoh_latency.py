@@ -54,6 +54,7 @@ from bench.pubsub_workers import (
 from components.runtime import Node
 from deploy import query
 from messages import topics
+from messages.process import stop
 from parsimony.output import emit, result_only_stdout
 from profiles.endpoints import free_port
 from profiles.profile import ZenohSettings, load_profile
@@ -196,12 +197,7 @@ def controller_loop(
             flood = decode_rate(bench, router, sink_node, arrivals)
         finally:
             sink_node.close()
-            process.send_signal(signal.SIGTERM)
-            try:
-                process.wait(WAIT_S)
-            except subprocess.TimeoutExpired:
-                process.kill()
-                process.wait()
+            stop(process, signal.SIGTERM, WAIT_S)
     name = "state -> lp_controller -> arm/command @50 Hz"
     counters = {name: count for name, count in counters.items() if count}
     return summary(name, sent, duration_s, arm, diagnostics), counters, flood

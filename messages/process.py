@@ -8,6 +8,7 @@ how a parameter's value travels in a query reply. The launcher (``deploy``) and 
 from __future__ import annotations
 
 import json
+import subprocess
 import sys
 from pathlib import Path
 
@@ -28,6 +29,16 @@ and from which it takes them back when it is started again (a restart keeps them
 def command(module_path: str, profile: Path, name: str) -> list[str]:
     """The command line of component ``name`` of ``profile``, running ``module_path``."""
     return [sys.executable, "-m", module_path, "--profile", str(profile), "--name", name]
+
+
+def stop(child: subprocess.Popen, signum: int, timeout_s: float) -> int:
+    """Send ``signum`` to ``child`` and wait ``timeout_s`` for it, then kill it; its exit code."""
+    child.send_signal(signum)
+    try:
+        return child.wait(timeout_s)
+    except subprocess.TimeoutExpired:
+        child.kill()
+        return child.wait()
 
 
 def encode_value(value: ParamValue) -> bytes:

@@ -18,6 +18,7 @@ effort of table 6.1 of the commands sent.
 from __future__ import annotations
 
 import bisect
+import contextlib
 import dataclasses
 import hashlib
 import math
@@ -29,17 +30,17 @@ import sys
 import threading
 import time
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
 import yaml
 import zenoh
 
 from deploy import query
-from messages import codec, topics
+from messages import codec, process, topics
 from parsimony.kinematic_demo import LP_PARAMS
 from parsimony.sessions import load_session
 from profiles.endpoints import free_port
@@ -52,7 +53,7 @@ from wbc.kinematic_run import effort_of
 from wbc.lp_law import LPParams
 from wbc.planar import in_frame, offset_pose, planar_pose, wrap
 from wbc.robot import MobileManipulator
-from wbc.staging_supervisor import Phase
+from wbc.supervisor_phase import Phase
 
 DEPLOY = Path(__file__).resolve().parents[1] / "deploy"
 PROFILES = {"lp": DEPLOY / "sim.yaml", "cascade": DEPLOY / "sim_cascade.yaml"}
@@ -222,29 +223,17 @@ def run_experiment(options: Options) -> dict[str, Any]:
     profile_path = options.out / "profile.yaml"
     profile_path.write_text(yaml.safe_dump(experiment_profile(options, base, setup)))
     profile = load_profile(profile_path)
-    log = (options.out / "launch.log").open("w")
-    launcher = subprocess.Popen(
-        [sys.executable, "-m", "parsimony.cli", "launch", str(profile_path)],
-        stdout=log, stderr=subprocess.STDOUT,
-    )  # fmt: skip
     started = time.monotonic()
-    try:
-        with connect(profile, launcher) as session:
-            recorder = Recorder(session, profile.namespace)
-            wait_alive(session, profile, launcher)
-            wait_reached(session, profile, launcher)
-            query.set_param(session, profile.namespace, "simulator", "paused", "false")
-            started = time.monotonic()
-            messages = follow(recorder, options, started)
-            counters = component_counters(session, profile.namespace)
-    finally:
-        launcher.send_signal(signal.SIGINT)
-        try:
-            launcher.wait(RECORDER_STOP_S + 20.0)
-        except subprocess.TimeoutExpired:
-            launcher.kill()
-            launcher.wait()
-        log.close()
+    with (options.out / "launch.log").open("w") as log,\
+            launched(profile_path, log, RECORDER_STOP_S + 20.0) as launcher,\
+            connect(profile, launcher) as session:  # fmt: skip
+        recorder = Recorder(session, profile.namespace)
+        wait_alive(session, profile, launcher)
+        wait_reached(session, profile, launcher)
+        query.set_param(session, profile.namespace, "simulator", "paused", "false")
+        started = time.monotonic()
+        messages = follow(recorder, options, started)
+        counters = component_counters(session, profile.namespace)
     wall_s = time.monotonic() - started
     end_ns, converged = end_of_run(messages, options.time_limit_s, origin_s(messages))
     messages = until(messages, end_ns)
@@ -257,6 +246,20 @@ def run_experiment(options: Options) -> dict[str, Any]:
     report["figures"] = [str(path) for path in figures]
     (options.out / "report.json").write_text(dumps(report))
     return report
+
+
+@contextlib.contextmanager
+def launched(profile_path: Path, log: IO[str] | int = subprocess.DEVNULL,
+             stop_timeout_s: float = 30.0) -> Iterator[subprocess.Popen]:  # fmt: skip
+    """``parsimony launch PROFILE`` as a child process, its output to ``log``; at the end of
+    the block it is stopped by SIGINT (its components in order), killed after
+    ``stop_timeout_s``."""
+    launcher = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "launch",
+                                 str(profile_path)], stdout=log, stderr=subprocess.STDOUT)
+    try:
+        yield launcher
+    finally:
+        process.stop(launcher, signal.SIGINT, stop_timeout_s)
 
 
 def connect(profile: Profile, launcher: subprocess.Popen) -> zenoh.Session:

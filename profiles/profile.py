@@ -152,9 +152,10 @@ class RestartPolicy(StrictModel):
     """What the launcher does when a component exits.
 
     ``on-failure`` restarts after a non-zero exit, ``always`` after any exit,
-    at most ``max_restarts`` times, waiting ``backoff_initial_s`` doubled per
-    restart up to ``backoff_max_s``. A run longer than ``reset_after_s``
-    resets the count. Exit code 2 (a configuration error) is never restarted.
+    at most ``max_restarts`` times: the first restart at once (a driver that died comes back
+    and stops its robot without waiting), then after ``backoff_initial_s`` doubled per
+    restart up to ``backoff_max_s``. A run longer than ``reset_after_s`` resets the count.
+    Exit code 2 (a configuration error) is never restarted.
     """
 
     policy: Literal["never", "on-failure", "always"] = "on-failure"
@@ -172,8 +173,10 @@ class RestartPolicy(StrictModel):
         return self
 
     def backoff_s(self, restarts: int) -> float:
-        """The wait before restart number ``restarts + 1``."""
-        return min(self.backoff_initial_s * 2.0**restarts, self.backoff_max_s)
+        """The wait before restart number ``restarts + 1``: none before the first."""
+        if restarts == 0:
+            return 0.0
+        return min(self.backoff_initial_s * 2.0 ** (restarts - 1), self.backoff_max_s)
 
 
 class ComponentSpec(StrictModel):

@@ -17,7 +17,7 @@ import yaml
 
 from deploy import query
 from messages import codec, topics
-from parsimony.experiment import connect
+from parsimony.experiment import connect, launched
 from profiles.endpoints import free_port
 from profiles.profile import load_profile, read_profile_data
 
@@ -85,10 +85,8 @@ def test_a_killed_controller_leaves_the_robot_stopped_by_its_drivers(tmp_path: P
     path = tmp_path / "profile.yaml"
     path.write_text(yaml.safe_dump(data))
     profile = load_profile(path)
-    launcher = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "launch", str(path)],
-                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
     truth: list = []
-    try:
+    with launched(path) as launcher:
         session = connect(profile, launcher)
         key = topics.SIM_TRUTH.key(profile.namespace)
         session.declare_subscriber(
@@ -114,12 +112,6 @@ def test_a_killed_controller_leaves_the_robot_stopped_by_its_drivers(tmp_path: P
         counters = query.statuses(session, profile.namespace)["base_driver"].counters
         assert counters["stops"] >= 1
         session.close()
-    finally:
-        launcher.send_signal(signal.SIGINT)
-        try:
-            launcher.wait(30)
-        except subprocess.TimeoutExpired:
-            launcher.kill()
 
 
 def moving(truth: list) -> bool:

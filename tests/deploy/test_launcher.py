@@ -40,24 +40,26 @@ def process_gone(pid: int) -> bool:
     return state == "Z"
 
 
-def test_killed_component_is_back_within_2_s_until_restarts_run_out(
+def test_a_killed_component_comes_back_at_once_then_after_a_backoff_until_restarts_run_out(
     write_profile: ProfileWriter, launch: LaunchFixture
 ) -> None:
     launched = launch(
-        write_profile([publisher("pub", restart={"backoff_initial_s": 0.1, "max_restarts": 1})])
+        write_profile([publisher("pub", restart={"backoff_initial_s": 0.1, "max_restarts": 2})])
     )
     started, _, match = launched.wait_for(r"\[launch\] started pub \(.*pid (\d+)\)")
     launched.wait_for(r"\[launch\] pub alive", after=started)
-    killed_at = time.monotonic()
     os.kill(int(match.group(1)), signal.SIGKILL)
-
-    exited, _, _ = launched.wait_for(r"\[launch\] pub exited with -9; restart 1/1 in 0\.1 s")
+    # The first restart waits for nothing: a driver that died stops its robot as it comes back.
+    exited, _, _ = launched.wait_for(r"\[launch\] pub exited with -9; restart 1/2 in 0\.0 s")
     restarted, _, match = launched.wait_for(r"\[launch\] started pub \(.*pid (\d+)\)", exited)
-    _, back_at, _ = launched.wait_for(r"\[launch\] pub alive", after=restarted)
-    assert back_at - killed_at < 2.0, f"back after {back_at - killed_at:.2f} s"
+    launched.wait_for(r"\[launch\] pub alive", after=restarted)
 
     os.kill(int(match.group(1)), signal.SIGKILL)
-    launched.wait_for(r"\[launch\] pub exited with -9; no restarts left \(1/1\)")
+    exited, _, _ = launched.wait_for(r"\[launch\] pub exited with -9; restart 2/2 in 0\.1 s")
+    restarted, _, match = launched.wait_for(r"\[launch\] started pub \(.*pid (\d+)\)", exited)
+    launched.wait_for(r"\[launch\] pub alive", after=restarted)
+    os.kill(int(match.group(1)), signal.SIGKILL)
+    launched.wait_for(r"\[launch\] pub exited with -9; no restarts left \(2/2\)")
     launched.wait_for(r"\[launch\] stopping \(no component left running\)")
     assert launched.process.wait(10.0) == 1
     assert "[launch] failed: pub" in launched.text()
