@@ -245,6 +245,13 @@ def format_report(report: dict) -> str:
             lines.append(f"  {law:<32} {row['reached']:9.2f} {row['within_joint_limits']:16.2f}"
                          f" {row['within_joint_and_speed_limits']:22.2f}"
                          f" {row['median_time_to_converge_s']:21.1f}")  # fmt: skip
+        lines.append("  nonzero entries of u   median moving  settling (x', y' as one)  "
+                     "steps by count 0..8: exact | practical (Upsilon 0.01)")
+        for law, row in result["laws"].items():
+            lines.append(f"  {law:<24} {row['median_nonzero_moving']:11.1f} "
+                         f"{row['median_nonzero_settling']:9.1f} "
+                         f"({row['median_nonzero_settling_forward_as_one']:.1f})"
+                         f"{'':14}{row['nonzero_histogram']} | {row['practical_histogram']}")
         for law, row in result["laws"].items():
             if law.startswith("lp"):
                 lines.append(f"  {law}: every command an optimal LP solution in "
@@ -253,6 +260,4 @@ def format_report(report: dict) -> str:
                 lines.append(f"  {law}: {row['plans_per_run']:.2f} plans per run, a plan takes "
                              f"{row['plan_median_ms']:.0f} ms median, "
                              f"{row['plan_p99_ms']:.0f} ms p99")  # fmt: skip
-            if "nonzero_histogram" in row:
-                lines.append(f"  {law} steps by nonzero count 0..8: {row['nonzero_histogram']}")
     return "\n".join(lines)

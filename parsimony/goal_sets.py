@@ -16,14 +16,15 @@ from pathlib import Path
 import numpy as np
 
 from parsimony.kinematic_demo import SUPERVISED_PARAMS
+from wbc import dq
 from wbc.cascade_law import CascadeLaw
 from wbc.kinematic_run import integrate, integrate_supervised
-from wbc.law_output import Law
+from wbc.law_output import Law, entry_mask
 from wbc.lp_law import LPLaw, LPParams
 from wbc.robot import BASE_DOF, MobileManipulator
 from wbc.scenarios import ARM_BOX, DT, HOME
 from wbc.staging_supervisor import StagingSupervisor, SupervisorParams
-from wbc.task import PoseTask
+from wbc.task import PoseTask, PositionTask, Task
 
 Array = np.ndarray
 
@@ -77,6 +78,12 @@ ahead, heading within 35 degrees); 'anywhere': within 1.2 m at any bearing and h
 arm's start and goal anywhere in the LP's joint box."""
 
 
+MOVING_ERROR = 0.05
+"""||e|| above which a step of a pose run counts as moving (figure 6.7's first part)."""
+SETTLING_S = 2.0
+"""The last seconds before convergence (figure 6.7's part after the 150th iteration)."""
+
+
 @dataclass(frozen=True)
 class Attempt:
     """One closed-loop run towards one goal."""
@@ -88,7 +95,12 @@ class Attempt:
     speed_overrun: float
     """Largest |u_i| beyond the speed bound velocity_max_i (0 inside)."""
     nonzero: tuple[int, ...]
-    """Nonzero entries of u at every step."""
+    """Which entries of u were nonzero at every step of the goal's own task (the pose task,
+    or the position task; a supervisor's drive legs left out): bit i for u_i."""
+    practical: tuple[int, ...]
+    """The same for entries at or above Upsilon = 0.01 (section 6.2.1)."""
+    errors: tuple[float, ...]
+    """||e|| at those steps."""
     planning_s: tuple[float, ...] = ()
     """How long each staging plan took (supervised runs only)."""
     every_step_optimal: bool = True
@@ -109,26 +121,47 @@ class Attempt:
 
 
 def attempt(law: Law, robot: MobileManipulator, start: Array, goal: Array,
-            supervised: bool = False) -> Attempt:  # fmt: skip
-    """Run ``law`` from ``start`` to the pose of ``goal`` for at most TIME_LIMIT_S, alone or
-    with the staging supervisor handing it its tasks."""
+            supervised: bool = False, position: bool = False) -> Attempt:  # fmt: skip
+    """Run ``law`` from ``start`` to the pose of ``goal`` (or its position) for at most
+    TIME_LIMIT_S, alone or with the staging supervisor handing it its tasks."""
     steps = int(TIME_LIMIT_S / DT)
     planning: tuple[float, ...] = ()
     if supervised:
         params = SupervisorParams(pose_tolerance=TOLERANCE)
         supervisor = StagingSupervisor(robot, robot.fkm(goal), params=params)
-        run = integrate_supervised(law, supervisor, start, DT, steps)
+        tasks: list[object] = []
+        run = integrate_supervised(law, _logged(supervisor, tasks), start, DT, steps)
+        own = [isinstance(task, PoseTask) for task in tasks[: len(run.outputs)]]
         planning = tuple(supervisor.planning_s)
     else:
-        run = integrate(law, start, PoseTask(robot.fkm(goal)), DT, steps, TOLERANCE)
+        task = PositionTask(dq.translation(robot.fkm(goal))[1:]) if position else PoseTask(
+            robot.fkm(goal))
+        run = integrate(law, start, task, DT, steps, TOLERANCE)
+        own = [True] * len(run.outputs)
     q = np.array([start, *run.configurations])  # a supervisor may stop before any step
     u = np.vstack((np.zeros(robot.dof), run.velocities().reshape(-1, robot.dof)))
     joint_overrun = np.maximum(q - robot.q_max, robot.q_min - q).max()
     speed_overrun = (np.abs(u) - robot.velocity_max).max()
+    outputs = [out for out, mine in zip(run.outputs, own, strict=True) if mine]
     return Attempt(run.converged, len(run.outputs), float(max(joint_overrun, 0.0)),
                    float(max(speed_overrun, 0.0)),
-                   tuple(out.nonzero for out in run.outputs), planning,
+                   tuple(entry_mask(out.u) for out in outputs),
+                   tuple(entry_mask(out.u, True) for out in outputs),
+                   tuple(out.error_norm for out in outputs), planning,
                    all(out.ok for out in run.outputs))  # fmt: skip
+
+
+def _logged(supervisor: StagingSupervisor, tasks: list[object]) -> StagingSupervisor:
+    """``supervisor`` noting the task of every step in ``tasks``."""
+    step = supervisor.step
+
+    def noted(q: Array, t: float) -> Task | None:
+        task = step(q, t)
+        tasks.append(task)
+        return task
+
+    supervisor.step = noted  # type: ignore[method-assign]
+    return supervisor
 
 
 def goals(family: GoalFamily, count: int, robot: MobileManipulator, seed: int = GOAL_SEED
@@ -163,12 +196,34 @@ def planning(attempts: Iterable[Attempt]) -> dict[str, float]:
     }
 
 
-def nonzero_histogram(attempts: Iterable[Attempt], dof: int) -> list[int]:
-    """How many control steps had 0, 1, ..., dof nonzero entries of u."""
-    counts = np.zeros(dof + 1, dtype=int)
-    for one in attempts:
-        counts += np.bincount(one.nonzero, minlength=dof + 1)
-    return counts.tolist()
+def parsimony(attempts: Iterable[Attempt], dof: int) -> dict:
+    """Nonzero entries of u: the exact and the practical (Upsilon) histograms over every step
+    of the goal's task; the median while ||e|| > MOVING_ERROR and over the last SETTLING_S of
+    the runs that converged; and the same median with x' and y' counted as one entry where
+    both are nonzero (the base's forward speed v, which 5.11 splits between them)."""
+    attempts = list(attempts)
+    exact = [m for a in attempts for m in a.nonzero]
+    settling = round(SETTLING_S / DT)
+    moving = [m for a in attempts for m, e in zip(a.nonzero, a.errors, strict=True)
+              if e > MOVING_ERROR]  # fmt: skip
+    last = [m for a in attempts if a.converged for m in a.nonzero[-settling:]]
+
+    def median(masks: list[int], forward_as_one: bool = False) -> float:
+        counts = [m.bit_count() - (forward_as_one and m & 3 == 3) for m in masks]
+        return float(np.median(counts)) if counts else math.nan
+
+    return {
+        "nonzero_histogram": histogram(exact, dof),
+        "practical_histogram": histogram([m for a in attempts for m in a.practical], dof),
+        "median_nonzero_moving": median(moving),
+        "median_nonzero_settling": median(last),
+        "median_nonzero_settling_forward_as_one": median(last, True),
+    }
+
+
+def histogram(masks: list[int], dof: int) -> list[int]:
+    """How many steps had 0, 1, ..., dof nonzero entries."""
+    return np.bincount([m.bit_count() for m in masks], minlength=dof + 1).tolist()
 
 
 SUPERVISED = "lp + staging supervisor"
@@ -180,30 +235,33 @@ LAWS: dict[str, Callable[[MobileManipulator], Law]] = {
 }
 """The laws compared: the default LP, LP 5.29 with no term added to the task, the LP under the
 staging supervisor (wbc.staging_supervisor) with its gains, the cascade."""
-EXACT_5_29 = LPParams(velocity_cost=0.0, waist_centring=0.0, base_target=0.0)
+EXACT_5_29 = LPParams(velocity_cost=0.0, waist_hold=0.0, waist_centring=0.0, base_target=0.0)
+POSITION_LAWS = ("lp", "lp 5.29 exactly", "cascade")
+"""The laws run on the position task of each family's goals (6.2.2)."""
 
 
-def _attempt_one(job: tuple[str, Path, Array, Array]) -> Attempt:
-    law_name, robot_file, start, goal = job
+def _attempt_one(job: tuple[str, Path, Array, Array, bool]) -> Attempt:
+    law_name, robot_file, start, goal, position = job
     robot = MobileManipulator.from_yaml(robot_file)
-    return attempt(LAWS[law_name](robot), robot, start, goal, law_name == SUPERVISED)
+    return attempt(LAWS[law_name](robot), robot, start, goal, law_name == SUPERVISED, position)
 
 
 def goal_report(robot_file: Path, count: int, processes: int = 2) -> dict:
-    """For every family and law: the three shares, and the LP's nonzero histograms."""
+    """For every family and law: the shares reached and the parsimony of u, for the pose task
+    and, with the laws of POSITION_LAWS, for the position task of the same goals."""
     robot = MobileManipulator.from_yaml(robot_file)
     report: dict = {}
     with multiprocessing.get_context("spawn").Pool(processes) as pool:
         for family in FAMILIES.values():
             pairs = goals(family, count, robot)
-            rows = {}
-            for law_name in LAWS:
-                jobs = [(law_name, robot_file, start, goal) for start, goal in pairs]
-                attempts = pool.map(_attempt_one, jobs, chunksize=1)
-                rows[law_name] = shares(attempts)
-                if law_name == SUPERVISED:
-                    rows[law_name].update(planning(attempts))
-                if law_name.startswith("lp"):
-                    rows[law_name]["nonzero_histogram"] = nonzero_histogram(attempts, robot.dof)
-            report[family.name] = {"goals": count, "laws": rows}
+            for task, law_names in (("pose", tuple(LAWS)), ("position", POSITION_LAWS)):
+                rows = {}
+                for law_name in law_names:
+                    jobs = [(law_name, robot_file, start, goal, task == "position")
+                            for start, goal in pairs]  # fmt: skip
+                    attempts = pool.map(_attempt_one, jobs, chunksize=1)
+                    rows[law_name] = {**shares(attempts), **parsimony(attempts, robot.dof)}
+                    if law_name == SUPERVISED:
+                        rows[law_name].update(planning(attempts))
+                report[f"{family.name} {task}"] = {"goals": count, "laws": rows}
     return report

@@ -41,15 +41,18 @@ def test_bench_prints_step_times_and_the_convergence_test_as_json():
     for test in ("holonomic/classic", "holonomic/lp", "nonholonomic/cascade", "nonholonomic/lp"):
         assert report["convergence"][test]["converged_trials"] == 1
     for family in ("ahead", "anywhere"):
-        laws = report["goals"][family]["laws"]
+        laws = report["goals"][f"{family} pose"]["laws"]
         assert laws.keys() == {"lp", "lp 5.29 exactly", "lp + staging supervisor", "cascade"}
         for row in laws.values():
             assert row["reached"] >= row["within_joint_limits"] >= (
                 row["within_joint_and_speed_limits"])
-        assert sum(laws["lp"]["nonzero_histogram"]) > 0
+            assert sum(row["nonzero_histogram"]) == sum(row["practical_histogram"]) > 0
         supervised = laws["lp + staging supervisor"]
         assert supervised["plans_per_run"] >= 1.0
         assert 0.0 < supervised["plan_median_ms"] <= supervised["plan_p99_ms"]
+        position = report["goals"][f"{family} position"]["laws"]
+        assert position.keys() == {"lp", "lp 5.29 exactly", "cascade"}
+        assert 1.0 <= position["lp"]["median_nonzero_moving"] <= 8.0
     assert "bench:" in result.stderr  # progress goes to stderr
 
 

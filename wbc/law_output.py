@@ -54,6 +54,14 @@ class Law(Protocol):
     def reset(self) -> None: ...
 
 
+def entry_mask(u: Array, practical: bool = False) -> int:
+    """Bit i set where u_i counts as nonzero: |u_i| > ZERO_THRESHOLD, or, ``practical``, where
+    |u_i| >= PRACTICAL_THRESHOLD (a motor acts on it)."""
+    magnitude = np.abs(u)
+    above = magnitude >= PRACTICAL_THRESHOLD if practical else magnitude > ZERO_THRESHOLD
+    return sum(1 << int(i) for i in np.flatnonzero(above))
+
+
 def summarise(
     u: Array,
     status: str,

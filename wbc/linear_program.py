@@ -12,7 +12,8 @@ sum_i c_i |u_i|:
           lower <= A u_P - A u_N <= upper       for every LinearRows (5.12, 5.28)
 
 At the optimum 2 y_b - r_b = |r_b|, so the objective is sum_b w_b ||r_b||_1 + c'|u|: with one
-residual cost (the task) and c = 0 it is 5.29 exactly.
+residual cost (the task) and c = 0 it is 5.29 exactly. A velocity cost may weigh the two
+directions of an entry differently (c_P on u_P, c_N on u_N): still linear, still a vertex.
 
 Every column has the bounds [0, inf), as in 5.29, and the velocity limits are rows on
 u_P - u_N as in 5.29's W_l. A nonbasic column is then 0, so every nonzero entry of u comes from
@@ -167,8 +168,9 @@ class WarmStartedLP:
             lower[row : row + count] = rows_.lower
             upper[row : row + count] = rows_.upper
             row += count
-        velocity = sum(cost.weights for cost in velocity_costs) if velocity_costs else 0.0
-        _fill_costs(layout, velocity)
+        positive = sum((cost.weights for cost in velocity_costs), np.zeros(n))
+        negative = sum((cost.negative_weights for cost in velocity_costs), np.zeros(n))
+        _fill_costs(layout, positive, negative)
         status, values = self._vertex(layout)
         if values is None:
             return _failed(n, status)
@@ -244,12 +246,13 @@ class WarmStartedLP:
         return "optimal", np.asarray(highs.getSolution().col_value)
 
 
-def _fill_costs(layout: _Layout, velocity: Array | float) -> None:
-    """u_P: c - sum_b w_b 1'A_b, u_N: c + sum_b w_b 1'A_b, y_b: 2 w_b (rows weighted by w)."""
+def _fill_costs(layout: _Layout, positive: Array, negative: Array) -> None:
+    """u_P: c_P - sum_b w_b 1'A_b, u_N: c_N + sum_b w_b 1'A_b, y_b: 2 w_b (rows weighted by
+    w), with c_P and c_N the velocity costs of each entry's two directions."""
     n, cost = layout.n, layout.cost
     column_sums = layout.row_weight @ layout.varying[: layout.residual_rows, :n]
-    np.subtract(velocity, column_sums, out=cost[:n])
-    np.add(velocity, column_sums, out=cost[n : 2 * n])
+    np.subtract(positive, column_sums, out=cost[:n])
+    np.add(negative, column_sums, out=cost[n : 2 * n])
     np.multiply(2.0, layout.row_weight, out=cost[2 * n :])
 
 

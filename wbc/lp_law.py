@@ -23,6 +23,7 @@ from wbc.objectives.base import ObjectiveTerm, ResidualCost
 from wbc.objectives.base_target import BaseTarget
 from wbc.objectives.velocity_cost import LeastVelocity
 from wbc.objectives.waist_centring import WaistCentring
+from wbc.objectives.waist_hold import WaistHold
 from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
 from wbc.step_context import StepContext
@@ -57,9 +58,12 @@ class LPParams:
                                          "of the wheel axle, m")
     velocity_cost: float = gain(1e-3, low=0.0, high=1.0,
                                 doc="w of w ||u||_1, the tie-break between optimal vertices; "
-                                    "0 with the other two weights solves 5.29 exactly "
+                                    "0 with the other weights solves 5.29 exactly "
                                     "(wbc.objectives.velocity_cost)")
-    waist_centring: float = gain(0.02, low=0.0, high=1.0,
+    waist_hold: float = gain(0.02, low=0.0, high=1.0,
+                             doc="extra weight of |q1'|: the task's yaw goes to the base, the "
+                                 "waist holds (wbc.objectives.waist_hold)")
+    waist_centring: float = gain(0.0, low=0.0, high=1.0,
                                  doc="weight of |q1' + k q1|: the waist/base-yaw self-motion "
                                      "spent on a centred waist (wbc.objectives.waist_centring)")
     waist_gain: float = gain(1.0, low=1e-3, high=100.0, doc="k of the waist centring, 1/s")
@@ -68,7 +72,7 @@ class LPParams:
     base_target: float = gain(0.05, low=0.0, high=1.0,
                               doc="weight of turning the base towards where it should stand "
                                   "for a pose goal (wbc.objectives.base_target)")
-    base_target_gain: float = gain(2.0, low=1e-3, high=100.0, doc="k of the base target, 1/s")
+    base_target_gain: float = gain(4.0, low=1e-3, high=100.0, doc="k of the base target, 1/s")
     base_target_reach: float = gain(0.36, low=0.0, high=5.0,
                                     doc="how far behind the goal, along the gripper's heading, "
                                         "the base should stand, m: the mean horizontal reach "
@@ -76,10 +80,18 @@ class LPParams:
     base_target_stop: float = gain(0.15, low=1e-3, high=5.0,
                                    doc="distance from the base target within which it is off "
                                        "(full weight at twice), m")
+    base_target_on: float = gain(0.3, low=0.0, high=3.2,
+                                 doc="heading error above which the base target starts a "
+                                     "steering burst, rad (0: always on)")
+    base_target_off: float = gain(0.05, low=0.0, high=3.2,
+                                  doc="heading error below which a steering burst ends, rad")
     nonholonomic: bool = gain(True, doc="False models a holonomic base (section 6.3, test 1)")
 
     def __post_init__(self) -> None:
         check_gains(self)
+        if self.base_target_on > 0.0 and not self.base_target_off < self.base_target_on:
+            raise ValueError(f"LPParams.base_target_off must be below base_target_on "
+                             f"({self.base_target_on}), got {self.base_target_off}")
 
 
 def default_constraints(params: LPParams) -> list[Constraint]:
@@ -104,11 +116,14 @@ def default_objectives(params: LPParams) -> list[ObjectiveTerm]:
     terms: list[ObjectiveTerm] = []
     if params.velocity_cost > 0.0:
         terms.append(LeastVelocity(params.velocity_cost))
+    if params.waist_hold > 0.0:
+        terms.append(WaistHold(params.waist_hold))
     if params.waist_centring > 0.0:
         terms.append(WaistCentring(params.waist_centring, params.waist_gain, params.waist_fade))
     if params.base_target > 0.0:
         terms.append(BaseTarget(params.base_target, params.base_target_gain,
-                                params.base_target_reach, params.base_target_stop))  # fmt: skip
+                                params.base_target_reach, params.base_target_stop,
+                                params.base_target_on, params.base_target_off))  # fmt: skip
     return terms
 
 
@@ -142,9 +157,11 @@ class LPLaw:
             self.objectives = None
 
     def reset(self) -> None:
-        """Forget the previous error and basis, as for a new task."""
+        """Forget the previous error, basis and terms' state, as for a new task."""
         self._last = None
         self._lp.reset()
+        for term in self.objectives or ():
+            term.reset()
 
     def step(
         self, q: Array, task: Task, dt: float, obstacles: Sequence[Circle] = ()

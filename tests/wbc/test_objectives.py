@@ -13,6 +13,7 @@ from wbc.lp_law import LPLaw, LPParams
 from wbc.objectives.base_target import BaseTarget, gripper_heading
 from wbc.objectives.velocity_cost import LeastVelocity
 from wbc.objectives.waist_centring import WaistCentring
+from wbc.objectives.waist_hold import WaistHold
 from wbc.scenarios import DT, HOME
 from wbc.step_context import StepContext
 from wbc.task import PoseTask, PositionTask
@@ -23,6 +24,21 @@ WAIST, YAW = 3, 2
 
 def context(q: np.ndarray, goal_pose: np.ndarray | None, error: np.ndarray) -> StepContext:
     return StepContext(MODEL, q, error, -error, np.zeros(2), (), goal_pose)
+
+
+def test_the_waist_hold_gives_the_tasks_yaw_to_the_base_at_no_cost_in_entries():
+    """phi' and q1' are never both nonzero (the split would be an eighth entry), and the waist
+    stays where it is."""
+    task = PoseTask(MODEL.fkm(np.concatenate(([0.3, 0.1, 0.2, 0.3], HOME[4:]))))
+    start = HOME.copy()
+    start[WAIST] = 0.2
+    law = LPLaw(MODEL)
+    for _ in range(50):
+        out = law.step(start, task, DT)
+        assert not (abs(out.u[YAW]) > 1e-9 and abs(out.u[WAIST]) > 1e-9), out.u
+        assert out.nonzero <= 7
+        start = start + DT * out.u
+    assert start[WAIST] == pytest.approx(0.2)
 
 
 def test_waist_centring_asks_for_q1_rate_minus_k_q1_and_fades_near_the_goal():
@@ -41,7 +57,7 @@ def test_waist_centring_asks_for_q1_rate_minus_k_q1_and_fades_near_the_goal():
 def test_the_law_spends_the_self_motion_on_centring_the_waist():
     """With the waist turned, the LP turns the base and the waist against each other
     (phi' = -q1' moves no part of the end effector, 4.9): q1 heads back to 0 at no cost to
-    the task residual ||J u + eta e||_1."""
+    the task residual ||J u + eta e||_1. (The term is off by default.)"""
     goal = HOME.copy()
     start = goal.copy()
     start[YAW], start[WAIST] = -0.3, 0.3  # the same end-effector pose as the goal's
@@ -54,8 +70,9 @@ def test_the_law_spends_the_self_motion_on_centring_the_waist():
         u = LPLaw(MODEL, params).step(start, task, DT).u
         return u, float(np.abs(jacobian @ u + params.eta * error).sum())
 
-    centred, centred_residual = residual(LPParams(base_target=0.0))
-    _, plain_residual = residual(LPParams(base_target=0.0, waist_centring=0.0))
+    centring = {"base_target": 0.0, "waist_hold": 0.0}
+    centred, centred_residual = residual(LPParams(waist_centring=0.02, **centring))
+    _, plain_residual = residual(LPParams(waist_centring=0.0, **centring))
     assert centred[WAIST] < 0.0 < centred[YAW]
     assert centred_residual == pytest.approx(plain_residual, abs=1e-9)
 
@@ -77,6 +94,19 @@ def test_base_target_lies_behind_the_goal_along_the_gripper_heading():
     np.testing.assert_allclose(end_effector - [target_x, target_y],
                                0.36 * np.array([math.cos(heading), math.sin(heading)]),
                                atol=1e-12)  # fmt: skip
+
+
+def test_base_target_steers_in_bursts_from_its_on_heading_error_down_to_its_off():
+    goal = np.array([1.0, 0.0, 0.0, 0.0, -0.4, 0.1, 0.0, 0.6])
+    pose = MODEL.fkm(goal)
+    term = BaseTarget(weight=0.05, gain=4.0, reach=0.36, stop_distance=0.15, on=0.3, off=0.05)
+    target_x, target_y = term.target(pose)
+    bearing = math.atan2(target_y, target_x)
+    weights = []
+    for phi in (bearing - 0.2, bearing - 0.4, bearing - 0.2, bearing - 0.01, bearing - 0.2):
+        q = np.concatenate(([0.0, 0.0, phi], HOME[3:]))
+        weights.append(term.cost(context(q, pose, np.ones(8))).weight)
+    assert weights == [0.0, 0.05, 0.05, 0.0, 0.0]
 
 
 def test_base_target_turns_towards_the_target_and_stops_near_it():
@@ -108,7 +138,8 @@ def test_least_velocity_weighs_every_entry_of_u():
 @pytest.mark.parametrize(
     "make", [lambda: WaistCentring(-1.0, 1.0), lambda: WaistCentring(0.02, 0.0),
              lambda: BaseTarget(0.05, 2.0, -0.1, 0.15), lambda: BaseTarget(0.05, 2.0, 0.36, 0.0),
-             lambda: LeastVelocity(float("nan"))],
+             lambda: LeastVelocity(float("nan")), lambda: WaistHold(-1e-3),
+             lambda: BaseTarget(0.05, 2.0, 0.36, 0.15, on=0.1, off=0.2)],
 )  # fmt: skip
 def test_invalid_term_parameters_are_refused(make):
     with pytest.raises(ValueError):

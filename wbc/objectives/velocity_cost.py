@@ -29,3 +29,6 @@ class LeastVelocity:
             weights.flags.writeable = False
             self._cost = VelocityCost(self.name, weights)
         return self._cost
+
+    def reset(self) -> None:
+        """Stateless."""

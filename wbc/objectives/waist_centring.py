@@ -5,6 +5,11 @@ phi' = -q1' moves no part of the end effector: under the nonholonomic equality i
 instantaneous redundancy. 5.29 leaves it to chance; this term asks for q1' = -k q1, which the
 base's turn can absorb at no cost to the task. The base then turns to face where the arm
 reaches, and the waist keeps its range for the task instead of stalling at its limit.
+
+It is off by default (weight 0): whenever it acts, phi' and q1' are both nonzero, an eighth
+entry of u, and with the waist hold term (wbc.objectives.waist_hold), which keeps the waist
+where it is at no cost in entries, it lowered the share of `parsimony bench`'s 'ahead' goals
+reached (weight 0.05: 0.93 and 0.88 on two sets of 100, against 0.94 and 0.90 without it).
 """
 
 from __future__ import annotations
@@ -38,3 +43,6 @@ class WaistCentring:
             fade = min(1.0, float(np.abs(context.error).sum()) / self.fade_error)
         offset = np.array([self.gain * context.q[BASE_DOF]])
         return ResidualCost(self.name, row, offset, self.weight * fade)
+
+    def reset(self) -> None:
+        """Stateless."""

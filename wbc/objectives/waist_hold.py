@@ -1,0 +1,41 @@
+"""Yaw by the base, the waist held: an extra w |q1'| on top of the tie-break.
+
+On this robot the base-yaw column of the whole-body Jacobian equals the waist's (q1), so the
+task's yaw can go to either, and any split of it between the two is an extra nonzero entry of
+u (a vertex has one of them 0). 5.29 leaves the choice to the simplex, which then turns the
+waist far from the base's heading. This term makes the waist dearer than the base: the base
+takes the task's yaw and faces where the arm works, and the waist moves only when the base
+cannot, or for the waist centring term (wbc.objectives.waist_centring). It is a velocity cost,
+so the solution stays a vertex: it costs no entry.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from wbc.objectives.base import VelocityCost
+from wbc.robot import BASE_DOF
+from wbc.step_context import StepContext
+
+
+class WaistHold:
+    """weight * |q1'|."""
+
+    name = "waist_hold"
+
+    def __init__(self, weight: float) -> None:
+        if not weight >= 0.0:
+            raise ValueError(f"waist hold weight must be >= 0, got {weight}")
+        self.weight = weight
+        self._cost: VelocityCost | None = None
+
+    def cost(self, context: StepContext) -> VelocityCost:
+        if self._cost is None or self._cost.weights.size != context.robot.dof:
+            weights = np.zeros(context.robot.dof)
+            weights[BASE_DOF] = self.weight
+            weights.flags.writeable = False
+            self._cost = VelocityCost(self.name, weights)
+        return self._cost
+
+    def reset(self) -> None:
+        """Stateless."""
