@@ -10,7 +10,7 @@ from parsimony.output import result_only_stdout
 
 COMMANDS = (
     "demo", "experiment", "bench", "launch", "status", "param", "node", "topic", "graph", "schema",
-    "record", "info", "replay", "rerun", "report", "view",
+    "record", "info", "replay", "rerun", "report", "view", "reproduce",
 )  # fmt: skip
 
 

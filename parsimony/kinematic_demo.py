@@ -25,13 +25,16 @@ from wbc.task import PoseTask, PositionTask, Task
 ROBOT_FILE = Path(__file__).resolve().parents[1] / "deploy" / "robots" / "little_john.yaml"
 STEPS = 4000
 BORDER_PARAMS = LPParams(obstacle_mode="border", base_target=0.0, waist_hold=0.0,
-                         waist_centring=0.02)
+                         waist_centring=0.02, error_bound="error")
 """The border-following law of 6.2.3 without the base target term, whose straight-line
 heading towards where the base should stand fights the detour round the obstacle, and with the
 waist centred through the self-motion instead of held: with the base alone taking the task's
 yaw, the base overran the goal by 0.4 m after its detour and stalled (error 0.18 after 80 s),
 and with neither, it stalled at 0.54 beside the obstacle; centred, it converges in 16 s. The
-self-motion costs an entry: figure 6.17 shows all 8 in use too."""
+self-motion costs an entry: figure 6.17 shows all 8 in use too. ||u||_1 is bounded by the error
+(5.7), not by its rate (5.10): when the base stalls on the border's saddle, e' is 0, 5.10 allows
+no motion at all and the circulation term (wbc.objectives.obstacle_circulation) could not start
+it again (seed 1 of the obstacle experiment: error 0.65 after 60 s either way)."""
 
 SUPERVISED_PARAMS = LPParams(base_target=0.0, error_bound="error")
 """The LP law under the staging supervisor (wbc.staging_supervisor), which plans where the base

@@ -21,6 +21,7 @@ from wbc.law_output import LawOutput, summarise
 from wbc.linear_program import WarmStartedLP
 from wbc.objectives.base import ObjectiveTerm, ResidualCost
 from wbc.objectives.base_target import BaseTarget
+from wbc.objectives.obstacle_circulation import ObstacleCirculation
 from wbc.objectives.velocity_cost import LeastVelocity
 from wbc.objectives.waist_centring import WaistCentring
 from wbc.objectives.waist_hold import WaistHold
@@ -56,6 +57,12 @@ class LPParams:
     obstacle_lookahead: float = gain(0.1, low=0.0, high=1.0,
                                      doc="d: the border constraint acts on the point d ahead "
                                          "of the wheel axle, m")
+    obstacle_circulation: float = gain(0.2, low=0.0, high=1.0,
+                                       doc="weight of going round an obstacle on the goal's "
+                                           "side while its border is engaged "
+                                           "(wbc.objectives.obstacle_circulation)")
+    circulation_speed: float = gain(0.1, low=0.0, high=1.0,
+                                    doc="the speed along the border that term asks for, m/s")
     velocity_cost: float = gain(1e-3, low=0.0, high=1.0,
                                 doc="w of w ||u||_1, the tie-break between optimal vertices; "
                                     "0 with the other weights solves 5.29 exactly "
@@ -120,6 +127,9 @@ def default_objectives(params: LPParams) -> list[ObjectiveTerm]:
         terms.append(WaistHold(params.waist_hold))
     if params.waist_centring > 0.0:
         terms.append(WaistCentring(params.waist_centring, params.waist_gain, params.waist_fade))
+    if params.obstacle_mode == "border" and params.obstacle_circulation > 0.0:
+        terms.append(ObstacleCirculation(params.obstacle_circulation, params.circulation_speed,
+                                         params.obstacle_margin, params.obstacle_lookahead))
     if params.base_target > 0.0:
         terms.append(BaseTarget(params.base_target, params.base_target_gain,
                                 params.base_target_reach, params.base_target_stop,
@@ -191,7 +201,7 @@ class LPLaw:
 
         goal_pose = task.pose if isinstance(task, PoseTask) else None
         context = StepContext(self.robot, q, error, error_rate, task.goal_position[:2],
-                              tuple(obstacles), goal_pose)  # fmt: skip
+                              tuple(obstacles), goal_pose, dt)  # fmt: skip
         rows = [constraint.rows(context) for constraint in self.constraints]
         costs = [ResidualCost("task", task_jacobian, self.params.eta * error)]
         costs += [term.cost(context) for term in self.objectives]

@@ -1,7 +1,15 @@
-"""The classic whole-body law u = -J^+ eta e (5.3): holonomic, continuous, uses every joint."""
+"""The classic whole-body law u = -J^+ eta e (5.3): holonomic, continuous, uses every joint.
+
+With ``nonholonomic`` it takes the pseudoinverse of the Jacobian of the velocities 5.11
+allows instead: u = N (J N)^+ (-eta e), the columns of N an orthonormal basis of them (the
+base's forward speed along its heading, its yaw, the arm joints). Not in the dissertation: it
+is the least 2-norm u the nonholonomic robot can take for the task, the 2-norm baseline the
+cascade of appendix B only approximates (table 6.1's metric 2).
+"""
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -26,9 +34,19 @@ def pinv_velocity(task_jacobian: Array, error: Array, eta: float) -> Array:
     return -eta * (np.linalg.pinv(task_jacobian, rcond=PINV_RCOND) @ error)
 
 
+def nonholonomic_basis(phi: float, dof: int) -> Array:
+    """N: orthonormal columns spanning the u that obey 5.11 at heading phi: (cos phi, sin phi)
+    on x', y', then one column for phi' and each arm joint."""
+    basis = np.zeros((dof, dof - 1))
+    basis[0, 0], basis[1, 0] = math.cos(phi), math.sin(phi)
+    basis[2:, 1:] = np.eye(dof - 2)
+    return basis
+
+
 @dataclass(frozen=True)
 class PinvParams:
     eta: float = gain(0.6, low=1e-3, high=100.0, doc="task gain, 1/s")
+    nonholonomic: bool = gain(False, doc="the pseudoinverse of J N, N spanning what 5.11 allows")
 
     def __post_init__(self) -> None:
         check_gains(self)
@@ -36,7 +54,8 @@ class PinvParams:
 
 @dataclass
 class PseudoinverseLaw:
-    """u = -J^+ eta e (5.3, B.1) with the holonomic base model of eq. 4.3; no constraints."""
+    """u = -J^+ eta e (5.3, B.1) with the holonomic base model of eq. 4.3, or under 5.11 with
+    ``nonholonomic``; no other constraint."""
 
     robot: MobileManipulator
     params: PinvParams = field(default_factory=PinvParams)
@@ -55,5 +74,9 @@ class PseudoinverseLaw:
         q = require_finite("configuration q", q)
         pose, jacobian = self.robot.kinematics(q)
         error, task_jacobian = task.error(pose, jacobian, q)
-        u = pinv_velocity(task_jacobian, error, self.params.eta)
+        if self.params.nonholonomic:
+            basis = nonholonomic_basis(float(q[2]), self.robot.dof)
+            u = basis @ pinv_velocity(task_jacobian @ basis, error, self.params.eta)
+        else:
+            u = pinv_velocity(task_jacobian, error, self.params.eta)
         return summarise(u, "optimal", None, (), error, start)

@@ -9,7 +9,7 @@ laws impose it (5.12).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -96,6 +96,14 @@ class MobileManipulator:
         # H+(r_z(q) L) = cos(q/2) H+(L) + sin(q/2) H+(k) H+(L), with r_z(q) = cos(q/2) + k sin(q/2).
         self._link_cos = links
         self._link_sin = np.matmul(2.0 * _HALF_K, links)
+
+    def with_velocity_max(self, velocity_max: Array) -> MobileManipulator:
+        """The same robot with other bounds on u (section 6.3's tests impose none)."""
+        bounds = np.asarray(velocity_max, dtype=float)
+        base = replace(self.base, velocity_max=_readonly(bounds[:BASE_DOF], (3,),
+                                                                     "base.velocity_max"))
+        return MobileManipulator(np.array(self.dh), base, self.q_min[BASE_DOF:].copy(),
+                                 self.q_max[BASE_DOF:].copy(), bounds[BASE_DOF:], self.name)
 
     @classmethod
     def from_yaml(cls, path: str | Path) -> MobileManipulator:

@@ -25,3 +25,5 @@ class StepContext:
     obstacles: tuple[Circle, ...] = ()
     goal_pose: Array | None = None
     """The goal's end-effector pose for a pose task; None for a position task."""
+    dt: float = 0.0
+    """The step's period, s (0 where no step is taken, as in a test of one term)."""

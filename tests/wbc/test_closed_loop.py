@@ -2,16 +2,20 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from wbc_scenarios import integrate, pose_task, position_task, robot
 
 from parsimony.kinematic_demo import BORDER_PARAMS
+from wbc import dq
 from wbc.cascade_law import CascadeLaw
 from wbc.lp_law import LPLaw, LPParams
+from wbc.obstacles import Circle
 from wbc.pinv_law import PseudoinverseLaw
 from wbc.scenarios import DT, HOME, JOINT_LIMIT_GOAL, OBSTACLE, OBSTACLE_GOAL, STARTS_AND_GOALS
-from wbc.task import PositionTask
+from wbc.task import PoseTask, PositionTask
 
 MODEL = robot()
 POSE_PARAMS = LPParams(eta=0.6, beta=15.0)  # section 6.2.1
@@ -133,3 +137,25 @@ def test_error_derivative_bound_stops_joints_when_the_end_effector_stalls():
 
     assert last_second_speed("derivative") < 1e-6
     assert last_second_speed("error") > 0.1
+
+
+SADDLE = np.array([-0.9022, -0.572, -0.0045, 0.0, 0.36, -0.8683, -0.0528, -0.4009])
+"""Where seed 1 of the simulated obstacle experiment stalled: the base's point on the border
+of the obstacle, facing its centre, the goal straight behind it (error 0.65 for 60 s)."""
+SADDLE_OBSTACLE = Circle(-0.3888, -0.6056, 0.1)
+SADDLE_GOAL = dq.normalize(np.array([0.945648, 0.023547, -0.251532, -0.204763, -0.076033,
+                                     0.509034, -0.351501, 0.139184]))  # fmt: skip
+
+
+def test_a_base_stalled_on_the_borders_saddle_goes_round_and_reaches_the_goal():
+    task = PoseTask(SADDLE_GOAL)
+    stuck = LPLaw(MODEL, dataclasses.replace(BORDER_PARAMS, obstacle_circulation=0.0))
+    run = integrate(stuck, SADDLE, task, 1000, obstacles=[SADDLE_OBSTACLE])
+    assert run.final_error > 0.5  # the saddle holds without the circulation term
+    law = LPLaw(MODEL, BORDER_PARAMS)
+    run = integrate(law, SADDLE, task, 3000, obstacles=[SADDLE_OBSTACLE])
+    assert run.converged
+    q = np.array(run.configurations)
+    gap = np.hypot(q[:, 0] - SADDLE_OBSTACLE.x, q[:, 1] - SADDLE_OBSTACLE.y)
+    assert gap.min() > SADDLE_OBSTACLE.radius + MODEL.base.body_radius
+    assert all(out.ok for out in run.outputs)

@@ -11,9 +11,11 @@ from wbc_scenarios import robot
 from wbc import dq
 from wbc.lp_law import LPLaw, LPParams
 from wbc.objectives.base_target import BaseTarget, gripper_heading
+from wbc.objectives.obstacle_circulation import ObstacleCirculation
 from wbc.objectives.velocity_cost import LeastVelocity
 from wbc.objectives.waist_centring import WaistCentring
 from wbc.objectives.waist_hold import WaistHold
+from wbc.obstacles import Circle
 from wbc.scenarios import DT, HOME
 from wbc.step_context import StepContext
 from wbc.task import PoseTask, PositionTask
@@ -144,3 +146,24 @@ def test_least_velocity_weighs_every_entry_of_u():
 def test_invalid_term_parameters_are_refused(make):
     with pytest.raises(ValueError):
         make()
+
+
+def test_obstacle_circulation_acts_only_after_the_base_stalls_on_an_engaged_border():
+    obstacle = Circle(0.45, 0.0, 0.1)
+    term = ObstacleCirculation(weight=0.2, speed=0.1, margin=0.05, lookahead=0.1,
+                               stall_speed=0.01, stall_time=0.1)  # fmt: skip
+    q = HOME.copy()  # the point 0.1 ahead lies 0.35 from the centre: inside the border
+
+    def step(at: np.ndarray):
+        ctx = StepContext(MODEL, at, np.ones(8), -np.ones(8), np.array([1.5, 0.0]), (obstacle,),
+                          None, 0.02)  # fmt: skip
+        return term.cost(ctx)
+
+    moving = [step(q + np.array([0.01 * k, 0, 0, 0, 0, 0, 0, 0])) for k in range(10)]
+    assert all(cost.weight == 0.0 for cost in moving)  # 0.5 m/s along the way: no stall
+    standing = [step(q + np.array([0.09, 0, 0, 0, 0, 0, 0, 0])) for _ in range(10)]
+    assert standing[3].weight == 0.0 and standing[-1].weight == 0.2
+    tangent = standing[-1].matrix[0, :2]
+    assert abs(tangent @ np.array([1.0, 0.0])) < 1e-12  # along the border, not into it
+    far = step(np.concatenate(([2.0, 0.0], HOME[2:])))  # past the obstacle: released
+    assert far.weight == 0.0

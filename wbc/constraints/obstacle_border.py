@@ -3,11 +3,51 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from wbc.constraints.base import LinearRows
+from wbc.obstacles import Circle
 from wbc.step_context import StepContext
+
+Array = np.ndarray
+
+
+@dataclass(frozen=True)
+class Border:
+    """Where the base's point p stands against one obstacle: p - c, f = R^2 - ||p - c||^2
+    (5.21), and whether 5.25 engages the border (f > 0, the obstacle between p and the goal)."""
+
+    dx: float
+    dy: float
+    f: float
+    h: float
+    """5.25's h: > 0 while the obstacle lies between p and the goal."""
+    engaged: bool
+
+
+def border(context: StepContext, obstacle: Circle, margin: float, lookahead: float) -> Border:
+    """The border of ``obstacle`` for the point ``lookahead`` ahead of the wheel axle, its
+    radius R = R_obs + body radius + ``margin`` + ``lookahead``."""
+    phi = float(context.q[2])
+    px = float(context.q[0]) + lookahead * math.cos(phi)
+    py = float(context.q[1]) + lookahead * math.sin(phi)
+    gx, gy = float(context.goal_xy[0]), float(context.goal_xy[1])
+    dx, dy = px - obstacle.x, py - obstacle.y
+    radius = obstacle.radius + context.robot.base.body_radius + margin + lookahead
+    f = radius * radius - (dx * dx + dy * dy)
+    h = math.hypot(gx - px, gy - py) - math.hypot(gx - obstacle.x, gy - obstacle.y)
+    return Border(dx, dy, f, h, f > 0.0 and h > 0.0)
+
+
+def point_velocity_row(dx: float, dy: float, phi: float, lookahead: float, dof: int) -> Array:
+    """The row a on u with a u = (dx, dy) . p', p' = (x' - d sin(phi) phi', y' + d cos(phi)
+    phi') the velocity of the point d ahead of the axle."""
+    row = np.zeros(dof)
+    row[0], row[1] = dx, dy
+    row[2] = lookahead * (dy * math.cos(phi) - dx * math.sin(phi))
+    return row
 
 
 class BorderObstacle:
@@ -45,18 +85,11 @@ class BorderObstacle:
         if count == 0:
             return LinearRows(self.name, matrix, np.zeros(0), np.zeros(0), engaged=False)
         rhs = np.zeros(count)
-        d = self.lookahead
         phi = float(context.q[2])
-        cos, sin = math.cos(phi), math.sin(phi)
-        px, py = float(context.q[0]) + d * cos, float(context.q[1]) + d * sin
-        gx, gy = float(context.goal_xy[0]), float(context.goal_xy[1])
         for row, obstacle in enumerate(context.obstacles):
-            dx, dy = px - obstacle.x, py - obstacle.y
-            radius = obstacle.radius + context.robot.base.body_radius + self.margin + d
-            f = radius * radius - (dx * dx + dy * dy)
-            h = math.hypot(gx - px, gy - py) - math.hypot(gx - obstacle.x, gy - obstacle.y)
-            if f > 0.0 and h > 0.0:
-                matrix[row, 0], matrix[row, 1] = -2.0 * dx, -2.0 * dy
-                matrix[row, 2] = 2.0 * d * (dx * sin - dy * cos)
-                rhs[row] = self.gain * -f
+            at = border(context, obstacle, self.margin, self.lookahead)
+            if at.engaged:
+                matrix[row] = point_velocity_row(-2.0 * at.dx, -2.0 * at.dy, phi,
+                                                 self.lookahead, context.robot.dof)
+                rhs[row] = self.gain * -at.f
         return LinearRows(self.name, matrix, rhs, rhs, engaged=bool(np.any(matrix)))

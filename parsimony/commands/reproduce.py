@@ -1,0 +1,56 @@
+"""`parsimony reproduce`: every result of chapter 6 beside ours (see parsimony.reproduce)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from dataclasses import asdict
+from pathlib import Path
+
+from parsimony.kinematic_demo import ROBOT_FILE
+from parsimony.output import emit
+from parsimony.reproduce import format_rows, reproduce, write_figures
+from wbc.robot import MobileManipulator
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    parser = subparsers.add_parser(
+        "reproduce", help="run chapter 6's set-ups kinematically and print each result beside "
+                          "the dissertation's")  # fmt: skip
+    parser.add_argument("--out", type=Path, default=Path("runs/reproduce"),
+                        help="where the figures go (default runs/reproduce)")
+    parser.add_argument("--trials", type=int, default=20,
+                        help="repetitions of the convergence test of 6.3 (default 20)")
+    parser.add_argument("--robot", type=Path, default=ROBOT_FILE, help="robot description")
+    parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    return parser
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.trials < 1:
+        print(f"parsimony reproduce: --trials must be at least 1, got {args.trials}",
+              file=sys.stderr)  # fmt: skip
+        return 2
+    robot = MobileManipulator.from_yaml(args.robot)
+    rows, found = reproduce(robot, args.trials)
+    figures = write_figures(robot, found, args.out)
+    print(f"reproduce: {len(figures)} figures and notes in {args.out}", file=sys.stderr)
+    if args.json:
+        emit(json.dumps({"rows": [_finite(asdict(row)) for row in rows],
+                         "figures": [str(path) for path in figures]}))  # fmt: skip
+    else:
+        emit(format_rows(rows))
+    return 0
+
+
+def _finite(value: object) -> object:
+    """NaN (a median of no steps) as null, so the JSON is standard."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, list):
+        return [_finite(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    return value
