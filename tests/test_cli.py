@@ -92,7 +92,9 @@ def test_demo_reports_every_experiment_and_exits_zero():
     assert result.returncode == 0, result.stdout + result.stderr
     rows = {(row["experiment"], row["law"]): row for row in json.loads(result.stdout)}
     assert rows[("pose", "LP")]["converged"] and rows[("position", "LP")]["converged"]
-    assert rows[("obstacle", "LP border")]["min_obstacle_clearance"] > 0.0
+    for law in ("LP vector field", "LP border"):
+        assert rows[("obstacle", law)]["converged"]
+        assert rows[("obstacle", law)]["min_obstacle_clearance"] > 0.0
     assert rows[("joint limit", "pinv")]["worst_joint_overrun"] > 0.0
     assert rows[("joint limit", "LP")]["worst_joint_overrun"] == 0.0
 

@@ -15,7 +15,8 @@ RESULTS = {
               "fig. 6.7: LP, last 2 s", "fig. 6.7: PINV", "fig. 6.8:", "fig. 6.10:"),
     "6.2.2": ("position task: converged", "fig. 6.12: median nonzero", "fig. 6.12: PINV",
               "fig. 6.13:"),
-    "6.2.3": ("obstacle: converged", "fig. 6.17:"),
+    "6.2.3": ("obstacle, the vector-field inequality: converged", "obstacle, 5.28: converged",
+              "fig. 6.17, the vector-field", "fig. 6.17, 5.28"),
     "6.3": ("test 1 (holonomic): iterations", "test 1: ms per iteration",
             "test 2 (nonholonomic): iterations", "test 2: ms per iteration"),
 }  # fmt: skip

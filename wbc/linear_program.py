@@ -270,10 +270,11 @@ def _active(
 ) -> tuple[str, ...]:
     """Names of the constraints that hold with equality at the solution.
 
-    Engaged equality rows are active; a one-norm bound when 1'(u_P + u_N) reaches it; a
-    velocity bound entry (named ``name[i]``) when u_i sits on a finite, non-degenerate bound.
+    Engaged equality rows are active, and engaged inequality rows that one of their finite
+    bounds holds tight; a one-norm bound when 1'(u_P + u_N) reaches it; a velocity bound entry
+    (named ``name[i]``) when u_i sits on a finite, non-degenerate bound.
     """
-    active = [rows.name for rows in linear if rows.engaged]
+    active = [rows.name for rows in linear if rows.engaged and _tight(rows, u)]
     active += [bound.name for bound in norms if split_sum >= bound.limit - ACTIVE_TOLERANCE]
     for bound in bounds:
         # An infinite bound is never within the tolerance of u; a degenerate one never counts.
@@ -282,3 +283,12 @@ def _active(
         if at_bound.any():
             active += [f"{bound.name}[{i}]" for i in np.flatnonzero(at_bound)]
     return tuple(active)
+
+
+def _tight(rows: LinearRows, u: Array) -> bool:
+    """An equality, or an inequality one of whose rows sits on a finite bound."""
+    if np.array_equal(rows.lower, rows.upper):
+        return True
+    value = rows.matrix @ u
+    return bool(np.any(np.minimum(np.abs(value - rows.lower), np.abs(rows.upper - value))
+                       <= ACTIVE_TOLERANCE))  # fmt: skip

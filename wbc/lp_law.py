@@ -16,6 +16,7 @@ from wbc.constraints.joint_limits import JointLimits
 from wbc.constraints.nonholonomic import Nonholonomic
 from wbc.constraints.obstacle_border import BorderObstacle
 from wbc.constraints.obstacle_conservative import ConservativeObstacle
+from wbc.constraints.obstacle_vector_field import VectorFieldObstacle
 from wbc.gains import check_gains, gain
 from wbc.law_output import LawOutput, summarise
 from wbc.linear_program import WarmStartedLP
@@ -46,12 +47,13 @@ class LPParams:
     error_bound: Literal["derivative", "error"] = gain(
         "derivative", choices=("derivative", "error"),
         doc="5.10 (bound on ||e'||_1) or the original 5.7 (bound on ||e||_1)")
-    obstacle_mode: Literal["border", "conservative", "off"] = gain(
-        "border", choices=("border", "conservative", "off"),
-        doc="obstacle constraint: 5.28 (border), 5.19 (conservative) or none")
+    obstacle_mode: Literal["border", "vector_field", "conservative", "off"] = gain(
+        "border", choices=("border", "vector_field", "conservative", "off"),
+        doc="obstacle constraint: 5.28 (border), the vector-field inequality d' >= -eta_d d "
+            "(vector_field, wbc.constraints.obstacle_vector_field), 5.19 (conservative) or none")
     obstacle_gain: float = gain(2.0, low=1e-3, high=100.0,
-                                doc="lambda of 5.26 (border), gain on the clearance "
-                                    "(conservative), 1/s")
+                                doc="lambda of 5.26 (border), eta_d (vector_field), gain on the "
+                                    "clearance (conservative), 1/s")
     obstacle_margin: float = gain(0.05, low=0.0, high=1.0,
                                   doc="extra clearance round each obstacle and the base, m")
     obstacle_lookahead: float = gain(0.1, low=0.0, high=1.0,
@@ -113,6 +115,9 @@ def default_constraints(params: LPParams) -> list[Constraint]:
         constraints.append(
             BorderObstacle(params.obstacle_gain, params.obstacle_margin, params.obstacle_lookahead)
         )
+    elif params.obstacle_mode == "vector_field":
+        constraints.append(VectorFieldObstacle(params.obstacle_gain, params.obstacle_margin,
+                                               params.obstacle_lookahead))
     elif params.obstacle_mode == "conservative":
         constraints.append(ConservativeObstacle(params.obstacle_gain, params.obstacle_margin))
     return constraints
@@ -127,7 +132,7 @@ def default_objectives(params: LPParams) -> list[ObjectiveTerm]:
         terms.append(WaistHold(params.waist_hold))
     if params.waist_centring > 0.0:
         terms.append(WaistCentring(params.waist_centring, params.waist_gain, params.waist_fade))
-    if params.obstacle_mode == "border" and params.obstacle_circulation > 0.0:
+    if params.obstacle_mode in ("border", "vector_field") and params.obstacle_circulation > 0.0:
         terms.append(ObstacleCirculation(params.obstacle_circulation, params.circulation_speed,
                                          params.obstacle_margin, params.obstacle_lookahead))
     if params.base_target > 0.0:

@@ -68,11 +68,17 @@ class System:
         return Inbox(self.router, self.profile.namespace, topic)
 
     def start(self, name: str) -> subprocess.Popen[str]:
-        """Start the profile's component ``name`` as its own process."""
+        """Start the profile's component ``name`` as its own process; what it logs goes to
+        ``<name>.log`` beside the profile (a pipe nobody reads would block it once full)."""
         module = self.profile.component(name).module_path
         command = [sys.executable, "-m", module, "--profile", str(self.path), "--name", name]
-        self.processes.append(subprocess.Popen(command, stderr=subprocess.PIPE, text=True))
+        with (self.path.parent / f"{name}.log").open("a") as log:
+            self.processes.append(subprocess.Popen(command, stderr=log, text=True))
         return self.processes[-1]
+
+    def log(self, name: str) -> str:
+        """What component ``name`` has logged so far."""
+        return (self.path.parent / f"{name}.log").read_text()
 
     def stop_processes(self) -> None:
         """Teardown: SIGTERM every process started, SIGKILL those that do not stop."""

@@ -10,7 +10,7 @@ import time
 from pathlib import Path
 
 import yaml
-from conftest import System
+from conftest import Inbox, System
 from driver_harness import DEPLOY, FakeLink, driver_system, frame, status
 
 from deploy import query
@@ -54,21 +54,23 @@ class Create:
 
 
 def started_driver(deployed, tmp_path: Path, wait_until, **params: object
-                   ) -> tuple[System, Create]:  # fmt: skip
+                   ) -> tuple[System, Create, Inbox]:  # fmt: skip
+    """The driver on a fake Create, driving at 0.1 m/s, and its odometry: subscribed before the
+    driver starts, so that its session knows the subscriber from its first frame on."""
     link = FakeLink(tmp_path / "create2")
     system = driver_system(deployed, tmp_path, "base_driver", link.link, **params)
+    odometry = system.inbox(topics.BASE_ODOMETRY)
     system.start("base_driver")
     create = Create(link, system.router, system.profile.namespace)
     wait_until(lambda: create.heard(STARTED), "Start, Safe, stop and Stream")
     wait_until(create.drive, "Drive Direct 100 100 mm/s")
-    return system, create
+    return system, create, odometry
 
 
 def test_the_base_driver_survives_bad_bytes_and_a_port_that_vanishes(
     deployed, tmp_path: Path, wait_until
 ) -> None:
-    system, create = started_driver(deployed, tmp_path, wait_until)
-    odometry = system.inbox(topics.BASE_ODOMETRY)
+    system, create, odometry = started_driver(deployed, tmp_path, wait_until)
     # Garbage, a bad checksum and a truncated frame, between good frames across the rollover,
     # 10 counts a frame (0.3 m/s).
     good = frame(65516, 0) + frame(65526, 0)
@@ -107,8 +109,7 @@ def test_a_rollover_storm_is_skipped_not_taken_for_motion(
     deployed, tmp_path: Path, wait_until
 ) -> None:
     """Counts that jump by 30,000 between frames with valid checksums would be 889 m/s."""
-    system, create = started_driver(deployed, tmp_path, wait_until)
-    odometry = system.inbox(topics.BASE_ODOMETRY)
+    system, create, odometry = started_driver(deployed, tmp_path, wait_until)
     storm = [1000, 31000, 1000, 31000, 1000, 1005, 1010]
     create.link.write(b"".join(frame(c, c) for c in storm))
     last = odometry.wait_for(lambda m: m.left_encoder == 1010, "the frame after the storm")
@@ -124,8 +125,7 @@ def test_a_stray_header_costs_one_frame_not_a_quarter_second(
 ) -> None:
     """``19 255`` announces 255 bytes; the driver knows its frames carry 6 and drops the 19 at
     once, so the very next frame is read (it used to wait for 258 bytes, 0.4 s of stream)."""
-    system, create = started_driver(deployed, tmp_path, wait_until)
-    odometry = system.inbox(topics.BASE_ODOMETRY)
+    system, create, odometry = started_driver(deployed, tmp_path, wait_until)
     create.link.write(frame(100, 100) + frame(104, 104))
     odometry.wait_for(lambda m: m.left_encoder == 104, "odometry before the stray header")
     create.link.write(bytes([create_oi.STREAM_HEADER, 255]) + frame(108, 108))
@@ -135,8 +135,7 @@ def test_a_stray_header_costs_one_frame_not_a_quarter_second(
 def test_a_frame_of_other_packets_is_counted_and_odometry_goes_on(
     deployed, tmp_path: Path, wait_until
 ) -> None:
-    system, create = started_driver(deployed, tmp_path, wait_until)
-    odometry = system.inbox(topics.BASE_ODOMETRY)
+    system, create, odometry = started_driver(deployed, tmp_path, wait_until)
     bumps = create_oi.stream_frame({create_oi.BUMPS_AND_WHEEL_DROPS: b"\x00"})
     cliff = create_oi.stream_frame({create_oi.CLIFF_FRONT_LEFT_SIGNAL: b"\x00\x10",
                                     create_oi.LEFT_ENCODER: b"\x00\x02"})  # 6 bytes too
@@ -151,9 +150,9 @@ def test_speeds_after_lost_frames_are_taken_over_the_time_that_passed(
 ) -> None:
     """At 0.2 m/s, 0.1 s of frames lost: the next frame's 45 counts are 0.1 s of motion (it
     used to be divided by one 15 ms period: 1.33 m/s). The command holds for the whole test."""
-    system, create = started_driver(deployed, tmp_path, wait_until, command_timeout_s=10.0)
+    system, create, odometry = started_driver(deployed, tmp_path, wait_until,
+                                              command_timeout_s=10.0)  # fmt: skip
     wait_until(lambda: create.drive(0.2), "Drive Direct 200 200 mm/s")
-    odometry = system.inbox(topics.BASE_ODOMETRY)
     create.link.write(frame(500, 500) + frame(509, 509))
     odometry.wait_for(lambda m: m.left_encoder == 509, "odometry before the loss")
     time.sleep(0.1)  # the frames of 0.1 s lost on the line

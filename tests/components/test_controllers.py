@@ -319,7 +319,7 @@ def test_a_robot_description_that_cannot_be_loaded_is_a_configuration_error(
     system = deployed(text)
     process = system.start("controller")
     assert process.wait(DEADLINE_S) == 2
-    assert "robot: cannot load /nonexistent/robot.yaml" in process.stderr.read()
+    assert "robot: cannot load /nonexistent/robot.yaml" in system.log("controller")
 
 
 def test_the_law_gets_changed_gains_and_only_then(deployed: Callable[[str], System]) -> None:

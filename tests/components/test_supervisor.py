@@ -75,9 +75,17 @@ def header() -> Header:
 
 
 def supervised(deployed: Callable[[str], System]) -> Operator:
+    """The supervisor process and the test as its operator; states go out until its first
+    (idle) status comes back, so that its session knows the test's subscribers."""
     system = deployed(PROFILE)
     system.start("supervisor")
-    return Operator(system)
+    operator = Operator(system)
+    deadline = time.monotonic() + DEADLINE_S
+    while not operator.statuses.messages:
+        assert time.monotonic() < deadline, "no status from the supervisor"
+        operator.send_state(HOME)
+        time.sleep(0.01)
+    return operator
 
 
 def test_a_goal_behind_the_robot_is_planned_off_the_handler_thread_then_driven_to(
@@ -86,8 +94,7 @@ def test_a_goal_behind_the_robot_is_planned_off_the_handler_thread_then_driven_t
     """While the plan runs the controller is told to hold where the robot stands, and the
     status says so: both come from the state that asked for the plan, before it returned."""
     operator = supervised(deployed)
-    operator.send_state(HOME)
-    operator.statuses.wait_for(lambda s: s.phase == "idle", "the idle status")
+    assert operator.statuses.messages[0].phase == "idle"
     behind = operator.robot.fkm(np.concatenate(([-0.8, 0.2, 3.0], REACH_GOAL[3:])))
     operator.ask(behind)
     operator.send_state(HOME)

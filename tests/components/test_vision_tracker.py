@@ -119,5 +119,5 @@ def test_a_device_that_does_not_open_is_a_configuration_error(deployed, tmp_path
     system = tracker_system(deployed, tmp_path, {"device": str(tmp_path / "no-such.avi")})
     process = system.start("vision_tracker")
     assert process.wait(system.deadline_s) == 2
-    assert "device: cannot open" in process.stderr.read()
+    assert "device: cannot open" in system.log("vision_tracker")
 

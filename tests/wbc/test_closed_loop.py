@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from wbc_scenarios import integrate, pose_task, position_task, robot
 
-from parsimony.kinematic_demo import BORDER_PARAMS
+from parsimony.kinematic_demo import BORDER_PARAMS, OBSTACLE_PARAMS
 from wbc import dq
 from wbc.cascade_law import CascadeLaw
 from wbc.lp_law import LPLaw, LPParams
@@ -108,11 +108,13 @@ def test_obstacle_lies_on_the_free_path():
     assert base_clearance(free).min() < 0.0
 
 
-def test_border_following_constraint_goes_round_the_obstacle_to_the_goal():
-    law = LPLaw(MODEL, BORDER_PARAMS)
+@pytest.mark.parametrize(("params", "constraint"), [
+    (OBSTACLE_PARAMS, "obstacle_vector_field"), (BORDER_PARAMS, "obstacle_border")])  # fmt: skip
+def test_an_obstacle_constraint_goes_round_the_obstacle_to_the_goal(params, constraint):
+    law = LPLaw(MODEL, params)
     run = integrate(law, HOME, pose_task(MODEL, OBSTACLE_GOAL), 4000, obstacles=[OBSTACLE])
     assert base_clearance(run).min() > 0.0
-    assert any("obstacle_border" in out.active_constraints for out in run.outputs)
+    assert any(constraint in out.active_constraints for out in run.outputs)
     assert run.final_error < 1e-3
 
 
@@ -149,10 +151,11 @@ SADDLE_GOAL = dq.normalize(np.array([0.945648, 0.023547, -0.251532, -0.204763, -
 
 def test_a_base_stalled_on_the_borders_saddle_goes_round_and_reaches_the_goal():
     task = PoseTask(SADDLE_GOAL)
-    stuck = LPLaw(MODEL, dataclasses.replace(BORDER_PARAMS, obstacle_circulation=0.0))
-    run = integrate(stuck, SADDLE, task, 1000, obstacles=[SADDLE_OBSTACLE])
-    assert run.final_error > 0.5  # the saddle holds without the circulation term
-    law = LPLaw(MODEL, BORDER_PARAMS)
+    for params in (BORDER_PARAMS, OBSTACLE_PARAMS):
+        stuck = LPLaw(MODEL, dataclasses.replace(params, obstacle_circulation=0.0))
+        run = integrate(stuck, SADDLE, task, 1000, obstacles=[SADDLE_OBSTACLE])
+        assert run.final_error > 0.5  # the saddle holds without the circulation term
+    law = LPLaw(MODEL, OBSTACLE_PARAMS)
     run = integrate(law, SADDLE, task, 3000, obstacles=[SADDLE_OBSTACLE])
     assert run.converged
     q = np.array(run.configurations)

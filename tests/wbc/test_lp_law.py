@@ -100,3 +100,40 @@ def test_cascade_reference_does_not_wind_up_when_the_base_cannot_move():
 def test_gains_of_the_wrong_type_or_not_finite_are_refused(field, value):
     with pytest.raises(ValueError, match=f"LPParams.{field}"):
         LPParams(**{field: value})
+
+
+def test_the_cascades_point_tracks_the_reference_as_appendix_b_linearises_it():
+    """B.2: the point d ahead of the axle moves at the reference point's velocity plus
+    diag(k1, k2) times the tracking error, whatever the base's heading."""
+    from wbc.cascade_law import CascadeLaw, CascadeParams, offset_point
+    from wbc.pinv_law import pinv_velocity
+
+    params = CascadeParams(k1=1.5, k2=3.0)
+    task = pose_task(MODEL, np.concatenate(([0.6, 0.3, 0.4], HOME[3:])))
+    start = np.concatenate(([0.1, -0.2, 0.7], HOME[3:]))
+    d = params.offset
+
+    def point_velocity(q, u):
+        phi = q[2]
+        return np.array([u[0] - d * np.sin(phi) * u[2], u[1] + d * np.cos(phi) * u[2]])
+
+    def reference_velocity(q, reference):
+        error, jacobian = task.error(*MODEL.kinematics(q), q)
+        x_dot, y_dot, phi_dot = pinv_velocity(jacobian, error, params.eta)[:3]
+        phi = reference[2]
+        return np.array([x_dot - d * np.sin(phi) * phi_dot, y_dot + d * np.cos(phi) * phi_dot])
+
+    law = CascadeLaw(MODEL, params)
+    first = law.step(start, task, DT).u  # the reference starts on the base: no error
+    np.testing.assert_allclose(point_velocity(start, first),
+                               reference_velocity(start, start), atol=1e-12)  # fmt: skip
+    error, jacobian = task.error(*MODEL.kinematics(start), start)
+    reference = start[:3] + DT * pinv_velocity(jacobian, error, params.eta)[:3]
+    lagging = start.copy()
+    lagging[:2] -= [0.01, -0.02]  # the real base has not followed
+    u = law.step(lagging, task, DT).u
+    target = np.array(offset_point(*reference, d))
+    point = np.array(offset_point(*lagging[:3], d))
+    expected = reference_velocity(lagging, reference) + np.array([1.5, 3.0]) * (target - point)
+    np.testing.assert_allclose(point_velocity(lagging, u), expected, atol=1e-12)
+    assert abs(u[0] * np.sin(lagging[2]) - u[1] * np.cos(lagging[2])) < 1e-12  # 5.11

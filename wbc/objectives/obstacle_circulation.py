@@ -4,8 +4,10 @@ The border constraint (5.28, wbc.constraints.obstacle_border) fixes the radial v
 base's point p on the border and leaves its tangential velocity free. When the start, the
 obstacle and the goal lie near one line, the task gains nothing to first order from either
 tangent, so the LP's best step is to stand still on the border: a saddle (seed 1 of the
-obstacle experiment stalled there at error 0.65). Once p has stood on an engaged border (moving
-slower than ``stall_speed``) for ``stall_time``, this term asks p to move along the border at
+obstacle experiment stalled there at error 0.65). Once p has stood still by an obstacle (moving
+slower than ``stall_speed``) for ``stall_time``, within ``near`` of the circle of the border
+(5.28's, or the vector-field inequality's, which stops p just short of it), with the obstacle
+between p and the goal, this term asks p to move along the border at
 ``speed``, t the unit tangent on the side the base heads to (counter-clockwise when it faces
 the centre exactly), until the obstacle no longer stands between p and the goal (5.25's h < 0)
 or p is ``release`` beyond the border. Away from a stall the task already picks its
@@ -31,14 +33,16 @@ class ObstacleCirculation:
 
     def __init__(self, weight: float, speed: float, margin: float, lookahead: float,
                  stall_speed: float = 0.01, stall_time: float = 0.5,
-                 release: float = 0.3) -> None:  # fmt: skip
+                 release: float = 0.3, near: float = 0.05) -> None:  # fmt: skip
         if not (weight >= 0.0 and speed >= 0.0 and margin >= 0.0 and lookahead >= 0.0
-                and stall_speed >= 0.0 and stall_time >= 0.0 and release >= 0.0):  # fmt: skip
+                and stall_speed >= 0.0 and stall_time >= 0.0 and release >= near >= 0.0
+                ):  # fmt: skip
             raise ValueError("obstacle circulation needs weight, speed, margin, lookahead, "
-                             "stall_speed, stall_time and release >= 0")  # fmt: skip
+                             "stall_speed, stall_time >= 0 and release >= near >= 0")  # fmt: skip
         self.weight, self.speed = weight, speed
         self.margin, self.lookahead = margin, lookahead
-        self.stall_speed, self.stall_time, self.release = stall_speed, stall_time, release
+        self.stall_speed, self.stall_time = stall_speed, stall_time
+        self.release, self.near = release, near
         self.reset()
 
     def reset(self) -> None:
@@ -63,7 +67,7 @@ class ObstacleCirculation:
                 row = point_velocity_row(*tangent, phi, self.lookahead, dof)
                 return ResidualCost(self.name, row[np.newaxis], np.array([-self.speed]),
                                     self.weight)
-            if not at.engaged:
+            if not (at.h > 0.0 and norm < radius + self.near):
                 continue
             slow = context.dt > 0.0 and moved < self.stall_speed * context.dt
             self._stalled_s = self._stalled_s + context.dt if slow else 0.0
