@@ -57,7 +57,6 @@ from parsimony.output import emit, result_only_stdout
 from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import Profile, ZenohSettings, load_profile
-from record.foxglove_views import views_of
 from record.report import write_report
 from record.session_file import MESSAGE_ENCODING, SessionWriter, info, read_session, stamp_of
 from sim2d.camera import ImageNoise, PlacedMarker, ceiling_camera, render
@@ -328,9 +327,7 @@ def repeated_session(source: Path, target: Path, seconds: float) -> float:
                 if r.log_time_ns + copy * period > end:
                     break
                 repeated = shifted(r.message, copy * period)
-                writer.write(r.key, repeated)
-                for view in views_of(r.topic_name, r.key, repeated):
-                    writer.write_raw(*view.channel(r.key), stamp_of(repeated))
+                writer.write(r.key, repeated, views=True)
                 latest = stamp_of(repeated)
             copy += 1
     return (latest - first) / 1e9

@@ -23,8 +23,7 @@ from components.process_entry import run_component
 from components.pubsub import Input
 from components.runtime import Component, Node
 from messages import topics
-from record.foxglove_views import views_of
-from record.session_file import SessionWriter, stamp_of
+from record.session_file import SessionWriter
 
 QUEUE = 10_000
 """Samples of one topic that may wait for the writer."""
@@ -61,10 +60,7 @@ class Recorder(Component):
 
     def _writer_of(self, name: str, key: str):
         def write(message) -> None:
-            self.writer.write(key, message)
-            if self.node.params["views"]:
-                for view in views_of(name, key, message):
-                    self.writer.write_raw(*view.channel(key), stamp_of(message))
+            self.writer.write(key, message, views=self.node.params["views"])
             self.node.counters["written"] += 1
 
         return write

@@ -1,11 +1,15 @@
 """The project's messages in Foxglove's well-known schemas, so that Foxglove's Image and 3D
 panels open a recording (or a live view) with no plugin:
 
-    CameraFrame            -> foxglove.RawImage         frame "camera", the same bytes (lossless)
+    CameraFrame            -> foxglove.CompressedImage  frame "camera", the same bytes: a JPEG
+                              or foxglove.RawImage      as it is, raw pixels as they are; the view
+                                                        alone carries them (``carries``)
     RobotState             -> foxglove.FrameTransforms  world -> estimate/base,
                                                         world -> estimate/end_effector
     SimTruth               -> foxglove.FrameTransforms  world -> truth/base, truth/end_effector
-    MarkerDetections       -> foxglove.FrameTransforms  camera -> marker_<id>
+    MarkerDetections       -> foxglove.FrameTransforms  camera -> marker_<id> (vision/markers),
+                                                        world -> estimate/marker_<id>
+                                                        (world/markers)
     Goal (pose task)       -> foxglove.FrameTransforms  world -> goal (control/goal, goal/request)
     Obstacles              -> foxglove.SceneUpdate      one cylinder per circle, frame "world"
 
@@ -17,6 +21,7 @@ protobuf, encoded by foxglove-sdk with its schema, and goes on the channel
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -24,9 +29,10 @@ from typing import Any
 
 import numpy as np
 from foxglove import messages as fox
+from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
 
 from messages import topics
-from messages.camera import CHANNELS, CameraFrame
+from messages.camera import CHANNELS, COMPRESSED, CameraFrame
 from messages.goal import Goal
 from messages.markers import MarkerDetections
 from messages.obstacles import Obstacles
@@ -51,19 +57,22 @@ class View:
     schema_data: bytes
     message_encoding: str
     data: bytes
+    carries: str = ""
+    """The bytes field of the message that this view carries as it is (a frame's pixels in its
+    RawImage): a file or a live view then sends it here alone (``carried``)."""
 
     def channel(self, key: str) -> tuple[str, str, str, bytes, str, bytes]:
-        """The arguments of ``SessionWriter.write_raw`` before the log time, for the view of
-        the message on ``key``."""
+        """The channel, schema, message encoding and data of the view of the message on
+        ``key`` (``record.session_file.Entry``)."""
         return (f"{key}/{self.channel_suffix}", self.schema_name, self.schema_encoding,
                 self.schema_data, self.message_encoding, self.data)  # fmt: skip
 
 
-def view(message: Any) -> View:
+def view(message: Any, carries: str = "") -> View:
     """A foxglove-sdk message as a ``View``: its protobuf schema and bytes."""
     schema = type(message).get_schema()
     return View(CHANNEL_SUFFIX, schema.name, schema.encoding, bytes(schema.data), "protobuf",
-                bytes(message.encode()))  # fmt: skip
+                bytes(message.encode()), carries)  # fmt: skip
 
 
 def timestamp(stamp_ns: int) -> fox.Timestamp:
@@ -96,11 +105,37 @@ def pose_transform(
 
 
 def image_views(frame: CameraFrame) -> list[View]:
-    return [view(fox.RawImage(
-        timestamp=timestamp(frame.header.stamp_ns), frame_id="camera", width=frame.width,
-        height=frame.height, encoding=frame.encoding,
-        step=frame.width * CHANNELS[frame.encoding], data=frame.data,
-    ))]  # fmt: skip
+    stamp = timestamp(frame.header.stamp_ns)
+    if frame.encoding in COMPRESSED:
+        image = fox.CompressedImage(timestamp=stamp, frame_id="camera", data=frame.data,
+                                    format=frame.encoding)  # fmt: skip
+    else:
+        step = frame.width * CHANNELS[frame.encoding]
+        image = fox.RawImage(timestamp=stamp, frame_id="camera", width=frame.width,
+                             height=frame.height, encoding=frame.encoding, step=step,
+                             data=frame.data)  # fmt: skip
+    return [view(image, carries="data")]
+
+
+CARRIERS = (fox.CompressedImage, fox.RawImage)
+"""The views that carry a field of their message (``View.carries``)."""
+
+
+@functools.cache
+def _protobuf_type(schema_name: str) -> type:
+    """A carrier's protobuf class, built from the schema foxglove-sdk writes for it."""
+    schemas = {carrier.get_schema().name: carrier.get_schema() for carrier in CARRIERS}
+    if schema_name not in schemas:
+        raise ValueError(f"a {schema_name} carries no field of a project message")
+    pool = descriptor_pool.DescriptorPool()
+    for file in descriptor_pb2.FileDescriptorSet.FromString(bytes(schemas[schema_name].data)).file:
+        pool.Add(file)
+    return message_factory.GetMessageClass(pool.FindMessageTypeByName(schema_name))
+
+
+def carried(schema_name: str, data: bytes) -> bytes:
+    """The bytes a view carries for its message: an image's ``data``."""
+    return bytes(_protobuf_type(schema_name).FromString(data).data)
 
 
 def robot_views(prefix: str) -> Callable[[RobotState | SimTruth], list[View]]:
@@ -116,11 +151,16 @@ def robot_views(prefix: str) -> Callable[[RobotState | SimTruth], list[View]]:
     return views
 
 
-def marker_views(detections: MarkerDetections) -> list[View]:
-    stamp = detections.header.stamp_ns
-    transforms = [pose_transform("camera", f"marker_{m.id}", m.pose, stamp)
-                  for m in detections.markers]  # fmt: skip
-    return [view(fox.FrameTransforms(transforms=transforms))] if transforms else []
+def marker_views(prefix: str) -> Callable[[MarkerDetections], list[View]]:
+    """Views of markers, ``<header.frame> -> <prefix>marker_<id>``."""
+
+    def views(detections: MarkerDetections) -> list[View]:
+        stamp, parent = detections.header.stamp_ns, detections.header.frame
+        transforms = [pose_transform(parent, f"{prefix}marker_{m.id}", m.pose, stamp)
+                      for m in detections.markers]  # fmt: skip
+        return [view(fox.FrameTransforms(transforms=transforms))] if transforms else []
+
+    return views
 
 
 def goal_views(goal: Goal) -> list[View]:
@@ -151,7 +191,8 @@ VIEWS: dict[str, Callable[[Any], list[View]]] = {
     topics.CAMERA_IMAGE.name: image_views,
     topics.ROBOT_STATE.name: robot_views("estimate/"),
     topics.SIM_TRUTH.name: robot_views("truth/"),
-    topics.VISION_MARKERS.name: marker_views,
+    topics.VISION_MARKERS.name: marker_views(""),
+    topics.WORLD_MARKERS.name: marker_views("estimate/"),
     topics.CONTROL_GOAL.name: goal_views,
     topics.GOAL_REQUEST.name: goal_views,
     topics.WORLD_OBSTACLES.name: obstacle_views,

@@ -1,10 +1,11 @@
 """A Foxglove live view of a running namespace: foxglove-sdk's WebSocket server, on 127.0.0.1
 only, carrying every message of the namespace's topics as it arrives.
 
-Each message goes out as a recording holds it (``record.session_file``): on the channel of its
-key as JSON with the project's JSON Schema, and beside it each of its well-known views
-(``record.foxglove_views``: ``foxglove.RawImage``, ``foxglove.FrameTransforms``,
-``foxglove.SceneUpdate``) on ``<key>/foxglove``, logged at the message's stamp. A channel is
+Each message goes out as a recording holds it (``record.session_file.entries``): on the channel
+of its key as JSON with the project's JSON Schema, and beside it each of its well-known views
+(``record.foxglove_views``: ``foxglove.CompressedImage`` or ``RawImage``,
+``foxglove.FrameTransforms``, ``foxglove.SceneUpdate``) on ``<key>/foxglove``, logged at the
+message's stamp; an image goes once, in its view. A channel is
 created, and advertised to the clients, on its first message. A sample that does not decode is
 dropped, counted (``malformed``) and said (``parsimony view`` logs it at most once per key every
 few seconds).
@@ -22,8 +23,7 @@ import foxglove
 import zenoh
 
 from messages import codec, topics
-from record.foxglove_views import views_of
-from record.session_file import json_channel, stamp_of
+from record.session_file import Entry, entries, stamp_of
 
 HOST = "127.0.0.1"
 """The only address the server listens on."""
@@ -101,30 +101,21 @@ class LiveView:
                 self._warn(key, f"view: malformed sample dropped: {error}")
             return
         stamp = stamp_of(message)
-        self._log(key, *json_channel(message), stamp)
-        for view in views_of(topic.name, key, message):
-            self._log(*view.channel(key), stamp)
+        for entry in entries(key, message):
+            self._log(entry, stamp)
         with self._lock:
             self.shown += 1
 
-    def _log(
-        self,
-        channel_name: str,
-        schema_name: str,
-        schema_encoding: str,
-        schema_data: bytes,
-        message_encoding: str,
-        data: bytes,
-        log_time_ns: int,
-    ) -> None:
-        """``data`` on the channel of this name and schema, created on first use."""
+    def _log(self, entry: Entry, log_time_ns: int) -> None:
+        """``entry`` on the channel of its name and schema, created on first use."""
         with self._lock:
-            channel = self._channels.get((channel_name, schema_name))
+            channel = self._channels.get((entry.channel, entry.schema_name))
             if channel is None:
-                schema = foxglove.Schema(name=schema_name, encoding=schema_encoding,
-                                         data=schema_data)  # fmt: skip
-                channel = foxglove.Channel(channel_name, schema=schema,
-                                           message_encoding=message_encoding,
-                                           context=self._context)  # fmt: skip
-                self._channels[(channel_name, schema_name)] = channel
-        channel.log(data, log_time=log_time_ns)
+                schema = foxglove.Schema(name=entry.schema_name, encoding=entry.schema_encoding,
+                                         data=entry.schema_data)  # fmt: skip
+                channel = foxglove.Channel(entry.channel, schema=schema,
+                                           message_encoding=entry.message_encoding,
+                                           context=self._context,
+                                           metadata=dict(entry.metadata))  # fmt: skip
+                self._channels[(entry.channel, entry.schema_name)] = channel
+        channel.log(entry.data, log_time=log_time_ns)

@@ -4,9 +4,14 @@ The project's messages go in as JSON (message encoding ``json``, schema encoding
 ``jsonschema``, schema name the type's name, schema data its JSON Schema, ``bytes`` fields as
 base64 strings marked ``"contentEncoding": "base64"``), so Foxglove plots them as they are, and
 come back into their pydantic types exactly: Python writes a float as its shortest repr, which
-reads back bit for bit. Other channels (the Foxglove views) are written as given
-(``write_raw``). Chunks are zstd-compressed; ``flush`` closes the current one and pushes it to
-the file, so a writer killed by SIGKILL loses only what came after its last flush.
+reads back bit for bit. Beside a message go its Foxglove views (``record.foxglove_views``), when
+asked for, on channels of their own. Each image is stored once: a view that carries a field as
+it is (a frame's JPEG or pixels in its ``foxglove.CompressedImage`` or ``RawImage``) holds it,
+and the message's JSON leaves it out; the channel's metadata names the carrier
+(``CARRIED_FIELD``, ``CARRIER``), and reading puts the field back from the view of the same
+log time. Other channels are written as given (``write_raw``). Chunks are zstd-compressed;
+``flush`` closes the current one and pushes it to the file, so a writer killed by SIGKILL loses
+only what came after its last flush.
 
 A file without a footer (its writer was killed) is read record by record with the streaming
 reader up to its last complete chunk: ``read_session`` and ``info`` work on it as they are, and
@@ -32,6 +37,7 @@ from pydantic import BaseModel
 
 from messages import topics
 from messages.schema import json_schema
+from record.foxglove_views import View, carried, views_of
 
 MESSAGE_ENCODING = "json"
 """The message encoding of the project's own channels."""
@@ -41,6 +47,10 @@ LIBRARY = "parsimony"
 """What the MCAP header names as the writer."""
 SEQUENCE_MODULUS = 2**32
 """MCAP's message sequence is a uint32 per channel; it wraps."""
+CARRIED_FIELD = "parsimony.carried_field"
+"""Channel metadata: the field the channel's JSON leaves out, because ``CARRIER`` holds it."""
+CARRIER = "parsimony.carrier"
+"""Channel metadata: the channel whose message of the same log time holds ``CARRIED_FIELD``."""
 
 
 @dataclass(frozen=True)
@@ -67,17 +77,17 @@ def bytes_fields(message_type: type[BaseModel]) -> tuple[str, ...]:
     return tuple(n for n, f in message_type.model_fields.items() if f.annotation is bytes)
 
 
-def to_json(message: BaseModel) -> bytes:
-    """``message`` as compact JSON, its ``bytes`` fields base64 (nested bytes are refused).
+def to_json(message: BaseModel, left_out: str = "") -> bytes:
+    """``message`` as compact JSON, its ``bytes`` fields base64 (nested bytes are refused), the
+    field ``left_out`` (one a view carries) left out.
 
-    A bytes field (an image: 300 kB) is neither copied by ``model_dump`` nor scanned by
-    ``json.dumps``: a marker holds its place, then gives it to the base64 text, which needs no
-    escaping. This halves the recorder's time per camera frame.
+    A bytes field (an image) is neither copied by ``model_dump`` nor scanned by ``json.dumps``:
+    a marker holds its place, then gives it to the base64 text, which needs no escaping.
     """
-    names = bytes_fields(type(message))
-    dumped = message.model_dump(exclude=set(names))
+    names = [name for name in bytes_fields(type(message)) if name != left_out]
+    dumped = message.model_dump(exclude={*bytes_fields(type(message)), left_out})
     fields = {name: BYTES_MARKER if name in names else dumped[name]
-              for name in type(message).model_fields}  # fmt: skip
+              for name in type(message).model_fields if name != left_out}  # fmt: skip
     text = json.dumps(fields, allow_nan=False, separators=(",", ":")).encode()
     for name in names:
         value = b'"' + base64.b64encode(getattr(message, name)) + b'"'
@@ -90,31 +100,59 @@ BYTES_MARKER = "\u0000bytes\u0000"
 _ENCODED_MARKER = json.dumps(BYTES_MARKER).encode()
 
 
-def json_channel(message: BaseModel) -> tuple[str, str, bytes, str, bytes]:
-    """(schema name, schema encoding, schema data, message encoding, data) of a project
-    message on its own channel: its type's name and JSON Schema, and the message as JSON."""
-    message_type = type(message)
-    return (message_type.__name__, SCHEMA_ENCODING, schema_of(message_type), MESSAGE_ENCODING,
-            to_json(message))  # fmt: skip
+@dataclass(frozen=True)
+class Entry:
+    """One record of a message as a session holds it: its channel (key, schema, encoding and
+    metadata) and its data."""
+
+    channel: str
+    schema_name: str
+    schema_encoding: str
+    schema_data: bytes
+    message_encoding: str
+    data: bytes
+    metadata: tuple[tuple[str, str], ...] = ()
 
 
-def from_json(data: bytes, message_type: type[BaseModel]) -> BaseModel:
-    """The message ``to_json`` wrote, exactly (``model_validate`` of the decoded JSON)."""
+def entries(key: str, message: BaseModel, views: bool = True) -> list[Entry]:
+    """A project message on ``key`` as a session (or a live view) holds it: its JSON on the
+    channel ``key``, then, if ``views``, each Foxglove view on its own channel; a field that a
+    view carries is left out of the JSON, which names the carrier in its metadata."""
+    found: list[View] = []
+    if views:
+        topic = _topic_of(key, type(message).__name__)
+        found = views_of(topic.name, key, message) if topic is not None else []
+    carrier = next((v for v in found if v.carries), None)
+    left_out = carrier.carries if carrier is not None else ""
+    metadata = ((CARRIED_FIELD, left_out), (CARRIER, carrier.channel(key)[0])) if left_out else ()
+    own = Entry(key, type(message).__name__, SCHEMA_ENCODING, schema_of(type(message), left_out),
+                MESSAGE_ENCODING, to_json(message, left_out), metadata)  # fmt: skip
+    return [own, *(Entry(*v.channel(key)) for v in found)]
+
+
+def from_json(
+    data: bytes, message_type: type[BaseModel], carried_fields: dict[str, bytes] | None = None
+) -> BaseModel:
+    """The message ``to_json`` wrote, exactly (``model_validate`` of the decoded JSON), with
+    the fields it left out taken from ``carried_fields``."""
     fields = json.loads(data)
     for name in bytes_fields(message_type):
         if isinstance(fields.get(name), str):
             fields[name] = base64.b64decode(fields[name], validate=True)
-    return message_type.model_validate(fields)
+    return message_type.model_validate({**fields, **(carried_fields or {})})
 
 
 @functools.cache
-def schema_of(message_type: type[BaseModel]) -> bytes:
-    """The JSON Schema of a type as written in the file, base64 fields marked as such."""
+def schema_of(message_type: type[BaseModel], left_out: str = "") -> bytes:
+    """The JSON Schema of a type as written in the file, base64 fields marked as such, the
+    field ``left_out`` (carried by a view) left out."""
     schema = json_schema(message_type)
-    properties = dict(schema["properties"])
+    properties = {n: p for n, p in schema["properties"].items() if n != left_out}
     for name in bytes_fields(message_type):
-        properties[name] = {**properties[name], "contentEncoding": "base64"}
-    return json.dumps({**schema, "properties": properties}).encode()
+        if name != left_out:
+            properties[name] = {**properties[name], "contentEncoding": "base64"}
+    required = [n for n in schema.get("required", ()) if n != left_out]
+    return json.dumps({**schema, "properties": properties, "required": required}).encode()
 
 
 class SessionWriter:
@@ -128,7 +166,7 @@ class SessionWriter:
         self._writer = Writer(self._file, chunk_size=chunk_size, compression=CompressionType.ZSTD)
         self._writer.start(library=LIBRARY)
         self._schemas: dict[tuple[str, str, bytes], int] = {}
-        self._channels: dict[str, int] = {}
+        self._channels: dict[tuple[str, tuple[str, str, bytes]], int] = {}
         self._sequences: dict[int, int] = {}
         self._closed = False
 
@@ -138,34 +176,30 @@ class SessionWriter:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def write(self, key: str, message: BaseModel, log_time_ns: int | None = None) -> None:
-        """``message`` as JSON on the channel ``key``, logged at its stamp unless given."""
-        log_time = stamp_of(message) if log_time_ns is None else log_time_ns
-        self.write_raw(key, *json_channel(message), log_time)
-
-    def write_raw(
-        self,
-        key: str,
-        schema_name: str,
-        schema_encoding: str,
-        schema_data: bytes,
-        message_encoding: str,
-        data: bytes,
-        log_time_ns: int,
+    def write(
+        self, key: str, message: BaseModel, log_time_ns: int | None = None, views: bool = False
     ) -> None:
-        """``data`` on the channel ``key``, which is created with this schema on first use
-        (later calls' schema arguments are then not looked at); published now."""
-        channel = self._channels.get(key)
+        """``message`` as JSON on the channel ``key`` and, if ``views``, its Foxglove views
+        (``entries``), logged at its stamp unless given."""
+        log_time = stamp_of(message) if log_time_ns is None else log_time_ns
+        for entry in entries(key, message, views):
+            self.write_raw(entry, log_time)
+
+    def write_raw(self, entry: Entry, log_time_ns: int) -> None:
+        """``entry`` on the channel of its key and schema, which is created with its metadata on
+        first use (later entries' are then not looked at); published now."""
+        schema = (entry.schema_name, entry.schema_encoding, bytes(entry.schema_data))
+        channel = self._channels.get((entry.channel, schema))
         if channel is None:
-            schema = (schema_name, schema_encoding, bytes(schema_data))
             if schema not in self._schemas:
                 self._schemas[schema] = self._writer.register_schema(*schema)
-            channel = self._writer.register_channel(key, message_encoding, self._schemas[schema])
-            self._channels[key] = channel
+            channel = self._writer.register_channel(entry.channel, entry.message_encoding,
+                                                    self._schemas[schema], dict(entry.metadata))
+            self._channels[(entry.channel, schema)] = channel
             self._sequences[channel] = 0
         sequence = self._sequences[channel]
         self._sequences[channel] = (sequence + 1) % SEQUENCE_MODULUS
-        self._writer.add_message(channel, log_time_ns, data, time.time_ns(), sequence)
+        self._writer.add_message(channel, log_time_ns, entry.data, time.time_ns(), sequence)
 
     def flush(self) -> None:
         """Close the current chunk and push it to the file (no fsync): a kill loses nothing
@@ -254,14 +288,42 @@ def _project_topic(schema: Schema | None, channel: Channel) -> topics.Topic | No
 def read_session(path: Path) -> Iterator[Recorded]:
     """Every message of a session file (all its complete chunks if it has no footer), in
     log-time order (stable: ties keep file order). The project's messages are decoded into
-    their types; other channels' messages (the Foxglove views) come with ``topic_name`` and
-    ``message`` None. Decoding is lazy, so a caller that skips images never builds them."""
-    found = sorted(_Scan(path), key=lambda record: record[2].log_time)
+    their types, a field carried by a view put back; other channels' messages (the Foxglove
+    views) come with ``topic_name`` and ``message`` None. Decoding is lazy, so a caller that
+    skips images never builds them. In a file cut short, a message whose carrier was cut off
+    is left out; in a whole file, it is an ``McapError``."""
+    scan = _Scan(path)
+    found = sorted(scan, key=lambda record: record[2].log_time)
+    keys = {channel.metadata[CARRIER] for _, channel, _ in found if CARRIER in channel.metadata}
+    carriers = {(channel.topic, message.log_time): (schema, message)
+                for schema, channel, message in found if channel.topic in keys}
     for schema, channel, message in found:
         topic = _project_topic(schema, channel)
-        decoded = from_json(message.data, topic.type) if topic is not None else None
+        decoded = None
+        if topic is not None:
+            carried_fields = _carried_fields(channel, message, carriers)
+            if carried_fields is None:
+                if scan.complete:
+                    raise McapError(f"{path}: {channel.topic} at {message.log_time} ns has no "
+                                    f"{channel.metadata[CARRIER]} message")  # fmt: skip
+                continue
+            decoded = from_json(message.data, topic.type, carried_fields)
         name = topic.name if topic is not None else None
         yield Recorded(channel.topic, name, message.log_time, decoded)
+
+
+def _carried_fields(
+    channel: Channel, message: Message, carriers: dict[tuple[str, int], tuple]
+) -> dict[str, bytes] | None:
+    """The fields of a project message that its channel's carrier holds (none for a channel
+    without one), or None when the carrier's message of its log time is missing."""
+    if CARRIER not in channel.metadata:
+        return {}
+    found = carriers.get((channel.metadata[CARRIER], message.log_time))
+    if found is None:
+        return None
+    schema, view = found
+    return {channel.metadata[CARRIED_FIELD]: carried(schema.name, view.data)}
 
 
 def info(path: Path) -> dict[str, Any]:

@@ -24,8 +24,9 @@ from messages.markers import MarkerDetection, MarkerDetections
 from messages.obstacles import Circle, Obstacles
 from messages.state import RobotState
 from messages.truth import SimTruth
-from record.foxglove_views import OBSTACLE_HEIGHT_M, View, views_of
-from record.session_file import SessionWriter, stamp_of
+from record.foxglove_views import OBSTACLE_HEIGHT_M, View, carried, views_of
+from record.session_file import SessionWriter
+from vision.images import jpeg
 from wbc import dq
 
 STAMP_NS = 1_700_000_000_123_456_789
@@ -161,6 +162,20 @@ def test_an_image_is_a_raw_image_with_the_same_bytes(encoding: str) -> None:
     )
 
 
+def test_a_jpeg_frame_is_a_compressed_image_with_the_same_file() -> None:
+    grey = np.random.default_rng(3).integers(0, 256, (24, 32), dtype=np.uint8)
+    data = jpeg(grey, 90)
+    frame = CameraFrame.model_validate({
+        "header": HEADER, "encoding": "jpeg", "width": 32, "height": 24, "data": data,
+        "intrinsics": {"fx": 40.0, "fy": 40.0, "cx": 15.5, "cy": 11.5},
+    })  # fmt: skip
+    (view,) = views_of(topics.CAMERA_IMAGE.name, "sim/camera/image", frame)
+    assert (view.schema_name, view.carries) == ("foxglove.CompressedImage", "data")
+    image = decode(view)
+    assert (image["data"], image["format"], image["frame_id"]) == (data, "jpeg", "camera")
+    assert carried(view.schema_name, view.data) == data
+
+
 def transforms_of(view: View) -> dict[str, dict[str, Any]]:
     assert view.schema_name == "foxglove.FrameTransforms"
     return {t["child_frame_id"]: t for t in decode(view)["transforms"]}
@@ -190,19 +205,26 @@ def test_a_robot_state_gives_the_base_and_end_effector_frames(message_type, pref
     assert vector(hand["rotation"], "xyzw") == pytest.approx([0, 0, half, half], abs=1e-12)
 
 
-def test_markers_are_frames_of_the_camera() -> None:
-    detections = MarkerDetections(header=HEADER, markers=(
-        MarkerDetection(id=3, pose=pose_dq(0.0, (0.1, 0.2, 2.5)), reprojection_error=0.3),
-        MarkerDetection(id=7, pose=pose_dq(math.pi, (-0.4, 0.0, 2.4)), reprojection_error=0.5),
-    ))  # fmt: skip
-    (view,) = views_of(topics.VISION_MARKERS.name, "sim/vision/markers", detections)
+def test_markers_are_frames_of_the_camera_and_placed_ones_of_the_world() -> None:
+    seen = (MarkerDetection(id=3, pose=pose_dq(0.0, (0.1, 0.2, 2.5)), reprojection_error=0.3),
+            MarkerDetection(id=7, pose=pose_dq(math.pi, (-0.4, 0.0, 2.4)),
+                            reprojection_error=0.5))  # fmt: skip
+    camera = Header(stamp_ns=STAMP_NS, frame="camera", seq=3, source="test")
+    (view,) = views_of(topics.VISION_MARKERS.name, "sim/vision/markers",
+                       MarkerDetections(header=camera, markers=seen))  # fmt: skip
     frames = transforms_of(view)
     assert set(frames) == {"marker_3", "marker_7"}
     assert {f["parent_frame_id"] for f in frames.values()} == {"camera"}
     assert vector(frames["marker_7"]["translation"], "xyz") == pytest.approx([-0.4, 0, 2.4])
     assert vector(frames["marker_7"]["rotation"], "xyzw") == pytest.approx([0, 0, 1, 0], abs=1e-12)
-    empty = MarkerDetections(header=HEADER)
+    empty = MarkerDetections(header=camera)
     assert views_of(topics.VISION_MARKERS.name, "sim/vision/markers", empty) == []
+    # The estimator's markers, placed in F0, are frames of the world beside the truth's.
+    (placed,) = views_of(topics.WORLD_MARKERS.name, "sim/world/markers",
+                         MarkerDetections(header=HEADER, markers=seen))  # fmt: skip
+    frames = transforms_of(placed)
+    assert set(frames) == {"estimate/marker_3", "estimate/marker_7"}
+    assert {f["parent_frame_id"] for f in frames.values()} == {"world"}
 
 
 def test_a_pose_goal_is_a_frame_and_a_position_goal_has_no_view() -> None:
@@ -253,9 +275,7 @@ def test_views_go_beside_their_message_in_a_session_file(tmp_path: Path) -> None
     )
     path = tmp_path / "session.mcap"
     with SessionWriter(path) as writer:
-        writer.write(KEY, state)
-        for view in views_of(topics.ROBOT_STATE.name, KEY, state):
-            writer.write_raw(*view.channel(KEY), stamp_of(state))
+        writer.write(KEY, state, views=True)
     with path.open("rb") as stream:
         read = {c.topic: (s, m) for s, c, m in make_reader(stream).iter_messages()}
     schema, message = read[f"{KEY}/foxglove"]

@@ -33,7 +33,7 @@ from messages.state import RobotState
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.foxglove_views import View
-from record.session_file import from_json, schema_of
+from record.session_file import CARRIED_FIELD, CARRIER, from_json, schema_of
 
 NAMESPACE = "live"
 WIDTH, HEIGHT = 64, 48
@@ -209,7 +209,9 @@ def test_a_websocket_client_sees_live_images_and_frames(system) -> None:
 
     camera_json = channels[f"{NAMESPACE}/camera/image"]
     assert (camera_json["schemaName"], camera_json["encoding"]) == ("CameraFrame", "json")
-    assert camera_json["schema"] == schema_of(CameraFrame).decode()
+    # The image goes once, in its view: the JSON leaves the pixels out and names the carrier.
+    assert camera_json["schema"] == schema_of(CameraFrame, "data").decode()
+    assert camera_json["metadata"] == {CARRIED_FIELD: "data", CARRIER: IMAGE_VIEW}
     assert channels[IMAGE_VIEW]["schemaName"] == "foxglove.RawImage"
     assert channels[FRAMES_VIEW]["schemaName"] == "foxglove.FrameTransforms"
 

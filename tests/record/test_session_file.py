@@ -10,6 +10,7 @@ import random
 import struct
 from pathlib import Path
 
+import numpy as np
 import pytest
 from mcap.exceptions import McapError
 from mcap.reader import make_reader
@@ -20,7 +21,8 @@ from messages.camera import CameraFrame
 from messages.clock import Clock
 from messages.header import Header
 from messages.state import RobotState
-from record.session_file import SessionWriter, info, read_session, recover
+from record.session_file import CARRIER, Entry, SessionWriter, info, read_session, recover
+from vision.images import jpeg
 
 NAMESPACE = "lab/robot1"
 TOPIC_OF_TYPE = {topic.type: topic for topic in topics.TOPICS.values()}
@@ -83,6 +85,31 @@ def test_log_time_is_the_stamp_unless_given(tmp_path: Path) -> None:
     assert [r.log_time_ns for r in read_session(path)] == [3_000, 5_000, 7_000]
 
 
+def jpeg_image(stamp_ns: int) -> CameraFrame:
+    grey = np.random.default_rng(stamp_ns).integers(0, 256, (48, 64), dtype=np.uint8)
+    return CameraFrame.model_validate({
+        "header": header(stamp_ns), "encoding": "jpeg", "width": 64, "height": 48,
+        "data": jpeg(grey, 90), "intrinsics": {"fx": 80.0, "fy": 80.0, "cx": 31.5, "cy": 23.5},
+    })  # fmt: skip
+
+
+def test_with_views_each_image_is_stored_once_and_reads_back_exactly(tmp_path: Path) -> None:
+    frames = [image(2, "rgb8"), image(3, "mono8"), jpeg_image(4), jpeg_image(5)]
+    path = tmp_path / "session.mcap"
+    with SessionWriter(path) as writer:
+        for frame in frames:
+            writer.write(topics.CAMERA_IMAGE.key(NAMESPACE), frame, views=True)
+    assert [r.message for r in read_session(path) if r.message is not None] == frames
+    # The pixels are in the views alone: the frames' JSON is a few hundred bytes each.
+    by_key = {c["key"]: c for c in info(path)["channels"]}
+    key = topics.CAMERA_IMAGE.key(NAMESPACE)
+    assert by_key[key]["bytes"] < 500 * len(frames)
+    assert by_key[f"{key}/foxglove"]["bytes"] < sum(len(f.data) for f in frames) + 200
+    with path.open("rb") as stream:
+        channels = make_reader(stream).get_summary().channels.values()
+    assert {c.topic: c.metadata.get(CARRIER) for c in channels}[key] == f"{key}/foxglove"
+
+
 def test_floats_and_images_survive_bit_for_bit(tmp_path: Path) -> None:
     awkward = (0.1 + 0.2, 1 / 3, -0.0, 5e-324, 1.7976931348623157e308)
     message = RobotState(header=header(1), base_pose=awkward[:3], arm_joints=awkward,
@@ -135,8 +162,8 @@ def test_the_mcap_package_reads_the_file_with_every_schema(tmp_path: Path) -> No
     with SessionWriter(path) as writer:
         for message in EXAMPLES:
             writer.write(key_of(message), message)
-        writer.write_raw(f"{NAMESPACE}/notes", "Note", "jsonschema", b'{"type":"object"}', "json",
-                         b'{"text":"hello"}', 5)  # fmt: skip
+        writer.write_raw(Entry(f"{NAMESPACE}/notes", "Note", "jsonschema", b'{"type":"object"}',
+                               "json", b'{"text":"hello"}'), 5)  # fmt: skip
     with path.open("rb") as stream:
         reader = make_reader(stream)
         summary = reader.get_summary()
