@@ -7,19 +7,23 @@ camera publish on the real robot, every ``step_s`` of simulated time::
     arm/joint_states   the servo angles and speeds
     base/odometry      the wheel encoder counts (noise and slip from the parameters), the
                        distances and the dead-reckoned pose from them, as the Create driver does
-    camera/image       a 640x480 mono8 frame of the scene's markers at the camera's rate
+    camera/image       a 640x480 grey frame of the scene's markers at the camera's rate, as a
+                       JPEG of ``jpeg_quality`` (as a UVC camera's MJPEG stream) or raw mono8
     sim/truth          the real pose, joints, end effector and contacts (tests and reports only)
 
 It stops the robot when no command has arrived for ``command_timeout_s`` of simulated time.
 
 Time: ``real_time_factor`` 1 runs as fast as the wall clock, 2 twice as fast, 0 as fast as it
 can. With ``lockstep`` each step waits until the loop has answered it, acknowledged by stamps:
-a camera frame stamped t by ``vision/markers`` (the tracker) and ``world/obstacles`` (the
-estimator, which publishes both each frame) stamped t, then the sensors of t by
-``base/command`` and ``arm/command`` stamped t (the controller answers the state of t with
-commands of t). Only then does t advance, so a run does not depend on the machine's load. An
-answer missing for ``ack_timeout_s`` host seconds is counted (``lockstep_timeouts``) and the
-step goes on. The simulator starts when ``paused`` is set false (a profile may start it so).
+the sensors of t by ``base/command`` and ``arm/command`` stamped t (the controller answers the
+state of t with commands of t), and a camera frame stamped t by ``vision/markers`` (the
+tracker) and ``world/markers`` (the estimator) stamped t, before the sensors of
+t + ``scene.camera.latency_s`` (when the estimator uses the frame) and before the next frame,
+whichever comes first: the tracker works on a frame while the loop runs on, and a frame is
+never replaced by the next before it is answered. Only then does t advance, so a run does not
+depend on the machine's load. An answer missing for ``ack_timeout_s`` host seconds is counted
+(``lockstep_timeouts``) and the step goes on. The simulator starts when ``paused`` is set false
+(a profile may start it so).
 """
 
 from __future__ import annotations
@@ -44,14 +48,9 @@ from messages.joints import JointStates
 from messages.odometry import BaseOdometry
 from messages.truth import SimTruth
 from profiles.scene import Scene
-from sim2d.camera import (
-    ImageNoise,
-    PinholeCamera,
-    PlacedMarker,
-    ceiling_camera,
-    render,
-)
+from sim2d.camera import ImageNoise, PlacedMarker, Renderer, ceiling_camera
 from sim2d.world import World, WorldSettings, wheel_distance_per_count
+from vision.images import jpeg
 from wbc.base_motion import dead_reckoning
 from wbc.obstacles import Circle
 from wbc.planar import planar_pose
@@ -83,6 +82,10 @@ def parses(name: str, count: int | None, group: int):
     return lambda text: floats(str(text), name, count, group)
 
 
+FRAME_ANSWERS = tuple(topic.name for topic in topics.FRAME_ANSWERS)
+COMMANDS = ("base/command", "arm/command")
+
+
 @dataclass
 class Awaited:
     """The answers a lockstep step waits for: the stamps that must reach ``stamp_ns``."""
@@ -93,6 +96,14 @@ class Awaited:
     deadline: float
 
 
+@dataclass
+class Frame:
+    """A camera frame published and not yet answered (lockstep), and when, host seconds."""
+
+    stamp_ns: int
+    published: float
+
+
 class Simulator(Component):
     """sim2d: world, encoders, servos and ceiling camera (see the module docstring)."""
 
@@ -100,7 +111,7 @@ class Simulator(Component):
         Input(topics.BASE_COMMAND),
         Input(topics.ARM_COMMAND),
         Input(topics.VISION_MARKERS),
-        Input(topics.WORLD_OBSTACLES),
+        Input(topics.WORLD_MARKERS),
     )
     writes = (
         topics.SIM_CLOCK,
@@ -133,6 +144,9 @@ class Simulator(Component):
         Param("camera", bool, True, doc="render camera frames"),
         Param("image_noise", float, 2.0, low=0.0, high=50.0, doc="pixel noise std, grey levels"),
         Param("image_blur_px", float, 0.6, low=0.0, high=5.0, doc="Gaussian blur sigma, px"),
+        Param("image_format", str, "jpeg", choices=("jpeg", "mono8"),
+              doc="camera frames as JPEG files or raw grey pixels"),
+        Param("jpeg_quality", int, 90, low=1, high=100, doc="JPEG quality of the frames"),
         Param("encoder_noise_counts", float, 0.0, low=0.0, high=100.0,
               doc="encoder noise std per step, counts"),
         Param("wheel_slip", float, 0.0, low=0.0, high=0.5, doc="wheel slip std, fraction"),
@@ -159,16 +173,21 @@ class Simulator(Component):
         self.rng = np.random.default_rng(p["seed"] + 1)
         self.step_ns = round(p["step_s"] * 1e9)
         self.now_ns = time.time_ns() if p["host_epoch"] else 0
-        self.camera = self._camera()
+        self.hidden = floats(p["hide_base_marker"], "hide_base_marker", None, 2)
+        self.renderer = self._renderer()
         self.frame_period_ns = round(1e9 / self.scene.camera.rate_hz)
         self.next_frame_ns = self.now_ns
         self.metres_per_count = wheel_distance_per_count(self.robot.base, settings.counts_per_turn)
         self.odometry_pose = (0.0, 0.0, 0.0)
         self.last_counts = self.world.encoder_counts
         self.last_command_ns: int | None = None
+        self.latency_ns = round(self.scene.camera.latency_s * 1e9)
         self.awaited: Awaited | None = None
+        self.unanswered: Frame | None = None
+        self.frame_done = True
         self.answered: dict[str, int] = {}
-        self.answer_times = {k: Durations(node.counters, k) for k in ("frame", "loop")}
+        self.answer_times = {k: Durations(node.counters, k)
+                             for k in ("frame", "frame_wait", "loop")}  # fmt: skip
         node.counters["lockstep_timeouts"] = 0
         node.counters["contacts"] = 0
         self.publishers = {t.name: node.publisher(t) for t in self.writes}
@@ -213,58 +232,75 @@ class Simulator(Component):
         self._kick()
 
     def step(self) -> None:
-        """Advance one step; publish the clock, and the camera frame when one is due."""
+        """Advance one step; publish the clock, the camera frame when one is due, the sensors."""
         self._apply_commands()
         self.world.step(self.step_ns / 1e9)
         # On host time the stamps are the host's: the paced steps lag it under load.
         host = self.node.params["host_epoch"]
         self.now_ns = time.time_ns() if host else self.now_ns + self.step_ns
         self.publishers["sim/clock"].put(Clock(stamp_ns=self.now_ns))
-        if self.camera is not None and self.now_ns >= self.next_frame_ns:
+        self.frame_done = self.renderer is None or self.now_ns < self.next_frame_ns
+        self._go_on()
+
+    def _go_on(self) -> None:
+        """The rest of a step, each part once the answers it needs are in (lockstep): the
+        frame due (after the last frame's answers), the sensors (after the answers of a frame
+        whose latency has passed), then the wait for the commands."""
+        frame = self.unanswered
+        if frame is not None and self._has_answers(frame.stamp_ns):
+            self.unanswered = frame = None
+        if not self.frame_done:
+            if frame is not None:
+                return self._await(FRAME_ANSWERS, frame.stamp_ns)
+            self.frame_done = True
             self.next_frame_ns += self.frame_period_ns
             self._publish_frame()
             if self.node.params["lockstep"]:
-                self._await(tuple(topic.name for topic in topics.FRAME_ANSWERS))
-                return
-        self._publish_sensors()
-
-    def _publish_sensors(self) -> None:
+                self.unanswered = frame = Frame(self.now_ns, time.monotonic())
+        if frame is not None and frame.stamp_ns + self.latency_ns <= self.now_ns:
+            return self._await(FRAME_ANSWERS, frame.stamp_ns)
         self._publish_joints()
         self._publish_odometry()
         self._publish_truth()
         if self.node.params["lockstep"]:
-            self._await(("base/command", "arm/command"))
+            self._await(COMMANDS, self.now_ns)
 
-    def _await(self, names: tuple[str, ...]) -> None:
+    def _has_answers(self, stamp_ns: int, names: tuple[str, ...] = FRAME_ANSWERS) -> bool:
+        return all(self.answered.get(name, -1) >= stamp_ns for name in names)
+
+    def _await(self, names: tuple[str, ...], stamp_ns: int) -> None:
         now = time.monotonic()
-        self.awaited = Awaited(self.now_ns, names, now, now + self.node.params["ack_timeout_s"])
+        self.awaited = Awaited(stamp_ns, names, now, now + self.node.params["ack_timeout_s"])
 
     def _answer_handler(self, name: str):
         def on_answer(message) -> None:
-            if name in ("base/command", "arm/command"):
+            if name in COMMANDS:
                 self._take_command(name, message)
             stamp = message.header.stamp_ns
             self.answered[name] = max(self.answered.get(name, -1), stamp)
+            frame = self.unanswered
+            if name in FRAME_ANSWERS and frame is not None and self._has_answers(frame.stamp_ns):
+                # Host time from publishing a frame to its last answer (tracker and estimator).
+                self.answer_times["frame"].note(time.monotonic() - frame.published)
             self._check_answered()
 
         return on_answer
 
     def _check_answered(self) -> None:
         awaited = self.awaited
-        if awaited is None:
-            return
-        if all(self.answered.get(name, -1) >= awaited.stamp_ns for name in awaited.topics):
-            # Host time from publishing to the last answer: a camera frame to the tracker's
-            # markers and the estimator's obstacles, or the sensors to the controller's commands.
-            kind = "frame" if "vision/markers" in awaited.topics else "loop"
+        if awaited is not None and self._has_answers(awaited.stamp_ns, awaited.topics):
+            # Host time the step waited: for a frame's answers, or for the commands that
+            # answer the sensors (the loop through the estimator and the controller).
+            kind = "frame_wait" if awaited.topics == FRAME_ANSWERS else "loop"
             self.answer_times[kind].note(time.monotonic() - awaited.since)
             self._proceed()
 
     def _proceed(self) -> None:
         """The awaited answers are in (or overdue): go on with the step or the next one."""
         awaited, self.awaited = self.awaited, None
-        if awaited is not None and "vision/markers" in awaited.topics:
-            self._publish_sensors()
+        if awaited is not None and awaited.topics == FRAME_ANSWERS:
+            self.unanswered = None
+            self._go_on()
         self._kick()
 
     def _check_overdue(self) -> None:
@@ -280,7 +316,7 @@ class Simulator(Component):
     # -- commands in, sensors out ---------------------------------------------------------
 
     def _take_command(self, name: str, message: BaseCommand | ArmCommand) -> None:
-        if name == "base/command":
+        if name == COMMANDS[0]:
             self.base_command = message
         else:
             self.arm_command = message
@@ -350,50 +386,52 @@ class Simulator(Component):
 
     # -- the camera -----------------------------------------------------------------------
 
-    def _camera(self) -> PinholeCamera | None:
+    def _renderer(self) -> Renderer | None:
+        """The camera's renderer: the floor markers (F0, the bin) under the base, the obstacles
+        (their top discs and markers) over it, drawn once."""
         if not self.node.params["camera"]:
             return None
-        return ceiling_camera(self.scene.camera)
-
-    def placed_markers(self) -> list[PlacedMarker]:
-        """Every marker visible now, where it is in the world."""
-        scene, q = self.scene, self.world.q
+        scene = self.scene
         reference = planar_pose(*scene.reference_pose, scene.reference.height_m)
-        markers = [PlacedMarker(scene.reference.id, scene.reference.size_m, reference)]
+        gx, gy, gyaw = floats(self.node.params["goal_marker"], "goal_marker", 1, 3)[0]
+        below = [PlacedMarker(scene.reference.id, scene.reference.size_m, reference),
+                 PlacedMarker(scene.goal.id, scene.goal.size_m,
+                              planar_pose(gx, gy, gyaw, scene.goal.height_m))]  # fmt: skip
+        above: list = [(o.x, o.y, scene.obstacles.height_m, o.radius, 200) for o in self.obstacles]
+        for marker_id, circle in zip(scene.obstacles.ids, self.obstacles, strict=False):
+            pose = planar_pose(circle.x, circle.y, 0.0, scene.obstacles.height_m)
+            above.append(PlacedMarker(marker_id, scene.obstacles.size_m, pose))
+        noise = ImageNoise(self.node.params["image_noise"], self.node.params["image_blur_px"])
+        return Renderer(ceiling_camera(scene.camera), scene.dictionary_id, noise, self.rng,
+                        below, above)  # fmt: skip
+
+    def moving(self) -> list:
+        """What moves in the camera's view: the base's top disc, and its marker unless hidden."""
+        scene, q = self.scene, self.world.q
+        elements: list = [(q[0], q[1], scene.base.height_m, self.robot.base.body_radius, 70)]
         if not self._base_marker_hidden():
             ox, oy = scene.base.offset
             c, s = math.cos(q[2]), math.sin(q[2])
             x, y = q[0] + c * ox - s * oy, q[1] + s * ox + c * oy
             pose = planar_pose(x, y, q[2], scene.base.height_m)
-            markers.append(PlacedMarker(scene.base.id, scene.base.size_m, pose))
-        gx, gy, gyaw = floats(self.node.params["goal_marker"], "goal_marker", 1, 3)[0]
-        goal_pose = planar_pose(gx, gy, gyaw, scene.goal.height_m)
-        markers.append(PlacedMarker(scene.goal.id, scene.goal.size_m, goal_pose))
-        for marker_id, circle in zip(scene.obstacles.ids, self.obstacles, strict=False):
-            pose = planar_pose(circle.x, circle.y, 0.0, scene.obstacles.height_m)
-            markers.append(PlacedMarker(marker_id, scene.obstacles.size_m, pose))
-        return markers
+            elements.append(PlacedMarker(scene.base.id, scene.base.size_m, pose))
+        return elements
 
     def _base_marker_hidden(self) -> bool:
-        windows = floats(self.node.params["hide_base_marker"], "hide_base_marker", None, 2)
         t = self.now_ns / 1e9
-        return any(start <= t < end for start, end in windows)
+        return any(start <= t < end for start, end in self.hidden)
 
     def _publish_frame(self) -> None:
-        camera, scene, q = self.camera, self.scene, self.world.q
-        base_top = scene.base.height_m
-        discs = [(q[0], q[1], base_top, self.robot.base.body_radius, 70)]
-        discs += [(o.x, o.y, scene.obstacles.height_m, o.radius, 200) for o in self.obstacles]
-        noise = ImageNoise(self.node.params["image_noise"], self.node.params["image_blur_px"])
-        image = render(camera, self.placed_markers(), scene.dictionary_id, noise, self.rng, discs)
-        c = scene.camera
+        image = self.renderer.frame(self.moving())
+        c, p = self.scene.camera, self.node.params
+        data = jpeg(image, p["jpeg_quality"]) if p["image_format"] == "jpeg" else image.tobytes()
         self.publishers["camera/image"].put(
             CameraFrame(
                 header=self._header("camera", "camera/image"),
-                encoding="mono8",
+                encoding=p["image_format"],
                 width=c.width,
                 height=c.height,
-                data=image.tobytes(),
+                data=data,
                 intrinsics=CameraIntrinsics(fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy),
             )
         )

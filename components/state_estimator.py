@@ -7,23 +7,31 @@ frame is at x_i^0 = (x_0^c)^* x_i^c, with x_0^c low-pass filtered by eq. 6.1 ove
 The base pose (x, y, phi) is carried by wheel odometry: each ``base/odometry`` moves it by
 the motion the odometry measured, in the base frame. A camera fix of the base marker F1 pulls
 it towards the measured pose by 1/``base_samples`` (eq. 6.1 on the plane, the odometry
-prediction standing for x_bar_{k-1}). Each odometry message yields one ``robot/state`` with
+prediction standing for x_bar_{k-1}), at the time the frame was taken, the odometry since laid
+on it again (``wbc.base_estimate``). Each odometry message yields one ``robot/state`` with
 the newest arm joints and the end effector of the robot model: ``valid`` once the base has
 had a fix; ``degraded`` while the base marker has not been seen for ``marker_timeout_s``.
 When odometry stops for ``odometry_timeout_s`` as well, a 10 Hz timer publishes the state
 as not valid.
 
-Each processed frame also yields ``control/goal``, the pose x_d^0 = x_2^0 x_d^2 of eq. 6.3
-with x_d^2 the scene's goal offset (its translation for a ``position`` task), once the bin
-marker F2 has been seen, then ``world/obstacles``: a circle of the scene's radius at every
-obstacle marker (the controller adds the robot's radius, section 5.5). Both carry the
-frame's stamp; the obstacles are published for every frame, seen or not (the simulator's
-lockstep waits for them).
+A frame's markers are placed in F0 as they arrive, and published at once as
+``world/markers`` (stamped with the frame's stamp: a lockstep simulator waits for them). The
+frame is used from the first odometry stamped ``scene.camera.latency_s`` after it, in the
+order the frames were taken: then the base is fixed, and ``control/goal`` and
+``world/obstacles`` are published, stamped with that odometry's stamp (the time they are
+known from), just before its state.
+The goal is the pose x_d^0 = x_2^0 x_d^2 of eq. 6.3 with x_d^2 the scene's goal offset (its
+translation for a ``position`` task), once the bin marker F2 has been seen; the obstacles, a
+circle of the scene's radius at every obstacle marker (the controller adds the robot's radius,
+section 5.5), for every frame, seen or not. So what the controller is given, and when, does
+not depend on when a frame's markers arrive within the latency.
 """
 
 from __future__ import annotations
 
 import math
+from collections import deque
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -35,18 +43,30 @@ from messages import topics
 from messages.base import ARM_JOINTS, IDENTITY_POSE
 from messages.goal import Goal
 from messages.joints import JointStates
-from messages.markers import MarkerDetections
+from messages.markers import MarkerDetection, MarkerDetections
 from messages.obstacles import Circle, Obstacles
 from messages.odometry import BaseOdometry
 from messages.state import RobotState
 from profiles.scene import Scene
 from wbc import dq
-from wbc.planar import offset_pose, planar_of, wrap
+from wbc.base_estimate import BaseEstimate
+from wbc.planar import offset_pose, planar_of
 from wbc.pose_filter import PoseFilter
 from wbc.robot import MobileManipulator
 
 WORLD_FRAME = "world"
 TIMEOUT_CHECK_S = 0.1
+
+
+@dataclass(frozen=True)
+class Frame:
+    """What one camera frame tells, ready to be used: the base pose F1 shows (None unseen),
+    the goal pose x_d^0 (None before F2 is seen) and the obstacle circles, (x, y) in F0."""
+
+    stamp_ns: int
+    base: tuple[float, float, float] | None
+    goal: np.ndarray | None
+    obstacles: tuple[tuple[float, float], ...]
 
 
 class StateEstimator(Component):
@@ -58,7 +78,8 @@ class StateEstimator(Component):
         Input(topics.BASE_ODOMETRY, queue=200),
         Input(topics.ARM_JOINT_STATES),
     )
-    writes = (topics.ROBOT_STATE, topics.CONTROL_GOAL, topics.WORLD_OBSTACLES)
+    writes = (topics.ROBOT_STATE, topics.CONTROL_GOAL, topics.WORLD_OBSTACLES,
+              topics.WORLD_MARKERS)
     params = (
         Param("task", str, "pose", choices=("pose", "position"), doc="the goal's task"),
         Param("reference_samples", int, 100, low=1, high=100000, doc="eq. 6.1 samples of F0"),
@@ -82,9 +103,10 @@ class StateEstimator(Component):
         p = node.params
         self.reference = PoseFilter(p["reference_samples"])
         self.statics: dict[int, PoseFilter] = {}
-        self.base: tuple[float, float, float] | None = None
+        self.base = BaseEstimate()
+        self.frames: deque[Frame] = deque()
+        self.latency_ns = round(self.scene.camera.latency_s * 1e9)
         self.fix_ns: int | None = None
-        self.odometry: tuple[float, float, float] | None = None
         self.odometry_ns: int | None = None
         self.joints: tuple[float, ...] | None = None
         self.joints_ns = -1
@@ -92,7 +114,9 @@ class StateEstimator(Component):
         self.state = node.publisher(topics.ROBOT_STATE)
         self.goal = node.publisher(topics.CONTROL_GOAL)
         self.obstacles = node.publisher(topics.WORLD_OBSTACLES)
-        for name in ("base_fixes", "duplicates", "degraded_states", "joints_behind"):
+        self.placed = node.publisher(topics.WORLD_MARKERS)
+        for name in ("base_fixes", "fixes_without_odometry", "duplicates", "degraded_states",
+                     "joints_behind"):
             node.counters[name] = 0
         node.subscribe(topics.VISION_MARKERS, self.on_markers)
         node.subscribe(topics.BASE_ODOMETRY, self.on_odometry)
@@ -110,8 +134,8 @@ class StateEstimator(Component):
     # -- the camera ------------------------------------------------------------------------
 
     def on_markers(self, message: MarkerDetections) -> None:
-        """Filter F0, place every other marker in F0 (eq. 6.2), correct the base, publish the
-        goal and the obstacles."""
+        """Filter F0, place every other marker in F0 (eq. 6.2) and publish them; keep what the
+        frame tells until its time comes (``use_frames``)."""
         stamp = message.header.stamp_ns
         if not self._fresh("markers", stamp):
             return
@@ -120,59 +144,79 @@ class StateEstimator(Component):
         if scene.reference.id in seen:
             self.reference.update(seen[scene.reference.id])
         x0c = self.reference.pose
+        in_world = {}
         if x0c is not None:
             in_world = {i: dq.normalize(dq.mul(dq.conj(x0c), p)) for i, p in seen.items()}
-            if scene.base.id in in_world:
-                self._correct_base(in_world[scene.base.id], stamp)
             for marker_id in (scene.goal.id, *scene.obstacles.ids):
                 if marker_id in in_world:
                     self._static(marker_id).update(in_world[marker_id])
-        self._publish_goal(stamp)
-        self._publish_obstacles(stamp)
+        base = in_world.get(scene.base.id)
+        self.frames.append(Frame(stamp, None if base is None else self._base_of(base),
+                                 self._goal_pose(), self._obstacle_centres()))  # fmt: skip
+        self.placed.put(MarkerDetections(
+            header=self.node.header(WORLD_FRAME, stamp, self.placed.next_seq),
+            markers=tuple(MarkerDetection(id=m.id, pose=tuple(in_world[m.id].tolist()),
+                                          reprojection_error=m.reprojection_error)
+                          for m in message.markers if m.id in in_world),
+        ))  # fmt: skip
 
     def _static(self, marker_id: int) -> PoseFilter:
         if marker_id not in self.statics:
             self.statics[marker_id] = PoseFilter(self.node.params["static_samples"])
         return self.statics[marker_id]
 
-    def _correct_base(self, marker_pose: np.ndarray, stamp_ns: int) -> None:
-        """The base pose the F1 marker shows (its offset undone), blended in by 1/base_samples."""
+    def _base_of(self, marker_pose: np.ndarray) -> tuple[float, float, float]:
+        """The base pose the F1 marker shows: its planar pose, its offset undone."""
         mx, my, mphi = planar_of(marker_pose)
         ox, oy = self.scene.base.offset
         c, s = math.cos(mphi), math.sin(mphi)
-        fix = (mx - c * ox + s * oy, my - s * ox - c * oy, mphi)
-        if self.base is None:
-            self.base = fix
-        else:
-            x, y, phi = self.base
-            gain = 1.0 / self.node.params["base_samples"]
-            self.base = (x + gain * (fix[0] - x), y + gain * (fix[1] - y),
-                         phi + gain * wrap(fix[2] - phi))  # fmt: skip
-        self.fix_ns = stamp_ns
-        self.node.count("base_fixes")
+        return mx - c * ox + s * oy, my - s * ox - c * oy, mphi
 
-    def _publish_goal(self, stamp_ns: int) -> None:
+    def _goal_pose(self) -> np.ndarray | None:
         bin_marker = self.statics.get(self.scene.goal.id)
         if bin_marker is None or bin_marker.pose is None:
-            return
-        desired = dq.normalize(dq.mul(bin_marker.pose, self.offset))
-        header = self.node.header(WORLD_FRAME, stamp_ns, self.goal.next_seq)
-        if self.node.params["task"] == "pose":
-            goal = Goal(header=header, task="pose", pose=tuple(desired.tolist()))
-        else:
-            goal = Goal(header=header, task="position",
-                        position=tuple(dq.translation(desired)[1:].tolist()))  # fmt: skip
-        self.goal.put(goal)
+            return None
+        return dq.normalize(dq.mul(bin_marker.pose, self.offset))
 
-    def _publish_obstacles(self, stamp_ns: int) -> None:
-        circles = []
+    def _obstacle_centres(self) -> tuple[tuple[float, float], ...]:
+        centres = []
         for marker_id in self.scene.obstacles.ids:
             marker = self.statics.get(marker_id)
             if marker is not None and marker.pose is not None:
-                x, y, _ = planar_of(marker.pose)
-                circles.append(Circle(x=x, y=y, radius=self.scene.obstacles.radius_m))
+                centres.append(planar_of(marker.pose)[:2])
+        return tuple(centres)
+
+    def use_frames(self, stamp_ns: int) -> None:
+        """Use every frame taken ``latency_s`` or more before ``stamp_ns``, oldest first: fix
+        the base at the frame's time, publish its goal and obstacles."""
+        while self.frames and self.frames[0].stamp_ns + self.latency_ns <= stamp_ns:
+            frame = self.frames.popleft()
+            if frame.base is not None:
+                gain = 1.0 / self.node.params["base_samples"]
+                if self.base.fix(frame.stamp_ns, frame.base, gain):
+                    self.fix_ns = frame.stamp_ns
+                    self.node.count("base_fixes")
+                else:
+                    self.node.count("fixes_without_odometry")
+            self._publish_goal(frame, stamp_ns)
+            self._publish_obstacles(frame, stamp_ns)
+
+    def _publish_goal(self, frame: Frame, stamp_ns: int) -> None:
+        if frame.goal is None:
+            return
+        header = self.node.header(WORLD_FRAME, stamp_ns, self.goal.next_seq)
+        if self.node.params["task"] == "pose":
+            goal = Goal(header=header, task="pose", pose=tuple(frame.goal.tolist()))
+        else:
+            goal = Goal(header=header, task="position",
+                        position=tuple(dq.translation(frame.goal)[1:].tolist()))  # fmt: skip
+        self.goal.put(goal)
+
+    def _publish_obstacles(self, frame: Frame, stamp_ns: int) -> None:
+        radius = self.scene.obstacles.radius_m
+        circles = tuple(Circle(x=x, y=y, radius=radius) for x, y in frame.obstacles)
         header = self.node.header(WORLD_FRAME, stamp_ns, self.obstacles.next_seq)
-        self.obstacles.put(Obstacles(header=header, circles=tuple(circles)))
+        self.obstacles.put(Obstacles(header=header, circles=circles))
 
     # -- odometry and joints ---------------------------------------------------------------
 
@@ -183,33 +227,27 @@ class StateEstimator(Component):
         self.joints_ns = message.header.stamp_ns
 
     def on_odometry(self, message: BaseOdometry) -> None:
-        """Move the base by the odometry's motion in the base frame; publish the state."""
+        """Move the base as the odometry says, use the frames whose time has come, publish
+        the state."""
         stamp = message.header.stamp_ns
         if not self._fresh("odometry", stamp):
             return
         if self.joints_ns < stamp:
             self.node.count("joints_behind")
-        current = (message.x, message.y, message.phi)
-        if self.odometry is not None and self.base is not None:
-            ox, oy, ophi = self.odometry
-            c, s = math.cos(ophi), math.sin(ophi)
-            forward = c * (current[0] - ox) + s * (current[1] - oy)
-            lateral = -s * (current[0] - ox) + c * (current[1] - oy)
-            x, y, phi = self.base
-            c, s = math.cos(phi), math.sin(phi)
-            self.base = (x + c * forward - s * lateral, y + s * forward + c * lateral,
-                         phi + (current[2] - ophi))  # fmt: skip
-        self.odometry, self.odometry_ns = current, stamp
+        self.base.move(stamp, (message.x, message.y, message.phi))
+        self.odometry_ns = stamp
+        self.use_frames(stamp)
         self.publish_state(stamp)
 
     def publish_state(self, stamp_ns: int) -> None:
         """One robot/state from the base estimate and the newest joints."""
-        valid = self.base is not None and self.joints is not None
+        pose = self.base.pose
+        valid = pose is not None and self.joints is not None
         age_s = (stamp_ns - self.fix_ns) / 1e9 if self.fix_ns is not None else 0.0
         degraded = valid and age_s > self.node.params["marker_timeout_s"]
         if degraded:
             self.node.count("degraded_states")
-        base = self.base if self.base is not None else (0.0, 0.0, 0.0)
+        base = pose if pose is not None else (0.0, 0.0, 0.0)
         joints = self.joints if self.joints is not None else (0.0,) * ARM_JOINTS
         q = np.array([*base, *joints])
         end_effector = tuple(self.robot.fkm(q).tolist()) if valid else IDENTITY_POSE
@@ -232,8 +270,10 @@ class StateEstimator(Component):
         odometry_silent = self.odometry_ns is None or now - self.odometry_ns > p[
             "odometry_timeout_s"] * 1e9  # fmt: skip
         marker_lost = self.fix_ns is None or now - self.fix_ns > p["marker_timeout_s"] * 1e9
-        if odometry_silent and marker_lost and self.base is not None:
-            self.base = None  # a fix is needed again
+        if odometry_silent and marker_lost:
+            self.base.reset()  # a fix is needed again
+        if odometry_silent:
+            self.use_frames(now)  # the camera's frames are still used, on the clock's time
         if odometry_silent and self.odometry_ns is not None:
             self.publish_state(now)
 

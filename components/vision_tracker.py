@@ -1,6 +1,7 @@
 """The vision tracker: ArUco markers in each camera frame, a pose per marker (section 6.1.1).
 
-Input: ``camera/image`` (the simulator's, or a camera component's), or with ``device`` set a
+Input: ``camera/image`` (the simulator's, or a camera component's: raw pixels or JPEG, made
+grey), or with ``device`` set a
 ``cv2.VideoCapture`` (a device index such as ``0``, a URL or a video file) read at the
 scene's camera rate, with the intrinsics of the ``calibration`` YAML file (``fx fy cx cy``
 and optional ``distortion``).
@@ -20,6 +21,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import cv2
 import numpy as np
 import yaml
 
@@ -31,6 +33,7 @@ from messages import topics
 from messages.camera import CameraFrame
 from messages.markers import MarkerDetection, MarkerDetections
 from profiles.scene import Scene
+from vision.images import grey
 from vision.markers import Intrinsics, MarkerDetector, plane_of, plane_pose, square_pose
 from wbc import dq
 from wbc.pose_filter import PoseFilter
@@ -52,6 +55,8 @@ class VisionTracker(Component):
         Param("reference_samples", int, 100, low=1, high=100000,
               doc="eq. 6.1 samples of the floor reference F0"),
         Param("plane_fit", bool, True, doc="fit markers on their known plane (else IPPE only)"),
+        Param("threads", int, 1, low=0, high=256,
+              doc="OpenCV's worker threads (0: one per core); 1 spends the least CPU per frame"),
     )  # fmt: skip
 
     def __init__(self, node: Node) -> None:
@@ -60,6 +65,7 @@ class VisionTracker(Component):
             raise ParamError("the vision tracker needs the profile's `scene` (markers)")
         self.scene: Scene = node.profile.scene
         self.markers = self.scene.markers()
+        cv2.setNumThreads(node.params["threads"] or -1)
         self.detector = MarkerDetector(self.scene.dictionary_id)
         self.reference = PoseFilter(node.params["reference_samples"])
         self.output = node.publisher(topics.VISION_MARKERS)
@@ -67,6 +73,7 @@ class VisionTracker(Component):
         node.counters["frames_without_markers"] = 0
         node.counters["unknown_markers"] = 0
         node.counters["reference_flips"] = 0
+        node.counters["undecodable_frames"] = 0
         self.capture = None
         if node.params["device"]:
             self.capture, self.intrinsics = self._open_device()
@@ -75,14 +82,17 @@ class VisionTracker(Component):
             node.subscribe(topics.CAMERA_IMAGE, self.on_frame)
 
     def on_frame(self, frame: CameraFrame) -> None:
-        """One image from the topic: detect, fit, publish."""
-        channels = len(frame.data) // (frame.width * frame.height)
-        image = np.frombuffer(frame.data, np.uint8).reshape(frame.height, frame.width, channels)
-        if channels == 3:
-            image = image.mean(axis=2).astype(np.uint8)
+        """One image from the topic: detect, fit, publish. A JPEG that does not decode to the
+        frame's size is dropped and counted (``undecodable_frames``)."""
+        try:
+            image = grey(frame.data, frame.encoding, frame.width, frame.height)
+        except ValueError as error:
+            self.node.count("undecodable_frames")
+            self.node.warn("undecodable_frames", f"dropped frame {frame.header.seq}: {error}")
+            return
         i = frame.intrinsics
         intrinsics = Intrinsics(i.fx, i.fy, i.cx, i.cy, tuple(i.distortion))
-        self.track(image.reshape(frame.height, frame.width), intrinsics, frame.header.stamp_ns)
+        self.track(image, intrinsics, frame.header.stamp_ns)
 
     def track(self, image: np.ndarray, intrinsics: Intrinsics, stamp_ns: int) -> None:
         """Publish the markers of ``image`` with the stamp of the frame."""
@@ -146,8 +156,6 @@ class VisionTracker(Component):
     # -- a real camera ---------------------------------------------------------------------
 
     def _open_device(self):
-        import cv2
-
         source = str(self.node.params["device"])
         capture = cv2.VideoCapture(int(source) if source.isdigit() else source)
         if not capture.isOpened():
@@ -155,8 +163,6 @@ class VisionTracker(Component):
         return capture, load_calibration(Path(str(self.node.params["calibration"])))
 
     def _read_device(self) -> None:
-        import cv2
-
         ok, image = self.capture.read()
         if not ok:
             self.node.count("capture_failures")

@@ -71,6 +71,8 @@ BASE_ODOMETRY = Topic("base/odometry", "base/odometry", BaseOdometry)
 ARM_JOINT_STATES = Topic("arm/joint_states", "arm/joint_states", JointStates)
 ROBOT_STATE = Topic("robot/state", "robot/state", RobotState)
 WORLD_OBSTACLES = Topic("world/obstacles", "world/obstacles", Obstacles)
+WORLD_MARKERS = Topic("world/markers", "world/markers", MarkerDetections)
+"""The markers of each camera frame placed in the world frame F0 by the state estimator."""
 CONTROL_GOAL = Topic("control/goal", "control/goal", Goal)
 GOAL_REQUEST = Topic("goal/request", "goal/request", Goal)
 """The operator's goal, for a supervisor that turns it into control/goal phase by phase."""
@@ -91,6 +93,7 @@ TOPICS: Mapping[str, Topic] = MappingProxyType(
             ARM_JOINT_STATES,
             ROBOT_STATE,
             WORLD_OBSTACLES,
+            WORLD_MARKERS,
             CONTROL_GOAL,
             GOAL_REQUEST,
             SUPERVISOR_STATUS,
@@ -104,10 +107,10 @@ TOPICS: Mapping[str, Topic] = MappingProxyType(
 )
 """Every topic, by name."""
 
-FRAME_ANSWERS = (VISION_MARKERS, WORLD_OBSTACLES)
-"""In lockstep, what answers a camera frame: the tracker's markers and the estimator's
-obstacles, stamped with the frame's stamp (the simulator waits for them; so does a lockstep
-replay)."""
+FRAME_ANSWERS = (VISION_MARKERS, WORLD_MARKERS)
+"""In lockstep, what answers a camera frame: the tracker's markers and the estimator's markers
+placed in the world, stamped with the frame's stamp (the simulator waits for them; so does a
+lockstep replay)."""
 
 STATUS_TYPE = ComponentStatus
 """The message type published on ``status_key(namespace, component)``."""

@@ -62,7 +62,10 @@ class ObstacleMarkers(_Strict):
 
 class Camera(_Strict):
     """The ceiling camera: pinhole intrinsics (px) and frame rate. ``position`` (x, y, height)
-    places the simulated one above the world; a real one is found through F0."""
+    places the simulated one above the world; a real one is found through F0. ``latency_s``:
+    the estimator uses a frame taken at t from its odometry of t + latency on (a real camera's
+    frames, and the tracker's markers, come that late); a lockstep simulator waits for a
+    frame's markers only then, so the tracker works while the loop runs on."""
 
     width: int = Field(default=640, gt=0)
     height: int = Field(default=480, gt=0)
@@ -71,6 +74,7 @@ class Camera(_Strict):
     cx: Finite = 319.5
     cy: Finite = 239.5
     rate_hz: Positive = 30.0
+    latency_s: Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)] = 0.0
     position: tuple[Finite, Finite, Positive] = (0.6, 0.15, 2.5)
 
 

@@ -4,8 +4,8 @@ A world point p_w maps to camera coordinates p_c = R_c^T (p_w - t_c), with (R_c,
 pose, and to pixels u = fx x_c / z_c + cx, v = fy y_c / z_c + cy (camera z = optical axis; pixel
 centres at integer coordinates). A marker on the plane z_m = 0 of its frame is drawn through the
 plane homography H = K [r1 r2 t] of its pose (R, t) in the camera frame, with area antialiasing.
-Rendering 640x480 with six 0.15 m markers at 2.5 m and one disc takes 6-9 ms on the 2-core dev
-machine, 3.5 ms of it drawing the Gaussian noise (tests/sim2d/test_camera.py prints the figure).
+A ``Renderer`` draws the elements that do not move once and each frame only the ones that do
+(tests/sim2d/test_camera.py prints both figures).
 """
 
 from __future__ import annotations
@@ -140,17 +140,29 @@ def _marker_image(dictionary: cv2.aruco.Dictionary, marker_id: int, module_px: i
     return np.where(padded > 127, WHITE, BLACK).astype(np.float32)
 
 
-def _draw_marker(
-    image: np.ndarray,
-    camera: PinholeCamera,
-    marker: PlacedMarker,
-    dictionary: cv2.aruco.Dictionary,
-) -> None:
-    """Composite one marker into ``image`` (float32) in place: I = a M + (1 - a) I.
+@dataclass(frozen=True, eq=False)
+class Composite:
+    """A drawn element over the rows v0:v1 and columns u0:u1 of the image: its coverage a and
+    its grey levels already multiplied by it, so that drawing it is I = colour + (1 - a) I."""
 
-    M is the marker warped by D K [r1 r2 t] A (A: source pixel -> marker plane, D: image pixel ->
-    supersampled region pixel), a the warped coverage mask; both are area-averaged S x S.
-    """
+    v0: int
+    v1: int
+    u0: int
+    u1: int
+    colour: np.ndarray
+    alpha: np.ndarray
+
+    def draw(self, image: np.ndarray) -> None:
+        patch = image[self.v0 : self.v1, self.u0 : self.u1]
+        patch[:] = self.colour + (1.0 - self.alpha) * patch
+
+
+def _marker_composite(
+    camera: PinholeCamera, marker: PlacedMarker, dictionary: cv2.aruco.Dictionary
+) -> Composite | None:
+    """One marker: M warped by D K [r1 r2 t] A (A: source pixel -> marker plane, D: image pixel
+    -> supersampled region pixel), a the warped coverage mask, both area-averaged S x S; None
+    when it faces away or falls outside the image."""
     modules = dictionary.markerSize + 2
     quiet_side = marker.size_m * (modules + 2 * QUIET_ZONE_MODULES) / modules
     outline_c = camera.to_camera(_plane_to_world(marker.pose, _square(quiet_side)))
@@ -160,12 +172,12 @@ def _draw_marker(
     )
     facing = float(rotation_c[:, 2] @ centre_c) < 0.0
     if not facing or np.any(outline_c[:, 2] < _MIN_DEPTH_M):
-        return
+        return None
     outline = outline_c[:, :2] / outline_c[:, 2:] * [camera.fx, camera.fy] + [camera.cx, camera.cy]
     u0, v0 = np.maximum(np.floor(outline.min(axis=0)).astype(int), 0)
-    u1, v1 = np.minimum(np.ceil(outline.max(axis=0)).astype(int) + 1, image.shape[::-1])
+    u1, v1 = np.minimum(np.ceil(outline.max(axis=0)).astype(int) + 1, (camera.width, camera.height))
     if u0 >= u1 or v0 >= v1:
-        return
+        return None
     s = SUPERSAMPLE
     side_px = float(np.max(np.linalg.norm(outline - np.roll(outline, 1, axis=0), axis=1)))
     module_px = int(np.clip(math.ceil(s * side_px / (modules + 2)), 4, 64))
@@ -190,39 +202,91 @@ def _draw_marker(
     mask = cv2.warpPerspective(np.ones_like(source), homography, size, flags=cv2.INTER_LINEAR)
     colour = cv2.resize(warped, region, interpolation=cv2.INTER_AREA)
     alpha = cv2.resize(mask, region, interpolation=cv2.INTER_AREA)
-    patch = image[v0:v1, u0:u1]
-    patch[:] = colour + (1.0 - alpha) * patch
+    return Composite(int(v0), int(v1), int(u0), int(u1), colour, alpha)
 
 
 Disc = tuple[float, float, float, float, int]
 """A horizontal filled disc: centre x, y, z (m), radius (m), grey level."""
 
 
-def _draw_disc(image: np.ndarray, camera: PinholeCamera, disc: Disc) -> None:
-    """Composite the horizontal disc {|p - (x, y, z)| <= r, p_z = z} in place: I = a g + (1 - a) I.
-
-    a is the coverage of the projected rim polygon, filled S x S finer and area-averaged.
-    """
+def _disc_composite(camera: PinholeCamera, disc: Disc) -> Composite | None:
+    """The horizontal disc {|p - (x, y, z)| <= r, p_z = z}: a the coverage of the projected rim
+    polygon, filled S x S finer and area-averaged, colour a g."""
     x, y, z, radius, grey = disc
     angles = np.linspace(0.0, 2.0 * math.pi, DISC_VERTICES, endpoint=False)
     rim = np.column_stack(
         (x + radius * np.cos(angles), y + radius * np.sin(angles), np.full_like(angles, z))
     )
     if np.any(camera.to_camera(rim)[:, 2] < _MIN_DEPTH_M):
-        return
+        return None
     polygon = camera.project(rim)
     u0, v0 = np.maximum(np.floor(polygon.min(axis=0)).astype(int), 0)
-    u1, v1 = np.minimum(np.ceil(polygon.max(axis=0)).astype(int) + 1, image.shape[::-1])
+    u1, v1 = np.minimum(np.ceil(polygon.max(axis=0)).astype(int) + 1, (camera.width, camera.height))
     if u0 >= u1 or v0 >= v1:
-        return
+        return None
     s, shift = SUPERSAMPLE, 4
     supersampled = s * (polygon - [u0, v0] + 0.5) - 0.5
     mask = np.zeros((s * (v1 - v0), s * (u1 - u0)), np.float32)
     vertices = np.rint(supersampled * (1 << shift)).astype(np.int32)
     cv2.fillPoly(mask, [vertices], color=1.0, lineType=cv2.LINE_8, shift=shift)
     alpha = cv2.resize(mask, (u1 - u0, v1 - v0), interpolation=cv2.INTER_AREA)
-    patch = image[v0:v1, u0:u1]
-    patch[:] = alpha * float(grey) + (1.0 - alpha) * patch
+    return Composite(int(v0), int(v1), int(u0), int(u1), alpha * float(grey), alpha)
+
+
+Element = PlacedMarker | Disc
+"""What a frame shows: markers and horizontal discs, drawn in the order given (far first)."""
+
+NOISE_TABLE_FRAMES = 4
+"""The noise table holds this many frames' worth of N(0, 1) samples."""
+
+
+class Renderer:
+    """Frames of one camera: I = clip(G_sigma * (floor, elements) + N(0, std^2)), uint8.
+
+    ``static`` elements (the floor markers, the obstacles) are drawn once: those ``below``
+    into the floor, those ``above`` kept as composites; each frame draws the moving elements
+    between them. The noise of a frame is a window of a table of N(0, 1) samples drawn once
+    from ``rng``, at an offset drawn each frame: every pixel's noise is normal and the windows
+    of two frames overlap at random, for 0.3 ms where drawing 307,200 normal samples took 4.8.
+    Rendering the default scene took 9.8 ms a frame from scratch, 1.8 ms this way.
+    """
+
+    def __init__(self, camera: PinholeCamera, dictionary: int, noise: ImageNoise,
+                 rng: np.random.Generator, below: Sequence[Element] = (),
+                 above: Sequence[Element] = (),
+                 table_frames: int = NOISE_TABLE_FRAMES) -> None:  # fmt: skip
+        self.camera, self.noise, self.rng = camera, noise, rng
+        self.dictionary = cv2.aruco.getPredefinedDictionary(dictionary)
+        self.floor = np.full((camera.height, camera.width), FLOOR_GREY, np.float32)
+        for composite in self._composites(below):
+            composite.draw(self.floor)
+        self.above = self._composites(above)
+        pixels = camera.height * camera.width
+        self.table = (rng.standard_normal(table_frames * pixels, dtype=np.float32)
+                      if noise.noise_std > 0.0 else None)  # fmt: skip
+
+    def _composites(self, elements: Sequence[Element]) -> list[Composite]:
+        made = [self._composite(element) for element in elements]
+        return [composite for composite in made if composite is not None]
+
+    def _composite(self, element: Element) -> Composite | None:
+        if isinstance(element, PlacedMarker):
+            return _marker_composite(self.camera, element, self.dictionary)
+        return _disc_composite(self.camera, element)
+
+    def frame(self, moving: Sequence[Element] = ()) -> np.ndarray:
+        """The image with ``moving`` elements drawn over the floor and under the ones above."""
+        image = self.floor.copy()
+        for composite in [*self._composites(moving), *self.above]:
+            composite.draw(image)
+        if self.noise.blur_sigma_px > 0.0:
+            image = cv2.GaussianBlur(image, (0, 0), self.noise.blur_sigma_px)
+        if self.table is None:
+            return cv2.add(image, 0.0, dtype=cv2.CV_8U)
+        pixels = image.size
+        start = int(self.rng.integers(0, self.table.size - pixels + 1))
+        window = self.table[start : start + pixels].reshape(image.shape)
+        return cv2.add(image, window * self.noise.noise_std, dtype=cv2.CV_8U)
 
 
 def render(
@@ -237,19 +301,7 @@ def render(
 
     ``dictionary`` is an OpenCV predefined dictionary id (``cv2.aruco.DICT_4X4_50``); ``discs``
     are horizontal filled discs (x, y, z, radius, grey), m, drawn under the markers. Markers
-    that face away from the camera or fall outside the image are skipped.
+    that face away from the camera or fall outside the image are skipped. One frame of a
+    ``Renderer`` with every element moving, and a noise table of that one frame.
     """
-    aruco_dictionary = cv2.aruco.getPredefinedDictionary(dictionary)
-    image = np.full((camera.height, camera.width), FLOOR_GREY, np.float32)
-    for disc in discs:
-        _draw_disc(image, camera, disc)
-    for marker in markers:
-        _draw_marker(image, camera, marker, aruco_dictionary)
-    if noise.blur_sigma_px > 0.0:
-        image = cv2.GaussianBlur(image, (0, 0), noise.blur_sigma_px)
-    if noise.noise_std > 0.0:
-        gaussian = rng.standard_normal(image.shape, dtype=np.float32)
-        gaussian *= noise.noise_std
-        image += gaussian
-    np.rint(image, out=image)
-    return np.clip(image, 0.0, 255.0, out=image).astype(np.uint8)
+    return Renderer(camera, dictionary, noise, rng, table_frames=1).frame([*discs, *markers])

@@ -52,7 +52,7 @@ def test_a_recorded_experiment_reads_back_with_every_channel_schema(runs) -> Non
     assert counted == summary.statistics.message_count > 1000
     assert all(channel.schema_id in summary.schemas for channel in summary.channels.values())
     names = {schema.name for schema in summary.schemas.values()}
-    assert {"RobotState", "CameraFrame", "foxglove.RawImage", "foxglove.FrameTransforms",
+    assert {"RobotState", "CameraFrame", "foxglove.CompressedImage", "foxglove.FrameTransforms",
             "foxglove.SceneUpdate"} <= names
     shown = json.loads(parsimony("info", str(path), "--json").stdout)
     assert shown["messages"] == counted

@@ -54,6 +54,22 @@ def in_frame(
     return c * (x - x0) + s * (y - y0), -s * (x - x0) + c * (y - y0), phi - yaw0
 
 
+def compose(
+    frame: tuple[float, float, float], pose: tuple[float, float, float]
+) -> tuple[float, float, float]:
+    """A pose (x, y, phi) given in a frame at (x0, y0, yaw0), in the frame's parent:
+    (x0, y0) + R(yaw0) (x, y), yaw0 + phi (the inverse of ``in_frame``)."""
+    x0, y0, yaw0 = frame
+    x, y, phi = pose
+    c, s = math.cos(yaw0), math.sin(yaw0)
+    return x0 + c * x - s * y, y0 + s * x + c * y, yaw0 + phi
+
+
+def inverse(pose: tuple[float, float, float]) -> tuple[float, float, float]:
+    """The frame's parent seen from the frame: ``in_frame(0, 0, 0, pose)``."""
+    return in_frame(0.0, 0.0, 0.0, pose)
+
+
 def offset_pose(x: float, y: float, z: float, yaw: float, pitch: float, roll: float) -> np.ndarray:
     """The pose of a translation (x, y, z) and the rotation Rz(yaw) Ry(pitch) Rx(roll)."""
     r = dq.qmul(dq.qmul(dq.rotation_quaternion(yaw, dq.K_[1:]),

@@ -34,6 +34,8 @@ LAWS = {"lp": lambda robot: LPLaw(robot, LPParams()),
         "cascade": lambda robot: CascadeLaw(robot, CascadeParams())}  # fmt: skip
 OUTPUTS = ("base/command", "arm/command", "control/diagnostics")
 """The topics the law writes; the recorded ones move to ``<key>/recorded``."""
+BEFORE_STATE = ("control/goal", "world/obstacles")
+"""The estimator publishes these before the state of the same stamp, which they hold for."""
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -51,7 +53,8 @@ def run(args: argparse.Namespace) -> int:
     law = LAWS[args.controller](robot)
     task, obstacles, last_ns, steps = None, (), None, 0
     try:
-        records = list(read_session(args.file))
+        records = sorted(read_session(args.file), key=lambda r: (
+            r.log_time_ns, r.topic_name not in BEFORE_STATE))  # fmt: skip
     except OSError as error:
         print(f"rerun: {error}", file=sys.stderr)
         return 2

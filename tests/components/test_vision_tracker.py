@@ -10,8 +10,10 @@ from typing import TYPE_CHECKING
 
 import cv2
 import numpy as np
+import pytest
 import yaml
 
+from deploy import query
 from messages import codec, topics
 from messages.camera import CameraFrame, CameraIntrinsics
 from messages.header import Header
@@ -23,6 +25,7 @@ from sim2d.camera import (
     ceiling_camera,
     render,
 )
+from vision.images import jpeg
 from wbc import dq
 from wbc.planar import planar_pose
 
@@ -57,9 +60,13 @@ def tracker_system(deployed: Callable[[Path], System], tmp_path: Path, params: d
     return deployed(path)
 
 
-def test_markers_of_a_camera_frame_are_found_where_they_are(deployed, tmp_path: Path) -> None:
+@pytest.mark.parametrize("encoding", ["mono8", "jpeg"])
+def test_markers_of_a_camera_frame_are_found_where_they_are(
+    deployed, tmp_path: Path, encoding: str
+) -> None:
     system = tracker_system(deployed, tmp_path, {})
     image, camera, markers = scene_image(system)
+    data = jpeg(image, 90) if encoding == "jpeg" else image.tobytes()
     inbox = system.inbox(topics.VISION_MARKERS)
     system.start("vision_tracker")
     c = system.profile.scene.camera
@@ -72,7 +79,7 @@ def test_markers_of_a_camera_frame_are_found_where_they_are(deployed, tmp_path: 
         stamp += 1
         frame = CameraFrame(
             header=Header(stamp_ns=stamp, frame="camera", seq=stamp, source="test"),
-            encoding="mono8", width=c.width, height=c.height, data=image.tobytes(),
+            encoding=encoding, width=c.width, height=c.height, data=data,
             intrinsics=CameraIntrinsics(fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy),
         )  # fmt: skip
         publisher.put(codec.encode(frame))
@@ -90,6 +97,42 @@ def test_markers_of_a_camera_frame_are_found_where_they_are(deployed, tmp_path: 
         relative = dq.mul(dq.conj(seen[0]), mine)
         assert distance(relative, dq.mul(dq.conj(truth[0]), true)) < 0.02
     assert all(d.reprojection_error < 1.0 for d in found.markers)
+
+
+def test_a_jpeg_of_another_size_is_dropped_and_counted(deployed, tmp_path: Path,
+                                                       wait_until) -> None:
+    system = tracker_system(deployed, tmp_path, {})
+    image, _, _ = scene_image(system)
+    inbox = system.inbox(topics.VISION_MARKERS)
+    system.start("vision_tracker")
+    c = system.profile.scene.camera
+    publisher = system.router.declare_publisher(topics.CAMERA_IMAGE.key(system.profile.namespace))
+
+    def frame(stamp: int, pixels: np.ndarray) -> bytes:
+        return codec.encode(CameraFrame(
+            header=Header(stamp_ns=stamp, frame="camera", seq=stamp, source="test"),
+            encoding="jpeg", width=c.width, height=c.height, data=jpeg(pixels, 90),
+            intrinsics=CameraIntrinsics(fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy),
+        ))  # fmt: skip
+
+    deadline = time.monotonic() + system.deadline_s
+    stamp = 0
+    while not inbox.messages:  # a frame of the right size first: the tracker is listening
+        assert time.monotonic() < deadline, "the tracker never answered a frame"
+        stamp += 1
+        publisher.put(frame(stamp, image))
+        time.sleep(0.05)
+    publisher.put(frame(stamp + 1, image[::2, ::2]))  # a 320x240 JPEG in a 640x480 frame
+
+    def undecodable() -> int:
+        status = query.statuses(system.router, system.profile.namespace)["vision_tracker"]
+        return status.counters["undecodable_frames"]
+
+    wait_until(lambda: undecodable() == 1, "the tracker counting the frame")
+    publisher.put(frame(stamp + 2, image))
+    inbox.wait_for(lambda m: m.header.stamp_ns == stamp + 2, "answering the frame after")
+    assert stamp + 1 not in {m.header.stamp_ns for m in inbox.messages}
+    assert "320x240" in system.log("vision_tracker")
 
 
 def distance(a: np.ndarray, b: np.ndarray) -> float:

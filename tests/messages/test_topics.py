@@ -55,6 +55,7 @@ def test_the_table_holds_every_topic_of_the_design() -> None:
         "arm/joint_states": "JointStates",
         "robot/state": "RobotState",
         "world/obstacles": "Obstacles",
+        "world/markers": "MarkerDetections",
         "control/goal": "Goal",
         "goal/request": "Goal",
         "supervisor/status": "SupervisorStatus",
