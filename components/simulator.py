@@ -20,7 +20,9 @@ state of t with commands of t), and a camera frame stamped t by ``vision/markers
 tracker) and ``world/markers`` (the estimator) stamped t, before the sensors of
 t + ``scene.camera.latency_s`` (when the estimator uses the frame) and before the next frame,
 whichever comes first: the tracker works on a frame while the loop runs on, and a frame is
-never replaced by the next before it is answered. Only then does t advance, so a run does not
+never replaced by the next before it is answered. Frames are drawn on a thread of their own,
+while the loop answers the sensors of the same step (published first when the latency is a
+step or more). Only then does t advance, so a run does not
 depend on the machine's load. An answer missing for ``ack_timeout_s`` host seconds is counted
 (``lockstep_timeouts``) and the step goes on. The simulator starts when ``paused`` is set false
 (a profile may start it so).
@@ -30,6 +32,7 @@ from __future__ import annotations
 
 import math
 import time
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -175,6 +178,9 @@ class Simulator(Component):
         self.now_ns = time.time_ns() if p["host_epoch"] else 0
         self.hidden = floats(p["hide_base_marker"], "hide_base_marker", None, 2)
         self.renderer = self._renderer()
+        # Frames are drawn on a thread of their own (OpenCV lets go of the GIL), one at a time.
+        self.camera_thread = ThreadPoolExecutor(1, "camera") if self.renderer else None
+        self.drawing: Future | None = None
         self.frame_period_ns = round(1e9 / self.scene.camera.rate_hz)
         self.next_frame_ns = self.now_ns
         self.metres_per_count = wheel_distance_per_count(self.robot.base, settings.counts_per_turn)
@@ -185,10 +191,12 @@ class Simulator(Component):
         self.awaited: Awaited | None = None
         self.unanswered: Frame | None = None
         self.frame_done = True
+        self.sensors_ns: int | None = None
         self.answered: dict[str, int] = {}
         self.answer_times = {k: Durations(node.counters, k)
                              for k in ("frame", "frame_wait", "loop")}  # fmt: skip
         node.counters["lockstep_timeouts"] = 0
+        node.counters["frames_skipped"] = 0
         node.counters["contacts"] = 0
         self.publishers = {t.name: node.publisher(t) for t in self.writes}
         for topic in self.reads:
@@ -244,26 +252,47 @@ class Simulator(Component):
 
     def _go_on(self) -> None:
         """The rest of a step, each part once the answers it needs are in (lockstep): the
-        frame due (after the last frame's answers), the sensors (after the answers of a frame
-        whose latency has passed), then the wait for the commands."""
+        sensors (after the answers of a frame whose latency has passed), the frame due (after
+        the last frame's answers), then the wait for the commands. When the latency is a step
+        or more, the sensors go first, so the loop runs while the frame is drawn."""
         frame = self.unanswered
         if frame is not None and self._has_answers(frame.stamp_ns):
             self.unanswered = frame = None
+        if frame is not None and frame.stamp_ns + self.latency_ns <= self.now_ns:
+            return self._await(FRAME_ANSWERS, frame.stamp_ns)
+        if self.latency_ns >= self.step_ns:
+            self._publish_sensors()
         if not self.frame_done:
             if frame is not None:
                 return self._await(FRAME_ANSWERS, frame.stamp_ns)
             self.frame_done = True
             self.next_frame_ns += self.frame_period_ns
-            self._publish_frame()
-            if self.node.params["lockstep"]:
-                self.unanswered = frame = Frame(self.now_ns, time.monotonic())
-        if frame is not None and frame.stamp_ns + self.latency_ns <= self.now_ns:
-            return self._await(FRAME_ANSWERS, frame.stamp_ns)
+            lockstep = self.node.params["lockstep"]
+            if self.drawing is not None and not self.drawing.done() and not lockstep:
+                self.node.count("frames_skipped")  # real time: the last is still being drawn
+            else:
+                if self.drawing is not None:
+                    self.drawing.result()  # lockstep: answered, so all but returned
+                self.drawing = self.camera_thread.submit(
+                    self._publish_frame, self._header("camera", "camera/image"), self.moving()
+                )
+            if lockstep:
+                self.unanswered = Frame(self.now_ns, time.monotonic())
+                if self.latency_ns == 0:
+                    return self._await(FRAME_ANSWERS, self.now_ns)
+        self._publish_sensors()
+        if self.node.params["lockstep"]:
+            self._await(COMMANDS, self.now_ns)
+            self._check_answered()  # the commands may be in already
+
+    def _publish_sensors(self) -> None:
+        """The joints, odometry and truth of the step, once."""
+        if self.sensors_ns == self.now_ns:
+            return
+        self.sensors_ns = self.now_ns
         self._publish_joints()
         self._publish_odometry()
         self._publish_truth()
-        if self.node.params["lockstep"]:
-            self._await(COMMANDS, self.now_ns)
 
     def _has_answers(self, stamp_ns: int, names: tuple[str, ...] = FRAME_ANSWERS) -> bool:
         return all(self.answered.get(name, -1) >= stamp_ns for name in names)
@@ -421,20 +450,24 @@ class Simulator(Component):
         t = self.now_ns / 1e9
         return any(start <= t < end for start, end in self.hidden)
 
-    def _publish_frame(self) -> None:
-        image = self.renderer.frame(self.moving())
-        c, p = self.scene.camera, self.node.params
-        data = jpeg(image, p["jpeg_quality"]) if p["image_format"] == "jpeg" else image.tobytes()
-        self.publishers["camera/image"].put(
-            CameraFrame(
-                header=self._header("camera", "camera/image"),
-                encoding=p["image_format"],
-                width=c.width,
-                height=c.height,
-                data=data,
-                intrinsics=CameraIntrinsics(fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy),
-            )
-        )
+    def _publish_frame(self, header, moving: list) -> None:
+        """On the camera thread: draw ``moving`` over the scene, encode, publish."""
+        try:
+            image = self.renderer.frame(moving)
+            c, p = self.scene.camera, self.node.params
+            jpeg_file = p["image_format"] == "jpeg"
+            data = jpeg(image, p["jpeg_quality"]) if jpeg_file else image.tobytes()
+            intrinsics = CameraIntrinsics(fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy)
+            self.publishers["camera/image"].put(CameraFrame(
+                header=header, encoding=p["image_format"], width=c.width, height=c.height,
+                data=data, intrinsics=intrinsics))  # fmt: skip
+        except Exception:
+            self.node.count("errors.camera")
+            self.node.warn("errors.camera", "drawing a camera frame failed", True)
+
+    def shutdown(self) -> None:
+        if self.camera_thread is not None:
+            self.camera_thread.shutdown(wait=True)
 
 
 if __name__ == "__main__":

@@ -34,7 +34,14 @@ from messages.camera import CameraFrame
 from messages.markers import MarkerDetection, MarkerDetections
 from profiles.scene import Scene
 from vision.images import grey
-from vision.markers import Intrinsics, MarkerDetector, plane_of, plane_pose, square_pose
+from vision.markers import (
+    THRESHOLD_WINDOW_PX,
+    Intrinsics,
+    MarkerDetector,
+    plane_of,
+    plane_pose,
+    square_pose,
+)
 from wbc import dq
 from wbc.pose_filter import PoseFilter
 
@@ -55,6 +62,8 @@ class VisionTracker(Component):
         Param("reference_samples", int, 100, low=1, high=100000,
               doc="eq. 6.1 samples of the floor reference F0"),
         Param("plane_fit", bool, True, doc="fit markers on their known plane (else IPPE only)"),
+        Param("threshold_window_px", int, THRESHOLD_WINDOW_PX, low=3, high=255,
+              doc="the adaptive threshold's window, px (about a marker's side or less)"),
         Param("threads", int, 1, low=0, high=256,
               doc="OpenCV's worker threads (0: one per core); 1 spends the least CPU per frame"),
     )  # fmt: skip
@@ -66,7 +75,7 @@ class VisionTracker(Component):
         self.scene: Scene = node.profile.scene
         self.markers = self.scene.markers()
         cv2.setNumThreads(node.params["threads"] or -1)
-        self.detector = MarkerDetector(self.scene.dictionary_id)
+        self.detector = MarkerDetector(self.scene.dictionary_id, node.params["threshold_window_px"])
         self.reference = PoseFilter(node.params["reference_samples"])
         self.output = node.publisher(topics.VISION_MARKERS)
         node.counters["frames"] = 0

@@ -103,7 +103,7 @@ def test_a_killed_controller_leaves_the_robot_stopped_by_its_drivers(tmp_path: P
         after = [t for t in truth if t.header.stamp_ns > killed_ns]
         # Command timeout 0.2 s, then the wheels decelerate at 1 m/s^2 from under 0.25 m/s.
         settled = [t for t in after if t.header.stamp_ns > killed_ns + 600_000_000]
-        assert len(settled) > 50
+        assert len(settled) > 25  # 0.9 s of the simulator's 50 Hz truth
         xs = [t.base_pose[0] for t in settled]
         ys = [t.base_pose[1] for t in settled]
         assert max(xs) - min(xs) < 1e-4 and max(ys) - min(ys) < 1e-4, (xs[0], xs[-1])

@@ -40,7 +40,7 @@ def assert_sound(report: dict) -> None:
     assert report["joint_limit_violations"] == 0
     assert report["final_error"] < 0.02
     error = report["estimator_error"]
-    assert error["samples"] > 100
+    assert error["samples"] > 50  # states of the steady state, 50 Hz
     assert error["position_m"] < 0.01 and error["angle_rad"] < ONE_DEGREE, error
 
 
@@ -90,7 +90,7 @@ def test_hidden_base_marker_degrades_the_state_and_the_run_still_converges(
     code, report = experiment(tmp_path, "pose", "--hide-base-marker", "1,4")
     assert code == 0
     assert_sound(report)
-    assert report["degraded_states"] > 100  # about 2.5 s of 100 Hz states after the timeout
+    assert report["degraded_states"] > 50  # about 2.5 s of 50 Hz states after the timeout
 
 
 def kill_during_run(tmp_path: Path, component: str, name: str = "pose"

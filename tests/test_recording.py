@@ -63,7 +63,7 @@ def test_a_recorded_experiment_reads_back_with_every_channel_schema(runs) -> Non
     assert [d.header.seq for d in diagnostics] == list(range(len(diagnostics)))
     state_key = next(k for k in by_key if k.endswith("/robot/state"))
     assert by_key[state_key]["messages"] == len(session["robot/state"])
-    assert abs(by_key[state_key]["rate_hz"] - 100.0) < 1.0
+    assert abs(by_key[state_key]["rate_hz"] - 50.0) < 1.0  # the simulator's 50 Hz sensors
 
 
 def test_the_report_of_two_laws_shows_the_norms_they_minimise(runs, tmp_path: Path) -> None:
