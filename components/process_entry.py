@@ -13,7 +13,6 @@ import logging
 import os
 import signal
 import sys
-import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn
@@ -22,7 +21,7 @@ import zenoh
 
 from components.params import ParamError
 from components.runtime import Component, Node
-from messages.process import EXIT_CONFIG_ERROR, LAUNCHER_PID_ENV, PARAMS_FILE_ENV
+from messages.process import EXIT_CONFIG_ERROR, EXIT_FOR_GOOD, LAUNCHER_PID_ENV, PARAMS_FILE_ENV
 from profiles.profile import ProfileError, load_profile
 
 log = logging.getLogger("components")
@@ -38,11 +37,11 @@ def _on_stop_signal(signum: int, _frame: object) -> None:
     raise _StopRequested(signal.Signals(signum).name)
 
 
-def _wait_for_stop() -> None:
-    """Sleep until a stop signal, or until the launcher that started us is gone."""
+def _wait_for_stop(node: Node) -> None:
+    """Sleep until a stop signal, the node's ``fail``, or the end of the launcher that
+    started us."""
     launcher = os.environ.get(LAUNCHER_PID_ENV)
-    while True:
-        time.sleep(1.0)
+    while not node.stop_requested.wait(1.0):
         if launcher is not None and os.getppid() != int(launcher):
             log.warning("launcher (pid %s) is gone; stopping", launcher)
             return
@@ -84,6 +83,7 @@ def main(component_class: type[Component], argv: Sequence[str] | None = None) ->
     )
     for stop_signal in (signal.SIGINT, signal.SIGTERM):
         signal.signal(stop_signal, _on_stop_signal)
+    node = None
     try:
         node = _configure(component_class, args)
         if node is None:
@@ -95,13 +95,13 @@ def main(component_class: type[Component], argv: Sequence[str] | None = None) ->
                 log.error("%s: %s: %s", args.profile, args.name, error)
                 return EXIT_CONFIG_ERROR
             node.start(component.shutdown, component.clock_stalled)
-            _wait_for_stop()
+            _wait_for_stop(node)
     except _StopRequested as stop:
         log.info("%s stopping on %s", args.name, stop)
     except zenoh.ZError as error:
         log.error("%s: Zenoh failed: %s", args.name, error)
         return 1
-    return 0
+    return EXIT_FOR_GOOD if node is not None and node.failure is not None else 0
 
 
 def run_component(component_class: type[Component]) -> NoReturn:

@@ -9,8 +9,12 @@ frames as ``foxglove.FrameTransforms``, obstacles as ``foxglove.SceneUpdate``), 
 Foxglove's 3D, Image and Plot panels open the file as it is. ``keys`` limits the recording to
 topics whose names match one of its comma-separated ``fnmatch`` patterns.
 
-The current chunk is flushed every ``flush_s`` (SIGKILL loses at most that much); a clean stop
-writes the file's footer and index.
+The current chunk is flushed every ``flush_s`` (SIGKILL loses at most that much and what
+waits); a clean stop writes all that waits, then the file's footer and index. A recorder stops
+after everything else (its role is ``recorder``), however long its backlog takes. A file that
+cannot be written (a full disk) stops the recorder for good, exit ``EXIT_FOR_GOOD``, with the
+error and how many messages the file holds: ``parsimony record --recover`` keeps every
+complete chunk.
 """
 
 from __future__ import annotations
@@ -37,7 +41,7 @@ class Recorder(Component):
     params = (
         Param("path", str, "session.mcap", doc="the MCAP file to write"),
         Param("keys", str, "*", doc="comma-separated patterns of the topic names to record"),
-        Param("flush_s", float, 1.0, low=0.05, high=60.0, doc="chunk flush period, s"),
+        Param("flush_s", float, 0.25, low=0.05, high=60.0, doc="chunk flush period, s"),
         Param("views", bool, True, doc="also write Foxglove's well-known schemas"),
     )
 
@@ -50,26 +54,43 @@ class Recorder(Component):
         except OSError as error:
             raise ParamError(f"path: cannot write {path}: {error}") from error
         patterns = [p.strip() for p in str(node.params["keys"]).split(",") if p.strip()]
+        self.path = path
+        self.failed = False
         node.counters["written"] = 0
         self.inputs = [
             node.subscribe(topic, self._writer_of(topic.name, topic.key(node.namespace)))
             for topic in topics.TOPICS.values()
             if any(fnmatch.fnmatch(topic.name, pattern) for pattern in patterns)
         ]
-        node.timer(node.params["flush_s"], self.writer.flush)
+        node.timer(node.params["flush_s"], lambda: self._writing(self.writer.flush))
 
     def _writer_of(self, name: str, key: str):
         def write(message) -> None:
-            self.writer.write(key, message, views=self.node.params["views"])
-            self.node.counters["written"] += 1
+            if self._writing(self.writer.write, key, message, views=self.node.params["views"]):
+                self.node.counters["written"] += 1
 
         return write
+
+    def _writing(self, operation, *args, **kwargs) -> bool:
+        """Run a write of the file; on an OSError stop for good (once), saying why."""
+        if self.failed:
+            return False
+        try:
+            operation(*args, **kwargs)
+            return True
+        except OSError as error:
+            self.failed = True
+            self.node.fail(f"cannot write {self.path}: {error}; stopping with "
+                           f"{self.node.counters['written']} messages written, the file recovers "
+                           f"to its last complete chunk (parsimony record --recover "
+                           f"{self.path} OUT)")  # fmt: skip
+            return False
 
     def shutdown(self) -> None:
         """Write what still waits, then the footer: the file is whole."""
         for subscription in self.inputs:
             subscription.drain()
-        self.writer.close()
+        self._writing(self.writer.close)
 
 
 if __name__ == "__main__":

@@ -89,6 +89,9 @@ class Node:
         self.clock: Clock = SimClock() if source == "sim" else WallClock()
         self.counters: dict[str, int] = {"clock_stalls": 0}
         self.state = "starting"
+        self.failure: str | None = None
+        """Why this component stopped for good (``fail``); the process exits non-zero."""
+        self.stop_requested = threading.Event()
         self._timers = Timers(self.clock)
         self._events: queue.SimpleQueue[Callable[[], None] | None] = queue.SimpleQueue()
         self._warnings = RateLimitedLog(log)
@@ -191,6 +194,14 @@ class Node:
             parameters=dict(self.params),
         )
 
+    def fail(self, reason: str) -> None:
+        """Stop this component for good: log ``reason``; the process then exits with
+        ``EXIT_FOR_GOOD`` and is not restarted."""
+        log.error("%s: %s", self.name, reason)
+        self.failure = reason
+        self.state = "failed"
+        self.stop_requested.set()
+
     def post(self, event: Callable[[], None]) -> None:
         """Run ``event`` on the handler thread (callable from any thread)."""
         self._events.put(event)
@@ -235,7 +246,9 @@ class Node:
         self.state = "stopping"
         if self._thread is not None:
             self._events.put(None)
-            patience_s = max(0.5, self.spec.stop_timeout_s - STOP_MARGIN_S)
+            # A recorder writes all that waits (the launcher kills it if it stops progressing).
+            recorder = self.spec.role == "recorder"
+            patience_s = None if recorder else max(0.5, self.spec.stop_timeout_s - STOP_MARGIN_S)
             self._thread.join(patience_s)
             if self._thread.is_alive():
                 log.warning("handler thread busy after %.1f s; closing anyway", patience_s)

@@ -4,7 +4,9 @@ It opens the router the components connect to, starts the enabled components
 (drivers, estimators, controllers, tools), prefixes every line they print with
 ``[name]``, restarts the ones that exit according to their restart policy,
 reports liveliness changes, and on SIGINT, SIGTERM or the end of the duration
-stops them in the reverse order: SIGTERM, then SIGKILL after each one's ``stop_timeout_s``.
+stops them in the reverse order: SIGTERM, then SIGKILL after each one's ``stop_timeout_s``
+(for a recorder, which stops last, ``stop_timeout_s`` without progress: it drains its backlog
+however long that takes, and is killed only when it has spent no CPU time for that long).
 
 The launch fails at start-up when a component is not alive within the profile's
 ``startup_timeout_s`` or stops for good before it ever was (a configuration error). A
@@ -35,7 +37,7 @@ import zenoh
 
 from deploy.query import statuses
 from messages import process, topics
-from messages.process import EXIT_CONFIG_ERROR, LAUNCHER_PID_ENV, PARAMS_FILE_ENV
+from messages.process import EXIT_CONFIG_ERROR, EXIT_FOR_GOOD, LAUNCHER_PID_ENV, PARAMS_FILE_ENV
 from profiles.profile import ROLES, ComponentSpec, Profile
 
 POLL_S = 0.05
@@ -79,6 +81,15 @@ class Child:
     """Whether the current process's liveliness token is present."""
     answered_at: float = 0.0
     """When it last answered a status query, or came alive (the watchdog's reference)."""
+
+
+def cpu_seconds(pid: int) -> float:
+    """The user and system CPU time a process has spent (Linux /proc), 0 when it is gone."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return 0.0
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 class Launcher:
@@ -267,10 +278,13 @@ class Launcher:
         if now - child.started_at >= policy.reset_after_s:
             child.restarts = 0
         wanted = policy.policy == "always" or (policy.policy == "on-failure" and code != 0)
-        if code == EXIT_CONFIG_ERROR or not wanted or child.restarts >= policy.max_restarts:
+        final = code in (EXIT_CONFIG_ERROR, EXIT_FOR_GOOD)
+        if final or not wanted or child.restarts >= policy.max_restarts:
             child.done, child.failed = True, code != 0
             if code == EXIT_CONFIG_ERROR:
                 why = "; configuration error, not restarting"
+            elif code == EXIT_FOR_GOOD:
+                why = "; cannot go on, not restarting"
             elif wanted:
                 why = f"; no restarts left ({child.restarts}/{policy.max_restarts})"
             else:
@@ -300,9 +314,18 @@ class Launcher:
                 self._reap(child, child.process, stopped_at + child.spec.stop_timeout_s)
 
     def _reap(self, child: Child, process: subprocess.Popen[str], deadline: float) -> None:
-        """Wait for a child sent SIGTERM until ``deadline``, then kill it."""
+        """Wait for a child sent SIGTERM until ``deadline``, then kill it; a recorder's
+        deadline moves on while it spends CPU time."""
         try:
-            code = process.wait(max(0.0, deadline - time.monotonic()))
+            while True:
+                spent = cpu_seconds(process.pid)
+                try:
+                    code = process.wait(max(0.0, deadline - time.monotonic()))
+                    break
+                except subprocess.TimeoutExpired:
+                    if child.spec.role != "recorder" or cpu_seconds(process.pid) <= spent:
+                        raise
+                    deadline = time.monotonic() + child.spec.stop_timeout_s
         except subprocess.TimeoutExpired:
             process.kill()
             process.wait()

@@ -18,6 +18,10 @@ ParamValue = bool | int | float | str
 EXIT_CONFIG_ERROR = 2
 """Exit code of a component refused by its configuration; the launcher never restarts it."""
 
+EXIT_FOR_GOOD = 3
+"""Exit code of a component that cannot go on (a recorder whose disk is full); the launcher
+never restarts it."""
+
 LAUNCHER_PID_ENV = "PARSIMONY_LAUNCHER_PID"
 """Set by the launcher; a component whose parent is no longer that pid stops."""
 
@@ -31,8 +35,9 @@ def command(module_path: str, profile: Path, name: str) -> list[str]:
     return [sys.executable, "-m", module_path, "--profile", str(profile), "--name", name]
 
 
-def stop(child: subprocess.Popen, signum: int, timeout_s: float) -> int:
-    """Send ``signum`` to ``child`` and wait ``timeout_s`` for it, then kill it; its exit code."""
+def stop(child: subprocess.Popen, signum: int, timeout_s: float | None) -> int:
+    """Send ``signum`` to ``child`` and wait ``timeout_s`` (None: as long as it takes) for it,
+    then kill it; its exit code."""
     child.send_signal(signum)
     try:
         return child.wait(timeout_s)

@@ -70,9 +70,9 @@ TIME_LIMIT_S = 60.0
 """Simulated seconds after which a run that has not converged stops."""
 STARTUP_S = 60.0
 """Host seconds the components may take to come up."""
-RECORDER_STOP_S = 60.0
-"""Host seconds the recorder may take at the end to write what still waits for it (a lockstep
-run faster than real time on a loaded machine leaves a backlog of camera frames)."""
+RECORDER_STOP_S = 10.0
+"""Host seconds a stopping recorder may go without progress before it is killed; it stops
+after everything else and writes all that still waits for it, however long that takes."""
 SESSION_FILE = "session.mcap"
 """The recording of a run, beside its report."""
 LISTENED = ("sim/truth", "robot/state", "control/diagnostics", "base/command", "arm/command",
@@ -89,7 +89,6 @@ class Options:
     realtime: bool = False
     time_limit_s: float = TIME_LIMIT_S
     hide_base_marker: tuple[float, float] | None = None
-
 
 
 def law_overrides(options: Options) -> dict[str, Any]:
@@ -114,8 +113,9 @@ def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict
     if options.hide_base_marker is not None:
         simulator["hide_base_marker"] = ", ".join(str(v) for v in options.hide_base_marker)
     controller = {"module": MODULES[options.controller], "params": law_overrides(options)}
-    recorder = {"name": "recorder", "module": "recorder", "role": "tool",
-                "stop_timeout_s": RECORDER_STOP_S,
+    # Never restarted: a new recorder would begin the file again; a killed one's file recovers.
+    recorder = {"name": "recorder", "module": "recorder", "role": "recorder",
+                "stop_timeout_s": RECORDER_STOP_S, "restart": {"policy": "never"},
                 "params": {"path": str((options.out / SESSION_FILE).resolve())}}  # fmt: skip
     components = [
         recorder,
@@ -225,7 +225,7 @@ def run_experiment(options: Options) -> dict[str, Any]:
     profile = load_profile(profile_path)
     started = time.monotonic()
     with (options.out / "launch.log").open("w") as log,\
-            launched(profile_path, log, RECORDER_STOP_S + 20.0) as launcher,\
+            launched(profile_path, log, None) as launcher,\
             connect(profile, launcher) as session:  # fmt: skip
         recorder = Recorder(session, profile.namespace)
         wait_alive(session, profile, launcher)
@@ -239,9 +239,15 @@ def run_experiment(options: Options) -> dict[str, Any]:
     messages = until(messages, end_ns)
     report = build_report(options, setup, profile, robot, messages, wall_s, counters, converged)
     write_commands(options.out / "commands.csv", messages)
+    start_ns = min((s.header.stamp_ns for s in messages["robot/state"]), default=end_ns)
+    report["recording"] = recording_check(options.out / SESSION_FILE, (start_ns, end_ns),
+                                          counters)  # fmt: skip
     whole_recording(options.out / SESSION_FILE)
     session = load_session(options.out / SESSION_FILE)
-    figures = write_report([(options.controller, session)], robot, options.out,
+    label = options.controller
+    if report["recording"]["missing"]:
+        label += " (RECORDING CUT SHORT: " + "; ".join(report["recording"]["missing"]) + ")"
+    figures = write_report([(label, session)], robot, options.out,
                            profile.scene.reference_pose)["figures"]  # fmt: skip
     report["figures"] = [str(path) for path in figures]
     (options.out / "report.json").write_text(dumps(report))
@@ -250,12 +256,15 @@ def run_experiment(options: Options) -> dict[str, Any]:
 
 @contextlib.contextmanager
 def launched(profile_path: Path, log: IO[str] | int = subprocess.DEVNULL,
-             stop_timeout_s: float = 30.0) -> Iterator[subprocess.Popen]:  # fmt: skip
+             stop_timeout_s: float | None = 30.0) -> Iterator[subprocess.Popen]:  # fmt: skip
     """``parsimony launch PROFILE`` as a child process, its output to ``log``; at the end of
     the block it is stopped by SIGINT (its components in order), killed after
-    ``stop_timeout_s``."""
-    launcher = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "launch",
-                                 str(profile_path)], stdout=log, stderr=subprocess.STDOUT)
+    ``stop_timeout_s`` (None: the launcher's own limits, a recorder's progress, decide)."""
+    launcher = subprocess.Popen(
+        [sys.executable, "-m", "parsimony.cli", "launch", str(profile_path)],
+        stdout=log,
+        stderr=subprocess.STDOUT,
+    )
     try:
         yield launcher
     finally:
@@ -272,6 +281,34 @@ def connect(profile: Profile, launcher: subprocess.Popen) -> zenoh.Session:
             if launcher.poll() is not None or time.monotonic() > deadline:
                 raise
             time.sleep(0.2)  # the launcher opens its router first thing
+
+
+def recording_check(path: Path, run_ns: tuple[int, int], counters: dict[str, dict[str, int]]
+                    ) -> dict:  # fmt: skip
+    """Whether the recording holds the whole run, from its first state to its last (``run_ns``):
+    its footer, no sample dropped by the recorder, and the run's states from start to end;
+    ``missing`` says what is not there (empty when whole). With its size, and bytes per
+    simulated second."""
+    start_ns, end_ns = run_ns
+    facts = info(path)
+    missing = []
+    if not facts["complete"]:
+        missing.append("no footer: the recorder was killed, the file keeps its complete chunks")
+    dropped = {k.split(".", 1)[1]: v for k, v in counters.get("recorder", {}).items()
+               if k.startswith("overflowed.") and v}  # fmt: skip
+    if dropped:
+        lost = ", ".join(f"{v} of {k}" for k, v in dropped.items())
+        missing.append(f"the recorder dropped {lost}")
+    states = [c for c in facts["channels"] if c["key"].endswith("/" + topics.ROBOT_STATE.name)]
+    first_ns = min((c["start_ns"] for c in states), default=0)
+    last_ns = max((c["end_ns"] for c in states), default=0)
+    if not states or first_ns > start_ns:
+        missing.append(f"its states begin {(first_ns - start_ns) / 1e9:.2f} s after the run's")
+    if last_ns < end_ns:
+        missing.append(f"its states end {(end_ns - last_ns) / 1e9:.2f} s before the run's")
+    span_s = max((end_ns - start_ns) / 1e9, 1e-9)
+    return {"whole": not missing, "missing": missing, "messages": facts["messages"],
+            "bytes": facts["bytes"], "bytes_per_sim_s": round(facts["bytes"] / span_s)}  # fmt: skip
 
 
 def whole_recording(path: Path) -> None:
@@ -424,8 +461,10 @@ def build_report(
         "estimator_error": estimator_error(truth, states, profile, end_s - HOLD_S),
         "nonzero_entries": dict(sorted(Counter(d.nonzero for d in steps).items())),
         "effort": effort(messages, truth),
-        "step_time_us": {"median": round(float(np.median(solve)), 1),
-                         "p99": round(float(np.percentile(solve, 99)), 1)},  # fmt: skip
+        "step_time_us": {
+            "median": round(float(np.median(solve)), 1),
+            "p99": round(float(np.percentile(solve, 99)), 1),
+        },  # fmt: skip
         "lockstep_timeouts": counters.get("simulator", {}).get("lockstep_timeouts", 0),
         "durations_us": durations(counters),
         "controller_statuses": dict(sorted(Counter(d.status for d in diagnostics).items())),

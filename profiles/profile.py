@@ -13,7 +13,7 @@ from __future__ import annotations
 import importlib.util
 import json
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Literal, get_args
 
 import yaml
 import zenoh
@@ -29,14 +29,17 @@ TLS_FILES = ("root_ca_certificate", "listen_certificate", "listen_private_key")
 COMPONENT_PACKAGE = "components"
 """The package of component modules: ``module: echo`` means ``components.echo``."""
 
-ROLES = ("driver", "estimator", "controller", "tool")
-"""Start order of the roles; the launcher stops them in the reverse order."""
+Role = Literal["recorder", "driver", "estimator", "controller", "tool"]
+ROLES: tuple[str, ...] = get_args(Role)
+"""Start order of the roles; the launcher stops them in the reverse order: a recorder starts
+first and stops last, once everything it records has stopped, so it drains all they sent."""
 
 Identifier = Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]*$")]
 """A lower-case Python identifier, also safe inside a key expression."""
 
 Namespace = Annotated[str, Field(pattern=r"^[A-Za-z0-9_-]+(/[A-Za-z0-9_-]+)*$")]
 """One or more key-expression chunks without wildcards, e.g. ``sim`` or ``lab/robot1``."""
+
 
 class ProfileError(Exception):
     """A profile that cannot be used; the message says where and what was expected."""
@@ -184,7 +187,7 @@ class ComponentSpec(StrictModel):
 
     name: Identifier
     module: Identifier
-    role: Literal["driver", "estimator", "controller", "tool"]
+    role: Role
     params: dict[str, ParamValue] = {}
     restart: RestartPolicy = RestartPolicy()
     enabled: bool = True
@@ -193,8 +196,8 @@ class ComponentSpec(StrictModel):
     profile's ``clock``, except for the component that publishes ``sim/clock`` (the simulator,
     a replayer), which always runs on its own, the host's, time."""
     stop_timeout_s: float = Field(default=5.0, gt=0.0)
-    """Seconds this component gets to exit after SIGTERM before SIGKILL (a recorder may need
-    longer, to write what still waits)."""
+    """Seconds this component gets to exit after SIGTERM before SIGKILL; for a ``recorder``,
+    seconds without progress (CPU time spent): it writes all that waits, however long."""
     remap: dict[str, str] = {}
     """Topic name -> topic name: the component reads or writes the second where its code says
     the first (as ROS 2 remaps a node's topics). Both must carry the same message type."""

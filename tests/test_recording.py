@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import resource
 import signal
 import subprocess
 import sys
@@ -17,7 +18,8 @@ import zenoh
 from mcap.reader import make_reader
 
 from deploy import query
-from messages import codec, topics
+from messages import codec, process, topics
+from messages.process import EXIT_FOR_GOOD
 from parsimony.experiment import connect
 from parsimony.sessions import load_session
 from profiles.endpoints import free_port
@@ -64,6 +66,11 @@ def test_a_recorded_experiment_reads_back_with_every_channel_schema(runs) -> Non
     state_key = next(k for k in by_key if k.endswith("/robot/state"))
     assert by_key[state_key]["messages"] == len(session["robot/state"])
     assert abs(by_key[state_key]["rate_hz"] - 50.0) < 1.0  # the simulator's 50 Hz sensors
+    # The recorder stopped after everything else and drained: the run is there to its end.
+    recording = json.loads((runs["lp"] / "report.json").read_text())["recording"]
+    assert recording["whole"] and recording["missing"] == [], recording
+    assert recording["bytes_per_sim_s"] < 2_000_000  # each image once, as JPEG
+    assert "recorder stopped (0)" in (runs["lp"] / "launch.log").read_text().splitlines()[-1]
 
 
 def test_the_report_of_two_laws_shows_the_norms_they_minimise(runs, tmp_path: Path) -> None:
@@ -80,42 +87,86 @@ def test_the_report_of_two_laws_shows_the_norms_they_minimise(runs, tmp_path: Pa
     assert "| 1 |" in (tmp_path / "effort.md").read_text()
 
 
-def test_a_recorder_killed_with_sigkill_leaves_all_but_the_last_second(tmp_path: Path) -> None:
-    """The experiment records; its recorder is killed mid-run, the file still reads."""
+def test_a_recorder_killed_with_sigkill_loses_at_most_half_a_second(tmp_path: Path) -> None:
+    """The experiment records; its recorder is killed mid-run: the file still reads, less at
+    most 0.5 s of messages, and the experiment says loudly that its recording is cut short."""
     command = [sys.executable, "-m", "parsimony.cli", "experiment", "pose", "--realtime",
                "--out", str(tmp_path)]  # fmt: skip
-    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    try:
-        deadline = time.monotonic() + 120
-        while not (tmp_path / "profile.yaml").exists():
-            assert time.monotonic() < deadline
-            time.sleep(0.1)  # the experiment writes its profile before it launches
-        target = query.Target.from_profile(tmp_path / "profile.yaml")
-        with connect(load_profile(tmp_path / "profile.yaml"), process) as session:
-            while True:
-                assert time.monotonic() < deadline
-                found = query.statuses(session, target.namespace, 0.5)
-                if found.get("recorder") and found["recorder"].counters["written"] > 2000:
-                    break
-            written = found["recorder"].counters["written"]
-            os.kill(found["recorder"].pid, signal.SIGKILL)
-            killed = time.monotonic()
-    finally:
-        process.wait(300)
-    assert time.monotonic() - killed < 300
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    while not (tmp_path / "profile.yaml").exists():
+        assert process.poll() is None, process.communicate()
+        time.sleep(0.1)  # the experiment writes its profile before it launches
+    target = query.Target.from_profile(tmp_path / "profile.yaml")
+    with connect(load_profile(tmp_path / "profile.yaml"), process) as session:
+        while True:
+            assert process.poll() is None, process.communicate()
+            found = query.statuses(session, target.namespace, 0.5)
+            if found.get("recorder") and found["recorder"].counters["written"] > 2000:
+                break
+        written = found["recorder"].counters["written"]
+        os.kill(found["recorder"].pid, signal.SIGKILL)
+    out, err = process.communicate()
+    assert "recording=CUT_SHORT" in out, out
+    assert "the recording is cut short: no footer" in err, err[-3000:]
     path = tmp_path / "session.mcap"
     recorded = list(read_session(path))
     project = [r for r in recorded if r.topic_name is not None]
-    # All but the last chunk (flushed every second) reads back: what was written when polled,
-    # less at most about 1.5 s of messages at the recording's own rate.
+    # All but the last chunk reads back: what was written when polled, less at most 0.5 s of
+    # messages at the recording's own rate.
     end = project[-1].log_time_ns
     rate = sum(r.log_time_ns > end - 2_000_000_000 for r in project) / 2.0  # while running
-    assert len(project) > 300 and written - len(project) <= 1.5 * rate, (written, rate)
+    assert len(project) > 300 and written - len(project) <= 0.5 * rate, (written, rate)
     assert info(path)["messages"] == len(recorded)
     whole = tmp_path / "recovered.mcap"
     assert recover(path, whole) == len(recorded)
     with whole.open("rb") as stream:
         assert sum(1 for _ in make_reader(stream).iter_messages()) == len(recorded)
+
+
+def test_a_recorder_whose_file_fills_up_stops_for_good_and_its_file_recovers(
+    tmp_path: Path,
+) -> None:
+    """A file size limit (RLIMIT_FSIZE, as a full disk: the write fails) stops the recorder
+    with EXIT_FOR_GOOD and a message naming the file and the error; the launcher does not
+    restart it, and the file recovers to its last complete chunk."""
+    path = tmp_path / "session.mcap"
+    profile = tmp_path / "profile.yaml"
+    profile.write_text(yaml.safe_dump({
+        "namespace": "full", "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
+        "components": [
+            {"name": "recorder", "module": "recorder", "role": "recorder",
+             "params": {"path": str(path), "flush_s": 0.05}},
+            {"name": "pub", "module": "scripted_publisher", "role": "tool",
+             "params": {"rate_hz": 1000.0}},
+        ],
+    }))  # fmt: skip
+    limit = 64 * 1024
+
+    def small_files() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    log = tmp_path / "launch.log"
+    with log.open("w") as stream:
+        launcher = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "launch",
+                                     str(profile)], stdout=stream, stderr=subprocess.STDOUT,
+                                    preexec_fn=small_files)  # fmt: skip
+    try:
+        while f"recorder exited with {EXIT_FOR_GOOD}" not in log.read_text():
+            assert launcher.poll() is None, log.read_text()
+            time.sleep(0.1)
+    finally:
+        process.stop(launcher, signal.SIGINT, None)
+    text = log.read_text()
+    assert "cannot go on, not restarting" in text
+    assert f"cannot write {path}: [Errno 27] File too large" in text, text
+    assert "parsimony record --recover" in text
+    assert text.count("started recorder") == 1
+    assert not info(path)["complete"]
+    kept = recover(path, tmp_path / "recovered.mcap")
+    assert kept > 0 and kept == info(tmp_path / "recovered.mcap")["messages"]
+    states = load_session(tmp_path / "recovered.mcap")["robot/state"]
+    seqs = [s.header.seq for s in states]  # none lost in between
+    assert seqs and seqs == list(range(seqs[0], seqs[0] + len(seqs)))
 
 
 def test_replay_republishes_the_sensors_with_headers_as_recorded(runs, tmp_path: Path) -> None:

@@ -68,7 +68,11 @@ def run(args: argparse.Namespace) -> int:
         keys = ("converged", "final_error", "sim_time_s", "wall_time_s", "real_time_factor",
                 "contacts")  # fmt: skip
         summary = {k: report[k] for k in keys}
+        summary["recording"] = "whole" if report["recording"]["whole"] else "CUT_SHORT"
         emit(" ".join(f"{k}={v}" for k, v in summary.items()))
+    for missing in report["recording"]["missing"]:
+        print(f"[experiment] WARNING: the recording is cut short: {missing}; the figures show "
+              "only what it holds", file=sys.stderr)  # fmt: skip
     print(f"[experiment] report: {args.out / 'report.json'}", file=sys.stderr)
     print(f"[experiment] figures: {', '.join(report.get('figures', []))}", file=sys.stderr)
     print(f"[experiment] recording: {args.out / 'session.mcap'} (parsimony info, replay, "

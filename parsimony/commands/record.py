@@ -50,8 +50,9 @@ def run(args: argparse.Namespace) -> int:
         params = {"path": str(args.output.resolve()), "keys": ",".join(args.keys)}
         profile.write_text(yaml.safe_dump({
             "extends": str(args.profile.resolve()),
-            "components": [{"name": "recorder", "module": "recorder", "role": "tool",
-                            "stop_timeout_s": RECORDER_STOP_S, "params": params}],
+            "components": [{"name": "recorder", "module": "recorder", "role": "recorder",
+                            "stop_timeout_s": RECORDER_STOP_S, "params": params,
+                            "restart": {"policy": "never"}}],
         }))  # fmt: skip
         command = [sys.executable, "-m", "components.recorder", "--profile", str(profile),
                    "--name", "recorder"]  # fmt: skip
