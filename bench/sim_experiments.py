@@ -1,22 +1,27 @@
 """The chapter 6 experiments on the whole simulated loop, over many seeds, and the loop's speed.
 
-Run as ``python -m bench.sim_experiments [--seeds N] [--json]``. For each experiment and law it
-runs ``parsimony experiment`` in lockstep for seeds 0..N-1 and prints the share that converged,
-contacts, the worst estimator error in steady state, and the real-time factor (simulated over
-wall seconds, on this machine). Then the speed of the parts: camera render, marker detection
-and pose fits per frame (in this process, on the scene of ``deploy/sim.yaml``), the camera-frame
-answer time (tracker and estimator) and the state-to-command time inside the running loop (the
-simulator's counters), and the controller's step time.
+Run as ``python -m bench.sim_experiments [--seeds N] [--workers W] [--json]``. For each
+experiment and law it runs ``parsimony experiment`` in lockstep, recorder on, for seeds
+0..N-1, W at a time (each system in its own process, namespace and router port), and prints the
+share that converged, contacts, the worst estimator error in steady state, the real-time factor
+(simulated over wall seconds, on this machine, with the other workers running), the cost of
+each stage (the handlers' median times, the simulator's frame answer and state-to-command
+times), the recorder's CPU per simulated second (its share of one core in real time) and the
+recording's bytes per simulated second; then experiments per minute over the whole study.
+Last, the speed of the camera's parts per frame in this process, on the scene of
+``deploy/sim.yaml``: render, JPEG encode and decode, marker detection and pose fits.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import sys
 import tempfile
 import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -24,13 +29,9 @@ import numpy as np
 from parsimony.experiment import PROFILES, SUPERVISED, Options, run_experiment
 from parsimony.output import emit, result_only_stdout
 from profiles.profile import load_profile
-from sim2d.camera import (
-    ImageNoise,
-    PlacedMarker,
-    ceiling_camera,
-    render,
-)
+from sim2d.camera import ImageNoise, PlacedMarker, Renderer, ceiling_camera
 from sim2d.scenarios import NAMES, scenario
+from vision.images import grey, jpeg
 from vision.markers import Intrinsics, MarkerDetector, plane_of, plane_pose, square_pose
 from wbc.planar import planar_pose
 from wbc.robot import MobileManipulator
@@ -46,18 +47,26 @@ def percentile(values: list[float], q: float) -> float:
     return round(float(np.percentile(values, q)), 1)
 
 
-def run_seeds(name: str, controller: str, seeds: int, directory: Path) -> dict:
+def run_one(name: str, controller: str, seed: int, directory: Path) -> dict:
+    """One lockstep run (in a worker process: its pid names the system's namespace)."""
+    options = Options(name=name, controller=controller, seed=seed,
+                      out=directory / f"{name}-{controller}-{seed}")  # fmt: skip
+    report = run_experiment(options)
+    print(f"[bench] {name} {controller} seed {seed}: converged={report['converged']} "
+          f"rtf={report['real_time_factor']}", file=sys.stderr, flush=True)  # fmt: skip
+    return report
+
+
+def median_of(reports: list[dict], component: str, counter: str) -> int:
+    return round(statistics.median(
+        r["durations_us"].get(component, {}).get(counter, 0) for r in reports))  # fmt: skip
+
+
+def summary(name: str, controller: str, reports: list[dict]) -> dict:
     """Every seed of one experiment and law, summarised."""
-    reports = []
-    for seed in range(seeds):
-        options = Options(name=name, controller=controller, seed=seed,
-                          out=directory / f"{name}-{controller}-{seed}")  # fmt: skip
-        reports.append(run_experiment(options))
-        print(f"[bench] {name} {controller} seed {seed}: converged={reports[-1]['converged']}",
-              file=sys.stderr, flush=True)  # fmt: skip
     estimator = [r["estimator_error"] for r in reports if r["estimator_error"]["samples"]]
-    answer = [r["durations_us"].get("simulator", {}) for r in reports]
-    handlers = [r["durations_us"].get("state_estimator", {}) for r in reports]
+    # The recorder's CPU per simulated second: its share of one core in real time (30 Hz).
+    recorder = [r["cpu_s"].get("recorder", 0.0) / r["sim_time_s"] for r in reports]
     return {
         "experiment": name,
         "law": controller,
@@ -68,53 +77,61 @@ def run_seeds(name: str, controller: str, seeds: int, directory: Path) -> dict:
         "estimator_position_mm": round(max(e["position_m"] for e in estimator) * 1e3, 2),
         "estimator_angle_deg": round(float(np.degrees(max(e["angle_rad"] for e in estimator))), 2),
         "real_time_factor": round(statistics.median(r["real_time_factor"] for r in reports), 2),
-        "tracker_frame_us": round(statistics.median(
-            r["durations_us"].get("vision_tracker", {}).get("handler.camera/image_us_median", 0)
-            for r in reports)),
-        "step_us_median": round(statistics.median(r["step_time_us"]["median"] for r in reports)),
-        "loop_us_median": round(statistics.median(a.get("loop_us_median", 0) for a in answer)),
-        "frame_us_median": round(statistics.median(a.get("frame_us_median", 0) for a in answer)),
-        "estimator_odometry_us": round(statistics.median(
-            e.get("handler.base/odometry_us_median", 0) for e in handlers)),
-        "estimator_markers_us": round(statistics.median(
-            e.get("handler.vision/markers_us_median", 0) for e in handlers)),
+        "rtf_min": round(min(r["real_time_factor"] for r in reports), 2),
+        "tracker_frame_us": median_of(reports, "vision_tracker", "handler.camera/image_us_median"),
+        "estimator_odometry_us": median_of(reports, "state_estimator",
+                                           "handler.base/odometry_us_median"),  # fmt: skip
+        "controller_state_us": median_of(reports, "controller", "handler.robot/state_us_median"),
+        "frame_answer_us": median_of(reports, "simulator", "frame_us_median"),
+        "loop_us": median_of(reports, "simulator", "loop_us_median"),
+        "recorder_cpu_pct_rt": round(100 * statistics.median(recorder), 1),
+        "bytes_per_sim_s": round(statistics.median(r["recording"]["bytes_per_sim_s"]
+                                                   for r in reports)),  # fmt: skip
+        "recordings_whole": sum(r["recording"]["whole"] for r in reports),
     }
 
 
 def vision_speed() -> dict:
-    """Render, detect and fit times per frame on the simulation profile's scene."""
+    """Render, JPEG encode and decode, detection and fit times per frame, on the simulation
+    profile's scene, as the simulator and the tracker run them."""
     profile = load_profile(PROFILES["lp"])
     scene, c = profile.scene, profile.scene.camera
     robot = MobileManipulator.from_yaml(profile.robot)
     setup = scenario("obstacle", robot)
     camera = ceiling_camera(c)
-    reference = planar_pose(*scene.reference_pose)
-    markers = [
-        PlacedMarker(scene.reference.id, scene.reference.size_m, reference),
-        PlacedMarker(scene.base.id, scene.base.size_m, planar_pose(0.0, 0.0, 0.2, 0.092)),
+    below = [
+        PlacedMarker(scene.reference.id, scene.reference.size_m,
+                     planar_pose(*scene.reference_pose)),
         PlacedMarker(scene.goal.id, scene.goal.size_m, planar_pose(*setup.bin)),
-        *(PlacedMarker(i, scene.obstacles.size_m, planar_pose(o.x, o.y, 0.0, 0.3))
-          for i, o in zip(scene.obstacles.ids, setup.obstacles, strict=False)),
     ]  # fmt: skip
+    above = [PlacedMarker(i, scene.obstacles.size_m, planar_pose(o.x, o.y, 0.0, 0.3))
+             for i, o in zip(scene.obstacles.ids, setup.obstacles, strict=False)]  # fmt: skip
+    rng = np.random.default_rng(0)
+    renderer = Renderer(camera, scene.dictionary_id, ImageNoise(), rng, below, above)
     detector = MarkerDetector(scene.dictionary_id)
     intrinsics = Intrinsics(c.fx, c.fy, c.cx, c.cy)
-    rng = np.random.default_rng(0)
-    times: dict[str, list[float]] = {"render_us": [], "detect_us": [], "fit_us": []}
-    for _ in range(FRAMES):
-        start = time.perf_counter()
-        image = render(camera, markers, scene.dictionary_id, ImageNoise(), rng)
-        rendered = time.perf_counter()
+    stages = ("render_us", "encode_us", "decode_us", "detect_us", "fit_us")
+    times: dict[str, list[float]] = {name: [] for name in stages}
+    for index in range(FRAMES):
+        base = PlacedMarker(scene.base.id, scene.base.size_m,
+                            planar_pose(0.002 * index, 0.0, 0.2, 0.092))  # fmt: skip
+        marks = [time.perf_counter()]
+        image = renderer.frame([base])
+        marks.append(time.perf_counter())
+        data = jpeg(image, 90)
+        marks.append(time.perf_counter())
+        image = grey(data, "jpeg", c.width, c.height)
+        marks.append(time.perf_counter())
         found = detector.detect(image)
-        detected = time.perf_counter()
+        marks.append(time.perf_counter())
         reference = next(d for d in found if d.id == scene.reference.id)
         pose, _ = square_pose(reference, scene.reference.size_m, intrinsics)
         normal, offset = plane_of(pose, 0.0)
         for detection in found:
             plane_pose(detection, 0.15, intrinsics, normal, offset)
-        fitted = time.perf_counter()
-        times["render_us"].append((rendered - start) * 1e6)
-        times["detect_us"].append((detected - rendered) * 1e6)
-        times["fit_us"].append((fitted - detected) * 1e6)
+        marks.append(time.perf_counter())
+        for name, start, end in zip(stages, marks[:-1], marks[1:], strict=True):
+            times[name].append((end - start) * 1e6)
     return {name: {"median": percentile(v, 50), "p99": percentile(v, 99)}
             for name, v in times.items()}  # fmt: skip
 
@@ -130,15 +147,28 @@ def format_table(rows: list[dict]) -> str:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seeds", type=int, default=20, help="seeds per experiment and law")
+    parser.add_argument("--workers", type=int, default=max(1, (os.cpu_count() or 2) // 2),
+                        help="experiments run at once (default: one per two cores)")  # fmt: skip
+    parser.add_argument("--only", help="comma-separated experiments to run (default: all)")
     parser.add_argument("--json", action="store_true", help="print JSON instead of tables")
     args = parser.parse_args(argv)
-    with tempfile.TemporaryDirectory() as directory:
-        rows = [run_seeds(name, law, args.seeds, Path(directory)) for name, law in RUNS]
+    runs = [(n, law) for n, law in RUNS if not args.only or n in args.only.split(",")]
+    started = time.monotonic()
+    with tempfile.TemporaryDirectory() as directory, ProcessPoolExecutor(args.workers) as pool:
+        jobs = {(n, law): [pool.submit(run_one, n, law, seed, Path(directory))
+                           for seed in range(args.seeds)] for n, law in runs}  # fmt: skip
+        rows = [summary(n, law, [job.result() for job in found])
+                for (n, law), found in jobs.items()]  # fmt: skip
+    minutes = (time.monotonic() - started) / 60.0
+    study = {"experiments": len(runs) * args.seeds, "workers": args.workers,
+             "experiments_per_minute": round(len(runs) * args.seeds / minutes, 1)}  # fmt: skip
     speed = vision_speed()
     if args.json:
-        emit(json.dumps({"bench": "sim_experiments", "experiments": rows, "vision": speed}))
+        emit(json.dumps({"bench": "sim_experiments", "study": study, "experiments": rows,
+                         "vision": speed}))  # fmt: skip
     else:
         emit(format_table(rows))
+        emit(" ".join(f"{k}={v}" for k, v in study.items()))
         emit("per camera frame: " + "  ".join(
             f"{k} median {v['median']} p99 {v['p99']}" for k, v in speed.items()))  # fmt: skip
     return 0

@@ -23,6 +23,7 @@ import logging
 import os
 import queue
 import threading
+import time
 from collections.abc import Callable, Iterable
 from functools import partial
 from pathlib import Path
@@ -190,7 +191,7 @@ class Node:
             module=self.spec.module,
             state=self.state,
             pid=os.getpid(),
-            counters=dict(self.counters),
+            counters={**self.counters, "cpu_ms": round(time.process_time() * 1e3)},
             parameters=dict(self.params),
         )
 

@@ -230,14 +230,19 @@ def run_experiment(options: Options) -> dict[str, Any]:
         recorder = Recorder(session, profile.namespace)
         wait_alive(session, profile, launcher)
         wait_reached(session, profile, launcher)
+        before = component_counters(session, profile.namespace)
         query.set_param(session, profile.namespace, "simulator", "paused", "false")
         started = time.monotonic()
-        messages = follow(recorder, options, started)
+        messages, wall_s = follow(recorder, options, started)
         counters = component_counters(session, profile.namespace)
-    wall_s = time.monotonic() - started
+    counters = {name: {**found, "run_cpu_ms": found["cpu_ms"] - before.get(name, found)["cpu_ms"]}
+                for name, found in counters.items()}  # fmt: skip
+    truth = messages["sim/truth"]  # the real-time factor: simulated over host s, as followed
+    ran_s = truth[-1].header.stamp_ns / 1e9 - origin_s(messages) if truth else 0.0
     end_ns, converged = end_of_run(messages, options.time_limit_s, origin_s(messages))
     messages = until(messages, end_ns)
-    report = build_report(options, setup, profile, robot, messages, wall_s, counters, converged)
+    report = build_report(options, setup, profile, robot, messages, (ran_s, wall_s), counters,
+                          converged)  # fmt: skip
     write_commands(options.out / "commands.csv", messages)
     start_ns = min((s.header.stamp_ns for s in messages["robot/state"]), default=end_ns)
     report["recording"] = recording_check(options.out / SESSION_FILE, (start_ns, end_ns),
@@ -358,8 +363,9 @@ def wait_launch(launcher: subprocess.Popen, missing: Callable[[], list[str]], wh
         time.sleep(0.1)  # polling the router (liveliness tokens, the components' counters)
 
 
-def follow(recorder: Recorder, options: Options, started: float) -> dict[str, list]:
-    """Print progress until the run converges or its time is up; return what was received."""
+def follow(recorder: Recorder, options: Options, started: float) -> tuple[dict[str, list], float]:
+    """Print progress until the run converges or its time is up; return what was received,
+    and the host seconds since ``started`` when it was."""
     last_print = 0.0
     wall_limit = max(120.0, options.time_limit_s * (3.0 if options.realtime else 10.0))
     while True:
@@ -373,9 +379,9 @@ def follow(recorder: Recorder, options: Options, started: float) -> dict[str, li
         now_s = diagnostics[-1].header.stamp_ns / 1e9 if diagnostics else 0.0
         since = converged_at(diagnostics, messages["supervisor/status"])
         if since is not None and now_s - since >= HOLD_S:
-            return messages
+            return messages, wall
         if now_s - origin_s(messages) >= options.time_limit_s or wall > wall_limit:
-            return messages
+            return messages, wall
 
 
 def component_counters(session: zenoh.Session, namespace: str) -> dict[str, dict[str, int]]:
@@ -425,9 +431,11 @@ def true_goal(setup: SimScenario, profile: Profile) -> np.ndarray:
 
 def build_report(
     options: Options, setup: SimScenario, profile: Profile, robot: MobileManipulator,
-    messages: dict[str, list], wall_s: float, counters: dict[str, dict[str, int]],
+    messages: dict[str, list], ran: tuple[float, float], counters: dict[str, dict[str, int]],
     converged: bool,
 ) -> dict[str, Any]:  # fmt: skip
+    """The run's report; ``ran`` is (simulated s, host s) of the run when it was last followed,
+    from the start to its last ground truth then (the real-time factor's two terms)."""
     truth, states = messages["sim/truth"], messages["robot/state"]
     diagnostics = messages["control/diagnostics"]
     sim_s = (truth[-1].header.stamp_ns - truth[0].header.stamp_ns) / 1e9 if truth else 0.0
@@ -451,8 +459,8 @@ def build_report(
         "final_error": final_error,
         "final_error_estimated": diagnostics[-1].error_norm if diagnostics else None,
         "sim_time_s": round(sim_s, 3),
-        "wall_time_s": round(wall_s, 3),
-        "real_time_factor": round(sim_s / wall_s, 2) if wall_s > 0 else None,
+        "wall_time_s": round(ran[1], 3),
+        "real_time_factor": round(ran[0] / ran[1], 2) if ran[1] > 0 else None,
         "iterations": len(diagnostics),
         "contacts": truth[-1].contacts if truth else 0,
         "supervisor": supervisor_summary(messages["supervisor/status"]),
@@ -467,6 +475,8 @@ def build_report(
         },  # fmt: skip
         "lockstep_timeouts": counters.get("simulator", {}).get("lockstep_timeouts", 0),
         "durations_us": durations(counters),
+        "cpu_s": {name: round(found["run_cpu_ms"] / 1e3, 3)
+                  for name, found in sorted(counters.items())},  # fmt: skip
         "controller_statuses": dict(sorted(Counter(d.status for d in diagnostics).items())),
         "degraded_states": sum(s.degraded for s in states),
         "invalid_states": sum(not s.valid for s in states),

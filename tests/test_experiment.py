@@ -101,14 +101,14 @@ def kill_during_run(tmp_path: Path, component: str, name: str = "pose"
     process = subprocess.Popen([*command, "--out", str(tmp_path)], stdout=subprocess.PIPE,
                                stderr=subprocess.DEVNULL, text=True)  # fmt: skip
     try:
-        deadline = time.monotonic() + 120
+        # No wall-clock deadline: the experiment ends by itself (its simulated time limit).
         while not (tmp_path / "profile.yaml").exists():
-            assert time.monotonic() < deadline and process.poll() is None
+            assert process.poll() is None
             time.sleep(0.1)  # the experiment writes its profile before it launches
         target = query.Target.from_profile(tmp_path / "profile.yaml")
         with connect(load_profile(tmp_path / "profile.yaml"), process) as session:
             while True:
-                assert time.monotonic() < deadline and process.poll() is None
+                assert process.poll() is None
                 found = query.statuses(session, target.namespace, 0.5)
                 steps = found.get("controller")
                 if steps and steps.counters.get("published.arm/command", 0) > 200:
