@@ -18,7 +18,7 @@ $(STAMP): $(LOCK) pyproject.toml
 
 # The pose experiment of section 6.2.1 on the whole simulated loop, in real time.
 demo: $(STAMP)
-	$(VENV)/bin/parsimony experiment pose --controller lp --realtime --out runs/demo
+	$(VENV)/bin/parsimony experiment pose --controller lp --realtime --out runs/demo --force
 
 test: $(STAMP)
 	$(VENV)/bin/ruff check .

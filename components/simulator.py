@@ -52,6 +52,7 @@ from messages.odometry import BaseOdometry
 from messages.truth import SimTruth
 from profiles.scene import Scene
 from sim2d.camera import ImageNoise, PlacedMarker, Renderer, ceiling_camera
+from sim2d.scenarios import SEED_MAX
 from sim2d.world import World, WorldSettings, wheel_distance_per_count
 from vision.images import jpeg
 from wbc.base_motion import dead_reckoning
@@ -133,7 +134,7 @@ class Simulator(Component):
         Param("paused", bool, False, doc="hold the simulation (set false to start)"),
         Param("command_timeout_s", float, 0.5, low=0.01, high=10.0,
               doc="stop the robot after this long without a command, s (simulated)"),
-        Param("seed", int, 0, low=0, high=2**31, doc="noise seed"),
+        Param("seed", int, 0, low=0, high=SEED_MAX, doc="noise seed"),
         Param("start", str, "0, 0, 0, 0, -0.2, 0.2, 0, 0.5", doc="q0 = x, y, phi, q1..q5",
               can_take=parses("start", 1, 8)),
         Param("obstacles", str, "", doc="obstacle circles 'x, y, radius; ...', m",

@@ -125,6 +125,9 @@ def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict
     ]
     base_profile = load_profile(base)
     if base_profile.component("simulator").module == "emulated_robot":
+        if not options.realtime:
+            raise ProfileError(f"{base}: a serial line carries no stamps, so the emulated "
+                               "devices run in real time only: add --realtime")  # fmt: skip
         # The emulated devices' ports live in the run's directory: runs never share one.
         devices = options.out.resolve() / "devices"
         links = {"base_driver": devices / "create2", "arm_driver": devices / "servos"}

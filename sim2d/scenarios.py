@@ -20,6 +20,8 @@ from wbc.planar import planar_of
 from wbc.robot import MobileManipulator
 from wbc.scenarios import HOME, OBSTACLE, REACH_GOAL
 
+SEED_MAX = 2**31
+"""Seeds of a set-up and of the simulator's noise: 0 to SEED_MAX (numpy's RandomState bound)."""
 NAMES = ("pose", "position", "obstacle", "anywhere")
 """The experiments of section 6.2, and 'anywhere': a pose goal behind the robot, past an
 obstacle, which the LP law reaches only under the staging supervisor (deploy/sim_supervised)."""

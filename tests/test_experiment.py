@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 
 from deploy import query
-from parsimony.experiment import connect
+from parsimony.experiment import DEPLOY, connect
 from profiles.profile import load_profile
 
 ONE_DEGREE = math.radians(1.0)
@@ -61,13 +61,14 @@ def test_pose_experiment_with_the_lp_reaches_the_goal_seen_by_the_camera(tmp_pat
 
 
 def test_two_lockstep_runs_of_one_seed_send_bit_identical_commands(tmp_path: Path) -> None:
-    _, first = experiment(tmp_path / "a", "position", "--seed", "3")
-    _, second = experiment(tmp_path / "b", "position", "--seed", "3")
+    # 3 simulated seconds each: 150 steps of the whole loop, with about 90 camera frames.
+    _, first = experiment(tmp_path / "a", "position", "--seed", "3", "--time-limit", "3")
+    _, second = experiment(tmp_path / "b", "position", "--seed", "3", "--time-limit", "3")
     assert first["commands_digest"] == second["commands_digest"]
     a = (tmp_path / "a" / "commands.csv").read_text()
     assert a == (tmp_path / "b" / "commands.csv").read_text()
-    assert len(a.splitlines()) > 100
-    _, other = experiment(tmp_path / "c", "position", "--seed", "4")
+    assert len(a.splitlines()) > 140
+    _, other = experiment(tmp_path / "c", "position", "--seed", "4", "--time-limit", "3")
     assert other["commands_digest"] != first["commands_digest"]
 
 
@@ -140,13 +141,31 @@ def test_a_killed_vision_tracker_is_restarted_and_the_run_converges(tmp_path: Pa
     assert report["lockstep_timeouts"] >= 1  # the frame the dead tracker never answered
 
 
-@pytest.mark.parametrize("bad", [["pose", "--seed", "x"], ["jump"], ["pose"]])
-def test_usage_errors_exit_2(bad: list[str], tmp_path: Path) -> None:
+@pytest.mark.parametrize("bad, why", [
+    (["pose", "--seed", "x"], "--seed: expected an integer"),
+    (["pose", "--seed", "-1"], "--seed: expected 0 to 2147483648, got -1"),
+    (["pose", "--seed", str(2**31 + 1)], "--seed: expected 0 to 2147483648"),
+    (["pose", "--time-limit", "nan"], "--time-limit: expected a finite number of seconds > 0"),
+    (["pose", "--time-limit", "0"], "--time-limit: expected a finite number of seconds > 0"),
+    (["pose", "--time-limit", "-3"], "--time-limit: expected a finite number of seconds > 0"),
+    (["pose", "--profile", str(DEPLOY / "emulated.yaml")], "add --realtime"),
+    (["jump"], "invalid choice: 'jump'"),
+    (["pose"], "the following arguments are required: --out"),
+])  # fmt: skip
+def test_usage_errors_exit_2_and_say_why(bad: list[str], why: str, tmp_path: Path) -> None:
     extra = [] if bad == ["pose"] else ["--out", str(tmp_path)]
     command = [sys.executable, "-m", "parsimony.cli", "experiment", *bad, *extra]
     done = subprocess.run(command, capture_output=True, text=True, timeout=60)
-    assert done.returncode == 2
-    assert done.stdout == ""
+    assert done.returncode == 2 and why in done.stderr, done.stderr
+    assert done.stdout == "" and "Traceback" not in done.stderr
+
+
+def test_an_experiment_does_not_write_over_a_directory_that_holds_files(tmp_path: Path) -> None:
+    (tmp_path / "report.json").write_text("{}")
+    command = [sys.executable, "-m", "parsimony.cli", "experiment", "pose", "--out", str(tmp_path)]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2 and "give --force" in done.stderr, done.stderr
+    assert (tmp_path / "report.json").read_text() == "{}"
 
 
 def assert_behind(report: dict) -> None:

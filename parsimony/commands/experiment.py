@@ -4,6 +4,7 @@ parsimony.experiment)."""
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 
@@ -11,7 +12,7 @@ from deploy.query import QueryError
 from parsimony.experiment import PROFILES, TIME_LIMIT_S, Options, dumps, run_experiment
 from parsimony.output import emit
 from profiles.profile import ProfileError
-from sim2d.scenarios import NAMES
+from sim2d.scenarios import NAMES, SEED_MAX
 
 EXIT_NOT_CONVERGED = 1
 EXIT_USAGE = 2
@@ -28,6 +29,28 @@ def seconds_window(text: str) -> tuple[float, float]:
     return start, end
 
 
+def seed(text: str) -> int:
+    """A seed, 0 to ``SEED_MAX``."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+    if not 0 <= value <= SEED_MAX:
+        raise argparse.ArgumentTypeError(f"expected 0 to {SEED_MAX}, got {value}")
+    return value
+
+
+def time_limit(text: str) -> float:
+    """A finite, positive number of simulated seconds."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected seconds, got {text!r}") from None
+    if not (value > 0.0 and math.isfinite(value)):
+        raise argparse.ArgumentTypeError(f"expected a finite number of seconds > 0, got {text}")
+    return value
+
+
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
         "experiment",
@@ -39,11 +62,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("name", choices=NAMES, help="the experiment of section 6.2")
     parser.add_argument("--controller", choices=tuple(PROFILES), default="lp")
     parser.add_argument("--out", type=Path, required=True, help="directory of the report")
-    parser.add_argument("--seed", type=int, help="draw the start and the bin from the ranges")
+    parser.add_argument("--force", action="store_true", help="replace what --out holds")
+    parser.add_argument("--seed", type=seed, help="draw the start and the bin from the ranges")
     parser.add_argument("--profile", type=Path, help="simulation profile to extend")
     parser.add_argument("--realtime", action="store_true",
                         help="run at the wall clock's pace instead of in lockstep")  # fmt: skip
-    parser.add_argument("--time-limit", type=float, default=TIME_LIMIT_S, metavar="S",
+    parser.add_argument("--time-limit", type=time_limit, default=TIME_LIMIT_S, metavar="S",
                         help="simulated seconds before giving up")  # fmt: skip
     parser.add_argument("--hide-base-marker", type=seconds_window, metavar="FROM,TO",
                         help="hide the base marker from the camera then (sim s)")  # fmt: skip
@@ -52,6 +76,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
 
 
 def run(args: argparse.Namespace) -> int:
+    holds = args.out.exists() and not (args.out.is_dir() and not any(args.out.iterdir()))
+    if holds and not args.force:
+        print(f"experiment: {args.out} is not empty; give --force to write over what it holds",
+              file=sys.stderr)  # fmt: skip
+        return EXIT_USAGE
     options = Options(
         name=args.name, controller=args.controller, out=args.out, seed=args.seed,
         profile=args.profile, realtime=args.realtime, time_limit_s=args.time_limit,

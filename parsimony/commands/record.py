@@ -1,10 +1,14 @@
 """`parsimony record PROFILE -o FILE`: every message of a running system into an MCAP file,
-until Ctrl-C (the recorder component of components.recorder, run in the foreground); or
-`--recover FILE -o OUT`: a whole file from what survives of one whose recorder was killed."""
+until Ctrl-C, SIGINT or SIGTERM (the recorder component of components.recorder, run as a child
+that stops with this process); or `--recover FILE -o OUT`: a whole file from what survives of
+one whose recorder was killed. An existing output is refused unless ``--force``; the input of
+``--recover`` never is its output. Exit 2 when the router cannot be reached."""
 
 from __future__ import annotations
 
 import argparse
+import os
+import signal
 import subprocess
 import sys
 import tempfile
@@ -12,9 +16,12 @@ from pathlib import Path
 
 import yaml
 
+from deploy.query import QueryError, Target
+from messages.process import LAUNCHER_PID_ENV
 from parsimony.experiment import RECORDER_STOP_S
 from parsimony.output import emit
-from profiles.profile import ProfileError, load_profile
+from parsimony.outputs import writable_output
+from profiles.profile import ProfileError
 from record.session_file import recover
 
 
@@ -25,10 +32,15 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("-o", "--output", type=Path, required=True, help="the MCAP file")
     parser.add_argument("--keys", nargs="*", default=["*"], help="topic name patterns")
     parser.add_argument("--recover", type=Path, metavar="FILE", help="a killed recording")
+    parser.add_argument("--force", action="store_true", help="replace an existing output")
     return parser
 
 
 def run(args: argparse.Namespace) -> int:
+    problem = writable_output(args.output, [args.recover] if args.recover else [], args.force)
+    if problem:
+        print(f"record: {problem}", file=sys.stderr)
+        return 2
     if args.recover is not None:
         try:
             saved = recover(args.recover, args.output)
@@ -41,9 +53,9 @@ def run(args: argparse.Namespace) -> int:
         print("record: a profile, or --recover FILE", file=sys.stderr)
         return 2
     try:
-        load_profile(args.profile)
-    except ProfileError as error:
-        print(error, file=sys.stderr)
+        Target.from_profile(args.profile).open().close()  # the router must be there
+    except (ProfileError, QueryError) as error:
+        print(f"record: {error}", file=sys.stderr)
         return 2
     with tempfile.TemporaryDirectory() as directory:
         profile = Path(directory) / "record.yaml"
@@ -54,10 +66,24 @@ def run(args: argparse.Namespace) -> int:
                             "stop_timeout_s": RECORDER_STOP_S, "params": params,
                             "restart": {"policy": "never"}}],
         }))  # fmt: skip
-        command = [sys.executable, "-m", "components.recorder", "--profile", str(profile),
-                   "--name", "recorder"]  # fmt: skip
-        process = subprocess.Popen(command)
-        try:
-            return process.wait()
-        except KeyboardInterrupt:
-            return process.wait()
+        return record(profile)
+
+
+def record(profile: Path) -> int:
+    """Run the recorder until it stops; SIGINT and SIGTERM are passed on to it (it writes all
+    that waits, then its footer), and it stops by itself if this process dies (it watches its
+    parent, ``LAUNCHER_PID_ENV``)."""
+    command = [sys.executable, "-m", "components.recorder", "--profile", str(profile),
+               "--name", "recorder"]  # fmt: skip
+    env = {**os.environ, LAUNCHER_PID_ENV: str(os.getpid())}
+    process = subprocess.Popen(command, env=env, start_new_session=True)
+
+    def pass_on(signum: int, _frame: object) -> None:
+        process.send_signal(signal.SIGTERM)
+
+    previous = {s: signal.signal(s, pass_on) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        return process.wait()
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)

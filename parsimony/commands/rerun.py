@@ -21,6 +21,7 @@ from messages.commands import ArmCommand, BaseCommand
 from messages.diagnostics import ControllerDiagnostics
 from messages.header import Header
 from parsimony.output import emit
+from parsimony.outputs import writable_output
 from record.session_file import SessionWriter, read_session
 from wbc.base_motion import unicycle, wheel_speeds
 from wbc.cascade_law import CascadeLaw, CascadeParams
@@ -45,10 +46,15 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("--controller", choices=tuple(LAWS), required=True)
     parser.add_argument("-o", "--output", type=Path, required=True, help="the MCAP to write")
     parser.add_argument("--robot", type=Path, default=ROBOT, help="robot description")
+    parser.add_argument("--force", action="store_true", help="replace an existing output")
     return parser
 
 
 def run(args: argparse.Namespace) -> int:
+    problem = writable_output(args.output, [args.file], args.force)
+    if problem:
+        print(f"rerun: {problem}", file=sys.stderr)
+        return 2
     robot = MobileManipulator.from_yaml(args.robot)
     law = LAWS[args.controller](robot)
     task, obstacles, last_ns, steps = None, (), None, 0

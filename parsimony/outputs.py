@@ -1,0 +1,20 @@
+"""The files and directories a command writes: never one of its inputs, never an existing one
+unless the user said ``--force``."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from pathlib import Path
+
+
+def writable_output(output: Path, inputs: Iterable[Path], force: bool) -> str | None:
+    """Why ``output`` may not be written (it is an input, or exists and ``force`` is not set),
+    or None."""
+    output = Path(output)
+    for given in map(Path, inputs):
+        both = given.exists() and output.exists()
+        if given.resolve() == output.resolve() or (both and given.samefile(output)):
+            return f"{output} is also an input; write the output elsewhere"
+    if Path(output).exists() and not force:
+        return f"{output} exists; give --force to replace it"
+    return None

@@ -1,0 +1,103 @@
+"""`parsimony record`, `rerun` and `record --recover` as a user runs them: the recorder stops
+with the command however the command ends, a missing router is said at once, and no input or
+existing file is written over."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+
+from deploy.query import live_components, statuses
+from parsimony.experiment import connect, launched
+from parsimony.sessions import load_session
+from profiles.endpoints import free_port
+from profiles.profile import load_profile
+from record.session_file import info
+
+
+def parsimony(*arguments: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "parsimony.cli", *arguments],
+                          capture_output=True, text=True)  # fmt: skip
+
+
+def system_profile(tmp_path: Path) -> Path:
+    path = tmp_path / "system.yaml"
+    path.write_text(yaml.safe_dump({
+        "namespace": "rec", "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
+        "components": [{"name": "pub", "module": "scripted_publisher", "role": "tool",
+                        "params": {"rate_hz": 100.0}}],
+    }))  # fmt: skip
+    return path
+
+
+def running(pid: int) -> bool:
+    """Whether process ``pid`` is there and not a zombie."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+@pytest.mark.parametrize("how", [signal.SIGKILL, signal.SIGTERM, signal.SIGINT])
+def test_the_recorder_stops_with_the_record_command(tmp_path: Path, how: signal.Signals) -> None:
+    """However `parsimony record` ends (kill -9 too), its recorder stops; on SIGINT or
+    SIGTERM the command passes the signal on and the file gets its footer."""
+    profile = system_profile(tmp_path)
+    out = tmp_path / "k.mcap"
+    with launched(profile) as launcher, connect(load_profile(profile), launcher) as session:
+        command = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "record",
+                                    str(profile), "-o", str(out)])  # fmt: skip
+        while "recorder" not in live_components(session, "rec", 0.5):
+            assert command.poll() is None
+        while not out.exists() or info(out)["messages"] < 50:
+            time.sleep(0.1)  # recording: at least a chunk flushed
+        child = statuses(session, "rec")["recorder"].pid
+        command.send_signal(how)
+        command.wait()
+        while running(child):
+            time.sleep(0.1)  # the recorder goes too (the test fails by hanging if not)
+    if how != signal.SIGKILL:
+        assert command.returncode == 0
+        assert info(out)["complete"], "the recorder wrote its footer"
+    assert load_session(out)["robot/state"]
+
+
+def test_record_without_a_router_says_so_and_exits_2(tmp_path: Path) -> None:
+    done = parsimony("record", str(system_profile(tmp_path)), "-o", str(tmp_path / "k.mcap"))
+    assert done.returncode == 2 and "cannot reach a router" in done.stderr, done.stderr
+    assert not (tmp_path / "k.mcap").exists()
+
+
+def test_no_command_writes_over_its_input_or_an_existing_file(tmp_path: Path) -> None:
+    profile = system_profile(tmp_path)
+    recording = tmp_path / "k.mcap"
+    with launched(profile) as launcher, connect(load_profile(profile), launcher):
+        command = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "record",
+                                    str(profile), "-o", str(recording)])  # fmt: skip
+        while not recording.exists() or info(recording)["messages"] < 50:
+            assert command.poll() is None
+            time.sleep(0.1)
+        command.send_signal(signal.SIGINT)
+        assert command.wait() == 0
+    kept = recording.read_bytes()
+    for arguments in (["rerun", str(recording), "--controller", "lp", "-o", str(recording)],
+                      ["record", "--recover", str(recording), "-o", str(recording)],
+                      ["record", str(profile), "-o", str(recording)]):  # fmt: skip
+        done = parsimony(*arguments)
+        assert done.returncode == 2, (arguments, done.stderr)
+        assert "Traceback" not in done.stderr and str(recording) in done.stderr, done.stderr
+        assert recording.read_bytes() == kept
+    other = tmp_path / "other.mcap"
+    other.write_bytes(b"mine")
+    done = parsimony("record", "--recover", str(recording), "-o", str(other))
+    assert done.returncode == 2 and "give --force" in done.stderr
+    assert other.read_bytes() == b"mine"
+    done = parsimony("record", "--recover", str(recording), "-o", str(other), "--force")
+    assert done.returncode == 0, done.stderr
+    assert info(other)["messages"] == info(recording)["messages"]
