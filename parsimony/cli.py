@@ -4,8 +4,12 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 
+from mcap.exceptions import McapError
+
+from deploy.query import QueryError
 from parsimony.output import result_only_stdout
 
 COMMANDS = (
@@ -24,9 +28,19 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run one command. A file it cannot read or write, a file that is not what it should be
+    (``McapError``) and a router it cannot reach end it with one line and exit 2, never a
+    traceback; a reader of its output that went away (``| head``) ends it quietly."""
     args = build_parser().parse_args(argv)
-    with result_only_stdout():
-        return int(args.run(args) or 0)
+    try:
+        with result_only_stdout():
+            return int(args.run(args) or 0)
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no error at exit
+        return 1
+    except (OSError, McapError, QueryError) as error:
+        print(f"parsimony {args.command}: {error}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

@@ -23,15 +23,17 @@ from __future__ import annotations
 import base64
 import functools
 import json
+import logging
+import struct
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
-from mcap.exceptions import EndOfFile, McapError
-from mcap.records import Channel, Footer, Message, Schema
-from mcap.stream_reader import StreamReader
+from mcap.exceptions import EndOfFile, InvalidMagic, McapError
+from mcap.records import Channel, Chunk, Footer, Message, Schema
+from mcap.stream_reader import StreamReader, breakup_chunk
 from mcap.writer import CompressionType, Writer
 from pydantic import BaseModel
 
@@ -233,40 +235,74 @@ class _ExactReads:
         return data
 
 
-class _Scan:
-    """``(schema or None, channel, message)`` of every complete chunk of a file, in file order.
+log = logging.getLogger("record")
 
-    Reading stops quietly where a file without a footer was cut (``EndOfFile``); any other
-    fault is raised. After iterating, ``complete`` says whether the footer was there.
+
+class _Scan:
+    """``(schema or None, channel, message)`` of every readable chunk of a file, in file order.
+
+    Reading stops quietly where a file without a footer was cut (``EndOfFile``). A chunk that
+    does not decompress or fails its CRC is skipped, and said in ``damaged`` (with the times of
+    the messages it held) and in a warning. A file that does not begin as an MCAP file, and a
+    fault outside the chunks, raise ``McapError`` naming the file. After iterating,
+    ``complete`` says whether the footer was there.
     """
 
     def __init__(self, path: Path) -> None:
         self.path = Path(path)
         self.complete = False
+        self.damaged: list[str] = []
 
     def __iter__(self) -> Iterator[tuple[Schema | None, Channel, Message]]:
         schemas: dict[int, Schema] = {}
         channels: dict[int, Channel] = {}
         with self.path.open("rb") as stream:
+            reader = StreamReader(_ExactReads(stream), emit_chunks=True)
+            begun = False
             try:
-                for record in StreamReader(_ExactReads(stream)).records:
-                    if isinstance(record, Schema):
-                        schemas[record.id] = record
-                    elif isinstance(record, Channel):
-                        if record.schema_id != 0 and record.schema_id not in schemas:
-                            raise McapError(f"{self.path}: channel {record.topic!r} has no "
-                                            f"schema record {record.schema_id}")  # fmt: skip
-                        channels[record.id] = record
-                    elif isinstance(record, Message):
-                        channel = channels.get(record.channel_id)
-                        if channel is None:
-                            raise McapError(f"{self.path}: message on unknown channel "
-                                            f"{record.channel_id}")  # fmt: skip
-                        yield schemas.get(channel.schema_id), channel, record
-                    elif isinstance(record, Footer):
-                        self.complete = True
+                for record in reader.records:
+                    begun = True  # the magic and the header were there
+                    inner = self._opened(record) if isinstance(record, Chunk) else [record]
+                    for item in inner:
+                        found = self._take(item, schemas, channels)
+                        if found is not None:
+                            yield found
+            except InvalidMagic:
+                raise McapError(f"{self.path}: not an MCAP file") from None
             except EndOfFile:
+                if not begun:
+                    raise McapError(f"{self.path}: not an MCAP file (too short)") from None
                 return
+            except (struct.error, UnicodeDecodeError, ValueError) as error:
+                raise McapError(f"{self.path}: damaged outside its chunks: {error}") from None
+
+    def _opened(self, chunk: Chunk) -> list:
+        """A chunk's records, or none when it is damaged (said)."""
+        try:
+            return breakup_chunk(chunk, validate_crc=True)
+        except Exception as error:  # noqa: BLE001 - zstandard's, mcap's CRC, struct's: all mean one thing
+            what = (f"the chunk of {chunk.message_start_time / 1e9:.3f} to "
+                    f"{chunk.message_end_time / 1e9:.3f} s ({error or type(error).__name__})")
+            self.damaged.append(what)
+            log.warning("%s: skipped %s", self.path, what)
+            return []
+
+    def _take(self, record, schemas: dict, channels: dict):
+        if isinstance(record, Schema):
+            schemas[record.id] = record
+        elif isinstance(record, Channel):
+            if record.schema_id != 0 and record.schema_id not in schemas:
+                raise McapError(f"{self.path}: channel {record.topic!r} has no schema record "
+                                f"{record.schema_id}")  # fmt: skip
+            channels[record.id] = record
+        elif isinstance(record, Message):
+            channel = channels.get(record.channel_id)
+            if channel is None:
+                raise McapError(f"{self.path}: message on unknown channel {record.channel_id}")
+            return schemas.get(channel.schema_id), channel, record
+        elif isinstance(record, Footer):
+            self.complete = True
+        return None
 
 
 @functools.cache
@@ -291,12 +327,15 @@ def read_session(path: Path) -> Iterator[Recorded]:
     their types, a field carried by a view put back; other channels' messages (the Foxglove
     views) come with ``topic_name`` and ``message`` None. Decoding is lazy, so a caller that
     skips images never builds them. In a file cut short, a message whose carrier was cut off
-    is left out; in a whole file, it is an ``McapError``."""
+    is left out; in a whole file, it is an ``McapError``. A message that does not decode into
+    its type is left out and said (the first of each channel, where and why, then how many);
+    so is a damaged chunk (``_Scan``)."""
     scan = _Scan(path)
     found = sorted(scan, key=lambda record: record[2].log_time)
     keys = {channel.metadata[CARRIER] for _, channel, _ in found if CARRIER in channel.metadata}
     carriers = {(channel.topic, message.log_time): (schema, message)
                 for schema, channel, message in found if channel.topic in keys}
+    skipped: dict[str, int] = {}
     for schema, channel, message in found:
         topic = _project_topic(schema, channel)
         decoded = None
@@ -307,9 +346,25 @@ def read_session(path: Path) -> Iterator[Recorded]:
                     raise McapError(f"{path}: {channel.topic} at {message.log_time} ns has no "
                                     f"{channel.metadata[CARRIER]} message")  # fmt: skip
                 continue
-            decoded = from_json(message.data, topic.type, carried_fields)
+            try:
+                decoded = from_json(message.data, topic.type, carried_fields)
+            except ValueError as error:  # JSON's, base64's and pydantic's errors are ValueErrors
+                skipped[channel.topic] = skipped.get(channel.topic, 0) + 1
+                if skipped[channel.topic] == 1:
+                    _skipped(path, channel.topic, message.log_time, topic.type, error)
+                continue
         name = topic.name if topic is not None else None
         yield Recorded(channel.topic, name, message.log_time, decoded)
+    for key, count in skipped.items():
+        if count > 1:
+            log.warning("%s: skipped %d messages of %s in all", path, count, key)
+
+
+def _skipped(path: Path, key: str, log_time_ns: int, expected: type, error: Exception) -> None:
+    """Say that a message was left out because it does not decode, where and why."""
+    reason = str(error).splitlines()[0] if str(error) else type(error).__name__
+    log.warning("%s: skipped the message of %s at %.3f s: not a %s (%s)", path, key,
+                log_time_ns / 1e9, expected.__name__, reason)  # fmt: skip
 
 
 def _carried_fields(
@@ -328,9 +383,9 @@ def _carried_fields(
 
 def info(path: Path) -> dict[str, Any]:
     """What a session file holds: totals (messages, file bytes, start, end and duration,
-    ``complete``: whether the footer is there) and, per channel, its key, schema name,
-    encoding and size in bytes, message count and bytes, first and last log time and mean
-    rate (Hz, (count - 1) / span)."""
+    ``complete``: whether the footer is there, ``damaged``: the chunks skipped) and, per
+    channel, its key, schema name, encoding and size in bytes, message count and bytes, first
+    and last log time and mean rate (Hz, (count - 1) / span)."""
     scan = _Scan(path)
     channels: dict[int, dict[str, Any]] = {}
     for schema, channel, message in scan:
@@ -359,6 +414,7 @@ def info(path: Path) -> dict[str, Any]:
     return {
         "path": str(path),
         "complete": scan.complete,
+        "damaged": scan.damaged,
         "messages": sum(c["messages"] for c in channels.values()),
         "bytes": Path(path).stat().st_size,
         "start_ns": start,

@@ -36,6 +36,10 @@ def run(args: argparse.Namespace) -> int:
     widths = [max(len(row[i]) for row in rows) for i in range(len(rows[0]))]
     emit(f"{found['path']}: {found['messages']} messages, {found['bytes']} bytes, "
          f"{found['duration_s']} s from {found['start_ns']} to {found['end_ns']} ns")  # fmt: skip
+    if not found["complete"]:
+        emit("no footer: cut short (parsimony record --recover FILE -o OUT makes it whole)")
+    for damaged in found["damaged"]:
+        emit(f"damaged, skipped: {damaged}")
     emit("\n".join("  ".join(cell.ljust(w) for cell, w in zip(row, widths, strict=True))
                    for row in rows))  # fmt: skip
     return 0

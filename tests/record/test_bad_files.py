@@ -1,0 +1,116 @@
+"""Broken and foreign files through the real commands: one line naming the file and exit 2,
+never a traceback; a damaged chunk skipped and named, and every other message read."""
+
+from __future__ import annotations
+
+import dataclasses
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from mcap.reader import make_reader
+
+from messages import topics
+from messages.header import Header
+from messages.state import RobotState
+from record.session_file import SessionWriter, entries, info, read_session, recover
+
+KEY = topics.ROBOT_STATE.key("bad")
+MESSAGES = 3000
+
+
+def parsimony(*arguments: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "parsimony.cli", *arguments],
+                          capture_output=True, text=True)  # fmt: skip
+
+
+def state(index: int) -> RobotState:
+    return RobotState(header=Header(stamp_ns=index * 20_000_000, frame="world", seq=index,
+                                    source="test"),
+                      base_pose=(index * 1e-3, 2.0, 0.3), arm_joints=(0.1, -0.2, 0.3, -0.4, 0.5),
+                      end_effector=(1.0, 0, 0, 0, 0, 0, 0, 0), valid=True, age_s=0.0)  # fmt: skip
+
+
+@pytest.fixture
+def session(tmp_path: Path) -> Path:
+    """A whole session of many small chunks."""
+    path = tmp_path / "good.mcap"
+    with SessionWriter(path, chunk_size=16_000) as writer:
+        for index in range(MESSAGES):
+            writer.write(KEY, state(index))
+    return path
+
+
+def damaged(session: Path, tmp_path: Path) -> tuple[Path, int]:
+    """The session with 100 bytes flipped inside its fourth chunk; the messages that chunk held."""
+    with session.open("rb") as stream:
+        chunk = make_reader(stream).get_summary().chunk_indexes[3]
+    data = bytearray(session.read_bytes())
+    middle = chunk.chunk_start_offset + chunk.chunk_length // 2
+    for offset in range(middle, middle + 100):
+        data[offset] ^= 0xFF
+    path = tmp_path / "flipped.mcap"
+    path.write_bytes(bytes(data))
+    with session.open("rb") as stream:
+        held = sum(1 for _, _, m in make_reader(stream).iter_messages()
+                   if chunk.message_start_time <= m.log_time <= chunk.message_end_time)  # fmt: skip
+    return path, held
+
+
+FOREIGN = {"text": b"this is not a recording\n" * 20, "zeros": bytes(4096), "empty": b""}
+
+
+@pytest.mark.parametrize("kind", sorted(FOREIGN))
+def test_a_file_that_is_not_mcap_is_said_in_one_line_by_every_command(
+    tmp_path: Path, kind: str
+) -> None:
+    path = tmp_path / f"{kind}.mcap"
+    path.write_bytes(FOREIGN[kind])
+    out = str(tmp_path / "out.mcap")
+    every = (["info", str(path)], ["report", str(path), "--out", str(tmp_path / "r")],
+             ["rerun", str(path), "--controller", "lp", "-o", out],
+             ["record", "--recover", str(path), "-o", out])  # fmt: skip
+    for arguments in every if kind == "text" else every[:1]:  # all read through one scan
+        done = parsimony(*arguments)
+        assert done.returncode == 2, (arguments, done.stderr)
+        assert "Traceback" not in done.stderr, done.stderr
+        assert f"{path}: not an MCAP file" in done.stderr, (arguments, done.stderr)
+
+
+def test_a_damaged_chunk_is_skipped_named_and_the_rest_read(session: Path, tmp_path: Path) -> None:
+    path, held = damaged(session, tmp_path)
+    found = info(path)
+    assert len(found["damaged"]) == 1 and found["complete"]
+    assert found["messages"] == MESSAGES - held and 0 < held < MESSAGES / 10
+    states = [r.message for r in read_session(path)]
+    assert len(states) == MESSAGES - held
+    assert all(s == state(s.header.seq) for s in states)  # every other message, exactly
+    # `info` says so; `record --recover` keeps every message of the other chunks.
+    shown = parsimony("info", str(path))
+    assert shown.returncode == 0 and "damaged, skipped: the chunk of" in shown.stdout
+    assert "Traceback" not in shown.stderr
+    whole = tmp_path / "whole.mcap"
+    done = parsimony("record", "--recover", str(path), "-o", str(whole))
+    assert done.returncode == 0 and "skipped the chunk of" in done.stderr, done.stderr
+    assert info(whole)["messages"] == MESSAGES - held and info(whole)["damaged"] == []
+    assert recover(path, tmp_path / "again.mcap") == MESSAGES - held
+
+
+def test_messages_that_do_not_decode_are_skipped_and_said_with_channel_and_time(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    path = tmp_path / "wrong.mcap"
+    with SessionWriter(path) as writer:
+        for index in range(10):
+            writer.write(KEY, state(index))
+        (entry,) = entries(KEY, state(10), views=False)
+        for data in (b"{not json", b'{"header": 3}'):
+            writer.write_raw(dataclasses.replace(entry, data=data), 11 * 20_000_000)
+    recorded = list(read_session(path))
+    assert [r.message.header.seq for r in recorded] == list(range(10))
+    said = caplog.text
+    assert f"skipped the message of {KEY} at 0.220 s: not a RobotState" in said, said
+    assert f"skipped 2 messages of {KEY} in all" in said
+    done = parsimony("report", str(path), "--out", str(tmp_path / "r"))
+    assert "Traceback" not in done.stderr and f"skipped the message of {KEY}" in done.stderr
