@@ -11,6 +11,11 @@ recording's inputs in its recorded order whatever the load. Progress goes to std
 terminal, keys: space pauses and resumes, ``s`` or the right arrow sends the next message
 while paused, ``+`` and ``-`` double and halve the rate, ``q`` quits; ``--start-paused``
 starts paused (elsewhere it waits for Enter).
+
+Into a namespace where components are alive, a replay refuses, before it sends anything, to
+send commands (live drivers would move the robot) and any topic a live component publishes
+(two sources of one topic: a second clock, a second truth), unless ``--into-live``; a
+namespace of its own (``--namespace``) is the safe way.
 """
 
 from __future__ import annotations
@@ -25,13 +30,14 @@ from pathlib import Path
 
 import zenoh
 
-from deploy.query import QueryError
+from deploy.graph import component_class
+from deploy.query import QueryError, live_components
 from messages import codec, topics
 from messages.clock import Clock
 from parsimony.commands.launch import positive_seconds
 from parsimony.replay_keys import QUIT, RIGHT, KeyReader, terminal_keys
 from parsimony.target_options import fail, profile_and_target, target_options
-from profiles.profile import ProfileError
+from profiles.profile import Profile, ProfileError
 from record.session_file import Recorded, read_session
 
 SENSORS = ("camera/image", "arm/joint_states", "base/odometry")
@@ -56,6 +62,9 @@ ANSWERING = {topic.name: topic for answers in ANSWERS.values() for topic in answ
 ANSWER_TIMEOUT_S = 1.0
 """Host seconds ``--lockstep`` waits for an answer before it goes on (said and counted)."""
 KEYS_HELP = "space: pause/play, s or right arrow: step, +/-: rate, q: quit"
+COMMANDS = (topics.BASE_COMMAND.name, topics.ARM_COMMAND.name)
+"""What moves a robot: never replayed into a namespace where anything is alive, unless
+``--into-live``."""
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -77,6 +86,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
                         help="wait for the live tracker's and estimator's answers")  # fmt: skip
     parser.add_argument("--start-paused", action="store_true",
                         help="start paused (in a terminal), else wait for Enter")  # fmt: skip
+    parser.add_argument("--into-live", action="store_true",
+                        help="send commands, and topics live components publish")  # fmt: skip
     return parser
 
 
@@ -107,10 +118,19 @@ def run(args: argparse.Namespace) -> int:
                    and wanted(args, r.topic_name)]  # fmt: skip
     except (OSError, ValueError) as error:
         session.close()
-        return fail(error)
+        print(f"replay: {error}", file=sys.stderr)
+        return 2
     if not records:
         session.close()
         return fail(ValueError(f"{args.file}: nothing to replay"))
+    conflicts = [] if args.into_live else live_conflicts(
+        session, profile, namespace, {r.topic_name for r in records})  # fmt: skip
+    if conflicts:
+        session.close()
+        print(f"replay: refused: {'; '.join(conflicts)}. Replay into a namespace of its own "
+              "(--namespace), leave those topics out (--exclude, --sensors), or say "
+              "--into-live", file=sys.stderr)  # fmt: skip
+        return 2
     records.sort(key=lambda r: (r.log_time_ns, sending_rank(r.topic_name)))
     if args.lockstep and ANSWERING.keys() & {r.topic_name for r in records}:
         session.close()
@@ -122,6 +142,29 @@ def run(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         print("\n[replay] interrupted", file=sys.stderr, flush=True)
         return 130
+
+
+def live_conflicts(session: zenoh.Session, profile: Profile, namespace: str,
+                   sending: set[str]) -> list[str]:  # fmt: skip
+    """What the replay may not send into ``namespace``: commands while anything there is alive,
+    and each topic a live component publishes (a live component the profile does not describe
+    might publish any). Empty when nothing there is alive."""
+    alive = live_components(session, namespace)
+    if not alive:
+        return []
+    found = []
+    if moving := sorted(sending & set(COMMANDS)):
+        found.append(f"{', '.join(moving)} into {namespace}, where {', '.join(alive)} "
+                     "are alive")  # fmt: skip
+    for name in alive:
+        spec = next((s for s in profile.components if s.name == name), None)
+        if spec is None or namespace != profile.namespace:
+            writes = set(topics.TOPICS)  # not described: it may publish anything
+        else:
+            writes = {spec.topic(t).name for t in component_class(spec).writes}
+        if clash := sorted((sending & writes) - set(COMMANDS)):
+            found.append(f"{', '.join(clash)}, which the live {name} publishes")
+    return found
 
 
 @dataclass
