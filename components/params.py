@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from messages.process import ParamValue
+from profiles.profile import shown
 
 log = logging.getLogger("components")
 
@@ -70,14 +71,14 @@ class Param:
         if self.type is float and isinstance(value, int) and not isinstance(value, bool):
             value = float(value)
         if type(value) is not self.type or (self.type is float and not math.isfinite(value)):
-            raise ParamError(f"{self.name}: expected {self.expected()}, got {value!r}")
+            raise ParamError(f"{self.name}: expected {self.expected()}, got {shown(value)}")
         if isinstance(value, int | float) and not isinstance(value, bool):
             if (self.low is not None and value < self.low) or (
                 self.high is not None and value > self.high
             ):
-                raise ParamError(f"{self.name}: expected {self.expected()}, got {value!r}")
+                raise ParamError(f"{self.name}: expected {self.expected()}, got {shown(value)}")
         if self.choices is not None and value not in self.choices:
-            raise ParamError(f"{self.name}: expected {self.expected()}, got {value!r}")
+            raise ParamError(f"{self.name}: expected {self.expected()}, got {shown(value)}")
         if self.can_take is not None:
             self.can_take(value)
         return value
@@ -93,7 +94,8 @@ class Param:
             else:
                 value = self.type(text)
         except ValueError:
-            raise ParamError(f"{self.name}: expected {self.expected()}, got {text!r}") from None
+            expected = self.expected()
+            raise ParamError(f"{self.name}: expected {expected}, got {shown(text)}") from None
         return self.check(value)
 
 

@@ -306,17 +306,60 @@ def _format_validation(path: Path, error: ValidationError) -> str:
         elif item["type"] == "missing":
             lines.append(f"  {location}: {item['msg']}")
         else:
-            lines.append(f"  {location}: {item['msg']} (got {item['input']!r})")
+            lines.append(f"  {location}: {item['msg']} (got {shown(item['input'])})")
     return "\n".join(lines)
+
+
+MAX_YAML_VALUES = 100_000
+"""A profile expands to at most this many YAML values, aliases counted where they point."""
+
+
+class _ProfileLoader(yaml.SafeLoader):
+    """Safe YAML whose document, aliases expanded, holds at most ``MAX_YAML_VALUES`` values:
+    a few hundred bytes of aliases inside aliases expand into gigabytes (an alias bomb)."""
+
+    def get_single_node(self):  # noqa: ANN201 - PyYAML's own signature
+        node = super().get_single_node()
+        if node is not None and _expanded(node, {}) > MAX_YAML_VALUES:
+            raise ProfileError(f"{self.name}: expands to more than {MAX_YAML_VALUES} values "
+                               "(aliases inside aliases?)")  # fmt: skip
+        return node
+
+
+def _expanded(node: yaml.Node, sizes: dict[int, int]) -> int:
+    """How many values ``node`` stands for once every alias is expanded (each shared node
+    counted once per use, computed once)."""
+    if id(node) not in sizes:
+        if isinstance(node, yaml.SequenceNode):
+            children = node.value
+        elif isinstance(node, yaml.MappingNode):
+            children = [item for pair in node.value for item in pair]
+        else:
+            children = []
+        sizes[id(node)] = 1 + sum(_expanded(child, sizes) for child in children)
+    return sizes[id(node)]
+
+
+def shown(value: object, limit: int = 120) -> str:
+    """``repr(value)``, cut to ``limit`` characters (an error never echoes a 50 MB value)."""
+    text = repr(value)
+    return text if len(text) <= limit else f"{text[:limit]}... ({len(text)} characters)"
 
 
 def _read_yaml(path: Path) -> object:
     try:
-        text = path.read_text()
+        text = path.read_bytes().decode("utf-8")
     except OSError as error:
         raise ProfileError(f"{path}: cannot read profile: {error.strerror}") from error
+    except UnicodeDecodeError as error:
+        raise ProfileError(f"{path}: not UTF-8 text (byte {error.start})") from None
     try:
-        return yaml.safe_load(text)
+        loader = _ProfileLoader(text)
+        loader.name = str(path)
+        try:
+            return loader.get_single_data()
+        finally:
+            loader.dispose()
     except yaml.YAMLError as error:
         mark = getattr(error, "problem_mark", None)
         where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else str(path)

@@ -102,6 +102,25 @@ def test_yaml_syntax_errors_give_the_line(tmp_path: Path) -> None:
         load_profile(path)
 
 
+def test_an_alias_bomb_and_a_file_that_is_not_utf8_are_refused_at_once(tmp_path: Path) -> None:
+    bomb = tmp_path / "bomb.yaml"
+    lines = ['a0: &a0 ["x", "x", "x", "x", "x", "x", "x", "x", "x"]']
+    lines += [f"a{i}: &a{i} [{', '.join([f'*a{i - 1}'] * 9)}]" for i in range(1, 9)]
+    bomb.write_text("\n".join(lines) + "\n")  # 9**9 strings once expanded
+    with pytest.raises(ProfileError, match=r"bomb\.yaml: expands to more than 100000 values"):
+        load_profile(bomb)
+    latin = tmp_path / "latin.yaml"
+    latin.write_bytes("namespace: régl\n".encode("latin-1"))
+    with pytest.raises(ProfileError, match=r"latin\.yaml: not UTF-8 text \(byte 12\)"):
+        load_profile(latin)
+
+
+def test_a_huge_wrong_value_is_not_echoed_whole(tmp_path: Path) -> None:
+    said = refusal(tmp_path, {"namespace": "t", "components": [
+        {**PUB, "params": {"rate_hz": list(range(50_000))}}]})  # fmt: skip
+    assert "components[0].params" in said and len(said) < 1000, said[:2000]
+
+
 def test_a_profile_that_is_not_a_mapping_or_not_there_is_refused(tmp_path: Path) -> None:
     assert "expected a mapping at the top level, got list" in refusal(tmp_path, [1, 2])
     with pytest.raises(ProfileError, match="cannot read profile"):
