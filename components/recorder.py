@@ -2,7 +2,8 @@
 
 Each topic of the table is read with a queue (``queue`` samples waiting at most), so no
 sample is dropped unless the writer falls that far behind, and then the loss is counted
-(``overflowed.<topic>``). Each message is written on the channel of its key with the
+(``overflowed.<topic>``) and written into the file (its ``DROPPED`` metadata, which
+``parsimony info`` shows). Each message is written on the channel of its key with the
 project's schema, log time from its stamp (``record.session_file``), and beside it in
 Foxglove's well-known schemas (``record.foxglove_views``: images as ``foxglove.RawImage``,
 frames as ``foxglove.FrameTransforms``, obstacles as ``foxglove.SceneUpdate``), so that
@@ -27,7 +28,7 @@ from components.process_entry import run_component
 from components.pubsub import Input
 from components.runtime import Component, Node
 from messages import topics
-from record.session_file import SessionWriter
+from record.session_file import DROPPED, SessionWriter
 
 QUEUE = 10_000
 """Samples of one topic that may wait for the writer."""
@@ -62,7 +63,8 @@ class Recorder(Component):
             for topic in topics.TOPICS.values()
             if any(fnmatch.fnmatch(topic.name, pattern) for pattern in patterns)
         ]
-        node.timer(node.params["flush_s"], lambda: self._writing(self.writer.flush))
+        self.dropped: dict[str, int] = {}
+        node.timer(node.params["flush_s"], lambda: self._writing(self._flush))
 
     def _writer_of(self, name: str, key: str):
         def write(message) -> None:
@@ -86,10 +88,21 @@ class Recorder(Component):
                            f"{self.path} OUT)")  # fmt: skip
             return False
 
+    def _flush(self) -> None:
+        """The chunk to the file, and what was lost since the last flush, if anything (the
+        file's ``DROPPED`` metadata)."""
+        dropped = {k: v for k, v in self.node.counters.items()
+                   if k.startswith(("overflowed.", "overwritten.")) and v}  # fmt: skip
+        if dropped != self.dropped:
+            self.writer.metadata(DROPPED, dropped)
+            self.dropped = dropped
+        self.writer.flush()
+
     def shutdown(self) -> None:
-        """Write what still waits, then the footer: the file is whole."""
+        """Write what still waits, what was lost, then the footer: the file is whole."""
         for subscription in self.inputs:
             subscription.drain()
+        self._writing(self._flush)
         self._writing(self.writer.close)
 
 

@@ -146,10 +146,10 @@ class Node:
         if actual.ground_truth and self.spec.role in ("estimator", "controller"):
             raise ValueError(f"{self.name} is an {self.spec.role}: it may not read the ground "
                              f"truth on {actual.name}")  # fmt: skip
-        if self.reads is not None and topic is not topics.SIM_CLOCK:
-            if topic.name not in self.reads:
-                raise ValueError(f"{self.name} reads {topic.name} without declaring it in `reads`")
-            queue = self.reads[topic.name].queue
+        if self.reads is not None and topic.name in self.reads:
+            queue = self.reads[topic.name].queue  # sim/clock too, when declared (a recorder)
+        elif self.reads is not None and topic is not topics.SIM_CLOCK:
+            raise ValueError(f"{self.name} reads {topic.name} without declaring it in `reads`")
         subscription = Subscription(self, actual, handler, queue, on_reject)
         self._declared.append(subscription)
         return subscription

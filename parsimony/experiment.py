@@ -248,8 +248,7 @@ def run_experiment(options: Options) -> dict[str, Any]:
                           converged)  # fmt: skip
     write_commands(options.out / "commands.csv", messages)
     start_ns = min((s.header.stamp_ns for s in messages["robot/state"]), default=end_ns)
-    report["recording"] = recording_check(options.out / SESSION_FILE, (start_ns, end_ns),
-                                          counters)  # fmt: skip
+    report["recording"] = recording_check(options.out / SESSION_FILE, (start_ns, end_ns))
     whole_recording(options.out / SESSION_FILE)
     session = load_session(options.out / SESSION_FILE)
     label = options.controller
@@ -291,8 +290,7 @@ def connect(profile: Profile, launcher: subprocess.Popen) -> zenoh.Session:
             time.sleep(0.2)  # the launcher opens its router first thing
 
 
-def recording_check(path: Path, run_ns: tuple[int, int], counters: dict[str, dict[str, int]]
-                    ) -> dict:  # fmt: skip
+def recording_check(path: Path, run_ns: tuple[int, int]) -> dict:
     """Whether the recording holds the whole run, from its first state to its last (``run_ns``):
     its footer, no sample dropped by the recorder, and the run's states from start to end;
     ``missing`` says what is not there (empty when whole). With its size, and bytes per
@@ -302,11 +300,9 @@ def recording_check(path: Path, run_ns: tuple[int, int], counters: dict[str, dic
     missing = []
     if not facts["complete"]:
         missing.append("no footer: the recorder was killed, the file keeps its complete chunks")
-    dropped = {k.split(".", 1)[1]: v for k, v in counters.get("recorder", {}).items()
-               if k.startswith("overflowed.") and v}  # fmt: skip
-    if dropped:
-        lost = ", ".join(f"{v} of {k}" for k, v in dropped.items())
-        missing.append(f"the recorder dropped {lost}")
+    if facts["dropped"]:
+        lost = ", ".join(f"{n} ({counter})" for counter, n in facts["dropped"].items())
+        missing.append(f"the recorder lost {lost}")
     states = [c for c in facts["channels"] if c["key"].endswith("/" + topics.ROBOT_STATE.name)]
     first_ns = min((c["start_ns"] for c in states), default=0)
     last_ns = max((c["end_ns"] for c in states), default=0)

@@ -32,9 +32,9 @@ from pathlib import Path
 from typing import IO, Any
 
 from mcap.exceptions import EndOfFile, InvalidMagic, McapError
-from mcap.records import Channel, Chunk, Footer, Message, Schema
+from mcap.records import Channel, Chunk, Footer, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader, breakup_chunk
-from mcap.writer import CompressionType, Writer
+from mcap.writer import MCAP0_MAGIC, CompressionType, Writer
 from pydantic import BaseModel
 
 from messages import topics
@@ -53,6 +53,9 @@ CARRIED_FIELD = "parsimony.carried_field"
 """Channel metadata: the field the channel's JSON leaves out, because ``CARRIER`` holds it."""
 CARRIER = "parsimony.carrier"
 """Channel metadata: the channel whose message of the same log time holds ``CARRIED_FIELD``."""
+DROPPED = "parsimony.dropped"
+"""Metadata record: the samples the recorder lost, by counter (``overflowed.<topic>``,
+``overwritten.<topic>``), those that are not 0; written as they change and at the end."""
 
 
 @dataclass(frozen=True)
@@ -203,6 +206,10 @@ class SessionWriter:
         self._sequences[channel] = (sequence + 1) % SEQUENCE_MODULUS
         self._writer.add_message(channel, log_time_ns, entry.data, time.time_ns(), sequence)
 
+    def metadata(self, name: str, values: dict[str, int | str]) -> None:
+        """A metadata record ``name`` (the last of a name is the one that holds)."""
+        self._writer.add_metadata(name, {k: str(v) for k, v in values.items()})
+
     def flush(self) -> None:
         """Close the current chunk and push it to the file (no fsync): a kill loses nothing
         written before."""
@@ -252,6 +259,7 @@ class _Scan:
         self.path = Path(path)
         self.complete = False
         self.damaged: list[str] = []
+        self.metadata: dict[str, dict[str, str]] = {}
 
     def __iter__(self) -> Iterator[tuple[Schema | None, Channel, Message]]:
         schemas: dict[int, Schema] = {}
@@ -270,9 +278,11 @@ class _Scan:
             except InvalidMagic:
                 raise McapError(f"{self.path}: not an MCAP file") from None
             except EndOfFile:
-                if not begun:
-                    raise McapError(f"{self.path}: not an MCAP file (too short)") from None
-                return
+                stream.seek(0)
+                start = stream.read(len(MCAP0_MAGIC))
+                if not begun and not MCAP0_MAGIC.startswith(start):
+                    raise McapError(f"{self.path}: not an MCAP file") from None
+                return  # cut short, maybe before anything was written
             except (struct.error, UnicodeDecodeError, ValueError) as error:
                 raise McapError(f"{self.path}: damaged outside its chunks: {error}") from None
 
@@ -302,6 +312,8 @@ class _Scan:
             return schemas.get(channel.schema_id), channel, record
         elif isinstance(record, Footer):
             self.complete = True
+        elif isinstance(record, Metadata):
+            self.metadata[record.name] = dict(record.metadata)
         return None
 
 
@@ -383,7 +395,8 @@ def _carried_fields(
 
 def info(path: Path) -> dict[str, Any]:
     """What a session file holds: totals (messages, file bytes, start, end and duration,
-    ``complete``: whether the footer is there, ``damaged``: the chunks skipped) and, per
+    ``complete``: whether the footer is there, ``damaged``: the chunks skipped, ``dropped``:
+    the samples its recorder lost, by counter, ``DROPPED``) and, per
     channel, its key, schema name, encoding and size in bytes, message count and bytes, first
     and last log time and mean rate (Hz, (count - 1) / span)."""
     scan = _Scan(path)
@@ -415,6 +428,7 @@ def info(path: Path) -> dict[str, Any]:
         "path": str(path),
         "complete": scan.complete,
         "damaged": scan.damaged,
+        "dropped": {key: int(n) for key, n in scan.metadata.get(DROPPED, {}).items()},
         "messages": sum(c["messages"] for c in channels.values()),
         "bytes": Path(path).stat().st_size,
         "start_ns": start,

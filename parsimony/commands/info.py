@@ -40,6 +40,9 @@ def run(args: argparse.Namespace) -> int:
         emit("no footer: cut short (parsimony record --recover FILE -o OUT makes it whole)")
     for damaged in found["damaged"]:
         emit(f"damaged, skipped: {damaged}")
+    if found["dropped"]:
+        lost = ", ".join(f"{n} ({counter})" for counter, n in found["dropped"].items())
+        emit(f"lost by the recorder: {lost}")
     emit("\n".join("  ".join(cell.ljust(w) for cell, w in zip(row, widths, strict=True))
                    for row in rows))  # fmt: skip
     return 0

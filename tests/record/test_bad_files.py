@@ -58,7 +58,7 @@ def damaged(session: Path, tmp_path: Path) -> tuple[Path, int]:
     return path, held
 
 
-FOREIGN = {"text": b"this is not a recording\n" * 20, "zeros": bytes(4096), "empty": b""}
+FOREIGN = {"text": b"this is not a recording\n" * 20, "zeros": bytes(4096), "short": b"\x89MCAX"}
 
 
 @pytest.mark.parametrize("kind", sorted(FOREIGN))

@@ -8,6 +8,8 @@ import json
 import math
 import random
 import struct
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -21,7 +23,15 @@ from messages.camera import CameraFrame
 from messages.clock import Clock
 from messages.header import Header
 from messages.state import RobotState
-from record.session_file import CARRIER, Entry, SessionWriter, info, read_session, recover
+from record.session_file import (
+    CARRIER,
+    DROPPED,
+    Entry,
+    SessionWriter,
+    info,
+    read_session,
+    recover,
+)
 from vision.images import jpeg
 
 NAMESPACE = "lab/robot1"
@@ -271,3 +281,16 @@ def test_recover_refuses_to_overwrite_its_source(tmp_path: Path) -> None:
     SessionWriter(path).close()
     with pytest.raises(ValueError, match="overwritten"):
         recover(path, path)
+
+
+def test_what_the_recorder_lost_is_in_the_file_and_info_shows_it(tmp_path: Path) -> None:
+    path = tmp_path / "lossy.mcap"
+    with SessionWriter(path) as writer:
+        writer.write(topics.ROBOT_STATE.key(NAMESPACE), state(5_000))
+        writer.metadata(DROPPED, {"overflowed.camera/image": 3})
+        writer.metadata(DROPPED, {"overflowed.camera/image": 7, "overwritten.sim/clock": 2})
+    assert info(path)["dropped"] == {"overflowed.camera/image": 7, "overwritten.sim/clock": 2}
+    shown = subprocess.run([sys.executable, "-m", "parsimony.cli", "info", str(path)],
+                           capture_output=True, text=True)  # fmt: skip
+    assert "lost by the recorder: 7 (overflowed.camera/image), 2 (overwritten.sim/clock)" in (
+        shown.stdout)
