@@ -26,9 +26,10 @@ from pathlib import Path
 
 import numpy as np
 
+from deploy.query import QueryError
 from parsimony.experiment import PROFILES, SUPERVISED, Options, run_experiment
 from parsimony.output import emit, result_only_stdout
-from profiles.profile import load_profile
+from profiles.profile import ProfileError, load_profile
 from sim2d.camera import ImageNoise, PlacedMarker, Renderer, ceiling_camera
 from sim2d.scenarios import NAMES, scenario
 from vision.images import grey, jpeg
@@ -47,11 +48,17 @@ def percentile(values: list[float], q: float) -> float:
     return round(float(np.percentile(values, q)), 1)
 
 
-def run_one(name: str, controller: str, seed: int, directory: Path) -> dict:
-    """One lockstep run (in a worker process: its pid names the system's namespace)."""
+def run_one(name: str, controller: str, seed: int, directory: Path) -> dict | None:
+    """One lockstep run (in a worker process: its pid names the system's namespace); None
+    when it could not run (said, with why)."""
     options = Options(name=name, controller=controller, seed=seed,
                       out=directory / f"{name}-{controller}-{seed}")  # fmt: skip
-    report = run_experiment(options)
+    try:
+        report = run_experiment(options)
+    except (OSError, RuntimeError, QueryError, ProfileError) as error:
+        print(f"[bench] {name} {controller} seed {seed}: did not run: {error}", file=sys.stderr,
+              flush=True)  # fmt: skip
+        return None
     print(f"[bench] {name} {controller} seed {seed}: converged={report['converged']} "
           f"rtf={report['real_time_factor']}", file=sys.stderr, flush=True)  # fmt: skip
     return report
@@ -62,8 +69,9 @@ def median_of(reports: list[dict], component: str, counter: str) -> int:
         r["durations_us"].get(component, {}).get(counter, 0) for r in reports))  # fmt: skip
 
 
-def summary(name: str, controller: str, reports: list[dict]) -> dict:
-    """Every seed of one experiment and law, summarised."""
+def summary(name: str, controller: str, found: list[dict | None]) -> dict:
+    """Every seed of one experiment and law, summarised (those that could not run counted)."""
+    reports = [r for r in found if r is not None]
     estimator = [r["estimator_error"] for r in reports if r["estimator_error"]["samples"]]
     # The recorder's CPU per simulated second: its share of one core in real time (30 Hz).
     recorder = [r["cpu_s"].get("recorder", 0.0) / r["sim_time_s"] for r in reports]
@@ -71,6 +79,7 @@ def summary(name: str, controller: str, reports: list[dict]) -> dict:
         "experiment": name,
         "law": controller,
         "runs": len(reports),
+        "did_not_run": len(found) - len(reports),
         "converged": sum(r["converged"] for r in reports),
         "with_contact": sum(r["contacts"] > 0 for r in reports),
         "at_joint_stops": sum(r["joint_limit_violations"] > 0 for r in reports),
@@ -150,9 +159,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--workers", type=int, default=max(1, (os.cpu_count() or 2) // 2),
                         help="experiments run at once (default: one per two cores)")  # fmt: skip
     parser.add_argument("--only", help="comma-separated experiments to run (default: all)")
+    parser.add_argument("--laws", default="lp,cascade", help="comma-separated laws to run")
     parser.add_argument("--json", action="store_true", help="print JSON instead of tables")
     args = parser.parse_args(argv)
-    runs = [(n, law) for n, law in RUNS if not args.only or n in args.only.split(",")]
+    runs = [(n, law) for n, law in RUNS
+            if (not args.only or n in args.only.split(",")) and law in args.laws.split(",")]
     started = time.monotonic()
     with tempfile.TemporaryDirectory() as directory, ProcessPoolExecutor(args.workers) as pool:
         jobs = {(n, law): [pool.submit(run_one, n, law, seed, Path(directory))
