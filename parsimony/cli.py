@@ -18,12 +18,17 @@ COMMANDS = (
 )  # fmt: skip
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """Every command's parser; with ``command``, only that command's module is imported (each
+    pulls in what it runs on: the laws, the plots, the components) and the others are named."""
     parser = argparse.ArgumentParser(prog="parsimony", description=__doc__)
     subparsers = parser.add_subparsers(dest="command", required=True)
     for name in COMMANDS:
-        module = importlib.import_module(f"parsimony.commands.{name}")
-        module.add_parser(subparsers).set_defaults(run=module.run)
+        if command in (None, name):
+            module = importlib.import_module(f"parsimony.commands.{name}")
+            module.add_parser(subparsers).set_defaults(run=module.run)
+        else:
+            subparsers.add_parser(name)
     return parser
 
 
@@ -31,7 +36,9 @@ def main(argv: list[str] | None = None) -> int:
     """Run one command. A file it cannot read or write, a file that is not what it should be
     (``McapError``) and a router it cannot reach end it with one line and exit 2, never a
     traceback; a reader of its output that went away (``| head``) ends it quietly."""
-    args = build_parser().parse_args(argv)
+    words = sys.argv[1:] if argv is None else argv
+    chosen = next((word for word in words if not word.startswith("-")), None)
+    args = build_parser(chosen if chosen in COMMANDS else None).parse_args(words)
     try:
         with result_only_stdout():
             return int(args.run(args) or 0)
