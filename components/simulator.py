@@ -57,7 +57,7 @@ from sim2d.world import World, WorldSettings, wheel_distance_per_count
 from vision.images import jpeg
 from wbc.base_motion import dead_reckoning
 from wbc.obstacles import Circle
-from wbc.planar import planar_pose
+from wbc.planar import compose, planar_pose
 from wbc.robot import MobileManipulator
 
 JOINT_NAMES = tuple(f"q{i}" for i in range(1, ARM_JOINTS + 1))
@@ -440,10 +440,8 @@ class Simulator(Component):
         scene, q = self.scene, self.world.q
         elements: list = [(q[0], q[1], scene.base.height_m, self.robot.base.body_radius, 70)]
         if not self._base_marker_hidden():
-            ox, oy = scene.base.offset
-            c, s = math.cos(q[2]), math.sin(q[2])
-            x, y = q[0] + c * ox - s * oy, q[1] + s * ox + c * oy
-            pose = planar_pose(x, y, q[2], scene.base.height_m)
+            x, y, phi = compose(tuple(q[:3]), (*scene.base.offset, 0.0))
+            pose = planar_pose(x, y, phi, scene.base.height_m)
             elements.append(PlacedMarker(scene.base.id, scene.base.size_m, pose))
         return elements
 

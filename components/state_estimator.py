@@ -29,7 +29,6 @@ not depend on when a frame's markers arrive within the latency.
 
 from __future__ import annotations
 
-import math
 from collections import deque
 from dataclasses import dataclass
 
@@ -50,7 +49,7 @@ from messages.state import RobotState
 from profiles.scene import Scene
 from wbc import dq
 from wbc.base_estimate import BaseEstimate
-from wbc.planar import offset_pose, planar_of
+from wbc.planar import compose, offset_pose, planar_of
 from wbc.pose_filter import PoseFilter
 from wbc.robot import MobileManipulator
 
@@ -167,10 +166,8 @@ class StateEstimator(Component):
 
     def _base_of(self, marker_pose: np.ndarray) -> tuple[float, float, float]:
         """The base pose the F1 marker shows: its planar pose, its offset undone."""
-        mx, my, mphi = planar_of(marker_pose)
         ox, oy = self.scene.base.offset
-        c, s = math.cos(mphi), math.sin(mphi)
-        return mx - c * ox + s * oy, my - s * ox - c * oy, mphi
+        return compose(planar_of(marker_pose), (-ox, -oy, 0.0))
 
     def _goal_pose(self) -> np.ndarray | None:
         bin_marker = self.statics.get(self.scene.goal.id)
