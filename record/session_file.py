@@ -441,7 +441,8 @@ def info(path: Path) -> dict[str, Any]:
 def recover(source: Path, target: Path) -> int:
     """Write at ``target`` a whole file (footer, indexes, statistics) of every message that
     survives in ``source`` (a file without a footer, or a whole one), schemas, channels,
-    times and sequence numbers unchanged, in file order; return the number of messages."""
+    times and sequence numbers unchanged, in file order, with the last metadata record of each
+    name (``DROPPED``: what the recorder lost); return the number of messages."""
     if Path(source).resolve() == Path(target).resolve():
         raise ValueError(f"recover: {source} would be overwritten while it is read")
     schema_ids: dict[int, int] = {0: 0}
@@ -450,7 +451,8 @@ def recover(source: Path, target: Path) -> int:
     with Path(target).open("wb") as stream:
         writer = Writer(stream, compression=CompressionType.ZSTD)
         writer.start(library=LIBRARY)
-        for schema, channel, message in _Scan(source):
+        scan = _Scan(source)
+        for schema, channel, message in scan:
             if schema is not None and schema.id not in schema_ids:
                 schema_ids[schema.id] = writer.register_schema(
                     schema.name, schema.encoding, schema.data
@@ -463,5 +465,7 @@ def recover(source: Path, target: Path) -> int:
             writer.add_message(channel_ids[channel.id], message.log_time, message.data,
                                message.publish_time, message.sequence)  # fmt: skip
             saved += 1
+        for name, values in scan.metadata.items():
+            writer.add_metadata(name, values)
         writer.finish()
     return saved

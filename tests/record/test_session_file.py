@@ -290,6 +290,9 @@ def test_what_the_recorder_lost_is_in_the_file_and_info_shows_it(tmp_path: Path)
         writer.metadata(DROPPED, {"overflowed.camera/image": 3})
         writer.metadata(DROPPED, {"overflowed.camera/image": 7, "overwritten.sim/clock": 2})
     assert info(path)["dropped"] == {"overflowed.camera/image": 7, "overwritten.sim/clock": 2}
+    recovered = tmp_path / "recovered.mcap"
+    recover(path, recovered)  # what was lost is still said of the recovered file
+    assert info(recovered)["dropped"] == info(path)["dropped"]
     shown = subprocess.run([sys.executable, "-m", "parsimony.cli", "info", str(path)],
                            capture_output=True, text=True)  # fmt: skip
     assert "lost by the recorder: 7 (overflowed.camera/image), 2 (overwritten.sim/clock)" in (
