@@ -248,8 +248,10 @@ def run_experiment(options: Options) -> dict[str, Any]:
                           converged)  # fmt: skip
     write_commands(options.out / "commands.csv", messages)
     start_ns = min((s.header.stamp_ns for s in messages["robot/state"]), default=end_ns)
-    report["recording"] = recording_check(options.out / SESSION_FILE, (start_ns, end_ns))
-    whole_recording(options.out / SESSION_FILE)
+    facts = info(options.out / SESSION_FILE)
+    report["recording"] = recording_check(facts, (start_ns, end_ns))
+    if not facts["complete"]:
+        whole_recording(options.out / SESSION_FILE)
     session = load_session(options.out / SESSION_FILE)
     label = options.controller
     if report["recording"]["missing"]:
@@ -290,13 +292,12 @@ def connect(profile: Profile, launcher: subprocess.Popen) -> zenoh.Session:
             time.sleep(0.2)  # the launcher opens its router first thing
 
 
-def recording_check(path: Path, run_ns: tuple[int, int]) -> dict:
-    """Whether the recording holds the whole run, from its first state to its last (``run_ns``):
-    its footer, no sample dropped by the recorder, and the run's states from start to end;
-    ``missing`` says what is not there (empty when whole). With its size, and bytes per
-    simulated second."""
+def recording_check(facts: dict[str, Any], run_ns: tuple[int, int]) -> dict:
+    """Whether the recording (``facts``: its ``info``) holds the whole run, from its first state
+    to its last (``run_ns``): its footer, no sample dropped by the recorder, and the run's
+    states from start to end; ``missing`` says what is not there (empty when whole). With its
+    size, and bytes per simulated second."""
     start_ns, end_ns = run_ns
-    facts = info(path)
     missing = []
     if not facts["complete"]:
         missing.append("no footer: the recorder was killed, the file keeps its complete chunks")
@@ -316,15 +317,14 @@ def recording_check(path: Path, run_ns: tuple[int, int]) -> dict:
 
 
 def whole_recording(path: Path) -> None:
-    """Make ``path`` whole if its recorder was stopped before it wrote the footer (killed after
-    the launcher's stop timeout on a loaded machine): every complete chunk is kept."""
-    if not info(path)["complete"]:
-        partial = path.with_suffix(".partial.mcap")
-        path.rename(partial)
-        saved = recover(partial, path)
-        partial.unlink()
-        print(f"[experiment] the recording had no footer: {saved} messages kept",
-              file=sys.stderr)  # fmt: skip
+    """Make ``path``, whose recorder was killed before it wrote the footer, whole: every
+    complete chunk is kept."""
+    partial = path.with_suffix(".partial.mcap")
+    path.rename(partial)
+    saved = recover(partial, path)
+    partial.unlink()
+    print(f"[experiment] the recording had no footer: {saved} messages kept",
+          file=sys.stderr)  # fmt: skip
 
 
 def wait_alive(session: zenoh.Session, profile: Profile, launcher: subprocess.Popen) -> None:
