@@ -19,11 +19,7 @@ from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.session_file import info
-
-
-def parsimony(*arguments: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "parsimony.cli", *arguments],
-                          capture_output=True, text=True)  # fmt: skip
+from tests.processes import parsimony, process_gone
 
 
 def system_profile(tmp_path: Path) -> Path:
@@ -34,14 +30,6 @@ def system_profile(tmp_path: Path) -> Path:
                         "params": {"rate_hz": 100.0}}],
     }))  # fmt: skip
     return path
-
-
-def running(pid: int) -> bool:
-    """Whether process ``pid`` is there and not a zombie."""
-    try:
-        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
-    except OSError:
-        return False
 
 
 @pytest.mark.parametrize("how", [signal.SIGKILL, signal.SIGTERM, signal.SIGINT])
@@ -60,7 +48,7 @@ def test_the_recorder_stops_with_the_record_command(tmp_path: Path, how: signal.
         child = statuses(session, "rec")["recorder"].pid
         command.send_signal(how)
         command.wait()
-        while running(child):
+        while not process_gone(child):
             time.sleep(0.1)  # the recorder goes too (the test fails by hanging if not)
     if how != signal.SIGKILL:
         assert command.returncode == 0

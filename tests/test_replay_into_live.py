@@ -4,7 +4,6 @@ publishes are refused before anything is sent, unless the user says --into-live.
 from __future__ import annotations
 
 import subprocess
-import sys
 from pathlib import Path
 
 import yaml
@@ -19,6 +18,7 @@ from parsimony.experiment import connect, launched
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.session_file import SessionWriter
+from tests.processes import parsimony
 
 
 def recording(path: Path, namespace: str) -> Path:
@@ -37,9 +37,7 @@ def recording(path: Path, namespace: str) -> Path:
 
 
 def replay(file: Path, profile: Path, *extra: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "parsimony.cli", "replay", str(file),
-                           "--profile", str(profile), "--rate", "16", *extra],
-                          capture_output=True, text=True)  # fmt: skip
+    return parsimony("replay", str(file), "--profile", str(profile), "--rate", "16", *extra)
 
 
 def test_a_replay_into_a_live_namespace_refuses_commands_and_live_topics(tmp_path: Path) -> None:

@@ -12,6 +12,7 @@ import yaml
 
 from deploy import query
 from tests.deploy.conftest import free_port
+from tests.processes import process_gone
 
 if TYPE_CHECKING:
     from tests.deploy.conftest import LaunchFixture, ProfileWriter
@@ -29,15 +30,6 @@ def publisher(name: str, role: str = "tool", **fields: object) -> dict[str, obje
         "restart": {"backoff_initial_s": 0.1},
         **fields,
     }
-
-
-def process_gone(pid: int) -> bool:
-    """Whether ``pid`` has exited (a zombie counts as exited)."""
-    try:
-        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-    except FileNotFoundError:
-        return True
-    return state == "Z"
 
 
 def test_a_killed_component_comes_back_at_once_then_after_a_backoff_until_restarts_run_out(

@@ -4,8 +4,6 @@ never a traceback; a damaged chunk skipped and named, and every other message re
 from __future__ import annotations
 
 import dataclasses
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -15,14 +13,10 @@ from messages import topics
 from messages.header import Header
 from messages.state import RobotState
 from record.session_file import SessionWriter, entries, info, read_session, recover
+from tests.processes import parsimony
 
 KEY = topics.ROBOT_STATE.key("bad")
 MESSAGES = 3000
-
-
-def parsimony(*arguments: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "parsimony.cli", *arguments],
-                          capture_output=True, text=True)  # fmt: skip
 
 
 def state(index: int) -> RobotState:

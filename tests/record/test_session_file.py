@@ -8,8 +8,6 @@ import json
 import math
 import random
 import struct
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +30,7 @@ from record.session_file import (
     read_session,
     recover,
 )
+from tests.processes import parsimony
 from vision.images import jpeg
 
 NAMESPACE = "lab/robot1"
@@ -293,7 +292,6 @@ def test_what_the_recorder_lost_is_in_the_file_and_info_shows_it(tmp_path: Path)
     recovered = tmp_path / "recovered.mcap"
     recover(path, recovered)  # what was lost is still said of the recovered file
     assert info(recovered)["dropped"] == info(path)["dropped"]
-    shown = subprocess.run([sys.executable, "-m", "parsimony.cli", "info", str(path)],
-                           capture_output=True, text=True)  # fmt: skip
+    shown = parsimony("info", str(path))
     assert "lost by the recorder: 7 (overflowed.camera/image), 2 (overwritten.sim/clock)" in (
         shown.stdout)
