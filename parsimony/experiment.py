@@ -45,7 +45,7 @@ from parsimony.kinematic_demo import LP_PARAMS
 from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import Profile, ProfileError, load_profile
-from record.report import write_report
+from record.report import READS, write_report
 from record.session_file import info, recover
 from sim2d.scenarios import SimScenario, scenario
 from wbc import dq
@@ -252,7 +252,7 @@ def run_experiment(options: Options) -> dict[str, Any]:
     report["recording"] = recording_check(facts, (start_ns, end_ns))
     if not facts["complete"]:
         whole_recording(options.out / SESSION_FILE)
-    session = load_session(options.out / SESSION_FILE)
+    session = load_session(options.out / SESSION_FILE, READS)
     label = options.controller
     if report["recording"]["missing"]:
         label += " (RECORDING CUT SHORT: " + "; ".join(report["recording"]["missing"]) + ")"

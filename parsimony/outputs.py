@@ -3,7 +3,9 @@ unless the user said ``--force``."""
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+import contextlib
+import os
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 
@@ -18,3 +20,18 @@ def writable_output(output: Path, inputs: Iterable[Path], force: bool) -> str | 
     if Path(output).exists() and not force:
         return f"{output} exists; give --force to replace it"
     return None
+
+
+@contextlib.contextmanager
+def written_whole(output: Path) -> Iterator[Path]:
+    """A path to write ``output`` at: a hidden file beside it, renamed onto it when the block
+    ends well and removed when it raises, so a failed command leaves no output, and a
+    replaced one stays whole until the new one is."""
+    output = Path(output)
+    partial = output.with_name(f".{output.name}.partial")
+    try:
+        yield partial
+    except BaseException:
+        partial.unlink(missing_ok=True)
+        raise
+    os.replace(partial, output)

@@ -62,6 +62,10 @@ METRICS: Mapping[str, tuple[str, str]] = {
 }
 """Table 6.1's metrics: the ``ControlEffort`` field each reports, and its formula."""
 
+READS = frozenset(t.name for t in (ROBOT_STATE, CONTROL_GOAL, GOAL_REQUEST, BASE_COMMAND,
+                                   ARM_COMMAND, CONTROL_DIAGNOSTICS, WORLD_OBSTACLES, SIM_TRUTH))
+"""The topics a report reads: a session loaded for one needs no others (no images)."""
+
 INPUT_NAMES = ("x'", "y'", "phi'", "q1'", "q2'", "q3'", "q4'", "q5'")
 """The entries of u, in order."""
 

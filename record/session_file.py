@@ -22,11 +22,13 @@ from __future__ import annotations
 
 import base64
 import functools
+import heapq
 import json
 import logging
 import struct
 import time
-from collections.abc import Iterator
+from array import array
+from collections.abc import Collection, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
@@ -253,6 +255,11 @@ class _Scan:
     the messages it held) and in a warning. A file that does not begin as an MCAP file, and a
     fault outside the chunks, raise ``McapError`` naming the file. After iterating,
     ``complete`` says whether the footer was there.
+
+    The data section is a sequence of units, each a chunk or a message outside any chunk:
+    ``units`` gives each unit's messages, ``unit_starts`` each unit's earliest log time without
+    decompressing anything (a chunk's header says it), so a reader can merge them in log-time
+    order holding only the units whose times overlap (``read_groups``).
     """
 
     def __init__(self, path: Path) -> None:
@@ -262,19 +269,41 @@ class _Scan:
         self.metadata: dict[str, dict[str, str]] = {}
 
     def __iter__(self) -> Iterator[tuple[Schema | None, Channel, Message]]:
+        for unit in self.units():
+            yield from unit
+
+    def units(self) -> Iterator[list[tuple[Schema | None, Channel, Message]]]:
+        """The messages of each unit (a chunk, or a message outside the chunks), in file order;
+        a damaged chunk gives an empty unit."""
         schemas: dict[int, Schema] = {}
         channels: dict[int, Channel] = {}
+        for record in self._records():
+            inner = self._opened(record) if isinstance(record, Chunk) else [record]
+            found = [f for f in (self._take(item, schemas, channels) for item in inner) if f]
+            if isinstance(record, (Chunk, Message)):
+                yield found
+
+    def unit_starts(self) -> array:
+        """The earliest log time of each unit, as its header says (nothing decompressed)."""
+        starts = array("q")
+        for record in self._records():
+            if isinstance(record, Chunk):
+                starts.append(record.message_start_time)
+            elif isinstance(record, Message):
+                starts.append(record.log_time)
+            elif isinstance(record, Footer):
+                self.complete = True
+        return starts
+
+    def _records(self) -> Iterator[Any]:
+        """The file's records, chunks unopened, the file's faults turned into ``McapError``."""
         with self.path.open("rb") as stream:
             reader = StreamReader(_ExactReads(stream), emit_chunks=True)
             begun = False
             try:
                 for record in reader.records:
                     begun = True  # the magic and the header were there
-                    inner = self._opened(record) if isinstance(record, Chunk) else [record]
-                    for item in inner:
-                        found = self._take(item, schemas, channels)
-                        if found is not None:
-                            yield found
+                    yield record
             except InvalidMagic:
                 raise McapError(f"{self.path}: not an MCAP file") from None
             except EndOfFile:
@@ -333,28 +362,66 @@ def _project_topic(schema: Schema | None, channel: Channel) -> topics.Topic | No
     return _topic_of(channel.topic, schema.name)
 
 
-def read_session(path: Path) -> Iterator[Recorded]:
-    """Every message of a session file (all its complete chunks if it has no footer), in
-    log-time order (stable: ties keep file order). The project's messages are decoded into
-    their types, a field carried by a view put back; other channels' messages (the Foxglove
-    views) come with ``topic_name`` and ``message`` None. Decoding is lazy, so a caller that
-    skips images never builds them. In a file cut short, a message whose carrier was cut off
-    is left out; in a whole file, it is an ``McapError``. A message that does not decode into
-    its type is left out and said (the first of each channel, where and why, then how many);
-    so is a damaged chunk (``_Scan``)."""
-    scan = _Scan(path)
-    found = sorted(scan, key=lambda record: record[2].log_time)
-    keys = {channel.metadata[CARRIER] for _, channel, _ in found if CARRIER in channel.metadata}
-    carriers = {(channel.topic, message.log_time): (schema, message)
-                for schema, channel, message in found if channel.topic in keys}
+def read_session(path: Path, only: Collection[str] | None = None) -> Iterator[Recorded]:
+    """Every message of a session file, in log-time order (``read_groups``, flattened)."""
+    for group in read_groups(path, only):
+        yield from group
+
+
+def read_groups(path: Path, only: Collection[str] | None = None) -> Iterator[list[Recorded]]:
+    """The messages of a session file (all its complete chunks if it has no footer) in
+    log-time order, one list per log time, in file order within it. The project's messages
+    are decoded into their types, a field carried by a view put back; other channels'
+    messages (the Foxglove views) come with ``topic_name`` and ``message`` None. Given
+    ``only`` (topic names), only those topics' messages come, and nothing else is decoded.
+
+    The file is streamed: a first pass reads each unit's earliest time from its header
+    (``_Scan.unit_starts``); the second opens the units in file order and gives a log time
+    once no later unit can start at or before it, so only units whose times overlap are held,
+    whatever the file's length.
+
+    In a file cut short, a message whose carrier was cut off is left out; in a whole file, it
+    is an ``McapError``. A message that does not decode into its type is left out and said
+    (the first of each channel, where and why, then how many); so is a damaged chunk
+    (``_Scan``)."""
+    headers = _Scan(path)
+    starts = headers.unit_starts()
+    later = array("q", starts) + array("q", [2**63 - 1])  # the earliest start from unit i on
+    for i in range(len(starts) - 1, -1, -1):
+        later[i] = min(later[i], later[i + 1])
+    pending: list = []  # (log time, unit, place in the unit, found): file order among ties
     skipped: dict[str, int] = {}
-    for schema, channel, message in found:
+    for index, unit in enumerate(_Scan(path).units()):
+        for place, found in enumerate(unit):
+            heapq.heappush(pending, (found[2].log_time, index, place, found))
+        while pending and pending[0][0] < later[index + 1]:
+            log_time = pending[0][0]
+            group = []
+            while pending and pending[0][0] == log_time:
+                group.append(heapq.heappop(pending)[3])
+            if decoded := _decoded(path, group, only, headers.complete, skipped):
+                yield decoded
+    for key, count in skipped.items():
+        if count > 1:
+            log.warning("%s: skipped %d messages of %s in all", path, count, key)
+
+
+def _decoded(path: Path, group: list, only: Collection[str] | None, complete: bool,
+             skipped: dict[str, int]) -> list[Recorded]:  # fmt: skip
+    """The messages of one log time as ``Recorded``, each carried field taken from its
+    carrier among them; those that do not decode left out, said once per channel and counted
+    in ``skipped``."""
+    carriers = {channel.topic: (schema, message) for schema, channel, message in group}
+    out = []
+    for schema, channel, message in group:
         topic = _project_topic(schema, channel)
+        if only is not None and (topic is None or topic.name not in only):
+            continue
         decoded = None
         if topic is not None:
-            carried_fields = _carried_fields(channel, message, carriers)
+            carried_fields = _carried_fields(channel, carriers)
             if carried_fields is None:
-                if scan.complete:
+                if complete:
                     raise McapError(f"{path}: {channel.topic} at {message.log_time} ns has no "
                                     f"{channel.metadata[CARRIER]} message")  # fmt: skip
                 continue
@@ -365,11 +432,9 @@ def read_session(path: Path) -> Iterator[Recorded]:
                 if skipped[channel.topic] == 1:
                     _skipped(path, channel.topic, message.log_time, topic.type, error)
                 continue
-        name = topic.name if topic is not None else None
-        yield Recorded(channel.topic, name, message.log_time, decoded)
-    for key, count in skipped.items():
-        if count > 1:
-            log.warning("%s: skipped %d messages of %s in all", path, count, key)
+        out.append(Recorded(channel.topic, topic.name if topic else None, message.log_time,
+                            decoded))  # fmt: skip
+    return out
 
 
 def _skipped(path: Path, key: str, log_time_ns: int, expected: type, error: Exception) -> None:
@@ -379,14 +444,13 @@ def _skipped(path: Path, key: str, log_time_ns: int, expected: type, error: Exce
                 log_time_ns / 1e9, expected.__name__, reason)  # fmt: skip
 
 
-def _carried_fields(
-    channel: Channel, message: Message, carriers: dict[tuple[str, int], tuple]
-) -> dict[str, bytes] | None:
+def _carried_fields(channel: Channel, carriers: dict[str, tuple]) -> dict[str, bytes] | None:
     """The fields of a project message that its channel's carrier holds (none for a channel
-    without one), or None when the carrier's message of its log time is missing."""
+    without one), or None when the carrier has no message of its log time (``carriers``: the
+    messages of that log time by key)."""
     if CARRIER not in channel.metadata:
         return {}
-    found = carriers.get((channel.metadata[CARRIER], message.log_time))
+    found = carriers.get(channel.metadata[CARRIER])
     if found is None:
         return None
     schema, view = found
@@ -397,15 +461,18 @@ def info(path: Path) -> dict[str, Any]:
     """What a session file holds: totals (messages, file bytes, start, end and duration,
     ``complete``: whether the footer is there, ``damaged``: the chunks skipped, ``dropped``:
     the samples its recorder lost, by counter, ``DROPPED``) and, per
-    channel, its key, schema name, encoding and size in bytes, message count and bytes, first
+    channel, its key, the project topic it carries (None for a view or a foreign channel),
+    schema name, encoding and size in bytes, message count and bytes, first
     and last log time and mean rate (Hz, (count - 1) / span)."""
     scan = _Scan(path)
     channels: dict[int, dict[str, Any]] = {}
     for schema, channel, message in scan:
         entry = channels.get(channel.id)
         if entry is None:
+            topic = _project_topic(schema, channel)
             entry = channels[channel.id] = {
                 "key": channel.topic,
+                "topic": topic.name if topic is not None else None,
                 "schema": schema.name if schema is not None else "",
                 "schema_encoding": schema.encoding if schema is not None else "",
                 "schema_bytes": len(schema.data) if schema is not None else 0,

@@ -20,7 +20,7 @@ from deploy.query import QueryError, Target
 from messages.process import LAUNCHER_PID_ENV
 from parsimony.experiment import RECORDER_STOP_S
 from parsimony.output import emit
-from parsimony.outputs import writable_output
+from parsimony.outputs import writable_output, written_whole
 from profiles.profile import ProfileError
 from record.session_file import recover
 
@@ -43,7 +43,8 @@ def run(args: argparse.Namespace) -> int:
         return 2
     if args.recover is not None:
         try:
-            saved = recover(args.recover, args.output)
+            with written_whole(args.output) as partial:
+                saved = recover(args.recover, partial)
         except OSError as error:
             print(f"record: {error}", file=sys.stderr)
             return 2

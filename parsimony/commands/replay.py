@@ -25,6 +25,7 @@ import fnmatch
 import sys
 import threading
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -38,7 +39,7 @@ from parsimony.commands.launch import positive_seconds
 from parsimony.replay_keys import QUIT, RIGHT, KeyReader, terminal_keys
 from parsimony.target_options import fail, profile_and_target, target_options
 from profiles.profile import Profile, ProfileError
-from record.session_file import Recorded, read_session
+from record.session_file import Recorded, info, read_groups
 
 SENSORS = ("camera/image", "arm/joint_states", "base/odometry")
 """What ``--sensors`` replays: the inputs a robot's drivers and camera give. Messages of one
@@ -113,32 +114,29 @@ def run(args: argparse.Namespace) -> int:
     namespace = args.namespace or profile.namespace
     try:
         topics.check_namespace(namespace)
-        records = [r for r in read_session(args.file)
-                   if r.topic_name is not None and r.message is not None
-                   and wanted(args, r.topic_name)]  # fmt: skip
+        recorded = Recording.of(args)
     except (OSError, ValueError) as error:
         session.close()
         print(f"replay: {error}", file=sys.stderr)
         return 2
-    if not records:
+    if not recorded.names:
         session.close()
         return fail(ValueError(f"{args.file}: nothing to replay"))
     conflicts = [] if args.into_live else live_conflicts(
-        session, profile, namespace, {r.topic_name for r in records})  # fmt: skip
+        session, profile, namespace, recorded.names)  # fmt: skip
     if conflicts:
         session.close()
         print(f"replay: refused: {'; '.join(conflicts)}. Replay into a namespace of its own "
               "(--namespace), leave those topics out (--exclude, --sensors), or say "
               "--into-live", file=sys.stderr)  # fmt: skip
         return 2
-    records.sort(key=lambda r: (r.log_time_ns, sending_rank(r.topic_name)))
-    if args.lockstep and ANSWERING.keys() & {r.topic_name for r in records}:
+    if args.lockstep and ANSWERING.keys() & recorded.names:
         session.close()
         return fail(ValueError(f"--lockstep: the replay would answer itself; leave out "
                                f"{', '.join(ANSWERING)} (or use --sensors)"))  # fmt: skip
     try:
         with session, terminal_keys() as keys:
-            return Player(args, session, namespace, records, keys).run()
+            return Player(args, session, namespace, recorded, keys).run()
     except KeyboardInterrupt:
         print("\n[replay] interrupted", file=sys.stderr, flush=True)
         return 130
@@ -165,6 +163,35 @@ def live_conflicts(session: zenoh.Session, profile: Profile, namespace: str,
         if clash := sorted((sending & writes) - set(COMMANDS)):
             found.append(f"{', '.join(clash)}, which the live {name} publishes")
     return found
+
+
+@dataclass(frozen=True)
+class Recording:
+    """What a replay sends from a file: the topics it holds that ``wanted`` lets through and
+    the log times of their first and last messages (from ``info``: one pass, nothing held);
+    ``groups`` streams their messages, one log time at a time, in sending order."""
+
+    path: Path
+    names: frozenset[str]
+    start_ns: int
+    end_ns: int
+
+    @classmethod
+    def of(cls, args: argparse.Namespace) -> Recording:
+        channels = [c for c in info(args.file)["channels"]
+                    if c["topic"] is not None and wanted(args, c["topic"])]  # fmt: skip
+        return cls(args.file, frozenset(c["topic"] for c in channels),
+                   min((c["start_ns"] for c in channels), default=0),
+                   max((c["end_ns"] for c in channels), default=0))  # fmt: skip
+
+    def groups(self, first_ns: int, last_ns: int) -> Iterator[list[Recorded]]:
+        """The messages of each log time in [first_ns, last_ns], ``SENSORS`` first."""
+        for group in read_groups(self.path, self.names):
+            log_time = group[0].log_time_ns
+            if log_time > last_ns:
+                return
+            if log_time >= first_ns:
+                yield sorted(group, key=lambda r: sending_rank(r.topic_name))
 
 
 @dataclass
@@ -283,17 +310,15 @@ class Player:
     """One replay: the passes over the records, the keys, the progress line."""
 
     def __init__(self, args: argparse.Namespace, session: zenoh.Session, namespace: str,
-                 records: list[Recorded], keys: KeyReader | None) -> None:  # fmt: skip
-        self.args, self.keys = args, keys
-        first = records[0].log_time_ns + round(args.start_offset * 1e9)
-        last = first + round(args.duration * 1e9) if args.duration else records[-1].log_time_ns
-        self.records = [r for r in records if first <= r.log_time_ns <= last]
-        self.first_ns = first
-        end_ns = self.records[-1].log_time_ns if self.records else first
-        self.progress = Progress(first, end_ns - first)
+                 recording: Recording, keys: KeyReader | None) -> None:  # fmt: skip
+        self.args, self.keys, self.recording = args, keys, recording
+        first = recording.start_ns + round(args.start_offset * 1e9)
+        last = first + round(args.duration * 1e9) if args.duration else recording.end_ns
+        self.first_ns, self.last_ns = first, min(last, recording.end_ns)
+        self.progress = Progress(first, max(0, self.last_ns - first))
         self.pace = Pace(args.rate, first, time.monotonic(), paused=args.start_paused)
         self.answers = Answers(session, namespace) if args.lockstep else None
-        names = {r.topic_name for r in self.records} | ({"sim/clock"} if args.clock else set())
+        names = recording.names | ({"sim/clock"} if args.clock else set())
         block = zenoh.CongestionControl.BLOCK  # a replay waits rather than drop a sample
         self.publishers = {
             name: session.declare_publisher(topics.TOPICS[name].key(namespace),
@@ -302,7 +327,7 @@ class Player:
         }  # fmt: skip
 
     def run(self) -> int:
-        if not self.records:
+        if self.first_ns > self.last_ns:
             self.progress.say("nothing in the window of --start-offset and --duration")
             return 0
         if self.keys is not None:
@@ -326,18 +351,19 @@ class Player:
         pace, clock_ns, sent = self.pace, None, 0
         pace.anchor(self.first_ns, time.monotonic())
         self.progress.show(pace, self.first_ns, sent, changed=True)
-        for record in self.records:
-            if not self.wait_until_due(record.log_time_ns, sent):
-                return sent, True
-            clock_due = clock_ns is None or record.log_time_ns - clock_ns >= CLOCK_PERIOD_NS
-            if self.args.clock and clock_due:
-                clock_ns = record.log_time_ns
-                self.publish("sim/clock", Clock(stamp_ns=clock_ns))
-            self.send(record)
-            sent += 1
-            if pace.paused:
-                pace.anchor(record.log_time_ns, time.monotonic())
-            self.progress.show(pace, record.log_time_ns, sent, changed=pace.paused)
+        for group in self.recording.groups(self.first_ns, self.last_ns):
+            for record in group:
+                if not self.wait_until_due(record.log_time_ns, sent):
+                    return sent, True
+                clock_due = clock_ns is None or record.log_time_ns - clock_ns >= CLOCK_PERIOD_NS
+                if self.args.clock and clock_due:
+                    clock_ns = record.log_time_ns
+                    self.publish("sim/clock", Clock(stamp_ns=clock_ns))
+                self.send(record)
+                sent += 1
+                if pace.paused:
+                    pace.anchor(record.log_time_ns, time.monotonic())
+                self.progress.show(pace, record.log_time_ns, sent, changed=pace.paused)
         return sent, False
 
     def wait_until_due(self, recorded_ns: int, sent: int) -> bool:

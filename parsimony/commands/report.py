@@ -11,7 +11,7 @@ from pathlib import Path
 from parsimony.output import emit
 from parsimony.sessions import load_session
 from profiles.profile import ProfileError, load_profile
-from record.report import write_report
+from record.report import READS, write_report
 from wbc.robot import MobileManipulator
 
 ROBOT = Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"
@@ -41,7 +41,7 @@ def run(args: argparse.Namespace) -> int:
     sessions = []
     try:
         for index, path in enumerate(args.files):
-            session = load_session(path)
+            session = load_session(path, READS)
             sessions.append((label_of(args.labels, index, session, path), session))
         args.out.mkdir(parents=True, exist_ok=True)
         frame = None

@@ -21,8 +21,8 @@ from messages.commands import ArmCommand, BaseCommand
 from messages.diagnostics import ControllerDiagnostics
 from messages.header import Header
 from parsimony.output import emit
-from parsimony.outputs import writable_output
-from record.session_file import SessionWriter, read_session
+from parsimony.outputs import writable_output, written_whole
+from record.session_file import SessionWriter, read_groups
 from wbc.base_motion import unicycle, wheel_speeds
 from wbc.cascade_law import CascadeLaw, CascadeParams
 from wbc.lp_law import LPLaw, LPParams
@@ -56,41 +56,51 @@ def run(args: argparse.Namespace) -> int:
         print(f"rerun: {problem}", file=sys.stderr)
         return 2
     robot = MobileManipulator.from_yaml(args.robot)
-    law = LAWS[args.controller](robot)
-    task, obstacles, last_ns, steps = None, (), None, 0
+    offline = Offline(LAWS[args.controller](robot), args.controller, robot)
     try:
-        records = sorted(read_session(args.file), key=lambda r: (
-            r.log_time_ns, r.topic_name not in BEFORE_STATE))  # fmt: skip
+        with written_whole(args.output) as partial, SessionWriter(partial) as out:
+            for group in read_groups(args.file):  # streamed: memory does not grow with it
+                for record in sorted(group, key=lambda r: r.topic_name not in BEFORE_STATE):
+                    offline.take(out, record)
     except OSError as error:
         print(f"rerun: {error}", file=sys.stderr)
         return 2
-    with SessionWriter(args.output) as out:
-        for record in records:
-            if record.message is None:
-                continue
-            name, key, message = record.topic_name, record.key, record.message
-            if name in OUTPUTS:
-                out.write(f"{key}/recorded", message, record.log_time_ns)
-                continue
-            out.write(key, message, record.log_time_ns)
-            namespace = key[: -len(name) - 1]
-            if name == "control/goal":
-                new = task_of(message)
-                if task is None or not same_task(task, new, MEASUREMENT_TOLERANCE):
-                    law.reset()
-                task = new
-            elif name == "world/obstacles":
-                obstacles = tuple(Circle(c.x, c.y, c.radius) for c in message.circles)
-            elif name == "robot/state" and message.valid and task is not None:
-                stamp = message.header.stamp_ns
-                dt = FIRST_DT_S if last_ns is None else (stamp - last_ns) / 1e9
-                last_ns = stamp
-                output = law.step(np.array(message.configuration()), task,
-                                  min(max(dt, DT_MIN_S), DT_MAX_S), obstacles)  # fmt: skip
-                write_step(out, namespace, args.controller, stamp, output, message, robot)
-                steps += 1
-    emit(f"{steps} steps of the {args.controller} law written to {args.output}")
+    emit(f"{offline.steps} steps of the {args.controller} law written to {args.output}")
     return 0
+
+
+class Offline:
+    """The law run on a recording's messages one by one: each is copied to the output (the
+    recorded commands and diagnostics renamed ``.../recorded``), and each valid state with a
+    goal gets one step of the law, written as its commands and diagnostics."""
+
+    def __init__(self, law, name: str, robot: MobileManipulator) -> None:
+        self.law, self.name, self.robot = law, name, robot
+        self.task, self.obstacles, self.last_ns, self.steps = None, (), None, 0
+
+    def take(self, out: SessionWriter, record) -> None:
+        if record.message is None:
+            return
+        name, key, message = record.topic_name, record.key, record.message
+        if name in OUTPUTS:
+            out.write(f"{key}/recorded", message, record.log_time_ns)
+            return
+        out.write(key, message, record.log_time_ns)
+        if name == "control/goal":
+            new = task_of(message)
+            if self.task is None or not same_task(self.task, new, MEASUREMENT_TOLERANCE):
+                self.law.reset()
+            self.task = new
+        elif name == "world/obstacles":
+            self.obstacles = tuple(Circle(c.x, c.y, c.radius) for c in message.circles)
+        elif name == "robot/state" and message.valid and self.task is not None:
+            stamp = message.header.stamp_ns
+            dt = FIRST_DT_S if self.last_ns is None else (stamp - self.last_ns) / 1e9
+            self.last_ns = stamp
+            output = self.law.step(np.array(message.configuration()), self.task,
+                                   min(max(dt, DT_MIN_S), DT_MAX_S), self.obstacles)  # fmt: skip
+            write_step(out, key[: -len(name) - 1], self.name, stamp, output, message, self.robot)
+            self.steps += 1
 
 
 def write_step(out, namespace: str, law: str, stamp: int, output, state, robot) -> None:

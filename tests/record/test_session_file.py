@@ -8,6 +8,7 @@ import json
 import math
 import random
 import struct
+import tracemalloc
 from pathlib import Path
 
 import numpy as np
@@ -295,3 +296,60 @@ def test_what_the_recorder_lost_is_in_the_file_and_info_shows_it(tmp_path: Path)
     shown = parsimony("info", str(path))
     assert "lost by the recorder: 7 (overflowed.camera/image), 2 (overwritten.sim/clock)" in (
         shown.stdout)
+
+
+def test_chunks_that_overlap_in_time_read_back_in_log_time_order(tmp_path: Path) -> None:
+    """A recorder that falls behind writes late messages into later chunks: the streamed read
+    gives what mcap's own indexed reader gives in log-time order, images put back."""
+    rng = random.Random(7)
+    times = [50_000 + 1_000 * i + rng.randrange(-30_000, 30_000) for i in range(600)]  # unordered
+    path = tmp_path / "session.mcap"
+    with SessionWriter(path, chunk_size=4_000) as writer:  # many small chunks
+        for log_time in times:
+            writer.write(topics.ROBOT_STATE.key(NAMESPACE), state(log_time), log_time)
+            if log_time % 7 == 0:
+                writer.write(topics.CAMERA_IMAGE.key(NAMESPACE), image(log_time), views=True)
+    with path.open("rb") as stream:
+        indexed = [(c.topic, m.log_time) for _, c, m in
+                   make_reader(stream).iter_messages(log_time_order=True)]  # fmt: skip
+    streamed = list(read_session(path))
+    assert [(r.key, r.log_time_ns) for r in streamed] == indexed
+    assert [r.message.header.stamp_ns for r in streamed if r.message is not None] == sorted(
+        times + [t for t in times if t % 7 == 0])
+
+
+def test_only_the_topics_asked_for_are_read(tmp_path: Path) -> None:
+    path = tmp_path / "session.mcap"
+    with SessionWriter(path) as writer:
+        for stamp in range(1, 20):
+            writer.write(topics.ROBOT_STATE.key(NAMESPACE), state(stamp))
+            writer.write(topics.CAMERA_IMAGE.key(NAMESPACE), image(stamp), views=True)
+    only = list(read_session(path, only={topics.ROBOT_STATE.name}))
+    assert [r.topic_name for r in only] == [topics.ROBOT_STATE.name] * 19
+    frames = [r.message for r in read_session(path, only={topics.CAMERA_IMAGE.name})]
+    assert frames == [image(stamp) for stamp in range(1, 20)]  # still put back from the views
+
+
+def peak_read_bytes(path: Path) -> int:
+    """The most memory Python held at once while reading every message of ``path``."""
+    tracemalloc.start()
+    try:
+        for _ in read_session(path):
+            pass
+        return tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+
+
+def test_reading_holds_the_same_memory_whatever_the_length_of_the_file(tmp_path: Path) -> None:
+    """A session four times as long (images and states, many chunks) is read holding no more
+    memory than a short one: the read is streamed, not gathered and sorted."""
+    peaks = []
+    for frames in (60, 240):
+        path = tmp_path / f"{frames}.mcap"
+        with SessionWriter(path, chunk_size=64 * 1024) as writer:
+            for stamp in range(1, frames + 1):
+                writer.write(topics.CAMERA_IMAGE.key(NAMESPACE), image(stamp * 1_000), views=True)
+                writer.write(topics.ROBOT_STATE.key(NAMESPACE), state(stamp * 1_000))
+        peaks.append(peak_read_bytes(path))
+    assert peaks[1] < 1.3 * peaks[0], peaks  # held in full, it would be 4 times
