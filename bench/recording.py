@@ -17,8 +17,13 @@ loopback port and runs the real commands as processes:
 3. ``parsimony report``'s work (``load_session``, ``write_report``) on that recording repeated
    to span 60 s (``repeated_session``): median and each of 3 runs.
 
+4. Memory: the recording repeated to span each of ``MEMORY_SPANS`` (s), and ``parsimony
+   info``, ``report``, ``rerun`` and ``replay --rate 64`` run on each as processes: the peak
+   resident memory of each (``ru_maxrss``, MB), and its ratio longest to shortest. A command
+   that streams the file stays near 1 however long the session.
+
 ``--quick`` (under a minute): 1.5 s floods, the experiment cut at 3 s, one report of its
-recording as it is. Prints tables, or ``--json``; progress goes to stderr.
+recording as it is, memory on spans of 5 and 20 s. Prints tables, or ``--json``; progress goes to stderr.
 """
 
 from __future__ import annotations
@@ -84,10 +89,15 @@ class Settings:
     experiment_s: float
     report_s: float | None
     report_runs: int
+    memory_spans_s: tuple[float, ...]
 
 
-FULL = Settings(flood_s=10.0, experiment_s=TIME_LIMIT_S, report_s=60.0, report_runs=3)
-QUICK = Settings(flood_s=1.5, experiment_s=3.0, report_s=None, report_runs=1)
+FULL = Settings(flood_s=10.0, experiment_s=TIME_LIMIT_S, report_s=60.0, report_runs=3,
+                memory_spans_s=(30.0, 120.0))  # fmt: skip
+QUICK = Settings(flood_s=1.5, experiment_s=3.0, report_s=None, report_runs=1,
+                 memory_spans_s=(5.0, 20.0))  # fmt: skip
+MEMORY_REPLAY_RATE = 64.0
+"""The rate of the replays whose memory is measured (their timing is part 2's)."""
 
 
 def progress(text: str) -> None:
@@ -356,6 +366,58 @@ def report_time(session_file: Path, experiment: Path, runs: int, directory: Path
             "runs_s": totals, "load_s": loads, "figures_s": draws}  # fmt: skip
 
 
+PEAK_MEMORY = """\
+import os, sys
+pid = os.fork()
+if pid == 0:
+    os.execv(sys.executable, [sys.executable, *sys.argv[2:]])
+_, status, usage = os.wait4(pid, 0)
+with open(sys.argv[1], "w") as out:
+    out.write(str(usage.ru_maxrss))
+sys.exit(os.waitstatus_to_exitcode(status))
+"""
+"""A small parent that runs a command and writes its peak resident memory (KiB): a process's
+``ru_maxrss`` counts the one it was forked from, so this bench's own memory would count in a
+child it forked itself."""
+
+
+def peak_memory_mb(arguments: Sequence[str], directory: Path) -> float:
+    """``parsimony ARGUMENTS`` as a process: its peak resident memory, MB (it must exit 0)."""
+    peak = directory / "peak_kib"
+    command = [sys.executable, "-c", PEAK_MEMORY, str(peak), "-m", "parsimony.cli", *arguments]
+    done = subprocess.run(command, stdout=subprocess.DEVNULL)
+    if done.returncode != 0:
+        raise RuntimeError(f"parsimony {' '.join(arguments)} failed (exit {done.returncode})")
+    return round(int(peak.read_text()) / 1024, 1)
+
+
+def memory_use(recorded: Path, spans_s: Sequence[float], profile: Path,
+               directory: Path) -> list[dict]:  # fmt: skip
+    """Peak memory of the commands that read a whole file, on the recording repeated to span
+    each of ``spans_s``; then each command's ratio of the longest span's to the shortest's."""
+    rows = []
+    for span in spans_s:
+        session = directory / f"span{span:g}.mcap"
+        progress(f"memory: a {span:g} s session")
+        repeated_session(recorded, session, span)
+        out = directory / f"memory{span:g}"
+        commands = {
+            "info": ["info", str(session)],
+            "report": ["report", str(session), "--out", str(out)],
+            "rerun": ["rerun", str(session), "--controller", "lp", "-o", str(out / "rerun.mcap")],
+            "replay": ["replay", str(session), "--profile", str(profile),
+                       "--rate", f"{MEMORY_REPLAY_RATE:g}"],
+        }  # fmt: skip
+        row = {"session_s": span, "file_MB": round(session.stat().st_size / 1e6, 1)}
+        row |= {f"{name}_MB": peak_memory_mb(arguments, directory) for name, arguments in commands.items()}
+        rows.append(row)
+        session.unlink()
+    rows.append({"session_s": "ratio", "file_MB": round(rows[-1]["file_MB"] / rows[0]["file_MB"], 2),
+                 **{k: round(rows[-1][k] / rows[0][k], 2) for k in rows[0]
+                    if k.endswith("_MB") and k != "file_MB"}})  # fmt: skip
+    return rows
+
+
 def bench_profile(directory: Path, zenoh_settings: ZenohSettings) -> Path:
     """The profile ``parsimony record`` and ``replay`` are given: the bench's namespace and
     router (its one component is never run)."""
@@ -387,6 +449,7 @@ def run(settings: Settings, directory: Path) -> dict:
         recorded = experiment / SESSION_FILE
         for rate in REPLAY_RATES:
             report["replay"].append(replay_timing(recorded, rate, profile, router))
+        report["memory"] = memory_use(recorded, settings.memory_spans_s, profile, directory)
     session = recorded
     if settings.report_s is not None:
         session = directory / "one_minute.mcap"
@@ -416,6 +479,9 @@ def main(argv: list[str] | None = None) -> int:
     emit(format_table(report["replay"]))
     emit("")
     emit(format_table([report["report"]]))
+    emit("")
+    emit("peak resident memory of each command, MB")
+    emit(format_table(report["memory"]))
     return 0
 
 
