@@ -23,7 +23,8 @@ loopback port and runs the real commands as processes:
    that streams the file stays near 1 however long the session.
 
 ``--quick`` (under a minute): 1.5 s floods, the experiment cut at 3 s, one report of its
-recording as it is, memory on spans of 5 and 20 s. Prints tables, or ``--json``; progress goes to stderr.
+recording as it is, memory on spans of 5 and 20 s. Prints tables, or ``--json``; progress
+goes to stderr.
 """
 
 from __future__ import annotations
@@ -409,12 +410,13 @@ def memory_use(recorded: Path, spans_s: Sequence[float], profile: Path,
                        "--rate", f"{MEMORY_REPLAY_RATE:g}"],
         }  # fmt: skip
         row = {"session_s": span, "file_MB": round(session.stat().st_size / 1e6, 1)}
-        row |= {f"{name}_MB": peak_memory_mb(arguments, directory) for name, arguments in commands.items()}
+        row |= {f"{name}_MB": peak_memory_mb(arguments, directory)
+                for name, arguments in commands.items()}  # fmt: skip
         rows.append(row)
         session.unlink()
-    rows.append({"session_s": "ratio", "file_MB": round(rows[-1]["file_MB"] / rows[0]["file_MB"], 2),
-                 **{k: round(rows[-1][k] / rows[0][k], 2) for k in rows[0]
-                    if k.endswith("_MB") and k != "file_MB"}})  # fmt: skip
+    first, last = rows[0], rows[-1]
+    rows.append({"session_s": "ratio", **{k: round(last[k] / first[k], 2)
+                                          for k in first if k.endswith("_MB")}})  # fmt: skip
     return rows
 
 
