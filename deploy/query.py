@@ -29,6 +29,10 @@ class QueryError(Exception):
     """A question the running system did not or could not answer."""
 
 
+class NoRouter(QueryError):
+    """The router of a target cannot be reached: there is no running system to ask."""
+
+
 @dataclass(frozen=True)
 class Target:
     """A namespace and how to reach the router that serves it."""
@@ -55,7 +59,7 @@ class Target:
         except zenoh.ZError as error:
             where = ", ".join(self.zenoh.connect_endpoints)
             reason = zenoh_error_text(error)
-            raise QueryError(f"cannot reach a router at {where}: {reason}") from error
+            raise NoRouter(f"cannot reach a router at {where}: {reason}") from error
 
 
 def live_components(

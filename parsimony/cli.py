@@ -11,6 +11,7 @@ from mcap.exceptions import McapError
 
 from deploy.query import QueryError
 from parsimony.output import result_only_stdout
+from parsimony.target_options import exit_code
 
 COMMANDS = (
     "demo", "experiment", "bench", "launch", "status", "param", "node", "topic", "graph", "schema",
@@ -34,7 +35,8 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Run one command. A file it cannot read or write, a file that is not what it should be
-    (``McapError``) and a router it cannot reach end it with one line and exit 2, never a
+    (``McapError``) and a router it cannot reach end it with one line and exit 2, a question
+    the running system did not answer with exit 1 (``target_options.exit_code``), never a
     traceback; a reader of its output that went away (``| head``) ends it quietly."""
     words = sys.argv[1:] if argv is None else argv
     chosen = next((word for word in words if not word.startswith("-")), None)
@@ -47,7 +49,7 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     except (OSError, McapError, QueryError) as error:
         print(f"parsimony {args.command}: {error}", file=sys.stderr)
-        return 2
+        return exit_code(error)
 
 
 if __name__ == "__main__":

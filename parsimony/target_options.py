@@ -6,7 +6,7 @@ import argparse
 import os
 import sys
 
-from deploy.query import DEFAULT_TIMEOUT_S, Target
+from deploy.query import DEFAULT_TIMEOUT_S, NoRouter, QueryError, Target
 from profiles.profile import Profile, ProfileError, load_profile
 
 PROFILE_ENV = "PARSIMONY_PROFILE"
@@ -34,6 +34,21 @@ def profile_and_target(args: argparse.Namespace) -> tuple[Profile, Target]:
     return profile, Target(profile.namespace, profile.zenoh)
 
 
+EXIT_REFUSED = 1
+"""The running system did not answer, or refused what was asked."""
+EXIT_BAD_INPUT = 2
+"""What the command was given cannot be used: an argument, a profile, a file, or a router
+that is not there."""
+
+
+def exit_code(error: Exception) -> int:
+    """``EXIT_REFUSED`` for a question the running system did not answer or refused, else
+    ``EXIT_BAD_INPUT``."""
+    refused = isinstance(error, QueryError) and not isinstance(error, NoRouter)
+    return EXIT_REFUSED if refused else EXIT_BAD_INPUT
+
+
 def fail(error: Exception) -> int:
+    """Say ``error`` in one line; its exit code (``exit_code``)."""
     print(error, file=sys.stderr)
-    return 1
+    return exit_code(error)

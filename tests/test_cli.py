@@ -108,12 +108,12 @@ def test_launch_refuses_a_duration_that_is_not_a_positive_number_of_seconds(dura
 
 def test_status_of_a_misspelt_profile_says_the_file_does_not_exist():
     result = run_cli("status", "deploy/controlers.yaml")
-    assert result.returncode == 1
+    assert result.returncode == 2
     assert "deploy/controlers.yaml: no such profile file" in result.stderr
 
 
 def test_zenoh_errors_reach_the_user_as_one_readable_line():
     result = run_cli("status", "test", "--router", "tcp/127.0.0.1:1", "--timeout", "0.5")
-    assert result.returncode == 1
+    assert result.returncode == 2
     assert "cannot reach a router at tcp/127.0.0.1:1" in result.stderr
     assert ".rs:" not in result.stderr and len(result.stderr.strip().splitlines()) == 1

@@ -4,6 +4,7 @@ existing file is written over."""
 
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import sys
@@ -34,13 +35,17 @@ def system_profile(tmp_path: Path) -> Path:
 
 @pytest.mark.parametrize("how", [signal.SIGKILL, signal.SIGTERM, signal.SIGINT])
 def test_the_recorder_stops_with_the_record_command(tmp_path: Path, how: signal.Signals) -> None:
-    """However `parsimony record` ends (kill -9 too), its recorder stops; on SIGINT or
-    SIGTERM the command passes the signal on and the file gets its footer."""
+    """However `parsimony record` ends (kill -9 too), its recorder stops and nothing is left
+    in the temporary directory; on SIGINT or SIGTERM the command passes the signal on and the
+    file gets its footer."""
     profile = system_profile(tmp_path)
     out = tmp_path / "k.mcap"
+    temporary = tmp_path / "tmp"
+    temporary.mkdir()
     with launched(profile) as launcher, connect(load_profile(profile), launcher) as session:
         command = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "record",
-                                    str(profile), "-o", str(out)])  # fmt: skip
+                                    str(profile), "-o", str(out)],
+                                   env={**os.environ, "TMPDIR": str(temporary)})  # fmt: skip
         while "recorder" not in live_components(session, "rec", 0.5):
             assert command.poll() is None
         while not out.exists() or info(out)["messages"] < 50:
@@ -50,6 +55,7 @@ def test_the_recorder_stops_with_the_record_command(tmp_path: Path, how: signal.
         command.wait()
         while not process_gone(child):
             time.sleep(0.1)  # the recorder goes too (the test fails by hanging if not)
+    assert list(temporary.iterdir()) == []
     if how != signal.SIGKILL:
         assert command.returncode == 0
         assert info(out)["complete"], "the recorder wrote its footer"

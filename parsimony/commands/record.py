@@ -11,7 +11,6 @@ import os
 import signal
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 import yaml
@@ -58,26 +57,28 @@ def run(args: argparse.Namespace) -> int:
     except (ProfileError, QueryError) as error:
         print(f"record: {error}", file=sys.stderr)
         return 2
-    with tempfile.TemporaryDirectory() as directory:
-        profile = Path(directory) / "record.yaml"
-        params = {"path": str(args.output.resolve()), "keys": ",".join(args.keys)}
-        profile.write_text(yaml.safe_dump({
-            "extends": str(args.profile.resolve()),
-            "components": [{"name": "recorder", "module": "recorder", "role": "recorder",
-                            "stop_timeout_s": RECORDER_STOP_S, "params": params,
-                            "restart": {"policy": "never"}}],
-        }))  # fmt: skip
-        return record(profile)
+    params = {"path": str(args.output.resolve()), "keys": ",".join(args.keys)}
+    return record(yaml.safe_dump({
+        "extends": str(args.profile.resolve()),
+        "components": [{"name": "recorder", "module": "recorder", "role": "recorder",
+                        "stop_timeout_s": RECORDER_STOP_S, "params": params,
+                        "restart": {"policy": "never"}}],
+    }))  # fmt: skip
 
 
-def record(profile: Path) -> int:
-    """Run the recorder until it stops; SIGINT and SIGTERM are passed on to it (it writes all
-    that waits, then its footer), and it stops by itself if this process dies (it watches its
-    parent, ``LAUNCHER_PID_ENV``)."""
-    command = [sys.executable, "-m", "components.recorder", "--profile", str(profile),
-               "--name", "recorder"]  # fmt: skip
+def record(profile: str) -> int:
+    """Run the recorder of ``profile`` (YAML text) until it stops; SIGINT and SIGTERM are
+    passed on to it (it writes all that waits, then its footer), and it stops by itself if
+    this process dies (it watches its parent, ``LAUNCHER_PID_ENV``). The profile is a file in
+    memory (``memfd_create``) the child inherits, so nothing is left behind whatever kills
+    this process."""
+    descriptor = os.memfd_create("record.yaml")
+    os.write(descriptor, profile.encode())
+    command = [sys.executable, "-m", "components.recorder", "--profile",
+               f"/proc/self/fd/{descriptor}", "--name", "recorder"]  # fmt: skip
     env = {**os.environ, LAUNCHER_PID_ENV: str(os.getpid())}
-    process = subprocess.Popen(command, env=env, start_new_session=True)
+    process = subprocess.Popen(command, env=env, start_new_session=True, pass_fds=(descriptor,))
+    os.close(descriptor)
 
     def pass_on(signum: int, _frame: object) -> None:
         process.send_signal(signal.SIGTERM)

@@ -17,6 +17,7 @@ from deploy.query import (
 )
 from messages.status import ComponentStatus
 from parsimony.output import emit
+from parsimony.target_options import fail
 from profiles.profile import ProfileError
 
 COLUMNS = ("NAME", "MODULE", "STATE", "PID", "COUNTERS (non-zero)")
@@ -53,7 +54,7 @@ def target_of(args: argparse.Namespace) -> Target:
     if Path(args.target).is_file():
         return Target.from_profile(args.target)
     if Path(args.target).suffix:
-        raise QueryError(f"{args.target}: no such profile file (a namespace has no '.')")
+        raise ProfileError(f"{args.target}: no such profile file (a namespace has no '.')")
     return Target.from_namespace(args.target, args.router)
 
 
@@ -65,8 +66,7 @@ def run(args: argparse.Namespace) -> int:
             names = live_components(session, target.namespace, args.timeout)
             found = statuses(session, target.namespace, args.timeout) if names else {}
     except (ProfileError, QueryError, ValueError) as error:
-        print(error, file=sys.stderr)
-        return 1
+        return fail(error)
     if args.json:
         rows = [
             {"name": name, "status": found[name].model_dump(mode="json") if name in found else None}

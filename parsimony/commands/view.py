@@ -12,6 +12,7 @@ from pathlib import Path
 
 from components.rate_limited_log import RateLimitedLog
 from deploy.query import QueryError, Target
+from parsimony.target_options import exit_code
 from profiles.profile import ProfileError
 from record.live_view import DEFAULT_PORT, LiveView, topics_matching
 
@@ -64,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
                   file=sys.stderr)  # fmt: skip
     except (QueryError, OSError) as error:
         print(f"view: {error}", file=sys.stderr)
-        return 1
+        return exit_code(error)
     except KeyboardInterrupt:
         pass  # before the server was up
     finally:

@@ -68,7 +68,7 @@ def test_status_of_an_empty_namespace_or_a_remote_router_fails(
     router = status.target_of(argparse.Namespace(profile=running_pub, target=None)).zenoh.router[0]
     assert command(status, "status", "nobody", "--router", router, "--timeout", "0.5") == 1
     assert "no live component in namespace 'nobody'" in capsys.readouterr().err
-    assert command(status, "status", "test", "--router", "tcp/10.1.2.3:7447") == 1
+    assert command(status, "status", "test", "--router", "tcp/10.1.2.3:7447") == 2
     assert "not on the loopback interface" in capsys.readouterr().err
 
 
@@ -151,7 +151,7 @@ def test_topic_list_info_and_pub(running_pub: Path) -> None:
             assert time.monotonic() < deadline, "the published message did not arrive"
             time.sleep(0.01)
     bad = cli("topic", "pub", "control/goal", '{"task": "pose"}', "--profile", str(running_pub))
-    assert bad.returncode == 1 and "a pose task needs a pose" in bad.stderr
+    assert bad.returncode == 2 and "a pose task needs a pose" in bad.stderr
 
 
 def test_param_list_describe_dump_and_load(running_pub: Path, tmp_path: Path) -> None:
