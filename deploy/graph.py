@@ -3,7 +3,9 @@
 Every enabled component's module is imported and its ``Component`` subclass asked for
 ``reads`` and ``writes`` (``components.runtime.Component``); a component on simulated time
 also reads ``sim/clock`` (``Profile.clock_of``); a profile's ``remap`` renames what a
-component reads and writes (``ComponentSpec.topic``). Nothing is started.
+component reads and writes (``ComponentSpec.topic``); its ``params`` are checked against what
+the class declares (names, types, bounds, choices), so a value no component could take is
+refused before anything starts. Nothing is started.
 """
 
 from __future__ import annotations
@@ -11,11 +13,13 @@ from __future__ import annotations
 import importlib
 import inspect
 from dataclasses import dataclass
+from pathlib import Path
 
+from components.params import ParamError, Parameters
 from components.pubsub import Input
 from components.runtime import Component
 from messages import topics
-from profiles.profile import ComponentSpec, Profile
+from profiles.profile import ComponentSpec, Profile, ProfileError
 
 
 @dataclass(frozen=True)
@@ -119,11 +123,18 @@ def component_class(spec: ComponentSpec) -> type[Component]:
     return found[0]
 
 
-def dataflow(profile: Profile) -> Dataflow:
-    """The graph of the profile's enabled components."""
+def dataflow(profile: Profile, path: Path | str = "profile") -> Dataflow:
+    """The graph of the profile's enabled components; ``ProfileError`` naming ``path`` and the
+    field for a parameter the component would refuse."""
     nodes = []
     for spec in profile.start_order():
         cls = component_class(spec)
+        try:
+            Parameters(cls.params, spec.params)
+        except ParamError as error:
+            index = profile.components.index(spec)
+            raise ProfileError(f"{path}: invalid profile\n  components[{index}] ({spec.name})"
+                               f".params.{error}") from None  # fmt: skip
         reads = tuple(Input(spec.topic(i.topic), i.queue) for i in cls.reads)
         if profile.clock_of(spec, topics.SIM_CLOCK in cls.writes) == "sim":
             reads += (Input(topics.SIM_CLOCK),)

@@ -14,7 +14,8 @@ characters ``* $ # ?``. Invalid names raise ``KeyExpressionError``.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import fnmatch
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Generic, TypeVar
@@ -228,3 +229,17 @@ def _check_path(path: str, what: str) -> str:
             f"{what} {path!r} must not contain the wildcard characters {' '.join(forbidden)}"
         )
     return path
+
+
+def topics_matching(patterns: Sequence[str]) -> list[Topic]:
+    """The topics whose names match one of the ``fnmatch`` patterns; ``ValueError`` when there
+    is no pattern, or one matches no topic (a typo beside good patterns too)."""
+    if not patterns:
+        raise ValueError(f"keys: give at least one topic name pattern (the topics: "
+                         f"{', '.join(TOPICS)})")  # fmt: skip
+    for pattern in patterns:
+        if not fnmatch.filter(TOPICS, pattern):
+            raise ValueError(f"keys: {pattern!r} matches no topic (the topics: "
+                             f"{', '.join(TOPICS)})")  # fmt: skip
+    return [topic for topic in TOPICS.values()
+            if any(fnmatch.fnmatch(topic.name, pattern) for pattern in patterns)]  # fmt: skip

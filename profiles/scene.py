@@ -101,13 +101,20 @@ class Scene(_Strict):
 
     @model_validator(mode="after")
     def _ids_unique(self) -> Scene:
-        """Each marker id once; the error names the later of two markers that share one."""
+        """Each marker id once and in the dictionary; the error names the marker (the later of
+        two that share an id)."""
+        import cv2
+
+        size = cv2.aruco.getPredefinedDictionary(self.dictionary_id).bytesList.shape[0]
         fields = [("reference.id", self.reference.id), ("base.id", self.base.id),
                   ("goal.id", self.goal.id)]  # fmt: skip
         fields += [(f"obstacles.ids[{i}]", marker_id) for i, marker_id in
                    enumerate(self.obstacles.ids)]  # fmt: skip
         seen: dict[int, str] = {}
         for field, marker_id in fields:
+            if not 0 <= marker_id < size:
+                raise ValueError(f"{field}: marker id {marker_id} is not in {self.dictionary} "
+                                 f"(ids 0 to {size - 1})")  # fmt: skip
             if marker_id in seen:
                 raise ValueError(f"{field}: marker id {marker_id} is already {seen[marker_id]}")
             seen[marker_id] = field

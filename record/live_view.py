@@ -13,7 +13,6 @@ few seconds).
 
 from __future__ import annotations
 
-import fnmatch
 import logging
 import threading
 from collections.abc import Callable, Sequence
@@ -31,16 +30,6 @@ DEFAULT_PORT = 8765
 """Foxglove's usual WebSocket port."""
 
 log = logging.getLogger(__name__)
-
-
-def topics_matching(patterns: Sequence[str]) -> list[topics.Topic]:
-    """The topics whose names match one of the ``fnmatch`` patterns; ``ValueError`` if none."""
-    chosen = [topic for topic in topics.TOPICS.values()
-              if any(fnmatch.fnmatch(topic.name, pattern) for pattern in patterns)]  # fmt: skip
-    if not chosen:
-        raise ValueError(f"keys: {' '.join(patterns)} matches no topic (the topics: "
-                         f"{', '.join(topics.TOPICS)})")  # fmt: skip
-    return chosen
 
 
 class LiveView:

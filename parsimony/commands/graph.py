@@ -32,7 +32,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
 
 def run(args: argparse.Namespace) -> int:
     try:
-        graph = dataflow(load_profile(args.profile))
+        graph = dataflow(load_profile(args.profile), args.profile)
     except (ProfileError, LookupError) as error:
         print(error, file=sys.stderr)
         return 2

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import zenoh
@@ -17,15 +18,26 @@ from profiles.profile import ProfileError, load_profile
 EXIT_INVALID_PROFILE = 2
 
 
-def positive_seconds(text: str) -> float:
-    """A duration: a finite number of seconds > 0 (``nan``, ``inf`` and ``-1`` are refused)."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected seconds, got {text!r}") from None
-    if not math.isfinite(value) or value <= 0.0:
-        raise argparse.ArgumentTypeError(f"expected a finite number of seconds > 0, got {text!r}")
-    return value
+def positive(what: str) -> Callable[[str], float]:
+    """An argument type: a finite number > 0 of ``what`` (``nan``, ``inf`` and ``-1`` are
+    refused, saying what was expected)."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}") from None
+        if not math.isfinite(value) or value <= 0.0:
+            raise argparse.ArgumentTypeError(f"expected a finite number of {what} > 0, "
+                                             f"got {text!r}")  # fmt: skip
+        return value
+
+    parse.__name__ = what  # argparse names the type in its own messages
+    return parse
+
+
+positive_seconds = positive("seconds")
+"""A duration in seconds."""
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -48,7 +60,7 @@ def run(args: argparse.Namespace) -> int:
     """Validate the profile, then launch it until stopped."""
     try:
         profile = load_profile(args.profile)
-        graph = dataflow(profile)
+        graph = dataflow(profile, args.profile)
     except (ProfileError, LookupError) as error:
         print(error, file=sys.stderr)
         return EXIT_INVALID_PROFILE

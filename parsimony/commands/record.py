@@ -17,6 +17,7 @@ import yaml
 
 from deploy.query import QueryError, Target
 from messages.process import LAUNCHER_PID_ENV
+from messages.topics import topics_matching
 from parsimony.experiment import RECORDER_STOP_S
 from parsimony.output import emit
 from parsimony.outputs import writable_output, written_whole
@@ -51,6 +52,11 @@ def run(args: argparse.Namespace) -> int:
         return 0
     if args.profile is None:
         print("record: a profile, or --recover FILE", file=sys.stderr)
+        return 2
+    try:
+        topics_matching(args.keys)
+    except ValueError as error:
+        print(f"record: {error}", file=sys.stderr)
         return 2
     try:
         Target.from_profile(args.profile).open().close()  # the router must be there

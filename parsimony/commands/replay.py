@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import fnmatch
+import math
 import sys
 import threading
 import time
@@ -35,7 +36,7 @@ from deploy.graph import component_class
 from deploy.query import QueryError, live_components
 from messages import codec, topics
 from messages.clock import Clock
-from parsimony.commands.launch import positive_seconds
+from parsimony.commands.launch import positive, positive_seconds
 from parsimony.replay_keys import QUIT, RIGHT, KeyReader, terminal_keys
 from parsimony.target_options import fail, profile_and_target, target_options
 from profiles.profile import Profile, ProfileError
@@ -74,13 +75,15 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         description=__doc__.split("\n\n")[1],
     )  # fmt: skip
     parser.add_argument("file", type=Path, help="MCAP session")
-    parser.add_argument("--rate", type=positive_seconds, default=1.0, help="speed factor")
+    parser.add_argument("--rate", type=positive("times the recorded speed"), default=1.0,
+                        help="speed factor")  # fmt: skip
     parser.add_argument("--loop", action="store_true", help="start again at the end")
     parser.add_argument("--start-offset", type=float, default=0.0, metavar="S")
     parser.add_argument("--duration", type=positive_seconds, metavar="S")
     parser.add_argument("--keys", nargs="*", default=["*"], help="topic name patterns to send")
     parser.add_argument("--exclude", nargs="*", default=[], help="topic name patterns to skip")
-    parser.add_argument("--namespace", help="publish under this namespace instead")
+    parser.add_argument("--namespace", type=namespace_argument,
+                        help="publish under this namespace instead")  # fmt: skip
     parser.add_argument("--sensors", action="store_true", help="only " + ", ".join(SENSORS))
     parser.add_argument("--clock", action="store_true", help="publish sim/clock as recorded")
     parser.add_argument("--lockstep", action="store_true",
@@ -90,6 +93,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("--into-live", action="store_true",
                         help="send commands, and topics live components publish")  # fmt: skip
     return parser
+
+
+def namespace_argument(text: str) -> str:
+    """A namespace a key can start with (``topics.check_namespace``), else an argument error."""
+    try:
+        return topics.check_namespace(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
 
 
 def wanted(args: argparse.Namespace, name: str) -> bool:
@@ -106,22 +117,27 @@ def sending_rank(topic_name: str) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
-    try:
+    try:  # what was asked is checked before the router is reached
         profile, target = profile_and_target(args)
+        if not math.isfinite(args.start_offset) or args.start_offset < 0:
+            raise ValueError(f"--start-offset: expected seconds >= 0, got {args.start_offset}")
+        topics.topics_matching(args.keys)
+        recorded = Recording.of(args)
+        if not recorded.names:
+            raise ValueError(f"{args.file}: nothing to replay (--keys, --exclude, --sensors)")
+        first, last = recorded.window(args.start_offset, args.duration)
+        if first > last:
+            raise ValueError(f"{args.file}: nothing in the window of --start-offset and "
+                             f"--duration (the recording spans "
+                             f"{(recorded.end_ns - recorded.start_ns) / 1e9:.2f} s)")  # fmt: skip
+        if args.lockstep and ANSWERING.keys() & recorded.names:
+            raise ValueError(f"--lockstep: the replay would answer itself; leave out "
+                             f"{', '.join(ANSWERING)} (or use --sensors)")  # fmt: skip
         session = target.open()
-    except (ProfileError, QueryError) as error:
+    except (ProfileError, QueryError, OSError, ValueError) as error:
+        print("replay: ", end="", file=sys.stderr)
         return fail(error)
     namespace = args.namespace or profile.namespace
-    try:
-        topics.check_namespace(namespace)
-        recorded = Recording.of(args)
-    except (OSError, ValueError) as error:
-        session.close()
-        print(f"replay: {error}", file=sys.stderr)
-        return 2
-    if not recorded.names:
-        session.close()
-        return fail(ValueError(f"{args.file}: nothing to replay"))
     conflicts = [] if args.into_live else live_conflicts(
         session, profile, namespace, recorded.names)  # fmt: skip
     if conflicts:
@@ -130,10 +146,6 @@ def run(args: argparse.Namespace) -> int:
               "(--namespace), leave those topics out (--exclude, --sensors), or say "
               "--into-live", file=sys.stderr)  # fmt: skip
         return 2
-    if args.lockstep and ANSWERING.keys() & recorded.names:
-        session.close()
-        return fail(ValueError(f"--lockstep: the replay would answer itself; leave out "
-                               f"{', '.join(ANSWERING)} (or use --sensors)"))  # fmt: skip
     try:
         with session, terminal_keys() as keys:
             return Player(args, session, namespace, recorded, keys).run()
@@ -183,6 +195,13 @@ class Recording:
         return cls(args.file, frozenset(c["topic"] for c in channels),
                    min((c["start_ns"] for c in channels), default=0),
                    max((c["end_ns"] for c in channels), default=0))  # fmt: skip
+
+    def window(self, start_offset_s: float, duration_s: float | None) -> tuple[int, int]:
+        """The log times replayed: from ``start_offset_s`` after the first message, for
+        ``duration_s`` (None: to the end), never past the last message."""
+        first = self.start_ns + round(start_offset_s * 1e9)
+        last = first + round(duration_s * 1e9) if duration_s else self.end_ns
+        return first, min(last, self.end_ns)
 
     def groups(self, first_ns: int, last_ns: int) -> Iterator[list[Recorded]]:
         """The messages of each log time in [first_ns, last_ns], ``SENSORS`` first."""
@@ -312,11 +331,9 @@ class Player:
     def __init__(self, args: argparse.Namespace, session: zenoh.Session, namespace: str,
                  recording: Recording, keys: KeyReader | None) -> None:  # fmt: skip
         self.args, self.keys, self.recording = args, keys, recording
-        first = recording.start_ns + round(args.start_offset * 1e9)
-        last = first + round(args.duration * 1e9) if args.duration else recording.end_ns
-        self.first_ns, self.last_ns = first, min(last, recording.end_ns)
-        self.progress = Progress(first, max(0, self.last_ns - first))
-        self.pace = Pace(args.rate, first, time.monotonic(), paused=args.start_paused)
+        self.first_ns, self.last_ns = recording.window(args.start_offset, args.duration)
+        self.progress = Progress(self.first_ns, self.last_ns - self.first_ns)
+        self.pace = Pace(args.rate, self.first_ns, time.monotonic(), paused=args.start_paused)
         self.answers = Answers(session, namespace) if args.lockstep else None
         names = recording.names | ({"sim/clock"} if args.clock else set())
         block = zenoh.CongestionControl.BLOCK  # a replay waits rather than drop a sample
@@ -327,9 +344,6 @@ class Player:
         }  # fmt: skip
 
     def run(self) -> int:
-        if self.first_ns > self.last_ns:
-            self.progress.say("nothing in the window of --start-offset and --duration")
-            return 0
         if self.keys is not None:
             self.progress.say(KEYS_HELP)
         elif self.args.start_paused:

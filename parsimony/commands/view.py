@@ -12,9 +12,10 @@ from pathlib import Path
 
 from components.rate_limited_log import RateLimitedLog
 from deploy.query import QueryError, Target
+from messages.topics import topics_matching
 from parsimony.target_options import exit_code
 from profiles.profile import ProfileError
-from record.live_view import DEFAULT_PORT, LiveView, topics_matching
+from record.live_view import DEFAULT_PORT, LiveView
 
 
 def port_number(text: str) -> int:

@@ -12,7 +12,7 @@ import pytest
 
 from deploy.graph import dataflow
 from parsimony.kinematic_demo import SUPERVISED_PARAMS
-from profiles.profile import load_profile
+from profiles.profile import ProfileError, load_profile
 from wbc.lp_law import LPParams
 
 DEPLOY = Path(__file__).resolve().parents[2] / "deploy"
@@ -99,3 +99,20 @@ def test_the_supervised_profile_gives_the_controller_the_gains_of_the_kinematic_
               if getattr(SUPERVISED_PARAMS, f.name) != getattr(LPParams(), f.name)}  # fmt: skip
     controller = load_profile(DEPLOY / "sim_supervised.yaml").component("controller")
     assert {k: v for k, v in controller.params.items() if k in wanted} == wanted
+
+
+def test_a_parameter_no_component_would_take_is_refused_before_anything_starts(
+    tmp_path: Path,
+) -> None:
+    """`graph` and `launch` name the file and the field, exit 2; nothing is launched."""
+    path = tmp_path / "profile.yaml"
+    path.write_text(f"extends: {DEPLOY / 'sim.yaml'}\n"
+                    "components: [{name: simulator, params: {real_time_factor: -1}}]\n")
+    with pytest.raises(ProfileError, match=r"components\[0\] \(simulator\)\.params\."
+                                           r"real_time_factor: expected a float in \[0.0"):
+        dataflow(load_profile(path), path)
+    for command in ("graph", "launch"):
+        done = subprocess.run([sys.executable, "-m", "parsimony.cli", command, str(path)],
+                              capture_output=True, text=True)  # fmt: skip
+        assert done.returncode == 2 and f"{path}: invalid profile" in done.stderr, done.stderr
+        assert "[launch]" not in done.stderr  # refused before a component was started

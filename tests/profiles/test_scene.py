@@ -83,6 +83,9 @@ def test_the_dictionary_id_is_opencvs() -> None:
     [
         ({"obstacles": {"ids": [3, 3]}}, "scene.obstacles.ids[1]", "obstacles.ids[0]"),
         ({"obstacles": {"ids": [3, 1]}}, "scene.obstacles.ids[1]", "already base.id"),
+        ({"obstacles": {"ids": [3, 50]}}, "scene.obstacles.ids[1]", "not in DICT_4X4_50"),
+        ({"obstacles": {"ids": [-3]}}, "scene.obstacles.ids[0]", "(ids 0 to 49)"),
+        ({"goal": {"id": 999, "size_m": 0.1}}, "scene.goal.id", "not in DICT_4X4_50"),
         ({"goal": {"id": 2, "size_m": -0.15}}, "scene.goal.size_m", "greater than 0"),
         ({"reference": {"id": 0, "size_m": 0.0}}, "scene.reference.size_m", "greater than 0"),
         (

@@ -12,6 +12,7 @@ from mcap.reader import make_reader
 from messages import topics
 from messages.header import Header
 from messages.state import RobotState
+from profiles.endpoints import free_port
 from record.session_file import SessionWriter, entries, info, read_session, recover
 from tests.processes import parsimony
 
@@ -108,3 +109,41 @@ def test_messages_that_do_not_decode_are_skipped_and_said_with_channel_and_time(
     assert f"skipped 2 messages of {KEY} in all" in said
     done = parsimony("report", str(path), "--out", str(tmp_path / "r"))
     assert "Traceback" not in done.stderr and f"skipped the message of {KEY}" in done.stderr
+
+
+BAD_ARGUMENTS = {
+    "--rate 0": (["--rate", "0"], "--rate: expected a finite number of times the recorded"),
+    "--start-offset past the end": (["--start-offset", "1000"], "nothing in the window"),
+    "--start-offset nan": (["--start-offset", "nan"], "--start-offset: expected seconds >= 0"),
+    "--keys matching nothing": (["--keys", "robot/state", "robot/stat"],
+                                "'robot/stat' matches no topic"),
+    "--keys none in the file": (["--keys", "camera/*"], "nothing to replay"),
+    "--namespace *": (["--namespace", "*"], "must not contain the wildcard"),
+    "--namespace ''": (["--namespace", ""], "namespace must not be empty"),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("case", sorted(BAD_ARGUMENTS))
+def test_bad_replay_arguments_are_said_before_any_router_is_reached(
+    session: Path, tmp_path: Path, case: str
+) -> None:
+    """Each is refused, said on the last line, exit 2; the profile's router is not there, so a
+    check made after connecting would say that instead."""
+    profile = tmp_path / "p.yaml"
+    profile.write_text(f"namespace: bad\nzenoh: {{router: ['tcp/127.0.0.1:{free_port()}']}}\n"
+                       "components: [{name: pub, module: scripted_publisher, role: tool}]\n")
+    arguments, said = BAD_ARGUMENTS[case]
+    done = parsimony("replay", str(session), "--profile", str(profile), *arguments)
+    assert done.returncode == 2, done.stderr
+    assert said in done.stderr.strip().splitlines()[-1], done.stderr
+    assert "router" not in done.stderr and "Traceback" not in done.stderr, done.stderr
+
+
+@pytest.mark.parametrize("keys", [[], ["robot/state", "robots/*"]])
+def test_record_refuses_keys_that_match_no_topic(tmp_path: Path, keys: list[str]) -> None:
+    profile = tmp_path / "p.yaml"
+    profile.write_text("namespace: bad\ncomponents: [{name: pub, module: scripted_publisher, "
+                       "role: tool}]\n")  # fmt: skip
+    done = parsimony("record", str(profile), "-o", str(tmp_path / "k.mcap"), "--keys", *keys)
+    assert done.returncode == 2 and "keys: " in done.stderr, done.stderr
+    assert not (tmp_path / "k.mcap").exists()
