@@ -147,3 +147,45 @@ def test_record_refuses_keys_that_match_no_topic(tmp_path: Path, keys: list[str]
     done = parsimony("record", str(profile), "-o", str(tmp_path / "k.mcap"), "--keys", *keys)
     assert done.returncode == 2 and "keys: " in done.stderr, done.stderr
     assert not (tmp_path / "k.mcap").exists()
+
+
+def foxglove_file(path: Path) -> Path:
+    """An MCAP file written by foxglove-sdk, as another tool would: a pose on a channel of
+    Foxglove's schema, and JSON on a key that ends like one of ours but is not our type."""
+    import foxglove
+    from foxglove.channels import PoseInFrameChannel
+    from foxglove.messages import Pose, PoseInFrame, Quaternion, Timestamp, Vector3
+
+    context = foxglove.Context()
+    with foxglove.open_mcap(path, context=context):
+        poses = PoseInFrameChannel("/goal", context=context)
+        state = foxglove.Channel("other/robot/state", schema={"type": "object"},
+                                 message_encoding="json", context=context)  # fmt: skip
+        for index in range(50):
+            stamp = Timestamp(sec=index, nsec=0)
+            poses.log(PoseInFrame(timestamp=stamp, frame_id="world",
+                                  pose=Pose(position=Vector3(x=index, y=0, z=0),
+                                            orientation=Quaternion(x=0, y=0, z=0, w=1))),
+                      log_time=index * 10**9)  # fmt: skip
+            state.log({"x": index}, log_time=index * 10**9)
+    return path
+
+
+def test_a_file_of_another_tool_is_read_for_what_it_holds(tmp_path: Path) -> None:
+    """`info` lists its channels, none of them ours; `report` and `replay` say it holds nothing
+    of ours (exit 2); `record --recover` keeps every message."""
+    path = foxglove_file(tmp_path / "foxglove.mcap")
+    shown = info(path)
+    assert shown["complete"] and shown["messages"] == 100
+    assert {c["key"]: c["topic"] for c in shown["channels"]} == {
+        "/goal": None, "other/robot/state": None}
+    assert {r.topic_name for r in read_session(path)} == {None}
+    report = parsimony("report", str(path), "--out", str(tmp_path / "r"))
+    assert report.returncode == 2 and "the session has no messages on topic" in report.stderr
+    profile = tmp_path / "p.yaml"
+    profile.write_text("namespace: bad\ncomponents: [{name: pub, module: scripted_publisher, "
+                       "role: tool}]\n")  # fmt: skip
+    replay = parsimony("replay", str(path), "--profile", str(profile))
+    assert replay.returncode == 2 and "nothing to replay" in replay.stderr, replay.stderr
+    assert recover(path, tmp_path / "copy.mcap") == 100
+    assert info(tmp_path / "copy.mcap")["channels"] == shown["channels"]
