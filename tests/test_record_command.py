@@ -5,6 +5,7 @@ existing file is written over."""
 from __future__ import annotations
 
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -15,6 +16,7 @@ import pytest
 import yaml
 
 from deploy.query import live_components, statuses
+from messages.process import EXIT_FOR_GOOD
 from parsimony.experiment import connect, launched
 from parsimony.sessions import load_session
 from profiles.endpoints import free_port
@@ -95,3 +97,34 @@ def test_no_command_writes_over_its_input_or_an_existing_file(tmp_path: Path) ->
     done = parsimony("record", "--recover", str(recording), "-o", str(other), "--force")
     assert done.returncode == 0, done.stderr
     assert info(other)["messages"] == info(recording)["messages"]
+
+
+def test_record_onto_a_full_disk_says_so_in_one_line_and_its_file_recovers(tmp_path: Path) -> None:
+    """`parsimony record` onto a real 64 KiB tmpfs, mounted by the test in a mount namespace
+    of its own (``unshare``): the recorder stops for good when the disk is full, the command
+    exits non-zero with one line saying so, no traceback, and the file recovers."""
+    unshare = shutil.which("unshare")
+    probe = unshare and subprocess.run([unshare, "-rm", "mount", "-t", "tmpfs", "tmpfs",
+                                        str(tmp_path)], capture_output=True)  # fmt: skip
+    if not probe or probe.returncode != 0:
+        pytest.skip("no mount namespace here to mount a tmpfs in")
+    profile = system_profile(tmp_path)
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    recovered = tmp_path / "recovered.mcap"
+    script = (f'mount -t tmpfs -o size=64k tmpfs {disk} && '
+              f'{sys.executable} -m parsimony.cli record {profile} -o {disk}/k.mcap; '
+              f'code=$?; {sys.executable} -m parsimony.cli record --recover {disk}/k.mcap '
+              f'-o {recovered} >&2; exit $code')  # fmt: skip
+    with launched(profile) as launcher, connect(load_profile(profile), launcher) as session:
+        while "pub" not in live_components(session, "rec", 0.5):
+            assert launcher.poll() is None
+        done = subprocess.run([unshare, "-rm", "sh", "-c", script], capture_output=True,
+                              text=True)  # fmt: skip
+    assert done.returncode == EXIT_FOR_GOOD, done.stderr
+    assert "Traceback" not in done.stderr, done.stderr
+    full = [line for line in done.stderr.splitlines() if "No space left on device" in line]
+    assert len(full) == 1 and f"cannot write {disk}/k.mcap" in full[0], done.stderr
+    states = load_session(recovered)["robot/state"]
+    seqs = [s.header.seq for s in states]  # what was flushed before the disk filled, none lost
+    assert seqs and seqs == list(range(seqs[0], seqs[0] + len(seqs)))
