@@ -48,6 +48,7 @@ from messages.camera import CameraFrame, CameraIntrinsics
 from messages.clock import Clock
 from messages.commands import ArmCommand, BaseCommand
 from messages.joints import JointStates
+from messages.obstacles import Circle as TruthCircle
 from messages.odometry import BaseOdometry
 from messages.truth import SimTruth
 from profiles.scene import Scene
@@ -55,9 +56,10 @@ from sim2d.camera import ImageNoise, PlacedMarker, Renderer, ceiling_camera
 from sim2d.scenarios import SEED_MAX
 from sim2d.world import World, WorldSettings, wheel_distance_per_count
 from vision.images import jpeg
+from wbc import dq
 from wbc.base_motion import dead_reckoning
 from wbc.obstacles import Circle
-from wbc.planar import compose, planar_pose
+from wbc.planar import compose, offset_pose, planar_pose
 from wbc.robot import MobileManipulator
 
 JOINT_NAMES = tuple(f"q{i}" for i in range(1, ARM_JOINTS + 1))
@@ -167,6 +169,9 @@ class Simulator(Component):
         self.robot = MobileManipulator.from_yaml(node.profile.robot)
         self.scene: Scene = node.profile.scene
         self.obstacles = [Circle(*c) for c in floats(p["obstacles"], "obstacles", None, 3)]
+        self.truth_obstacles = tuple(TruthCircle(x=c.x, y=c.y, radius=c.radius)
+                                     for c in self.obstacles)  # fmt: skip
+        self.goal_of: tuple[str, tuple[float, ...]] = ("", ())
         settings = WorldSettings(
             wheel_acceleration_max=p["wheel_acceleration_max"],
             encoder_noise_counts=p["encoder_noise_counts"],
@@ -411,8 +416,22 @@ class Simulator(Component):
                 end_effector=tuple(self.world.end_effector.tolist()),
                 contacts=self.world.contacts,
                 in_contact=self.world.in_contact,
+                goal=self._true_goal(),
+                reference_pose=self.scene.reference_pose,
+                obstacles=self.truth_obstacles,
             )
         )
+
+    def _true_goal(self) -> tuple[float, ...]:
+        """x_d in this world (eq. 6.3): the bin marker's pose times the scene's offset; worked
+        out again only when ``goal_marker`` changes."""
+        text = self.node.params["goal_marker"]
+        if self.goal_of[0] != text:
+            gx, gy, gyaw = floats(text, "goal_marker", 1, 3)[0]
+            marker = planar_pose(gx, gy, gyaw, self.scene.goal.height_m)
+            goal = dq.normalize(dq.mul(marker, offset_pose(*self.scene.goal.offset)))
+            self.goal_of = (text, tuple(goal.tolist()))
+        return self.goal_of[1]
 
     # -- the camera -----------------------------------------------------------------------
 

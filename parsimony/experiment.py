@@ -3,57 +3,58 @@
 It writes a profile that extends the simulation profile with the experiment's set-up
 (``sim2d.scenarios``), the law and its gains, launches it (``parsimony launch``, its logs in
 ``DIR/launch.log``), unpauses the simulator once every component is alive, follows the run
-on Zenoh, stops when the controller's error has stayed under ``CONVERGED_ERROR`` for
-``HOLD_S`` of simulated time or the time limit passes, and writes ``DIR/report.json``.
+on Zenoh (the controller's diagnostics, the supervisor's status), stops when the controller's
+error has stayed under ``CONVERGED_ERROR`` for ``HOLD_S`` of simulated time or the time limit
+passes, and judges the run from its recording, ``DIR/session.mcap``, alone (``record.judge``:
+what ``parsimony report`` says of the same file), into ``DIR/report.json`` with the figures.
 
 By default the simulator runs in lockstep as fast as the loop answers; ``realtime`` runs it
 at the wall clock's pace instead, as ``make demo`` does.
 
-The report judges the run against the simulator's ground truth, which no component of the
-loop reads: the true end-effector error, the estimator's error in steady state (the last
-``HOLD_S`` s), contacts, joints at their hard stops, obstacle clearance, and the control
-effort of table 6.1 of the commands sent.
+To the judgement the report adds what only the launch knows: the real-time factor over the
+followed run, each component's CPU time and handler durations, and the set-up.
 """
 
 from __future__ import annotations
 
-import bisect
 import contextlib
 import dataclasses
-import hashlib
 import math
 import os
 import signal
-import struct
 import subprocess
 import sys
 import threading
 import time
-from collections import Counter
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
-import numpy as np
 import yaml
 import zenoh
 
 from deploy import query
 from messages import codec, process, topics
+from messages.topics import CONTROL_DIAGNOSTICS, ROBOT_STATE, SIM_TRUTH, SUPERVISOR_STATUS
 from parsimony.kinematic_demo import LP_PARAMS
 from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import Profile, ProfileError, load_profile
-from record.report import READS, write_report
+from record.judge import (
+    HOLD_S,
+    JUDGED,
+    commands_csv,
+    converged_at,
+    end_of_run,
+    judge,
+    the_run,
+)
+from record.report import write_report
 from record.session_file import info, recover
 from sim2d.scenarios import SimScenario, scenario
-from wbc import dq
-from wbc.kinematic_run import effort_of
 from wbc.lp_law import LPParams
-from wbc.planar import in_frame, offset_pose, planar_pose, wrap
 from wbc.robot import MobileManipulator
-from wbc.supervisor_phase import Phase
 
 DEPLOY = Path(__file__).resolve().parents[1] / "deploy"
 PROFILES = {"lp": DEPLOY / "sim.yaml", "cascade": DEPLOY / "sim_cascade.yaml"}
@@ -62,10 +63,6 @@ SUPERVISED = {"anywhere": DEPLOY / "sim_supervised.yaml"}
 """Experiments whose LP runs under the staging supervisor (components/supervisor.py)."""
 MODULES = {"lp": "lp_controller", "cascade": "cascade_controller"}
 
-CONVERGED_ERROR = 0.01
-"""The controller's error norm ||e|| under which the goal counts as reached."""
-HOLD_S = 2.0
-"""Simulated seconds the error must stay under ``CONVERGED_ERROR``; also the steady state."""
 TIME_LIMIT_S = 60.0
 """Simulated seconds after which a run that has not converged stops."""
 STARTUP_S = 60.0
@@ -75,8 +72,6 @@ RECORDER_STOP_S = 10.0
 after everything else and writes all that still waits for it, however long that takes."""
 SESSION_FILE = "session.mcap"
 """The recording of a run, beside its report."""
-LISTENED = ("sim/truth", "robot/state", "control/diagnostics", "base/command", "arm/command",
-            "supervisor/status")  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -142,72 +137,44 @@ def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict
     }
 
 
-class Recorder:
-    """Every message of ``LISTENED`` in the namespace, decoded, in arrival order."""
+class Follower:
+    """What the run's end is decided on, as it arrives: the controller's diagnostics, the
+    supervisor's statuses, and the stamps of the first and the latest ground truth (the
+    recording holds everything else; the run is judged from it)."""
 
     def __init__(self, session: zenoh.Session, namespace: str) -> None:
-        self.messages: dict[str, list] = {name: [] for name in LISTENED}
+        self.session: dict[str, list] = {CONTROL_DIAGNOSTICS.name: [], SUPERVISOR_STATUS.name: []}
+        self.truth_ns: list[int] = []  # the first and the latest
         self._lock = threading.Lock()
         self._subscribers = [
-            session.declare_subscriber(topics.TOPICS[name].key(namespace), self._taker(name))
-            for name in LISTENED
+            session.declare_subscriber(topic.key(namespace), self._taker(topic))
+            for topic in (CONTROL_DIAGNOSTICS, SUPERVISOR_STATUS, SIM_TRUTH)
         ]
 
-    def _taker(self, name: str):
-        topic = topics.TOPICS[name]
-
+    def _taker(self, topic: topics.Topic):
         def take(sample: zenoh.Sample) -> None:
             message = codec.decode(sample.payload.to_bytes(), topic.type)
             with self._lock:
-                self.messages[name].append(message)
+                if topic is SIM_TRUTH:
+                    self.truth_ns[1:] = [message.header.stamp_ns]
+                    self.truth_ns[:1] = self.truth_ns[:1] or [message.header.stamp_ns]
+                else:
+                    self.session[topic.name].append(message)
 
         return take
 
-    def snapshot(self) -> dict[str, list]:
+    def snapshot(self) -> tuple[dict[str, list], list[int]]:
+        """The diagnostics and statuses so far, and the first and latest truth stamps."""
         with self._lock:
-            return {name: list(values) for name, values in self.messages.items()}
+            return {n: list(ms) for n, ms in self.session.items()}, list(self.truth_ns)
 
 
-def converged_at(diagnostics: list, statuses: list) -> float | None:
-    """The simulated time since which every step's error stayed under ``CONVERGED_ERROR``;
-    under a supervisor (``statuses`` of supervisor/status), only the steps of its last pose
-    phase count: a drive leg's error is not the goal's."""
-    pose_since = pose_phase_since(statuses)
-    if pose_since is None:
-        return None
-    since = None
-    for d in diagnostics:
-        if d.header.stamp_ns / 1e9 < pose_since:
-            continue
-        small = d.status == "optimal" and d.error_norm is not None
-        small = small and d.error_norm < CONVERGED_ERROR
-        if not small:
-            since = None
-        elif since is None:
-            since = d.header.stamp_ns / 1e9
-    return since
-
-
-def pose_phase_since(statuses: list) -> float | None:
-    """When the supervisor's last run of pose (or reached) phases began; 0 with no supervisor,
-    None while it is in another phase."""
-    if not statuses:
-        return 0.0
-    since = None
-    for status in statuses:
-        if status.phase not in (Phase.POSE, Phase.REACHED):
-            since = None
-        elif since is None:
-            since = status.header.stamp_ns / 1e9
-    return since
-
-
-def progress_line(messages: dict[str, list], wall_s: float) -> str:
-    diagnostics = messages["control/diagnostics"]
+def progress_line(session: dict[str, list], origin: float, wall_s: float) -> str:
+    diagnostics = session[CONTROL_DIAGNOSTICS.name]
     if not diagnostics:
         return f"[experiment] wall {wall_s:5.1f} s  waiting for the first control step"
     d = diagnostics[-1]
-    t = d.header.stamp_ns / 1e9 - min(origin_s(messages), d.header.stamp_ns / 1e9)
+    t = d.header.stamp_ns / 1e9 - min(origin, d.header.stamp_ns / 1e9)
     error = "-" if d.error_norm is None else f"{d.error_norm:.4f}"
     return (f"[experiment] sim {t:6.2f} s  wall {wall_s:5.1f} s  error {error}  "
             f"nonzero {d.nonzero}  {d.status}")  # fmt: skip
@@ -230,33 +197,45 @@ def run_experiment(options: Options) -> dict[str, Any]:
     with (options.out / "launch.log").open("w") as log,\
             launched(profile_path, log, None) as launcher,\
             connect(profile, launcher) as session:  # fmt: skip
-        recorder = Recorder(session, profile.namespace)
+        follower = Follower(session, profile.namespace)
         wait_alive(session, profile, launcher)
         wait_reached(session, profile, launcher)
         before = component_counters(session, profile.namespace)
         query.set_param(session, profile.namespace, "simulator", "paused", "false")
         started = time.monotonic()
-        messages, wall_s = follow(recorder, options, started)
+        (followed, truth_ns), wall_s = follow(follower, options, started)
         counters = component_counters(session, profile.namespace)
     counters = {name: {**found, "run_cpu_ms": found["cpu_ms"] - before.get(name, found)["cpu_ms"]}
                 for name, found in counters.items()}  # fmt: skip
-    truth = messages["sim/truth"]  # the real-time factor: simulated over host s, as followed
-    ran_s = truth[-1].header.stamp_ns / 1e9 - origin_s(messages) if truth else 0.0
-    end_ns, converged = end_of_run(messages, options.time_limit_s, origin_s(messages))
-    messages = until(messages, end_ns)
-    report = build_report(options, setup, profile, robot, messages, (ran_s, wall_s), counters,
-                          converged)  # fmt: skip
-    write_commands(options.out / "commands.csv", messages)
-    start_ns = min((s.header.stamp_ns for s in messages["robot/state"]), default=end_ns)
-    facts = info(options.out / SESSION_FILE)
-    report["recording"] = recording_check(facts, (start_ns, end_ns))
+    ran_s = (truth_ns[-1] - truth_ns[0]) / 1e9 if truth_ns else 0.0  # simulated s, as followed
+    origin = truth_ns[0] / 1e9 if truth_ns else math.inf
+    end_ns, _ = end_of_run(followed, options.time_limit_s, origin)
+    path = options.out / SESSION_FILE
+    facts = info(path)
     if not facts["complete"]:
-        whole_recording(options.out / SESSION_FILE)
-    session = load_session(options.out / SESSION_FILE, READS)
+        whole_recording(path)
+    recorded = load_session(path, JUDGED)
+    start_ns = min((s.header.stamp_ns for s in recorded.get(ROBOT_STATE.name, [])),
+                   default=end_ns)  # fmt: skip
+    report = {
+        "experiment": options.name, "controller": options.controller, "seed": options.seed,
+        "mode": "realtime" if options.realtime else "lockstep",
+        **judge(recorded, robot, options.time_limit_s),
+        "wall_time_s": round(wall_s, 3),
+        "real_time_factor": round(ran_s / wall_s, 2) if wall_s > 0 else None,
+        "lockstep_timeouts": counters.get("simulator", {}).get("lockstep_timeouts", 0),
+        "durations_us": durations(counters),
+        "cpu_s": {name: round(found["run_cpu_ms"] / 1e3, 3)
+                  for name, found in sorted(counters.items())},  # fmt: skip
+        "scenario": dataclasses.asdict(setup) | {"obstacles": setup.sim_params()["obstacles"]},
+        "recording": recording_check(facts, (start_ns, end_ns)),
+    }  # fmt: skip
+    run, _ = the_run(recorded, options.time_limit_s)
+    (options.out / "commands.csv").write_text(commands_csv(run))
     label = options.controller
     if report["recording"]["missing"]:
         label += " (RECORDING CUT SHORT: " + "; ".join(report["recording"]["missing"]) + ")"
-    figures = write_report([(label, session)], robot, options.out,
+    figures = write_report([(label, run)], robot, options.out,
                            profile.scene.reference_pose)["figures"]  # fmt: skip
     report["figures"] = [str(path) for path in figures]
     (options.out / "report.json").write_text(dumps(report))
@@ -362,25 +341,27 @@ def wait_launch(launcher: subprocess.Popen, missing: Callable[[], list[str]], wh
         time.sleep(0.1)  # polling the router (liveliness tokens, the components' counters)
 
 
-def follow(recorder: Recorder, options: Options, started: float) -> tuple[dict[str, list], float]:
-    """Print progress until the run converges or its time is up; return what was received,
-    and the host seconds since ``started`` when it was."""
+def follow(follower: Follower, options: Options, started: float
+           ) -> tuple[tuple[dict[str, list], list[int]], float]:  # fmt: skip
+    """Print progress until the run converges or its time is up; return what was followed
+    (``Follower.snapshot``), and the host seconds since ``started`` when it was."""
     last_print = 0.0
     wall_limit = max(120.0, options.time_limit_s * (3.0 if options.realtime else 10.0))
     while True:
-        time.sleep(0.2)  # progress is sampled, the data itself is all kept by the recorder
-        messages = recorder.snapshot()
+        time.sleep(0.2)  # progress is sampled; the recording holds the run itself
+        followed, truth_ns = follower.snapshot()
+        origin = truth_ns[0] / 1e9 if truth_ns else math.inf
         wall = time.monotonic() - started
         if wall - last_print >= 1.0:
-            print(progress_line(messages, wall), file=sys.stderr, flush=True)
+            print(progress_line(followed, origin, wall), file=sys.stderr, flush=True)
             last_print = wall
-        diagnostics = messages["control/diagnostics"]
+        diagnostics = followed[CONTROL_DIAGNOSTICS.name]
         now_s = diagnostics[-1].header.stamp_ns / 1e9 if diagnostics else 0.0
-        since = converged_at(diagnostics, messages["supervisor/status"])
+        since = converged_at(diagnostics, followed[SUPERVISOR_STATUS.name])
         if since is not None and now_s - since >= HOLD_S:
-            return messages, wall
-        if now_s - origin_s(messages) >= options.time_limit_s or wall > wall_limit:
-            return messages, wall
+            return (followed, truth_ns), wall
+        if now_s - origin >= options.time_limit_s or wall > wall_limit:
+            return (followed, truth_ns), wall
 
 
 def component_counters(session: zenoh.Session, namespace: str) -> dict[str, dict[str, int]]:
@@ -395,210 +376,6 @@ def durations(counters: dict[str, dict[str, int]]) -> dict[str, dict[str, int]]:
         name: {k: v for k, v in sorted(found.items()) if k.endswith(("_us_median", "_us_p99"))}
         for name, found in sorted(counters.items())
     }
-
-
-def origin_s(messages: dict[str, list]) -> float:
-    """The simulated time the run started at: its first ground truth (0 in lockstep, the host's
-    clock when the simulator keeps host time), s."""
-    truth = messages["sim/truth"]
-    return truth[0].header.stamp_ns / 1e9 if truth else math.inf
-
-
-def end_of_run(messages: dict[str, list], time_limit_s: float, origin: float
-               ) -> tuple[int, bool]:  # fmt: skip
-    """The stamp (ns) a run ends at, ``HOLD_S`` after it converged, else the time limit (a
-    simulated time: two lockstep runs of one set-up report the same steps); and whether it
-    converged."""
-    diagnostics = messages["control/diagnostics"]
-    since = converged_at(diagnostics, messages["supervisor/status"])
-    if since is not None and diagnostics[-1].header.stamp_ns / 1e9 - since >= HOLD_S:
-        return round((since + HOLD_S) * 1e9), True
-    return round((origin + time_limit_s) * 1e9), False
-
-
-def until(messages: dict[str, list], end_ns: int) -> dict[str, list]:
-    """The messages stamped up to ``end_ns``."""
-    return {n: [m for m in ms if m.header.stamp_ns <= end_ns] for n, ms in messages.items()}
-
-
-def true_goal(setup: SimScenario, profile: Profile) -> np.ndarray:
-    """x_d in the simulator's world: the bin marker's pose times the scene's offset (eq. 6.3)."""
-    scene = profile.scene
-    bin_pose = planar_pose(*setup.bin[:2], setup.bin[2], scene.goal.height_m)
-    return dq.normalize(dq.mul(bin_pose, offset_pose(*scene.goal.offset)))
-
-
-def build_report(
-    options: Options, setup: SimScenario, profile: Profile, robot: MobileManipulator,
-    messages: dict[str, list], ran: tuple[float, float], counters: dict[str, dict[str, int]],
-    converged: bool,
-) -> dict[str, Any]:  # fmt: skip
-    """The run's report; ``ran`` is (simulated s, host s) of the run when it was last followed,
-    from the start to its last ground truth then (the real-time factor's two terms)."""
-    truth, states = messages["sim/truth"], messages["robot/state"]
-    diagnostics = messages["control/diagnostics"]
-    sim_s = (truth[-1].header.stamp_ns - truth[0].header.stamp_ns) / 1e9 if truth else 0.0
-    end_s = diagnostics[-1].header.stamp_ns / 1e9 if diagnostics else 0.0
-    goal = true_goal(setup, profile)
-    final_error = None
-    if truth:
-        x = np.array(truth[-1].end_effector)
-        if setup.task == "pose":
-            final_error = float(np.linalg.norm(x - dq.nearest_equivalent(goal, x)))
-        else:
-            final_error = float(np.linalg.norm(dq.translation(x) - dq.translation(goal)))
-    steps = [d for d in diagnostics if d.status == "optimal"]
-    solve = np.array([d.solve_time_us for d in steps]) if steps else np.zeros(1)
-    return {
-        "experiment": options.name,
-        "controller": options.controller,
-        "seed": options.seed,
-        "mode": "realtime" if options.realtime else "lockstep",
-        "converged": converged,
-        "final_error": final_error,
-        "final_error_estimated": diagnostics[-1].error_norm if diagnostics else None,
-        "sim_time_s": round(sim_s, 3),
-        "wall_time_s": round(ran[1], 3),
-        "real_time_factor": round(ran[0] / ran[1], 2) if ran[1] > 0 else None,
-        "iterations": len(diagnostics),
-        "contacts": truth[-1].contacts if truth else 0,
-        "supervisor": supervisor_summary(messages["supervisor/status"]),
-        "joint_limit_violations": joints_at_stops(truth, robot),
-        "min_obstacle_clearance_m": clearance(truth, setup, robot),
-        "estimator_error": estimator_error(truth, states, profile, end_s - HOLD_S),
-        "nonzero_entries": dict(sorted(Counter(d.nonzero for d in steps).items())),
-        "effort": effort(messages, truth),
-        "step_time_us": {
-            "median": round(float(np.median(solve)), 1),
-            "p99": round(float(np.percentile(solve, 99)), 1),
-        },  # fmt: skip
-        "lockstep_timeouts": counters.get("simulator", {}).get("lockstep_timeouts", 0),
-        "durations_us": durations(counters),
-        "cpu_s": {name: round(found["run_cpu_ms"] / 1e3, 3)
-                  for name, found in sorted(counters.items())},  # fmt: skip
-        "controller_statuses": dict(sorted(Counter(d.status for d in diagnostics).items())),
-        "degraded_states": sum(s.degraded for s in states),
-        "invalid_states": sum(not s.valid for s in states),
-        "commands_digest": commands_digest(messages),
-        "scenario": dataclasses.asdict(setup) | {"obstacles": setup.sim_params()["obstacles"]},
-    }
-
-
-def supervisor_summary(statuses: list) -> dict[str, Any] | None:
-    """The staging supervisor's last word: phase, plans, re-plans, stalls, reason; and when
-    each phase began (simulated s). None when the run had no supervisor."""
-    if not statuses:
-        return None
-    last = statuses[-1]
-    began: list[tuple[str, float]] = []
-    for status in statuses:
-        if not began or began[-1][0] != status.phase:
-            began.append((status.phase, status.header.stamp_ns / 1e9))
-    return {"phase": last.phase, "plans": last.plans, "replans": last.replans,
-            "stalls": last.stalls, "reason": last.reason, "candidate_base": last.candidate_base,
-            "phases": [{"phase": p, "from_s": t} for p, t in began]}  # fmt: skip
-
-
-def joints_at_stops(truth: list, robot: MobileManipulator) -> int:
-    """Ground-truth samples with an arm joint at (or past) its limit: the simulated servo's
-    hard stop. The LP's joint constraint (5.14) keeps them inside."""
-    if not truth:
-        return 0
-    arm = np.array([t.arm_joints for t in truth])
-    low, high = robot.q_min[3:], robot.q_max[3:]
-    return int(np.any((arm <= low + 1e-9) | (arm >= high - 1e-9), axis=1).sum())
-
-
-def clearance(truth: list, setup: SimScenario, robot: MobileManipulator) -> float | None:
-    """The least distance between the base's disc and an obstacle, m (None without obstacles)."""
-    if not truth or not setup.obstacles:
-        return None
-    base = np.array([t.base_pose[:2] for t in truth])
-    gaps = [np.hypot(base[:, 0] - o.x, base[:, 1] - o.y) - o.radius - robot.base.body_radius
-            for o in setup.obstacles]  # fmt: skip
-    return round(float(np.min(gaps)), 4)
-
-
-class Truth:
-    """The ground truth nearest a stamp (the same stamp in lockstep; on host time, as with
-    emulated devices, the simulator's step nearest the driver's reading)."""
-
-    def __init__(self, truth: list) -> None:
-        self.samples = sorted(truth, key=lambda t: t.header.stamp_ns)
-        self.stamps = [t.header.stamp_ns for t in self.samples]
-
-    def at(self, stamp_ns: int, within_ns: int = 20_000_000):
-        index = bisect.bisect_left(self.stamps, stamp_ns)
-        near = [i for i in (index - 1, index) if 0 <= i < len(self.stamps)]
-        if not near:
-            return None
-        best = min(near, key=lambda i: abs(self.stamps[i] - stamp_ns))
-        return self.samples[best] if abs(self.stamps[best] - stamp_ns) <= within_ns else None
-
-
-def estimator_error(truth: list, states: list, profile: Profile, since_s: float) -> dict:
-    """The largest base position and heading error of the estimate against the truth, both in
-    F0's frame, over the states stamped after ``since_s`` (the steady state)."""
-    nearest = Truth(truth)
-    position, angle = [], []
-    for state in states:
-        t = nearest.at(state.header.stamp_ns)
-        if t is None or not state.valid or state.header.stamp_ns / 1e9 < since_s:
-            continue
-        x, y, phi = in_frame(*t.base_pose, profile.scene.reference_pose)
-        position.append(math.hypot(state.base_pose[0] - x, state.base_pose[1] - y))
-        angle.append(abs(wrap(state.base_pose[2] - phi)))
-    if not position:
-        return {"position_m": None, "angle_rad": None, "samples": 0}
-    return {"position_m": round(max(position), 5), "angle_rad": round(max(angle), 5),
-            "samples": len(position)}  # fmt: skip
-
-
-def effort(messages: dict[str, list], truth: list) -> dict[str, float]:
-    """Table 6.1's four metrics of the commanded u = [x', y', phi', q'] (x' = v cos phi,
-    y' = v sin phi with the true heading at the command's stamp)."""
-    nearest = Truth(truth)
-    arm = {a.header.stamp_ns: a.joint_velocities for a in messages["arm/command"]}
-    rows, stamps = [], []
-    for b in messages["base/command"]:
-        stamp = b.header.stamp_ns
-        t = nearest.at(stamp)
-        if stamp not in arm or t is None:
-            continue
-        phi = t.base_pose[2]
-        v, w = b.forward_velocity, b.angular_velocity
-        rows.append([v * math.cos(phi), v * math.sin(phi), w, *arm[stamp]])
-        stamps.append(stamp)
-    if len(rows) < 2:
-        return {f"metric{i}": 0.0 for i in range(1, 5)}
-    dt = float(np.median(np.diff(stamps))) / 1e9
-    e = effort_of(np.array(rows), dt)
-    values = (e.velocity_l1, e.velocity_l2, e.acceleration_l1, e.acceleration_l2)
-    return {f"metric{i}": round(v, 4) for i, v in enumerate(values, start=1)}
-
-
-def write_commands(path: Path, messages: dict[str, list]) -> None:
-    """Every command pair the controller sent, one row per stamp (s, m/s, rad/s)."""
-    arm = {a.header.stamp_ns: a.joint_velocities for a in messages["arm/command"]}
-    lines = ["stamp_s,forward,angular," + ",".join(f"q{i}_dot" for i in range(1, 6))]
-    for b in sorted(messages["base/command"], key=lambda c: c.header.stamp_ns):
-        joints = arm.get(b.header.stamp_ns)
-        if joints is not None:
-            values = (b.forward_velocity, b.angular_velocity, *joints)
-            lines.append(f"{b.header.stamp_ns / 1e9:.3f}," + ",".join(repr(v) for v in values))
-    path.write_text("\n".join(lines) + "\n")
-
-
-def commands_digest(messages: dict[str, list]) -> str:
-    """SHA-256 of every command's stamp and values in stamp order: two runs that sent the same
-    commands have the same digest."""
-    digest = hashlib.sha256()
-    for name in ("base/command", "arm/command"):
-        for command in sorted(messages[name], key=lambda c: c.header.stamp_ns):
-            values = command.model_dump(exclude={"header"})
-            digest.update(struct.pack("<q", command.header.stamp_ns))
-            digest.update(repr(sorted(values.items())).encode())
-    return digest.hexdigest()
 
 
 def dumps(report: dict) -> str:

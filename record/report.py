@@ -18,7 +18,7 @@ Times are in s from the session's first command.
     joints.png             q1..q5 against their limits, dashed green (6.10)
     end_effector_path.png  x-y of the end effector and the goal (6.14)
     base_path.png          x-y of the base and the obstacles
-    effort.json, effort.md the four metrics of table 6.1 (``wbc.kinematic_run.effort_of``)
+    effort.json, effort.md the four metrics of table 6.1 (``record.judge.effort_of_inputs``)
 """
 
 from __future__ import annotations
@@ -36,35 +36,28 @@ from matplotlib.patches import Circle
 
 from messages.goal import Goal
 from messages.topics import (
-    ARM_COMMAND,
-    BASE_COMMAND,
     CONTROL_DIAGNOSTICS,
     CONTROL_GOAL,
     GOAL_REQUEST,
     ROBOT_STATE,
     SIM_TRUTH,
     WORLD_OBSTACLES,
-    Topic,
 )
+from record.judge import commands, effort_of_inputs, messages, required
 from wbc import dq
-from wbc.kinematic_run import effort_of
 from wbc.planar import in_frame, planar_pose
 from wbc.robot import MobileManipulator
 
 Array = np.ndarray
 Session = Mapping[str, Sequence[Any]]
 
-METRICS: Mapping[str, tuple[str, str]] = {
-    "metric1": ("velocity_l1", r"$\int \lVert\dot{q}\rVert_1\,dt$"),
-    "metric2": ("velocity_l2", r"$\sqrt{\int \lVert\dot{q}\rVert_2^2\,dt}$"),
-    "metric3": ("acceleration_l1", r"$\int \lVert\ddot{q}\rVert_1\,dt$"),
-    "metric4": ("acceleration_l2", r"$\sqrt{\int \lVert\ddot{q}\rVert_2^2\,dt}$"),
+FORMULAS: Mapping[str, str] = {
+    "metric1": r"$\int \lVert\dot{q}\rVert_1\,dt$",
+    "metric2": r"$\sqrt{\int \lVert\dot{q}\rVert_2^2\,dt}$",
+    "metric3": r"$\int \lVert\ddot{q}\rVert_1\,dt$",
+    "metric4": r"$\sqrt{\int \lVert\ddot{q}\rVert_2^2\,dt}$",
 }
-"""Table 6.1's metrics: the ``ControlEffort`` field each reports, and its formula."""
-
-READS = frozenset(t.name for t in (ROBOT_STATE, CONTROL_GOAL, GOAL_REQUEST, BASE_COMMAND,
-                                   ARM_COMMAND, CONTROL_DIAGNOSTICS, WORLD_OBSTACLES, SIM_TRUTH))
-"""The topics a report reads: a session loaded for one needs no others (no images)."""
+"""Table 6.1's metrics (``record.judge.METRICS``) as formulas."""
 
 INPUT_NAMES = ("x'", "y'", "phi'", "q1'", "q2'", "q3'", "q4'", "q5'")
 """The entries of u, in order."""
@@ -73,13 +66,8 @@ INPUT_NAMES = ("x'", "y'", "phi'", "q1'", "q2'", "q3'", "q4'", "q5'")
 def control_inputs(session: Session) -> tuple[Array, Array]:
     """(t, u): times in s from the first command, and one row u = [x', y', phi', q1'..q5']
     per stamp that has both a base and an arm command."""
-    stamps, u = _commands(session)
+    stamps, u = commands(session)
     return (stamps - stamps[0]) * 1e-9, u
-
-
-def effort(session: Session) -> dict[str, float]:
-    """Table 6.1's metrics of the session's control inputs, as ``metric1`` .. ``metric4``."""
-    return _effort(*_commands(session))
 
 
 def write_report(
@@ -110,7 +98,9 @@ def write_report(
         figure = draw(recordings, robot)
         figure.savefig(out / name, dpi=100)
         figures.append(out / name)
-    efforts = {rec.label: _effort(rec.stamps_ns, rec.u) for rec in recordings}
+    efforts = {rec.label: effort_of_inputs(rec.stamps_ns, rec.u) for rec in recordings}
+    if short := [label for label, found in efforts.items() if found is None]:
+        raise ValueError(f"{', '.join(short)}: the control effort needs two commands or more")
     (out / "effort.json").write_text(json.dumps(efforts, indent=2) + "\n")
     (out / "effort.md").write_text(_effort_table(efforts))
     return {"figures": figures, "effort": efforts}
@@ -149,67 +139,18 @@ def _in_frame(truth: Any, frame: tuple[float, float, float]) -> Any:
 def _recording(
     label: str, session: Session, truth_frame: tuple[float, float, float] | None
 ) -> _Recording:
-    stamps, u = _commands(session)
-    truth = _messages(session, SIM_TRUTH, required=False) if truth_frame is not None else []
+    stamps, u = commands(session)
+    truth = messages(session, SIM_TRUTH) if truth_frame is not None else []
     return _Recording(
         label=label,
         stamps_ns=stamps,
         u=u,
-        states=_messages(session, ROBOT_STATE),
-        goals=_messages(session, GOAL_REQUEST, required=False) or _messages(session, CONTROL_GOAL),
-        diagnostics=_messages(session, CONTROL_DIAGNOSTICS),
-        obstacles=_messages(session, WORLD_OBSTACLES, required=False),
+        states=required(session, ROBOT_STATE),
+        goals=messages(session, GOAL_REQUEST) or required(session, CONTROL_GOAL),
+        diagnostics=required(session, CONTROL_DIAGNOSTICS),
+        obstacles=messages(session, WORLD_OBSTACLES),
         truth=[_in_frame(t, truth_frame) for t in truth],
     )
-
-
-def _messages(session: Session, topic: Topic, required: bool = True) -> list:
-    """The messages on ``topic`` sorted by stamp; none is an error when ``required``."""
-    messages = session.get(topic.name) or []
-    if required and not messages:
-        raise ValueError(f"the session has no messages on topic {topic.name!r}")
-    wrong = [type(m).__name__ for m in messages if not isinstance(m, topic.type)]
-    if wrong:
-        raise ValueError(f"topic {topic.name!r} carries {topic.type.__name__}, got {wrong[0]}")
-    return sorted(messages, key=lambda m: m.header.stamp_ns)
-
-
-def _commands(session: Session) -> tuple[Array, Array]:
-    """(stamps in ns, u rows) of the stamps that have a base and an arm command."""
-    base = {m.header.stamp_ns: m for m in _messages(session, BASE_COMMAND)}
-    arm = {m.header.stamp_ns: m for m in _messages(session, ARM_COMMAND)}
-    stamps = np.array(sorted(base.keys() & arm.keys()), dtype=np.int64)
-    if stamps.size == 0:
-        raise ValueError(
-            f"no {BASE_COMMAND.name!r} message shares a stamp with {ARM_COMMAND.name!r}"
-        )
-    states = _messages(session, ROBOT_STATE)
-    state_stamps = np.array([s.header.stamp_ns for s in states], dtype=np.int64)
-    phi = np.array([states[i].base_pose[2] for i in _nearest(state_stamps, stamps)])
-    v = np.array([base[s].forward_velocity for s in stamps])
-    omega = np.array([base[s].angular_velocity for s in stamps])
-    joints = np.array([arm[s].joint_velocities for s in stamps])
-    u = np.column_stack((v * np.cos(phi), v * np.sin(phi), omega, joints))
-    return stamps, u
-
-
-def _nearest(sorted_stamps: Array, stamps: Array) -> Array:
-    """The index into ``sorted_stamps`` of the one nearest each of ``stamps``."""
-    if len(sorted_stamps) == 1:
-        return np.zeros(len(stamps), dtype=int)
-    after = np.clip(np.searchsorted(sorted_stamps, stamps), 1, len(sorted_stamps) - 1)
-    before = after - 1
-    nearer_before = stamps - sorted_stamps[before] <= sorted_stamps[after] - stamps
-    return np.where(nearer_before, before, after)
-
-
-def _effort(stamps_ns: Array, u: Array) -> dict[str, float]:
-    """``effort_of`` u with dt the median command period."""
-    if len(stamps_ns) < 2:
-        raise ValueError(f"the control effort needs two commands or more, got {len(stamps_ns)}")
-    dt = float(np.median(np.diff(stamps_ns))) * 1e-9
-    metrics = effort_of(u, dt)
-    return {name: getattr(metrics, field) for name, (field, _) in METRICS.items()}
 
 
 def _effort_table(efforts: Mapping[str, Mapping[str, float]]) -> str:
@@ -220,7 +161,7 @@ def _effort_table(efforts: Mapping[str, Mapping[str, float]]) -> str:
         "| | Metric | " + " | ".join(labels) + " |",
         "| :-: | :-- |" + " --: |" * len(labels),
     ]
-    for number, (name, (_, formula)) in enumerate(METRICS.items(), start=1):
+    for number, (name, formula) in enumerate(FORMULAS.items(), start=1):
         values = " | ".join(f"{metrics[name]:.4g}" for metrics in efforts.values())
         lines.append(f"| {number} | {formula} | {values} |")
     return "\n".join(lines) + "\n"

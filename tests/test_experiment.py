@@ -58,6 +58,15 @@ def test_pose_experiment_with_the_lp_reaches_the_goal_seen_by_the_camera(tmp_pat
         assert report["effort"][key] > 0.0
     assert report["step_time_us"]["median"] > 0.0
     assert report["iterations"] == sum(report["controller_statuses"].values())
+    # The folder never disagrees with itself: `report` judges the file as `experiment` did.
+    out = tmp_path / "again"
+    done = subprocess.run([sys.executable, "-m", "parsimony.cli", "report",
+                           str(tmp_path / "session.mcap"), "--out", str(out), "--json"],
+                          capture_output=True, text=True, timeout=300)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    judged = json.loads(done.stdout)["judged"]["lp"]
+    assert judged == {key: report[key] for key in judged}
+    assert json.loads((out / "effort.json").read_text())["lp"] == report["effort"]
 
 
 def test_two_lockstep_runs_of_one_seed_send_bit_identical_commands(tmp_path: Path) -> None:

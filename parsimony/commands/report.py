@@ -1,5 +1,7 @@
 """`parsimony report FILE [FILE2] --out DIR`: the chapter 6 figures and table 6.1 of recorded
-sessions (see record.report)."""
+sessions (see record.report), and each run judged from its file (record.judge) into
+``DIR/judged.json``: what ``parsimony experiment`` wrote into its report.json of the same
+file."""
 
 from __future__ import annotations
 
@@ -8,10 +10,12 @@ import json
 import sys
 from pathlib import Path
 
+from parsimony.commands.launch import positive_seconds
 from parsimony.output import emit
 from parsimony.sessions import load_session
 from profiles.profile import ProfileError, load_profile
-from record.report import READS, write_report
+from record.judge import JUDGED, judge, the_run
+from record.report import write_report
 from wbc.robot import MobileManipulator
 
 ROBOT = Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"
@@ -30,6 +34,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("--robot", type=Path, default=ROBOT, help="robot description")
     parser.add_argument("--profile", type=Path,
                         help="the recorded profile: truth drawn in F0's frame")  # fmt: skip
+    parser.add_argument("--time-limit", type=positive_seconds, metavar="S",
+                        help="a run that did not converge ends S s after its start, as "
+                        "`experiment --time-limit` ended it (default: at its last step)")
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
     return parser
 
@@ -41,18 +48,21 @@ def run(args: argparse.Namespace) -> int:
     sessions = []
     try:
         for index, path in enumerate(args.files):
-            session = load_session(path, READS)
+            session = the_run(load_session(path, JUDGED), args.time_limit)[0]
             sessions.append((label_of(args.labels, index, session, path), session))
         args.out.mkdir(parents=True, exist_ok=True)
         frame = None
         if args.profile is not None:
             scene = load_profile(args.profile).scene
             frame = scene.reference_pose if scene is not None else None
-        result = write_report(sessions, MobileManipulator.from_yaml(args.robot), args.out, frame)
+        robot = MobileManipulator.from_yaml(args.robot)
+        result = write_report(sessions, robot, args.out, frame)
+        judged = {label: judge(session, robot, args.time_limit) for label, session in sessions}
     except (OSError, ValueError, ProfileError) as error:
         print(f"report: {error}", file=sys.stderr)
         return 2
-    result = {**result, "figures": [str(p) for p in result["figures"]]}
+    (args.out / "judged.json").write_text(json.dumps(judged, indent=2) + "\n")
+    result = {**result, "figures": [str(p) for p in result["figures"]], "judged": judged}
     emit(json.dumps(result, indent=2) if args.json else "\n".join(result["figures"]))
     return 0
 

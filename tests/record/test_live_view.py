@@ -247,4 +247,4 @@ def test_keys_that_match_no_topic_are_refused(tmp_path: Path) -> None:
                            "--keys", "camera/imag"], capture_output=True, text=True,
                           timeout=60)  # fmt: skip
     assert done.returncode == 2
-    assert "keys: camera/imag matches no topic" in done.stderr
+    assert "keys: 'camera/imag' matches no topic" in done.stderr

@@ -1,0 +1,74 @@
+"""record.judge on sessions of real kinematic runs of the LP (tests/record/test_report.py's):
+a run judged from its messages alone, with the truth and without it."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from messages.obstacles import Circle
+from messages.topics import CONTROL_DIAGNOSTICS, ROBOT_STATE, SIM_TRUTH
+from messages.truth import SimTruth
+from record.judge import HOLD_S, commands, effort, judge, the_run
+from tests.record.test_report import ROBOT, START_NS, runs  # noqa: F401 - the fixture
+from wbc import scenarios
+from wbc.kinematic_run import effort_of
+
+
+def with_truth(session: dict[str, list], goal: np.ndarray, shift: float = 0.0) -> dict:
+    """The session with a ground truth at each state: the state moved by ``shift`` in x (an
+    estimator that far off), the goal and one obstacle as the simulator places them."""
+    obstacle = scenarios.OBSTACLE
+    truth = [SimTruth(header=s.header, base_pose=(s.base_pose[0] + shift, *s.base_pose[1:]),
+                      arm_joints=s.arm_joints, end_effector=s.end_effector, contacts=0,
+                      in_contact=False, goal=tuple(goal), reference_pose=(0.0, 0.0, 0.0),
+                      obstacles=(Circle(x=obstacle.x, y=obstacle.y, radius=obstacle.radius),))
+             for s in session[ROBOT_STATE.name]]  # fmt: skip
+    return {**session, SIM_TRUTH.name: truth}
+
+
+def test_a_converged_run_ends_hold_s_after_it_converged_and_is_judged_on_the_truth(runs):  # noqa: F811
+    run, session = runs["LP"]
+    goal = ROBOT.fkm(scenarios.REACH_GOAL)
+    judged = judge(with_truth(session, goal, shift=0.004), ROBOT)
+    assert judged["converged"] and judged["truth"] == "recorded"
+    cut, _ = the_run(session)
+    diagnostics = cut[CONTROL_DIAGNOSTICS.name]
+    since = next(d.header.stamp_ns for d in diagnostics if d.error_norm < 0.01) / 1e9
+    assert diagnostics[-1].header.stamp_ns / 1e9 == pytest.approx(since + HOLD_S, abs=0.02)
+    assert judged["iterations"] == len(diagnostics) < len(session[CONTROL_DIAGNOSTICS.name])
+    x = np.array(cut[ROBOT_STATE.name][-1].end_effector)
+    assert judged["final_error"] == pytest.approx(np.linalg.norm(x - goal), abs=1e-12)
+    assert judged["estimator_error"]["position_m"] == pytest.approx(0.004, abs=1e-9)
+    assert judged["contacts"] == 0 and judged["joint_limit_violations"] == 0
+    centre = min(np.hypot(s.base_pose[0] + 0.004 - scenarios.OBSTACLE.x,
+                          s.base_pose[1] - scenarios.OBSTACLE.y)
+                 for s in cut[ROBOT_STATE.name])  # fmt: skip
+    gap = centre - scenarios.OBSTACLE.radius - ROBOT.base.body_radius
+    assert judged["min_obstacle_clearance_m"] == pytest.approx(gap, abs=1e-4)
+    stamps, u = commands(cut)
+    inputs = np.array([out.u for out in run.outputs[: len(u)]])
+    assert np.allclose(u, inputs, atol=1e-12)  # u as the law computed it
+    dt = float(np.median(np.diff(stamps))) * 1e-9
+    assert effort(cut)["metric1"] == effort_of(u, dt).velocity_l1
+
+
+def test_a_recording_without_truth_says_so_and_judges_the_rest(runs):  # noqa: F811
+    _, session = runs["LP"]
+    judged = judge(session, ROBOT)
+    assert judged["truth"] == "absent"
+    for key in ("final_error", "contacts", "joint_limit_violations", "min_obstacle_clearance_m"):
+        assert judged[key] is None, key
+    assert judged["estimator_error"]["samples"] == 0
+    assert judged["converged"] and judged["final_error_estimated"] < 0.01
+    assert judged["effort"] is not None and judged["iterations"] > 0
+
+
+def test_a_time_limit_ends_a_run_that_did_not_converge_at_the_limit(runs):  # noqa: F811
+    _, session = runs["LP"]
+    early = {name: [m for m in messages if m.header.stamp_ns < START_NS + 2 * 10**9]
+             for name, messages in session.items()}  # fmt: skip
+    judged = judge(early, ROBOT, time_limit_s=1.0)
+    assert not judged["converged"]
+    last = the_run(early, 1.0)[0][CONTROL_DIAGNOSTICS.name][-1].header.stamp_ns
+    assert last <= START_NS + 10**9 < last + 30_000_000
