@@ -2,20 +2,13 @@
 
 A controller module only names its law (``wbc.lp_law``, ``wbc.cascade_law``...) and
 declares its parameters; the mathematics stays in ``wbc``. Each ``robot/state`` is one
-control step::
-
-    u = law.step(q, task, dt, obstacles)          u = [x', y', phi', q1'..q5']
-    base/command = wheel_speeds(unicycle(x', y', phi', phi))        (m/s, rad/s)
-    arm/command  = u[3:]                                            (rad/s)
-
-with ``dt`` the difference of consecutive state stamps, clamped to [1 ms, 0.2 s] (0.02 s
-at the first step), and a ``control/diagnostics`` message saying what the law did.
+control step (``components.control_step``, the same step ``parsimony rerun`` runs), with a
+``control/diagnostics`` message saying what the law did and every gain in force.
 
 The controller commands zero, and says why in the diagnostics' ``status`` and ``reason``,
-whenever it cannot trust its output: the state is older than ``stale_timeout_s`` (by its
-stamp, or because states stopped arriving: a 10 Hz timer checks), the state is not
-``valid``, there is no goal, the law raises or returns a status other than ``optimal``,
-or a command would not be finite (counted as ``non_finite_commands``).
+whenever it cannot trust its output (``ControlStep.step``), and also while states stop
+arriving (a 10 Hz timer checks); a law that raises is counted as ``law_errors``, a command
+that would not be finite as ``non_finite_commands``.
 
 Commands and diagnostics carry the stamp of the state they answer, so their age on
 arrival measures the whole loop; zeros sent by the timer carry the current time.
@@ -28,42 +21,40 @@ directory); empty means the profile's robot.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, ClassVar
 
-import numpy as np
 import yaml
 
+from components.control_step import (
+    GOAL_OVERRIDES,
+    ControlStep,
+    Step,
+    gain_values,
+    gains_of,
+)
 from components.params import Param, ParamError
 from components.pubsub import Input
 from components.runtime import Component, Node
 from messages import topics
-from messages.base import ARM_JOINTS
 from messages.commands import ArmCommand, BaseCommand
 from messages.diagnostics import ControllerDiagnostics
 from messages.goal import Goal
 from messages.header import Header
 from messages.obstacles import Obstacles
 from messages.state import RobotState
-from wbc.base_motion import unicycle, wheel_speeds
 from wbc.drive_tasks import HeadingTask, PointTask
 from wbc.gains import gain_specs
-from wbc.law_output import Law, LawOutput
+from wbc.law_output import Law
 from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
-from wbc.task import MEASUREMENT_TOLERANCE, PoseTask, PositionTask, Task, same_task
+from wbc.task import PoseTask, PositionTask, Task
 
 STALE_CHECK_PERIOD_S = 0.1
 """How often the controller checks that states still arrive."""
 
-FIRST_DT_S = 0.02
-"""dt of the first step, before two state stamps exist."""
-
-DT_MIN_S, DT_MAX_S = 1e-3, 0.2
-"""dt is clamped to this range, whatever the stamps say."""
 
 
 def robot_loads(path: object) -> None:
@@ -93,27 +84,6 @@ CONTROLLER_PARAMS = (
     ),
 )
 """The parameters of every controller, after those of its law."""
-
-
-class Hold(Exception):
-    """A reason to command zero: a short ``status`` and a human ``reason``."""
-
-    def __init__(self, status: str, reason: str, output: LawOutput | None = None) -> None:
-        super().__init__(reason)
-        self.status = status
-        self.reason = reason
-        self.output = output
-
-
-def task_of(goal: Goal) -> Task:
-    """The ``wbc`` task a goal asks for."""
-    if goal.task == "pose":
-        return PoseTask(np.array(goal.pose))
-    if goal.task == "position":
-        return PositionTask(np.array(goal.position))
-    if goal.task == "point":
-        return PointTask(np.array(goal.point), np.array(goal.arm), float(goal.lookahead))
-    return HeadingTask(float(goal.heading), np.array(goal.arm), np.array(goal.point))
 
 
 def goal_of(task: Task, header: Header) -> Goal:
@@ -146,16 +116,11 @@ class Controller(Component):
         self.base_command = node.publisher(topics.BASE_COMMAND)
         self.arm_command = node.publisher(topics.ARM_COMMAND)
         self.diagnostics = node.publisher(topics.CONTROL_DIAGNOSTICS)
-        self.goal: Goal | None = None
-        self.task: Task | None = None
-        self.obstacles: tuple[Circle, ...] = ()
         self.robot_path = self._robot_path()
-        self.robot = load_robot(self.robot_path)
-        self._gains_cache: tuple[int, Goal | None, Any, dict[str, float]] | None = None
-        self.gains = self.current_gains()[0]
-        self.law = self.law_type(self.robot, self.gains)
-        self._robot_version = node.params.version
-        self._last_stamp_ns: int | None = None
+        gains = gains_of(self.gains_type, node.params, None)
+        self.stepper = ControlStep(self.law_name, self.law_type, load_robot(self.robot_path),
+                                   gains)  # fmt: skip
+        self._seen = (node.params.version, None)  # the parameters and goal the gains are of
         node.counters["non_finite_commands"] = 0
         node.counters["law_errors"] = 0
         self.state_input = node.subscribe(topics.ROBOT_STATE, self.on_state)
@@ -163,39 +128,44 @@ class Controller(Component):
         node.subscribe(topics.WORLD_OBSTACLES, self.on_obstacles)
         node.timer(STALE_CHECK_PERIOD_S, self.check_inputs_arrive)
 
+    @property
+    def robot(self) -> MobileManipulator:
+        return self.stepper.robot
+
     def on_goal(self, goal: Goal) -> None:
-        """Take a goal; a different task (another kind, or a goal moved by over
-        ``MEASUREMENT_TOLERANCE``) resets the law. A goal the law refuses (ValueError,
-        counted in ``errors.control/goal``) drops the current one: no goal, zero commands.
-        The goal's ``eta`` and ``beta`` must lie in the bounds of the parameters they override,
-        as for ``parsimony param set``."""
+        """Take a goal (``ControlStep.take_goal``). A goal the law refuses (ValueError, counted
+        in ``errors.control/goal``) drops the current one: no goal, zero commands. The goal's
+        ``eta`` and ``beta`` must lie in the bounds of the parameters they override, as for
+        ``parsimony param set``."""
         try:
-            for name in ("eta", "beta"):
+            for name in GOAL_OVERRIDES:
                 value = getattr(goal, name)
                 if value is not None and name in self.node.params:
                     self.node.params.param(name).check(value)
-            task = task_of(goal)
         except ValueError:
-            self.goal = self.task = None
+            self.stepper.goal = self.stepper.task = None
             raise
-        if self.task is None or not same_task(self.task, task, MEASUREMENT_TOLERANCE):
-            self.law.reset()
-        self.goal, self.task = goal, task
+        self.stepper.take_goal(goal)
 
     def on_obstacles(self, message: Obstacles) -> None:
         """Take the obstacles every following step avoids."""
-        self.obstacles = tuple(Circle(c.x, c.y, c.radius) for c in message.circles)
+        self.stepper.take_obstacles(tuple(Circle(c.x, c.y, c.radius) for c in message.circles))
 
     def on_state(self, state: RobotState) -> None:
-        """One control step: publish the law's commands, or zeros and why."""
-        stamp = state.header.stamp_ns
-        dt = FIRST_DT_S if self._last_stamp_ns is None else (stamp - self._last_stamp_ns) / 1e9
-        self._last_stamp_ns = stamp
+        """One control step: publish its commands and diagnostics."""
         try:
-            output = self.control(state, min(max(dt, DT_MIN_S), DT_MAX_S))
-            self.publish(stamp, output, state.base_pose[2])
-        except Hold as hold:
-            self.publish_zero(stamp, hold.status, hold.reason, hold.output)
+            self.update_law()
+        except ParamError as error:
+            self.stepper.last_stamp_ns = state.header.stamp_ns
+            self.publish(Step.zero(state.header.stamp_ns, "error", str(error)))
+            return
+        step = self.stepper.step(state, self.node.clock.now_ns(),
+                                 self.node.params["stale_timeout_s"])  # fmt: skip
+        counter = {"error": "law_errors", "non-finite": "non_finite_commands"}.get(step.status)
+        if counter is not None:
+            self.node.count(counter)
+            self.node.warn(counter, f"{step.reason}; zero sent")
+        self.publish(step)
 
     def check_inputs_arrive(self) -> None:
         """Timer: command zero while no state has arrived for ``stale_timeout_s``."""
@@ -207,142 +177,39 @@ class Controller(Component):
             if math.isinf(age_s)
             else f"no robot/state for {age_s:.2f} s (timeout {timeout_s} s)"
         )
-        self.publish_zero(self.node.clock.now_ns(), "stale", reason)
+        self.publish(Step.zero(self.node.clock.now_ns(), "stale", reason))
 
     def clock_stalled(self, stalled_s: float) -> None:
         """The simulated clock stopped: command zero and say why."""
-        self.publish_zero(self.node.clock.now_ns(), "stale",
-                          f"sim/clock has not moved for {stalled_s:.2f} s")  # fmt: skip
-
-    def control(self, state: RobotState, dt: float) -> LawOutput:
-        """The law's output for ``state``, or ``Hold`` saying why there is none."""
-        age_s = (self.node.clock.now_ns() - state.header.stamp_ns) / 1e9
-        timeout_s = self.node.params["stale_timeout_s"]
-        if age_s > timeout_s:
-            raise Hold("stale", f"robot/state is {age_s:.2f} s old (timeout {timeout_s} s)")
-        if not state.valid:
-            raise Hold("invalid state", "robot/state is not valid (the estimator has no fix)")
-        if self.task is None:
-            raise Hold("no goal", "no control/goal received yet")
-        self.update_law()
-        try:
-            output = self.law.step(np.array(state.configuration()), self.task, dt, self.obstacles)
-        except Exception as error:
-            self.node.count("law_errors")
-            self.node.warn("law_errors", f"{self.law_name} law failed: {error}")
-            raise Hold("error", f"the {self.law_name} law raised: {error}") from error
-        if not output.ok:
-            raise Hold(output.status, f"the {self.law_name} law returned {output.status}", output)
-        return output
-
-    def wanted_gains(self) -> Any:
-        """The law's parameters from the current values, the goal's ``eta``/``beta`` first."""
-        fields = {field.name for field in dataclasses.fields(self.gains_type)}
-        values = {name: self.node.params[name] for name in fields if name in self.node.params}
-        if self.goal is not None:
-            for name in ("eta", "beta"):
-                override = getattr(self.goal, name)
-                if override is not None and name in fields:
-                    values[name] = override
-        return self.gains_type(**values)
-
-    def current_gains(self) -> tuple[Any, dict[str, float]]:
-        """``wanted_gains()`` and its float fields (the diagnostics' ``parameters``), computed
-        again only after a parameter or the goal changed."""
-        version, goal = self.node.params.version, self.goal
-        cached = self._gains_cache
-        if cached is None or cached[0] != version or cached[1] is not goal:
-            gains = self.wanted_gains()
-            values = dataclasses.asdict(gains)
-            floats = {name: v for name, v in values.items() if isinstance(v, float)}
-            cached = self._gains_cache = (version, goal, gains, floats)
-        return cached[2], cached[3]
+        self.publish(Step.zero(self.node.clock.now_ns(), "stale",
+                               f"sim/clock has not moved for {stalled_s:.2f} s"))  # fmt: skip
 
     def update_law(self) -> None:
-        """Reload the robot if its parameter changed; pass changed gains to the law.
-        Both are looked at only after a parameter or the goal changed."""
-        version = self.node.params.version
-        if version != self._robot_version:
-            try:
-                path = self._robot_path()
-                if path != self.robot_path:
-                    self.robot, self.robot_path = load_robot(path), path
-                    self.gains = self.current_gains()[0]
-                    self.law = self.law_type(self.robot, self.gains)
-            except ParamError as error:
-                raise Hold("error", str(error)) from error
-            self._robot_version = version
-        gains = self.current_gains()[0]
-        if gains is not self.gains:
-            if gains != self.gains:
-                self.law.set_params(gains)
-            self.gains = gains
+        """After a parameter or the goal changed: reload the robot if its parameter changed,
+        and pass the gains (the goal's ``eta``/``beta`` over the parameters) to the law."""
+        seen = (self.node.params.version, self.stepper.goal)
+        if seen[0] == self._seen[0] and seen[1] is self._seen[1]:
+            return
+        path = self._robot_path()
+        if path != self.robot_path:
+            robot = load_robot(path)
+            self.robot_path = path
+            self.stepper.use(robot)
+        self.stepper.set_gains(gains_of(self.gains_type, self.node.params, self.stepper.goal))
+        self._seen = seen
 
-    def publish(self, stamp_ns: int, output: LawOutput, phi: float) -> None:
-        """Publish the commands of ``output``, or zeros if one of them is not finite."""
-        u = output.u
-        if u.shape != (3 + ARM_JOINTS,):
-            raise Hold("error", f"u has shape {u.shape}; the arm command takes {ARM_JOINTS} joints")
-        if not np.all(np.isfinite(u)):
-            self._non_finite(u)
-        base = wheel_speeds(*unicycle(u[0], u[1], u[2], phi), self.robot.base)
-        wheels = (base.forward, base.angular, base.left_wheel, base.right_wheel)
-        if not all(math.isfinite(value) for value in wheels):
-            self._non_finite(np.array(wheels))
-        self._put_commands(stamp_ns, wheels, tuple(u[3:].tolist()))
-        self._put_diagnostics(stamp_ns, "optimal", "", output)
-
-    def publish_zero(
-        self, stamp_ns: int, status: str, reason: str, output: LawOutput | None = None
-    ) -> None:
-        """Publish zero commands and diagnostics saying why."""
-        self._put_commands(stamp_ns, (0.0, 0.0, 0.0, 0.0), (0.0,) * ARM_JOINTS)
-        self._put_diagnostics(stamp_ns, status, reason, output)
-
-    def _non_finite(self, values: np.ndarray) -> None:
-        self.node.count("non_finite_commands")
-        self.node.warn("non_finite_commands", f"{self.law_name} law gave {values}; zero sent")
-        raise Hold("non-finite", f"the {self.law_name} law gave a non-finite command {values}")
-
-    def _put_commands(
-        self, stamp_ns: int, wheels: tuple[float, ...], joints: tuple[float, ...]
-    ) -> None:
-        forward, angular, left, right = wheels
+    def publish(self, step: Step) -> None:
+        """The commands and the diagnostics of ``step``."""
+        forward, angular, left, right = step.wheels
         base, arm = self.base_command, self.arm_command
-        base.put(
-            BaseCommand(
-                header=self.node.header("base", stamp_ns, base.next_seq),
-                forward_velocity=forward,
-                angular_velocity=angular,
-                left_wheel=left,
-                right_wheel=right,
-            )
-        )
-        arm.put(
-            ArmCommand(
-                header=self.node.header("arm", stamp_ns, arm.next_seq), joint_velocities=joints
-            )
-        )
-
-    def _put_diagnostics(
-        self, stamp_ns: int, status: str, reason: str, output: LawOutput | None
-    ) -> None:
-        parameters = self.current_gains()[1]
-        self.diagnostics.put(
-            ControllerDiagnostics(
-                header=self.node.header("world", stamp_ns, self.diagnostics.next_seq),
-                law=self.law_name,
-                status=status,
-                reason=reason,
-                objective=_finite_or_none(output.objective if output else None),
-                nonzero=output.nonzero if output else 0,
-                practical_nonzero=output.practical_nonzero if output else 0,
-                active_constraints=output.active_constraints if output else (),
-                solve_time_us=output.solve_time_s * 1e6 if output else 0.0,
-                error_norm=_finite_or_none(output.error_norm if output else None),
-                parameters=parameters,
-            )
-        )
+        base.put(BaseCommand(header=self.node.header("base", step.stamp_ns, base.next_seq),
+                             forward_velocity=forward, angular_velocity=angular,
+                             left_wheel=left, right_wheel=right))  # fmt: skip
+        arm.put(ArmCommand(header=self.node.header("arm", step.stamp_ns, arm.next_seq),
+                           joint_velocities=step.joints))  # fmt: skip
+        self.diagnostics.put(diagnostics_of(
+            step, self.law_name, self.stepper.gains,
+            self.node.header("world", step.stamp_ns, self.diagnostics.next_seq)))  # fmt: skip
 
     def _robot_path(self) -> Path:
         """The ``robot`` parameter, or the profile's robot when it is empty."""
@@ -360,6 +227,24 @@ def load_robot(path: Path) -> MobileManipulator:
         return MobileManipulator.from_yaml(path)
     except (OSError, ValueError, yaml.YAMLError) as error:
         raise ParamError(f"robot: cannot load {path}: {error}") from error
+
+
+def diagnostics_of(step: Step, law: str, gains: Any, header: Header) -> ControllerDiagnostics:
+    """What ``step`` did, as the diagnostics say it, with every gain in force."""
+    output = step.output
+    return ControllerDiagnostics(
+        header=header,
+        law=law,
+        status=step.status,
+        reason=step.reason,
+        objective=_finite_or_none(output.objective if output else None),
+        nonzero=output.nonzero if output else 0,
+        practical_nonzero=output.practical_nonzero if output else 0,
+        active_constraints=output.active_constraints if output else (),
+        solve_time_us=output.solve_time_s * 1e6 if output else 0.0,
+        error_norm=_finite_or_none(output.error_norm if output else None),
+        parameters=gain_values(gains),
+    )
 
 
 def _finite_or_none(value: float | None) -> float | None:

@@ -17,7 +17,8 @@ class ControllerDiagnostics(Message):
     of ``u`` and ``practical_nonzero`` those above the practical threshold.
     ``active_constraints`` names the constraints at their bound,
     ``solve_time_us`` is the solve's wall time in microseconds, ``error_norm``
-    the task error's norm, ``parameters`` the gains in force.
+    the task error's norm, ``parameters`` every gain in force (a recording says what each step
+    ran with).
     """
 
     header: Header
@@ -30,4 +31,4 @@ class ControllerDiagnostics(Message):
     active_constraints: tuple[str, ...] = ()
     solve_time_us: NonNegative
     error_norm: NonNegative | None = None
-    parameters: dict[str, Finite] = Field(default_factory=dict)
+    parameters: dict[str, bool | Finite | str] = Field(default_factory=dict)

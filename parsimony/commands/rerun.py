@@ -3,8 +3,11 @@ robot states, goals and obstacles of a recording.
 
 OUT holds the recording's inputs, the law's commands and diagnostics on the keys the
 controller used, and the recorded ones beside them on ``<key>/recorded``; so
-``parsimony report FILE OUT`` compares the two laws on the same inputs. Each state is one step,
-dt the difference of state stamps as in the controller process (``components.controller``).
+``parsimony report FILE OUT`` compares the two laws on the same inputs. Each state is one step
+of the controller process's own (``components.control_step``), at the state's stamp (a
+recording does not say how late a state came, so none is stale); the recorded law is run with
+the gains its diagnostics carry at each step, another law with its defaults. On a lockstep
+recording of the same law, the commands come out bit for bit as recorded.
 """
 
 from __future__ import annotations
@@ -14,29 +17,26 @@ import math
 import sys
 from pathlib import Path
 
-import numpy as np
-
-from components.controller import DT_MAX_S, DT_MIN_S, FIRST_DT_S, task_of
+from components.cascade_controller import CascadeController
+from components.control_step import ControlStep, Step, gains_of
+from components.controller import Controller, diagnostics_of
+from components.lp_controller import LPController
 from messages.commands import ArmCommand, BaseCommand
-from messages.diagnostics import ControllerDiagnostics
 from messages.header import Header
 from parsimony.output import emit
 from parsimony.outputs import writable_output, written_whole
-from record.session_file import SessionWriter, read_groups
-from wbc.base_motion import unicycle, wheel_speeds
-from wbc.cascade_law import CascadeLaw, CascadeParams
-from wbc.lp_law import LPLaw, LPParams
+from record.session_file import Recorded, SessionWriter, read_groups
 from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
-from wbc.task import MEASUREMENT_TOLERANCE, same_task
 
 ROBOT = Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"
-LAWS = {"lp": lambda robot: LPLaw(robot, LPParams()),
-        "cascade": lambda robot: CascadeLaw(robot, CascadeParams())}  # fmt: skip
+LAWS: dict[str, type[Controller]] = {c.law_name: c for c in (LPController, CascadeController)}
+"""The controllers whose law can be run again, by law name."""
 OUTPUTS = ("base/command", "arm/command", "control/diagnostics")
 """The topics the law writes; the recorded ones move to ``<key>/recorded``."""
-BEFORE_STATE = ("control/goal", "world/obstacles")
-"""The estimator publishes these before the state of the same stamp, which they hold for."""
+BEFORE_STATE = ("control/goal", "world/obstacles", "control/diagnostics")
+"""Taken before the state of the same stamp: the estimator publishes the goal and obstacles
+a state holds for before it, and the diagnostics answering it carry the gains it ran with."""
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -55,8 +55,7 @@ def run(args: argparse.Namespace) -> int:
     if problem:
         print(f"rerun: {problem}", file=sys.stderr)
         return 2
-    robot = MobileManipulator.from_yaml(args.robot)
-    offline = Offline(LAWS[args.controller](robot), args.controller, robot)
+    offline = Offline(LAWS[args.controller], MobileManipulator.from_yaml(args.robot))
     try:
         with written_whole(args.output) as partial, SessionWriter(partial) as out:
             for group in read_groups(args.file):  # streamed: memory does not grow with it
@@ -71,50 +70,50 @@ def run(args: argparse.Namespace) -> int:
 
 class Offline:
     """The law run on a recording's messages one by one: each is copied to the output (the
-    recorded commands and diagnostics renamed ``.../recorded``), and each valid state with a
-    goal gets one step of the law, written as its commands and diagnostics."""
+    recorded commands and diagnostics renamed ``.../recorded``), and each state is one
+    ``ControlStep``, written as its commands and diagnostics."""
 
-    def __init__(self, law, name: str, robot: MobileManipulator) -> None:
-        self.law, self.name, self.robot = law, name, robot
-        self.task, self.obstacles, self.last_ns, self.steps = None, (), None, 0
+    def __init__(self, controller: type[Controller], robot: MobileManipulator) -> None:
+        self.name, self.gains_type = controller.law_name, controller.gains_type
+        self.stepper = ControlStep(self.name, controller.law_type, robot,
+                                   self.gains_type())  # fmt: skip
+        self.steps = 0
+        self.recorded_gains = False  # whether the recording said the gains of this law
 
-    def take(self, out: SessionWriter, record) -> None:
+    def take(self, out: SessionWriter, record: Recorded) -> None:
         if record.message is None:
             return
         name, key, message = record.topic_name, record.key, record.message
         if name in OUTPUTS:
             out.write(f"{key}/recorded", message, record.log_time_ns)
+            if name == "control/diagnostics" and message.law == self.name:
+                self.stepper.set_gains(gains_of(self.gains_type, message.parameters, None))
+                self.recorded_gains = True
             return
         out.write(key, message, record.log_time_ns)
         if name == "control/goal":
-            new = task_of(message)
-            if self.task is None or not same_task(self.task, new, MEASUREMENT_TOLERANCE):
-                self.law.reset()
-            self.task = new
+            try:
+                self.stepper.take_goal(message)  # a goal the law refuses: no goal, as live
+            except ValueError:
+                return
+            if not self.recorded_gains:  # the defaults, the goal's eta and beta over them
+                self.stepper.set_gains(gains_of(self.gains_type, {}, message))
         elif name == "world/obstacles":
-            self.obstacles = tuple(Circle(c.x, c.y, c.radius) for c in message.circles)
-        elif name == "robot/state" and message.valid and self.task is not None:
+            self.stepper.take_obstacles(tuple(Circle(c.x, c.y, c.radius)
+                                              for c in message.circles))  # fmt: skip
+        elif name == "robot/state":
             stamp = message.header.stamp_ns
-            dt = FIRST_DT_S if self.last_ns is None else (stamp - self.last_ns) / 1e9
-            self.last_ns = stamp
-            output = self.law.step(np.array(message.configuration()), self.task,
-                                   min(max(dt, DT_MIN_S), DT_MAX_S), self.obstacles)  # fmt: skip
-            write_step(out, key[: -len(name) - 1], self.name, stamp, output, message, self.robot)
+            step = self.stepper.step(message, stamp, math.inf)
+            write_step(out, key[: -len(name) - 1], self.name, step, self.stepper.gains)
             self.steps += 1
 
 
-def write_step(out, namespace: str, law: str, stamp: int, output, state, robot) -> None:
-    """The commands and diagnostics of one step, stamped with the state's stamp."""
-    u = output.u if output.ok and np.all(np.isfinite(output.u)) else np.zeros(8)
-    base = wheel_speeds(*unicycle(u[0], u[1], u[2], state.base_pose[2]), robot.base)
-    header = Header(stamp_ns=stamp, frame="world", seq=0, source=f"rerun_{law}")
+def write_step(out: SessionWriter, namespace: str, law: str, step: Step, gains) -> None:
+    """The commands and diagnostics of one step, stamped with its state's stamp."""
+    header = Header(stamp_ns=step.stamp_ns, frame="world", seq=0, source=f"rerun_{law}")
+    forward, angular, left, right = step.wheels
     out.write(f"{namespace}/base/command", BaseCommand(
-        header=header, forward_velocity=base.forward, angular_velocity=base.angular,
-        left_wheel=base.left_wheel, right_wheel=base.right_wheel))  # fmt: skip
-    out.write(f"{namespace}/arm/command",
-              ArmCommand(header=header, joint_velocities=tuple(u[3:].tolist())))  # fmt: skip
-    error = output.error_norm if math.isfinite(output.error_norm) else None
-    out.write(f"{namespace}/control/diagnostics", ControllerDiagnostics(
-        header=header, law=law, status=output.status if output.ok else "error",
-        nonzero=output.nonzero, practical_nonzero=output.practical_nonzero,
-        solve_time_us=output.solve_time_s * 1e6, error_norm=error))  # fmt: skip
+        header=header, forward_velocity=forward, angular_velocity=angular, left_wheel=left,
+        right_wheel=right))  # fmt: skip
+    out.write(f"{namespace}/arm/command", ArmCommand(header=header, joint_velocities=step.joints))
+    out.write(f"{namespace}/control/diagnostics", diagnostics_of(step, law, gains, header))

@@ -327,20 +327,20 @@ def test_the_law_gets_changed_gains_and_only_then(deployed: Callable[[str], Syst
     system = deployed(LP_PROFILE.read_text())
     with Node(system.profile, "controller", LPController.params) as node:
         controller = LPController(node)
-        law = controller.law
-        gains = controller.gains
+        law = controller.stepper.law
+        gains = controller.stepper.gains
         controller.update_law()
-        assert controller.gains is gains and law.params.eta == 0.6
+        assert controller.stepper.gains is gains and law.params.eta == 0.6
 
         node.params.set_text("eta", "2.0")
         controller.update_law()
-        assert controller.law is law and law.params.eta == 2.0
-        assert controller.current_gains()[1]["eta"] == 2.0
+        assert controller.stepper.law is law and law.params.eta == 2.0
+        assert controller.stepper.gains.eta == 2.0
 
         header = Header(stamp_ns=1, frame="world", seq=0, source="test")
         controller.on_goal(Goal(header=header, task="pose", pose=GOAL_POSE, eta=1.5))
         controller.update_law()
-        assert law.params.eta == 1.5 and controller.current_gains()[1]["eta"] == 1.5
+        assert law.params.eta == 1.5 and controller.stepper.gains.eta == 1.5
         node.params.set_text("joint_gain", "3.0")
         controller.update_law()
         assert (law.params.eta, law.params.joint_gain) == (1.5, 3.0)

@@ -12,7 +12,8 @@ import pytest
 from conftest import DEADLINE_S, DEPLOY, System
 from driver_harness import status as component_status
 
-from components.controller import goal_of, task_of
+from components.control_step import task_of
+from components.controller import goal_of
 from messages import codec, topics
 from messages.goal import Goal
 from messages.header import Header

@@ -122,9 +122,11 @@ def test_a_component_that_never_comes_alive_fails_the_launch_by_name(
 def test_a_configuration_error_at_start_up_fails_the_whole_launch(
     write_profile: ProfileWriter, launch: LaunchFixture
 ) -> None:
-    """One component refuses its parameters (exit 2): the others are stopped, the launch
-    fails, instead of running on without it."""
-    bad = publisher("bad", params={"rate_hz": 0.0})
+    """One component cannot start with what it was given (exit 2: a recorder whose file
+    cannot be made, which no check of the profile can know): the others are stopped, the
+    launch fails, instead of running on without it."""
+    bad = {"name": "bad", "module": "recorder", "role": "tool",
+           "params": {"path": "/dev/null/session.mcap"}}  # fmt: skip
     launched = launch(write_profile([publisher("good"), bad]))
     launched.wait_for(r"\[launch\] bad exited with 2; configuration error, not restarting")
     launched.wait_for(r"\[launch\] stopping \(start-up failed: bad failed during start-up\)")

@@ -1,0 +1,162 @@
+"""One control step: a pure function of the law, the state, the goal, the obstacles and the
+clock, shared by the controller process (``components.controller``) and ``parsimony rerun``::
+
+    u = law.step(q, task, dt, obstacles)          u = [x', y', phi', q1'..q5']
+    base/command = wheel_speeds(unicycle(x', y', phi', phi))        (m/s, rad/s)
+    arm/command  = u[3:]                                            (rad/s)
+
+with ``dt`` the difference of consecutive state stamps, clamped to [1 ms, 0.2 s] (0.02 s at
+the first step). The step commands zero, and says why (``status``, ``reason``), whenever its
+output cannot be trusted: the state is older than the stale timeout, it is not ``valid``,
+there is no goal, the law raises or returns a status other than ``optimal``, or a command
+would not be finite.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from messages.base import ARM_JOINTS
+from messages.goal import Goal
+from messages.state import RobotState
+from wbc.base_motion import unicycle, wheel_speeds
+from wbc.drive_tasks import HeadingTask, PointTask
+from wbc.law_output import Law, LawOutput
+from wbc.obstacles import Circle
+from wbc.robot import MobileManipulator
+from wbc.task import MEASUREMENT_TOLERANCE, PoseTask, PositionTask, Task, same_task
+
+FIRST_DT_S = 0.02
+"""dt of the first step, before two state stamps exist."""
+DT_MIN_S, DT_MAX_S = 1e-3, 0.2
+"""dt is clamped to this range, whatever the stamps say."""
+GOAL_OVERRIDES = ("eta", "beta")
+"""The gains a goal may set while it holds."""
+ZERO_WHEELS = (0.0, 0.0, 0.0, 0.0)
+
+
+def task_of(goal: Goal) -> Task:
+    """The ``wbc`` task a goal asks for."""
+    if goal.task == "pose":
+        return PoseTask(np.array(goal.pose))
+    if goal.task == "position":
+        return PositionTask(np.array(goal.position))
+    if goal.task == "point":
+        return PointTask(np.array(goal.point), np.array(goal.arm), float(goal.lookahead))
+    return HeadingTask(float(goal.heading), np.array(goal.arm), np.array(goal.point))
+
+
+@dataclass(frozen=True)
+class Step:
+    """What one step commands: the base's (forward, angular, left wheel, right wheel) and the
+    arm's joint speeds, the outcome (``optimal`` or why zero was sent) and the law's output
+    when there is one."""
+
+    stamp_ns: int
+    wheels: tuple[float, float, float, float]
+    joints: tuple[float, ...]
+    status: str
+    reason: str = ""
+    output: LawOutput | None = None
+
+    @classmethod
+    def zero(cls, stamp_ns: int, status: str, reason: str,
+             output: LawOutput | None = None) -> Step:  # fmt: skip
+        return cls(stamp_ns, ZERO_WHEELS, (0.0,) * ARM_JOINTS, status, reason, output)
+
+
+class ControlStep:
+    """A law stepped on states: the task of the last goal (a different task resets the law),
+    the last obstacles, the last state's stamp (for dt) and the gains in force."""
+
+    def __init__(self, name: str, law_type: Callable[[MobileManipulator, Any], Law],
+                 robot: MobileManipulator, gains: Any) -> None:  # fmt: skip
+        self.name, self.law_type, self.robot = name, law_type, robot
+        self.gains = gains
+        self.law = law_type(robot, gains)
+        self.goal: Goal | None = None
+        self.task: Task | None = None
+        self.obstacles: tuple[Circle, ...] = ()
+        self.last_stamp_ns: int | None = None
+
+    def take_goal(self, goal: Goal) -> None:
+        """Follow ``goal``; a goal the law cannot take (``ValueError``) drops the current one."""
+        try:
+            task = task_of(goal)
+        except ValueError:
+            self.goal = self.task = None
+            raise
+        if self.task is None or not same_task(self.task, task, MEASUREMENT_TOLERANCE):
+            self.law.reset()
+        self.goal, self.task = goal, task
+
+    def take_obstacles(self, circles: tuple[Circle, ...]) -> None:
+        self.obstacles = circles
+
+    def use(self, robot: MobileManipulator) -> None:
+        """Control ``robot`` from now on (a new law of the gains in force)."""
+        self.robot, self.law = robot, self.law_type(robot, self.gains)
+
+    def set_gains(self, gains: Any) -> None:
+        """The gains of the following steps (the law is told only when they differ)."""
+        if gains != self.gains:
+            self.law.set_params(gains)
+        self.gains = gains
+
+    def step(self, state: RobotState, now_ns: int, stale_timeout_s: float) -> Step:
+        """The commands answering ``state`` at ``now_ns``, stamped with its stamp."""
+        stamp = state.header.stamp_ns
+        dt = FIRST_DT_S if self.last_stamp_ns is None else (stamp - self.last_stamp_ns) / 1e9
+        self.last_stamp_ns = stamp
+        age_s = (now_ns - stamp) / 1e9
+        if age_s > stale_timeout_s:
+            return Step.zero(stamp, "stale", f"robot/state is {age_s:.2f} s old "
+                                             f"(timeout {stale_timeout_s} s)")  # fmt: skip
+        if not state.valid:
+            return Step.zero(stamp, "invalid state",
+                             "robot/state is not valid (the estimator has no fix)")  # fmt: skip
+        if self.task is None:
+            return Step.zero(stamp, "no goal", "no control/goal received yet")
+        try:
+            output = self.law.step(np.array(state.configuration()), self.task,
+                                   min(max(dt, DT_MIN_S), DT_MAX_S), self.obstacles)  # fmt: skip
+        except Exception as error:  # noqa: BLE001 - any failure of the law holds the robot
+            return Step.zero(stamp, "error", f"the {self.name} law raised: {error}")
+        if not output.ok:
+            return Step.zero(stamp, output.status, f"the {self.name} law returned "
+                                                   f"{output.status}", output)  # fmt: skip
+        u = output.u
+        if u.shape != (3 + ARM_JOINTS,):
+            return Step.zero(stamp, "error", f"u has shape {u.shape}; the arm command takes "
+                                             f"{ARM_JOINTS} joints")  # fmt: skip
+        base = wheel_speeds(*unicycle(u[0], u[1], u[2], state.base_pose[2]), self.robot.base)
+        wheels = (base.forward, base.angular, base.left_wheel, base.right_wheel)
+        if not (np.all(np.isfinite(u)) and all(math.isfinite(w) for w in wheels)):
+            return Step.zero(stamp, "non-finite", f"the {self.name} law gave a non-finite "
+                                                  f"command {u}")  # fmt: skip
+        return Step(stamp, wheels, tuple(u[3:].tolist()), "optimal", "", output)
+
+
+def gains_of(gains_type: type, values: Mapping[str, Any], goal: Goal | None) -> Any:
+    """The law's gains from ``values`` (the fields of ``gains_type`` they name), a goal's
+    ``GOAL_OVERRIDES`` over them while it holds."""
+    fields = {field.name for field in dataclasses.fields(gains_type)}
+    chosen = {name: value for name, value in values.items() if name in fields}
+    if goal is not None:
+        for name in GOAL_OVERRIDES:
+            override = getattr(goal, name)
+            if override is not None and name in fields:
+                chosen[name] = override
+    return gains_type(**chosen)
+
+
+def gain_values(gains: Any) -> dict[str, float | bool | str]:
+    """Every gain in force by name: what the diagnostics carry, so a recording says which
+    gains each step ran with (``parsimony rerun`` takes them back with ``gains_of``)."""
+    return dataclasses.asdict(gains)
