@@ -64,13 +64,8 @@ def robot_loads(path: object) -> None:
 
 
 def law_params(gains_type: type) -> tuple[Param, ...]:
-    """A law's gains as run-time parameters, each with the bounds, choices and doc its
-    dataclass declares (``wbc.gains``)."""
-    return tuple(
-        Param(spec.name, spec.type, spec.default, low=spec.low, high=spec.high,
-              choices=spec.choices, doc=spec.doc)
-        for spec in gain_specs(gains_type)
-    )  # fmt: skip
+    """A law's gains as run-time parameters, as its dataclass declares them (``wbc.gains``)."""
+    return tuple(Param.of(spec) for spec in gain_specs(gains_type))
 
 
 CONTROLLER_PARAMS = (

@@ -10,15 +10,15 @@ replied as plain text.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
-import math
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from messages.process import ParamValue
-from profiles.profile import shown
+from wbc.gains import GainSpec, shown
 
 log = logging.getLogger("components")
 
@@ -31,54 +31,27 @@ class ParamError(ValueError):
 
 
 @dataclass(frozen=True)
-class Param:
-    """A declared parameter: ``name``, ``type`` (bool, int, float or str), ``default``,
-    optional inclusive bounds ``low`` and ``high`` for numbers, optional ``choices``
-    (the only values allowed), a one-line ``doc`` and an optional ``can_take`` check."""
+class Param(GainSpec):
+    """A declared parameter: a ``GainSpec`` (name, type, default, bounds, choices, doc; its
+    validator), with an optional ``can_take`` check."""
 
-    name: str
-    type: type[bool] | type[int] | type[float] | type[str]
-    default: ParamValue
-    low: float | None = None
-    high: float | None = None
-    choices: tuple[ParamValue, ...] | None = None
-    doc: str = ""
     can_take: Callable[[ParamValue], None] | None = field(default=None, compare=False)
     """Raises ``ParamError`` when a value of the right type could not take effect (a robot
     file that does not load): such a value is refused when set, not failed on later."""
 
-    def __post_init__(self) -> None:
-        self.check(self.default)
-
-    def expected(self) -> str:
-        """What a valid value is, in words: ``"a float in [0, 10]"``."""
-        what = f"a {self.type.__name__}"
-        if self.choices is not None:
-            return f"{what} in {{{', '.join(map(repr, self.choices))}}}"
-        if self.low is not None and self.high is not None:
-            return f"{what} in [{self.low}, {self.high}]"
-        if self.low is not None:
-            return f"{what} >= {self.low}"
-        if self.high is not None:
-            return f"{what} <= {self.high}"
-        return what
+    @classmethod
+    def of(cls, spec: GainSpec) -> Param:
+        """The run-time parameter of a law's gain, as declared."""
+        return cls(**{f.name: getattr(spec, f.name) for f in dataclasses.fields(GainSpec)})
 
     def check(self, value: object) -> ParamValue:
-        """``value`` as this parameter's type, or ``ParamError`` saying what was expected.
-
-        An int is accepted for a float; a bool is never accepted as a number.
-        """
-        if self.type is float and isinstance(value, int) and not isinstance(value, bool):
-            value = float(value)
-        if type(value) is not self.type or (self.type is float and not math.isfinite(value)):
-            raise ParamError(f"{self.name}: expected {self.expected()}, got {shown(value)}")
-        if isinstance(value, int | float) and not isinstance(value, bool):
-            if (self.low is not None and value < self.low) or (
-                self.high is not None and value > self.high
-            ):
-                raise ParamError(f"{self.name}: expected {self.expected()}, got {shown(value)}")
-        if self.choices is not None and value not in self.choices:
-            raise ParamError(f"{self.name}: expected {self.expected()}, got {shown(value)}")
+        """``value`` as this parameter's type, or ``ParamError`` saying what was expected."""
+        try:
+            value = super().check(value)
+        except ParamError:
+            raise
+        except ValueError as error:
+            raise ParamError(str(error)) from None
         if self.can_take is not None:
             self.can_take(value)
         return value

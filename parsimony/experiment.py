@@ -88,8 +88,8 @@ class Options:
 
 def law_overrides(options: Options) -> dict[str, Any]:
     """The LP gains of the experiment that differ from the law's defaults (the cascade's
-    defaults are the dissertation's)."""
-    if options.controller != "lp":
+    defaults are the dissertation's; an experiment under the supervisor takes its profile's)."""
+    if options.controller != "lp" or options.name not in LP_PARAMS:
         return {}
     wanted, default = LP_PARAMS[options.name], LPParams()
     return {

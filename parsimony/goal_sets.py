@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from parsimony.kinematic_demo import SUPERVISED_PARAMS
+from parsimony.kinematic_demo import supervised_params
 from wbc import dq
 from wbc.cascade_law import CascadeLaw
 from wbc.kinematic_run import integrate, integrate_supervised
@@ -230,7 +230,7 @@ SUPERVISED = "lp + staging supervisor"
 LAWS: dict[str, Callable[[MobileManipulator], Law]] = {
     "lp": lambda robot: LPLaw(robot),
     "lp 5.29 exactly": lambda robot: LPLaw(robot, EXACT_5_29),
-    SUPERVISED: lambda robot: LPLaw(robot, SUPERVISED_PARAMS),
+    SUPERVISED: lambda robot: LPLaw(robot, supervised_params()),
     "cascade": lambda robot: CascadeLaw(robot),
 }
 """The laws compared: the default LP, LP 5.29 with no term added to the task, the LP under the

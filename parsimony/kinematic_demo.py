@@ -7,11 +7,14 @@ effort of table 6.1.
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
+from profiles.profile import load_profile
 from wbc import dq
 from wbc.cascade_law import CascadeLaw
 from wbc.kinematic_run import Run, control_effort, integrate
@@ -40,19 +43,26 @@ the circulation could not start it again (seed 1: error 0.65 after 60 s)."""
 BORDER_PARAMS = replace(OBSTACLE_PARAMS, obstacle_mode="border")
 """The same law with the dissertation's border constraint 5.28, for comparison."""
 
-SUPERVISED_PARAMS = LPParams(base_target=0.0, error_bound="error")
-"""The LP law under the staging supervisor (wbc.staging_supervisor), which plans where the base
-should stand: the base target term, a cruder guess of the same, is off, and ||u||_1 is bounded
-by the error (5.7), not by its measured rate (5.10), which shrinks as a leg slows and then
-starves it (the share of goals 'anywhere' reached went from 0.9 to 0.95 on 40 goals)."""
+SUPERVISED_PROFILE = Path(__file__).resolve().parents[1] / "deploy" / "sim_supervised.yaml"
+"""The profile of the LP under the staging supervisor, which declares that LP's gains."""
+
+
+@functools.cache
+def supervised_params() -> LPParams:
+    """The LP law's gains under the staging supervisor (wbc.staging_supervisor), as
+    ``SUPERVISED_PROFILE`` gives its controller (declared there once, the reasons beside)."""
+    controller = load_profile(SUPERVISED_PROFILE).component("controller")
+    return LPParams(**{f.name: controller.params[f.name] for f in dataclasses.fields(LPParams)
+                       if f.name in controller.params})  # fmt: skip
+
 
 LP_PARAMS = {
     "pose": LPParams(eta=0.6, beta=15.0),
     "position": LPParams(eta=1.0, beta=10.0),
     "obstacle": OBSTACLE_PARAMS,
-    "anywhere": SUPERVISED_PARAMS,
 }
-"""The LP law's gains in each experiment of section 6.2 (6.2.1 gives eta 0.6 and beta 15)."""
+"""The LP law's gains in each experiment of section 6.2 (6.2.1 gives eta 0.6 and beta 15);
+an experiment under the supervisor takes its profile's (``supervised_params``)."""
 
 
 @dataclass(frozen=True)

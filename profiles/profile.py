@@ -24,6 +24,7 @@ from messages.process import ParamValue
 from profiles.access import AccessSettings, insert
 from profiles.endpoints import endpoint_problem
 from profiles.scene import Scene
+from wbc.gains import shown
 
 TLS_FILES = ("root_ca_certificate", "listen_certificate", "listen_private_key")
 COMPONENT_PACKAGE = "components"
@@ -338,12 +339,6 @@ def _expanded(node: yaml.Node, sizes: dict[int, int]) -> int:
             children = []
         sizes[id(node)] = 1 + sum(_expanded(child, sizes) for child in children)
     return sizes[id(node)]
-
-
-def shown(value: object, limit: int = 120) -> str:
-    """``repr(value)``, cut to ``limit`` characters (an error never echoes a 50 MB value)."""
-    text = repr(value)
-    return text if len(text) <= limit else f"{text[:limit]}... ({len(text)} characters)"
 
 
 def _read_yaml(path: Path) -> object:

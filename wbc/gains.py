@@ -1,67 +1,90 @@
 """One declaration per gain: default, bounds, choices and doc, read by the law and the process.
 
-A law's parameter dataclass declares each field with ``gain(...)``; ``check_gains`` validates
-an instance against those declarations, and a component derives its run-time parameters from
-``gain_specs`` (``components.controller.law_params``), so a bound is written once.
+A law's parameter dataclass declares each field with ``gain(...)``; a string field's choices
+are its ``Literal`` annotation's. ``check_gains`` validates an instance against those
+declarations, and a component's run-time parameters are those very declarations
+(``components.params.Param`` is a ``GainSpec``), so a bound, a choice and the validator are
+written once.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
+import typing
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Literal
 
 GAIN = "gain"
 
 
+def shown(value: object, limit: int = 120) -> str:
+    """``repr(value)``, cut to ``limit`` characters (an error never echoes a 50 MB value)."""
+    text = repr(value)
+    return text if len(text) <= limit else f"{text[:limit]}... ({len(text)} characters)"
+
+
 @dataclass(frozen=True)
 class GainSpec:
-    """What may be set on one field: its ``type`` (that of its default), inclusive bounds
-    ``low`` and ``high`` for numbers, or the ``choices`` of a string, and a one-line ``doc``."""
+    """What may be set on one value: its ``type`` (bool, int, float or str), its ``default``,
+    inclusive bounds ``low`` and ``high`` for numbers, or the only values allowed
+    (``choices``), and a one-line ``doc``."""
 
     name: str
     type: type
     default: Any
-    low: float | None
-    high: float | None
-    choices: tuple[str, ...] | None
-    doc: str
+    low: float | None = None
+    high: float | None = None
+    choices: tuple[Any, ...] | None = None
+    doc: str = ""
 
-    def problem(self, value: object) -> str | None:
-        """Why ``value`` cannot be this gain, or None."""
+    def __post_init__(self) -> None:
+        self.check(self.default)
+
+    def expected(self) -> str:
+        """What a valid value is, in words: ``"a float in [0, 10]"``."""
+        what = f"a {self.type.__name__}"
+        if self.choices is not None:
+            return f"{what} in {{{', '.join(map(repr, self.choices))}}}"
+        if self.low is not None and self.high is not None:
+            return f"{what} in [{self.low}, {self.high}]"
+        if self.low is not None:
+            return f"{what} >= {self.low}"
+        if self.high is not None:
+            return f"{what} <= {self.high}"
+        return what
+
+    def check(self, value: object) -> Any:
+        """``value`` as this type (an int is taken for a float, a bool never for a number), or
+        ``ValueError`` naming the value and saying what was expected."""
         if self.type is float and isinstance(value, int) and not isinstance(value, bool):
             value = float(value)
-        if type(value) is not self.type:
-            return f"must be a {self.type.__name__}, got {value!r}"
-        if isinstance(value, float) and not math.isfinite(value):
-            return f"must be finite, got {value}"
-        low = -math.inf if self.low is None else self.low
-        high = math.inf if self.high is None else self.high
-        if isinstance(value, float) and not low <= value <= high:
-            return f"must be in [{self.low}, {self.high}], got {value}"
-        if self.choices is not None and value not in self.choices:
-            return f"must be one of {', '.join(map(repr, self.choices))}, got {value!r}"
-        return None
+        number = isinstance(value, int | float) and not isinstance(value, bool)
+        wrong = type(value) is not self.type or (number and not math.isfinite(value))
+        outside = number and not wrong and (
+            (self.low is not None and value < self.low)
+            or (self.high is not None and value > self.high))  # fmt: skip
+        if wrong or outside or (self.choices is not None and value not in self.choices):
+            raise ValueError(f"{self.name}: expected {self.expected()}, got {shown(value)}")
+        return value
 
 
-def gain(
-    default: Any,
-    *,
-    doc: str,
-    low: float | None = None,
-    high: float | None = None,
-    choices: tuple[str, ...] | None = None,
-) -> Any:
-    """A dataclass field with its declaration (see ``GainSpec``)."""
-    return dataclasses.field(default=default, metadata={GAIN: (low, high, choices, doc)})
+def gain(default: Any, *, doc: str, low: float | None = None, high: float | None = None) -> Any:
+    """A dataclass field with its declaration (see ``GainSpec``; choices come from the
+    field's ``Literal`` annotation)."""
+    return dataclasses.field(default=default, metadata={GAIN: (low, high, doc)})
 
 
+@functools.cache
 def gain_specs(params_type: type) -> tuple[GainSpec, ...]:
     """The declarations of every field of a parameter dataclass."""
+    hints = typing.get_type_hints(params_type)
     specs = []
     for field in dataclasses.fields(params_type):
-        low, high, choices, doc = field.metadata[GAIN]
+        low, high, doc = field.metadata[GAIN]
+        hint = hints[field.name]
+        choices = typing.get_args(hint) if typing.get_origin(hint) is Literal else None
         specs.append(GainSpec(field.name, type(field.default), field.default, low, high,
                               choices, doc))  # fmt: skip
     return tuple(specs)
@@ -70,6 +93,7 @@ def gain_specs(params_type: type) -> tuple[GainSpec, ...]:
 def check_gains(params: object) -> None:
     """ValueError naming ``Type.field`` for the first value its declaration refuses."""
     for spec in gain_specs(type(params)):
-        problem = spec.problem(getattr(params, spec.name))
-        if problem is not None:
-            raise ValueError(f"{type(params).__name__}.{spec.name} {problem}")
+        try:
+            spec.check(getattr(params, spec.name))
+        except ValueError as error:
+            raise ValueError(f"{type(params).__name__}.{error}") from None

@@ -11,7 +11,7 @@ from typing import Literal
 import numpy as np
 
 from wbc.constraints.base import Constraint
-from wbc.constraints.error_bound import ErrorBound
+from wbc.constraints.error_bound import ErrorBound, ErrorBoundMode
 from wbc.constraints.joint_limits import JointLimits
 from wbc.constraints.nonholonomic import Nonholonomic
 from wbc.constraints.obstacle_border import BorderObstacle
@@ -44,11 +44,10 @@ class LPParams:
     beta: float = gain(15.0, low=1e-3, high=1e3, doc="bound gain of 5.10 / 5.7")
     joint_gain: float = gain(1.0, low=1e-3, high=1e4, doc="k of 5.14, 1/s")
     safety_factor: float = gain(0.9, low=0.01, high=1.0, doc="beta_l of 5.14")
-    error_bound: Literal["derivative", "error"] = gain(
-        "derivative", choices=("derivative", "error"),
-        doc="5.10 (bound on ||e'||_1) or the original 5.7 (bound on ||e||_1)")
+    error_bound: ErrorBoundMode = gain(
+        "derivative", doc="5.10 (bound on ||e'||_1) or the original 5.7 (bound on ||e||_1)")
     obstacle_mode: Literal["border", "vector_field", "conservative", "off"] = gain(
-        "border", choices=("border", "vector_field", "conservative", "off"),
+        "border",
         doc="obstacle constraint: 5.28 (border), the vector-field inequality d' >= -eta_d d "
             "(vector_field, wbc.constraints.obstacle_vector_field), 5.19 (conservative) or none")
     obstacle_gain: float = gain(2.0, low=1e-3, high=100.0,

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import subprocess
 import sys
@@ -11,9 +10,7 @@ from pathlib import Path
 import pytest
 
 from deploy.graph import dataflow
-from parsimony.kinematic_demo import SUPERVISED_PARAMS
 from profiles.profile import ProfileError, load_profile
-from wbc.lp_law import LPParams
 
 DEPLOY = Path(__file__).resolve().parents[2] / "deploy"
 
@@ -92,13 +89,6 @@ def test_the_supervised_profile_puts_the_supervisor_between_the_goal_and_the_con
     plain = dataflow(load_profile(DEPLOY / "sim.yaml"))
     assert plain.writers("control/goal") == ["state_estimator"]
     assert "goal/request" not in plain.topics()
-
-
-def test_the_supervised_profile_gives_the_controller_the_gains_of_the_kinematic_bench() -> None:
-    wanted = {f.name: getattr(SUPERVISED_PARAMS, f.name) for f in dataclasses.fields(LPParams)
-              if getattr(SUPERVISED_PARAMS, f.name) != getattr(LPParams(), f.name)}  # fmt: skip
-    controller = load_profile(DEPLOY / "sim_supervised.yaml").component("controller")
-    assert {k: v for k, v in controller.params.items() if k in wanted} == wanted
 
 
 def test_a_parameter_no_component_would_take_is_refused_before_anything_starts(

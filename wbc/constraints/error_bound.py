@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Literal, get_args
 
 import numpy as np
 
 from wbc.constraints.base import OneNormBound
 from wbc.step_context import StepContext
+
+ErrorBoundMode = Literal["derivative", "error"]
+"""What the bound measures: e' (5.10) or e (5.7)."""
 
 
 class ErrorBound:
@@ -17,9 +20,10 @@ class ErrorBound:
     goal (e' = 0); with the error form they may keep moving as long as e != 0.
     """
 
-    def __init__(self, beta: float, mode: Literal["derivative", "error"] = "derivative") -> None:
-        if beta <= 0.0 or mode not in ("derivative", "error"):
-            raise ValueError("error bound needs beta > 0 and mode 'derivative' or 'error'")
+    def __init__(self, beta: float, mode: ErrorBoundMode = "derivative") -> None:
+        if beta <= 0.0 or mode not in get_args(ErrorBoundMode):
+            raise ValueError(f"error bound needs beta > 0 and a mode in "
+                             f"{get_args(ErrorBoundMode)}")  # fmt: skip
         self.beta = beta
         self.mode = mode
         self.name = "error_derivative_bound" if mode == "derivative" else "error_bound"
