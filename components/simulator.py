@@ -48,6 +48,7 @@ from messages.camera import CameraFrame, CameraIntrinsics
 from messages.clock import Clock
 from messages.commands import ArmCommand, BaseCommand
 from messages.joints import JointStates
+from messages.lockstep import AnswerStamps
 from messages.obstacles import Circle as TruthCircle
 from messages.odometry import BaseOdometry
 from messages.truth import SimTruth
@@ -198,7 +199,7 @@ class Simulator(Component):
         self.unanswered: Frame | None = None
         self.frame_done = True
         self.sensors_ns: int | None = None
-        self.answered: dict[str, int] = {}
+        self.answered = AnswerStamps()
         self.answer_times = {k: Durations(node.counters, k)
                              for k in ("frame", "frame_wait", "loop")}  # fmt: skip
         node.counters["lockstep_timeouts"] = 0
@@ -301,7 +302,7 @@ class Simulator(Component):
         self._publish_truth()
 
     def _has_answers(self, stamp_ns: int, names: tuple[str, ...] = FRAME_ANSWERS) -> bool:
-        return all(self.answered.get(name, -1) >= stamp_ns for name in names)
+        return self.answered.answered(stamp_ns, names)
 
     def _await(self, names: tuple[str, ...], stamp_ns: int) -> None:
         now = time.monotonic()
@@ -312,7 +313,7 @@ class Simulator(Component):
             if name in COMMANDS:
                 self._take_command(name, message)
             stamp = message.header.stamp_ns
-            self.answered[name] = max(self.answered.get(name, -1), stamp)
+            self.answered.note(name, stamp)
             frame = self.unanswered
             if name in FRAME_ANSWERS and frame is not None and self._has_answers(frame.stamp_ns):
                 # Host time from publishing a frame to its last answer (tracker and estimator).
@@ -341,7 +342,7 @@ class Simulator(Component):
     def _check_overdue(self) -> None:
         awaited = self.awaited
         if awaited is not None and time.monotonic() > awaited.deadline:
-            missing = [n for n in awaited.topics if self.answered.get(n, -1) < awaited.stamp_ns]
+            missing = self.answered.missing(awaited.stamp_ns, awaited.topics)
             self.node.count("lockstep_timeouts")
             self.node.warn("lockstep_timeouts", f"no answer on {', '.join(missing)} for "
                            f"t={awaited.stamp_ns / 1e9:.3f} s; going on")  # fmt: skip

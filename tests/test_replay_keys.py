@@ -23,9 +23,9 @@ import zenoh
 from messages import codec, topics
 from messages.header import Header
 from messages.odometry import BaseOdometry
-from parsimony.commands.replay import Pace
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
+from record.replayer import Pace
 from record.session_file import SessionWriter
 
 MESSAGES = 30
