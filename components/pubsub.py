@@ -73,13 +73,12 @@ class Publisher(Generic[M]):
     """Publishes messages of one topic; ``put`` sets the header's ``seq``.
 
     A message whose header already carries ``next_seq`` is published as it is; any other is
-    copied with the right ``seq`` first. A ``verbatim`` publisher (replay) publishes every
-    message as it is, its recorded header unchanged.
+    copied with the right ``seq`` first. (A replay publishes recorded headers as they are with
+    Zenoh's own publishers: ``record.replayer``.)
     """
 
-    def __init__(self, node: Host, topic: topics.Topic[M], verbatim: bool = False) -> None:
+    def __init__(self, node: Host, topic: topics.Topic[M]) -> None:
         self.topic = topic
-        self.verbatim = verbatim
         self._node = node
         self._publisher = node.session.declare_publisher(topic.key(node.namespace))
         self._seq = 0
@@ -92,13 +91,13 @@ class Publisher(Generic[M]):
         return self._seq
 
     def put(self, message: M) -> None:
-        """Encode and publish ``message``, its header's ``seq`` replaced by this topic's count
-        unless the publisher is verbatim."""
+        """Encode and publish ``message``, its header's ``seq`` replaced by this topic's
+        count."""
         if not isinstance(message, self.topic.type):
             expected = self.topic.type.__name__
             raise TypeError(f"{self.topic.name} carries {expected}, not {type(message).__name__}")
         header = getattr(message, "header", None)
-        if not self.verbatim and isinstance(header, Header) and header.seq != self._seq:
+        if isinstance(header, Header) and header.seq != self._seq:
             stamped = header.model_copy(update={"seq": self._seq})
             message = message.model_copy(update={"header": stamped})
         self._seq += 1

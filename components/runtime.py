@@ -119,12 +119,11 @@ class Node:
             raise RuntimeError("the node's session is not open; use `with Node(...) as node`")
         return self._session
 
-    def publisher(self, topic: topics.Topic[M], verbatim: bool = False) -> Publisher[M]:
-        """A typed publisher on ``topic`` in this node's namespace, declared until close;
-        ``verbatim`` publishes headers as given (replay) instead of numbering them."""
+    def publisher(self, topic: topics.Topic[M]) -> Publisher[M]:
+        """A typed publisher on ``topic`` in this node's namespace, declared until close."""
         if self.writes is not None and topic.name not in self.writes:
             raise ValueError(f"{self.name} writes {topic.name} without declaring it in `writes`")
-        publisher = Publisher(self, self.spec.topic(topic), verbatim)
+        publisher = Publisher(self, self.spec.topic(topic))
         self._declared.append(publisher)
         return publisher
 

@@ -59,21 +59,6 @@ def test_typed_round_trip_between_two_nodes(system: System, wait_until: WaitUnti
     assert listener.counters["rejected.robot/state"] == 0
 
 
-def test_a_verbatim_publisher_keeps_the_recorded_header(
-    system: System, wait_until: WaitUntil
-) -> None:
-    """Replay publishes a recorded message as it was: its seq is not renumbered."""
-    received: list[RobotState] = []
-    with Node(system.profile, "listener") as listener, Node(system.profile, "talker") as talker:
-        listener.subscribe(topics.ROBOT_STATE, received.append)
-        listener.start()
-        publisher = talker.publisher(topics.ROBOT_STATE, verbatim=True)
-        talker.timer(0.02, lambda: publisher.put(robot_state()))
-        talker.start()
-        wait_until(lambda: len(received) >= 2, "two RobotStates")
-    assert {message.header.seq for message in received} == {UNSTAMPED_SEQ}
-
-
 @pytest.mark.parametrize(("queue", "dropped"), [(None, "overwritten"), (4, "overflowed")])
 def test_a_busy_handler_gets_the_newest_or_every_sample_and_drops_are_counted(
     system: System, wait_until: WaitUntil, queue: int | None, dropped: str
