@@ -60,7 +60,9 @@ class Param(GainSpec):
         """The value written as ``text`` (as typed on a command line), checked."""
         text = text.strip() if self.type is not str else text
         try:
-            if self.type is bool:
+            if self.type in (tuple, list):  # JSON: [0.6, 0, 0], or [[1, 0, 0.1], [2, 0, 0.1]]
+                value = json.loads(text)
+            elif self.type is bool:
                 if text.lower() not in _TRUE + _FALSE:
                     raise ValueError(text)
                 value: ParamValue = text.lower() in _TRUE
@@ -87,7 +89,7 @@ class Parameters(Mapping[str, ParamValue]):
                 f"{', '.join(unknown)}: unknown parameter; "
                 f"declared: {', '.join(self.declared) or 'none'}"
             )
-        self._values = {name: param.default for name, param in self.declared.items()}
+        self._values = {name: param.check(param.default) for name, param in self.declared.items()}
         self.version = 0
         self.changed: dict[str, ParamValue] = {}
         """The values set while the component runs (what a restart must keep)."""

@@ -30,7 +30,6 @@ depend on the machine's load. An answer missing for ``ack_timeout_s`` host secon
 
 from __future__ import annotations
 
-import math
 import time
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
@@ -68,25 +67,6 @@ LOCKSTEP_CHECK_S = 0.05
 """How often the simulator looks for an answer that is overdue (host seconds)."""
 PAUSED_CLOCK_S = 0.1
 """How often a paused simulator publishes its clock (host seconds)."""
-
-
-def floats(text: str, name: str, count: int | None = None, group: int = 1) -> list[tuple]:
-    """``"1, 2; 3, 4"`` as [(1, 2), (3, 4)] (``group`` numbers each), or ``ParamError``."""
-    groups = [g for g in str(text).split(";") if g.strip()]
-    try:
-        values = [tuple(float(v) for v in g.split(",")) for g in groups]
-    except ValueError as error:
-        raise ParamError(f"{name}: {error}") from error
-    if any(len(v) != group or not all(math.isfinite(x) for x in v) for v in values):
-        raise ParamError(f"{name}: expected groups of {group} finite numbers, got {text!r}")
-    if count is not None and len(values) != count:
-        raise ParamError(f"{name}: expected {count} group(s), got {len(values)}")
-    return values
-
-
-def parses(name: str, count: int | None, group: int):
-    """A ``can_take`` check: the text parses as ``floats(text, name, count, group)``."""
-    return lambda text: floats(str(text), name, count, group)
 
 
 FRAME_ANSWERS = tuple(topic.name for topic in topics.FRAME_ANSWERS)
@@ -138,14 +118,13 @@ class Simulator(Component):
         Param("command_timeout_s", float, 0.5, low=0.01, high=10.0,
               doc="stop the robot after this long without a command, s (simulated)"),
         Param("seed", int, 0, low=0, high=SEED_MAX, doc="noise seed"),
-        Param("start", str, "0, 0, 0, 0, -0.2, 0.2, 0, 0.5", doc="q0 = x, y, phi, q1..q5",
-              can_take=parses("start", 1, 8)),
-        Param("obstacles", str, "", doc="obstacle circles 'x, y, radius; ...', m",
-              can_take=parses("obstacles", None, 3)),
-        Param("goal_marker", str, "0.6, 0.0, 0.0", doc="the bin marker F2: x, y, yaw",
-              can_take=parses("goal_marker", 1, 3)),
-        Param("hide_base_marker", str, "", doc="sim seconds 'from, to' the base marker is hidden",
-              can_take=parses("hide_base_marker", None, 2)),
+        Param("start", tuple, (0.0, 0.0, 0.0, 0.0, -0.2, 0.2, 0.0, 0.5), length=8,
+              doc="q0 = [x, y, phi, q1..q5]"),
+        Param("obstacles", list, (), length=3, doc="obstacle circles [[x, y, radius], ...], m"),
+        Param("goal_marker", tuple, (0.6, 0.0, 0.0), length=3,
+              doc="the bin marker F2: [x, y, yaw]"),
+        Param("hide_base_marker", list, (), length=2,
+              doc="sim seconds [[from, to], ...] the base marker is hidden"),
         Param("host_epoch", bool, False,
               doc="stamp with the host's clock, to match drivers on host time (real time)"),
         Param("camera", bool, True, doc="render camera frames"),
@@ -169,21 +148,21 @@ class Simulator(Component):
             raise ParamError("the simulator needs the profile's `scene` (markers and camera)")
         self.robot = MobileManipulator.from_yaml(node.profile.robot)
         self.scene: Scene = node.profile.scene
-        self.obstacles = [Circle(*c) for c in floats(p["obstacles"], "obstacles", None, 3)]
+        self.obstacles = [Circle(*c) for c in p["obstacles"]]
         self.truth_obstacles = tuple(TruthCircle(x=c.x, y=c.y, radius=c.radius)
                                      for c in self.obstacles)  # fmt: skip
-        self.goal_of: tuple[str, tuple[float, ...]] = ("", ())
+        self.goal_of: tuple[tuple, tuple[float, ...]] = ((), ())
         settings = WorldSettings(
             wheel_acceleration_max=p["wheel_acceleration_max"],
             encoder_noise_counts=p["encoder_noise_counts"],
             wheel_slip=p["wheel_slip"],
         )
-        start = np.array(floats(p["start"], "start", 1, 8)[0])
+        start = np.array(p["start"])
         self.world = World(self.robot, start, self.obstacles, settings, seed=p["seed"])
         self.rng = np.random.default_rng(p["seed"] + 1)
         self.step_ns = round(p["step_s"] * 1e9)
         self.now_ns = time.time_ns() if p["host_epoch"] else 0
-        self.hidden = floats(p["hide_base_marker"], "hide_base_marker", None, 2)
+        self.hidden = p["hide_base_marker"]
         self.renderer = self._renderer()
         # Frames are drawn on a thread of their own (OpenCV lets go of the GIL), one at a time.
         self.camera_thread = ThreadPoolExecutor(1, "camera") if self.renderer else None
@@ -426,12 +405,12 @@ class Simulator(Component):
     def _true_goal(self) -> tuple[float, ...]:
         """x_d in this world (eq. 6.3): the bin marker's pose times the scene's offset; worked
         out again only when ``goal_marker`` changes."""
-        text = self.node.params["goal_marker"]
-        if self.goal_of[0] != text:
-            gx, gy, gyaw = floats(text, "goal_marker", 1, 3)[0]
+        placed = self.node.params["goal_marker"]
+        if self.goal_of[0] != placed:
+            gx, gy, gyaw = placed
             marker = planar_pose(gx, gy, gyaw, self.scene.goal.height_m)
             goal = dq.normalize(dq.mul(marker, offset_pose(*self.scene.goal.offset)))
-            self.goal_of = (text, tuple(goal.tolist()))
+            self.goal_of = (placed, tuple(goal.tolist()))
         return self.goal_of[1]
 
     # -- the camera -----------------------------------------------------------------------
@@ -443,7 +422,7 @@ class Simulator(Component):
             return None
         scene = self.scene
         reference = planar_pose(*scene.reference_pose, scene.reference.height_m)
-        gx, gy, gyaw = floats(self.node.params["goal_marker"], "goal_marker", 1, 3)[0]
+        gx, gy, gyaw = self.node.params["goal_marker"]
         below = [PlacedMarker(scene.reference.id, scene.reference.size_m, reference),
                  PlacedMarker(scene.goal.id, scene.goal.size_m,
                               planar_pose(gx, gy, gyaw, scene.goal.height_m))]  # fmt: skip

@@ -6,6 +6,7 @@ from pydantic import Field
 
 from messages.base import Finite, Message, NonNegative
 from messages.header import Header
+from messages.process import ParamValue
 
 
 class ControllerDiagnostics(Message):
@@ -31,4 +32,4 @@ class ControllerDiagnostics(Message):
     active_constraints: tuple[str, ...] = ()
     solve_time_us: NonNegative
     error_norm: NonNegative | None = None
-    parameters: dict[str, bool | Finite | str] = Field(default_factory=dict)
+    parameters: dict[str, ParamValue] = Field(default_factory=dict)

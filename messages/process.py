@@ -12,7 +12,11 @@ import subprocess
 import sys
 from pathlib import Path
 
-ParamValue = bool | int | float | str
+from messages.base import Finite
+
+ParamValue = bool | int | Finite | str | tuple[Finite, ...] | tuple[tuple[Finite, ...], ...]
+"""A parameter's value: a flag, a number, a word, a vector of numbers or a list of vectors;
+pydantic keeps the exact type (``True`` stays a bool, ``1`` an int)."""
 """A parameter's value."""
 
 EXIT_CONFIG_ERROR = 2

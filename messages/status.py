@@ -4,11 +4,9 @@ from __future__ import annotations
 
 from pydantic import Field
 
-from messages.base import Count, Finite, Message
+from messages.base import Count, Message
 from messages.header import Header
-
-ParameterValue = bool | int | Finite | str
-"""A parameter's value; pydantic keeps the exact type (``True`` stays a bool, ``1`` an int)."""
+from messages.process import ParamValue
 
 
 class ComponentStatus(Message):
@@ -26,4 +24,4 @@ class ComponentStatus(Message):
     state: str
     pid: Count
     counters: dict[str, Count] = Field(default_factory=dict)
-    parameters: dict[str, ParameterValue] = Field(default_factory=dict)
+    parameters: dict[str, ParamValue] = Field(default_factory=dict)

@@ -106,7 +106,7 @@ def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict
     simulator |= {"lockstep": not options.realtime,
                   "real_time_factor": 1.0 if options.realtime else 0.0}  # fmt: skip
     if options.hide_base_marker is not None:
-        simulator["hide_base_marker"] = ", ".join(str(v) for v in options.hide_base_marker)
+        simulator["hide_base_marker"] = [list(options.hide_base_marker)]
     controller = {"module": MODULES[options.controller], "params": law_overrides(options)}
     # Never restarted: a new recorder would begin the file again; a killed one's file recovers.
     recorder = {"name": "recorder", "module": "recorder", "role": "recorder",

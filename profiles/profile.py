@@ -17,7 +17,15 @@ from typing import Annotated, Literal, get_args
 
 import yaml
 import zenoh
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PlainValidator,
+    ValidationError,
+    model_validator,
+)
+from pydantic_core import PydanticCustomError
 
 from messages import topics
 from messages.process import ParamValue
@@ -183,13 +191,29 @@ class RestartPolicy(StrictModel):
         return min(self.backoff_initial_s * 2.0 ** (restarts - 1), self.backoff_max_s)
 
 
+def _param_value(value: object) -> ParamValue:
+    """A parameter's value as a profile gives it: a number, a flag, a word, or a list (of
+    numbers, or of lists of numbers); what the component declares is checked later
+    (``deploy.graph.dataflow``)."""
+    def numbers(row: object) -> bool:
+        return isinstance(row, list | tuple) and all(
+            isinstance(v, int | float) and not isinstance(v, bool) for v in row)  # fmt: skip
+
+    if isinstance(value, bool | int | float | str) or numbers(value):
+        return value
+    if isinstance(value, list | tuple) and all(numbers(row) for row in value):
+        return value
+    raise PydanticCustomError("param_value", "expected a number, a flag, a word or a list of "
+                              "numbers (or of lists of numbers)")  # fmt: skip
+
+
 class ComponentSpec(StrictModel):
     """One process: ``python -m components.<module> --profile P --name <name>``."""
 
     name: Identifier
     module: Identifier
     role: Role
-    params: dict[str, ParamValue] = {}
+    params: dict[str, Annotated[ParamValue, PlainValidator(_param_value)]] = {}
     restart: RestartPolicy = RestartPolicy()
     enabled: bool = True
     clock: Literal["wall", "sim"] | None = None

@@ -54,12 +54,13 @@ class SimScenario:
     bin: tuple[float, float, float]
     obstacles: tuple[Circle, ...]
 
-    def sim_params(self) -> dict[str, str]:
-        """The simulator's parameters that place this set-up."""
+    def sim_params(self) -> dict[str, list]:
+        """The simulator's parameters that place this set-up (to the micrometre and the
+        microradian)."""
         return {
-            "start": ", ".join(f"{v:.6f}" for v in self.start),
-            "goal_marker": ", ".join(f"{v:.6f}" for v in self.bin),
-            "obstacles": "; ".join(f"{c.x}, {c.y}, {c.radius}" for c in self.obstacles),
+            "start": [round(float(v), 6) for v in self.start],
+            "goal_marker": [round(float(v), 6) for v in self.bin],
+            "obstacles": [[float(c.x), float(c.y), float(c.radius)] for c in self.obstacles],
         }
 
 

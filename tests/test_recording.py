@@ -165,8 +165,11 @@ def test_a_recorder_whose_file_fills_up_stops_for_good_and_its_file_recovers(
     kept = recover(path, tmp_path / "recovered.mcap")
     assert kept > 0 and kept == info(tmp_path / "recovered.mcap")["messages"]
     states = load_session(tmp_path / "recovered.mcap")["robot/state"]
-    seqs = [s.header.seq for s in states]  # none lost in between
-    assert seqs and seqs == list(range(seqs[0], seqs[0] + len(seqs)))
+    seqs = [s.header.seq for s in states]  # none lost in between but what the recorder said
+    lost = info(path)["dropped"]  # (a loaded machine may overflow the recorder's queue)
+    missing = set(range(seqs[0], seqs[-1] + 1)) - set(seqs)
+    said = lost.get("overflowed.robot/state", 0) + lost.get("overwritten.robot/state", 0)
+    assert seqs == sorted(seqs) and len(missing) <= said, (sorted(missing), lost)
 
 
 def test_replay_republishes_the_sensors_with_headers_as_recorded(runs, tmp_path: Path) -> None:

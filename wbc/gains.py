@@ -27,9 +27,10 @@ def shown(value: object, limit: int = 120) -> str:
 
 @dataclass(frozen=True)
 class GainSpec:
-    """What may be set on one value: its ``type`` (bool, int, float or str), its ``default``,
-    inclusive bounds ``low`` and ``high`` for numbers, or the only values allowed
-    (``choices``), and a one-line ``doc``."""
+    """What may be set on one value: its ``type`` (bool, int, float, str; ``tuple``, a vector
+    of ``length`` numbers; ``list``, any number of such vectors), its ``default``, inclusive
+    bounds ``low`` and ``high`` for numbers, or the only values allowed (``choices``), and a
+    one-line ``doc``. A vector is held as a tuple of floats, a list as a tuple of them."""
 
     name: str
     type: type
@@ -38,12 +39,17 @@ class GainSpec:
     high: float | None = None
     choices: tuple[Any, ...] | None = None
     doc: str = ""
+    length: int | None = None
 
     def __post_init__(self) -> None:
         self.check(self.default)
 
     def expected(self) -> str:
         """What a valid value is, in words: ``"a float in [0, 10]"``."""
+        if self.type is tuple:
+            return f"{self.length} finite numbers"
+        if self.type is list:
+            return f"a list of groups of {self.length} finite numbers"
         what = f"a {self.type.__name__}"
         if self.choices is not None:
             return f"{what} in {{{', '.join(map(repr, self.choices))}}}"
@@ -58,6 +64,8 @@ class GainSpec:
     def check(self, value: object) -> Any:
         """``value`` as this type (an int is taken for a float, a bool never for a number), or
         ``ValueError`` naming the value and saying what was expected."""
+        if self.type in (tuple, list):
+            return self._vectors(value)
         if self.type is float and isinstance(value, int) and not isinstance(value, bool):
             value = float(value)
         number = isinstance(value, int | float) and not isinstance(value, bool)
@@ -68,6 +76,27 @@ class GainSpec:
         if wrong or outside or (self.choices is not None and value not in self.choices):
             raise ValueError(f"{self.name}: expected {self.expected()}, got {shown(value)}")
         return value
+
+
+    def _vectors(self, value: object) -> tuple:
+        """A vector (or list of vectors) as tuples of floats."""
+        try:
+            rows = [value] if self.type is tuple else list(value)
+            held = tuple(self._vector(row) for row in rows)
+        except (TypeError, ValueError):
+            raise ValueError(f"{self.name}: expected {self.expected()}, got {shown(value)}"
+                             ) from None  # fmt: skip
+        return held[0] if self.type is tuple else held
+
+    def _vector(self, row: object) -> tuple[float, ...]:
+        if isinstance(row, str | bytes) or len(row) != self.length:
+            raise ValueError(row)
+        if any(isinstance(v, bool) or not isinstance(v, int | float) for v in row):
+            raise ValueError(row)
+        numbers = tuple(float(v) for v in row)
+        if not all(math.isfinite(v) for v in numbers):
+            raise ValueError(row)
+        return numbers
 
 
 def gain(default: Any, *, doc: str, low: float | None = None, high: float | None = None) -> Any:

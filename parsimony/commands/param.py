@@ -47,8 +47,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
 
 
 def as_text(value: object) -> str:
-    """A value as `param set` takes it: true, 0.5, pose."""
-    return json.dumps(value) if isinstance(value, bool | int | float) else str(value)
+    """A value as `param set` takes it: true, 0.5, pose, [0.6, 0.0, 0.0]."""
+    return value if isinstance(value, str) else json.dumps(value)
 
 
 def describe(args: argparse.Namespace) -> list[dict]:

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from components.simulator import Simulator
 from profiles.profile import load_profile
 from profiles.scene import Scene
 from sim2d.camera import PinholeCamera, ceiling_camera
@@ -114,28 +115,20 @@ def test_seeds_repeat_and_differ() -> None:
     assert scenario("pose", ROBOT, 0).start != tuple(HOME.tolist())
 
 
-def groups(text: str) -> list[tuple[float, ...]]:
-    """'1, 2; 3, 4' as [(1, 2), (3, 4)]."""
-    return [tuple(float(v) for v in g.split(",")) for g in text.split(";") if g.strip()]
-
-
 @pytest.mark.parametrize(("name", "seed"), [("pose", None), ("obstacle", None), ("obstacle", 7)])
-def test_sim_params_parse_back_to_the_set_up(name: str, seed: int | None) -> None:
+def test_sim_params_are_the_simulators_typed_values_of_the_set_up(name: str, seed: int | None
+                                                                  ) -> None:  # fmt: skip
+    """What the simulator's declared parameters take as they are: no vector as text."""
     setup = scenario(name, ROBOT, seed)
     params = setup.sim_params()
     assert set(params) == {"start", "goal_marker", "obstacles"}
-    (start,) = groups(params["start"])
-    (bin_pose,) = groups(params["goal_marker"])
-    assert start == pytest.approx(setup.start, abs=5e-7)
-    assert bin_pose == pytest.approx(setup.bin, abs=5e-7)
-    obstacles = groups(params["obstacles"])
-    assert obstacles == [(c.x, c.y, c.radius) for c in setup.obstacles]
-
-
-def test_several_obstacles_are_separated_by_semicolons() -> None:
-    setup = SimScenario("obstacle", "pose", tuple(HOME), (1.0, 0.0, 0.0), (OBSTACLE, OBSTACLE))
-    one = (OBSTACLE.x, OBSTACLE.y, OBSTACLE.radius)
-    assert groups(setup.sim_params()["obstacles"]) == [one, one]
+    declared = {p.name: p for p in Simulator.params}
+    held = {name: declared[name].check(value) for name, value in params.items()}
+    assert held["start"] == pytest.approx(setup.start, abs=5e-7)
+    assert held["goal_marker"] == pytest.approx(setup.bin, abs=5e-7)
+    assert held["obstacles"] == tuple((c.x, c.y, c.radius) for c in setup.obstacles)
+    two = SimScenario("obstacle", "pose", tuple(HOME), (1.0, 0.0, 0.0), (OBSTACLE, OBSTACLE))
+    assert len(declared["obstacles"].check(two.sim_params()["obstacles"])) == 2
 
 
 def camera() -> PinholeCamera:
