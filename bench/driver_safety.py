@@ -39,7 +39,7 @@ from messages import codec, topics
 from messages.commands import ArmCommand, BaseCommand
 from messages.header import Header
 from parsimony.experiment import connect, launched
-from parsimony.output import result_only_stdout
+from parsimony.output import result_only_stdout, table
 from profiles.endpoints import free_port
 from profiles.profile import load_profile, read_profile_data
 from protocols import create_oi
@@ -281,8 +281,8 @@ def measure(runs: int) -> dict:
 
 
 def lines(report: dict) -> list[str]:
-    return [f"{name:22} median {value['median']:>8} p99 {value['p99']:>8} max {value['max']:>8} "
-            f"(n {value['n']})" for name, value in report.items() if isinstance(value, dict)]
+    rows = [{"figure": name, **value} for name, value in report.items() if isinstance(value, dict)]
+    return [table(rows)]
 
 
 def main(argv: list[str] | None = None) -> int:

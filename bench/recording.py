@@ -50,7 +50,7 @@ import zenoh
 from pydantic import BaseModel
 
 from bench.pubsub_workers import NAMESPACE, WAIT_S, message
-from bench.sim_experiments import format_table, percentile
+from bench.sim_experiments import percentile
 from components.simulator import JOINT_NAMES
 from deploy import query
 from messages import codec, topics
@@ -59,7 +59,7 @@ from messages.header import Header
 from messages.joints import JointStates
 from messages.odometry import BaseOdometry
 from parsimony.experiment import PROFILES, SESSION_FILE, TIME_LIMIT_S, Options, run_experiment
-from parsimony.output import emit, result_only_stdout
+from parsimony.output import emit, result_only_stdout, table
 from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import Profile, ZenohSettings, load_profile
@@ -474,16 +474,16 @@ def main(argv: list[str] | None = None) -> int:
     if args.json:
         emit(json.dumps(report))
         return 0
-    emit(format_table(report["record"]))
+    emit(table(report["record"]))
     for name, counters in report["recorder_counters"].items():
         emit(f"recorder counters ({name}): " + " ".join(f"{k}={v}" for k, v in counters.items()))
     emit("")
-    emit(format_table(report["replay"]))
+    emit(table(report["replay"]))
     emit("")
-    emit(format_table([report["report"]]))
+    emit(table([report["report"]]))
     emit("")
     emit("peak resident memory of each command, MB")
-    emit(format_table(report["memory"]))
+    emit(table(report["memory"]))
     return 0
 
 

@@ -28,7 +28,7 @@ import numpy as np
 
 from deploy.query import QueryError
 from parsimony.experiment import PROFILES, SUPERVISED, Options, run_experiment
-from parsimony.output import emit, result_only_stdout
+from parsimony.output import emit, result_only_stdout, table
 from profiles.profile import ProfileError, load_profile
 from sim2d.camera import ImageNoise, PlacedMarker, Renderer, ceiling_camera
 from sim2d.scenarios import NAMES, scenario
@@ -145,14 +145,6 @@ def vision_speed() -> dict:
             for name, v in times.items()}  # fmt: skip
 
 
-def format_table(rows: list[dict]) -> str:
-    header = list(rows[0])
-    table = [header] + [[str(row[k]) for k in header] for row in rows]
-    widths = [max(len(line[i]) for line in table) for i in range(len(header))]
-    return "\n".join("  ".join(cell.rjust(w) for cell, w in zip(line, widths, strict=True))
-                     for line in table)  # fmt: skip
-
-
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seeds", type=int, default=20, help="seeds per experiment and law")
@@ -178,7 +170,7 @@ def main(argv: list[str] | None = None) -> int:
         emit(json.dumps({"bench": "sim_experiments", "study": study, "experiments": rows,
                          "vision": speed}))  # fmt: skip
     else:
-        emit(format_table(rows))
+        emit(table(rows))
         emit(" ".join(f"{k}={v}" for k, v in study.items()))
         emit("per camera frame: " + "  ".join(
             f"{k} median {v['median']} p99 {v['p99']}" for k, v in speed.items()))  # fmt: skip

@@ -23,7 +23,7 @@ import zenoh
 
 from bench.figures import run_bench, spread
 from messages import process, topics
-from parsimony.output import result_only_stdout
+from parsimony.output import result_only_stdout, table
 from profiles.endpoints import free_port
 from profiles.profile import load_profile, read_profile_data
 
@@ -106,12 +106,11 @@ def measure(runs: int) -> dict:
 
 
 def lines(report: dict) -> list[str]:
-    rows = [f"{'component':16} {'alive ms (median, max)':>24} {'import ms (median, max)':>25}"]
-    for name, figures in report["components"].items():
-        alive, imports = figures["alive_ms"], figures["import_ms"]
-        rows.append(f"{name:16} {alive['median']:>12} {alive['max']:>11} "
-                    f"{imports['median']:>13} {imports['max']:>11}")  # fmt: skip
-    return rows
+    rows = [{"component": name, "alive_ms_median": f["alive_ms"]["median"],
+             "alive_ms_max": f["alive_ms"]["max"], "import_ms_median": f["import_ms"]["median"],
+             "import_ms_max": f["import_ms"]["max"]}
+            for name, f in report["components"].items()]  # fmt: skip
+    return [table(rows)]
 
 
 def main(argv: list[str] | None = None) -> int:

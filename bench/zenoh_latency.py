@@ -55,7 +55,7 @@ from components.runtime import Node
 from deploy import query
 from messages import topics
 from messages.process import stop
-from parsimony.output import emit, result_only_stdout
+from parsimony.output import emit, result_only_stdout, table
 from profiles.endpoints import free_port
 from profiles.profile import ZenohSettings, load_profile
 
@@ -271,19 +271,6 @@ def goal_taken(router: zenoh.Session) -> bool:
     return status is not None and status.counters["received.control/goal"] > 0
 
 
-def format_table(results: list[Result]) -> str:
-    """One row per measurement, numbers right-aligned; '-' where a column does not apply."""
-    rows = [("measurement", "sent", "recv", "drops", "sent_hz", "recv_hz", "median_us", "p99_us")]
-    rows[0] += ("solve_us", "optimal")
-    rows += [tuple("-" if v is None else str(v) for v in asdict(r).values()) for r in results]
-    widths = [max(len(row[i]) for row in rows) for i in range(len(rows[0]))]
-    return "\n".join(
-        "  ".join([row[0].ljust(widths[0]), *(row[i].rjust(widths[i]) for i in range(1, len(row)))])
-        for row in rows
-    )
-
-
-
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--mode", choices=("peer", "client"), default=ZenohSettings().mode)
@@ -306,7 +293,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.json:
         emit(json.dumps(report))
     else:
-        emit(format_table(results))
+        emit(table([asdict(r) for r in results]))
         emit("lp_controller counters: "
              + " ".join(f"{k}={v}" for k, v in sorted(counters.items())))  # fmt: skip
         for name, figures in flood.items():

@@ -16,6 +16,7 @@ import numpy as np
 
 from parsimony.goal_sets import goal_report
 from parsimony.kinematic_demo import ROBOT_FILE
+from parsimony.output import table
 from wbc import dq
 from wbc.cascade_law import CascadeLaw, CascadeParams
 from wbc.kinematic_run import integrate
@@ -232,43 +233,37 @@ def progress(what: str) -> None:
 
 
 def format_report(report: dict) -> str:
-    lines = ["control step (model + Jacobian + rows + solve)   median us    p99 us"]
-    for name, figures in report["step"].items():
-        lines.append(f"  {name:<44} {figures['median_us']:9.1f} {figures['p99_us']:9.1f}")
-    for name, figures in report["dqrobotics"].items():
-        label = f"DQ Robotics {name}"
-        lines.append(f"  {label:<44} {figures['median_us']:9.1f} {figures['p99_us']:9.1f}")
-    lines.append("LP step, median us by part")
-    lines.append("  " + "  ".join(f"{k} {v:.1f}" for k, v in report["lp_breakdown_us"].items()))
-    lines.append("ratios (medians, same run)")
-    lines += [f"  {name:<44} {value:9.2f}" for name, value in report["ratios"].items()]
-    lines.append("section 6.3 convergence   iterations  converged  time ms (std)   us/iteration")
-    for name, row in report["convergence"].items():
-        lines.append(
-            f"  {name:<22} {row['iterations']:>10} {row['converged_trials']:>10}"
-            f"  {row['convergence_time_ms']:7.2f} ({row['convergence_time_std_ms']:.2f})"
-            f"  {row['time_per_iteration_us']:10.1f}"
-        )
+    """The figures as tables, one per section."""
+    steps = [{"control step (model + Jacobian + rows + solve)": name, **figures}
+             for name, figures in report["step"].items()]
+    steps += [{"control step (model + Jacobian + rows + solve)": f"DQ Robotics {name}",
+               **figures} for name, figures in report["dqrobotics"].items()]  # fmt: skip
+    parts = [table(steps, floatfmt=".1f"), "",
+             "LP step, median us by part",
+             table([report["lp_breakdown_us"]], floatfmt=".1f"), "",
+             table([{"ratios (medians, same run)": n, "ratio": v}
+                    for n, v in report["ratios"].items()], floatfmt=".2f"), "",
+             table([{"section 6.3 convergence": n, **row}
+                    for n, row in report["convergence"].items()], floatfmt=".2f")]  # fmt: skip
     for family, result in report.get("goals", {}).items():
-        lines.append(f"{family} goals ({result['goals']}): share reached   "
-                     "overall  in joint limits  in joint+speed limits  median s to converge")
-        for law, row in result["laws"].items():
-            lines.append(f"  {law:<32} {row['reached']:9.2f} {row['within_joint_limits']:16.2f}"
-                         f" {row['within_joint_and_speed_limits']:22.2f}"
-                         f" {row['median_time_to_converge_s']:21.1f}")  # fmt: skip
-        lines.append("  nonzero entries of u   median moving  settling (x', y' as one)  "
-                     "steps by count 0..8: exact | practical (Upsilon 0.01)")
-        for law, row in result["laws"].items():
-            lines.append(f"  {law:<24} {row['median_nonzero_moving']:11.1f} "
-                         f"{row['median_nonzero_settling']:9.1f} "
-                         f"({row['median_nonzero_settling_forward_as_one']:.1f})"
-                         f"{'':14}{row['nonzero_histogram']} | {row['practical_histogram']}")
+        reached = [{f"{family} goals ({result['goals']})": law,
+                    **{k: row[k] for k in ("reached", "within_joint_limits",
+                                           "within_joint_and_speed_limits",
+                                           "median_time_to_converge_s")}}
+                   for law, row in result["laws"].items()]  # fmt: skip
+        nonzero = [{"nonzero entries of u": law,
+                    **{k: row[k] for k in ("median_nonzero_moving", "median_nonzero_settling",
+                                           "median_nonzero_settling_forward_as_one")},
+                    "steps by count 0..8 (exact | practical, Upsilon 0.01)":
+                        f"{row['nonzero_histogram']} | {row['practical_histogram']}"}
+                   for law, row in result["laws"].items()]  # fmt: skip
+        parts += ["", table(reached, floatfmt=".2f"), "", table(nonzero, floatfmt=".1f")]
         for law, row in result["laws"].items():
             if law.startswith("lp"):
-                lines.append(f"  {law}: every command an optimal LP solution in "
+                parts.append(f"{law}: every command an optimal LP solution in "
                              f"{row['every_step_optimal']:.2f} of the runs")
             if "plans_per_run" in row:
-                lines.append(f"  {law}: {row['plans_per_run']:.2f} plans per run, a plan takes "
+                parts.append(f"{law}: {row['plans_per_run']:.2f} plans per run, a plan takes "
                              f"{row['plan_median_ms']:.0f} ms median, "
                              f"{row['plan_p99_ms']:.0f} ms p99")  # fmt: skip
-    return "\n".join(lines)
+    return "\n".join(parts)

@@ -11,10 +11,19 @@ from __future__ import annotations
 import contextlib
 import os
 import sys
-from collections.abc import Iterator
-from typing import TextIO
+from collections.abc import Iterator, Sequence
+from typing import Any, TextIO
+
+from tabulate import tabulate
 
 _result: TextIO | None = None
+
+
+def table(rows: Sequence, headers: Sequence[str] | str = "keys", **style: Any) -> str:
+    """Rows (dicts, with ``headers="keys"``, or sequences under ``headers``) as a plain text
+    table, numbers right-aligned: the one table style of every command and benchmark
+    (``tabulate``; ``style`` passes ``floatfmt`` and the like on)."""
+    return tabulate(rows, headers=headers, tablefmt="plain", missingval="-", **style)
 
 
 def emit(text: str) -> None:

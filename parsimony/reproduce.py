@@ -30,6 +30,7 @@ from messages.state import RobotState
 from parsimony.benchmark import UNBOUNDED_SPEED, convergence_test
 from parsimony.goal_sets import MOVING_ERROR, SETTLING_S
 from parsimony.kinematic_demo import BORDER_PARAMS, LP_PARAMS
+from parsimony.output import table
 from record.report import write_report
 from wbc import dq
 from wbc.cascade_law import CascadeLaw, CascadeParams
@@ -363,8 +364,8 @@ def format_rows(found_rows: list[Row]) -> str:
             return f"{value:.4g}"
         return str(value)
 
-    lines = [f"{'':9} {'result':<74} {'dissertation':<26} {'ours':<40} should be"]
-    lines += [f"{r.section:<9} {r.result:<74} {shown(r.dissertation):<26} {shown(r.ours):<40} "
-              f"{r.direction}" for r in found_rows]  # fmt: skip
-    return "\n".join(lines)
+    return table([(r.section, r.result, shown(r.dissertation), shown(r.ours), r.direction)
+                  for r in found_rows],
+                 ("section", "result", "dissertation", "ours", "should be"),
+                 disable_numparse=True)  # fmt: skip
 

@@ -7,7 +7,7 @@ import json
 import sys
 from pathlib import Path
 
-from parsimony.output import emit
+from parsimony.output import emit, table
 from record.session_file import info
 
 
@@ -30,10 +30,8 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         emit(json.dumps(found, indent=2))
         return 0
-    rows = [("channel", "schema", "schema_bytes", "messages", "rate_hz")]
-    rows += [(c["key"], c["schema"], str(c["schema_bytes"]), str(c["messages"]),
-              str(c["rate_hz"])) for c in found["channels"]]  # fmt: skip
-    widths = [max(len(row[i]) for row in rows) for i in range(len(rows[0]))]
+    rows = [{"channel": c["key"], "schema": c["schema"], "schema_bytes": c["schema_bytes"],
+             "messages": c["messages"], "rate_hz": c["rate_hz"]} for c in found["channels"]]
     emit(f"{found['path']}: {found['messages']} messages, {found['bytes']} bytes, "
          f"{found['duration_s']} s from {found['start_ns']} to {found['end_ns']} ns")  # fmt: skip
     if not found["complete"]:
@@ -43,6 +41,5 @@ def run(args: argparse.Namespace) -> int:
     if found["dropped"]:
         lost = ", ".join(f"{n} ({counter})" for counter, n in found["dropped"].items())
         emit(f"lost by the recorder: {lost}")
-    emit("\n".join("  ".join(cell.ljust(w) for cell, w in zip(row, widths, strict=True))
-                   for row in rows))  # fmt: skip
+    emit(table(rows))
     return 0

@@ -16,7 +16,7 @@ from deploy.query import (
     statuses,
 )
 from messages.status import ComponentStatus
-from parsimony.output import emit
+from parsimony.output import emit, table
 from parsimony.target_options import fail
 from profiles.profile import ProfileError
 
@@ -82,15 +82,11 @@ def run(args: argparse.Namespace) -> int:
 
 def format_table(rows: list[tuple[str, ComponentStatus | None]]) -> str:
     """One line per component; a component that did not answer shows '?'."""
-    cells = [COLUMNS]
+    cells = []
     for name, status in rows:
         if status is None:
             cells.append((name, "?", "?", "?", ""))
             continue
         counters = " ".join(f"{k}={v}" for k, v in sorted(status.counters.items()) if v)
         cells.append((name, status.module, status.state, str(status.pid), counters))
-    widths = [max(len(row[i]) for row in cells) for i in range(len(COLUMNS) - 1)]
-    return "\n".join(
-        "  ".join([*(cell.ljust(w) for cell, w in zip(row, widths, strict=False)), row[-1]])
-        for row in cells
-    )
+    return table(cells, COLUMNS, disable_numparse=True)
