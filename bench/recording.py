@@ -8,7 +8,7 @@ loopback port and runs the real commands as processes:
    ``deploy/sim.yaml``'s camera at its rate. The publishers block rather than drop, so only
    the recorder can lose a sample (and counts it, ``overflowed.<topic>``). Once its counters
    account for every message it is stopped with SIGINT and the file read back
-   (``record.session_file.info``): messages sent, read back, lost; per second until the last
+   (``record.session_reader.info``): messages sent, read back, lost; per second until the last
    was written: messages, file MB and payload MB (the encoded messages sent).
 2. ``parsimony replay FILE --rate R`` sends the recording of ``parsimony experiment pose``
    (lockstep) into the namespace; this process stamps each arrival (``time.monotonic_ns``),
@@ -64,7 +64,8 @@ from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import Profile, ZenohSettings, load_profile
 from record.report import write_report
-from record.session_file import MESSAGE_ENCODING, SessionWriter, info, read_session, stamp_of
+from record.session_file import MESSAGE_ENCODING, SessionWriter, stamp_of
+from record.session_reader import info, read_session
 from sim2d.camera import ImageNoise, PlacedMarker, ceiling_camera, render
 from wbc.planar import planar_pose
 from wbc.robot import MobileManipulator

@@ -51,7 +51,7 @@ from record.judge import (
     the_run,
 )
 from record.report import write_report
-from record.session_file import info, recover
+from record.session_reader import info, recover
 from sim2d.scenarios import SimScenario, scenario
 from wbc.lp_law import LPParams
 from wbc.robot import MobileManipulator

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Collection
 from pathlib import Path
 
-from record.session_file import read_session
+from record.session_reader import read_session
 
 
 def load_session(path: Path, only: Collection[str] | None = None) -> dict[str, list]:

@@ -2,7 +2,7 @@
 
 Messages go out as recorded, headers unchanged, spaced by their recorded log times divided by
 the rate (those of one time sensors first: camera, joints, odometry), streamed from the file
-(``record.session_file.read_groups``). ``clock`` also publishes ``sim/clock`` at the recorded
+(``record.session_reader.read_groups``). ``clock`` also publishes ``sim/clock`` at the recorded
 times; ``lockstep`` waits after each camera frame and odometry message until the live tracker
 and estimator have answered it (``messages.lockstep``, the simulator's own handshake). Keys
 (``record.replay_keys``) pause, step, change the rate and quit; progress goes to stderr.
@@ -23,7 +23,8 @@ from messages import codec, topics
 from messages.clock import Clock
 from messages.lockstep import AnswerStamps
 from record.replay_keys import QUIT, RIGHT, KeyReader
-from record.session_file import Recorded, info, read_groups
+from record.session_file import Recorded
+from record.session_reader import info, read_groups
 
 SENSORS = ("camera/image", "arm/joint_states", "base/odometry")
 """What ``--sensors`` replays: the inputs a robot's drivers and camera give. Messages of one

@@ -21,7 +21,7 @@ from parsimony.experiment import connect, launched
 from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
-from record.session_file import info
+from record.session_reader import info
 from tests.processes import parsimony, process_gone
 
 

@@ -24,7 +24,7 @@ from parsimony.experiment import connect
 from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
-from record.session_file import info, read_session, recover
+from record.session_reader import info, read_session, recover
 
 
 def parsimony(*arguments: str, timeout: float = 300) -> subprocess.CompletedProcess:

@@ -1,4 +1,4 @@
-"""`parsimony info FILE`: what a recorded session holds (see record.session_file.info)."""
+"""`parsimony info FILE`: what a recorded session holds (see record.session_reader.info)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from parsimony.output import emit, table
-from record.session_file import info
+from record.session_reader import info
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

@@ -22,7 +22,7 @@ from parsimony.experiment import RECORDER_STOP_S
 from parsimony.output import emit
 from parsimony.outputs import writable_output, written_whole
 from profiles.profile import ProfileError
-from record.session_file import recover
+from record.session_reader import recover
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

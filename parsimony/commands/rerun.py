@@ -25,7 +25,8 @@ from messages.commands import ArmCommand, BaseCommand
 from messages.header import Header
 from parsimony.output import emit
 from parsimony.outputs import writable_output, written_whole
-from record.session_file import Recorded, SessionWriter, read_groups
+from record.session_file import Recorded, SessionWriter
+from record.session_reader import read_groups
 from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
 

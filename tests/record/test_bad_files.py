@@ -13,7 +13,8 @@ from messages import topics
 from messages.header import Header
 from messages.state import RobotState
 from profiles.endpoints import free_port
-from record.session_file import SessionWriter, entries, info, read_session, recover
+from record.session_file import SessionWriter, entries
+from record.session_reader import info, read_session, recover
 from tests.processes import parsimony
 
 KEY = topics.ROBOT_STATE.key("bad")

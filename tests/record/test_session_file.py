@@ -22,15 +22,8 @@ from messages.camera import CameraFrame
 from messages.clock import Clock
 from messages.header import Header
 from messages.state import RobotState
-from record.session_file import (
-    CARRIER,
-    DROPPED,
-    Entry,
-    SessionWriter,
-    info,
-    read_session,
-    recover,
-)
+from record.session_file import CARRIER, DROPPED, Entry, SessionWriter
+from record.session_reader import info, read_session, recover
 from tests.processes import parsimony
 from vision.images import jpeg
 
