@@ -41,7 +41,8 @@ from messages.header import Header
 from parsimony.experiment import connect, launched
 from parsimony.output import result_only_stdout, table
 from profiles.endpoints import free_port
-from profiles.profile import load_profile, read_profile_data
+from profiles.profile import load_profile
+from profiles.profile_files import read_profile_data
 from protocols import create_oi
 from sim2d.devices.ax_servos import AXChainEmulator, IntegratingJoints
 from sim2d.devices.create2 import Create2Emulator

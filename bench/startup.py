@@ -25,7 +25,8 @@ from bench.figures import run_bench, spread
 from messages import process, topics
 from parsimony.output import result_only_stdout, table
 from profiles.endpoints import free_port
-from profiles.profile import load_profile, read_profile_data
+from profiles.profile import load_profile
+from profiles.profile_files import read_profile_data
 
 DEPLOY = Path(__file__).resolve().parents[1] / "deploy"
 

@@ -19,7 +19,8 @@ from deploy import query
 from messages import codec, topics
 from parsimony.experiment import connect, launched
 from profiles.endpoints import free_port
-from profiles.profile import load_profile, read_profile_data
+from profiles.profile import load_profile
+from profiles.profile_files import read_profile_data
 
 DEPLOY = Path(__file__).resolve().parents[1] / "deploy"
 

@@ -19,7 +19,8 @@ from pydantic import BaseModel
 
 from messages import codec, topics
 from profiles.endpoints import free_port
-from profiles.profile import Profile, load_profile, read_profile_data
+from profiles.profile import Profile, load_profile
+from profiles.profile_files import read_profile_data
 
 M = TypeVar("M", bound=BaseModel)
 

@@ -11,7 +11,7 @@ import yaml
 
 from deploy import query
 from messages.status import ComponentStatus
-from profiles.profile import read_profile_data
+from profiles.profile_files import read_profile_data
 from protocols import create_oi
 from sim2d.devices.pty_link import PtyLink
 

@@ -17,7 +17,7 @@ from deploy import query
 from messages import codec, topics
 from messages.camera import CameraFrame, CameraIntrinsics
 from messages.header import Header
-from profiles.profile import read_profile_data
+from profiles.profile_files import read_profile_data
 from sim2d.camera import (
     ImageNoise,
     PinholeCamera,
