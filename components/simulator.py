@@ -31,7 +31,6 @@ depend on the machine's load. An answer missing for ``ack_timeout_s`` host secon
 from __future__ import annotations
 
 import time
-from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -41,9 +40,9 @@ from components.params import Param, ParamError
 from components.process_entry import run_component
 from components.pubsub import Input
 from components.runtime import Component, Node
+from components.sim_camera import SimCamera
 from messages import topics
 from messages.base import ARM_JOINTS
-from messages.camera import CameraFrame, CameraIntrinsics
 from messages.clock import Clock
 from messages.commands import ArmCommand, BaseCommand
 from messages.joints import JointStates
@@ -52,14 +51,12 @@ from messages.obstacles import Circle as TruthCircle
 from messages.odometry import BaseOdometry
 from messages.truth import SimTruth
 from profiles.scene import Scene
-from sim2d.camera import ImageNoise, PlacedMarker, Renderer, ceiling_camera
 from sim2d.scenarios import SEED_MAX
 from sim2d.world import World, WorldSettings, wheel_distance_per_count
-from vision.images import jpeg
 from wbc import dq
 from wbc.base_motion import dead_reckoning
 from wbc.obstacles import Circle
-from wbc.planar import compose, offset_pose, planar_pose
+from wbc.planar import offset_pose, planar_pose
 from wbc.robot import MobileManipulator
 
 JOINT_NAMES = tuple(f"q{i}" for i in range(1, ARM_JOINTS + 1))
@@ -159,14 +156,12 @@ class Simulator(Component):
         )
         start = np.array(p["start"])
         self.world = World(self.robot, start, self.obstacles, settings, seed=p["seed"])
-        self.rng = np.random.default_rng(p["seed"] + 1)
         self.step_ns = round(p["step_s"] * 1e9)
         self.now_ns = time.time_ns() if p["host_epoch"] else 0
-        self.hidden = p["hide_base_marker"]
-        self.renderer = self._renderer()
-        # Frames are drawn on a thread of their own (OpenCV lets go of the GIL), one at a time.
-        self.camera_thread = ThreadPoolExecutor(1, "camera") if self.renderer else None
-        self.drawing: Future | None = None
+        self.camera = SimCamera(node, self.robot, self.obstacles,
+                                np.random.default_rng(p["seed"] + 1),
+                                lambda frame: self.publishers["camera/image"].put(frame),
+                                ) if p["camera"] else None  # fmt: skip
         self.frame_period_ns = round(1e9 / self.scene.camera.rate_hz)
         self.next_frame_ns = self.now_ns
         self.metres_per_count = wheel_distance_per_count(self.robot.base, settings.counts_per_turn)
@@ -233,7 +228,7 @@ class Simulator(Component):
         host = self.node.params["host_epoch"]
         self.now_ns = time.time_ns() if host else self.now_ns + self.step_ns
         self.publishers["sim/clock"].put(Clock(stamp_ns=self.now_ns))
-        self.frame_done = self.renderer is None or self.now_ns < self.next_frame_ns
+        self.frame_done = self.camera is None or self.now_ns < self.next_frame_ns
         self._go_on()
 
     def _go_on(self) -> None:
@@ -254,14 +249,8 @@ class Simulator(Component):
             self.frame_done = True
             self.next_frame_ns += self.frame_period_ns
             lockstep = self.node.params["lockstep"]
-            if self.drawing is not None and not self.drawing.done() and not lockstep:
-                self.node.count("frames_skipped")  # real time: the last is still being drawn
-            else:
-                if self.drawing is not None:
-                    self.drawing.result()  # lockstep: answered, so all but returned
-                self.drawing = self.camera_thread.submit(
-                    self._publish_frame, self._header("camera", "camera/image"), self.moving()
-                )
+            self.camera.take(self._header("camera", "camera/image"), self.world.q,
+                             self.now_ns / 1e9, wait=lockstep)  # fmt: skip
             if lockstep:
                 self.unanswered = Frame(self.now_ns, time.monotonic())
                 if self.latency_ns == 0:
@@ -415,57 +404,9 @@ class Simulator(Component):
 
     # -- the camera -----------------------------------------------------------------------
 
-    def _renderer(self) -> Renderer | None:
-        """The camera's renderer: the floor markers (F0, the bin) under the base, the obstacles
-        (their top discs and markers) over it, drawn once."""
-        if not self.node.params["camera"]:
-            return None
-        scene = self.scene
-        reference = planar_pose(*scene.reference_pose, scene.reference.height_m)
-        gx, gy, gyaw = self.node.params["goal_marker"]
-        below = [PlacedMarker(scene.reference.id, scene.reference.size_m, reference),
-                 PlacedMarker(scene.goal.id, scene.goal.size_m,
-                              planar_pose(gx, gy, gyaw, scene.goal.height_m))]  # fmt: skip
-        above: list = [(o.x, o.y, scene.obstacles.height_m, o.radius, 200) for o in self.obstacles]
-        for marker_id, circle in zip(scene.obstacles.ids, self.obstacles, strict=False):
-            pose = planar_pose(circle.x, circle.y, 0.0, scene.obstacles.height_m)
-            above.append(PlacedMarker(marker_id, scene.obstacles.size_m, pose))
-        noise = ImageNoise(self.node.params["image_noise"], self.node.params["image_blur_px"])
-        return Renderer(ceiling_camera(scene.camera), scene.dictionary_id, noise, self.rng,
-                        below, above)  # fmt: skip
-
-    def moving(self) -> list:
-        """What moves in the camera's view: the base's top disc, and its marker unless hidden."""
-        scene, q = self.scene, self.world.q
-        elements: list = [(q[0], q[1], scene.base.height_m, self.robot.base.body_radius, 70)]
-        if not self._base_marker_hidden():
-            x, y, phi = compose(tuple(q[:3]), (*scene.base.offset, 0.0))
-            pose = planar_pose(x, y, phi, scene.base.height_m)
-            elements.append(PlacedMarker(scene.base.id, scene.base.size_m, pose))
-        return elements
-
-    def _base_marker_hidden(self) -> bool:
-        t = self.now_ns / 1e9
-        return any(start <= t < end for start, end in self.hidden)
-
-    def _publish_frame(self, header, moving: list) -> None:
-        """On the camera thread: draw ``moving`` over the scene, encode, publish."""
-        try:
-            image = self.renderer.frame(moving)
-            c, p = self.scene.camera, self.node.params
-            jpeg_file = p["image_format"] == "jpeg"
-            data = jpeg(image, p["jpeg_quality"]) if jpeg_file else image.tobytes()
-            intrinsics = CameraIntrinsics(fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy)
-            self.publishers["camera/image"].put(CameraFrame(
-                header=header, encoding=p["image_format"], width=c.width, height=c.height,
-                data=data, intrinsics=intrinsics))  # fmt: skip
-        except Exception:
-            self.node.count("errors.camera")
-            self.node.warn("errors.camera", "drawing a camera frame failed", True)
-
     def shutdown(self) -> None:
-        if self.camera_thread is not None:
-            self.camera_thread.shutdown(wait=True)
+        if self.camera is not None:
+            self.camera.shutdown()
 
 
 if __name__ == "__main__":
