@@ -43,13 +43,10 @@ from messages.topics import (
     SIM_TRUTH,
     WORLD_OBSTACLES,
 )
-from record.judge import commands, effort_of_inputs, messages, required
+from record.judge import Array, Session, commands, effort_of_inputs, messages, required
 from wbc import dq
 from wbc.planar import in_frame, planar_pose
 from wbc.robot import MobileManipulator
-
-Array = np.ndarray
-Session = Mapping[str, Sequence[Any]]
 
 FORMULAS: Mapping[str, str] = {
     "metric1": r"$\int \lVert\dot{q}\rVert_1\,dt$",
