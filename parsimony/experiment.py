@@ -48,10 +48,11 @@ from record.judge import (
     converged_at,
     end_of_run,
     judge,
+    recording_check,
     the_run,
 )
 from record.report import write_report
-from record.session_reader import info, recover
+from record.session_reader import info, make_whole
 from sim2d.scenarios import SimScenario, scenario
 from wbc.lp_law import LPParams
 from wbc.robot import MobileManipulator
@@ -213,7 +214,9 @@ def run_experiment(options: Options) -> dict[str, Any]:
     path = options.out / SESSION_FILE
     facts = info(path)
     if not facts["complete"]:
-        whole_recording(path)
+        saved = make_whole(path)
+        print(f"[experiment] the recording had no footer: {saved} messages kept",
+              file=sys.stderr)  # fmt: skip
     recorded = load_session(path, JUDGED)
     start_ns = min((s.header.stamp_ns for s in recorded.get(ROBOT_STATE.name, [])),
                    default=end_ns)  # fmt: skip
@@ -269,41 +272,6 @@ def connect(profile: Profile, launcher: subprocess.Popen) -> zenoh.Session:
             if launcher.poll() is not None or time.monotonic() > deadline:
                 raise
             time.sleep(0.2)  # the launcher opens its router first thing
-
-
-def recording_check(facts: dict[str, Any], run_ns: tuple[int, int]) -> dict:
-    """Whether the recording (``facts``: its ``info``) holds the whole run, from its first state
-    to its last (``run_ns``): its footer, no sample dropped by the recorder, and the run's
-    states from start to end; ``missing`` says what is not there (empty when whole). With its
-    size, and bytes per simulated second."""
-    start_ns, end_ns = run_ns
-    missing = []
-    if not facts["complete"]:
-        missing.append("no footer: the recorder was killed, the file keeps its complete chunks")
-    if facts["dropped"]:
-        lost = ", ".join(f"{n} ({counter})" for counter, n in facts["dropped"].items())
-        missing.append(f"the recorder lost {lost}")
-    states = [c for c in facts["channels"] if c["key"].endswith("/" + topics.ROBOT_STATE.name)]
-    first_ns = min((c["start_ns"] for c in states), default=0)
-    last_ns = max((c["end_ns"] for c in states), default=0)
-    if not states or first_ns > start_ns:
-        missing.append(f"its states begin {(first_ns - start_ns) / 1e9:.2f} s after the run's")
-    if last_ns < end_ns:
-        missing.append(f"its states end {(end_ns - last_ns) / 1e9:.2f} s before the run's")
-    span_s = max((end_ns - start_ns) / 1e9, 1e-9)
-    return {"whole": not missing, "missing": missing, "messages": facts["messages"],
-            "bytes": facts["bytes"], "bytes_per_sim_s": round(facts["bytes"] / span_s)}  # fmt: skip
-
-
-def whole_recording(path: Path) -> None:
-    """Make ``path``, whose recorder was killed before it wrote the footer, whole: every
-    complete chunk is kept."""
-    partial = path.with_suffix(".partial.mcap")
-    path.rename(partial)
-    saved = recover(partial, path)
-    partial.unlink()
-    print(f"[experiment] the recording had no footer: {saved} messages kept",
-          file=sys.stderr)  # fmt: skip
 
 
 def wait_alive(session: zenoh.Session, profile: Profile, launcher: subprocess.Popen) -> None:

@@ -321,3 +321,27 @@ def commands_csv(session: Session) -> str:
             values = (b.forward_velocity, b.angular_velocity, *joints)
             lines.append(f"{b.header.stamp_ns / 1e9:.3f}," + ",".join(repr(v) for v in values))
     return "\n".join(lines) + "\n"
+
+
+def recording_check(facts: dict[str, Any], run_ns: tuple[int, int]) -> dict:
+    """Whether the recording (``facts``: its ``info``) holds the whole run, from its first state
+    to its last (``run_ns``): its footer, no sample dropped by the recorder, and the run's
+    states from start to end; ``missing`` says what is not there (empty when whole). With its
+    size, and bytes per simulated second."""
+    start_ns, end_ns = run_ns
+    missing = []
+    if not facts["complete"]:
+        missing.append("no footer: the recorder was killed, the file keeps its complete chunks")
+    if facts["dropped"]:
+        lost = ", ".join(f"{n} ({counter})" for counter, n in facts["dropped"].items())
+        missing.append(f"the recorder lost {lost}")
+    states = [c for c in facts["channels"] if c["key"].endswith("/" + ROBOT_STATE.name)]
+    first_ns = min((c["start_ns"] for c in states), default=0)
+    last_ns = max((c["end_ns"] for c in states), default=0)
+    if not states or first_ns > start_ns:
+        missing.append(f"its states begin {(first_ns - start_ns) / 1e9:.2f} s after the run's")
+    if last_ns < end_ns:
+        missing.append(f"its states end {(end_ns - last_ns) / 1e9:.2f} s before the run's")
+    span_s = max((end_ns - start_ns) / 1e9, 1e-9)
+    return {"whole": not missing, "missing": missing, "messages": facts["messages"],
+            "bytes": facts["bytes"], "bytes_per_sim_s": round(facts["bytes"] / span_s)}  # fmt: skip

@@ -335,3 +335,13 @@ def recover(source: Path, target: Path) -> int:
             writer.add_metadata(name, values)
         writer.finish()
     return saved
+
+
+def make_whole(path: Path) -> int:
+    """Make ``path``, whose writer was killed before the footer, whole in place: every
+    complete chunk kept (``recover``), written beside it and renamed onto it; the number of
+    messages kept."""
+    partial = path.with_name(f".{path.name}.whole")
+    saved = recover(path, partial)
+    partial.replace(path)
+    return saved
