@@ -13,6 +13,7 @@ import dataclasses
 import functools
 import math
 import typing
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -103,6 +104,32 @@ def gain(default: Any, *, doc: str, low: float | None = None, high: float | None
     """A dataclass field with its declaration (see ``GainSpec``; choices come from the
     field's ``Literal`` annotation)."""
     return dataclasses.field(default=default, metadata={GAIN: (low, high, doc)})
+
+
+def composed(name: str, doc: str, parts: Sequence[type], module: str) -> type:
+    """A frozen dataclass ``name`` of every field of the gains dataclasses ``parts`` (each
+    once, in order), validated on construction (``check_gains``, then each part's
+    ``check_together``): a law's parameters, as each of its terms declares its own."""
+    fields, seen = [], set()
+    for part in dict.fromkeys(parts):
+        hints = typing.get_type_hints(part)
+        for field in dataclasses.fields(part):
+            if field.name in seen:
+                raise TypeError(f"{name}: two parts declare the gain {field.name!r}")
+            seen.add(field.name)
+            fields.append((field.name, hints[field.name],
+                           dataclasses.field(default=field.default, metadata=field.metadata)))
+    checks = [part.check_together for part in parts if hasattr(part, "check_together")]
+
+    def __post_init__(self) -> None:  # noqa: N807 - the dataclass hook
+        check_gains(self)
+        for check in checks:
+            check(self)
+
+    made = dataclasses.make_dataclass(name, fields, frozen=True,
+                                      namespace={"__post_init__": __post_init__})  # fmt: skip
+    made.__doc__, made.__module__ = doc, module  # where pickle finds it
+    return made
 
 
 @functools.cache

@@ -6,18 +6,17 @@ import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Literal
 
 import numpy as np
 
 from wbc.constraints.base import Constraint
-from wbc.constraints.error_bound import ErrorBound, ErrorBoundMode
+from wbc.constraints.error_bound import ErrorBound
 from wbc.constraints.joint_limits import JointLimits
 from wbc.constraints.nonholonomic import Nonholonomic
 from wbc.constraints.obstacle_border import BorderObstacle
 from wbc.constraints.obstacle_conservative import ConservativeObstacle
 from wbc.constraints.obstacle_vector_field import VectorFieldObstacle
-from wbc.gains import check_gains, gain
+from wbc.gains import composed, gain
 from wbc.law_output import LawOutput, summarise
 from wbc.linear_program import WarmStartedLP
 from wbc.objectives.base import ObjectiveTerm, ResidualCost
@@ -35,110 +34,39 @@ from wbc.validation import NonFiniteInputError, require_finite
 Array = np.ndarray
 
 
-@dataclass(frozen=True)
-class LPParams:
-    """Gains of the LP law; the defaults are those of the pose experiment (section 6.2.1)."""
+CONSTRAINTS: tuple[type[Constraint], ...] = (Nonholonomic, JointLimits, ErrorBound,
+                                             BorderObstacle, VectorFieldObstacle,
+                                             ConservativeObstacle)  # fmt: skip
+"""The constraints of 5.29, in the order of their rows; each builds itself from the gains it
+declares (``of``), or stays out."""
+OBJECTIVES: tuple[type[ObjectiveTerm], ...] = (LeastVelocity, WaistHold, WaistCentring,
+                                               ObstacleCirculation, BaseTarget)  # fmt: skip
+"""The terms added to the task residual of 5.29, likewise."""
 
+
+@dataclass(frozen=True)
+class TaskGains:
     eta: float = gain(0.6, low=1e-3, high=100.0,
                       doc="task gain: the LP seeks J u = -eta e, 1/s")
-    beta: float = gain(15.0, low=1e-3, high=1e3, doc="bound gain of 5.10 / 5.7")
-    joint_gain: float = gain(1.0, low=1e-3, high=1e4, doc="k of 5.14, 1/s")
-    safety_factor: float = gain(0.9, low=0.01, high=1.0, doc="beta_l of 5.14")
-    error_bound: ErrorBoundMode = gain(
-        "derivative", doc="5.10 (bound on ||e'||_1) or the original 5.7 (bound on ||e||_1)")
-    obstacle_mode: Literal["border", "vector_field", "conservative", "off"] = gain(
-        "border",
-        doc="obstacle constraint: 5.28 (border), the vector-field inequality d' >= -eta_d d "
-            "(vector_field, wbc.constraints.obstacle_vector_field), 5.19 (conservative) or none")
-    obstacle_gain: float = gain(2.0, low=1e-3, high=100.0,
-                                doc="lambda of 5.26 (border), eta_d (vector_field), gain on the "
-                                    "clearance (conservative), 1/s")
-    obstacle_margin: float = gain(0.05, low=0.0, high=1.0,
-                                  doc="extra clearance round each obstacle and the base, m")
-    obstacle_lookahead: float = gain(0.1, low=0.0, high=1.0,
-                                     doc="d: the border constraint acts on the point d ahead "
-                                         "of the wheel axle, m")
-    obstacle_circulation: float = gain(0.2, low=0.0, high=1.0,
-                                       doc="weight of going round an obstacle on the goal's "
-                                           "side while its border is engaged "
-                                           "(wbc.objectives.obstacle_circulation)")
-    circulation_speed: float = gain(0.1, low=0.0, high=1.0,
-                                    doc="the speed along the border that term asks for, m/s")
-    velocity_cost: float = gain(1e-3, low=0.0, high=1.0,
-                                doc="w of w ||u||_1, the tie-break between optimal vertices; "
-                                    "0 with the other weights solves 5.29 exactly "
-                                    "(wbc.objectives.velocity_cost)")
-    waist_hold: float = gain(0.02, low=0.0, high=1.0,
-                             doc="extra weight of |q1'|: the task's yaw goes to the base, the "
-                                 "waist holds (wbc.objectives.waist_hold)")
-    waist_centring: float = gain(0.0, low=0.0, high=1.0,
-                                 doc="weight of |q1' + k q1|: the waist/base-yaw self-motion "
-                                     "spent on a centred waist (wbc.objectives.waist_centring)")
-    waist_gain: float = gain(1.0, low=1e-3, high=100.0, doc="k of the waist centring, 1/s")
-    waist_fade: float = gain(0.05, low=0.0, high=10.0,
-                             doc="||e||_1 below which the waist centring fades out (0: never)")
-    base_target: float = gain(0.05, low=0.0, high=1.0,
-                              doc="weight of turning the base towards where it should stand "
-                                  "for a pose goal (wbc.objectives.base_target)")
-    base_target_gain: float = gain(4.0, low=1e-3, high=100.0, doc="k of the base target, 1/s")
-    base_target_reach: float = gain(0.36, low=0.0, high=5.0,
-                                    doc="how far behind the goal, along the gripper's heading, "
-                                        "the base should stand, m: the mean horizontal reach "
-                                        "over the arm goals of `parsimony bench` (0.36 +- 0.08)")
-    base_target_stop: float = gain(0.15, low=1e-3, high=5.0,
-                                   doc="distance from the base target within which it is off "
-                                       "(full weight at twice), m")
-    base_target_on: float = gain(0.3, low=0.0, high=3.2,
-                                 doc="heading error above which the base target starts a "
-                                     "steering burst, rad (0: always on)")
-    base_target_off: float = gain(0.05, low=0.0, high=3.2,
-                                  doc="heading error below which a steering burst ends, rad")
-    nonholonomic: bool = gain(True, doc="False models a holonomic base (section 6.3, test 1)")
 
-    def __post_init__(self) -> None:
-        check_gains(self)
-        if self.base_target_on > 0.0 and not self.base_target_off < self.base_target_on:
-            raise ValueError(f"LPParams.base_target_off must be below base_target_on "
-                             f"({self.base_target_on}), got {self.base_target_off}")
+
+LPParams = composed(
+    "LPParams",
+    "Gains of the LP law, each declared by the term that reads it; the defaults are those of "
+    "the pose experiment (section 6.2.1).",
+    [TaskGains, *(part for term in CONSTRAINTS + OBJECTIVES for part in term.gains)],
+    __name__,
+)
 
 
 def default_constraints(params: LPParams) -> list[Constraint]:
     """The constraints of 5.29 that ``params`` selects."""
-    constraints: list[Constraint] = [
-        JointLimits(params.joint_gain, params.safety_factor),
-        ErrorBound(params.beta, params.error_bound),
-    ]
-    if params.nonholonomic:
-        constraints.insert(0, Nonholonomic())
-    if params.obstacle_mode == "border":
-        constraints.append(
-            BorderObstacle(params.obstacle_gain, params.obstacle_margin, params.obstacle_lookahead)
-        )
-    elif params.obstacle_mode == "vector_field":
-        constraints.append(VectorFieldObstacle(params.obstacle_gain, params.obstacle_margin,
-                                               params.obstacle_lookahead))
-    elif params.obstacle_mode == "conservative":
-        constraints.append(ConservativeObstacle(params.obstacle_gain, params.obstacle_margin))
-    return constraints
+    return [c for c in (term.of(params) for term in CONSTRAINTS) if c is not None]
 
 
 def default_objectives(params: LPParams) -> list[ObjectiveTerm]:
     """The terms added to the task residual of 5.29 that ``params`` selects."""
-    terms: list[ObjectiveTerm] = []
-    if params.velocity_cost > 0.0:
-        terms.append(LeastVelocity(params.velocity_cost))
-    if params.waist_hold > 0.0:
-        terms.append(WaistHold(params.waist_hold))
-    if params.waist_centring > 0.0:
-        terms.append(WaistCentring(params.waist_centring, params.waist_gain, params.waist_fade))
-    if params.obstacle_mode in ("border", "vector_field") and params.obstacle_circulation > 0.0:
-        terms.append(ObstacleCirculation(params.obstacle_circulation, params.circulation_speed,
-                                         params.obstacle_margin, params.obstacle_lookahead))
-    if params.base_target > 0.0:
-        terms.append(BaseTarget(params.base_target, params.base_target_gain,
-                                params.base_target_reach, params.base_target_stop,
-                                params.base_target_on, params.base_target_off))  # fmt: skip
-    return terms
+    return [t for t in (term.of(params) for term in OBJECTIVES) if t is not None]
 
 
 @dataclass

@@ -2,10 +2,20 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
 import numpy as np
 
 from wbc.constraints.base import VelocityBounds
+from wbc.gains import gain
 from wbc.step_context import StepContext
+
+
+@dataclass(frozen=True)
+class JointLimitGains:
+    joint_gain: float = gain(1.0, low=1e-3, high=1e4, doc="k of 5.14, 1/s")
+    safety_factor: float = gain(0.9, low=0.01, high=1.0, doc="beta_l of 5.14")
 
 
 class JointLimits:
@@ -18,6 +28,14 @@ class JointLimits:
     """
 
     name = "joint_limits"
+
+    gains: ClassVar[tuple[type, ...]] = (JointLimitGains,)
+    """The gains this term reads (declared once, there)."""
+
+    @classmethod
+    def of(cls, params: Any) -> JointLimits | None:
+        """The term as the law's gains ``params`` ask for it, or None when they turn it off."""
+        return cls(params.joint_gain, params.safety_factor)
 
     def __init__(self, gain: float = 1.0, safety_factor: float = 0.9) -> None:
         if gain <= 0.0 or not 0.0 < safety_factor <= 1.0:

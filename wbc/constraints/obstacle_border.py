@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 
 from wbc.constraints.base import LinearRows
+from wbc.constraints.obstacle_gains import ObstacleGains
 from wbc.obstacles import Circle
 from wbc.step_context import StepContext
 
@@ -71,6 +73,16 @@ class BorderObstacle:
     """
 
     name = "obstacle_border"
+
+    gains: ClassVar[tuple[type, ...]] = (ObstacleGains,)
+    """The gains this term reads (declared once, there)."""
+
+    @classmethod
+    def of(cls, params: Any) -> BorderObstacle | None:
+        """The term as the law's gains ``params`` ask for it, or None when they turn it off."""
+        on = params.obstacle_mode == "border"
+        return cls(params.obstacle_gain, params.obstacle_margin,
+                   params.obstacle_lookahead) if on else None  # fmt: skip
 
     def __init__(self, gain: float = 2.0, margin: float = 0.05, lookahead: float = 0.1) -> None:
         if gain <= 0.0 or margin < 0.0 or lookahead < 0.0:

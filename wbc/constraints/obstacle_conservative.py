@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import math
+from typing import Any, ClassVar
 
 import numpy as np
 
 from wbc.constraints.base import VelocityBounds
+from wbc.constraints.obstacle_gains import ObstacleGains
 from wbc.step_context import StepContext
 
 
@@ -19,6 +21,15 @@ class ConservativeObstacle:
     """
 
     name = "obstacle_conservative"
+
+    gains: ClassVar[tuple[type, ...]] = (ObstacleGains,)
+    """The gains this term reads (declared once, there)."""
+
+    @classmethod
+    def of(cls, params: Any) -> ConservativeObstacle | None:
+        """The term as the law's gains ``params`` ask for it, or None when they turn it off."""
+        on = params.obstacle_mode == "conservative"
+        return cls(params.obstacle_gain, params.obstacle_margin) if on else None
 
     def __init__(self, gain: float = 1.0, margin: float = 0.05) -> None:
         if gain <= 0.0 or margin < 0.0:

@@ -19,11 +19,13 @@ p, so a base that faces the obstacle can steer along it.
 from __future__ import annotations
 
 import math
+from typing import Any, ClassVar
 
 import numpy as np
 
 from wbc.constraints.base import LinearRows
 from wbc.constraints.obstacle_border import point_velocity_row
+from wbc.constraints.obstacle_gains import ObstacleGains
 from wbc.step_context import StepContext
 
 
@@ -31,6 +33,16 @@ class VectorFieldObstacle:
     """-n . p' <= gain * d, one row per obstacle (the VFI of the module's docstring)."""
 
     name = "obstacle_vector_field"
+
+    gains: ClassVar[tuple[type, ...]] = (ObstacleGains,)
+    """The gains this term reads (declared once, there)."""
+
+    @classmethod
+    def of(cls, params: Any) -> VectorFieldObstacle | None:
+        """The term as the law's gains ``params`` ask for it, or None when they turn it off."""
+        on = params.obstacle_mode == "vector_field"
+        return cls(params.obstacle_gain, params.obstacle_margin,
+                   params.obstacle_lookahead) if on else None  # fmt: skip
 
     def __init__(self, gain: float = 2.0, margin: float = 0.05, lookahead: float = 0.1) -> None:
         if gain <= 0.0 or margin < 0.0 or lookahead < 0.0:

@@ -18,18 +18,42 @@ the wrong side. It is a cost, not a row: u = 0 stays feasible.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 
 from wbc.constraints.obstacle_border import border, point_velocity_row
+from wbc.constraints.obstacle_gains import ObstacleGains
+from wbc.gains import gain
 from wbc.objectives.base import ResidualCost
 from wbc.step_context import StepContext
+
+
+@dataclass(frozen=True)
+class CirculationGains:
+    obstacle_circulation: float = gain(0.2, low=0.0, high=1.0,
+                                       doc="weight of going round an obstacle on the goal's "
+                                           "side while its border is engaged "
+                                           "(wbc.objectives.obstacle_circulation)")
+    circulation_speed: float = gain(0.1, low=0.0, high=1.0,
+                                    doc="the speed along the border that term asks for, m/s")
 
 
 class ObstacleCirculation:
     """weight * |t . p' - speed| for the obstacle whose engaged border p stalled on."""
 
     name = "obstacle_circulation"
+
+    gains: ClassVar[tuple[type, ...]] = (ObstacleGains, CirculationGains)
+    """The gains this term reads (declared once, there)."""
+
+    @classmethod
+    def of(cls, params: Any) -> ObstacleCirculation | None:
+        """The term as the law's gains ``params`` ask for it, or None when they turn it off."""
+        on = params.obstacle_mode in ("border", "vector_field") and params.obstacle_circulation > 0
+        return cls(params.obstacle_circulation, params.circulation_speed, params.obstacle_margin,
+                   params.obstacle_lookahead) if on else None  # fmt: skip
 
     def __init__(self, weight: float, speed: float, margin: float, lookahead: float,
                  stall_speed: float = 0.01, stall_time: float = 0.5,

@@ -2,10 +2,22 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
 import numpy as np
 
+from wbc.gains import gain
 from wbc.objectives.base import VelocityCost
 from wbc.step_context import StepContext
+
+
+@dataclass(frozen=True)
+class VelocityCostGains:
+    velocity_cost: float = gain(1e-3, low=0.0, high=1.0,
+                                doc="w of w ||u||_1, the tie-break between optimal vertices; "
+                                    "0 with the other weights solves 5.29 exactly "
+                                    "(wbc.objectives.velocity_cost)")
 
 
 class LeastVelocity:
@@ -16,6 +28,14 @@ class LeastVelocity:
     """
 
     name = "least_velocity"
+
+    gains: ClassVar[tuple[type, ...]] = (VelocityCostGains,)
+    """The gains this term reads (declared once, there)."""
+
+    @classmethod
+    def of(cls, params: Any) -> LeastVelocity | None:
+        """The term as the law's gains ``params`` ask for it, or None when they turn it off."""
+        return cls(params.velocity_cost) if params.velocity_cost > 0.0 else None
 
     def __init__(self, weight: float = 1e-3) -> None:
         if not weight >= 0.0:

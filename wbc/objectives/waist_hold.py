@@ -11,17 +11,36 @@ so the solution stays a vertex: it costs no entry.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
 import numpy as np
 
+from wbc.gains import gain
 from wbc.objectives.base import VelocityCost
 from wbc.robot import BASE_DOF
 from wbc.step_context import StepContext
+
+
+@dataclass(frozen=True)
+class WaistHoldGains:
+    waist_hold: float = gain(0.02, low=0.0, high=1.0,
+                             doc="extra weight of |q1'|: the task's yaw goes to the base, the "
+                                 "waist holds (wbc.objectives.waist_hold)")
 
 
 class WaistHold:
     """weight * |q1'|."""
 
     name = "waist_hold"
+
+    gains: ClassVar[tuple[type, ...]] = (WaistHoldGains,)
+    """The gains this term reads (declared once, there)."""
+
+    @classmethod
+    def of(cls, params: Any) -> WaistHold | None:
+        """The term as the law's gains ``params`` ask for it, or None when they turn it off."""
+        return cls(params.waist_hold) if params.waist_hold > 0.0 else None
 
     def __init__(self, weight: float) -> None:
         if not weight >= 0.0:
