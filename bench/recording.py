@@ -17,10 +17,10 @@ loopback port and runs the real commands as processes:
 3. ``parsimony report``'s work (``load_session``, ``write_report``) on that recording repeated
    to span 60 s (``repeated_session``): median and each of 3 runs.
 
-4. Memory: the recording repeated to span each of ``MEMORY_SPANS`` (s), and ``parsimony
-   info``, ``report``, ``rerun`` and ``replay --rate 64`` run on each as processes: the peak
-   resident memory of each (``ru_maxrss``, MB), and its ratio longest to shortest. A command
-   that streams the file stays near 1 however long the session.
+4. Memory (``bench.long_sessions``): the recording repeated to span 30 and 120 s, and
+   ``parsimony info``, ``report``, ``rerun`` and ``replay --rate 64`` run on each as processes:
+   the peak resident memory of each (``ru_maxrss``, MB), and its ratio longest to shortest. A
+   command that streams the file stays near 1 however long the session.
 
 ``--quick`` (under a minute): 1.5 s floods, the experiment cut at 3 s, one report of its
 recording as it is, memory on spans of 5 and 20 s. Prints tables, or ``--json``; progress
@@ -49,6 +49,7 @@ import yaml
 import zenoh
 from pydantic import BaseModel
 
+from bench.long_sessions import memory_use, repeated_session
 from bench.pubsub_workers import NAMESPACE, WAIT_S, message
 from bench.sim_experiments import percentile
 from components.simulator import JOINT_NAMES
@@ -64,7 +65,7 @@ from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import Profile, ZenohSettings, load_profile
 from record.report import write_report
-from record.session_file import MESSAGE_ENCODING, SessionWriter, stamp_of
+from record.session_file import MESSAGE_ENCODING
 from record.session_reader import info, read_session
 from sim2d.camera import ImageNoise, PlacedMarker, ceiling_camera, render
 from wbc.planar import planar_pose
@@ -76,8 +77,6 @@ FRAMES = 8
 """Distinct rendered camera frames the image load cycles through (noise differs)."""
 SETTLE_S = 2.0
 """How long the recorder's counters, or the replay's arrivals, may stay still before we count."""
-REPEAT_GAP_NS = 10_000_000
-"""Between the last stamp of one copy of a session and the first of the next (a 100 Hz step)."""
 REPLAY_RATES = (1.0, 2.0)
 
 
@@ -98,8 +97,6 @@ FULL = Settings(flood_s=10.0, experiment_s=TIME_LIMIT_S, report_s=60.0, report_r
                 memory_spans_s=(30.0, 120.0))  # fmt: skip
 QUICK = Settings(flood_s=1.5, experiment_s=3.0, report_s=None, report_runs=1,
                  memory_spans_s=(5.0, 20.0))  # fmt: skip
-MEMORY_REPLAY_RATE = 64.0
-"""The rate of the replays whose memory is measured (their timing is part 2's)."""
 
 
 def progress(text: str) -> None:
@@ -316,35 +313,6 @@ def percentile_ms(values_ms: list[float], q: float) -> float | None:
     return round(percentile([v * 1e3 for v in values_ms], q) / 1e3, 4) if values_ms else None
 
 
-def shifted(recorded: BaseModel, offset_ns: int) -> BaseModel:
-    """The message with its stamp (its header's, or a clock's) ``offset_ns`` later."""
-    header = getattr(recorded, "header", None)
-    if header is None:
-        return recorded.model_copy(update={"stamp_ns": recorded.stamp_ns + offset_ns})
-    later = header.model_copy(update={"stamp_ns": header.stamp_ns + offset_ns})
-    return recorded.model_copy(update={"header": later})
-
-
-def repeated_session(source: Path, target: Path, seconds: float) -> float:
-    """Write at ``target`` the project messages of ``source`` and their Foxglove views (as the
-    recorder writes them), copy after copy, each copy's stamps shifted to follow the last,
-    until ``seconds`` from the first stamp; return the seconds it spans."""
-    records = [r for r in read_session(source) if r.message is not None]
-    first, last = records[0].log_time_ns, records[-1].log_time_ns
-    period, end = last - first + REPEAT_GAP_NS, first + round(seconds * 1e9)
-    latest, copy = first, 0
-    with SessionWriter(target) as writer:
-        while first + copy * period <= end:
-            for r in records:
-                if r.log_time_ns + copy * period > end:
-                    break
-                repeated = shifted(r.message, copy * period)
-                writer.write(r.key, repeated, views=True)
-                latest = stamp_of(repeated)
-            copy += 1
-    return (latest - first) / 1e9
-
-
 def report_time(session_file: Path, experiment: Path, runs: int, directory: Path) -> dict:
     """Seconds to load a session and write its figures and table (what ``parsimony report``
     does after its imports), ``runs`` times."""
@@ -366,59 +334,6 @@ def report_time(session_file: Path, experiment: Path, runs: int, directory: Path
     return {"session_s": shown["duration_s"], "messages": shown["messages"],
             "file_MB": round(shown["bytes"] / 1e6, 1), "median_s": statistics.median(totals),
             "runs_s": totals, "load_s": loads, "figures_s": draws}  # fmt: skip
-
-
-PEAK_MEMORY = """\
-import os, sys
-pid = os.fork()
-if pid == 0:
-    os.execv(sys.executable, [sys.executable, *sys.argv[2:]])
-_, status, usage = os.wait4(pid, 0)
-with open(sys.argv[1], "w") as out:
-    out.write(str(usage.ru_maxrss))
-sys.exit(os.waitstatus_to_exitcode(status))
-"""
-"""A small parent that runs a command and writes its peak resident memory (KiB): a process's
-``ru_maxrss`` counts the one it was forked from, so this bench's own memory would count in a
-child it forked itself."""
-
-
-def peak_memory_mb(arguments: Sequence[str], directory: Path) -> float:
-    """``parsimony ARGUMENTS`` as a process: its peak resident memory, MB (it must exit 0)."""
-    peak = directory / "peak_kib"
-    command = [sys.executable, "-c", PEAK_MEMORY, str(peak), "-m", "parsimony.cli", *arguments]
-    done = subprocess.run(command, stdout=subprocess.DEVNULL)
-    if done.returncode != 0:
-        raise RuntimeError(f"parsimony {' '.join(arguments)} failed (exit {done.returncode})")
-    return round(int(peak.read_text()) / 1024, 1)
-
-
-def memory_use(recorded: Path, spans_s: Sequence[float], profile: Path,
-               directory: Path) -> list[dict]:  # fmt: skip
-    """Peak memory of the commands that read a whole file, on the recording repeated to span
-    each of ``spans_s``; then each command's ratio of the longest span's to the shortest's."""
-    rows = []
-    for span in spans_s:
-        session = directory / f"span{span:g}.mcap"
-        progress(f"memory: a {span:g} s session")
-        repeated_session(recorded, session, span)
-        out = directory / f"memory{span:g}"
-        commands = {
-            "info": ["info", str(session)],
-            "report": ["report", str(session), "--out", str(out)],
-            "rerun": ["rerun", str(session), "--controller", "lp", "-o", str(out / "rerun.mcap")],
-            "replay": ["replay", str(session), "--profile", str(profile),
-                       "--rate", f"{MEMORY_REPLAY_RATE:g}"],
-        }  # fmt: skip
-        row = {"session_s": span, "file_MB": round(session.stat().st_size / 1e6, 1)}
-        row |= {f"{name}_MB": peak_memory_mb(arguments, directory)
-                for name, arguments in commands.items()}  # fmt: skip
-        rows.append(row)
-        session.unlink()
-    first, last = rows[0], rows[-1]
-    rows.append({"session_s": "ratio", **{k: round(last[k] / first[k], 2)
-                                          for k in first if k.endswith("_MB")}})  # fmt: skip
-    return rows
 
 
 def bench_profile(directory: Path, zenoh_settings: ZenohSettings) -> Path:
