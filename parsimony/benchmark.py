@@ -22,6 +22,7 @@ from wbc.cascade_law import CascadeLaw, CascadeParams
 from wbc.kinematic_run import integrate
 from wbc.lp_law import LPLaw, LPParams
 from wbc.pinv_law import PinvParams, PseudoinverseLaw
+from wbc.qp_law import QPLaw
 from wbc.robot import MobileManipulator
 from wbc.scenarios import CONVERGENCE_GOAL, DT, HOME, REACH_GOAL
 from wbc.task import PoseTask
@@ -56,7 +57,8 @@ def step_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str, fl
     """
     task = PoseTask(robot.fkm(GOAL))
     trajectory = integrate(LPLaw(robot), HOME, task, DT, 3000).configurations
-    laws = {"lp": LPLaw(robot), "classic": PseudoinverseLaw(robot), "cascade": CascadeLaw(robot)}
+    laws = {"lp": LPLaw(robot), "qp": QPLaw(robot), "classic": PseudoinverseLaw(robot),
+            "cascade": CascadeLaw(robot)}  # fmt: skip
     samples: dict[str, list[float]] = {name: [] for name in laws}
     position = 0
     while len(samples["lp"]) < repeats:
@@ -210,7 +212,8 @@ def run_bench(repeats: int, trials: int, goals: int, robot_file: Path = ROBOT_FI
     reference = dqrobotics_times(robot, repeats)
     report: dict = {"step": steps, "lp_breakdown_us": breakdown, "dqrobotics": reference}
     report["ratios"] = {
-        "lp_over_classic": steps["lp"]["median_us"] / steps["classic"]["median_us"]
+        "lp_over_classic": steps["lp"]["median_us"] / steps["classic"]["median_us"],
+        "qp_over_classic": steps["qp"]["median_us"] / steps["classic"]["median_us"],
     }
     if reference:
         report["ratios"]["kinematics_over_dqrobotics"] = (

@@ -34,6 +34,9 @@ from typing import IO, Any
 import yaml
 import zenoh
 
+from components.cascade_controller import CascadeController
+from components.lp_controller import LPController
+from components.qp_controller import QPController
 from deploy import query
 from messages import codec, process, topics
 from messages.topics import CONTROL_DIAGNOSTICS, ROBOT_STATE, SIM_TRUTH, SUPERVISOR_STATUS
@@ -58,11 +61,14 @@ from wbc.lp_law import LPParams
 from wbc.robot import MobileManipulator
 
 DEPLOY = Path(__file__).resolve().parents[1] / "deploy"
-PROFILES = {"lp": DEPLOY / "sim.yaml", "cascade": DEPLOY / "sim_cascade.yaml"}
+PROFILES = {"lp": DEPLOY / "sim.yaml", "cascade": DEPLOY / "sim_cascade.yaml",
+            "qp": DEPLOY / "sim_qp.yaml"}
 """The profile each controller runs in unless ``--profile`` names another."""
 SUPERVISED = {"anywhere": DEPLOY / "sim_supervised.yaml"}
 """Experiments whose LP runs under the staging supervisor (components/supervisor.py)."""
-MODULES = {"lp": "lp_controller", "cascade": "cascade_controller"}
+MODULES = {c.law_name: c.__module__.rsplit(".", 1)[-1]
+           for c in (LPController, CascadeController, QPController)}
+"""The controller module of each law, as the controllers name themselves."""
 
 TIME_LIMIT_S = 60.0
 """Simulated seconds after which a run that has not converged stops."""
@@ -88,9 +94,10 @@ class Options:
 
 
 def law_overrides(options: Options) -> dict[str, Any]:
-    """The LP gains of the experiment that differ from the law's defaults (the cascade's
-    defaults are the dissertation's; an experiment under the supervisor takes its profile's)."""
-    if options.controller != "lp" or options.name not in LP_PARAMS:
+    """The LP gains of the experiment that differ from the LP's defaults, for the LP and the QP
+    (which reads the same gains; the cascade's defaults are the dissertation's; an experiment
+    under the supervisor takes its profile's)."""
+    if options.controller not in ("lp", "qp") or options.name not in LP_PARAMS:
         return {}
     wanted, default = LP_PARAMS[options.name], LPParams()
     return {

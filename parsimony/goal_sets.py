@@ -21,6 +21,7 @@ from wbc.cascade_law import CascadeLaw
 from wbc.kinematic_run import integrate, integrate_supervised
 from wbc.law_output import Law, entry_mask
 from wbc.lp_law import LPLaw, LPParams
+from wbc.qp_law import QPLaw
 from wbc.robot import BASE_DOF, MobileManipulator
 from wbc.scenarios import ARM_BOX, DT, HOME
 from wbc.staging_supervisor import StagingSupervisor, SupervisorParams
@@ -231,12 +232,14 @@ LAWS: dict[str, Callable[[MobileManipulator], Law]] = {
     "lp": lambda robot: LPLaw(robot),
     "lp 5.29 exactly": lambda robot: LPLaw(robot, EXACT_5_29),
     SUPERVISED: lambda robot: LPLaw(robot, supervised_params()),
+    "qp": lambda robot: QPLaw(robot),
     "cascade": lambda robot: CascadeLaw(robot),
 }
 """The laws compared: the default LP, LP 5.29 with no term added to the task, the LP under the
-staging supervisor (wbc.staging_supervisor) with its gains, the cascade."""
+staging supervisor (wbc.staging_supervisor) with its gains, the QP of the same rows and terms
+(wbc.qp_law), the cascade."""
 EXACT_5_29 = LPParams(velocity_cost=0.0, waist_hold=0.0, waist_centring=0.0, base_target=0.0)
-POSITION_LAWS = ("lp", "lp 5.29 exactly", "cascade")
+POSITION_LAWS = ("lp", "lp 5.29 exactly", "qp", "cascade")
 """The laws run on the position task of each family's goals (6.2.2)."""
 
 

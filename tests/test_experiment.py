@@ -69,6 +69,17 @@ def test_pose_experiment_with_the_lp_reaches_the_goal_seen_by_the_camera(tmp_pat
     assert json.loads((out / "effort.json").read_text())["lp"] == report["effort"]
 
 
+def test_the_qp_controller_runs_the_pose_experiment_as_the_lp_does(tmp_path: Path) -> None:
+    """deploy/sim_qp.yaml: the QP of the LP's rows and terms, a process like the others, reaches
+    the goal seen by the camera; it spreads u over every entry (not parsimonious)."""
+    code, report = experiment(tmp_path, "pose", "--controller", "qp")
+    assert code == 0
+    assert_sound(report)
+    assert set(report["controller_statuses"]) <= {"optimal", "invalid state"}  # before a fix
+    histogram = {int(k): v for k, v in report["nonzero_entries"].items()}
+    assert max(histogram, key=histogram.get) == 8, histogram
+
+
 def test_two_lockstep_runs_of_one_seed_send_bit_identical_commands(tmp_path: Path) -> None:
     # 3 simulated seconds each: 150 steps of the whole loop, with about 90 camera frames.
     _, first = experiment(tmp_path / "a", "position", "--seed", "3", "--time-limit", "3")

@@ -13,7 +13,7 @@ import dataclasses
 import functools
 import math
 import typing
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -106,10 +106,13 @@ def gain(default: Any, *, doc: str, low: float | None = None, high: float | None
     return dataclasses.field(default=default, metadata={GAIN: (low, high, doc)})
 
 
-def composed(name: str, doc: str, parts: Sequence[type], module: str) -> type:
+def composed(name: str, doc: str, parts: Sequence[type], module: str,
+             defaults: Mapping[str, Any] | None = None) -> type:  # fmt: skip
     """A frozen dataclass ``name`` of every field of the gains dataclasses ``parts`` (each
     once, in order), validated on construction (``check_gains``, then each part's
-    ``check_together``): a law's parameters, as each of its terms declares its own."""
+    ``check_together``): a law's parameters, as each of its terms declares its own. A law that
+    wants another default for a gain says it in ``defaults``."""
+    defaults = dict(defaults or {})
     fields, seen = [], set()
     for part in dict.fromkeys(parts):
         hints = typing.get_type_hints(part)
@@ -117,8 +120,11 @@ def composed(name: str, doc: str, parts: Sequence[type], module: str) -> type:
             if field.name in seen:
                 raise TypeError(f"{name}: two parts declare the gain {field.name!r}")
             seen.add(field.name)
+            default = defaults.pop(field.name, field.default)
             fields.append((field.name, hints[field.name],
-                           dataclasses.field(default=field.default, metadata=field.metadata)))
+                           dataclasses.field(default=default, metadata=field.metadata)))
+    if defaults:
+        raise TypeError(f"{name}: no part declares {', '.join(defaults)}")
     checks = [part.check_together for part in parts if hasattr(part, "check_together")]
 
     def __post_init__(self) -> None:  # noqa: N807 - the dataclass hook

@@ -21,6 +21,7 @@ from components.cascade_controller import CascadeController
 from components.control_step import ControlStep, Step, gains_of
 from components.controller import Controller, diagnostics_of
 from components.lp_controller import LPController
+from components.qp_controller import QPController
 from messages.commands import ArmCommand, BaseCommand
 from messages.header import Header
 from parsimony.output import emit
@@ -31,7 +32,8 @@ from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
 
 ROBOT = Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"
-LAWS: dict[str, type[Controller]] = {c.law_name: c for c in (LPController, CascadeController)}
+LAWS: dict[str, type[Controller]] = {
+    c.law_name: c for c in (LPController, CascadeController, QPController)}
 """The controllers whose law can be run again, by law name."""
 OUTPUTS = ("base/command", "arm/command", "control/diagnostics")
 """The topics the law writes; the recorded ones move to ``<key>/recorded``."""

@@ -1,0 +1,176 @@
+"""The same robot, rows and terms as the LP, as a quadratic program (future work 5 of chapter 7:
+"a comparison between the linear programming and nonlinear programming approaches").
+
+    min  ||J u + eta e||_2^2 + sum_b w_b^2 ||A_b u + b_b||_2^2 + c'|u| + lambda ||u||_2^2
+    s.t. the rows of 5.29: velocity bounds (5.15), ||u||_1 <= beta ||e'||_1 (5.10), the
+         nonholonomic equality (5.12) and the obstacle rows, as the LP's constraints give them
+
+Each residual term of the LP's objective is squared here (the task first, w = 1), each velocity
+term stays linear. As in the LP, u = u_P - u_N with u_P, u_N >= 0, so the 1-norm rows stay
+linear; the damping lambda is put on both halves (lambda (||u_P||^2 + ||u_N||^2), which equals
+lambda ||u||^2 at the optimum, where one of each pair is 0) and makes the Hessian positive
+definite. DAQP (a dual active-set solver for small dense QPs) solves it, warm-started from the
+last step's active set; HiGHS's QP solver, tried first, took 35 ms a step at this size.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import daqp
+import numpy as np
+
+from wbc.constraints.base import Constraint, LinearRows, OneNormBound, VelocityBounds
+from wbc.gains import composed, gain
+from wbc.law_output import LawOutput, summarise
+from wbc.lp_law import CONSTRAINTS, OBJECTIVES, TaskGains
+from wbc.objectives.base import ObjectiveTerm, ResidualCost, VelocityCost
+from wbc.obstacles import Circle
+from wbc.robot import MobileManipulator
+from wbc.step_context import StepContext
+from wbc.task import PoseTask, Task, same_task
+from wbc.validation import NonFiniteInputError, require_finite
+
+Array = np.ndarray
+INF = 1e30
+"""DAQP's infinite bound."""
+
+
+@dataclass(frozen=True)
+class DampingGains:
+    damping: float = gain(1e-3, low=1e-9, high=10.0,
+                          doc="lambda of lambda ||u||^2: keeps the QP strictly convex")
+
+
+QP_DEFAULTS = {"velocity_cost": 0.0, "waist_hold": 0.0}
+"""The LP's 1-norm velocity terms are off in the QP: beside a squared task residual, a constant
+price on |u| is a dead zone (a lasso), where the task's pull, eta e, no longer beats it; on the
+pose goal of 6.2.1 the QP with them stalls at ||e|| = 0.006 (0.001 without)."""
+QPParams = composed(
+    "QPParams",
+    "Gains of the QP law: the LP's, each declared by the term that reads it, and the damping.",
+    [TaskGains, DampingGains, *(part for term in CONSTRAINTS + OBJECTIVES for part in term.gains)],
+    __name__,
+    QP_DEFAULTS,
+)
+
+
+@dataclass
+class QPLaw:
+    """u = argmin of the quadratic program above, solved by HiGHS.
+
+    ``step`` never raises for a solver failure: it returns u = 0 with HiGHS's status. The error
+    rate e' is measured as the LP measures it (the rows are the LP's).
+    """
+
+    robot: MobileManipulator
+    params: QPParams = field(default_factory=QPParams)
+    _last: tuple[Task, Array] | None = field(default=None, init=False, repr=False)
+    _constraints: list[Constraint] | None = field(default=None, init=False, repr=False)
+    _objectives: list[ObjectiveTerm] | None = field(default=None, init=False, repr=False)
+    _qp: WarmStartedQP = field(default_factory=lambda: WarmStartedQP(), init=False, repr=False)
+
+    def set_params(self, params: QPParams) -> None:
+        self.params, self._constraints, self._objectives = params, None, None
+
+    def reset(self) -> None:
+        self._last = None
+        self._qp.reset()
+        for term in self._objectives or ():
+            term.reset()
+
+    def step(self, q: Array, task: Task, dt: float, obstacles: Sequence[Circle] = ()
+             ) -> LawOutput:  # fmt: skip
+        start = time.perf_counter()
+        q = require_finite("configuration q", q)
+        dt = float(dt)
+        if not math.isfinite(dt):
+            raise NonFiniteInputError(f"dt must be finite, got {dt}")
+        if dt <= 0.0:
+            raise ValueError(f"dt must be > 0, got {dt}")
+        if self._constraints is None:
+            self._constraints = [c for c in (t.of(self.params) for t in CONSTRAINTS) if c]
+            self._objectives = [o for o in (t.of(self.params) for t in OBJECTIVES) if o]
+        pose, jacobian = self.robot.kinematics(q)
+        error, task_jacobian = task.error(pose, jacobian, q)
+        if self._last is not None and same_task(self._last[0], task):
+            error_rate = (error - self._last[1]) / dt
+        else:
+            error_rate = -self.params.eta * error
+        self._last = (task, error)
+        goal_pose = task.pose if isinstance(task, PoseTask) else None
+        context = StepContext(self.robot, q, error, error_rate, task.goal_position[:2],
+                              tuple(obstacles), goal_pose, dt)  # fmt: skip
+        costs = [ResidualCost("task", task_jacobian, self.params.eta * error)]
+        costs += [term.cost(context) for term in self._objectives]
+        rows = [constraint.rows(context) for constraint in self._constraints]
+        u, status, objective = self._qp.solve(self.robot.dof, costs, rows, self.params.damping)
+        return summarise(u, status, objective, (), error, start)
+
+
+@dataclass
+class WarmStartedQP:
+    """The QP over g = [u_P, u_N] >= 0, solved by DAQP from the last step's active set:
+    min c'g + g'H g / 2 with H = 2 (sum_b w_b^2 S'A_b'A_b S + lambda I), c = 2 sum_b w_b^2
+    S'A_b'b_b plus the velocity costs, S = [I -I]."""
+
+    _active: Array | None = None
+
+    def reset(self) -> None:
+        self._active = None
+
+    def solve(self, n: int, costs: list, rows: list, damping: float
+              ) -> tuple[Array, str, float | None]:  # fmt: skip
+        """u, the status and the objective."""
+        split = np.hstack((np.eye(n), -np.eye(n)))
+        hessian = 2.0 * damping * np.eye(2 * n)
+        linear = np.zeros(2 * n)
+        for cost in costs:
+            if isinstance(cost, ResidualCost):
+                a = cost.matrix @ split
+                weight = cost.weight**2
+                hessian += 2.0 * weight * (a.T @ a)
+                linear += 2.0 * weight * (a.T @ cost.offset)
+            elif isinstance(cost, VelocityCost):
+                linear += np.concatenate((cost.weights, cost.negative_weights))
+        matrix, lower, upper = [split], [np.full(n, -INF)], [np.full(n, INF)]
+        for row in rows:
+            if isinstance(row, VelocityBounds):
+                np.maximum(lower[0], row.lower, out=lower[0])
+                np.minimum(upper[0], row.upper, out=upper[0])
+            elif isinstance(row, OneNormBound):
+                matrix.append(np.ones((1, 2 * n)))
+                lower.append(np.array([-INF]))
+                upper.append(np.array([row.limit]))
+            elif isinstance(row, LinearRows):
+                matrix.append(row.matrix @ split)
+                lower.append(np.asarray(row.lower, dtype=float))
+                upper.append(np.asarray(row.upper, dtype=float))
+        if (lower[0] > upper[0]).any():
+            return np.zeros(n), "infeasible", None
+        a = np.vstack(matrix)
+        # The first 2n bounds are g >= 0 (simple bounds), then the rows.
+        low = np.concatenate((np.zeros(2 * n), *lower))
+        high = np.concatenate((np.full(2 * n, INF), *upper))
+        equal = np.concatenate((np.zeros(2 * n, dtype=bool), *(lo == hi for lo, hi in
+                                                                zip(lower, upper, strict=True))))
+        sense = np.where(equal, EQUALITY, 0).astype(np.intc)
+        if self._active is not None and self._active.shape == sense.shape:
+            sense |= np.where(equal, 0, self._active).astype(np.intc)
+        g, objective, flag, info = daqp.solve(hessian, linear, a, high, low, sense)
+        if flag < 1:
+            self._active = None
+            return np.zeros(n), EXIT_FLAGS.get(flag, f"daqp exit {flag}"), None
+        self._active = np.where(np.abs(np.asarray(info["lam"])) > 0, ACTIVE, 0)
+        g = np.asarray(g)
+        return g[:n] - g[n:], "optimal", float(objective)
+
+
+EQUALITY, ACTIVE = 5, 1
+"""DAQP's senses: an equality row, and an inequality taken as active (a warm start)."""
+EXIT_FLAGS = {-1: "infeasible", -2: "cycling", -3: "unbounded", -4: "iteration limit",
+              -5: "nonconvex", -6: "initial active set infeasible"}
+"""DAQP's exit flags below 1, as statuses."""
