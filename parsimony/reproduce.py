@@ -38,6 +38,7 @@ from wbc.kinematic_run import Run, control_effort, integrate
 from wbc.law_output import Law, entry_mask
 from wbc.lp_law import LPLaw
 from wbc.pinv_law import PINV_RCOND, PinvParams, PseudoinverseLaw, nonholonomic_basis
+from wbc.qp_law import QPLaw, QPParams
 from wbc.robot import MobileManipulator
 from wbc.scenarios import DT, HOME, JOINT_LIMIT_GOAL, OBSTACLE, OBSTACLE_GOAL, REACH_GOAL
 from wbc.task import PoseTask, PositionTask, Task
@@ -120,6 +121,7 @@ def experiments(robot: MobileManipulator) -> dict[str, Experiment]:
             "LP, no speed bound": LPLaw(free, params),
             "PINV under 5.11": PseudoinverseLaw(robot, PinvParams(eta=params.eta,
                                                                   nonholonomic=True)),
+            "QP": QPLaw(robot, QPParams(eta=params.eta, beta=params.beta)),
         })  # fmt: skip
         eta = matched_eta(robot, task, len(found[name].runs["LP"].outputs))
         found[name].runs["PINV, same time"] = integrate(
@@ -197,6 +199,8 @@ def rows(robot: MobileManipulator, found: dict[str, Experiment]) -> list[Row]:
     out += count_rows("6.2.2", "fig. 6.12", "fig. 6.13", position, moving=5, settling=5, pinv=8)
     for experiment in (pose, position):
         out += effort_rows(experiment)
+    for experiment in (pose, position):
+        out += qp_rows(experiment)
     for label, run in found["obstacle"].runs.items():
         q = np.array(run.configurations)
         gap = np.hypot(q[:, 0] - OBSTACLE.x, q[:, 1] - OBSTACLE.y) - OBSTACLE.radius
@@ -244,6 +248,22 @@ def effort_rows(experiment: Experiment) -> list[Row]:
             out.append(Row("table 6.1", f"{experiment.name}, metric {index + 1}{suffix}",
                            {**theirs, "LP/PINV": theirs["LP"] / theirs["PINV"]},
                            {**ours, "LP/PINV": ours["LP"] / ours["PINV"]}, EXPECTED[index]))
+    return out
+
+
+def qp_rows(experiment: Experiment) -> list[Row]:
+    """Future work 5 (7.2): the LP against the QP of the same rows and terms, on one run each:
+    iterations, nonzero entries while moving, and table 6.1's four metrics."""
+    lp, qp = experiment.runs["LP"], experiment.runs["QP"]
+    efforts = {label: asdict(control_effort(run)) for label, run in (("LP", lp), ("QP", qp))}
+    out = [Row("7.2 (5)", f"{experiment.name}: LP against QP, iterations; nonzero entries "
+                          "while moving", "not done",
+               {"LP": [len(lp.outputs), counts(lp)["moving"]],
+                "QP": [len(qp.outputs), counts(qp)["moving"]]}, "LP sparser")]  # fmt: skip
+    for index, metric in enumerate(METRICS):
+        out.append(Row("7.2 (5)", f"{experiment.name}: LP against QP, metric {index + 1}",
+                       "not done", {"LP": efforts["LP"][metric], "QP": efforts["QP"][metric],
+                                    "LP/QP": efforts["LP"][metric] / efforts["QP"][metric]}))
     return out
 
 
