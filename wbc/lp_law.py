@@ -69,6 +69,37 @@ def default_objectives(params: LPParams) -> list[ObjectiveTerm]:
     return [t for t in (term.of(params) for term in OBJECTIVES) if t is not None]
 
 
+def program(robot: MobileManipulator, q: Array, task: Task, dt: float,
+            obstacles: Sequence[Circle], eta: float, last: tuple[Task, Array] | None,
+            constraints: Sequence[Constraint], objectives: Sequence[ObjectiveTerm],
+            ) -> tuple[list, list, Array, tuple[Task, Array]]:  # fmt: skip
+    """One step's program of 5.29: the inputs checked (``NonFiniteInputError``, dt > 0), e
+    and e' measured (e' = (e - e_last) / dt against the ``last`` error of the same task, else
+    the commanded -eta e), the costs (the task's first, ||J u + eta e||) and the rows; with e
+    and the new ``last``. The LP and the QP (``wbc.qp_law``) solve the same one."""
+    q = require_finite("configuration q", q)
+    dt = float(dt)
+    if not math.isfinite(dt):
+        raise NonFiniteInputError(f"dt must be finite, got {dt}")
+    if dt <= 0.0:
+        raise ValueError(f"dt must be > 0, got {dt}")
+    for index, obstacle in enumerate(obstacles):
+        require_finite(f"obstacle {index}", (obstacle.x, obstacle.y, obstacle.radius))
+    pose, jacobian = robot.kinematics(q)
+    error, task_jacobian = task.error(pose, jacobian, q)
+    if last is not None and same_task(last[0], task):
+        error_rate = (error - last[1]) / dt
+    else:
+        error_rate = -eta * error
+    goal_pose = task.pose if isinstance(task, PoseTask) else None
+    context = StepContext(robot, q, error, error_rate, task.goal_position[:2], tuple(obstacles),
+                          goal_pose, dt)  # fmt: skip
+    rows = [constraint.rows(context) for constraint in constraints]  # first: a term may read
+    costs = [ResidualCost("task", task_jacobian, eta * error)]  # what a row engaged
+    costs += [term.cost(context) for term in objectives]
+    return costs, rows, error, (task, error)
+
+
 @dataclass
 class LPLaw:
     """u = argmin ||J u + eta e||_1 subject to the constraints (5.29), solved by HiGHS simplex.
@@ -110,33 +141,13 @@ class LPLaw:
     ) -> LawOutput:
         """One control step at configuration q (8,) towards ``task``; dt in seconds."""
         start = time.perf_counter()
-        q = require_finite("configuration q", q)
-        dt = float(dt)
-        if not math.isfinite(dt):
-            raise NonFiniteInputError(f"dt must be finite, got {dt}")
-        if dt <= 0.0:
-            raise ValueError(f"dt must be > 0, got {dt}")
-        for index, obstacle in enumerate(obstacles):
-            require_finite(f"obstacle {index}", (obstacle.x, obstacle.y, obstacle.radius))
         if self.constraints is None:
             self.constraints = default_constraints(self.params)
         if self.objectives is None:
             self.objectives = default_objectives(self.params)
-
-        pose, jacobian = self.robot.kinematics(q)
-        error, task_jacobian = task.error(pose, jacobian, q)
-        if self._last is not None and same_task(self._last[0], task):
-            error_rate = (error - self._last[1]) / dt
-        else:
-            error_rate = -self.params.eta * error
-        self._last = (task, error)
-
-        goal_pose = task.pose if isinstance(task, PoseTask) else None
-        context = StepContext(self.robot, q, error, error_rate, task.goal_position[:2],
-                              tuple(obstacles), goal_pose, dt)  # fmt: skip
-        rows = [constraint.rows(context) for constraint in self.constraints]
-        costs = [ResidualCost("task", task_jacobian, self.params.eta * error)]
-        costs += [term.cost(context) for term in self.objectives]
+        costs, rows, error, self._last = program(
+            self.robot, q, task, dt, obstacles, self.params.eta, self._last,
+            self.constraints, self.objectives)  # fmt: skip
         solution = self._lp.solve(costs, rows)
         return summarise(
             solution.u, solution.status, solution.objective, solution.active, error, start

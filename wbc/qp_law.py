@@ -15,7 +15,6 @@ last step's active set; HiGHS's QP solver, tried first, took 35 ms a step at thi
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -26,13 +25,11 @@ import numpy as np
 from wbc.constraints.base import Constraint, LinearRows, OneNormBound, VelocityBounds
 from wbc.gains import composed, gain
 from wbc.law_output import LawOutput, summarise
-from wbc.lp_law import CONSTRAINTS, OBJECTIVES, TaskGains
+from wbc.lp_law import CONSTRAINTS, OBJECTIVES, TaskGains, program
 from wbc.objectives.base import ObjectiveTerm, ResidualCost, VelocityCost
 from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
-from wbc.step_context import StepContext
-from wbc.task import PoseTask, Task, same_task
-from wbc.validation import NonFiniteInputError, require_finite
+from wbc.task import Task
 
 Array = np.ndarray
 INF = 1e30
@@ -85,28 +82,12 @@ class QPLaw:
     def step(self, q: Array, task: Task, dt: float, obstacles: Sequence[Circle] = ()
              ) -> LawOutput:  # fmt: skip
         start = time.perf_counter()
-        q = require_finite("configuration q", q)
-        dt = float(dt)
-        if not math.isfinite(dt):
-            raise NonFiniteInputError(f"dt must be finite, got {dt}")
-        if dt <= 0.0:
-            raise ValueError(f"dt must be > 0, got {dt}")
         if self._constraints is None:
             self._constraints = [c for c in (t.of(self.params) for t in CONSTRAINTS) if c]
             self._objectives = [o for o in (t.of(self.params) for t in OBJECTIVES) if o]
-        pose, jacobian = self.robot.kinematics(q)
-        error, task_jacobian = task.error(pose, jacobian, q)
-        if self._last is not None and same_task(self._last[0], task):
-            error_rate = (error - self._last[1]) / dt
-        else:
-            error_rate = -self.params.eta * error
-        self._last = (task, error)
-        goal_pose = task.pose if isinstance(task, PoseTask) else None
-        context = StepContext(self.robot, q, error, error_rate, task.goal_position[:2],
-                              tuple(obstacles), goal_pose, dt)  # fmt: skip
-        costs = [ResidualCost("task", task_jacobian, self.params.eta * error)]
-        costs += [term.cost(context) for term in self._objectives]
-        rows = [constraint.rows(context) for constraint in self._constraints]
+        costs, rows, error, self._last = program(
+            self.robot, q, task, dt, obstacles, self.params.eta, self._last,
+            self._constraints, self._objectives)  # fmt: skip
         u, status, objective = self._qp.solve(self.robot.dof, costs, rows, self.params.damping)
         return summarise(u, status, objective, (), error, start)
 
