@@ -25,7 +25,14 @@ import numpy as np
 from wbc.constraints.base import Constraint, LinearRows, OneNormBound, VelocityBounds
 from wbc.gains import composed, gain
 from wbc.law_output import LawOutput, summarise
-from wbc.lp_law import CONSTRAINTS, OBJECTIVES, TaskGains, program
+from wbc.lp_law import (
+    CONSTRAINTS,
+    OBJECTIVES,
+    TaskGains,
+    default_constraints,
+    default_objectives,
+    program,
+)
 from wbc.objectives.base import ObjectiveTerm, ResidualCost, VelocityCost
 from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
@@ -83,8 +90,8 @@ class QPLaw:
              ) -> LawOutput:  # fmt: skip
         start = time.perf_counter()
         if self._constraints is None:
-            self._constraints = [c for c in (t.of(self.params) for t in CONSTRAINTS) if c]
-            self._objectives = [o for o in (t.of(self.params) for t in OBJECTIVES) if o]
+            self._constraints = default_constraints(self.params)
+            self._objectives = default_objectives(self.params)
         costs, rows, error, self._last = program(
             self.robot, q, task, dt, obstacles, self.params.eta, self._last,
             self._constraints, self._objectives)  # fmt: skip
