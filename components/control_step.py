@@ -27,6 +27,7 @@ from messages.goal import Goal
 from messages.state import RobotState
 from wbc.base_motion import unicycle, wheel_speeds
 from wbc.drive_tasks import HeadingTask, PointTask
+from wbc.gains import gain_specs
 from wbc.law_output import Law, LawOutput
 from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
@@ -86,8 +87,15 @@ class ControlStep:
         self.last_stamp_ns: int | None = None
 
     def take_goal(self, goal: Goal) -> None:
-        """Follow ``goal``; a goal the law cannot take (``ValueError``) drops the current one."""
+        """Follow ``goal``; a goal the law cannot take (``ValueError``: its ``eta`` or ``beta``
+        outside the bounds the gains declare, or a task the law refuses) drops the current
+        one."""
         try:
+            declared = {spec.name: spec for spec in gain_specs(type(self.gains))}
+            for name in GOAL_OVERRIDES:
+                value = getattr(goal, name)
+                if value is not None and name in declared:
+                    declared[name].check(value)
             task = task_of(goal)
         except ValueError:
             self.goal = self.task = None

@@ -29,7 +29,6 @@ from typing import Any, ClassVar
 import yaml
 
 from components.control_step import (
-    GOAL_OVERRIDES,
     ControlStep,
     Step,
     gain_values,
@@ -130,16 +129,8 @@ class Controller(Component):
     def on_goal(self, goal: Goal) -> None:
         """Take a goal (``ControlStep.take_goal``). A goal the law refuses (ValueError, counted
         in ``errors.control/goal``) drops the current one: no goal, zero commands. The goal's
-        ``eta`` and ``beta`` must lie in the bounds of the parameters they override, as for
-        ``parsimony param set``."""
-        try:
-            for name in GOAL_OVERRIDES:
-                value = getattr(goal, name)
-                if value is not None and name in self.node.params:
-                    self.node.params.param(name).check(value)
-        except ValueError:
-            self.stepper.goal = self.stepper.task = None
-            raise
+        ``eta`` and ``beta`` must lie in the bounds of the gains they override, the bounds of
+        their parameters too (``parsimony param set``)."""
         self.stepper.take_goal(goal)
 
     def on_obstacles(self, message: Obstacles) -> None:
