@@ -140,6 +140,7 @@ def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict
     return {
         "extends": str(base.resolve()),
         "namespace": f"experiment{os.getpid()}",
+        "startup_timeout_s": STARTUP_S,  # the launcher's and this module's wait are one
         "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
         "components": components,
     }
