@@ -1,0 +1,134 @@
+"""Plücker lines and planes as dual quaternions, and the Jacobian of a line on the robot
+(Marinho, Adorno et al., T-RO 2019, arXiv 1804.11270, section III; DQ Robotics' DQ_Kinematics).
+
+A line through the point p with unit direction l (pure quaternions) is l_ = l + eps m with the
+moment m = p x l. A plane with unit normal n whose points p satisfy <p, n> = d is pi = n + eps d
+(d the signed distance of the plane from the origin along n). Points are pure quaternions
+``[0, x, y, z]`` (vec4) or 3-vectors where a function says so.
+
+For dual quaternions a, b: dot(a, b) = -(a b + b a) / 2 and cross(a, b) = (a b - b a) / 2
+(DQ Robotics' ``dot`` and ``cross``); on pure quaternions they are the Euclidean dot and cross
+products.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from wbc import dq
+from wbc.robot import translation_jacobian
+
+Array = np.ndarray
+
+I4 = np.eye(4)
+
+
+def pure(vector: Array) -> Array:
+    """The pure quaternion [0, v] of a 3-vector (a pure quaternion is returned as it is)."""
+    v = np.asarray(vector, dtype=float)
+    return v if v.shape == (4,) else np.concatenate(([0.0], v))
+
+
+def line(direction: Array, point: Array) -> Array:
+    """vec8 of the Plücker line l + eps (p x l) through ``point`` along ``direction`` (made
+    unit)."""
+    unit = pure(direction)
+    unit = unit / np.linalg.norm(unit[1:])
+    return np.concatenate((unit, crossmatrix4(pure(point)) @ unit))
+
+
+def plane(normal: Array, offset: float) -> Array:
+    """vec8 of the plane n + eps d of unit ``normal`` n and ``offset`` d: <p, n> = d on it."""
+    n = pure(normal)
+    return np.concatenate((n, [float(offset), 0.0, 0.0, 0.0]))
+
+
+def crossmatrix4(a: Array) -> Array:
+    """C4(a) with vec4(cross(a, b)) = C4(a) vec4(b) for pure quaternions (DQ Robotics'
+    ``crossmatrix4``): the skew matrix of Im(a) in the lower 3 x 3 block."""
+    _, x, y, z = a
+    return np.array([[0.0, 0.0, 0.0, 0.0], [0.0, 0.0, -z, y], [0.0, z, 0.0, -x],
+                     [0.0, -y, x, 0.0]])  # fmt: skip
+
+
+def dual_dot(a: Array, b: Array) -> Array:
+    """dot(a, b) = -(a b + b a) / 2."""
+    return -0.5 * (dq.mul(a, b) + dq.mul(b, a))
+
+
+def dual_cross(a: Array, b: Array) -> Array:
+    """cross(a, b) = (a b - b a) / 2."""
+    return 0.5 * (dq.mul(a, b) - dq.mul(b, a))
+
+
+def is_line(x: Array, tol: float = 1e-9) -> bool:
+    """True for a Plücker line: pure primary and dual parts, |l| = 1 and <l, m> = 0."""
+    x = np.asarray(x, dtype=float)
+    return bool(abs(x[0]) < tol and abs(x[4]) < tol and abs(np.linalg.norm(x[1:4]) - 1.0) < tol
+                and abs(float(x[1:4] @ x[5:8])) < tol)  # fmt: skip
+
+
+def closest_parameters(first: Array, second: Array) -> tuple[Array, Array, Array]:
+    """(s, t, c) for the lines ``first`` (8,) or (j, 8) and ``second`` (8,) or (k, 8), each of
+    shape (j, k) (j = 1 or k = 1 for a single line): the closest points are p1 + s l1 and
+    p2 + t l2, with p_i = l_i x m_i the point of line i nearest the origin, and
+    c = 1 - <l1, l2>^2 = ||l1 x l2||^2 (0 for parallel lines, which have no unique pair: s and
+    t are then not finite).
+
+    With w = p1 - p2, b = <l1, l2>: s = (b <l2, w> - <l1, w>) / c and
+    t = (<l2, w> - b <l1, w>) / c (the normal equations of min ||p1 + s l1 - p2 - t l2||^2).
+    """
+    first, second = first.reshape(-1, 8), second.reshape(-1, 8)
+    l1, l2 = first[:, 1:4], second[:, 1:4]
+    p1, p2 = foot(first), foot(second)
+    b = l1 @ l2.T
+    c = 1.0 - b * b
+    # <l1, w> and <l2, w> with w = p1 - p2, for every pair.
+    d = (l1 * p1).sum(axis=1)[:, None] - l1 @ p2.T
+    e = p1 @ l2.T - (l2 * p2).sum(axis=1)[None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return (b * e - d) / c, (e - b * d) / c, c
+
+
+def foot(x: Array) -> Array:
+    """The point l x m of the line ``x`` (8,) nearest the origin (a 3-vector), or of each
+    line of ``x`` (k, 8), (k, 3)."""
+    return cross3(x[..., 1:4], x[..., 5:8])
+
+
+def cross3(a: Array, b: Array) -> Array:
+    """a x b of 3-vectors (..., 3): numpy's ``cross`` costs several times as much at this
+    size."""
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
+    out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
+    out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return out
+
+
+def line_of_pose(pose: Array, direction: Array) -> Array:
+    """The line through the origin of the frame ``pose`` along its local ``direction`` (a unit
+    pure quaternion such as k): l = r d r*, m = p x l with p = translation(pose)."""
+    r = pose[:4]
+    along = dq.qmul(dq.qmul(r, direction), dq.qconj(r))
+    return np.concatenate((along, crossmatrix4(dq.translation(pose)) @ along))
+
+
+def line_jacobian(pose: Array, pose_jacobian: Array, direction: Array) -> Array:
+    """J_l (8 x n) with vec8(l_)' = J_l q' for the line of ``line_of_pose`` (DQ Robotics'
+    ``line_jacobian``; Marinho et al. eq. 26-28):
+
+        J_rx = (H-_4(d r*) + H+_4(r d) C4) J_r,   l' = J_rx q'            (l = r d r*)
+        J_mx = C4(l)^T J_t + C4(p) J_rx,          m' = J_mx q'            (m = p x l)
+
+    with J_r the rotation rows of the pose Jacobian and J_t the translation Jacobian (4.18).
+    """
+    r = pose[:4]
+    along = dq.qmul(dq.qmul(r, direction), dq.qconj(r))
+    jacobian_r = pose_jacobian[:4]
+    jacobian_t = translation_jacobian(pose, pose_jacobian)
+    jacobian_l = (dq.haminus4(dq.qmul(direction, dq.qconj(r)))
+                  + dq.hamiplus4(dq.qmul(r, direction)) @ dq.C4) @ jacobian_r  # fmt: skip
+    position = dq.translation(pose)
+    jacobian_m = crossmatrix4(along).T @ jacobian_t + crossmatrix4(position) @ jacobian_l
+    return np.vstack((jacobian_l, jacobian_m))
