@@ -1,0 +1,215 @@
+"""Obstacles in 3-D for the arm (future work 3 of section 7.2): planes and vertical cylinders.
+
+A ``Plane`` of unit normal n and offset d is the DQ plane pi = n + eps d (``wbc.plucker.plane``);
+the obstacle is the solid behind it, {p : <p, n> < d}: a wall, or the floor. With a
+``footprint`` (a convex polygon in the xy plane; the normal then vertical, n = +-k) the solid is
+that half-space inside the polygon's vertical prism: a table top and what lies under it. A
+``Cylinder`` is a vertical pole round the axis line k + eps (c x k) through (x, y), of
+``radius``, from the floor up to ``height`` (None: no top).
+
+Each solid is the intersection of half-spaces, its faces (``faces``: DQ planes with outward
+normals; a cylinder's side is its axis and radius). The signed distance of a point from any
+face's half-space is a lower bound of its distance from the solid (the solid lies inside each),
+and the largest of them is the distance wherever the point faces one face: the constraint keeps
+that one. ``edges`` are the lines where two faces meet (a table top's rim, its corners), as
+Plücker lines with their extent, for the line-to-line distance of a segment of the robot.
+
+``clearance`` is the exact signed distance of points from the solid (negative inside), for the
+simulator's and the judge's penetration counts.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from wbc.plucker import foot, line, plane
+
+Array = np.ndarray
+
+UNIT_TOLERANCE = 1e-6
+"""How far a plane's normal may stray from unit length."""
+
+
+def _finite(field: str, *values: float) -> None:
+    if not all(math.isfinite(v) for v in values):
+        raise ValueError(f"{field}: expected finite numbers, got {list(values)}")
+
+
+@dataclass(frozen=True)
+class Edge:
+    """A line where two faces meet, ``line`` = l + eps m, over the parameters [low, high]
+    along it (points p_0 + s l, p_0 = l x m; -inf or inf where it has no end)."""
+
+    line: Array
+    low: float
+    high: float
+
+
+@dataclass(frozen=True)
+class Plane:
+    """The solid behind the plane <p, n> = offset, over an optional convex ``footprint``."""
+
+    normal: tuple[float, float, float]
+    offset: float
+    footprint: tuple[tuple[float, float], ...] = ()
+    """Convex polygon (x, y) vertices in either turning order; () for an unbounded plane."""
+    name: str = "plane"
+
+    def __post_init__(self) -> None:
+        _finite("normal", *self.normal)
+        _finite("offset", self.offset)
+        norm = math.sqrt(sum(v * v for v in self.normal))
+        if abs(norm - 1.0) > UNIT_TOLERANCE:
+            raise ValueError(f"normal: expected a unit vector, got {list(self.normal)} "
+                             f"(norm {norm:.6g})")  # fmt: skip
+        if self.footprint:
+            if abs(abs(self.normal[2]) - 1.0) > UNIT_TOLERANCE:
+                raise ValueError("footprint: only a horizontal plane (normal [0, 0, 1] or "
+                                 f"[0, 0, -1]) has a footprint, got normal {list(self.normal)}")
+            object.__setattr__(self, "footprint", _convex_ccw(self.footprint))
+
+    @property
+    def dq(self) -> Array:
+        """pi = n + eps d."""
+        return plane(self.normal, self.offset)
+
+    @property
+    def side(self) -> float:
+        """+1 for a top (solid below, n = +k), -1 for an underside, 0 without a footprint."""
+        return math.copysign(1.0, self.normal[2]) if self.footprint else 0.0
+
+    def faces(self) -> tuple[Array, ...]:
+        """The plane and, with a footprint, the vertical planes of its sides (outward)."""
+        return (self.dq, *_side_planes(self.footprint))
+
+    def edges(self) -> tuple[Edge, ...]:
+        """With a footprint: the rim (the plane's height along each side) and the vertical
+        corner lines from the rim away from the plane (down under a top); else none."""
+        if not self.footprint:
+            return ()
+        vertices = np.array(self.footprint)
+        height, side = self.offset * self.side, self.side
+        edges = []
+        for a, b in zip(vertices, np.roll(vertices, -1, axis=0), strict=True):
+            rim = line([*(b - a), 0.0], [*a, height])
+            start = float((np.array([*a, height]) - foot(rim)) @ rim[1:4])
+            edges.append(Edge(rim, start, start + float(np.hypot(*(b - a)))))
+        for a in vertices:
+            corner = line([0.0, 0.0, 1.0], [*a, 0.0])
+            edges.append(Edge(corner, -math.inf, height) if side > 0
+                         else Edge(corner, height, math.inf))  # fmt: skip
+        return tuple(edges)
+
+    def moved(self, x: float, y: float, yaw: float) -> Plane:
+        """This obstacle after the planar motion (rotation yaw about k, then (x, y, 0))."""
+        c, s = math.cos(yaw), math.sin(yaw)
+        nx, ny, nz = self.normal
+        normal = (c * nx - s * ny, s * nx + c * ny, nz)
+        footprint = tuple((x + c * px - s * py, y + s * px + c * py) for px, py in self.footprint)
+        return Plane(normal, self.offset + normal[0] * x + normal[1] * y, footprint, self.name)
+
+    def clearance(self, points: Array) -> Array:
+        """Signed distances (k,) of ``points`` (k, 3) from the solid, negative inside."""
+        points = np.asarray(points, dtype=float).reshape(-1, 3)
+        across = points @ np.array(self.normal) - self.offset
+        if not self.footprint:
+            return across
+        beside = _polygon_distance(np.array(self.footprint), points[:, :2])
+        outside = (across > 0.0) & (beside > 0.0)
+        return np.where(outside, np.hypot(across, beside), np.maximum(across, beside))
+
+
+@dataclass(frozen=True)
+class Cylinder:
+    """A vertical pole of ``radius`` round (x, y), from the floor to ``height`` (None: no
+    top)."""
+
+    x: float
+    y: float
+    radius: float
+    height: float | None = None
+    name: str = "cylinder"
+
+    def __post_init__(self) -> None:
+        _finite("x, y", self.x, self.y)
+        if not (math.isfinite(self.radius) and self.radius > 0.0):
+            raise ValueError(f"radius: expected a finite number > 0, got {self.radius}")
+        if self.height is not None and not (math.isfinite(self.height) and self.height > 0.0):
+            raise ValueError(f"height: expected a finite number > 0 or none, got {self.height}")
+
+    @property
+    def axis(self) -> Array:
+        """The axis line k + eps (c x k), c = (x, y, 0)."""
+        return line([0.0, 0.0, 1.0], [self.x, self.y, 0.0])
+
+    @property
+    def top(self) -> Array | None:
+        """The plane k + eps height of its top, None without one."""
+        return None if self.height is None else plane([0.0, 0.0, 1.0], self.height)
+
+    def moved(self, x: float, y: float, yaw: float) -> Cylinder:
+        """This obstacle after the planar motion (rotation yaw about k, then (x, y, 0))."""
+        c, s = math.cos(yaw), math.sin(yaw)
+        return Cylinder(x + c * self.x - s * self.y, y + s * self.x + c * self.y, self.radius,
+                        self.height, self.name)  # fmt: skip
+
+    def clearance(self, points: Array) -> Array:
+        """Signed distances (k,) of ``points`` (k, 3) from the solid, negative inside."""
+        points = np.asarray(points, dtype=float).reshape(-1, 3)
+        beside = np.hypot(points[:, 0] - self.x, points[:, 1] - self.y) - self.radius
+        if self.height is None:
+            return beside
+        above = points[:, 2] - self.height
+        outside = (above > 0.0) & (beside > 0.0)
+        return np.where(outside, np.hypot(above, beside), np.maximum(above, beside))
+
+
+Solid = Plane | Cylinder
+"""An obstacle in 3-D."""
+
+
+def _convex_ccw(footprint: tuple[tuple[float, float], ...]) -> tuple[tuple[float, float], ...]:
+    """The footprint as counter-clockwise vertices; ``ValueError`` unless it is a convex
+    polygon of at least 3 distinct vertices."""
+    vertices = np.array(footprint, dtype=float)
+    if vertices.ndim != 2 or vertices.shape[0] < 3 or vertices.shape[1] != 2:
+        raise ValueError(f"footprint: expected at least 3 (x, y) vertices, got {footprint!r}")
+    _finite("footprint", *vertices.ravel())
+    edges = np.roll(vertices, -1, axis=0) - vertices
+    turns = edges[:, 0] * np.roll(edges, -1, axis=0)[:, 1] - edges[:, 1] * np.roll(edges, -1,
+                                                                                   axis=0)[:, 0]
+    if np.any(np.hypot(edges[:, 0], edges[:, 1]) < 1e-9):
+        raise ValueError("footprint: two consecutive vertices coincide")
+    if not (np.all(turns > 1e-12) or np.all(turns < -1e-12)):
+        raise ValueError(f"footprint: expected a convex polygon, got {footprint!r}")
+    ordered = vertices if turns[0] > 0 else vertices[::-1]
+    return tuple((float(x), float(y)) for x, y in ordered)
+
+
+def _side_planes(footprint: tuple[tuple[float, float], ...]) -> list[Array]:
+    """The vertical planes through the sides of a counter-clockwise polygon, normals outward
+    (the side's direction turned by -90 degrees)."""
+    vertices = np.array(footprint).reshape(-1, 2)
+    planes = []
+    for a, b in zip(vertices, np.roll(vertices, -1, axis=0), strict=True):
+        direction = (b - a) / np.hypot(*(b - a))
+        normal = np.array([direction[1], -direction[0], 0.0])
+        planes.append(plane(normal, float(normal[:2] @ a)))
+    return planes
+
+
+def _polygon_distance(vertices: Array, points: Array) -> Array:
+    """Signed distances of 2-D ``points`` from a convex counter-clockwise polygon: from its
+    boundary outside, minus the depth inside."""
+    a = vertices[None, :, :]
+    edge = np.roll(vertices, -1, axis=0)[None, :, :] - a
+    offset = points[:, None, :] - a
+    length2 = (edge**2).sum(axis=2)
+    along = np.clip((offset * edge).sum(axis=2) / length2, 0.0, 1.0)
+    nearest = np.sqrt(((offset - along[:, :, None] * edge) ** 2).sum(axis=2)).min(axis=1)
+    outward = (offset[:, :, 0] * edge[:, :, 1] - offset[:, :, 1] * edge[:, :, 0])
+    depth = outward / np.sqrt(length2)
+    return np.where(np.any(depth > 0.0, axis=1), nearest, depth.max(axis=1))
