@@ -52,13 +52,13 @@ def translation_jacobians(poses: Array, jacobians: Array) -> Array:
                   + dq.hamiplus4_stack(poses[:, 4:]) @ (jacobians[:, :4] * _CONJ4[:, None]))
 
 
+_CROSS_INDEX = np.array([[0, 0, 0, 0], [0, 0, 3, 2], [0, 3, 0, 1], [0, 2, 1, 0]])
+_CROSS_SIGN = np.array([[0.0, 0, 0, 0], [0, 0, -1, 1], [0, 1, 0, -1], [0, -1, 1, 0]])
+
+
 def _cross_matrices(vectors: Array) -> Array:
     """C4 (``wbc.plucker.crossmatrix4``) of each pure quaternion of a stack: (k, 4, 4)."""
-    out = np.zeros((vectors.shape[0], 4, 4))
-    x, y, z = vectors[:, 1], vectors[:, 2], vectors[:, 3]
-    out[:, 1, 2], out[:, 1, 3], out[:, 2, 1] = -z, y, z
-    out[:, 2, 3], out[:, 3, 1], out[:, 3, 2] = -x, -y, x
-    return out
+    return vectors[:, _CROSS_INDEX] * _CROSS_SIGN
 
 
 def line_jacobians(poses: Array, jacobians: Array, directions: Array, positions: Array,

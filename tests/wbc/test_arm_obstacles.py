@@ -105,7 +105,7 @@ def test_segment_rows_engage_across_a_table_edge_and_a_pole() -> None:
     assert np.isinf(rows.upper[forearm]) and not np.any(rows.matrix[forearm])
 
 
-def test_a_point_is_held_on_the_face_it_is_farthest_outside() -> None:
+def test_a_point_is_held_by_the_feature_nearest_it() -> None:
     """The gripper above the table top is held by the top (its row lifts it: -J_t's z row),
     the base beside the near edge by the edge (its row pushes it back along -x)."""
     parts = ROBOT.collision.names

@@ -27,6 +27,8 @@ from wbc.distance_jacobians import (
     point_to_line_squared_distance,
     point_to_plane_distance,
     point_to_plane_distance_jacobian,
+    point_to_point_distance_jacobian,
+    point_to_point_squared_distance,
 )
 from wbc.plucker import closest_parameters, is_line, line, line_jacobian, line_of_pose, plane
 from wbc.robot import MobileManipulator
@@ -170,6 +172,23 @@ def test_point_to_line_jacobian_is_the_derivative_and_dqrobotics(part: int) -> N
         np.testing.assert_allclose(row, oracle.ravel(), atol=ORACLE_TOL)
         assert point_to_line_squared_distance(point, workspace_line) == pytest.approx(
             DQ_Geometry.point_to_line_squared_distance(DQ(point), DQ(workspace_line)), abs=1e-12)
+
+
+@pytest.mark.parametrize("part", range(POINTS))
+def test_point_to_point_jacobian_is_the_derivative_and_dqrobotics(part: int) -> None:
+    rng = np.random.default_rng(part)
+    for q in configurations(20, seed=50 + part):
+        corner = np.r_[0.0, rng.uniform(-1.0, 1.0, 3)]
+        parts = primitive_kinematics(ROBOT, q)
+        point, jacobian = parts.points[part], parts.point_jacobians[part]
+        row = point_to_point_distance_jacobian(jacobian, point, corner)
+        np.testing.assert_allclose(row, central_difference(
+            lambda c, w=corner: point_to_point_squared_distance(
+                primitive_kinematics(ROBOT, c).points[part], w), q), atol=FD_TOL)  # fmt: skip
+        oracle = DQ_Kinematics.point_to_point_distance_jacobian(jacobian, DQ(point), DQ(corner))
+        np.testing.assert_allclose(row, oracle.ravel(), atol=ORACLE_TOL)
+        assert point_to_point_squared_distance(point, corner) == pytest.approx(
+            DQ_Geometry.point_to_point_squared_distance(DQ(point), DQ(corner)), abs=1e-12)
 
 
 @pytest.mark.parametrize("segment", range(len(ROBOT.collision.segments)))

@@ -9,8 +9,12 @@ import re
 import numpy as np
 import pytest
 
-from wbc.distance_jacobians import point_to_line_squared_distance, point_to_plane_distance
-from wbc.obstacles3d import Cylinder, Plane
+from wbc.distance_jacobians import (
+    point_to_line_squared_distance,
+    point_to_plane_distance,
+    point_to_point_squared_distance,
+)
+from wbc.obstacles3d import CORNER, EDGE, FACE, RIM, SIDE, Cylinder, Plane
 from wbc.plucker import foot
 
 TABLE = Plane((0.0, 0.0, 1.0), 0.4, ((0.5, -0.4), (1.1, -0.4), (1.1, 0.4), (0.5, 0.4)), "table")
@@ -136,3 +140,33 @@ def test_bad_obstacles_are_refused_naming_the_field(make, field: str) -> None:
         make()
 
 
+
+
+def feature_distance(solid: Plane | Cylinder, point: np.ndarray, kind: int, index: int
+                     ) -> float:  # fmt: skip
+    """The distance of ``point`` from the feature (``kind``, ``index``), by the distances of
+    wbc.distance_jacobians."""
+    vec4 = np.r_[0.0, point]
+    if kind == FACE:
+        return float(point_to_plane_distance(vec4, solid.faces()[index]))
+    if kind == EDGE:
+        return math.sqrt(point_to_line_squared_distance(vec4, solid.edges()[index].line))
+    if kind == CORNER:
+        corner = np.r_[0.0, solid.corners()[index]]
+        return math.sqrt(point_to_point_squared_distance(vec4, corner))
+    radial = math.sqrt(point_to_line_squared_distance(vec4, solid.axis)) - solid.radius
+    return radial if kind == SIDE else math.hypot(radial, point[2] - solid.height)
+
+
+@pytest.mark.parametrize("solid", [TABLE, POLE, Plane((0.0, 0.0, -1.0), -1.2, TABLE.footprint)],
+                         ids=["table", "pole", "shelf"])  # fmt: skip
+def test_the_nearest_feature_gives_the_exact_distance(solid: Plane | Cylinder) -> None:
+    """Outside, the distance from the feature ``nearest`` names is the distance from the
+    solid; inside, the face named is the one the point is least deep behind."""
+    points = random_points(3000, seed=5)
+    kinds, indices = solid.nearest(points)
+    found = [feature_distance(solid, p, k, i) for p, k, i in zip(points, kinds, indices,
+                                                                 strict=True)]  # fmt: skip
+    np.testing.assert_allclose(found, solid.clearance(points), atol=1e-12)
+    expected = {FACE, EDGE, CORNER} if isinstance(solid, Plane) else {SIDE, FACE, RIM}
+    assert set(kinds.tolist()) == expected

@@ -9,15 +9,21 @@ The parts are the points and segments of ``robot.collision`` (``wbc.collision_mo
 sphere or capsule of radius rho; the obstacles are ``wbc.obstacles3d``'s. The distances and
 their Jacobians are ``wbc.distance_jacobians``':
 
-    point - plane face      d = <p, n> - d_pi,       d_safe = rho + margin
-    point - cylinder side   D = ||p x l - m||^2,     D_safe = (R + rho + margin)^2   (squared)
+    point - face            d = <p, n> - d_pi,       d_safe = rho + margin
+    point - edge            D = ||p x l - m||^2,     D_safe = (rho + margin)^2       (squared)
+    point - corner          D = ||p - c||^2,         D_safe = (rho + margin)^2       (squared)
+    point - cylinder side   D = ||p x l - m||^2,     D_safe = (R + rho + margin)^2   (axis)
+    point - cylinder rim    d = sqrt((sqrt(D) - R)^2 + (z - h)^2),  d_safe = rho + margin
     segment - cylinder      D = line to line, axis,  D_safe = (R + rho + margin)^2
     segment - solid's edge  D = line to line, edge,  D_safe = (rho + margin)^2
 
-A point keeps one row per obstacle: the face whose half-space it is farthest outside (a lower
-bound of its distance from the solid, which the solid lies behind; a cylinder's faces are its
-side and its top). Planes bound a segment by its ends, which are points. Across a cylinder's
-axis or a table's rim or corner the segment's middle can come closer than either end: a row on
+A point keeps one row per obstacle: on its distance from the feature of the solid nearest it
+(``nearest`` of wbc.obstacles3d: a face, an edge, a corner; a cylinder's side, top or rim), the
+Euclidean distance from the solid, continuously differentiable outside it, so a point held at
+a table's rim slides round it (on the largest face distance alone it stalls there). Inside, the
+face it is least deep behind. Planes bound a segment by its ends, which are points. Across a
+cylinder's axis or a table's rim or corner the segment's middle can come closer than either end:
+a row on
 the squared distance between its line and that line holds when their closest points lie inside
 both (the segment, the edge's extent, the cylinder's height) and they are not nearly parallel
 (sin of their angle >= ``SKEW_MIN``; nearer parallel, the ends' rows bound the segment within
@@ -41,10 +47,13 @@ from wbc.distance_jacobians import (
     line_to_line_squared_distance,
     point_to_line_distance_jacobian,
     point_to_line_squared_distance,
+    point_to_plane_distance,
     point_to_plane_distance_jacobian,
+    point_to_point_distance_jacobian,
+    point_to_point_squared_distance,
 )
 from wbc.gains import gain
-from wbc.obstacles3d import Cylinder, Edge, Plane, Solid
+from wbc.obstacles3d import CORNER, EDGE, FACE, RIM, SIDE, Cylinder, Edge, Plane, Solid
 from wbc.plucker import closest_parameters
 from wbc.robot_primitives import PrimitiveKinematics, primitive_kinematics
 from wbc.step_context import StepContext
@@ -69,9 +78,15 @@ class ArmObstacleGains:
 
 
 @functools.cache
-def _faces(obstacle: Plane) -> Array:
-    """The faces (k, 8) of ``obstacle`` (``Plane.faces``)."""
-    return np.array(obstacle.faces())
+def _faces(obstacle: Solid) -> Array:
+    """The faces (k, 8) of ``obstacle`` (``faces``)."""
+    return np.array(obstacle.faces()).reshape(-1, 8)
+
+
+@functools.cache
+def _corners(obstacle: Plane) -> Array:
+    """The corners (k, 4) of ``obstacle`` as pure quaternions (``Plane.corners``)."""
+    return np.hstack((np.zeros((len(obstacle.footprint), 1)), obstacle.corners()))
 
 
 @dataclass(frozen=True)
@@ -141,26 +156,55 @@ class ArmObstacles:
 
     def _point_rows(self, parts: PrimitiveKinematics, safe: Array, obstacle: Solid
                     ) -> tuple[Array, Array]:  # fmt: skip
-        """Each point's row on the face it is farthest outside (module docstring), and its
-        bound; ``safe`` is each point's radius plus the margin."""
+        """Each point's row on the distance from the feature of ``obstacle`` nearest it
+        (module docstring), and its bound; ``safe`` is each point's radius plus the margin.
+        The points are taken kind by kind, each kind's distance once for all of its points."""
         points, jacobians = parts.points, parts.point_jacobians
-        if isinstance(obstacle, Plane):
-            faces = _faces(obstacle)
-            gaps = points[:, 1:4] @ faces[:, 1:4].T - faces[:, 4]
-            chosen = np.argmax(gaps, axis=1)
-            gap = gaps[np.arange(len(points)), chosen]
-            rows = -np.einsum("ki,kin->kn", faces[chosen, :4], jacobians)
-            return rows, self.gain * np.maximum(gap - safe, 0.0)
-        squared = point_to_line_squared_distance(points, obstacle.axis)
-        rows = -point_to_line_distance_jacobian(jacobians, points, obstacle.axis)
-        upper = self.gain * np.maximum(squared - (obstacle.radius + safe) ** 2, 0.0)
-        if obstacle.height is not None:
-            above = points[:, 3] - obstacle.height
-            on_top = above > np.sqrt(squared) - obstacle.radius
-            top = point_to_plane_distance_jacobian(jacobians, obstacle.top)
-            rows[on_top] = -top[on_top]
-            upper[on_top] = self.gain * np.maximum(above[on_top] - safe[on_top], 0.0)
-        return rows, upper
+        kind, index = obstacle.nearest(points[:, 1:])
+        rows, upper = np.empty((len(points), jacobians.shape[2])), np.empty(len(points))
+        faces = kind == FACE
+        if faces.any():
+            face = _faces(obstacle)[index[faces]]
+            rows[faces] = -point_to_plane_distance_jacobian(jacobians[faces], face)
+            upper[faces] = point_to_plane_distance(points[faces], face) - safe[faces]
+        edges = kind == EDGE
+        if edges.any():
+            edge = lines_of(obstacle).lines[index[edges]]
+            rows[edges] = -point_to_line_distance_jacobian(jacobians[edges], points[edges], edge)
+            upper[edges] = (point_to_line_squared_distance(points[edges], edge)
+                            - safe[edges] ** 2)  # fmt: skip
+        corners = kind == CORNER
+        if corners.any():
+            corner = _corners(obstacle)[index[corners]]
+            rows[corners] = -point_to_point_distance_jacobian(jacobians[corners],
+                                                              points[corners], corner)
+            upper[corners] = (point_to_point_squared_distance(points[corners], corner)
+                              - safe[corners] ** 2)  # fmt: skip
+        pole = (kind == SIDE) | (kind == RIM)
+        if pole.any():
+            rows[pole], upper[pole] = self._pole_rows(points[pole], jacobians[pole], safe[pole],
+                                                      obstacle, kind[pole] == RIM)  # fmt: skip
+        return rows, self.gain * np.maximum(upper, 0.0)
+
+    @staticmethod
+    def _pole_rows(points: Array, jacobians: Array, safe: Array, pole: Cylinder, rim: Array
+                   ) -> tuple[Array, Array]:  # fmt: skip
+        """Rows and distances less the safe ones beside a cylinder: its side, the squared
+        distance D from the axis held from (R + safe)^2; its rim, d = sqrt((sqrt(D) - R)^2 +
+        (z - h)^2) held from safe, whose row is the chain rule of the two,
+        J_d = ((sqrt(D) - R) J_D / (2 sqrt(D)) + (z - h) J_z) / d."""
+        squared = point_to_line_squared_distance(points, pole.axis)
+        rows = -point_to_line_distance_jacobian(jacobians, points, pole.axis)
+        gaps = squared - (pole.radius + safe) ** 2
+        if rim.any():
+            radial = np.sqrt(squared[rim])
+            beside, above = radial - pole.radius, points[rim, 3] - pole.height
+            distance = np.hypot(beside, above)
+            rows[rim] = (beside / (2.0 * radial))[:, None] * rows[rim]
+            rows[rim] -= above[:, None] * jacobians[rim, 3]
+            rows[rim] /= distance[:, None]
+            gaps[rim] = distance - safe[rim]
+        return rows, gaps
 
     def _segment_rows(self, parts: PrimitiveKinematics, obstacle: Solid, context: StepContext
                       ) -> tuple[Array, Array]:  # fmt: skip
