@@ -17,7 +17,7 @@ from wbc.lp_law import LPLaw, LPParams, default_constraints
 from wbc.obstacles import Circle
 from wbc.obstacles3d import Cylinder, Plane
 from wbc.robot import MobileManipulator
-from wbc.scenarios import DT, TABLE, TABLE_GOAL, TABLE_START
+from wbc.scenarios import DT, HOME, REACH_GOAL, TABLE, TABLE_GOAL, TABLE_START
 from wbc.step_context import StepContext
 from wbc.task import PoseTask
 
@@ -156,3 +156,13 @@ def test_the_rows_hold_the_gripper_off_a_pole_it_is_driven_into() -> None:
     least, penetrations = least_clearances(run.configurations, (pole,))
     assert penetrations == 0 and least > MARGIN - 0.005
     assert not run.converged  # the goal lies inside the pole
+
+
+def test_without_solids_the_constraint_changes_nothing() -> None:
+    """The pose experiment's run with the constraint in the law and no solid is bit-identical
+    to the run without it: the commands of every run before this feature stay as they were."""
+    task = PoseTask(ROBOT.fkm(REACH_GOAL))
+    on = integrate(LPLaw(ROBOT, LPParams()), HOME, task, DT, 300, obstacles=(Circle(2, 2, 0.1),))
+    off = integrate(LPLaw(ROBOT, LPParams(arm_obstacles=False)), HOME, task, DT, 300,
+                    obstacles=(Circle(2, 2, 0.1),))  # fmt: skip
+    assert np.array_equal(on.velocities(), off.velocities())
