@@ -8,12 +8,9 @@ A robot description may declare (``collision`` in deploy/robots/little_john.yaml
 ``frame`` i is the i-th pose of ``MobileManipulator.frames``: 0 the base top x_2^0, i the DH
 frame after arm link i. A point is a sphere of ``radius`` round p = translation(x_i (1 + eps
 offset / 2)); a segment is the capsule of ``radius`` round the part of the frame's axis line
-l_ = l + eps p x l between its two points, which must lie on that
-line in every configuration (checked when the robot is built).
-
-Per step, ``primitive_kinematics`` gives each point's position and translation Jacobian J_t
-(4.18, from the frame's pose Jacobian H-(offset) J_i) and each segment's line, line Jacobian
-(``wbc.plucker.line_jacobian``) and the parameters s of its ends along the line (p + s l).
+l_ = l + eps p x l between its two points, which must lie on that line in every
+configuration (checked when the robot is built). ``wbc.robot_primitives`` gives their
+Jacobians.
 """
 
 from __future__ import annotations

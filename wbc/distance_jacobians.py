@@ -17,9 +17,9 @@ Each Jacobian J_d is a row on q' with d' = J_d q' for a static workspace primiti
                               + (2 a^2 / s^2) (l x l_z)^T C4(l_z) J_l
 
 with p the robot's point, J_t its translation Jacobian (4.18), c a workspace point,
-n + eps d_pi the plane, l + eps m
-a line, J_l = [J_l; J_m] the robot line's Jacobian (``wbc.plucker.line_jacobian``) and l_z + eps
-m_z the workspace line. Line to line holds for lines that are not parallel (s > 0).
+n + eps d_pi the plane, l + eps m a line, J_l = [J_l; J_m] the robot line's Jacobian
+(``wbc.robot_primitives.line_jacobians``) and l_z + eps m_z the workspace line. Line to line
+holds for lines that are not parallel (s > 0).
 """
 
 from __future__ import annotations

@@ -13,11 +13,10 @@ meet (a table top's rim, its corners), as Plücker lines with their extent, and 
 points where three do. ``nearest`` names the feature of the solid nearest a point outside it:
 a face (the distance is the point-to-plane one; a cylinder's face is its top), an edge (point
 to line), a corner (point to point), or a cylinder's side (point to its axis) or rim (the
-circle round its top). The
-distance from a convex solid is continuously differentiable outside it, so a constraint on it
-slides round an edge where the nearest feature changes; the largest face distance, a lower
-bound of it, would stop a point at an edge's corner region instead. Inside, ``nearest`` names
-the face the point is least deep behind.
+circle round its top). The distance from a convex solid is continuously differentiable outside
+it, so a constraint on it slides round an edge where the nearest feature changes; the largest
+face distance, a lower bound of it, would stop a point at an edge's corner region instead.
+Inside, ``nearest`` names the face the point is least deep behind.
 
 ``clearance`` is the exact signed distance of points from the solid (negative inside), for the
 simulator's and the judge's penetration counts.

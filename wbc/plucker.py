@@ -1,22 +1,16 @@
-"""Plücker lines and planes as dual quaternions, and the Jacobian of a line on the robot
-(Marinho, Adorno et al., T-RO 2019, arXiv 1804.11270, section III; DQ Robotics' DQ_Kinematics).
+"""Plücker lines and planes as dual quaternions (Marinho, Adorno et al., T-RO 2019, arXiv
+1804.11270, section III; DQ Robotics). The Jacobian of a line on the robot is
+``wbc.robot_primitives.line_jacobians``.
 
 A line through the point p with unit direction l (pure quaternions) is l_ = l + eps m with the
 moment m = p x l. A plane with unit normal n whose points p satisfy <p, n> = d is pi = n + eps d
 (d the signed distance of the plane from the origin along n). Points are pure quaternions
 ``[0, x, y, z]`` (vec4) or 3-vectors where a function says so.
-
-For dual quaternions a, b: dot(a, b) = -(a b + b a) / 2 and cross(a, b) = (a b - b a) / 2
-(DQ Robotics' ``dot`` and ``cross``); on pure quaternions they are the Euclidean dot and cross
-products.
 """
 
 from __future__ import annotations
 
 import numpy as np
-
-from wbc import dq
-from wbc.robot import translation_jacobian
 
 Array = np.ndarray
 
@@ -49,16 +43,6 @@ def crossmatrix4(a: Array) -> Array:
     _, x, y, z = a
     return np.array([[0.0, 0.0, 0.0, 0.0], [0.0, 0.0, -z, y], [0.0, z, 0.0, -x],
                      [0.0, -y, x, 0.0]])  # fmt: skip
-
-
-def dual_dot(a: Array, b: Array) -> Array:
-    """dot(a, b) = -(a b + b a) / 2."""
-    return -0.5 * (dq.mul(a, b) + dq.mul(b, a))
-
-
-def dual_cross(a: Array, b: Array) -> Array:
-    """cross(a, b) = (a b - b a) / 2."""
-    return 0.5 * (dq.mul(a, b) - dq.mul(b, a))
 
 
 def is_line(x: Array, tol: float = 1e-9) -> bool:
@@ -103,31 +87,3 @@ def cross3(a: Array, b: Array) -> Array:
     """a x b of 3-vectors (..., 3), componentwise a_(i+1) b_(i+2) - a_(i+2) b_(i+1): numpy's
     ``cross`` costs several times as much at this size."""
     return a[..., _NEXT] * b[..., _AFTER] - a[..., _AFTER] * b[..., _NEXT]
-
-
-def line_of_pose(pose: Array, direction: Array) -> Array:
-    """The line through the origin of the frame ``pose`` along its local ``direction`` (a unit
-    pure quaternion such as k): l = r d r*, m = p x l with p = translation(pose)."""
-    r = pose[:4]
-    along = dq.qmul(dq.qmul(r, direction), dq.qconj(r))
-    return np.concatenate((along, crossmatrix4(dq.translation(pose)) @ along))
-
-
-def line_jacobian(pose: Array, pose_jacobian: Array, direction: Array) -> Array:
-    """J_l (8 x n) with vec8(l_)' = J_l q' for the line of ``line_of_pose`` (DQ Robotics'
-    ``line_jacobian``; Marinho et al. eq. 26-28):
-
-        J_rx = (H-_4(d r*) + H+_4(r d) C4) J_r,   l' = J_rx q'            (l = r d r*)
-        J_mx = C4(l)^T J_t + C4(p) J_rx,          m' = J_mx q'            (m = p x l)
-
-    with J_r the rotation rows of the pose Jacobian and J_t the translation Jacobian (4.18).
-    """
-    r = pose[:4]
-    along = dq.qmul(dq.qmul(r, direction), dq.qconj(r))
-    jacobian_r = pose_jacobian[:4]
-    jacobian_t = translation_jacobian(pose, pose_jacobian)
-    jacobian_l = (dq.haminus4(dq.qmul(direction, dq.qconj(r)))
-                  + dq.hamiplus4(dq.qmul(r, direction)) @ dq.C4) @ jacobian_r  # fmt: skip
-    position = dq.translation(pose)
-    jacobian_m = crossmatrix4(along).T @ jacobian_t + crossmatrix4(position) @ jacobian_l
-    return np.vstack((jacobian_l, jacobian_m))

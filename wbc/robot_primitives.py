@@ -4,8 +4,8 @@ For a point at ``offset`` in frame i: x = x_i (1 + eps offset / 2), its pose Jac
 H-(1 + eps offset / 2) J_i and its translation Jacobian J_t (4.18), J_i the pose Jacobian of
 frame i (``MobileManipulator.frame_kinematics``: the columns of the joints after frame i are 0).
 For a segment on the axis a of frame i: its Plücker line l + eps p x l with l = r a r*
-(``wbc.plucker.line_of_pose``) and the line Jacobian of DQ Robotics (``wbc.plucker.
-line_jacobian``), and its ends as parameters s along the line, p_0 + s l with p_0 = l x m.
+and the line Jacobian of DQ Robotics' ``line_jacobian`` (``line_jacobians``; Marinho et al.
+eq. 26-28), and its ends as parameters s along the line, p_0 + s l with p_0 = l x m.
 """
 
 from __future__ import annotations
@@ -63,9 +63,13 @@ def _cross_matrices(vectors: Array) -> Array:
 
 def line_jacobians(poses: Array, jacobians: Array, directions: Array, positions: Array,
                    position_jacobians: Array) -> tuple[Array, Array]:  # fmt: skip
-    """The lines l + eps p x l through each pose's origin along its local direction (k, 4)
-    and their Jacobians (k, 8, n): ``wbc.plucker.line_of_pose`` and ``line_jacobian`` of a
-    stack, given the poses' translations p (k, 4) and translation Jacobians (k, 4, n)."""
+    """The lines l + eps p x l through each pose's origin along its local direction d (k, 4),
+    and their Jacobians (k, 8, n), DQ Robotics' ``line_jacobian`` of each, given the poses'
+    translations p (k, 4) and translation Jacobians J_t (k, 4, n) (4.18):
+
+        l = r d r*,   J_l = (H-_4(d r*) + H+_4(r d) C4) J_r        (J_r the pose rows 1-4)
+        m = p x l,    J_m = C4(l)^T J_t + C4(p) J_l
+    """
     r, conjugates = poses[:, :4], poses[:, :4] * _CONJ4
     along_r = (dq.hamiplus4_stack(r) @ directions[:, :, None])[:, :, 0]  # r d
     along = (dq.hamiplus4_stack(along_r) @ conjugates[:, :, None])[:, :, 0]  # r d r*

@@ -30,9 +30,14 @@ from wbc.distance_jacobians import (
     point_to_point_distance_jacobian,
     point_to_point_squared_distance,
 )
-from wbc.plucker import closest_parameters, is_line, line, line_jacobian, line_of_pose, plane
+from wbc.plucker import closest_parameters, is_line, line, plane
 from wbc.robot import MobileManipulator
-from wbc.robot_primitives import primitive_kinematics
+from wbc.robot_primitives import (
+    line_jacobians,
+    primitive_kinematics,
+    translation_jacobians,
+    translations,
+)
 
 ROBOT = MobileManipulator.from_yaml(
     Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml")
@@ -112,6 +117,15 @@ def test_part_jacobians_are_the_derivatives_of_the_parts() -> None:
         assert all(is_line(x) for x in parts.lines)
 
 
+def line_of(pose: np.ndarray, jacobian: np.ndarray, axis: np.ndarray
+            ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """The line along ``axis`` through one frame and its Jacobian, by the stack version."""
+    stack = pose[None], jacobian[None]
+    lines, jacobians = line_jacobians(*stack, axis[None], translations(stack[0]),
+                                      translation_jacobians(*stack))  # fmt: skip
+    return lines[0], jacobians[0]
+
+
 def test_line_jacobian_matches_dqrobotics() -> None:
     for q in configurations(50, seed=13):
         poses, jacobians = ROBOT.frame_kinematics(q)
@@ -119,8 +133,11 @@ def test_line_jacobian_matches_dqrobotics() -> None:
             for axis in (dq.I_, dq.J_, dq.K_):
                 expected = DQ_Kinematics.line_jacobian(jacobians[frame], DQ(poses[frame]),
                                                        DQ(axis))  # fmt: skip
-                np.testing.assert_allclose(line_jacobian(poses[frame], jacobians[frame], axis),
-                                           expected, atol=ORACLE_TOL)  # fmt: skip
+                found, jacobian = line_of(poses[frame], jacobians[frame], axis)
+                np.testing.assert_allclose(jacobian, expected, atol=ORACLE_TOL)
+                direction = dq.qmul(dq.qmul(poses[frame][:4], axis), dq.qconj(poses[frame][:4]))
+                np.testing.assert_allclose(found, line(direction, dq.translation(poses[frame])),
+                                           atol=1e-12)  # fmt: skip
 
 
 def test_segments_run_along_their_lines_from_end_to_end() -> None:
@@ -242,5 +259,5 @@ def test_closest_parameters_give_the_common_perpendicular() -> None:
 
 def test_line_of_a_pose_passes_through_its_origin_along_its_axis() -> None:
     pose = dq.pose(dq.rotation_quaternion(np.pi / 2, [0, 1, 0]), [1.0, 2.0, 3.0])
-    z_axis = line_of_pose(pose, dq.K_)
+    z_axis, _ = line_of(pose, np.zeros((8, 8)), dq.K_)
     np.testing.assert_allclose(z_axis, line([1, 0, 0], [1, 2, 3]), atol=1e-12)
