@@ -29,7 +29,7 @@ from wbc.base_motion import unicycle, wheel_speeds
 from wbc.drive_tasks import HeadingTask, PointTask
 from wbc.gains import gain_specs
 from wbc.law_output import Law, LawOutput
-from wbc.obstacles import Circle
+from wbc.obstacles import Obstacle
 from wbc.robot import MobileManipulator
 from wbc.task import MEASUREMENT_TOLERANCE, PoseTask, PositionTask, Task, same_task
 
@@ -83,7 +83,7 @@ class ControlStep:
         self.law = law_type(robot, gains)
         self.goal: Goal | None = None
         self.task: Task | None = None
-        self.obstacles: tuple[Circle, ...] = ()
+        self.obstacles: tuple[Obstacle, ...] = ()
         self.last_stamp_ns: int | None = None
 
     def take_goal(self, goal: Goal) -> None:
@@ -104,8 +104,9 @@ class ControlStep:
             self.law.reset()
         self.goal, self.task = goal, task
 
-    def take_obstacles(self, circles: tuple[Circle, ...]) -> None:
-        self.obstacles = circles
+    def take_obstacles(self, obstacles: tuple[Obstacle, ...]) -> None:
+        """The circles and solids every following step avoids."""
+        self.obstacles = obstacles
 
     def use(self, robot: MobileManipulator) -> None:
         """Control ``robot`` from now on (a new law of the gains in force)."""

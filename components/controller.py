@@ -42,12 +42,11 @@ from messages.commands import ArmCommand, BaseCommand
 from messages.diagnostics import ControllerDiagnostics
 from messages.goal import Goal
 from messages.header import Header
-from messages.obstacles import Obstacles
+from messages.obstacles import Obstacles, obstacles_of
 from messages.state import RobotState
 from wbc.drive_tasks import HeadingTask, PointTask
 from wbc.gains import gain_specs
 from wbc.law_output import Law
-from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
 from wbc.task import PoseTask, PositionTask, Task
 
@@ -135,7 +134,7 @@ class Controller(Component):
 
     def on_obstacles(self, message: Obstacles) -> None:
         """Take the obstacles every following step avoids."""
-        self.stepper.take_obstacles(tuple(Circle(c.x, c.y, c.radius) for c in message.circles))
+        self.stepper.take_obstacles(obstacles_of(message))
 
     def on_state(self, state: RobotState) -> None:
         """One control step: publish its commands and diagnostics."""

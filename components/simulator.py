@@ -9,7 +9,8 @@ camera publish on the real robot, every ``step_s`` of simulated time::
                        distances and the dead-reckoned pose from them, as the Create driver does
     camera/image       a 640x480 grey frame of the scene's markers at the camera's rate, as a
                        JPEG of ``jpeg_quality`` (as a UVC camera's MJPEG stream) or raw mono8
-    sim/truth          the real pose, joints, end effector and contacts (tests and reports only)
+    sim/truth          the real pose, joints, end effector, contacts and the arm's penetrations
+                       into the scene's solids in 3-D (tests and reports only)
 
 It stops the robot when no command has arrived for ``command_timeout_s`` of simulated time.
 
@@ -48,6 +49,7 @@ from messages.commands import ArmCommand, BaseCommand
 from messages.joints import JointStates
 from messages.lockstep import AnswerStamps
 from messages.obstacles import Circle as TruthCircle
+from messages.obstacles import Solids
 from messages.odometry import BaseOdometry
 from messages.truth import SimTruth
 from profiles.scene import Scene
@@ -148,6 +150,10 @@ class Simulator(Component):
         self.obstacles = [Circle(*c) for c in p["obstacles"]]
         self.truth_obstacles = tuple(TruthCircle(x=c.x, y=c.y, radius=c.radius)
                                      for c in self.obstacles)  # fmt: skip
+        # The scene declares its solids in F0; this world has F0 at the reference pose.
+        solids = tuple(solid.moved(*self.scene.reference_pose)
+                       for solid in self.scene.arm_obstacles.solids())  # fmt: skip
+        self.truth_solids = Solids.of(solids)
         self.goal_of: tuple[tuple, tuple[float, ...]] = ((), ())
         settings = WorldSettings(
             wheel_acceleration_max=p["wheel_acceleration_max"],
@@ -155,7 +161,8 @@ class Simulator(Component):
             wheel_slip=p["wheel_slip"],
         )
         start = np.array(p["start"])
-        self.world = World(self.robot, start, self.obstacles, settings, seed=p["seed"])
+        self.world = World(self.robot, start, self.obstacles, settings, seed=p["seed"],
+                           solids=solids)  # fmt: skip
         self.step_ns = round(p["step_s"] * 1e9)
         self.now_ns = time.time_ns() if p["host_epoch"] else 0
         self.camera = SimCamera(node, self.robot, self.obstacles,
@@ -179,6 +186,7 @@ class Simulator(Component):
         node.counters["lockstep_timeouts"] = 0
         node.counters["frames_skipped"] = 0
         node.counters["contacts"] = 0
+        node.counters["arm_penetrations"] = 0
         self.publishers = {t.name: node.publisher(t) for t in self.writes}
         for topic in self.reads:
             node.subscribe(topic.topic, self._answer_handler(topic.topic.name))
@@ -377,6 +385,7 @@ class Simulator(Component):
     def _publish_truth(self) -> None:
         q = self.world.q
         self.node.counters["contacts"] = self.world.contacts
+        self.node.counters["arm_penetrations"] = self.world.arm_penetrations
         self.publishers["sim/truth"].put(
             SimTruth(
                 header=self._header("world", "sim/truth"),
@@ -388,6 +397,9 @@ class Simulator(Component):
                 goal=self._true_goal(),
                 reference_pose=self.scene.reference_pose,
                 obstacles=self.truth_obstacles,
+                solids=self.truth_solids,
+                arm_penetrations=self.world.arm_penetrations,
+                arm_penetrating=self.world.arm_penetrating,
             )
         )
 

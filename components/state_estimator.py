@@ -23,7 +23,8 @@ known from), just before its state.
 The goal is the pose x_d^0 = x_2^0 x_d^2 of eq. 6.3 with x_d^2 the scene's goal offset (its
 translation for a ``position`` task), once the bin marker F2 has been seen; the obstacles, a
 circle of the scene's radius at every obstacle marker (the controller adds the robot's radius,
-section 5.5), for every frame, seen or not. So what the controller is given, and when, does
+section 5.5), for every frame, seen or not, with the planes and cylinders the scene declares
+(``scene.arm_obstacles``, already in F0). So what the controller is given, and when, does
 not depend on when a frame's markers arrive within the latency.
 """
 
@@ -213,7 +214,8 @@ class StateEstimator(Component):
         radius = self.scene.obstacles.radius_m
         circles = tuple(Circle(x=x, y=y, radius=radius) for x, y in frame.obstacles)
         header = self.node.header(WORLD_FRAME, stamp_ns, self.obstacles.next_seq)
-        self.obstacles.put(Obstacles(header=header, circles=circles))
+        self.obstacles.put(Obstacles(header=header, circles=circles,
+                                     solids=self.scene.arm_obstacles))  # fmt: skip
 
     # -- odometry and joints ---------------------------------------------------------------
 

@@ -10,7 +10,7 @@ from pydantic import Field
 
 from messages.base import ArmVector, Count, Message, UnitDualQuaternion, Vector3
 from messages.header import Header
-from messages.obstacles import MAX_CIRCLES, Circle
+from messages.obstacles import MAX_CIRCLES, Circle, Solids
 
 
 class SimTruth(Message):
@@ -31,3 +31,6 @@ class SimTruth(Message):
     goal: UnitDualQuaternion | None = None
     reference_pose: Vector3 | None = None
     obstacles: tuple[Circle, ...] = Field(default=(), max_length=MAX_CIRCLES)
+    solids: Solids = Solids()
+    arm_penetrations: Count = 0
+    arm_penetrating: bool = False

@@ -15,16 +15,26 @@ from pathlib import Path
 import numpy as np
 
 from parsimony.goal_sets import goal_report
-from parsimony.kinematic_demo import ROBOT_FILE
+from parsimony.kinematic_demo import ROBOT_FILE, TABLE_PARAMS, WITHOUT_ARM_ROWS
 from parsimony.output import table
 from wbc import dq
 from wbc.cascade_law import CascadeLaw, CascadeParams
+from wbc.constraints.arm_obstacles import ArmObstacles
 from wbc.kinematic_run import integrate
 from wbc.lp_law import LPLaw, LPParams
 from wbc.pinv_law import PinvParams, PseudoinverseLaw
 from wbc.qp_law import QPLaw
 from wbc.robot import MobileManipulator
-from wbc.scenarios import CONVERGENCE_GOAL, DT, HOME, REACH_GOAL
+from wbc.scenarios import (
+    CONVERGENCE_GOAL,
+    DT,
+    HOME,
+    REACH_GOAL,
+    TABLE,
+    TABLE_GOAL,
+    TABLE_START,
+)
+from wbc.step_context import StepContext
 from wbc.task import PoseTask
 
 GOAL = REACH_GOAL
@@ -75,6 +85,39 @@ def step_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str, fl
     results = {name: percentiles(values) for name, values in samples.items()}
     results["kinematics"] = percentiles(time_calls(lambda: robot.kinematics(GOAL), repeats))
     return results
+
+
+def arm_row_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str, float]]:
+    """The LP step with and without the rows that keep the arm clear of the table
+    (wbc.constraints.arm_obstacles), taking turns BLOCK steps each over the states of the
+    guarded reach over the table's edge, and those rows alone (6 rows: 4 points, 2 segments)."""
+    task = PoseTask(robot.fkm(TABLE_GOAL))
+    obstacles = (TABLE,)
+    trajectory = integrate(LPLaw(robot, TABLE_PARAMS), TABLE_START, task, DT, 3000,
+                           obstacles=obstacles).configurations  # fmt: skip
+    laws = {"lp_with_arm_rows": LPLaw(robot, TABLE_PARAMS),
+            "lp_without_arm_rows": LPLaw(robot, WITHOUT_ARM_ROWS)}  # fmt: skip
+    samples: dict[str, list[float]] = {name: [] for name in (*laws, "arm_rows")}
+    rows = ArmObstacles(TABLE_PARAMS.arm_obstacle_gain, TABLE_PARAMS.arm_obstacle_margin)
+    position = 0
+    while len(samples["arm_rows"]) < repeats:
+        if position == 0:
+            for law in laws.values():
+                law.reset()
+        block = trajectory[position : position + min(BLOCK, repeats - len(samples["arm_rows"]))]
+        for name, law in laws.items():
+            for q in block:
+                start = time.perf_counter()
+                law.step(q, task, DT, obstacles)
+                samples[name].append(time.perf_counter() - start)
+        for q in block:
+            context = StepContext(robot, q, np.zeros(8), np.zeros(8), np.zeros(2), (), None, DT,
+                                  obstacles)  # fmt: skip
+            start = time.perf_counter()
+            rows.rows(context)
+            samples["arm_rows"].append(time.perf_counter() - start)
+        position = (position + len(block)) % len(trajectory)
+    return {name: percentiles(values) for name, values in samples.items()}
 
 
 def lp_breakdown(robot: MobileManipulator, repeats: int) -> dict[str, float]:
@@ -210,10 +253,14 @@ def run_bench(repeats: int, trials: int, goals: int, robot_file: Path = ROBOT_FI
     steps = step_times(robot, repeats)
     breakdown = lp_breakdown(robot, repeats)
     reference = dqrobotics_times(robot, repeats)
-    report: dict = {"step": steps, "lp_breakdown_us": breakdown, "dqrobotics": reference}
+    arm = arm_row_times(robot, repeats)
+    report: dict = {"step": steps, "lp_breakdown_us": breakdown, "dqrobotics": reference,
+                    "arm_rows": arm}  # fmt: skip
     report["ratios"] = {
         "lp_over_classic": steps["lp"]["median_us"] / steps["classic"]["median_us"],
         "qp_over_classic": steps["qp"]["median_us"] / steps["classic"]["median_us"],
+        "lp_with_arm_rows_over_without": (arm["lp_with_arm_rows"]["median_us"]
+                                          / arm["lp_without_arm_rows"]["median_us"]),
     }
     if reference:
         report["ratios"]["kinematics_over_dqrobotics"] = (
@@ -241,7 +288,9 @@ def format_report(report: dict) -> str:
              for name, figures in report["step"].items()]
     steps += [{"control step (model + Jacobian + rows + solve)": f"DQ Robotics {name}",
                **figures} for name, figures in report["dqrobotics"].items()]  # fmt: skip
-    parts = [table(steps, floatfmt=".1f"), "",
+    arm = [{"reach over the table (wbc.constraints.arm_obstacles)": name, **figures}
+           for name, figures in report["arm_rows"].items()]  # fmt: skip
+    parts = [table(steps, floatfmt=".1f"), "", table(arm, floatfmt=".1f"), "",
              "LP step, median us by part",
              table([report["lp_breakdown_us"]], floatfmt=".1f"), "",
              table([{"ratios (medians, same run)": n, "ratio": v}

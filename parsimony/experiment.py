@@ -39,6 +39,7 @@ from components.lp_controller import LPController
 from components.qp_controller import QPController
 from deploy import query
 from messages import codec, process, topics
+from messages.obstacles import Solids
 from messages.topics import CONTROL_DIAGNOSTICS, ROBOT_STATE, SIM_TRUTH, SUPERVISOR_STATUS
 from parsimony.kinematic_demo import LP_PARAMS
 from parsimony.sessions import load_session
@@ -58,6 +59,7 @@ from record.report import write_report
 from record.session_reader import info, make_whole
 from sim2d.scenarios import SimScenario, scenario
 from wbc.lp_law import LPParams
+from wbc.planar import inverse
 from wbc.robot import MobileManipulator
 
 DEPLOY = Path(__file__).resolve().parents[1] / "deploy"
@@ -91,20 +93,41 @@ class Options:
     realtime: bool = False
     time_limit_s: float = TIME_LIMIT_S
     hide_base_marker: tuple[float, float] | None = None
+    arm_obstacles: bool = True
+    """False: the law's rows that keep the arm clear of solids in 3-D are off."""
 
 
 def law_overrides(options: Options) -> dict[str, Any]:
     """The LP gains of the experiment that differ from the LP's defaults, for the LP and the QP
     (which reads the same gains; the cascade's defaults are the dissertation's; an experiment
-    under the supervisor takes its profile's)."""
-    if options.controller not in ("lp", "qp") or options.name not in LP_PARAMS:
+    under the supervisor takes its profile's), and ``arm_obstacles`` off when asked."""
+    if options.controller not in ("lp", "qp"):
         return {}
-    wanted, default = LP_PARAMS[options.name], LPParams()
-    return {
-        f.name: getattr(wanted, f.name)
-        for f in dataclasses.fields(LPParams)
-        if getattr(wanted, f.name) != getattr(default, f.name)
-    }
+    overrides = {}
+    if options.name in LP_PARAMS:
+        wanted, default = LP_PARAMS[options.name], LPParams()
+        overrides = {f.name: getattr(wanted, f.name) for f in dataclasses.fields(LPParams)
+                     if getattr(wanted, f.name) != getattr(default, f.name)}  # fmt: skip
+    if not options.arm_obstacles:
+        overrides["arm_obstacles"] = False
+    return overrides
+
+
+def scene_overrides(setup: SimScenario, reference_pose: tuple[float, float, float]
+                    ) -> dict[str, Any]:  # fmt: skip
+    """What the set-up changes in the profile's scene: its solids, moved from the simulator's
+    world into F0 (which the simulator places at ``reference_pose``), and its goal marker's
+    height and offset."""
+    scene: dict[str, Any] = {}
+    if setup.solids:
+        in_f0 = tuple(solid.moved(*inverse(reference_pose)) for solid in setup.solids)
+        scene["arm_obstacles"] = Solids.of(in_f0).model_dump(mode="json")
+    goal: dict[str, Any] = {}
+    if setup.goal_height is not None:
+        goal["height_m"] = setup.goal_height
+    if setup.goal_offset is not None:
+        goal["offset"] = list(setup.goal_offset)
+    return scene | ({"goal": goal} if goal else {})
 
 
 def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict[str, Any]:
@@ -127,6 +150,8 @@ def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict
         {"name": "controller", **controller},
     ]
     base_profile = load_profile(base)
+    scene = scene_overrides(setup, base_profile.scene.reference_pose) \
+        if base_profile.scene is not None else {}  # fmt: skip
     if base_profile.component("simulator").module == "emulated_robot":
         if not options.realtime:
             raise ProfileError(f"{base}: a serial line carries no stamps, so the emulated "
@@ -143,7 +168,7 @@ def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict
         "startup_timeout_s": STARTUP_S,  # the launcher's and this module's wait are one
         "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
         "components": components,
-    }
+    } | ({"scene": scene} if scene else {})
 
 
 class Follower:
@@ -191,6 +216,9 @@ def progress_line(session: dict[str, list], origin: float, wall_s: float) -> str
 
 def run_experiment(options: Options) -> dict[str, Any]:
     """Run one experiment; return its report (also written to ``out/report.json``)."""
+    if not options.arm_obstacles and options.controller == "cascade":
+        raise ProfileError("the cascade keeps nothing clear of obstacles in 3-D: "
+                           "--no-arm-obstacles is for the LP and the QP")  # fmt: skip
     if options.name in SUPERVISED and options.controller != "lp":
         raise ProfileError(f"the {options.name} experiment runs the LP under the staging "
                            "supervisor; the cascade cannot follow its drive tasks")  # fmt: skip
@@ -238,6 +266,7 @@ def run_experiment(options: Options) -> dict[str, Any]:
         "durations_us": durations(counters),
         "cpu_s": {name: round(found["run_cpu_ms"] / 1e3, 3)
                   for name, found in sorted(counters.items())},  # fmt: skip
+        "arm_obstacles": options.arm_obstacles,
         "scenario": dataclasses.asdict(setup) | {"obstacles": setup.sim_params()["obstacles"]},
         "recording": recording_check(facts, (start_ns, end_ns)),
     }  # fmt: skip

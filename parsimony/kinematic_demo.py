@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -17,13 +17,24 @@ import numpy as np
 from parsimony.output import table
 from profiles.profile import load_profile
 from wbc import dq
+from wbc.arm_clearance import PenetrationCount, part_clearances
 from wbc.cascade_law import CascadeLaw
 from wbc.kinematic_run import Run, control_effort, integrate
 from wbc.lp_law import LPLaw, LPParams
-from wbc.obstacles import Circle
+from wbc.obstacles import Obstacle, split
 from wbc.pinv_law import PseudoinverseLaw
 from wbc.robot import MobileManipulator
-from wbc.scenarios import DT, HOME, JOINT_LIMIT_GOAL, OBSTACLE, OBSTACLE_GOAL, REACH_GOAL
+from wbc.scenarios import (
+    DT,
+    HOME,
+    JOINT_LIMIT_GOAL,
+    OBSTACLE,
+    OBSTACLE_GOAL,
+    REACH_GOAL,
+    TABLE,
+    TABLE_GOAL,
+    TABLE_START,
+)
 from wbc.task import PoseTask, PositionTask, Task
 
 ROBOT_FILE = Path(__file__).resolve().parents[1] / "deploy" / "robots" / "little_john.yaml"
@@ -57,10 +68,17 @@ def supervised_params() -> LPParams:
                        if f.name in controller.params})  # fmt: skip
 
 
+TABLE_PARAMS = LPParams(eta=0.6, beta=15.0)
+"""Reaching over a table (future work 3 of 7.2): the pose experiment's law, whose rows of
+wbc.constraints.arm_obstacles keep the arm and the base clear of the table."""
+WITHOUT_ARM_ROWS = replace(TABLE_PARAMS, arm_obstacles=False)
+"""The same law blind to the table, for comparison."""
+
 LP_PARAMS = {
     "pose": LPParams(eta=0.6, beta=15.0),
     "position": LPParams(eta=1.0, beta=10.0),
     "obstacle": OBSTACLE_PARAMS,
+    "table": TABLE_PARAMS,
 }
 """The LP law's gains in each experiment of section 6.2 (6.2.1 gives eta 0.6 and beta 15);
 an experiment under the supervisor takes its profile's (``supervised_params``)."""
@@ -71,11 +89,13 @@ class Experiment:
     name: str
     task: Task
     laws: dict[str, object]
-    obstacles: tuple[Circle, ...] = ()
+    obstacles: tuple[Obstacle, ...] = ()
+    start: np.ndarray = field(default_factory=HOME.copy)
 
 
 def experiments(robot: MobileManipulator) -> list[Experiment]:
-    """Pose (6.2.1), position (6.2.2), obstacle (6.2.3) and the joint limit of figure 6.10."""
+    """Pose (6.2.1), position (6.2.2), obstacle (6.2.3), the joint limit of figure 6.10, and
+    the reach over a table's edge."""
     reach = robot.fkm(REACH_GOAL)
     beyond_obstacle = robot.fkm(OBSTACLE_GOAL)
     past_elbow_limit = robot.fkm(JOINT_LIMIT_GOAL)
@@ -105,6 +125,14 @@ def experiments(robot: MobileManipulator) -> list[Experiment]:
             PoseTask(past_elbow_limit),
             {"LP": LPLaw(robot), "pinv": PseudoinverseLaw(robot)},
         ),
+        Experiment(
+            "table",
+            PoseTask(robot.fkm(TABLE_GOAL)),
+            {"LP": LPLaw(robot, TABLE_PARAMS),
+             "LP without arm rows": LPLaw(robot, WITHOUT_ARM_ROWS)},  # fmt: skip
+            (TABLE,),
+            TABLE_START,
+        ),
     ]
 
 
@@ -129,11 +157,20 @@ def summary_row(experiment: Experiment, law_name: str, run: Run, robot: MobileMa
         "effort_velocity_l2": effort.velocity_l2,
         "median_step_us": float(np.median([out.solve_time_s for out in run.outputs]) * 1e6),
     }
-    for obstacle in experiment.obstacles:
+    circles, solids = split(experiment.obstacles)
+    for obstacle in circles:
         gap = np.hypot(configurations[:, 0] - obstacle.x, configurations[:, 1] - obstacle.y)
         row["min_obstacle_clearance"] = float(
             (gap - obstacle.radius - robot.base.body_radius).min()
         )
+    if solids:
+        count = PenetrationCount()
+        least = np.inf
+        for q in configurations:
+            clearances = part_clearances(robot, q, solids)
+            count.update(clearances)
+            least = min(least, float(clearances.min()))
+        row["min_arm_clearance"], row["arm_penetrations"] = least, count.count
     return row
 
 
@@ -142,15 +179,17 @@ def run_demo(robot_file: Path = ROBOT_FILE) -> list[dict]:
     rows = []
     for experiment in experiments(robot):
         for law_name, law in experiment.laws.items():
-            run = integrate(law, HOME, experiment.task, DT, STEPS, obstacles=experiment.obstacles)
+            run = integrate(law, experiment.start, experiment.task, DT, STEPS,
+                            obstacles=experiment.obstacles)  # fmt: skip
             rows.append(summary_row(experiment, law_name, run, robot))
     return rows
 
 
 COLUMNS = ("experiment", "law", "converged", "steps", "final_error", "median_nonzero",
            "median_practical_nonzero", "worst_joint_overrun", "effort_velocity_l1",
-           "effort_velocity_l2", "median_step_us", "min_obstacle_clearance")
-"""The demo's table: these figures of each run (a clearance where there is an obstacle)."""
+           "effort_velocity_l2", "median_step_us", "min_obstacle_clearance", "min_arm_clearance",
+           "arm_penetrations")  # fmt: skip
+"""The demo's table: these figures of each run (clearances where there are obstacles)."""
 
 
 def format_table(rows: list[dict]) -> str:

@@ -11,6 +11,15 @@ their roles::
 
 Every marker lies flat, its face up, ``height`` metres above the floor (the plane the tracker
 intersects its ray with). Sizes are the black square's side, m.
+
+``arm_obstacles`` declares what no marker shows: planes (a wall, a table top over its
+footprint) and vertical cylinders (poles), in F0, that the robot's collision parts keep clear
+of (``wbc.obstacles3d``, ``wbc.constraints.arm_obstacles``)::
+
+    arm_obstacles:
+      planes:    [{name: table, normal: [0, 0, 1], offset: 0.4,
+                   footprint: [[0.5, -0.4], [1.1, -0.4], [1.1, 0.4], [0.5, 0.4]]}]
+      cylinders: [{name: pole, x: 0.2, y: -0.3, radius: 0.05, height: 0.6}]
 """
 
 from __future__ import annotations
@@ -18,6 +27,8 @@ from __future__ import annotations
 from typing import Annotated
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from messages.obstacles import Solids
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
@@ -89,6 +100,8 @@ class Scene(_Strict):
     base: BaseMarker
     goal: GoalMarker
     obstacles: ObstacleMarkers = ObstacleMarkers()
+    arm_obstacles: Solids = Solids()
+    """Planes and cylinders in 3-D, in F0 (see the module docstring)."""
 
     @model_validator(mode="after")
     def _known_dictionary(self) -> Scene:

@@ -37,6 +37,7 @@ from messages.topics import (
     Topic,
 )
 from wbc import dq
+from wbc.arm_clearance import part_clearances
 from wbc.kinematic_run import effort_of
 from wbc.planar import in_frame, wrap
 from wbc.robot import MobileManipulator
@@ -82,6 +83,8 @@ def judge(session: Session, robot: MobileManipulator, time_limit_s: float | None
         "supervisor": supervisor_summary(messages(run, SUPERVISOR_STATUS)),
         "joint_limit_violations": joints_at_stops(truth, robot) if truth else None,
         "min_obstacle_clearance_m": clearance(truth, robot),
+        "arm_penetrations": truth[-1].arm_penetrations if truth else None,
+        "arm_clearance_m": arm_clearance(truth, robot),
         "estimator_error": estimator_error(truth, states, end_s - HOLD_S),
         "nonzero_entries": dict(sorted(Counter(d.nonzero for d in steps).items())),
         "effort": effort(run),
@@ -210,6 +213,19 @@ def clearance(truth: Sequence, robot: MobileManipulator) -> float | None:
     gaps = [np.hypot(base[:, 0] - o.x, base[:, 1] - o.y) - o.radius - robot.base.body_radius
             for o in truth[-1].obstacles]  # fmt: skip
     return round(float(np.min(gaps)), 4)
+
+
+def arm_clearance(truth: Sequence, robot: MobileManipulator) -> dict[str, float] | None:
+    """The least clearance of each collision part of the robot from the solids in 3-D over
+    the run, m (negative: the deepest penetration), from the true configurations
+    (``wbc.arm_clearance``); None without the truth or solids."""
+    if not truth or not truth[-1].solids.solids() or not robot.collision.names:
+        return None
+    solids = truth[-1].solids.solids()
+    least = np.min([part_clearances(robot, np.array([*t.base_pose, *t.arm_joints]), solids)
+                    .min(axis=1) for t in truth], axis=0)  # fmt: skip
+    return {name: round(float(value), 4)
+            for name, value in zip(robot.collision.names, least, strict=True)}  # fmt: skip
 
 
 def nearest(sorted_stamps: Array, stamps: Array) -> Array:

@@ -7,6 +7,12 @@ under the pose of ``REACH_GOAL`` (pose and position experiments, 6.2.1 and 6.2.2
 x_d = x_2 x_d^2 with the scene's offset x_d^2 (eq. 6.3). A seed draws the start and the bin
 from ``START_RANGE`` and ``BIN_RANGE`` around them: the goal stays a pose the arm reaches
 above some base pose (the bin only moves and turns on the floor), inside the joint limits.
+
+'table' reaches over the edge of ``wbc.scenarios.TABLE`` from ``TABLE_START`` to the gripper
+of ``TABLE_GOAL``: its marker lies on the table top, under that gripper, and the set-up
+carries its own offset x_d^2 (``goal_offset``) and the table (``solids``), which a profile's
+scene declares; a seed draws the bin from ``TABLE_BIN_RANGE`` (along the edge more than
+across it: the base must stop short of the table).
 """
 
 from __future__ import annotations
@@ -15,16 +21,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from wbc import dq
 from wbc.obstacles import Circle
-from wbc.planar import planar_of
+from wbc.obstacles3d import Solid
+from wbc.planar import offset_of, planar_of, planar_pose
 from wbc.robot import MobileManipulator
-from wbc.scenarios import HOME, OBSTACLE, REACH_GOAL
+from wbc.scenarios import HOME, OBSTACLE, REACH_GOAL, TABLE, TABLE_GOAL, TABLE_START
 
 SEED_MAX = 2**31
 """Seeds of a set-up and of the simulator's noise: 0 to SEED_MAX (numpy's RandomState bound)."""
-NAMES = ("pose", "position", "obstacle", "anywhere")
-"""The experiments of section 6.2, and 'anywhere': a pose goal behind the robot, past an
-obstacle, which the LP law reaches only under the staging supervisor (deploy/sim_supervised)."""
+NAMES = ("pose", "position", "obstacle", "anywhere", "table")
+"""The experiments of section 6.2, 'anywhere': a pose goal behind the robot, past an obstacle,
+which the LP law reaches only under the staging supervisor (deploy/sim_supervised), and
+'table': a pose goal over a table's edge, which the arm reaches without touching it."""
 
 ANYWHERE_START = (1.3, 0.2, 0.0)
 """The base of 'anywhere' (x, y, phi): at the far side of the camera's view, facing away."""
@@ -42,6 +51,8 @@ START_RANGE = np.array([0.05, 0.05, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1])
 
 BIN_RANGE = np.array([0.1, 0.1, 0.2])
 """A seeded bin is the set-up's + U(-range, range) in (x, y, yaw) (m, m, rad)."""
+TABLE_BIN_RANGE = np.array([0.03, 0.1, 0.2])
+"""The same for 'table'."""
 
 
 @dataclass(frozen=True)
@@ -53,6 +64,12 @@ class SimScenario:
     start: tuple[float, ...]
     bin: tuple[float, float, float]
     obstacles: tuple[Circle, ...]
+    solids: tuple[Solid, ...] = ()
+    """Obstacles in 3-D, in the simulator's world frame."""
+    goal_height: float | None = None
+    """The height of the bin marker's face, m; None: the scene's."""
+    goal_offset: tuple[float, ...] | None = None
+    """x_d^2 of eq. 6.3 (x, y, z, yaw, pitch, roll); None: the scene's."""
 
     def sim_params(self) -> dict[str, list]:
         """The simulator's parameters that place this set-up (to the micrometre and the
@@ -78,6 +95,8 @@ def scenario(name: str, robot: MobileManipulator, seed: int | None = None) -> Si
         (x, y), yaw = ANYWHERE_BIN, yaw + np.pi
         start[:3] = ANYWHERE_START
         obstacles = (ANYWHERE_OBSTACLE,)
+    if name == "table":
+        return _table(robot, seed)
     bin_pose = np.array([x, y, yaw])
     if seed is not None:
         rng = np.random.default_rng(seed)
@@ -85,3 +104,19 @@ def scenario(name: str, robot: MobileManipulator, seed: int | None = None) -> Si
         bin_pose = bin_pose + rng.uniform(-BIN_RANGE, BIN_RANGE)
     task = "position" if name == "position" else "pose"
     return SimScenario(name, task, tuple(start.tolist()), tuple(bin_pose.tolist()), obstacles)
+
+
+def _table(robot: MobileManipulator, seed: int | None) -> SimScenario:
+    """'table': the bin marker on the table top under TABLE_GOAL's gripper, x_d^2 the gripper's
+    pose seen from it (eq. 6.3 backwards)."""
+    goal = robot.fkm(TABLE_GOAL)
+    height = TABLE.offset
+    x, y, yaw = planar_of(goal)
+    offset = offset_of(dq.mul(dq.conj(planar_pose(x, y, yaw, height)), goal))
+    start, bin_pose = TABLE_START.copy(), np.array([x, y, yaw])
+    if seed is not None:
+        rng = np.random.default_rng(seed)
+        start = start + rng.uniform(-START_RANGE, START_RANGE)
+        bin_pose = bin_pose + rng.uniform(-TABLE_BIN_RANGE, TABLE_BIN_RANGE)
+    return SimScenario("table", "pose", tuple(start.tolist()), tuple(bin_pose.tolist()), (),
+                       (TABLE,), height, tuple(round(v, 9) for v in offset))  # fmt: skip

@@ -1,5 +1,7 @@
 """A 2D pymunk world: a differential-drive base with no lateral slip, a kinematic arm, circular
-obstacles and wheel encoders. Pure simulation: no I/O.
+obstacles and wheel encoders. Pure simulation: no I/O. Solids in 3-D (``wbc.obstacles3d``) stop
+nothing: the world counts the penetrations of the robot's collision parts into them, from the
+kinematics (``wbc.arm_clearance``), as pymunk counts the base's contacts.
 
 The base is a dynamic disc tied to a kinematic control body by a PivotJoint and a GearJoint
 (max_bias 0, max_force = friction), as in pymunk's tank example: the joints make the disc take
@@ -20,7 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 import pymunk
 
+from wbc.arm_clearance import PenetrationCount, part_clearances
 from wbc.obstacles import Circle
+from wbc.obstacles3d import Solid
 from wbc.robot import BASE_DOF, BaseDescription, MobileManipulator
 
 BASE_COLLISION_TYPE = 1
@@ -80,6 +84,7 @@ class World:
         obstacles: Sequence[Circle],
         settings: WorldSettings = WorldSettings(),  # noqa: B008 (frozen, so sharing is safe)
         seed: int = 0,
+        solids: Sequence[Solid] = (),
     ) -> None:
         q0 = np.array(q0, dtype=float)
         if q0.shape != (robot.dof,) or not np.all(np.isfinite(q0)):
@@ -112,6 +117,9 @@ class World:
         self._contacts = 0
         self._touching = 0
         self._time = 0.0
+        self._solids = tuple(solids)
+        self._penetrations = PenetrationCount()
+        self._count_penetrations()
 
     def _add_base(self, pose: np.ndarray) -> tuple[pymunk.Body, pymunk.Body]:
         """The base disc and the kinematic body whose velocity it follows through two joints."""
@@ -175,6 +183,11 @@ class World:
         self._step_arm(dt)
         self._step_encoders(*before)
         self._time += dt
+        self._count_penetrations()
+
+    def _count_penetrations(self) -> None:
+        if self._solids:
+            self._penetrations.update(part_clearances(self.robot, self.q, self._solids))
 
     def _drive_control_body(self, dt: float) -> None:
         """Control velocity v sinc(omega dt/2) along heading theta + omega dt/2: the chord of the
@@ -246,6 +259,17 @@ class World:
     def in_contact(self) -> bool:
         """Whether the base touches an obstacle now."""
         return self._touching > 0
+
+    @property
+    def arm_penetrations(self) -> int:
+        """Number of penetrations of a collision part into a solid that began so far (one at
+        the start counts)."""
+        return self._penetrations.count
+
+    @property
+    def arm_penetrating(self) -> bool:
+        """Whether a collision part penetrates a solid now."""
+        return self._penetrations.penetrating
 
     @property
     def time_s(self) -> float:

@@ -35,6 +35,9 @@ def test_bench_prints_step_times_and_the_convergence_test_as_json():
     for law in ("lp", "qp", "classic", "cascade", "kinematics"):
         assert 0.0 < report["step"][law]["median_us"] <= report["step"][law]["p99_us"]
     assert report["ratios"]["lp_over_classic"] > 0.0 and report["ratios"]["qp_over_classic"] > 0
+    for name in ("lp_with_arm_rows", "lp_without_arm_rows", "arm_rows"):
+        assert 0.0 < report["arm_rows"][name]["median_us"] <= report["arm_rows"][name]["p99_us"]
+    assert report["ratios"]["lp_with_arm_rows_over_without"] > 0.0
     parts = report["lp_breakdown_us"]
     assert {"kinematics", "rows", "vertex", "highs", "glue", "highs_runs"} <= parts.keys()
     assert min(parts["kinematics"], parts["rows"], parts["vertex"]) > 0.0
@@ -98,6 +101,10 @@ def test_demo_reports_every_experiment_and_exits_zero():
         assert rows[("obstacle", law)]["min_obstacle_clearance"] > 0.0
     assert rows[("joint limit", "pinv")]["worst_joint_overrun"] > 0.0
     assert rows[("joint limit", "LP")]["worst_joint_overrun"] == 0.0
+    guarded, blind = rows[("table", "LP")], rows[("table", "LP without arm rows")]
+    assert guarded["converged"] and guarded["arm_penetrations"] == 0
+    assert guarded["min_arm_clearance"] > 0.0
+    assert blind["arm_penetrations"] > 0 and blind["min_arm_clearance"] < 0.0
 
 
 @pytest.mark.parametrize("duration", ["nan", "inf", "-1", "0", "soon"])

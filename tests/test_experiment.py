@@ -99,6 +99,23 @@ def test_obstacle_experiment_with_the_lp_goes_round_the_obstacle(tmp_path: Path)
     assert report["min_obstacle_clearance_m"] > 0.0
 
 
+def test_table_experiment_reaches_over_the_edge_without_touching_the_table(tmp_path: Path
+                                                                           ) -> None:  # fmt: skip
+    """The scene declares the table (in F0, the simulator places it in its world), the
+    estimator publishes it, the LP's rows keep every collision part clear, and the simulator
+    counts the penetrations from the true kinematics; blind to it, the LP reaches the same goal
+    through the table's edge."""
+    code, report = experiment(tmp_path / "guarded", "table")
+    assert code == 0
+    assert_sound(report)
+    assert report["arm_penetrations"] == 0
+    assert min(report["arm_clearance_m"].values()) > 0.0
+    assert report["scenario"]["solids"][0]["name"] == "table"
+    code, blind = experiment(tmp_path / "blind", "table", "--no-arm-obstacles")
+    assert code == 0 and blind["converged"] and not blind["arm_obstacles"]
+    assert blind["arm_penetrations"] > 0 and min(blind["arm_clearance_m"].values()) < -0.01
+
+
 def test_position_experiment_with_the_cascade_converges(tmp_path: Path) -> None:
     code, report = experiment(tmp_path, "position", "--controller", "cascade", "--seed", "2")
     assert code == 0 and report["converged"]

@@ -23,7 +23,7 @@ import numpy as np
 
 from wbc.gains import check_gains, gain
 from wbc.law_output import LawOutput, summarise
-from wbc.obstacles import Circle
+from wbc.obstacles import Obstacle
 from wbc.pinv_law import pinv_velocity
 from wbc.robot import MobileManipulator
 from wbc.task import MEASUREMENT_TOLERANCE, Task, same_task
@@ -75,7 +75,8 @@ class CascadeLaw:
         self._reference = None
         self._task = None
 
-    def step(self, q: Array, task: Task, dt: float, obstacles: Sequence[Circle] = ()) -> LawOutput:
+    def step(self, q: Array, task: Task, dt: float, obstacles: Sequence[Obstacle] = ()
+             ) -> LawOutput:  # fmt: skip
         """One step; the reference base advances by the outer loop's u_b over ``dt``."""
         start = time.perf_counter()
         q = require_finite("configuration q", q)

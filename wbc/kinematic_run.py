@@ -9,7 +9,7 @@ from typing import Protocol
 import numpy as np
 
 from wbc.law_output import Law, LawOutput
-from wbc.obstacles import Circle
+from wbc.obstacles import Obstacle
 from wbc.task import Task
 
 Array = np.ndarray
@@ -47,7 +47,7 @@ def integrate(
     dt: float,
     steps: int,
     tolerance: float = 1e-3,
-    obstacles: Sequence[Circle] = (),
+    obstacles: Sequence[Obstacle] = (),
 ) -> Run:
     """Step ``law`` and integrate q += u dt until ||e|| < ``tolerance`` or ``steps`` run out."""
     run = Run(dt=dt, tolerance=tolerance)
@@ -77,7 +77,7 @@ def integrate_supervised(
     q0: Array,
     dt: float,
     steps: int,
-    obstacles: Sequence[Circle] = (),
+    obstacles: Sequence[Obstacle] = (),
 ) -> Run:
     """As ``integrate``, with the task of each step from ``supervisor``, until it reports the
     goal reached, gives no task (the robot stops) or ``steps`` run out. The law is reset

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 import numpy as np
 
 if TYPE_CHECKING:
-    from wbc.obstacles import Circle
+    from wbc.obstacles import Obstacle
     from wbc.task import Task
 
 Array = np.ndarray
@@ -46,7 +46,7 @@ class Law(Protocol):
     params: Any
 
     def step(
-        self, q: Array, task: Task, dt: float, obstacles: Sequence[Circle] = ()
+        self, q: Array, task: Task, dt: float, obstacles: Sequence[Obstacle] = ()
     ) -> LawOutput: ...
 
     def set_params(self, params: Any) -> None: ...

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from wbc.constraints.arm_obstacles import ArmObstacles
 from wbc.constraints.base import Constraint
 from wbc.constraints.error_bound import ErrorBound
 from wbc.constraints.joint_limits import JointLimits
@@ -25,7 +26,7 @@ from wbc.objectives.obstacle_circulation import ObstacleCirculation
 from wbc.objectives.velocity_cost import LeastVelocity
 from wbc.objectives.waist_centring import WaistCentring
 from wbc.objectives.waist_hold import WaistHold
-from wbc.obstacles import Circle
+from wbc.obstacles import Obstacle, split
 from wbc.robot import MobileManipulator
 from wbc.step_context import StepContext
 from wbc.task import PoseTask, Task, same_task
@@ -36,7 +37,7 @@ Array = np.ndarray
 
 CONSTRAINTS: tuple[type[Constraint], ...] = (Nonholonomic, JointLimits, ErrorBound,
                                              BorderObstacle, VectorFieldObstacle,
-                                             ConservativeObstacle)  # fmt: skip
+                                             ConservativeObstacle, ArmObstacles)  # fmt: skip
 """The constraints of 5.29, in the order of their rows; each builds itself from the gains it
 declares (``of``), or stays out."""
 OBJECTIVES: tuple[type[ObjectiveTerm], ...] = (LeastVelocity, WaistHold, WaistCentring,
@@ -70,20 +71,22 @@ def default_objectives(params: LPParams) -> list[ObjectiveTerm]:
 
 
 def program(robot: MobileManipulator, q: Array, task: Task, dt: float,
-            obstacles: Sequence[Circle], eta: float, last: tuple[Task, Array] | None,
+            obstacles: Sequence[Obstacle], eta: float, last: tuple[Task, Array] | None,
             constraints: Sequence[Constraint], objectives: Sequence[ObjectiveTerm],
             ) -> tuple[list, list, Array, tuple[Task, Array]]:  # fmt: skip
     """One step's program of 5.29: the inputs checked (``NonFiniteInputError``, dt > 0), e
     and e' measured (e' = (e - e_last) / dt against the ``last`` error of the same task, else
     the commanded -eta e), the costs (the task's first, ||J u + eta e||) and the rows; with e
-    and the new ``last``. The LP and the QP (``wbc.qp_law``) solve the same one."""
+    and the new ``last``. ``obstacles`` mixes circles for the base and solids in 3-D
+    (``wbc.obstacles.split``). The LP and the QP (``wbc.qp_law``) solve the same one."""
     q = require_finite("configuration q", q)
     dt = float(dt)
     if not math.isfinite(dt):
         raise NonFiniteInputError(f"dt must be finite, got {dt}")
     if dt <= 0.0:
         raise ValueError(f"dt must be > 0, got {dt}")
-    for index, obstacle in enumerate(obstacles):
+    circles, solids = split(obstacles)  # a solid checked its numbers when it was made
+    for index, obstacle in enumerate(circles):
         require_finite(f"obstacle {index}", (obstacle.x, obstacle.y, obstacle.radius))
     pose, jacobian = robot.kinematics(q)
     error, task_jacobian = task.error(pose, jacobian, q)
@@ -92,8 +95,8 @@ def program(robot: MobileManipulator, q: Array, task: Task, dt: float,
     else:
         error_rate = -eta * error
     goal_pose = task.pose if isinstance(task, PoseTask) else None
-    context = StepContext(robot, q, error, error_rate, task.goal_position[:2], tuple(obstacles),
-                          goal_pose, dt)  # fmt: skip
+    context = StepContext(robot, q, error, error_rate, task.goal_position[:2], circles,
+                          goal_pose, dt, solids)  # fmt: skip
     rows = [constraint.rows(context) for constraint in constraints]  # first: a term may read
     costs = [ResidualCost("task", task_jacobian, eta * error)]  # what a row engaged
     costs += [term.cost(context) for term in objectives]
@@ -137,7 +140,7 @@ class LPLaw:
             term.reset()
 
     def step(
-        self, q: Array, task: Task, dt: float, obstacles: Sequence[Circle] = ()
+        self, q: Array, task: Task, dt: float, obstacles: Sequence[Obstacle] = ()
     ) -> LawOutput:
         """One control step at configuration q (8,) towards ``task``; dt in seconds."""
         start = time.perf_counter()

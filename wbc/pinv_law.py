@@ -18,7 +18,7 @@ import numpy as np
 
 from wbc.gains import check_gains, gain
 from wbc.law_output import LawOutput, summarise
-from wbc.obstacles import Circle
+from wbc.obstacles import Obstacle
 from wbc.robot import MobileManipulator
 from wbc.task import Task
 from wbc.validation import require_finite
@@ -67,7 +67,7 @@ class PseudoinverseLaw:
         """Stateless: nothing to forget."""
 
     def step(
-        self, q: Array, task: Task, dt: float, obstacles: Sequence[Circle] = ()
+        self, q: Array, task: Task, dt: float, obstacles: Sequence[Obstacle] = ()
     ) -> LawOutput:
         """One step; ``dt`` and ``obstacles`` are accepted for a common signature and unused."""
         start = time.perf_counter()

@@ -76,3 +76,14 @@ def offset_pose(x: float, y: float, z: float, yaw: float, pitch: float, roll: fl
                         dq.rotation_quaternion(pitch, dq.J_[1:])),
                 dq.rotation_quaternion(roll, dq.I_[1:]))  # fmt: skip
     return dq.pose(r, np.array([x, y, z]))
+
+
+def offset_of(pose: np.ndarray) -> tuple[float, float, float, float, float, float]:
+    """(x, y, z, yaw, pitch, roll) of a pose, the inverse of ``offset_pose``: its translation,
+    and the angles of R = Rz(yaw) Ry(pitch) Rx(roll) (pitch in [-pi/2, pi/2])."""
+    x, y, z = dq.translation(pose)[1:]
+    m = dq.rotation_matrix(dq.rotation(pose))
+    yaw = math.atan2(m[1, 0], m[0, 0])
+    pitch = math.atan2(-m[2, 0], math.hypot(m[0, 0], m[1, 0]))
+    roll = math.atan2(m[2, 1], m[2, 2])
+    return float(x), float(y), float(z), yaw, pitch, roll

@@ -34,7 +34,7 @@ from wbc.lp_law import (
     program,
 )
 from wbc.objectives.base import ObjectiveTerm, ResidualCost, VelocityCost
-from wbc.obstacles import Circle
+from wbc.obstacles import Obstacle
 from wbc.robot import MobileManipulator
 from wbc.task import Task
 
@@ -86,7 +86,7 @@ class QPLaw:
         for term in self._objectives or ():
             term.reset()
 
-    def step(self, q: Array, task: Task, dt: float, obstacles: Sequence[Circle] = ()
+    def step(self, q: Array, task: Task, dt: float, obstacles: Sequence[Obstacle] = ()
              ) -> LawOutput:  # fmt: skip
         start = time.perf_counter()
         if self._constraints is None:

@@ -16,6 +16,7 @@ import numpy as np
 import yaml
 
 from wbc import dq
+from wbc.collision_model import CollisionModel, check_segments, collision_model
 
 Array = np.ndarray
 
@@ -75,6 +76,7 @@ class MobileManipulator:
         joint_max: Array,
         arm_velocity_max: Array,
         name: str = "robot",
+        collision: CollisionModel = CollisionModel(),  # noqa: B008 (frozen, so sharing is safe)
     ) -> None:
         self.name = name
         self.dh = _readonly(dh, (5, dh.shape[1]), "dh")
@@ -96,6 +98,12 @@ class MobileManipulator:
         # H+(r_z(q) L) = cos(q/2) H+(L) + sin(q/2) H+(k) H+(L), with r_z(q) = cos(q/2) + k sin(q/2).
         self._link_cos = links
         self._link_sin = np.matmul(2.0 * _HALF_K, links)
+        self._frame_columns = (np.arange(self.dof)[None, None, :]
+                               < BASE_DOF + np.arange(self.arm_dof + 1)[:, None, None])
+        """Which columns of u move frame i: the base's and those of joints 1..i."""
+        check_segments(self, collision)
+        self.collision = collision
+        """The parts that obstacles in 3-D must clear (``wbc.collision_model``)."""
 
     def with_velocity_max(self, velocity_max: Array) -> MobileManipulator:
         """The same robot with other bounds on u (section 6.3's tests impose none)."""
@@ -103,7 +111,8 @@ class MobileManipulator:
         base = replace(self.base, velocity_max=_readonly(bounds[:BASE_DOF], (3,),
                                                                      "base.velocity_max"))
         return MobileManipulator(np.array(self.dh), base, self.q_min[BASE_DOF:].copy(),
-                                 self.q_max[BASE_DOF:].copy(), bounds[BASE_DOF:], self.name)
+                                 self.q_max[BASE_DOF:].copy(), bounds[BASE_DOF:], self.name,
+                                 self.collision)  # fmt: skip
 
     @classmethod
     def from_yaml(cls, path: str | Path) -> MobileManipulator:
@@ -130,6 +139,7 @@ class MobileManipulator:
                 np.array(arm["joint_max"], float),
                 np.array(arm["velocity_max"], float),
                 name=str(data.get("name", path.stem)),
+                collision=collision_model(data.get("collision"), dh.shape[1] + 1),
             )
         except (KeyError, TypeError, ValueError) as error:
             if isinstance(error, RobotDescriptionError):
@@ -174,13 +184,34 @@ class MobileManipulator:
         for i in range(1, n):
             prefixes[i] = prefixes[i - 1] @ links[i - 1]
         pose = prefixes[n - 1] @ links[n - 1][:, 0]
+        return pose, dq.haminus8(pose) @ self._twists(q, prefixes)
+
+    def _twists(self, q: Array, prefixes: Array) -> Array:
+        """T (8 x dof), the twists of kinematics' docstring, from H+ of the poses before each
+        arm joint (``prefixes``, n x 8 x 8)."""
         # vec(x k x*) = H+(x) H+(k) C8 vec(x), for every prefix pose x = H+(x) e_1.
         axes = np.matmul(prefixes, (_HALF_K_CONJ @ prefixes[:, :, 0].T).T[:, :, None])
         twists = np.zeros((8, self.dof))
         twists[5, 0] = twists[6, 1] = twists[3, 2] = 0.5
         twists[5, 2], twists[6, 2] = 0.5 * q[1], -0.5 * q[0]
         twists[:, BASE_DOF:] = axes[:, :, 0].T
-        return pose, dq.haminus8(pose) @ twists
+        return twists
+
+    def frame_kinematics(self, q: Array) -> tuple[Array, Array]:
+        """The poses (n + 1, 8) of ``frames`` and their pose Jacobians (n + 1, 8, dof): frame i
+        moves with the base and joints 1..i, J_i = H-(x_i) T with the columns of joints
+        i + 1..n zero (the twists T of ``kinematics``); the last is (x, J) of eq. 4.9."""
+        q = self._check(q)
+        links = self._arm_link_operators(q[BASE_DOF:])
+        n = self.arm_dof
+        prefixes = np.empty((n + 1, 8, 8))
+        prefixes[0] = dq.hamiplus8(self.base_pose(q))
+        for i in range(n):
+            prefixes[i + 1] = prefixes[i] @ links[i]
+        poses = prefixes[:, :, 0].copy()
+        jacobians = dq.haminus8_stack(poses) @ self._twists(q, prefixes[:n])
+        jacobians *= self._frame_columns
+        return poses, jacobians
 
     def frames(self, q: Array) -> list[Array]:
         """Poses of the base top x_2^0 and of every DH frame after it; the last is x_3^0."""

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from wbc.obstacles import Circle
+from wbc.obstacles3d import Solid
 from wbc.robot import MobileManipulator
 
 Array = np.ndarray
@@ -23,7 +24,10 @@ class StepContext:
     goal_xy: Array
     """The goal's end-effector position projected on the floor (q_d of 5.25)."""
     obstacles: tuple[Circle, ...] = ()
+    """The circles the base keeps clear of."""
     goal_pose: Array | None = None
     """The goal's end-effector pose for a pose task; None for a position task."""
     dt: float = 0.0
     """The step's period, s (0 where no step is taken, as in a test of one term)."""
+    solids: tuple[Solid, ...] = ()
+    """The obstacles in 3-D the robot's collision parts keep clear of (wbc.obstacles3d)."""

@@ -71,6 +71,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
                         help="simulated seconds before giving up")  # fmt: skip
     parser.add_argument("--hide-base-marker", type=seconds_window, metavar="FROM,TO",
                         help="hide the base marker from the camera then (sim s)")  # fmt: skip
+    parser.add_argument("--no-arm-obstacles", action="store_true",
+                        help="switch off the LP's rows that keep the arm clear of the scene's "
+                             "planes and cylinders, to see what they prevent")  # fmt: skip
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
     return parser
 
@@ -84,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
     options = Options(
         name=args.name, controller=args.controller, out=args.out, seed=args.seed,
         profile=args.profile, realtime=args.realtime, time_limit_s=args.time_limit,
-        hide_base_marker=args.hide_base_marker,
+        hide_base_marker=args.hide_base_marker, arm_obstacles=not args.no_arm_obstacles,
     )  # fmt: skip
     try:
         report = run_experiment(options)
@@ -95,7 +98,7 @@ def run(args: argparse.Namespace) -> int:
         emit(dumps(report))
     else:
         keys = ("converged", "final_error", "sim_time_s", "wall_time_s", "real_time_factor",
-                "contacts")  # fmt: skip
+                "contacts", "arm_penetrations")  # fmt: skip
         summary = {k: report[k] for k in keys}
         summary["recording"] = "whole" if report["recording"]["whole"] else "CUT_SHORT"
         emit(" ".join(f"{k}={v}" for k, v in summary.items()))

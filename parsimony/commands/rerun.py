@@ -24,11 +24,11 @@ from components.lp_controller import LPController
 from components.qp_controller import QPController
 from messages.commands import ArmCommand, BaseCommand
 from messages.header import Header
+from messages.obstacles import obstacles_of
 from parsimony.output import emit
 from parsimony.outputs import writable_output, written_whole
 from record.session_file import Recorded, SessionWriter
 from record.session_reader import read_groups
-from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
 
 ROBOT = Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"
@@ -102,8 +102,7 @@ class Offline:
             if not self.recorded_gains:  # the defaults, the goal's eta and beta over them
                 self.stepper.set_gains(gains_of(self.gains_type, {}, message))
         elif name == "world/obstacles":
-            self.stepper.take_obstacles(tuple(Circle(c.x, c.y, c.radius)
-                                              for c in message.circles))  # fmt: skip
+            self.stepper.take_obstacles(obstacles_of(message))
         elif name == "robot/state":
             stamp = message.header.stamp_ns
             step = self.stepper.step(message, stamp, math.inf)

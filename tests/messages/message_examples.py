@@ -23,6 +23,7 @@ from messages import (
     RobotState,
 )
 from messages.base import Message
+from messages.obstacles import Cylinder, Plane, Solids
 from messages.supervisor import SupervisorStatus
 from messages.truth import SimTruth
 
@@ -40,6 +41,14 @@ QUARTER_TURN_SHIFTED: tuple[float, ...] = (
     0.25 * math.cos(math.pi / 8),
 )
 """A unit dual quaternion: rotation pi/4 about z, then translation (1, 2, 0.5) m."""
+
+SOLIDS = Solids(
+    planes=(Plane(name="table", normal=(0.0, 0.0, 1.0), offset=0.4,
+                  footprint=((0.5, -0.4), (1.1, -0.4), (1.1, 0.4), (0.5, 0.4))),
+            Plane(normal=(-1.0, 0.0, 0.0), offset=-2.0)),
+    cylinders=(Cylinder(name="pole", x=0.2, y=-0.3, radius=0.05, height=0.6),
+               Cylinder(x=1.0, y=1.0, radius=0.1)),
+)  # fmt: skip
 
 INTRINSICS = CameraIntrinsics(fx=525.0, fy=524.5, cx=319.5, cy=239.5, distortion=(0.1, -0.2, 0, 0))
 
@@ -91,7 +100,7 @@ EXAMPLES: tuple[Message, ...] = (
     ),
     JointStates(header=HEADER, names=("q1", "q2"), positions=(0.1, 0.2), velocities=(0.0, -0.01)),
     STATE,
-    Obstacles(header=HEADER, circles=(Circle(x=1.0, y=1.5, radius=0.3),)),
+    Obstacles(header=HEADER, circles=(Circle(x=1.0, y=1.5, radius=0.3),), solids=SOLIDS),
     POSE_GOAL,
     POSITION_GOAL,
     BaseCommand(
@@ -128,6 +137,9 @@ EXAMPLES: tuple[Message, ...] = (
         end_effector=QUARTER_TURN_SHIFTED,
         contacts=2,
         in_contact=False,
+        solids=SOLIDS,
+        arm_penetrations=1,
+        arm_penetrating=True,
     ),
     POINT_GOAL,
     HEADING_GOAL,

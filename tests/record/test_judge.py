@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from messages.obstacles import Circle
+from messages.obstacles import Circle, Plane, Solids
 from messages.topics import CONTROL_DIAGNOSTICS, ROBOT_STATE, SIM_TRUTH
 from messages.truth import SimTruth
 from record.judge import HOLD_S, commands, effort, judge, the_run
@@ -57,7 +57,8 @@ def test_a_recording_without_truth_says_so_and_judges_the_rest(runs):  # noqa: F
     _, session = runs["LP"]
     judged = judge(session, ROBOT)
     assert judged["truth"] == "absent"
-    for key in ("final_error", "contacts", "joint_limit_violations", "min_obstacle_clearance_m"):
+    for key in ("final_error", "contacts", "joint_limit_violations", "min_obstacle_clearance_m",
+                "arm_penetrations", "arm_clearance_m"):
         assert judged[key] is None, key
     assert judged["estimator_error"]["samples"] == 0
     assert judged["converged"] and judged["final_error_estimated"] < 0.01
@@ -72,3 +73,23 @@ def test_a_time_limit_ends_a_run_that_did_not_converge_at_the_limit(runs):  # no
     assert not judged["converged"]
     last = the_run(early, 1.0)[0][CONTROL_DIAGNOSTICS.name][-1].header.stamp_ns
     assert last <= START_NS + 10**9 < last + 30_000_000
+
+
+def test_the_arms_clearance_and_penetrations_are_judged_from_the_truth(runs):  # noqa: F811
+    """A solid in the truth: the judge reports the simulator's count and each part's least
+    clearance over the run, from the true configurations; a table top cut at the arm's least
+    height has the wrist or the hand at a negative clearance."""
+    _, session = runs["LP"]
+    truth = with_truth(session, ROBOT.fkm(scenarios.REACH_GOAL))[SIM_TRUTH.name]
+    heights = [ROBOT.link_points(np.array([*t.base_pose, *t.arm_joints]))[3:, 2].min()
+               for t in truth]  # fmt: skip
+    table = Plane(name="table", normal=(0.0, 0.0, 1.0), offset=float(min(heights)) + 0.01,
+                  footprint=((-5.0, -5.0), (5.0, -5.0), (5.0, 5.0), (-5.0, 5.0)))
+    solids = Solids(planes=(table,))
+    marked = [t.model_copy(update={"solids": solids, "arm_penetrations": 3}) for t in truth]
+    judged = judge({**session, SIM_TRUTH.name: marked}, ROBOT)
+    assert judged["arm_penetrations"] == 3
+    least = judged["arm_clearance_m"]
+    assert set(least) == set(ROBOT.collision.names)
+    assert min(least.values()) < -0.01
+    assert judge({**session, SIM_TRUTH.name: truth}, ROBOT)["arm_clearance_m"] is None

@@ -19,13 +19,15 @@ from sim2d.scenarios import (
     NAMES,
     OBSTACLE_SHIFT,
     START_RANGE,
+    TABLE_BIN_RANGE,
     SimScenario,
     scenario,
 )
 from wbc import dq
+from wbc.arm_clearance import part_clearances
 from wbc.planar import offset_pose, planar_of, planar_pose
 from wbc.robot import BASE_DOF, MobileManipulator
-from wbc.scenarios import HOME, OBSTACLE, REACH_GOAL
+from wbc.scenarios import HOME, OBSTACLE, REACH_GOAL, TABLE, TABLE_GOAL, TABLE_START
 
 REPO = Path(__file__).resolve().parents[2]
 ROBOT = MobileManipulator.from_yaml(REPO / "deploy/robots/little_john.yaml")
@@ -52,10 +54,11 @@ def test_the_default_goal_is_the_dissertations_reach_goal() -> None:
 
 @pytest.mark.parametrize("name", NAMES)
 def test_the_default_set_up_starts_at_home(name: str) -> None:
-    """Every set-up starts with HOME's arm; all but 'anywhere' at HOME's base too."""
+    """Every set-up but 'table' starts with HOME's arm; all but 'anywhere' at HOME's base
+    too; 'table' at TABLE_START."""
     setup = scenario(name, ROBOT)
     assert setup.name == name
-    home = HOME.copy()
+    home = TABLE_START.copy() if name == "table" else HOME.copy()
     if name == "anywhere":
         home[:BASE_DOF] = ANYWHERE_START
     assert np.array_equal(setup.start, home)
@@ -89,6 +92,21 @@ def test_the_obstacle_set_up_shifts_the_bin_past_the_obstacle() -> None:
     assert np.allclose(setup.bin, shifted, atol=1e-12)
 
 
+def test_the_table_set_up_puts_its_goal_over_the_table_edge() -> None:
+    """The bin marker lies on the table top under TABLE_GOAL's gripper, and x_d = x_2 x_d^2
+    with the set-up's own offset is TABLE_GOAL's pose; the start is clear of the table, and
+    so is the goal, by more than the arm rows' margin."""
+    setup = scenario("table", ROBOT)
+    assert setup.task == "pose" and setup.solids == (TABLE,) and setup.obstacles == ()
+    assert setup.goal_height == TABLE.offset
+    x_d = dq.mul(planar_pose(*setup.bin, setup.goal_height), offset_pose(*setup.goal_offset))
+    expected = ROBOT.fkm(TABLE_GOAL)
+    assert min(np.abs(x_d - expected).max(), np.abs(x_d + expected).max()) < 1e-8
+    assert TABLE.clearance(np.array([*setup.bin[:2], TABLE.offset]))[0] == 0.0  # on its top
+    for q in (TABLE_START, TABLE_GOAL):
+        assert part_clearances(ROBOT, q, (TABLE,)).min() > 0.05
+
+
 def test_an_unknown_experiment_is_refused() -> None:
     with pytest.raises(ValueError, match="no experiment 'dance'; choose one of pose, position"):
         scenario("dance", ROBOT)
@@ -101,7 +119,8 @@ def test_seeded_set_ups_stay_in_their_ranges_and_the_joint_limits(name: str) -> 
         setup = scenario(name, ROBOT, seed)
         start, bin_pose = np.array(setup.start), np.array(setup.bin)
         assert np.all(np.abs(start - default.start) <= START_RANGE)
-        assert np.all(np.abs(bin_pose - default.bin) <= BIN_RANGE)
+        bins = TABLE_BIN_RANGE if name == "table" else BIN_RANGE
+        assert np.all(np.abs(bin_pose - default.bin) <= bins)
         arm = start[BASE_DOF:]
         assert np.all(arm >= ROBOT.q_min[BASE_DOF:]) and np.all(arm <= ROBOT.q_max[BASE_DOF:])
         assert setup.obstacles == default.obstacles and setup.task == default.task
@@ -145,7 +164,7 @@ def markers(setup: SimScenario) -> list[tuple[str, float, float, float, float]]:
     found = [
         ("reference", *s.reference_pose[:2], s.reference.height_m, s.reference.size_m),
         ("base", *base, s.base.height_m, s.base.size_m),
-        ("bin", *setup.bin[:2], s.goal.height_m, s.goal.size_m),
+        ("bin", *setup.bin[:2], setup.goal_height or s.goal.height_m, s.goal.size_m),
     ]
     found += [("obstacle", c.x, c.y, s.obstacles.height_m, s.obstacles.size_m)
               for c in setup.obstacles]  # fmt: skip

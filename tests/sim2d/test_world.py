@@ -10,6 +10,7 @@ import pytest
 
 from sim2d.world import World, WorldSettings, wheel_distance_per_count
 from wbc.obstacles import Circle
+from wbc.obstacles3d import Plane
 from wbc.robot import MobileManipulator
 
 ROBOT = MobileManipulator.from_yaml(
@@ -202,3 +203,24 @@ def test_invalid_inputs_are_rejected() -> None:
         world.step(0.0)
     with pytest.raises(ValueError, match="outside their limits"):
         World(ROBOT, np.array([0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]), [])
+
+
+def test_the_arm_penetrating_a_solid_counts_once_per_entry_from_the_kinematics() -> None:
+    """The shoulder lowers the arm into a table top in front of the base and raises it again,
+    twice: each entry counts once per part that enters (the second as many as the first),
+    nothing while the arm stays in, and the count holds when it leaves."""
+    table = Plane((0.0, 0.0, 1.0), 0.3, ((0.3, -0.5), (0.9, -0.5), (0.9, 0.5), (0.3, 0.5)))
+    start = np.array([0.0, 0.0, 0.0, 0.0, -0.3, -0.3, 0.0, 0.0])  # the arm level, above 0.3 m
+    world = World(ROBOT, start, [], INSTANT_WHEELS, solids=[table])
+    assert world.arm_penetrations == 0 and not world.arm_penetrating
+    entries = []
+    for _ in range(2):
+        world.command(0.0, 0.0, [0.0, 0.8, 0.0, 0.0, 0.0])  # shoulder down
+        run(world, 100)
+        assert world.arm_penetrating
+        entries.append(world.arm_penetrations)
+        world.command(0.0, 0.0, [0.0, -0.8, 0.0, 0.0, 0.0])  # and up again
+        run(world, 100)
+        assert not world.arm_penetrating
+    first = entries[0]
+    assert first >= 1 and entries[1] == 2 * first and world.arm_penetrations == 2 * first

@@ -271,6 +271,43 @@ def test_prismatic_joint_is_rejected(tmp_path: Path, description: dict) -> None:
         MobileManipulator.from_yaml(path)
 
 
+def test_the_collision_parts_come_from_the_description(robot: MobileManipulator) -> None:
+    """The base disc, the elbow, the wrist and the gripper, the forearm and the hand."""
+    assert robot.collision.names == ("base", "elbow", "wrist", "gripper", "forearm", "hand")
+    base = robot.collision.points[0]
+    assert (base.frame, base.radius) == (0, robot.base.body_radius)
+    forearm, hand = robot.collision.segments
+    assert (forearm.frame, forearm.axis, forearm.start, forearm.end) == (3, "z", 1, 2)
+    assert (hand.frame, hand.axis, hand.start, hand.end) == (5, "x", 2, 3)
+    assert robot.with_velocity_max(np.ones(8)).collision == robot.collision
+
+
+@pytest.mark.parametrize(
+    ("change", "expected"),
+    [
+        (lambda c: c["points"][1].update(frame=9), "collision.points[1].frame: expected a frame"),
+        (lambda c: c["points"][1].update(radius=0.0), "collision.points[1].radius"),
+        (lambda c: c["points"][1].update(offset=[0, 0]), "collision.points[1].offset"),
+        (lambda c: c["points"][1].update(colour="red"), "collision.points[1]: unknown fields"),
+        (lambda c: c["points"][2].update(name="elbow"), "collision.points: names must differ"),
+        (lambda c: c["segments"][0].update(axis="w"), "collision.segments[0].axis"),
+        (lambda c: c["segments"][0].update(end="knee"), "collision.segments[0].end"),
+        (lambda c: c["segments"][0].update(axis="x"),
+         "collision.segments[0] (forearm): point wrist is 0.122 m off the x axis of frame 3"),
+        (lambda c: c["segments"][1].update(frame=4), "collision.segments[1] (hand): point"),
+    ],
+)  # fmt: skip
+def test_a_broken_collision_section_names_the_field(tmp_path: Path, description: dict,
+                                                    change, expected: str) -> None:  # fmt: skip
+    broken = yaml.safe_load(yaml.safe_dump(description))
+    change(broken["collision"])
+    path = tmp_path / "broken_collision.yaml"
+    path.write_text(yaml.safe_dump(broken))
+    with pytest.raises(RobotDescriptionError) as raised:
+        MobileManipulator.from_yaml(path)
+    assert str(path) in str(raised.value) and expected in str(raised.value), str(raised.value)
+
+
 # --- Geometry of the joint limits -------------------------------------------------------------
 
 CLEARANCE = 0.03

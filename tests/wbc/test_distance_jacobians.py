@@ -1,0 +1,263 @@
+"""The distance Jacobians of the arm's parts (wbc/distance_jacobians.py, wbc/plucker.py,
+wbc/robot_primitives.py): central finite differences over random configurations, and DQ
+Robotics' DQ_Kinematics and DQ_Geometry, which have the same ones."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pytest
+from dqrobotics import DQ
+from dqrobotics.robot_modeling import (
+    DQ_HolonomicBase,
+    DQ_Kinematics,
+    DQ_SerialManipulatorDH,
+    DQ_WholeBody,
+)
+from dqrobotics.utils import DQ_Geometry
+
+from wbc import dq
+from wbc.distance_jacobians import (
+    ParallelLinesError,
+    line_to_line_distance_jacobian,
+    line_to_line_squared_distance,
+    point_to_line_distance_jacobian,
+    point_to_line_squared_distance,
+    point_to_plane_distance,
+    point_to_plane_distance_jacobian,
+    point_to_point_distance_jacobian,
+    point_to_point_squared_distance,
+)
+from wbc.plucker import closest_parameters, is_line, line, plane
+from wbc.robot import MobileManipulator
+from wbc.robot_primitives import (
+    line_jacobians,
+    primitive_kinematics,
+    translation_jacobians,
+    translations,
+)
+
+ROBOT = MobileManipulator.from_yaml(
+    Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml")
+STEP = 1e-6
+FD_TOL = 1e-7
+ORACLE_TOL = 1e-12
+NAMES = ROBOT.collision.names
+POINTS = len(ROBOT.collision.points)
+
+
+def configurations(count: int, seed: int) -> np.ndarray:
+    """Base anywhere in a 4 m square facing anywhere, the arm over its joint box."""
+    rng = np.random.default_rng(seed)
+    base = rng.uniform([-2.0, -2.0, -np.pi], [2.0, 2.0, np.pi], (count, 3))
+    arm = rng.uniform(ROBOT.q_min[3:], ROBOT.q_max[3:], (count, ROBOT.arm_dof))
+    return np.hstack((base, arm))
+
+
+def central_difference(function: Callable[[np.ndarray], np.ndarray | float],
+                       q: np.ndarray) -> np.ndarray:  # fmt: skip
+    columns = []
+    for i in range(q.size):
+        step = np.zeros_like(q)
+        step[i] = STEP
+        columns.append((np.asarray(function(q + step)) - np.asarray(function(q - step)))
+                       / (2.0 * STEP))  # fmt: skip
+    return np.stack(columns, axis=-1)
+
+
+def workspace(seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """A random plane (unit normal, offset) and a random line, both vec8."""
+    rng = np.random.default_rng(seed)
+    normal = rng.normal(size=3)
+    return (plane(normal / np.linalg.norm(normal), rng.uniform(-1.0, 1.0)),
+            line(rng.normal(size=3), rng.uniform(-1.0, 1.0, 3)))  # fmt: skip
+
+
+def oracle_chain(frame: int) -> DQ_WholeBody:
+    """DQ Robotics' whole body up to DH frame ``frame``: the base, its height and the first
+    ``frame`` links (``frame`` >= 1)."""
+    base = DQ_HolonomicBase()
+    base.set_frame_displacement(DQ(dq.pose(dq.ONE[:4], [0.0, 0.0, ROBOT.base_height])))
+    body = DQ_WholeBody(base)
+    body.add(DQ_SerialManipulatorDH(np.array(ROBOT.dh)[:, :frame]))
+    return body
+
+
+# --- Frames and parts -------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("frame", range(1, 6))
+def test_frame_poses_and_jacobians_match_dqrobotics_chains(frame: int) -> None:
+    body = oracle_chain(frame)
+    for q in configurations(30, seed=frame):
+        poses, jacobians = ROBOT.frame_kinematics(q)
+        moving = 3 + frame
+        np.testing.assert_allclose(poses[frame], body.fkm(q[:moving]).vec8(), atol=ORACLE_TOL)
+        np.testing.assert_allclose(jacobians[frame, :, :moving], body.pose_jacobian(q[:moving]),
+                                   atol=ORACLE_TOL)  # fmt: skip
+        np.testing.assert_array_equal(jacobians[frame, :, moving:], 0.0)
+
+
+def test_frame_jacobians_are_the_derivatives_of_the_frames() -> None:
+    for q in configurations(10, seed=11):
+        _, jacobians = ROBOT.frame_kinematics(q)
+        expected = central_difference(lambda c: ROBOT.frame_kinematics(c)[0], q)
+        np.testing.assert_allclose(jacobians, expected, atol=FD_TOL)
+
+
+def test_part_jacobians_are_the_derivatives_of_the_parts() -> None:
+    for q in configurations(10, seed=12):
+        parts = primitive_kinematics(ROBOT, q)
+        points = central_difference(lambda c: primitive_kinematics(ROBOT, c).points, q)
+        lines = central_difference(lambda c: primitive_kinematics(ROBOT, c).lines, q)
+        np.testing.assert_allclose(parts.point_jacobians, points, atol=FD_TOL)
+        np.testing.assert_allclose(parts.line_jacobians, lines, atol=FD_TOL)
+        assert all(is_line(x) for x in parts.lines)
+
+
+def line_of(pose: np.ndarray, jacobian: np.ndarray, axis: np.ndarray
+            ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """The line along ``axis`` through one frame and its Jacobian, by the stack version."""
+    stack = pose[None], jacobian[None]
+    lines, jacobians = line_jacobians(*stack, axis[None], translations(stack[0]),
+                                      translation_jacobians(*stack))  # fmt: skip
+    return lines[0], jacobians[0]
+
+
+def test_line_jacobian_matches_dqrobotics() -> None:
+    for q in configurations(50, seed=13):
+        poses, jacobians = ROBOT.frame_kinematics(q)
+        for frame in range(6):
+            for axis in (dq.I_, dq.J_, dq.K_):
+                expected = DQ_Kinematics.line_jacobian(jacobians[frame], DQ(poses[frame]),
+                                                       DQ(axis))  # fmt: skip
+                found, jacobian = line_of(poses[frame], jacobians[frame], axis)
+                np.testing.assert_allclose(jacobian, expected, atol=ORACLE_TOL)
+                direction = dq.qmul(dq.qmul(poses[frame][:4], axis), dq.qconj(poses[frame][:4]))
+                np.testing.assert_allclose(found, line(direction, dq.translation(poses[frame])),
+                                           atol=1e-12)  # fmt: skip
+
+
+def test_segments_run_along_their_lines_from_end_to_end() -> None:
+    """The forearm is the elbow-wrist segment on z of frame 3, the hand the wrist-gripper one
+    on x of frame 5; their ends' parameters along the line are 0.1225 and 0.17 m apart."""
+    for q in configurations(10, seed=14):
+        parts = primitive_kinematics(ROBOT, q)
+        for i, segment in enumerate(ROBOT.collision.segments):
+            start, end = parts.points[segment.start, 1:], parts.points[segment.end, 1:]
+            foot = np.cross(parts.lines[i, 1:4], parts.lines[i, 5:8])
+            for s, point in zip(parts.ends[i], (start, end), strict=True):
+                np.testing.assert_allclose(foot + s * parts.lines[i, 1:4], point, atol=1e-12)
+        np.testing.assert_allclose(np.abs(np.diff(parts.ends, axis=1)).ravel(), [0.1225, 0.17],
+                                   atol=1e-12)  # fmt: skip
+
+
+# --- Distances and their Jacobians ------------------------------------------------------------
+
+
+@pytest.mark.parametrize("part", range(POINTS))
+def test_point_to_plane_jacobian_is_the_derivative_and_dqrobotics(part: int) -> None:
+    for index, q in enumerate(configurations(20, seed=20 + part)):
+        workspace_plane, _ = workspace(index)
+        parts = primitive_kinematics(ROBOT, q)
+        point, jacobian = parts.points[part], parts.point_jacobians[part]
+        row = point_to_plane_distance_jacobian(jacobian, workspace_plane)
+        np.testing.assert_allclose(row, central_difference(
+            lambda c, w=workspace_plane: point_to_plane_distance(
+                primitive_kinematics(ROBOT, c).points[part], w), q), atol=FD_TOL)  # fmt: skip
+        oracle = DQ_Kinematics.point_to_plane_distance_jacobian(jacobian, DQ(point),
+                                                                DQ(workspace_plane))  # fmt: skip
+        np.testing.assert_allclose(row, oracle.ravel(), atol=ORACLE_TOL)
+        assert point_to_plane_distance(point, workspace_plane) == pytest.approx(
+            DQ_Geometry.point_to_plane_distance(DQ(point), DQ(workspace_plane)), abs=1e-12)
+
+
+@pytest.mark.parametrize("part", range(POINTS))
+def test_point_to_line_jacobian_is_the_derivative_and_dqrobotics(part: int) -> None:
+    for index, q in enumerate(configurations(20, seed=30 + part)):
+        _, workspace_line = workspace(index)
+        parts = primitive_kinematics(ROBOT, q)
+        point, jacobian = parts.points[part], parts.point_jacobians[part]
+        row = point_to_line_distance_jacobian(jacobian, point, workspace_line)
+        np.testing.assert_allclose(row, central_difference(
+            lambda c, w=workspace_line: point_to_line_squared_distance(
+                primitive_kinematics(ROBOT, c).points[part], w), q), atol=FD_TOL)  # fmt: skip
+        oracle = DQ_Kinematics.point_to_line_distance_jacobian(jacobian, DQ(point),
+                                                               DQ(workspace_line))  # fmt: skip
+        np.testing.assert_allclose(row, oracle.ravel(), atol=ORACLE_TOL)
+        assert point_to_line_squared_distance(point, workspace_line) == pytest.approx(
+            DQ_Geometry.point_to_line_squared_distance(DQ(point), DQ(workspace_line)), abs=1e-12)
+
+
+@pytest.mark.parametrize("part", range(POINTS))
+def test_point_to_point_jacobian_is_the_derivative_and_dqrobotics(part: int) -> None:
+    rng = np.random.default_rng(part)
+    for q in configurations(20, seed=50 + part):
+        corner = np.r_[0.0, rng.uniform(-1.0, 1.0, 3)]
+        parts = primitive_kinematics(ROBOT, q)
+        point, jacobian = parts.points[part], parts.point_jacobians[part]
+        row = point_to_point_distance_jacobian(jacobian, point, corner)
+        np.testing.assert_allclose(row, central_difference(
+            lambda c, w=corner: point_to_point_squared_distance(
+                primitive_kinematics(ROBOT, c).points[part], w), q), atol=FD_TOL)  # fmt: skip
+        oracle = DQ_Kinematics.point_to_point_distance_jacobian(jacobian, DQ(point), DQ(corner))
+        np.testing.assert_allclose(row, oracle.ravel(), atol=ORACLE_TOL)
+        assert point_to_point_squared_distance(point, corner) == pytest.approx(
+            DQ_Geometry.point_to_point_squared_distance(DQ(point), DQ(corner)), abs=1e-12)
+
+
+@pytest.mark.parametrize("segment", range(len(ROBOT.collision.segments)))
+def test_line_to_line_jacobian_is_the_derivative_and_dqrobotics(segment: int) -> None:
+    for index, q in enumerate(configurations(20, seed=40 + segment)):
+        _, workspace_line = workspace(100 + index)
+        parts = primitive_kinematics(ROBOT, q)
+        robot_line, jacobian = parts.lines[segment], parts.line_jacobians[segment]
+        row = line_to_line_distance_jacobian(jacobian, robot_line, workspace_line)
+        expected = central_difference(
+            lambda c, w=workspace_line: line_to_line_squared_distance(
+                primitive_kinematics(ROBOT, c).lines[segment], w), q)  # fmt: skip
+        np.testing.assert_allclose(row, expected, atol=1e-6 * max(1.0, np.abs(row).max()))
+        oracle = DQ_Kinematics.line_to_line_distance_jacobian(jacobian, DQ(robot_line),
+                                                              DQ(workspace_line))  # fmt: skip
+        np.testing.assert_allclose(row, oracle.ravel(), atol=1e-10 * max(1.0, np.abs(row).max()))
+        assert line_to_line_squared_distance(robot_line, workspace_line) == pytest.approx(
+            DQ_Geometry.line_to_line_squared_distance(DQ(robot_line), DQ(workspace_line)),
+            rel=1e-10, abs=1e-12)  # fmt: skip
+
+
+def test_distances_are_the_euclidean_ones() -> None:
+    """The table top z = 0.3 from (1, 2, 0.5) is 0.2; a vertical pole through (1, 0) is 2 from
+    (1, 2, z), squared 4; the x axis raised to z = 0.5 is 0.5 from the pole, squared 0.25."""
+    point = np.array([0.0, 1.0, 2.0, 0.5])
+    assert point_to_plane_distance(point, plane([0, 0, 1], 0.3)) == pytest.approx(0.2)
+    pole = line([0, 0, 1], [1, 0, 0])
+    assert point_to_line_squared_distance(point, pole) == pytest.approx(4.0)
+    assert line_to_line_squared_distance(line([1, 0, 0], [0, 0, 0.5]), pole) == pytest.approx(0.0)
+    raised = line([0, 1, 0], [3.0, 0, 0.5])
+    assert line_to_line_squared_distance(raised, pole) == pytest.approx(4.0)
+    beside = line([0, 0, 1], [1.0, 0.5, 0])
+    assert line_to_line_squared_distance(beside, pole) == pytest.approx(0.25)  # parallel
+
+
+def test_parallel_lines_have_no_distance_jacobian() -> None:
+    pole = line([0, 0, 1], [1, 0, 0])
+    with pytest.raises(ParallelLinesError, match="parallel"):
+        line_to_line_distance_jacobian(np.ones((8, 8)), line([0, 0, -1], [2, 0, 0]), pole)
+
+
+def test_closest_parameters_give_the_common_perpendicular() -> None:
+    first, second = line([1, 0, 0], [0, 0, 1]), line([0, 1, 0], [2, 0, -1])
+    s, t, skew = closest_parameters(first, second)
+    np.testing.assert_allclose([s.item(), t.item(), skew.item()], [2.0, 0.0, 1.0], atol=1e-12)
+    _, _, parallel = closest_parameters(first, line([-1, 0, 0], [0, 1, 0]))
+    assert parallel.item() == pytest.approx(0.0)
+    many, _, _ = closest_parameters(np.array([first, second]), np.array([second, first]))
+    np.testing.assert_allclose(many, [[2.0, np.nan], [np.nan, 0.0]], atol=1e-12)  # parallel: nan
+
+
+def test_line_of_a_pose_passes_through_its_origin_along_its_axis() -> None:
+    pose = dq.pose(dq.rotation_quaternion(np.pi / 2, [0, 1, 0]), [1.0, 2.0, 3.0])
+    z_axis, _ = line_of(pose, np.zeros((8, 8)), dq.K_)
+    np.testing.assert_allclose(z_axis, line([1, 0, 0], [1, 2, 3]), atol=1e-12)
