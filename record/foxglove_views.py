@@ -104,17 +104,16 @@ def view(message: Any, carries: str = "", suffix: str = CHANNEL_SUFFIX) -> View:
                 bytes(message.encode()), carries)  # fmt: skip
 
 
-def image_views(frame: CameraFrame) -> list[View]:
+def image_view(frame: CameraFrame) -> fox.CompressedImage | fox.RawImage:
+    """A JPEG frame as it is, raw pixels as they are; the view carries them (``carries``)."""
     stamp = timestamp(frame.header.stamp_ns)
     if frame.encoding in COMPRESSED:
-        image = fox.CompressedImage(timestamp=stamp, frame_id="camera", data=frame.data,
-                                    format=frame.encoding)  # fmt: skip
-    else:
-        step = frame.width * CHANNELS[frame.encoding]
-        image = fox.RawImage(timestamp=stamp, frame_id="camera", width=frame.width,
-                             height=frame.height, encoding=frame.encoding, step=step,
-                             data=frame.data)  # fmt: skip
-    return [view(image, carries="data")]
+        return fox.CompressedImage(timestamp=stamp, frame_id="camera", data=frame.data,
+                                   format=frame.encoding)  # fmt: skip
+    step = frame.width * CHANNELS[frame.encoding]
+    return fox.RawImage(timestamp=stamp, frame_id="camera", width=frame.width,
+                        height=frame.height, encoding=frame.encoding, step=step,
+                        data=frame.data)  # fmt: skip
 
 
 CARRIERS = (fox.CompressedImage, fox.RawImage)
@@ -138,31 +137,31 @@ def carried(schema_name: str, data: bytes) -> bytes:
     return bytes(_protobuf_type(schema_name).FromString(data).data)
 
 
-def marker_views(prefix: str) -> Callable[[MarkerDetections], list[View]]:
-    """Views of markers, ``<header.frame> -> <prefix>marker_<id>``."""
+def marker_frames(prefix: str) -> Callable[[MarkerDetections], fox.FrameTransforms | None]:
+    """Markers as frames, ``<header.frame> -> <prefix>marker_<id>``; none without markers."""
 
-    def views(detections: MarkerDetections) -> list[View]:
+    def make(detections: MarkerDetections) -> fox.FrameTransforms | None:
         stamp, parent = detections.header.stamp_ns, detections.header.frame
         transforms = [pose_transform(parent, f"{prefix}marker_{m.id}", m.pose, stamp)
                       for m in detections.markers]  # fmt: skip
-        return [view(fox.FrameTransforms(transforms=transforms))] if transforms else []
+        return fox.FrameTransforms(transforms=transforms) if transforms else None
 
-    return views
+    return make
 
 
-def goal_views(frame: str) -> Callable[[Goal], list[View]]:
-    """Views of a pose goal, ``world -> <frame>``."""
+def goal_frame(frame: str) -> Callable[[Goal], fox.FrameTransforms | None]:
+    """A pose goal as the frame ``world -> <frame>``; no frame for another task."""
 
-    def views(goal: Goal) -> list[View]:
+    def make(goal: Goal) -> fox.FrameTransforms | None:
         if goal.pose is None:
-            return []
+            return None
         transform = pose_transform("world", frame, goal.pose, goal.header.stamp_ns)
-        return [view(fox.FrameTransforms(transforms=[transform]))]
+        return fox.FrameTransforms(transforms=[transform])
 
-    return views
+    return make
 
 
-def obstacle_views(obstacles: Obstacles) -> list[View]:
+def obstacle_scene(obstacles: Obstacles) -> fox.SceneUpdate:
     """Every obstacle as a cylinder standing on the floor; the update first deletes all the
     entities of the previous one, so obstacles that are gone disappear."""
     stamp = timestamp(obstacles.header.stamp_ns)
@@ -176,23 +175,22 @@ def obstacle_views(obstacles: Obstacles) -> list[View]:
         )],
     ) for index, c in enumerate(obstacles.circles)]  # fmt: skip
     deletion = fox.SceneEntityDeletion(timestamp=stamp, type=fox.SceneEntityDeletionType.All)
-    return [view(fox.SceneUpdate(deletions=[deletion], entities=entities))]
+    return fox.SceneUpdate(deletions=[deletion], entities=entities)
 
 
-def state_views(drawing: RobotDrawing | None, state: RobotState) -> list[View]:
+def state_frames(drawing: RobotDrawing | None, state: RobotState) -> fox.FrameTransforms:
     """The estimate's frames: its base and links (with a robot to draw, else the base alone)
-    and the end effector as the estimator gives it; the model one state in ``MODEL_EVERY``."""
+    and the end effector as the estimator gives it."""
     stamp = state.header.stamp_ns
     end_effector = pose_transform("world", "estimate/end_effector", state.end_effector, stamp)
     if drawing is None:
         base = planar_transform("world", "estimate/base", state.base_pose, stamp)
-        return [view(fox.FrameTransforms(transforms=[base, end_effector]))]
+        return fox.FrameTransforms(transforms=[base, end_effector])
     q = np.array(state.configuration())
-    found = [view(fox.FrameTransforms(transforms=[*drawing.transforms(q, stamp), end_effector]))]
-    return found + model_views(drawing, state.header.seq, stamp)
+    return fox.FrameTransforms(transforms=[*drawing.transforms(q, stamp), end_effector])
 
 
-def truth_views(drawing: RobotDrawing | None, truth: SimTruth) -> list[View]:
+def truth_frames(drawing: RobotDrawing | None, truth: SimTruth) -> fox.FrameTransforms:
     """The simulated robot in the simulator's world ``truth/world``, which hangs under the
     estimate's ``world`` (F0) where F0 stands in it, and the true goal."""
     stamp = truth.header.stamp_ns
@@ -207,21 +205,41 @@ def truth_views(drawing: RobotDrawing | None, truth: SimTruth) -> list[View]:
     transforms.append(pose_transform(parent, "truth/end_effector", truth.end_effector, stamp))
     if truth.goal is not None:
         transforms.append(pose_transform(parent, "truth/goal", truth.goal, stamp))
-    found = [view(fox.FrameTransforms(transforms=transforms))]
-    return found + (model_views(drawing, truth.header.seq, stamp) if drawing else [])
+    return fox.FrameTransforms(transforms=transforms)
 
 
-def model_views(drawing: RobotDrawing, seq: int, stamp_ns: int) -> list[View]:
-    """The robot's model, with one message in ``MODEL_EVERY``."""
-    if seq % MODEL_EVERY:
-        return []
-    return [view(fox.SceneUpdate(entities=drawing.model(stamp_ns)), suffix=MODEL_SUFFIX)]
+def robot_model(drawing: RobotDrawing) -> Callable[[RobotState | SimTruth],
+                                                   fox.SceneUpdate | None]:  # fmt: skip
+    """The robot's model, with one state in ``MODEL_EVERY``."""
+
+    def make(state: RobotState | SimTruth) -> fox.SceneUpdate | None:
+        if state.header.seq % MODEL_EVERY:
+            return None
+        return fox.SceneUpdate(entities=drawing.model(state.header.stamp_ns))
+
+    return make
 
 
-def camera_marker_views(detections: MarkerDetections) -> list[View]:
-    """The tracker's markers in the camera frame, and on the image."""
-    annotations = view(marker_annotations(detections), suffix=ANNOTATIONS_SUFFIX)
-    return [*marker_views("")(detections), annotations]
+@dataclass(frozen=True)
+class ViewMaker:
+    """One view of a topic's messages: its channel suffix, its Foxglove type (None when the
+    message decides it: an image's), and ``make(key, message)``, the foxglove-sdk message or
+    None when this message has no such view; ``carries``: see ``View``."""
+
+    suffix: str
+    schema: type | None
+    make: Callable[[str, Any], Any]
+    carries: str = ""
+
+
+def maker(suffix: str, schema: type | None, make: Callable[[Any], Any], carries: str = ""
+          ) -> ViewMaker:  # fmt: skip
+    """A ``ViewMaker`` of a view that depends on the message alone."""
+    return ViewMaker(suffix, schema, lambda _key, message: make(message), carries)
+
+
+def everything(suffix: str) -> bool:
+    return True
 
 
 class Viewer:
@@ -238,38 +256,64 @@ class Viewer:
         truth = drawing("truth/", TRUTH_COLOR, "truth/world") if drawing else None
         self._candidate = drawing(CANDIDATE_PREFIX, CANDIDATE_COLOR) if drawing else None
         self._plans: dict[str, tuple] = {}
-        self._views: dict[str, Callable[[Any], list[View]]] = {
-            topics.CAMERA_IMAGE.name: image_views,
-            topics.ROBOT_STATE.name: functools.partial(state_views, estimate),
-            topics.SIM_TRUTH.name: functools.partial(truth_views, truth),
-            topics.VISION_MARKERS.name: camera_marker_views,
-            topics.WORLD_MARKERS.name: marker_views("estimate/"),
-            topics.CONTROL_GOAL.name: goal_views("goal"),
-            topics.GOAL_REQUEST.name: goal_views("goal"),
-            topics.WORLD_GOAL.name: goal_views("estimate/goal"),
-            topics.WORLD_OBSTACLES.name: obstacle_views,
-        }
+        frames, scene = fox.FrameTransforms, fox.SceneUpdate
+        goal = maker(CHANNEL_SUFFIX, frames, goal_frame("goal"))
+        self._makers: dict[str, tuple[ViewMaker, ...]] = {
+            topics.CAMERA_IMAGE.name: (maker(CHANNEL_SUFFIX, None, image_view, "data"),),
+            topics.ROBOT_STATE.name: (
+                maker(CHANNEL_SUFFIX, frames, functools.partial(state_frames, estimate)),
+                *([maker(MODEL_SUFFIX, scene, robot_model(estimate))] if estimate else [])),
+            topics.SIM_TRUTH.name: (
+                maker(CHANNEL_SUFFIX, frames, functools.partial(truth_frames, truth)),
+                *([maker(MODEL_SUFFIX, scene, robot_model(truth))] if truth else [])),
+            topics.VISION_MARKERS.name: (
+                maker(CHANNEL_SUFFIX, frames, marker_frames("")),
+                maker(ANNOTATIONS_SUFFIX, fox.ImageAnnotations, marker_annotations)),
+            topics.WORLD_MARKERS.name: (maker(CHANNEL_SUFFIX, frames,
+                                              marker_frames("estimate/")),),
+            topics.CONTROL_GOAL.name: (goal,),
+            topics.GOAL_REQUEST.name: (goal,),
+            topics.WORLD_GOAL.name: (maker(CHANNEL_SUFFIX, frames, goal_frame("estimate/goal")),),
+            topics.WORLD_OBSTACLES.name: (maker(CHANNEL_SUFFIX, scene, obstacle_scene),),
+            topics.SUPERVISOR_STATUS.name: (
+                maker(CHANNEL_SUFFIX, frames, self._plan_frames),
+                ViewMaker(SCENE_SUFFIX, scene, self._plan_scene)),
+        }  # fmt: skip
 
-    def __call__(self, topic_name: str, key: str, message: Any) -> list[View]:
-        """The well-known views of one message of ``topic_name``; each goes on
-        ``view.channel(key)``, beside the channel ``key`` the message itself is on."""
-        if topic_name == topics.SUPERVISOR_STATUS.name:
-            return self._plan_views(key, message)
-        make = self._views.get(topic_name)
-        return make(message) if make is not None else []
-
-    def _plan_views(self, key: str, status: SupervisorStatus) -> list[View]:
-        """The candidate's frames; the plan's scene when it changed, and every ``MODEL_EVERY``
-        statuses."""
+    def __call__(self, topic_name: str, key: str, message: Any,
+                 wanted: Callable[[str], bool] = everything) -> list[View]:  # fmt: skip
+        """The well-known views of one message of ``topic_name`` whose suffix is ``wanted``;
+        each goes on ``view.channel(key)``, beside the channel ``key`` the message is on."""
         found = []
-        transforms = plan_transforms(self._candidate, status)
-        if transforms:
-            found.append(view(fox.FrameTransforms(transforms=transforms)))
-        plan = (status.candidate_base, status.candidate_arm, status.way)
-        if self._plans.get(key) != plan or status.header.seq % MODEL_EVERY == 0:
-            self._plans[key] = plan
-            found.append(view(plan_scene(self._candidate, status), suffix=SCENE_SUFFIX))
+        for each in self._makers.get(topic_name, ()):
+            if wanted(each.suffix):
+                made = each.make(key, message)
+                if made is not None:
+                    found.append(view(made, each.carries, each.suffix))
         return found
+
+    def carrier(self, topic_name: str) -> tuple[str, str] | None:
+        """The field of the message a view of ``topic_name`` carries, and that view's suffix
+        (an image's pixels in its view), or None."""
+        return next(((m.carries, m.suffix) for m in self._makers.get(topic_name, ())
+                     if m.carries), None)  # fmt: skip
+
+    def channels(self, topic_name: str) -> list[tuple[str, type]]:
+        """The suffix and Foxglove type of every view of ``topic_name`` whose type does not
+        depend on the message: the channels a live view can open before their first view."""
+        return [(m.suffix, m.schema) for m in self._makers.get(topic_name, ()) if m.schema]
+
+    def _plan_frames(self, status: SupervisorStatus) -> fox.FrameTransforms | None:
+        transforms = plan_transforms(self._candidate, status)
+        return fox.FrameTransforms(transforms=transforms) if transforms else None
+
+    def _plan_scene(self, key: str, status: SupervisorStatus) -> fox.SceneUpdate | None:
+        """The plan's scene when it changed, and every ``MODEL_EVERY`` statuses."""
+        plan = (status.candidate_base, status.candidate_arm, status.way)
+        if self._plans.get(key) == plan and status.header.seq % MODEL_EVERY:
+            return None
+        self._plans[key] = plan
+        return plan_scene(self._candidate, status)
 
 
 PLAIN = Viewer()

@@ -15,6 +15,10 @@ most ``BACKLOG`` messages per client and drops the oldest data first (foxglove-s
 handlers. The time each sample takes, from its arrival to its last channel's log, is kept
 (``handler_us``).
 
+Work nobody reads is not done: once a key has had a message (which opens its channel and those
+of all its views, so clients see them), a message of it whose channels no client subscribes to
+is dropped undecoded (``unwatched``), and of one that is read only the channels read are made.
+
 What clients may do beyond watching (publish, parameters) is the ``listener``'s, with the
 ``capabilities`` it needs; this module only serves.
 """
@@ -34,7 +38,7 @@ import zenoh
 from foxglove.websocket import Capability
 
 from messages import codec, topics
-from record.foxglove_views import Viewer
+from record.foxglove_views import Viewer, everything
 from record.session_file import Entry, entries, stamp_of
 
 HOST = "127.0.0.1"
@@ -82,12 +86,16 @@ class LiveView:
             raise OSError(f"port: cannot listen on {HOST}:{port}: {error}") from error
         self._viewer = viewer if viewer is not None else Viewer()
         self._channels: dict[tuple[str, str], foxglove.Channel] = {}
+        self._by_name: dict[str, foxglove.Channel] = {}
+        self._of_key: dict[str, list[foxglove.Channel]] = {}
+        """The channels of each key (its message's and its views'), once it has had one."""
         self._lock = threading.Lock()
         self._warn = warn or (lambda _key, message: log.warning("%s", message))
         self._timings: collections.deque[int] = collections.deque(maxlen=TIMINGS)
         self.shown = 0
         self.malformed = 0
         self.failed = 0
+        self.unwatched = 0
         self._subscribers = [
             session.declare_subscriber(topic.key(namespace), partial(self._on_sample, topic))
             for topic in chosen
@@ -124,6 +132,12 @@ class LiveView:
     def _on_sample(self, topic: topics.Topic, sample: zenoh.Sample) -> None:
         started = time.perf_counter_ns()
         key = str(sample.key_expr)
+        with self._lock:
+            opened = self._of_key.get(key)
+        if opened is not None and not any(channel.has_sinks() for channel in opened):
+            with self._lock:
+                self.unwatched += 1
+            return
         try:
             message = codec.decode(sample.payload.to_bytes(), topic.type, key)
         except codec.DecodeError as error:
@@ -132,8 +146,9 @@ class LiveView:
                 self._warn(key, f"view: malformed sample dropped: {error}")
             return
         stamp = stamp_of(message)
+        wanted = self._wanted if opened is not None else everything
         try:
-            found = entries(key, message, viewer=self._viewer)
+            found = entries(key, message, viewer=self._viewer, wanted=wanted)
         except Exception as error:  # a view that fails must not take the others with it
             with self._lock:
                 self.failed += 1
@@ -141,21 +156,52 @@ class LiveView:
                                 f"{type(error).__name__}: {error}")  # fmt: skip
             found = entries(key, message, views=False)
         for entry in found:
-            self._log(entry, stamp)
+            self._log(key, entry, stamp)
+        if opened is None:
+            self._open_the_others(topic, key)
         with self._lock:
             self.shown += 1
             self._timings.append(time.perf_counter_ns() - started)
 
-    def _log(self, entry: Entry, log_time_ns: int) -> None:
-        """``entry`` on the channel of its name and schema, created on first use."""
+    def _wanted(self, name: str) -> bool:
+        """Whether a channel is to be made: it is not open yet, or a client reads it."""
+        channel = self._by_name.get(name)
+        return channel is None or channel.has_sinks()
+
+    def _open_the_others(self, topic: topics.Topic, key: str) -> None:
+        """After a key's first message: open every view channel it may have, so that a client
+        can read one before its first view comes (a robot's model, the plan's scene)."""
+        for suffix, kind in self._viewer.channels(topic.name):
+            if f"{key}/{suffix}" not in self._by_name:
+                schema = kind.get_schema()
+                self._open(key, f"{key}/{suffix}", foxglove.Schema(
+                    name=schema.name, encoding=schema.encoding, data=bytes(schema.data)),
+                    "protobuf", {})  # fmt: skip
+        with self._lock:
+            self._of_key.setdefault(key, [])
+
+    def _log(self, key: str, entry: Entry, log_time_ns: int) -> None:
+        """``entry`` of a message on ``key`` on the channel of its name and schema, opened on
+        first use."""
         with self._lock:
             channel = self._channels.get((entry.channel, entry.schema_name))
-            if channel is None:
-                schema = foxglove.Schema(name=entry.schema_name, encoding=entry.schema_encoding,
-                                         data=entry.schema_data)  # fmt: skip
-                channel = foxglove.Channel(entry.channel, schema=schema,
-                                           message_encoding=entry.message_encoding,
-                                           context=self._context,
-                                           metadata=dict(entry.metadata))  # fmt: skip
-                self._channels[(entry.channel, entry.schema_name)] = channel
+        if channel is None:
+            schema = foxglove.Schema(name=entry.schema_name, encoding=entry.schema_encoding,
+                                     data=entry.schema_data)  # fmt: skip
+            channel = self._open(key, entry.channel, schema, entry.message_encoding,
+                                 dict(entry.metadata))  # fmt: skip
         channel.log(entry.data, log_time=log_time_ns)
+
+    def _open(self, key: str, name: str, schema: foxglove.Schema, encoding: str,
+              metadata: dict[str, str]) -> foxglove.Channel:  # fmt: skip
+        """A channel, advertised to the clients, and remembered under its message's key."""
+        with self._lock:
+            found = self._channels.get((name, schema.name))
+            if found is not None:
+                return found
+            channel = foxglove.Channel(name, schema=schema, message_encoding=encoding,
+                                       context=self._context, metadata=metadata)  # fmt: skip
+            self._channels[(name, schema.name)] = channel
+            self._by_name.setdefault(name, channel)
+            self._of_key.setdefault(key, []).append(channel)
+            return channel

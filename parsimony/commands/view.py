@@ -102,9 +102,11 @@ def _serve(view: LiveView, station: ControlStation, namespace: str, as_json: boo
     except KeyboardInterrupt:
         pass
     handler = view.handler_us()
-    print(f"view: {view.shown} messages shown, {view.malformed} malformed, handler "
-          f"{handler['median']} us median, {handler['p99']} us p99 over {handler['samples']}, "
+    print(f"view: {view.shown} messages shown, {view.malformed} malformed, {view.unwatched} "
+          f"read by no client, {view.failed} without views; handler "
+          f"{handler['median']} us median, {handler['p99']} us p99 over {handler['samples']}; "
           f"{station.goals_sent} goals sent", file=sys.stderr)  # fmt: skip
     if as_json:
-        emit(json.dumps({"shown": view.shown, "malformed": view.malformed,
+        emit(json.dumps({"shown": view.shown, "unwatched": view.unwatched,
+                         "malformed": view.malformed, "failed": view.failed,
                          "handler_us": handler, "goals_sent": station.goals_sent}))  # fmt: skip

@@ -12,8 +12,9 @@
 // foxglove-sdk 0.30.3 can, with "Unknown channel ID"); {"op": "unsubscribe", "topics": [...]};
 // {"op": "advertise", "topic", "encoding",
 // "schemaName"} answers {"event": "advertised", "topic", "channel"}; {"op": "publish",
-// "channel", "text"} sends the text's bytes; {"op": "subscribeAll"} subscribes to every channel,
-// advertised already or later; {"op": "getParameters", "names", "id"};
+// "channel", "text"} sends the text's bytes; {"op": "subscribeAll", "schemaPrefix", "topics"} subscribes to
+// every channel, advertised already or later (with "schemaPrefix", to those whose schema name
+// starts with it, and the "topics"); {"op": "getParameters", "names", "id"};
 // {"op": "setParameters", "parameters", "id"}; {"op": "pause"} and {"op": "resume"} stop and
 // start reading the socket (a client that reads nothing); {"op": "close"}.
 //
@@ -36,7 +37,7 @@ const ws = new WebSocket(process.argv[2], [SDK_SUBPROTOCOL, FoxgloveClient.SUPPO
 const client = new FoxgloveClient({ ws });
 const channels = new Map(); // topic -> channel
 const wanted = new Set(); // topics to subscribe to
-let everything = false; // subscribe to every channel, those advertised later too
+let everything = null; // which channels to subscribe to, those advertised later too
 const subscribed = new Map(); // subscription id -> topic
 const subscriptionOf = new Map(); // topic -> subscription id
 
@@ -45,7 +46,10 @@ function say(event) {
 }
 
 function subscribeWanted() {
-  for (const topic of everything ? channels.keys() : wanted) {
+  const chosen = everything
+    ? [...channels.values()].filter(everything).map((channel) => channel.topic)
+    : wanted;
+  for (const topic of chosen) {
     const channel = channels.get(topic);
     if (channel !== undefined && !subscriptionOf.has(topic)) {
       const id = client.subscribe(channel.id);
@@ -122,8 +126,11 @@ const commands = {
   publish: ({ channel, text }) => client.sendMessage(channel, new TextEncoder().encode(text)),
   getParameters: ({ names, id }) => client.getParameters(names ?? [], id),
   setParameters: ({ parameters, id }) => client.setParameters(parameters, id),
-  subscribeAll: () => {
-    everything = true;
+  subscribeAll: ({ schemaPrefix, topics }) => {
+    everything = (channel) =>
+      schemaPrefix === undefined ||
+      channel.schemaName.startsWith(schemaPrefix) ||
+      (topics ?? []).includes(channel.topic);
     subscribeWanted();
   },
   counts: () => say({ event: "counts", counts }),
