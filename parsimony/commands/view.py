@@ -3,14 +3,17 @@
 opens as a live source, until Ctrl-C or SIGTERM. It draws the robot of the profile's
 description, lets its clients send goals on goal/request (when the user may write it) and set
 any running component's parameters. A replay into the profile's namespace is watched the same
-way. ``--layout FILE`` writes the Foxglove layout of the namespace (``parsimony layout``);
-``--json`` prints what the view did when it stops (messages, the handler's times)."""
+way. It runs ``--nice`` steps below the loop's priority (10 by default), so that on a busy
+machine the loop takes the CPU first. ``--layout FILE`` writes the Foxglove layout of the
+namespace (``parsimony layout``); ``--json`` prints what the view did when it stops (messages,
+the handler's times)."""
 
 from __future__ import annotations
 
 import argparse
 import json
 import logging
+import os
 import signal
 import sys
 from pathlib import Path
@@ -48,8 +51,15 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("--keys", nargs="*", default=["*"], help="topic name patterns")
     parser.add_argument("--layout", type=Path, help="write the Foxglove layout to this file")
     parser.add_argument("--force", action="store_true", help="write over an existing layout")
+    parser.add_argument("--nice", type=int, default=NICE, choices=range(0, 20), metavar="N",
+                        help=f"run N steps below the loop's priority (default {NICE})")
     parser.add_argument("--json", action="store_true", help="print what it did, as JSON")
     return parser
+
+
+NICE = 10
+"""How far below the loop's CPU priority the view runs: on a busy machine the loop's components
+take the CPU first, and the view falls behind and sheds rather than slow them."""
 
 
 def _interrupt(signum: int, frame: object) -> None:
@@ -67,6 +77,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"view: {error}", file=sys.stderr)
         return 2
     target = Target(profile.namespace, profile.zenoh)
+    os.nice(args.nice)
     previous = signal.signal(signal.SIGTERM, _interrupt)
     try:
         warnings = RateLimitedLog(logging.getLogger("parsimony.view"))
