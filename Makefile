@@ -6,8 +6,12 @@ VENV := .venv
 STAMP := $(VENV)/.installed
 LOCK := requirements.lock
 UV_VERSION := 0.13.8
+# Foxglove's own WebSocket client (@foxglove/ws-protocol, run by node), which the tests of
+# `parsimony view` drive: installed exactly as package-lock.json pins it.
+FOXGLOVE_CLIENT := tests/foxglove_client
+CLIENT_STAMP := $(FOXGLOVE_CLIENT)/node_modules/.installed
 
-.PHONY: demo test bench lint lock clean
+.PHONY: demo test bench lint lock clean foxglove-client
 
 $(STAMP): $(LOCK) pyproject.toml
 	rm -rf $(VENV)
@@ -20,7 +24,13 @@ $(STAMP): $(LOCK) pyproject.toml
 demo: $(STAMP)
 	$(VENV)/bin/parsimony experiment pose --controller lp --realtime --out runs/demo --force
 
-test: $(STAMP)
+$(CLIENT_STAMP): $(FOXGLOVE_CLIENT)/package.json $(FOXGLOVE_CLIENT)/package-lock.json
+	cd $(FOXGLOVE_CLIENT) && npm ci --no-audit --no-fund --loglevel=error
+	touch $(CLIENT_STAMP)
+
+foxglove-client: $(CLIENT_STAMP)
+
+test: $(STAMP) $(CLIENT_STAMP)
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/python -m pytest -q --durations=20
 
@@ -38,4 +48,4 @@ lock: $(STAMP)
 		--universal --python-version 3.11 --generate-hashes --quiet -o $(LOCK)
 
 clean:
-	rm -rf $(VENV) build *.egg-info
+	rm -rf $(VENV) build *.egg-info $(FOXGLOVE_CLIENT)/node_modules

@@ -6,7 +6,8 @@ sample is dropped unless the writer falls that far behind, and then the loss is 
 ``parsimony info`` shows). Each message is written on the channel of its key with the
 project's schema, log time from its stamp (``record.session_file``), and beside it in
 Foxglove's well-known schemas (``record.foxglove_views``: images as ``foxglove.RawImage``,
-frames as ``foxglove.FrameTransforms``, obstacles as ``foxglove.SceneUpdate``), so that
+frames as ``foxglove.FrameTransforms``, obstacles and the robot of the profile's description
+as ``foxglove.SceneUpdate``, markers on the image as ``foxglove.ImageAnnotations``), so that
 Foxglove's 3D, Image and Plot panels open the file as it is. ``keys`` limits the recording to
 topics whose names match one of its comma-separated ``fnmatch`` patterns.
 
@@ -23,12 +24,16 @@ from __future__ import annotations
 import fnmatch
 from pathlib import Path
 
+import yaml
+
 from components.params import Param, ParamError
 from components.process_entry import run_component
 from components.pubsub import Input
 from components.runtime import Component, Node
 from messages import topics
+from record.foxglove_views import Viewer
 from record.session_file import DROPPED, SessionWriter
+from wbc.robot import MobileManipulator
 
 QUEUE = 10_000
 """Samples of one topic that may wait for the writer."""
@@ -49,9 +54,10 @@ class Recorder(Component):
     def __init__(self, node: Node) -> None:
         super().__init__(node)
         path = Path(str(node.params["path"]))
+        viewer = Viewer(self._robot(node))
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
-            self.writer = SessionWriter(path)
+            self.writer = SessionWriter(path, viewer=viewer)
         except OSError as error:
             raise ParamError(f"path: cannot write {path}: {error}") from error
         patterns = [p.strip() for p in str(node.params["keys"]).split(",") if p.strip()]
@@ -65,6 +71,16 @@ class Recorder(Component):
         ]
         self.dropped: dict[str, int] = {}
         node.timer(node.params["flush_s"], lambda: self._writing(self._flush))
+
+    @staticmethod
+    def _robot(node: Node) -> MobileManipulator | None:
+        """The profile's robot, which the file draws (none: its bases and end effectors)."""
+        if node.profile.robot is None or not node.params["views"]:
+            return None
+        try:
+            return MobileManipulator.from_yaml(node.profile.robot)
+        except (OSError, ValueError, yaml.YAMLError) as error:
+            raise ParamError(f"robot: cannot read {node.profile.robot}: {error}") from error
 
     def _writer_of(self, name: str, key: str):
         def write(message) -> None:

@@ -195,6 +195,8 @@ class Supervisor(Component):
             phase=supervisor.phase.value,
             candidate=len(supervisor.tried),
             candidate_base=None if candidate is None else tuple(candidate.base.tolist()),
+            candidate_arm=None if candidate is None else tuple(candidate.arm.tolist()),
+            way=tuple(tuple(point.tolist()) for point in supervisor.way()),
             plans=len(supervisor.planning_s),
             replans=supervisor.replans,
             stalls=sum(e.kind == "stall" for e in supervisor.events),

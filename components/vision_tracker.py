@@ -6,12 +6,13 @@ grey), or with ``device`` set a
 scene's camera rate, with the intrinsics of the ``calibration`` YAML file (``fx fy cx cy``
 and optional ``distortion``).
 
-Output: ``vision/markers``, every scene marker found, its pose in the camera frame and the
-fit's reprojection error, stamped with the frame's stamp (an empty list when none is found:
-``frames_without_markers`` counts them). Corners are refined to sub-pixel. The reference
-marker F0 is fitted by the square-marker method (``solvePnP`` IPPE; a fit tilted away from the
-filtered one, IPPE's other solution, is left out) and low-pass filtered (eq. 6.1): that gives
-the floor plane, on which F0's own position and yaw are then measured like the others'.
+Output: ``vision/markers``, every scene marker found, its pose in the camera frame, the fit's
+reprojection error and its corners in the image (refined to sub-pixel), stamped with the
+frame's stamp (an empty list when none is found: ``frames_without_markers`` counts them).
+The reference marker F0 is fitted by the square-marker method (``solvePnP`` IPPE; a fit tilted
+away from the filtered one, IPPE's other solution, is left out) and low-pass filtered (eq.
+6.1): that gives the floor plane, on which F0's own position and yaw are then measured like
+the others'.
 Every other marker lies flat at a known height above that floor, so its pose comes from the
 plane instead: the ray through its centre meets the plane, the yaw comes from its edges.
 Before F0 is seen, every marker gets the square fit.
@@ -120,7 +121,7 @@ class VisionTracker(Component):
                 normal, offset = plane_of(reference_pose, 0.0)
                 pose, error = plane_pose(reference, self.scene.reference.size_m, intrinsics,
                                          normal, offset)  # fmt: skip
-            found.append((reference.id, pose, error))
+            found.append((reference, pose, error))
         elif self.reference.pose is not None:
             reference_pose = self.reference.pose
         for marker_id, detection in detections.items():
@@ -136,15 +137,16 @@ class VisionTracker(Component):
                 pose, error = plane_pose(detection, marker.size_m, intrinsics, normal, offset)
             else:
                 pose, error = square_pose(detection, marker.size_m, intrinsics)
-            found.append((marker_id, pose, error))
+            found.append((detection, pose, error))
         if not found:
             self.node.count("frames_without_markers")
         self.output.put(
             MarkerDetections(
                 header=self.node.header("camera", stamp_ns, self.output.next_seq),
                 markers=tuple(
-                    MarkerDetection(id=i, pose=tuple(p.tolist()), reprojection_error=float(e))
-                    for i, p, e in sorted(found, key=lambda item: item[0])
+                    MarkerDetection(id=d.id, pose=tuple(p.tolist()), reprojection_error=float(e),
+                                    corners=tuple(map(tuple, d.corners.tolist())))
+                    for d, p, e in sorted(found, key=lambda item: item[0].id)
                 ),
             )
         )

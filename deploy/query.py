@@ -7,6 +7,7 @@ query with a timeout on a client session.
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -98,6 +99,12 @@ def get_param(
 ) -> ParamValue:
     """The current value of a component's parameter."""
     return _param_query(session, namespace, component, name, None, timeout_s)
+
+
+def value_text(value: object) -> str:
+    """A value as ``set_param`` takes it, as typed on a command line: true, 0.5, pose,
+    [0.6, 0.0, 0.0]."""
+    return value if isinstance(value, str) else json.dumps(value)
 
 
 def set_param(

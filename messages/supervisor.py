@@ -6,7 +6,7 @@ from typing import Literal
 
 from pydantic import Field
 
-from messages.base import Finite, Message, NonNegative
+from messages.base import ArmVector, Finite, Message, NonNegative
 from messages.header import Header
 from wbc.supervisor_phase import Phase
 
@@ -19,8 +19,11 @@ class SupervisorStatus(Message):
     with every control-rate tick that follows.
 
     ``phase`` is a ``PhaseName``; ``candidate`` numbers the staging candidate being driven to
-    (1 the best), ``candidate_base`` is its base pose (x, y, phi); ``plans``, ``replans`` and
-    ``stalls`` count since the goal came; ``reason`` says why a goal is unreachable;
+    (1 the best), ``candidate_base`` is its base pose (x, y, phi) and ``candidate_arm`` its arm
+    joints (rad); ``way`` is where the base has still to pass, in order (x, y): the staging
+    point while it drives there, then the candidate's base (empty with no candidate);
+    ``plans``, ``replans`` and ``stalls`` count since the goal came; ``reason`` says why a goal
+    is unreachable;
     ``last_event`` is the latest thing the supervisor did, in words; ``planning_ms`` is the
     time of the last plan; ``refusals`` counts the requests refused as malformed since the
     supervisor started, ``last_refusal`` says why the latest was (a refused request leaves
@@ -31,6 +34,8 @@ class SupervisorStatus(Message):
     phase: PhaseName
     candidate: int = Field(ge=0)
     candidate_base: tuple[Finite, Finite, Finite] | None = None
+    candidate_arm: ArmVector | None = None
+    way: tuple[tuple[Finite, Finite], ...] = Field(default=(), max_length=2)
     plans: int = Field(ge=0)
     replans: int = Field(ge=0)
     stalls: int = Field(ge=0)

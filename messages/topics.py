@@ -77,6 +77,9 @@ WORLD_MARKERS = Topic("world/markers", "world/markers", MarkerDetections)
 CONTROL_GOAL = Topic("control/goal", "control/goal", Goal)
 GOAL_REQUEST = Topic("goal/request", "goal/request", Goal)
 """The operator's goal, for a supervisor that turns it into control/goal phase by phase."""
+WORLD_GOAL = Topic("world/goal", "world/goal", Goal)
+"""The goal the state estimator measures (eq. 6.3), where it is shown and not obeyed: in a
+profile whose operator gives the goals on goal/request (deploy/sim_station.yaml)."""
 SUPERVISOR_STATUS = Topic("supervisor/status", "supervisor/status", SupervisorStatus)
 BASE_COMMAND = Topic("base/command", "base/command", BaseCommand)
 ARM_COMMAND = Topic("arm/command", "arm/command", ArmCommand)
@@ -97,6 +100,7 @@ TOPICS: Mapping[str, Topic] = MappingProxyType(
             WORLD_MARKERS,
             CONTROL_GOAL,
             GOAL_REQUEST,
+            WORLD_GOAL,
             SUPERVISOR_STATUS,
             BASE_COMMAND,
             ARM_COMMAND,
@@ -204,6 +208,21 @@ def param_key(namespace: str, component: str, name: str) -> str:
 def param_selector(namespace: str, component: str) -> str:
     """Selects every parameter of a component: ``"<ns>/component/<component>/param/**"``."""
     return f"{_component_prefix(namespace, component)}/param/**"
+
+
+def all_params_selector(namespace: str) -> str:
+    """Selects every parameter of every component: ``"<ns>/component/*/param/**"``."""
+    return f"{check_namespace(namespace)}/component/*/param/**"
+
+
+def param_of_key(namespace: str, key_expr: str) -> tuple[str, str]:
+    """The component and the parameter name in a parameter key (the inverse of
+    ``param_key``)."""
+    rest = _strip_prefix(key_expr, f"{check_namespace(namespace)}/component/")
+    component, marker, name = rest.partition("/param/")
+    if not marker:
+        raise KeyExpressionError(f"{key_expr!r} is no parameter key of namespace {namespace!r}")
+    return check_component(component), _check_path(name, "parameter")
 
 
 def _component_prefix(namespace: str, component: str) -> str:

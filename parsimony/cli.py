@@ -15,7 +15,7 @@ from parsimony.target_options import exit_code
 
 COMMANDS = (
     "demo", "experiment", "bench", "launch", "status", "param", "node", "topic", "graph", "schema",
-    "record", "info", "replay", "rerun", "report", "view", "reproduce",
+    "record", "info", "replay", "rerun", "report", "view", "layout", "reproduce",
 )  # fmt: skip
 
 

@@ -32,6 +32,11 @@ USER_ENV = "PARSIMONY_USER"
 DEFAULT_TOOL_USER = "operator"
 
 
+def tool_user(user: str | None = None) -> str:
+    """``user``, or the user a tool authenticates as: ``$PARSIMONY_USER``, else ``operator``."""
+    return user or os.environ.get(USER_ENV, DEFAULT_TOOL_USER)
+
+
 def read_credentials(path: Path) -> dict[str, str]:
     """``user -> password`` from a file of ``user:password`` lines (blank lines and # skipped)."""
     users = {}
@@ -93,9 +98,14 @@ class AccessSettings(BaseModel):
                                "subjects": subjects, "policies": policies},
         }  # fmt: skip
 
+    def may_write(self, topic: str, user: str | None) -> bool:
+        """Whether ``user`` (a tool's: ``$PARSIMONY_USER``) may put on ``topic``: the topic
+        names no writers, or names the user."""
+        return topic not in self.writers or tool_user(user) in self.writers[topic]
+
     def session_json(self, user: str | None) -> dict[str, Any]:
         """A session's credentials: ``user`` (a tool's: ``$PARSIMONY_USER``) and its password."""
-        user = user or os.environ.get(USER_ENV, DEFAULT_TOOL_USER)
+        user = tool_user(user)
         users = self.users()
         if user not in users:
             raise ValueError(f"user {user!r} has no line in {self.credentials}")

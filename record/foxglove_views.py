@@ -4,25 +4,39 @@ panels open a recording (or a live view) with no plugin:
     CameraFrame            -> foxglove.CompressedImage  frame "camera", the same bytes: a JPEG
                               or foxglove.RawImage      as it is, raw pixels as they are; the view
                                                         alone carries them (``carries``)
-    RobotState             -> foxglove.FrameTransforms  world -> estimate/base,
-                                                        world -> estimate/end_effector
-    SimTruth               -> foxglove.FrameTransforms  world -> truth/base, truth/end_effector
+    RobotState             -> foxglove.FrameTransforms  world -> estimate/base -> link_0..link_5
+                                                        (with the robot description, else the
+                                                        base alone), world ->
+                                                        estimate/end_effector
+                           -> foxglove.SceneUpdate      the robot's model (``model``)
+    SimTruth               -> foxglove.FrameTransforms  world -> truth/world (the simulator's,
+                                                        where F0 stands at ``reference_pose``)
+                                                        -> truth/base ..., truth/end_effector,
+                                                        truth/goal
+                           -> foxglove.SceneUpdate      the robot's model (``model``)
     MarkerDetections       -> foxglove.FrameTransforms  camera -> marker_<id> (vision/markers),
                                                         world -> estimate/marker_<id>
                                                         (world/markers)
-    Goal (pose task)       -> foxglove.FrameTransforms  world -> goal (control/goal, goal/request)
+                           -> foxglove.ImageAnnotations each marker's corners and id on the
+                                                        image (vision/markers, ``annotations``)
+    Goal (pose task)       -> foxglove.FrameTransforms  world -> goal (control/goal, goal/request),
+                                                        world -> estimate/goal (world/goal)
     Obstacles              -> foxglove.SceneUpdate      one cylinder per circle, frame "world"
+    SupervisorStatus       -> foxglove.FrameTransforms  world -> candidate/base -> ... (its
+                                                        staging candidate)
+                           -> foxglove.SceneUpdate      its way and the candidate's ghost
+                                                        (``scene``)
 
-The base transform is the planar pose (x, y, phi): translation (x, y, 0), rotation phi about z.
-A pose dual quaternion x gives translation(x) and rotation(x) (``wbc.dq``). Each view is
-protobuf, encoded by foxglove-sdk with its schema, and goes on the channel
-``<key>/foxglove`` (``View.channel``).
+The robot, its frames and its model are ``record.robot_scene``'s; the plan's
+``record.plan_views``'; the annotations ``record.marker_annotations``'. Each view is protobuf,
+encoded by foxglove-sdk with its schema, and goes on the channel ``<key>/<suffix>``
+(``View.channel``): ``foxglove`` for the transforms, images and obstacles, the name above for
+the others, so no two views of a key share a channel.
 """
 
 from __future__ import annotations
 
 import functools
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -37,11 +51,25 @@ from messages.goal import Goal
 from messages.markers import MarkerDetections
 from messages.obstacles import Obstacles
 from messages.state import RobotState
+from messages.supervisor import SupervisorStatus
 from messages.truth import SimTruth
-from wbc import dq
+from record.foxglove_frames import planar_transform, pose_transform, timestamp
+from record.marker_annotations import marker_annotations
+from record.plan_views import CANDIDATE_COLOR, CANDIDATE_PREFIX, plan_scene, plan_transforms
+from record.robot_scene import RobotDrawing
+from wbc.planar import inverse
+from wbc.robot import MobileManipulator
 
 CHANNEL_SUFFIX = "foxglove"
-"""A view of the message on key K goes on the channel ``K/foxglove``."""
+"""A view of the message on key K goes on the channel ``K/foxglove`` unless it says another."""
+MODEL_SUFFIX, ANNOTATIONS_SUFFIX, SCENE_SUFFIX = "model", "annotations", "scene"
+"""The channels of a robot's model, a frame's marker annotations, the supervisor's plan."""
+MODEL_EVERY = 25
+"""A robot's model goes with one state in this many, by its sequence number (twice a second
+at 50 Hz), and the supervisor's plan when it changes and as often: a client that joins late,
+or a file opened anywhere, has them within that; the frames move them in between."""
+ESTIMATE_COLOR = fox.Color(r=0.25, g=0.5, b=0.95, a=1.0)
+TRUTH_COLOR = fox.Color(r=0.3, g=0.85, b=0.35, a=0.45)
 OBSTACLE_HEIGHT_M = 0.3
 """How tall the 3D panel draws an obstacle, m."""
 OBSTACLE_COLOR = fox.Color(r=0.8, g=0.2, b=0.2, a=0.8)
@@ -68,53 +96,24 @@ class View:
                 self.schema_data, self.message_encoding, self.data)  # fmt: skip
 
 
-def view(message: Any, carries: str = "") -> View:
-    """A foxglove-sdk message as a ``View``: its protobuf schema and bytes."""
+def view(message: Any, carries: str = "", suffix: str = CHANNEL_SUFFIX) -> View:
+    """A foxglove-sdk message as a ``View`` on ``<key>/<suffix>``: its protobuf schema and
+    bytes."""
     schema = type(message).get_schema()
-    return View(CHANNEL_SUFFIX, schema.name, schema.encoding, bytes(schema.data), "protobuf",
+    return View(suffix, schema.name, schema.encoding, bytes(schema.data), "protobuf",
                 bytes(message.encode()), carries)  # fmt: skip
 
 
-def timestamp(stamp_ns: int) -> fox.Timestamp:
-    return fox.Timestamp(stamp_ns // 1_000_000_000, stamp_ns % 1_000_000_000)
-
-
-def planar_transform(
-    parent: str, child: str, base_pose: tuple[float, ...], stamp_ns: int
-) -> fox.FrameTransform:
-    """The transform of a planar pose (x, y, phi): translation (x, y, 0), phi about z."""
-    x, y, phi = base_pose
-    return fox.FrameTransform(
-        timestamp=timestamp(stamp_ns), parent_frame_id=parent, child_frame_id=child,
-        translation=fox.Vector3(x=x, y=y, z=0.0),
-        rotation=fox.Quaternion(x=0.0, y=0.0, z=math.sin(phi / 2), w=math.cos(phi / 2)),
-    )  # fmt: skip
-
-
-def pose_transform(
-    parent: str, child: str, pose: tuple[float, ...], stamp_ns: int
-) -> fox.FrameTransform:
-    """The transform of a unit dual quaternion: its translation and rotation."""
-    x = np.asarray(pose, dtype=float)
-    t, r = dq.translation(x), dq.rotation(x)
-    return fox.FrameTransform(
-        timestamp=timestamp(stamp_ns), parent_frame_id=parent, child_frame_id=child,
-        translation=fox.Vector3(x=float(t[1]), y=float(t[2]), z=float(t[3])),
-        rotation=fox.Quaternion(w=float(r[0]), x=float(r[1]), y=float(r[2]), z=float(r[3])),
-    )  # fmt: skip
-
-
-def image_views(frame: CameraFrame) -> list[View]:
+def image_view(frame: CameraFrame) -> fox.CompressedImage | fox.RawImage:
+    """A JPEG frame as it is, raw pixels as they are; the view carries them (``carries``)."""
     stamp = timestamp(frame.header.stamp_ns)
     if frame.encoding in COMPRESSED:
-        image = fox.CompressedImage(timestamp=stamp, frame_id="camera", data=frame.data,
-                                    format=frame.encoding)  # fmt: skip
-    else:
-        step = frame.width * CHANNELS[frame.encoding]
-        image = fox.RawImage(timestamp=stamp, frame_id="camera", width=frame.width,
-                             height=frame.height, encoding=frame.encoding, step=step,
-                             data=frame.data)  # fmt: skip
-    return [view(image, carries="data")]
+        return fox.CompressedImage(timestamp=stamp, frame_id="camera", data=frame.data,
+                                   format=frame.encoding)  # fmt: skip
+    step = frame.width * CHANNELS[frame.encoding]
+    return fox.RawImage(timestamp=stamp, frame_id="camera", width=frame.width,
+                        height=frame.height, encoding=frame.encoding, step=step,
+                        data=frame.data)  # fmt: skip
 
 
 CARRIERS = (fox.CompressedImage, fox.RawImage)
@@ -138,39 +137,31 @@ def carried(schema_name: str, data: bytes) -> bytes:
     return bytes(_protobuf_type(schema_name).FromString(data).data)
 
 
-def robot_views(prefix: str) -> Callable[[RobotState | SimTruth], list[View]]:
-    """Views of a robot's state, its frames named ``<prefix>base`` and ``<prefix>end_effector``."""
+def marker_frames(prefix: str) -> Callable[[MarkerDetections], fox.FrameTransforms | None]:
+    """Markers as frames, ``<header.frame> -> <prefix>marker_<id>``; none without markers."""
 
-    def views(state: RobotState | SimTruth) -> list[View]:
-        stamp = state.header.stamp_ns
-        return [view(fox.FrameTransforms(transforms=[
-            planar_transform("world", prefix + "base", state.base_pose, stamp),
-            pose_transform("world", prefix + "end_effector", state.end_effector, stamp),
-        ]))]  # fmt: skip
-
-    return views
-
-
-def marker_views(prefix: str) -> Callable[[MarkerDetections], list[View]]:
-    """Views of markers, ``<header.frame> -> <prefix>marker_<id>``."""
-
-    def views(detections: MarkerDetections) -> list[View]:
+    def make(detections: MarkerDetections) -> fox.FrameTransforms | None:
         stamp, parent = detections.header.stamp_ns, detections.header.frame
         transforms = [pose_transform(parent, f"{prefix}marker_{m.id}", m.pose, stamp)
                       for m in detections.markers]  # fmt: skip
-        return [view(fox.FrameTransforms(transforms=transforms))] if transforms else []
+        return fox.FrameTransforms(transforms=transforms) if transforms else None
 
-    return views
-
-
-def goal_views(goal: Goal) -> list[View]:
-    if goal.pose is None:
-        return []
-    transform = pose_transform("world", "goal", goal.pose, goal.header.stamp_ns)
-    return [view(fox.FrameTransforms(transforms=[transform]))]
+    return make
 
 
-def obstacle_views(obstacles: Obstacles) -> list[View]:
+def goal_frame(frame: str) -> Callable[[Goal], fox.FrameTransforms | None]:
+    """A pose goal as the frame ``world -> <frame>``; no frame for another task."""
+
+    def make(goal: Goal) -> fox.FrameTransforms | None:
+        if goal.pose is None:
+            return None
+        transform = pose_transform("world", frame, goal.pose, goal.header.stamp_ns)
+        return fox.FrameTransforms(transforms=[transform])
+
+    return make
+
+
+def obstacle_scene(obstacles: Obstacles) -> fox.SceneUpdate:
     """Every obstacle as a cylinder standing on the floor; the update first deletes all the
     entities of the previous one, so obstacles that are gone disappear."""
     stamp = timestamp(obstacles.header.stamp_ns)
@@ -184,24 +175,152 @@ def obstacle_views(obstacles: Obstacles) -> list[View]:
         )],
     ) for index, c in enumerate(obstacles.circles)]  # fmt: skip
     deletion = fox.SceneEntityDeletion(timestamp=stamp, type=fox.SceneEntityDeletionType.All)
-    return [view(fox.SceneUpdate(deletions=[deletion], entities=entities))]
+    return fox.SceneUpdate(deletions=[deletion], entities=entities)
 
 
-VIEWS: dict[str, Callable[[Any], list[View]]] = {
-    topics.CAMERA_IMAGE.name: image_views,
-    topics.ROBOT_STATE.name: robot_views("estimate/"),
-    topics.SIM_TRUTH.name: robot_views("truth/"),
-    topics.VISION_MARKERS.name: marker_views(""),
-    topics.WORLD_MARKERS.name: marker_views("estimate/"),
-    topics.CONTROL_GOAL.name: goal_views,
-    topics.GOAL_REQUEST.name: goal_views,
-    topics.WORLD_OBSTACLES.name: obstacle_views,
-}
-"""Topic name -> the views of one of its messages; topics not named here have none."""
+def state_frames(drawing: RobotDrawing | None, state: RobotState) -> fox.FrameTransforms:
+    """The estimate's frames: its base and links (with a robot to draw, else the base alone)
+    and the end effector as the estimator gives it."""
+    stamp = state.header.stamp_ns
+    end_effector = pose_transform("world", "estimate/end_effector", state.end_effector, stamp)
+    if drawing is None:
+        base = planar_transform("world", "estimate/base", state.base_pose, stamp)
+        return fox.FrameTransforms(transforms=[base, end_effector])
+    q = np.array(state.configuration())
+    return fox.FrameTransforms(transforms=[*drawing.transforms(q, stamp), end_effector])
+
+
+def truth_frames(drawing: RobotDrawing | None, truth: SimTruth) -> fox.FrameTransforms:
+    """The simulated robot in the simulator's world ``truth/world``, which hangs under the
+    estimate's ``world`` (F0) where F0 stands in it, and the true goal."""
+    stamp = truth.header.stamp_ns
+    world = inverse(truth.reference_pose) if truth.reference_pose is not None else (0.0,) * 3
+    parent = "truth/world"
+    transforms = [planar_transform("world", parent, world, stamp)]
+    if drawing is None:
+        transforms.append(planar_transform(parent, "truth/base", truth.base_pose, stamp))
+    else:
+        q = np.array([*truth.base_pose, *truth.arm_joints])
+        transforms += drawing.transforms(q, stamp)
+    transforms.append(pose_transform(parent, "truth/end_effector", truth.end_effector, stamp))
+    if truth.goal is not None:
+        transforms.append(pose_transform(parent, "truth/goal", truth.goal, stamp))
+    return fox.FrameTransforms(transforms=transforms)
+
+
+def robot_model(drawing: RobotDrawing) -> Callable[[RobotState | SimTruth],
+                                                   fox.SceneUpdate | None]:  # fmt: skip
+    """The robot's model, with one state in ``MODEL_EVERY``."""
+
+    def make(state: RobotState | SimTruth) -> fox.SceneUpdate | None:
+        if state.header.seq % MODEL_EVERY:
+            return None
+        return fox.SceneUpdate(entities=drawing.model(state.header.stamp_ns))
+
+    return make
+
+
+@dataclass(frozen=True)
+class ViewMaker:
+    """One view of a topic's messages: its channel suffix, its Foxglove type (None when the
+    message decides it: an image's), and ``make(key, message)``, the foxglove-sdk message or
+    None when this message has no such view; ``carries``: see ``View``."""
+
+    suffix: str
+    schema: type | None
+    make: Callable[[str, Any], Any]
+    carries: str = ""
+
+
+def maker(suffix: str, schema: type | None, make: Callable[[Any], Any], carries: str = ""
+          ) -> ViewMaker:  # fmt: skip
+    """A ``ViewMaker`` of a view that depends on the message alone."""
+    return ViewMaker(suffix, schema, lambda _key, message: make(message), carries)
+
+
+def everything(suffix: str) -> bool:
+    return True
+
+
+class Viewer:
+    """The views of every topic's messages (the table of the module docstring). Given the
+    robot description, the estimate and the truth are drawn as robots and the supervisor's
+    staging candidate as a ghost (``record.robot_scene``); without it, their bases and end
+    effectors alone. A ``Viewer`` remembers the last plan of each key, to send it when it
+    changes: one writer or server uses one."""
+
+    def __init__(self, robot: MobileManipulator | None = None) -> None:
+        self.robot = robot
+        drawing = functools.partial(RobotDrawing, robot) if robot is not None else None
+        estimate = drawing("estimate/", ESTIMATE_COLOR) if drawing else None
+        truth = drawing("truth/", TRUTH_COLOR, "truth/world") if drawing else None
+        self._candidate = drawing(CANDIDATE_PREFIX, CANDIDATE_COLOR) if drawing else None
+        self._plans: dict[str, tuple] = {}
+        frames, scene = fox.FrameTransforms, fox.SceneUpdate
+        goal = maker(CHANNEL_SUFFIX, frames, goal_frame("goal"))
+        self._makers: dict[str, tuple[ViewMaker, ...]] = {
+            topics.CAMERA_IMAGE.name: (maker(CHANNEL_SUFFIX, None, image_view, "data"),),
+            topics.ROBOT_STATE.name: (
+                maker(CHANNEL_SUFFIX, frames, functools.partial(state_frames, estimate)),
+                *([maker(MODEL_SUFFIX, scene, robot_model(estimate))] if estimate else [])),
+            topics.SIM_TRUTH.name: (
+                maker(CHANNEL_SUFFIX, frames, functools.partial(truth_frames, truth)),
+                *([maker(MODEL_SUFFIX, scene, robot_model(truth))] if truth else [])),
+            topics.VISION_MARKERS.name: (
+                maker(CHANNEL_SUFFIX, frames, marker_frames("")),
+                maker(ANNOTATIONS_SUFFIX, fox.ImageAnnotations, marker_annotations)),
+            topics.WORLD_MARKERS.name: (maker(CHANNEL_SUFFIX, frames,
+                                              marker_frames("estimate/")),),
+            topics.CONTROL_GOAL.name: (goal,),
+            topics.GOAL_REQUEST.name: (goal,),
+            topics.WORLD_GOAL.name: (maker(CHANNEL_SUFFIX, frames, goal_frame("estimate/goal")),),
+            topics.WORLD_OBSTACLES.name: (maker(CHANNEL_SUFFIX, scene, obstacle_scene),),
+            topics.SUPERVISOR_STATUS.name: (
+                maker(CHANNEL_SUFFIX, frames, self._plan_frames),
+                ViewMaker(SCENE_SUFFIX, scene, self._plan_scene)),
+        }  # fmt: skip
+
+    def __call__(self, topic_name: str, key: str, message: Any,
+                 wanted: Callable[[str], bool] = everything) -> list[View]:  # fmt: skip
+        """The well-known views of one message of ``topic_name`` whose suffix is ``wanted``;
+        each goes on ``view.channel(key)``, beside the channel ``key`` the message is on."""
+        found = []
+        for each in self._makers.get(topic_name, ()):
+            if wanted(each.suffix):
+                made = each.make(key, message)
+                if made is not None:
+                    found.append(view(made, each.carries, each.suffix))
+        return found
+
+    def carrier(self, topic_name: str) -> tuple[str, str] | None:
+        """The field of the message a view of ``topic_name`` carries, and that view's suffix
+        (an image's pixels in its view), or None."""
+        return next(((m.carries, m.suffix) for m in self._makers.get(topic_name, ())
+                     if m.carries), None)  # fmt: skip
+
+    def channels(self, topic_name: str) -> list[tuple[str, type]]:
+        """The suffix and Foxglove type of every view of ``topic_name`` whose type does not
+        depend on the message: the channels a live view can open before their first view."""
+        return [(m.suffix, m.schema) for m in self._makers.get(topic_name, ()) if m.schema]
+
+    def _plan_frames(self, status: SupervisorStatus) -> fox.FrameTransforms | None:
+        transforms = plan_transforms(self._candidate, status)
+        return fox.FrameTransforms(transforms=transforms) if transforms else None
+
+    def _plan_scene(self, key: str, status: SupervisorStatus) -> fox.SceneUpdate | None:
+        """The plan's scene when it changed, and every ``MODEL_EVERY`` statuses."""
+        plan = (status.candidate_base, status.candidate_arm, status.way)
+        if self._plans.get(key) == plan and status.header.seq % MODEL_EVERY:
+            return None
+        self._plans[key] = plan
+        return plan_scene(self._candidate, status)
+
+
+PLAIN = Viewer()
+"""The views of a session with no robot description."""
 
 
 def views_of(topic_name: str, key: str, message: Any) -> list[View]:
-    """The well-known views of one message of ``topic_name``; each goes on
-    ``view.channel(key)``, beside the channel ``key`` the message itself is on."""
-    make = VIEWS.get(topic_name)
-    return make(message) if make is not None else []
+    """The well-known views of one message of ``topic_name`` with no robot description
+    (``Viewer``)."""
+    return PLAIN(topic_name, key, message)

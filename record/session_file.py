@@ -22,6 +22,7 @@ import base64
 import functools
 import json
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -30,7 +31,7 @@ from pydantic import BaseModel
 
 from messages import topics
 from messages.schema import json_schema
-from record.foxglove_views import View, views_of
+from record.foxglove_views import PLAIN, Viewer, everything
 
 MESSAGE_ENCODING = "json"
 """The message encoding of the project's own channels."""
@@ -110,20 +111,32 @@ class Entry:
     metadata: tuple[tuple[str, str], ...] = ()
 
 
-def entries(key: str, message: BaseModel, views: bool = True) -> list[Entry]:
+def entries(
+    key: str,
+    message: BaseModel,
+    views: bool = True,
+    viewer: Viewer = PLAIN,
+    wanted: Callable[[str], bool] = everything,
+) -> list[Entry]:
     """A project message on ``key`` as a session (or a live view) holds it: its JSON on the
-    channel ``key``, then, if ``views``, each Foxglove view on its own channel; a field that a
-    view carries is left out of the JSON, which names the carrier in its metadata."""
-    found: list[View] = []
-    if views:
-        topic = topic_of(key, type(message).__name__)
-        found = views_of(topic.name, key, message) if topic is not None else []
-    carrier = next((v for v in found if v.carries), None)
-    left_out = carrier.carries if carrier is not None else ""
-    metadata = ((CARRIED_FIELD, left_out), (CARRIER, carrier.channel(key)[0])) if left_out else ()
-    own = Entry(key, type(message).__name__, SCHEMA_ENCODING, schema_of(type(message), left_out),
-                MESSAGE_ENCODING, to_json(message, left_out), metadata)  # fmt: skip
-    return [own, *(Entry(*v.channel(key)) for v in found)]
+    channel ``key``, then, if ``views``, each Foxglove view (of ``viewer``) on its own channel;
+    a field that a view carries is left out of the JSON, which names the carrier in its
+    metadata. Only the channels ``wanted`` (by name) are made: a live view leaves out those no
+    client reads."""
+    topic = topic_of(key, type(message).__name__) if views else None
+    found = viewer(topic.name, key, message, lambda suffix: wanted(f"{key}/{suffix}")
+                   ) if topic is not None else []  # fmt: skip
+    carrier = viewer.carrier(topic.name) if topic is not None else None
+    made: list[Entry] = []
+    if wanted(key):
+        left_out, metadata = "", ()
+        if carrier is not None:
+            left_out, suffix = carrier
+            metadata = ((CARRIED_FIELD, left_out), (CARRIER, f"{key}/{suffix}"))
+        made.append(Entry(key, type(message).__name__, SCHEMA_ENCODING,
+                          schema_of(type(message), left_out), MESSAGE_ENCODING,
+                          to_json(message, left_out), metadata))  # fmt: skip
+    return [*made, *(Entry(*v.channel(key)) for v in found)]
 
 
 def from_json(
@@ -154,10 +167,14 @@ def schema_of(message_type: type[BaseModel], left_out: str = "") -> bytes:
 class SessionWriter:
     """An MCAP file being written: a context manager, ``close`` writes the footer.
 
-    ``chunk_size`` is the uncompressed size (bytes) at which a chunk is closed on its own.
+    ``chunk_size`` is the uncompressed size (bytes) at which a chunk is closed on its own;
+    ``viewer`` makes the Foxglove views (``record.foxglove_views.Viewer``: give it the robot
+    description, and the file draws the robot).
     """
 
-    def __init__(self, path: Path, chunk_size: int = 1024 * 1024) -> None:
+    def __init__(self, path: Path, chunk_size: int = 1024 * 1024, viewer: Viewer | None = None
+                 ) -> None:  # fmt: skip
+        self._viewer = viewer if viewer is not None else Viewer()
         self._file = Path(path).open("wb")
         self._writer = Writer(self._file, chunk_size=chunk_size, compression=CompressionType.ZSTD)
         self._writer.start(library=LIBRARY)
@@ -178,7 +195,7 @@ class SessionWriter:
         """``message`` as JSON on the channel ``key`` and, if ``views``, its Foxglove views
         (``entries``), logged at its stamp unless given."""
         log_time = stamp_of(message) if log_time_ns is None else log_time_ns
-        for entry in entries(key, message, views):
+        for entry in entries(key, message, views, self._viewer):
             self.write_raw(entry, log_time)
 
     def write_raw(self, entry: Entry, log_time_ns: int) -> None:

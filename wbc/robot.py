@@ -221,6 +221,25 @@ class MobileManipulator:
             poses.append(dq.mul(poses[-1], link[:, 0]))
         return poses
 
+    def link_transforms(self, q: Array) -> list[Array]:
+        """Each frame of ``frames(q)`` in the one before it, the first in the base frame x_1^0:
+        the base top x_2^1 (4.2), then every DH link x_i^{i-1} = r_z(q_i) r_theta p_d p_a
+        r_alpha (4.4). After the planar base pose (4.1) their product is ``frames(q)``."""
+        q = self._check(q)
+        top = dq.pose(dq.ONE[:4], [0.0, 0.0, self.base.height])
+        return [top, *(link[:, 0].copy() for link in self._arm_link_operators(q[BASE_DOF:]))]
+
+    def link_outline(self, link: int) -> Array:
+        """The DH link ``link`` (1 to arm_dof) as three points (3, 3) in its own frame i, m:
+        the origin of frame i-1, the point d along z_{i-1} from it, and the origin of frame i.
+
+        Frame i-1's origin is at R_x(alpha)^T Rz(theta)^T (-Rz(theta) (a, 0, d)) =
+        -(a, d sin alpha, d cos alpha) from frame i's, whatever q_i (a rotation about z_{i-1}
+        turns the whole link); the point after d is -(a, 0, 0)."""
+        _, d, a, alpha = self.dh[:4, link - 1]
+        origin_before = -np.array([a, d * math.sin(alpha), d * math.cos(alpha)])
+        return np.array([origin_before, [-a, 0.0, 0.0], [0.0, 0.0, 0.0]])
+
     def fkm(self, q: Array) -> Array:
         """vec8 of the end-effector pose x_3^0 = x_1^0 x_2^1 x_3^2 (4.6)."""
         return self.frames(q)[-1]

@@ -126,6 +126,18 @@ class StagingSupervisor:
     def reached(self) -> bool:
         return self.phase is Phase.REACHED
 
+    def way(self) -> tuple[Array, ...]:
+        """Where the base has still to pass, in order, (x, y) each: the staging point and the
+        candidate's base while it drives, the candidate's base while it turns and approaches,
+        nothing before a candidate or once the base stands at it."""
+        candidate = self.candidate
+        if candidate is None or self.phase not in (Phase.DRIVE, Phase.TURN, Phase.APPROACH):
+            return ()
+        base = np.array(candidate.base[:2])
+        if self.phase is Phase.DRIVE:
+            return (candidate.staging_point(self.staging.final_leg), base)
+        return (base,)
+
     def update(self, q: Array, t: float) -> Task | None:
         """Advance the phases at configuration q and time t (s); the task to step now, None
         while planning (the caller holds the robot) or once the goal is unreachable."""

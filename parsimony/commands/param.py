@@ -9,7 +9,7 @@ from pathlib import Path
 import yaml
 
 from deploy.graph import component_class
-from deploy.query import QueryError, all_params, get_param, set_param
+from deploy.query import QueryError, all_params, get_param, set_param, value_text
 from parsimony.output import emit
 from parsimony.target_options import fail, profile_and_target, target_options
 from profiles.profile import ProfileError
@@ -44,11 +44,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     load.add_argument("component")
     load.add_argument("file", type=Path)
     return parser
-
-
-def as_text(value: object) -> str:
-    """A value as `param set` takes it: true, 0.5, pose, [0.6, 0.0, 0.0]."""
-    return value if isinstance(value, str) else json.dumps(value)
 
 
 def describe(args: argparse.Namespace) -> list[dict]:
@@ -90,7 +85,7 @@ def run(args: argparse.Namespace) -> int:
                 if not isinstance(wanted, dict):
                     raise QueryError(f"{args.file}: expected a mapping of parameter: value")
                 values = {
-                    name: set_param(session, ns, component, name, as_text(value), args.timeout)
+                    name: set_param(session, ns, component, name, value_text(value), args.timeout)
                     for name, value in wanted.items()
                 }
             else:

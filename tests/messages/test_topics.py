@@ -28,6 +28,7 @@ from messages import (
     topic_of_key,
 )
 from messages.base import Message
+from messages.topics import all_params_selector, param_of_key
 
 NAMESPACE = "lab/robot1"
 
@@ -58,6 +59,7 @@ def test_the_table_holds_every_topic_of_the_design() -> None:
         "world/markers": "MarkerDetections",
         "control/goal": "Goal",
         "goal/request": "Goal",
+        "world/goal": "Goal",
         "supervisor/status": "SupervisorStatus",
         "base/command": "BaseCommand",
         "arm/command": "ArmCommand",
@@ -169,3 +171,13 @@ def test_param_keys_sit_under_their_component() -> None:
     assert not _includes(param_selector("sim", "lp"), param_key("sim", "cascade", "eta"))
     with pytest.raises(KeyExpressionError):
         param_key("sim", "lp", "*")
+
+
+def test_every_components_parameters_are_selected_and_named_back() -> None:
+    key = param_key("sim", "lp", "gains/beta")
+    assert _includes(all_params_selector("sim"), key)
+    assert _includes(all_params_selector("sim"), param_key("sim", "cascade", "eta"))
+    assert not _includes(all_params_selector("sim"), status_key("sim", "lp"))
+    assert param_of_key("sim", key) == ("lp", "gains/beta")
+    with pytest.raises(KeyExpressionError):
+        param_of_key("sim", status_key("sim", "lp"))

@@ -181,21 +181,21 @@ def transforms_of(view: View) -> dict[str, dict[str, Any]]:
     return {t["child_frame_id"]: t for t in decode(view)["transforms"]}
 
 
-@pytest.mark.parametrize(("message_type", "prefix"), [(RobotState, "estimate/"),
-                                                      (SimTruth, "truth/")])  # fmt: skip
-def test_a_robot_state_gives_the_base_and_end_effector_frames(message_type, prefix) -> None:
-    fields = {"header": HEADER, "base_pose": (1.5, -2.0, 0.6),
-              "arm_joints": (0.1, -0.2, 0.3, -0.4, 0.5),
-              "end_effector": pose_dq(math.pi / 2, (0.7, 0.2, 0.45))}  # fmt: skip
-    if message_type is RobotState:
-        fields |= {"valid": True, "age_s": 0.01}
-    else:
-        fields |= {"contacts": 0, "in_contact": False}
-    topic = topics.ROBOT_STATE if message_type is RobotState else topics.SIM_TRUTH
-    (view,) = views_of(topic.name, KEY, message_type(**fields))
+ARM = (0.1, -0.2, 0.3, -0.4, 0.5)
+
+
+def robot_state(seq: int = 3) -> RobotState:
+    header = Header(stamp_ns=STAMP_NS, frame="world", seq=seq, source="test")
+    return RobotState(header=header, base_pose=(1.5, -2.0, 0.6), arm_joints=ARM,
+                      end_effector=pose_dq(math.pi / 2, (0.7, 0.2, 0.45)), valid=True,
+                      age_s=0.01)  # fmt: skip
+
+
+def test_a_robot_state_gives_the_base_and_end_effector_frames() -> None:
+    (view,) = views_of(topics.ROBOT_STATE.name, KEY, robot_state())
     frames = transforms_of(view)
-    assert set(frames) == {prefix + "base", prefix + "end_effector"}
-    base, hand = frames[prefix + "base"], frames[prefix + "end_effector"]
+    assert set(frames) == {"estimate/base", "estimate/end_effector"}
+    base, hand = frames["estimate/base"], frames["estimate/end_effector"]
     assert base["parent_frame_id"] == hand["parent_frame_id"] == "world"
     assert vector(base["translation"], "xyz") == [1.5, -2.0, 0.0]
     assert vector(base["rotation"], "xyzw") == pytest.approx([0, 0, math.sin(0.3),
@@ -205,12 +205,30 @@ def test_a_robot_state_gives_the_base_and_end_effector_frames(message_type, pref
     assert vector(hand["rotation"], "xyzw") == pytest.approx([0, 0, half, half], abs=1e-12)
 
 
+def test_the_truth_stands_in_the_simulators_world_under_the_estimates() -> None:
+    truth = SimTruth(header=HEADER, base_pose=(1.5, -2.0, 0.6), arm_joints=ARM,
+                     end_effector=pose_dq(0.0, (0.7, 0.2, 0.45)), contacts=0,
+                     in_contact=False, goal=pose_dq(0.3, (1.0, 0.5, 0.4)),
+                     reference_pose=(0.75, 0.85, 0.3))  # fmt: skip
+    (view,) = views_of(topics.SIM_TRUTH.name, "sim/sim/truth", truth)
+    frames = transforms_of(view)
+    assert set(frames) == {"truth/world", "truth/base", "truth/end_effector", "truth/goal"}
+    assert frames["truth/world"]["parent_frame_id"] == "world"
+    assert {frames[n]["parent_frame_id"] for n in frames if n != "truth/world"} == {"truth/world"}
+    # F0 stands at (0.75, 0.85, 0.3) in the simulator's world: there is its origin.
+    world = frames["truth/world"]
+    f0 = dq.pose(np.array(vector(world["rotation"], "wxyz")),
+                 np.array(vector(world["translation"], "xyz")))  # fmt: skip
+    assert np.allclose(dq.translation(dq.conj(f0))[1:], [0.75, 0.85, 0.0], atol=1e-12)
+    assert vector(frames["truth/base"]["translation"], "xyz") == [1.5, -2.0, 0.0]
+
+
 def test_markers_are_frames_of_the_camera_and_placed_ones_of_the_world() -> None:
     seen = (MarkerDetection(id=3, pose=pose_dq(0.0, (0.1, 0.2, 2.5)), reprojection_error=0.3),
             MarkerDetection(id=7, pose=pose_dq(math.pi, (-0.4, 0.0, 2.4)),
                             reprojection_error=0.5))  # fmt: skip
     camera = Header(stamp_ns=STAMP_NS, frame="camera", seq=3, source="test")
-    (view,) = views_of(topics.VISION_MARKERS.name, "sim/vision/markers",
+    view, _ = views_of(topics.VISION_MARKERS.name, "sim/vision/markers",
                        MarkerDetections(header=camera, markers=seen))  # fmt: skip
     frames = transforms_of(view)
     assert set(frames) == {"marker_3", "marker_7"}
@@ -218,7 +236,7 @@ def test_markers_are_frames_of_the_camera_and_placed_ones_of_the_world() -> None
     assert vector(frames["marker_7"]["translation"], "xyz") == pytest.approx([-0.4, 0, 2.4])
     assert vector(frames["marker_7"]["rotation"], "xyzw") == pytest.approx([0, 0, 1, 0], abs=1e-12)
     empty = MarkerDetections(header=camera)
-    assert views_of(topics.VISION_MARKERS.name, "sim/vision/markers", empty) == []
+    assert views_of(topics.WORLD_MARKERS.name, "sim/world/markers", empty) == []
     # The estimator's markers, placed in F0, are frames of the world beside the truth's.
     (placed,) = views_of(topics.WORLD_MARKERS.name, "sim/world/markers",
                          MarkerDetections(header=HEADER, markers=seen))  # fmt: skip

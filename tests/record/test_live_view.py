@@ -49,6 +49,10 @@ MESSAGE_DATA = 0x01
 """The opcode of a binary message-data frame: then u32 subscription id, u64 log time."""
 UNKNOWN_CHANNEL = "Unknown channel ID: "
 """How the server's status message starts when it refuses a subscription."""
+WATCHED_MESSAGES = 30
+"""How many messages the client reads before it leaves: while it reads the image, every payload
+on its key, the ones that are not messages too, reaches the view's decoder (a key no client
+reads is not decoded)."""
 
 
 def header(seq: int) -> Header:
@@ -149,8 +153,8 @@ class StderrLines:
 
 async def watch(address: str, wanted: set[str]) -> tuple[dict, dict[str, tuple[int, bytes]]]:
     """As the Foxglove app: read serverInfo and the advertisements until the ``wanted``
-    channels are there, subscribe to them, and return them by topic with the first
-    (log time, payload) each sends."""
+    channels are there, subscribe to them, read ``WATCHED_MESSAGES`` at least, and return them
+    by topic with the first (log time, payload) each sends."""
     async with asyncio.timeout(DEADLINE_S), connect(
         address, subprotocols=[Subprotocol("foxglove.sdk.v1")], max_size=None
     ) as client:  # fmt: skip
@@ -171,11 +175,13 @@ async def watch(address: str, wanted: set[str]) -> tuple[dict, dict[str, tuple[i
 
         await subscribe(topic_of)
         first: dict[str, tuple[int, bytes]] = {}
-        while set(first) != wanted:
+        received = 0
+        while set(first) != wanted or received < WATCHED_MESSAGES:
             message = await client.recv()
             if isinstance(message, bytes) and message[0] == MESSAGE_DATA:
                 subscription, log_time = struct.unpack_from("<IQ", message, 1)
                 first.setdefault(topic_of[subscription], (log_time, message[13:]))
+                received += 1
             elif isinstance(message, str) and UNKNOWN_CHANNEL in message:
                 # foxglove-sdk 0.30 sends an advertisement before it records the channel as
                 # advertised to this client: a subscription that follows at once can be refused.

@@ -353,3 +353,21 @@ def test_clearance_check_detects_an_arm_folded_onto_the_base(robot: MobileManipu
     folded = np.array([0.0, 0.0, 0.0, 0.0, -0.7, 1.6, -1.9, 0.85])
     assert _points_too_close_to_the_base(robot, folded)
     assert not _points_too_close_to_the_base(robot, np.zeros(8))
+
+
+def test_each_link_in_the_one_before_composes_into_the_frames(robot: MobileManipulator) -> None:
+    """The planar base on the floor, then the base top and the DH links (4.1, 4.2, 4.4), each
+    in the frame before it, multiply into ``frames(q)``; each link's outline starts at the
+    origin of the frame before it, whatever the joint's angle."""
+    rng = np.random.default_rng(7)
+    for _ in range(20):
+        q = rng.uniform(robot.q_min.clip(-3.0), robot.q_max.clip(max=3.0))
+        pose = dq.pose(dq.rotation_quaternion(q[2], [0.0, 0.0, 1.0]), [q[0], q[1], 0.0])
+        frames = robot.frames(q)
+        for link, expected in zip(robot.link_transforms(q), frames, strict=True):
+            pose = dq.mul(pose, link)
+            assert np.allclose(pose, expected, atol=ORACLE_TOL)
+        for i in range(1, robot.arm_dof + 1):
+            rotation = dq.rotation_matrix(dq.rotation(frames[i]))
+            start = rotation @ robot.link_outline(i)[0] + dq.translation(frames[i])[1:]
+            assert np.allclose(start, dq.translation(frames[i - 1])[1:], atol=ORACLE_TOL)

@@ -106,6 +106,7 @@ def test_a_goal_behind_the_robot_is_reached_through_lp_steps_within_the_limits()
     run = integrate_supervised(LPLaw(MODEL), supervisor, HOME, DT, STEPS)
     assert run.converged and supervisor.phase is Phase.REACHED
     assert [e.detail for e in supervisor.events if e.kind == "phase"][-1] == "pose"
+    assert supervisor.way() == ()  # the base stands at its candidate
     q = np.array(run.configurations)
     assert np.all(q >= MODEL.q_min - 1e-9) and np.all(q <= MODEL.q_max + 1e-9)
     u = run.velocities()
@@ -186,3 +187,15 @@ def test_a_supervisor_waits_for_its_plan_and_holds_meanwhile() -> None:
     supervisor.take(request.run(), 0.04)
     assert supervisor.pending is None and supervisor.phase is not Phase.PLANNING
     assert supervisor.update(HOME, 0.06) is not None
+
+
+def test_the_way_is_the_staging_point_then_the_candidates_base() -> None:
+    goal = MODEL.fkm(np.array([-0.7, 0.3, math.pi - 0.4, 0.2, -0.3, -0.4, 0.2, 0.3]))
+    supervisor = StagingSupervisor(MODEL, goal)
+    assert supervisor.way() == ()  # no candidate yet
+    supervisor.step(HOME, 0.0)
+    assert supervisor.phase is Phase.DRIVE
+    candidate = supervisor.candidate
+    staging, base = supervisor.way()
+    assert np.allclose(staging, candidate.staging_point(supervisor.staging.final_leg))
+    assert np.allclose(base, candidate.base[:2])

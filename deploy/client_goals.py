@@ -1,0 +1,108 @@
+"""A goal a Foxglove client sends on goal/request, checked like any goal before it is passed on.
+
+Foxglove's 3-D panel (its publish-pose tool) sends a pose on the floor of the panel's fixed
+frame as JSON: a ``foxglove.PoseInFrame`` or a ``foxglove.Pose``, or in the shape of ROS's
+``geometry_msgs/PoseStamped`` (the schema versions of Foxglove give it on a source that is not
+ROS), whose frame is in its header. It is taken as the
+place of a goal marker F2, so the goal is the one the state estimator would measure there,
+x_d = x_2 x_d^2 (eq. 6.3), with the scene's offset x_d^2 (the gripper over the bin), a pose
+task. It is refused, with the reason, when its JSON is not of those schemas, a number is
+missing or not finite, its frame is not ``world`` (F0, where the estimate is), its
+orientation is not a unit quaternion (within ``messages.base.UNIT_TOLERANCE``, as a goal's
+pose is checked), the goal lies below the floor, or the supervisor would refuse it at once
+(``wbc.staging.refusal``: in an obstacle, farther than a plan may cover from the base).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+
+import numpy as np
+from pydantic import ValidationError
+
+from messages.base import UNIT_TOLERANCE
+from messages.goal import Goal
+from messages.header import Header
+from wbc import dq
+from wbc.obstacles import Circle
+from wbc.staging import StagingParams, refusal
+
+IN_FRAME = ("foxglove.PoseInFrame",)
+STAMPED = ("geometry_msgs/PoseStamped", "geometry_msgs/msg/PoseStamped")
+SCHEMAS = (*IN_FRAME, "foxglove.Pose", *STAMPED)
+"""What a client may publish on goal/request: a pose in a frame (``frame_id``, ``pose``), a
+pose alone (``position``, ``orientation``), a stamped pose (``header.frame_id``, ``pose``)."""
+ENCODING = "json"
+"""How it may encode it."""
+FRAME = "world"
+"""The frame a PoseInFrame must be in (an empty frame is taken as it)."""
+
+
+class GoalRefused(ValueError):
+    """A client's goal that is not passed on; the text says why."""
+
+
+def _number(fields: dict, path: str) -> float:
+    """The finite number at ``path`` (``"position.x"``); a missing one is 0, as protobuf's."""
+    value: object = fields
+    for name in path.split("."):
+        if not isinstance(value, dict):
+            raise GoalRefused(f"{path}: expected an object at {name!r}")
+        value = value.get(name, 0.0)
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise GoalRefused(f"{path}: expected a number, got {json.dumps(value)}")
+    if not math.isfinite(value):
+        raise GoalRefused(f"{path}: expected a finite number, got {value}")
+    return float(value)
+
+
+def marker_pose(schema_name: str, data: bytes) -> np.ndarray:
+    """The pose (a unit dual quaternion) a client's message of ``SCHEMAS`` gives, or
+    ``GoalRefused``."""
+    if schema_name not in SCHEMAS:
+        raise GoalRefused(f"schema {schema_name!r}: goal/request takes {' or '.join(SCHEMAS)}")
+    try:
+        fields = json.loads(data)
+    except (UnicodeDecodeError, ValueError) as error:
+        raise GoalRefused(f"not JSON: {error}") from None
+    if not isinstance(fields, dict):
+        raise GoalRefused(f"expected a {schema_name} object, got {json.dumps(fields)[:40]}")
+    if schema_name in (*IN_FRAME, *STAMPED):
+        header = fields.get("header", {}) if schema_name in STAMPED else fields
+        frame = header.get("frame_id", "") if isinstance(header, dict) else None
+        if frame not in ("", FRAME):
+            raise GoalRefused(f"frame_id {frame!r}: a goal is given in {FRAME!r} (F0)")
+        fields = fields.get("pose", {})
+    position = [_number(fields, f"position.{axis}") for axis in "xyz"]
+    w, x, y, z = (_number(fields, f"orientation.{axis}") for axis in "wxyz")
+    norm = math.sqrt(w * w + x * x + y * y + z * z)
+    if abs(norm - 1.0) > UNIT_TOLERANCE:
+        raise GoalRefused(f"orientation has norm {norm:.9g}, expected 1 (tolerance "
+                          f"{UNIT_TOLERANCE:g})")  # fmt: skip
+    return dq.pose(np.array([w, x, y, z]), np.array(position))
+
+
+def client_goal(
+    schema_name: str,
+    data: bytes,
+    offset: np.ndarray,
+    header: Header,
+    q_now: np.ndarray | None,
+    obstacles: Sequence[Circle] = (),
+) -> Goal:
+    """The pose goal x_d = x_2 x_d^2 of a client's message, x_d^2 = ``offset``; checked against
+    the robot at ``q_now`` (when the view knows it) and the ``obstacles``, or ``GoalRefused``."""
+    pose = dq.mul(marker_pose(schema_name, data), offset)
+    height = float(dq.translation(pose)[3])
+    if height < 0.0:
+        raise GoalRefused(f"the goal is {-height:.3f} m below the floor")
+    if q_now is not None:
+        reason = refusal(q_now, pose, obstacles, StagingParams())
+        if reason:
+            raise GoalRefused(reason)
+    try:
+        return Goal(header=header, task="pose", pose=tuple(pose.tolist()))
+    except ValidationError as error:
+        raise GoalRefused(error.errors()[0]["msg"]) from None

@@ -1,0 +1,47 @@
+"""`parsimony layout PROFILE [-o FILE]`: the Foxglove layout of the profile's namespace
+(record.foxglove_layout): the 3-D panel on the robot, the annotated camera image, plots of the
+task error and of the nonzero entries of u, the controller's diagnostics, the supervisor's
+status and a Parameters panel. Foxglove imports it from the file (Layouts, Import from file);
+without ``-o`` it is printed."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from parsimony.output import emit
+from profiles.profile import ProfileError, load_profile
+from record.foxglove_layout import layout
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    parser = subparsers.add_parser("layout", help="the Foxglove layout of a profile's view",
+                                   description=__doc__)  # fmt: skip
+    parser.add_argument("profile", type=Path, help="deploy profile of the system")
+    parser.add_argument("-o", "--output", type=Path, help="write it to this file")
+    parser.add_argument("--force", action="store_true", help="write over an existing file")
+    return parser
+
+
+def write_layout(namespace: str, path: Path, force: bool) -> None:
+    """The layout of ``namespace`` into ``path``; ``FileExistsError`` if there is a file
+    there and not ``force``."""
+    if path.exists() and not force:
+        raise FileExistsError(f"{path} exists (--force writes over it)")
+    path.write_text(layout(namespace).to_json() + "\n")
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        namespace = load_profile(args.profile).namespace
+        if args.output is None:
+            emit(layout(namespace).to_json())
+        else:
+            write_layout(namespace, args.output, args.force)
+            print(f"layout: {args.output}: import it in Foxglove (Layouts, Import from file)",
+                  file=sys.stderr)  # fmt: skip
+    except (ProfileError, OSError) as error:
+        print(f"layout: {error}", file=sys.stderr)
+        return 2
+    return 0

@@ -1,0 +1,125 @@
+"""The robot in Foxglove's 3-D panel, from the robot description and the controller's own
+kinematics (``wbc.robot``), as rviz draws a robot from its URDF and its TF tree.
+
+Frames, for a configuration q = [x, y, phi, q1..q5], named with a ``prefix`` (``estimate/``,
+``truth/``, ``candidate/``), each in the one before it::
+
+    <parent> -> <prefix>base      the planar base pose (x, y, phi) on the floor (4.1)
+    base     -> <prefix>link_0    the base top, where the arm stands (4.2)
+    link_i-1 -> <prefix>link_i    the DH link i (4.4), i = 1..5; link_5 is the end effector
+
+The model is a ``foxglove.SceneUpdate`` of primitives fixed in those frames (``frame_locked``):
+the Create as a disc of the base's radius and height with its two wheels and an arrow to its
+front, each arm link as a thick line through its DH outline (``MobileManipulator.link_outline``)
+with a sphere at the joint, and two fingers at the end effector. Its primitives never change;
+only the transforms move them. Why primitives and not a URDF served by the server's asset
+handler: a recording carries them as it carries everything else, so a session file shows the
+robot in Foxglove with no server behind it, and the live view and the file draw the same.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from foxglove import messages as fox
+
+from record.foxglove_frames import planar_transform, pose_transform, timestamp
+from wbc.robot import BASE_DOF, MobileManipulator
+
+LINK_THICKNESS_M = 0.03
+"""How thick an arm link is drawn."""
+JOINT_DIAMETER_M = 0.045
+WHEEL_WIDTH_M = 0.02
+FINGER_SIZE_M = (0.06, 0.012, 0.025)
+"""A finger (x along the last link, y across the gripper, z), m."""
+FINGER_GAP_M = 0.04
+"""Between the fingers' centres."""
+WHEEL_COLOR = fox.Color(r=0.15, g=0.15, b=0.15, a=1.0)
+IDENTITY = fox.Quaternion(x=0.0, y=0.0, z=0.0, w=1.0)
+AXLE = fox.Quaternion(x=math.sin(math.pi / 4), y=0.0, z=0.0, w=math.cos(math.pi / 4))
+"""A cylinder's axis (z) turned onto the wheel axle (y)."""
+
+
+def point(p: np.ndarray) -> fox.Point3:
+    return fox.Point3(x=float(p[0]), y=float(p[1]), z=float(p[2]))
+
+
+def at(x: float, y: float, z: float, orientation: fox.Quaternion = IDENTITY) -> fox.Pose:
+    return fox.Pose(position=fox.Vector3(x=x, y=y, z=z), orientation=orientation)
+
+
+@dataclass(frozen=True)
+class RobotDrawing:
+    """One robot of the 3-D panel: its frames named ``<prefix>...``, under ``parent``, drawn
+    in ``color``."""
+
+    robot: MobileManipulator
+    prefix: str
+    color: fox.Color
+    parent: str = "world"
+
+    def frame(self, name: str) -> str:
+        return self.prefix + name
+
+    def links(self) -> list[str]:
+        """Every frame of the robot below its base: link_0 (the base top) to link_5."""
+        return [self.frame(f"link_{i}") for i in range(self.robot.arm_dof + 1)]
+
+    def transforms(self, q: np.ndarray, stamp_ns: int) -> list[fox.FrameTransform]:
+        """The base on the floor, then every link in the one before it, at configuration q."""
+        found = [planar_transform(self.parent, self.frame("base"), tuple(q[:BASE_DOF]), stamp_ns)]
+        links = self.links()
+        for parent, child, pose in zip([self.frame("base"), *links[:-1]], links,
+                                       self.robot.link_transforms(q), strict=True):  # fmt: skip
+            found.append(pose_transform(parent, child, pose, stamp_ns))
+        return found
+
+    def model(self, stamp_ns: int) -> list[fox.SceneEntity]:
+        """The robot's primitives, each entity fixed in its frame."""
+        stamp = timestamp(stamp_ns)
+        entities = [self._entity("base", stamp, **self._base())]
+        for i in range(1, self.robot.arm_dof + 1):
+            outline = self.robot.link_outline(i)
+            joint = fox.SpherePrimitive(pose=at(*map(float, outline[0])), color=self.color,
+                                        size=fox.Vector3(x=JOINT_DIAMETER_M, y=JOINT_DIAMETER_M,
+                                                         z=JOINT_DIAMETER_M))  # fmt: skip
+            line = fox.LinePrimitive(type=fox.LinePrimitiveLineType.LineStrip, pose=at(0, 0, 0),
+                                     thickness=LINK_THICKNESS_M, color=self.color,
+                                     points=[point(p) for p in outline])  # fmt: skip
+            entities.append(self._entity(f"link_{i}", stamp, spheres=[joint], lines=[line]))
+        entities.append(self._entity(f"link_{self.robot.arm_dof}", stamp, "gripper",
+                                     cubes=self._fingers()))  # fmt: skip
+        return entities
+
+    def _entity(self, frame: str, stamp: fox.Timestamp, part: str = "", **primitives: list
+                ) -> fox.SceneEntity:  # fmt: skip
+        return fox.SceneEntity(timestamp=stamp, frame_id=self.frame(frame), frame_locked=True,
+                               id=self.frame(part or frame), **primitives)  # fmt: skip
+
+    def _base(self) -> dict[str, list]:
+        """The Create: a disc of the base's radius up to the arm's mount, two wheels on the
+        axle, an arrow to its front."""
+        base = self.robot.base
+        height, radius, wheel = base.height, base.body_radius, base.wheel_radius
+        disc = fox.CylinderPrimitive(pose=at(0.0, 0.0, height / 2), color=self.color,
+                                     size=fox.Vector3(x=2 * radius, y=2 * radius, z=height),
+                                     bottom_scale=1.0, top_scale=1.0)  # fmt: skip
+        wheels = [fox.CylinderPrimitive(pose=at(0.0, side * base.wheel_base / 2, wheel, AXLE),
+                                        size=fox.Vector3(x=2 * wheel, y=2 * wheel,
+                                                         z=WHEEL_WIDTH_M),
+                                        bottom_scale=1.0, top_scale=1.0, color=WHEEL_COLOR)
+                  for side in (-1.0, 1.0)]  # fmt: skip
+        front = fox.ArrowPrimitive(pose=at(0.0, 0.0, height + 0.01), shaft_length=0.7 * radius,
+                                   shaft_diameter=0.02, head_length=0.25 * radius,
+                                   head_diameter=0.05, color=self.color)  # fmt: skip
+        return {"cylinders": [disc, *wheels], "arrows": [front]}
+
+    def _fingers(self) -> list[fox.CubePrimitive]:
+        """Two fingers either side of the end effector, along the last link (its x axis)."""
+        length, width, height = FINGER_SIZE_M
+        size = fox.Vector3(x=length, y=width, z=height)
+        return [fox.CubePrimitive(pose=at(-length / 2, side * FINGER_GAP_M / 2, 0.0), size=size,
+                                  color=self.color)
+                for side in (-1.0, 1.0)]  # fmt: skip

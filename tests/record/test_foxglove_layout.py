@@ -1,0 +1,108 @@
+"""The Foxglove layout of a namespace opens ready: every topic its panels name is a channel that a
+recording (and so the live view) of that namespace holds, and `parsimony layout` gives it."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+from test_foxglove_views import pose_dq
+from test_robot_scene import ROBOT, robot_state
+
+from messages import topics
+from messages.camera import CameraFrame
+from messages.diagnostics import ControllerDiagnostics
+from messages.header import Header
+from messages.markers import MarkerDetection, MarkerDetections
+from messages.obstacles import Circle, Obstacles
+from messages.supervisor import SupervisorStatus
+from messages.truth import SimTruth
+from record.foxglove_layout import layout
+from record.foxglove_views import Viewer
+from record.session_file import SessionWriter
+from record.session_reader import info
+from tests.processes import parsimony
+from vision.images import jpeg
+
+NAMESPACE = "sim"
+HEADER = Header(stamp_ns=1_000_000_000, frame="world", seq=0, source="test")
+
+
+def one_of_each() -> list[tuple[topics.Topic, object]]:
+    """A message of every topic the layout shows."""
+    camera = HEADER.model_copy(update={"frame": "camera"})
+    corners = ((10.0, 10.0), (20.0, 10.0), (20.0, 20.0), (10.0, 20.0))
+    image = jpeg(np.zeros((48, 64), np.uint8), 90)
+    return [
+        (topics.CAMERA_IMAGE, CameraFrame.model_validate({
+            "header": camera, "encoding": "jpeg", "width": 64, "height": 48, "data": image,
+            "intrinsics": {"fx": 60.0, "fy": 60.0, "cx": 31.5, "cy": 23.5}})),
+        (topics.VISION_MARKERS, MarkerDetections(header=camera, markers=(MarkerDetection(
+            id=1, pose=pose_dq(0.0, (0.0, 0.0, 2.5)), reprojection_error=0.1,
+            corners=corners),))),
+        (topics.ROBOT_STATE, robot_state(seq=0)),
+        (topics.SIM_TRUTH, SimTruth(header=HEADER, base_pose=(0.0, 0.0, 0.0),
+                                    arm_joints=(0.0,) * 5, end_effector=pose_dq(0.0, (0.5, 0, 0.4)),
+                                    contacts=0, in_contact=False)),
+        (topics.WORLD_OBSTACLES, Obstacles(header=HEADER, circles=(Circle(x=1.0, y=0.0,
+                                                                          radius=0.1),))),
+        (topics.SUPERVISOR_STATUS, SupervisorStatus(header=HEADER, phase="drive", candidate=1,
+                                                    plans=1, replans=0, stalls=0,
+                                                    way=((0.1, 0.2),))),
+        (topics.CONTROL_DIAGNOSTICS, ControllerDiagnostics(
+            header=HEADER, law="lp", status="optimal", nonzero=7, practical_nonzero=6,
+            solve_time_us=100.0, error_norm=math.pi)),
+    ]  # fmt: skip
+
+
+def named_topics(node: object) -> set[str]:
+    """Every topic a layout's panels name: topic settings, image and annotation topics, the
+    publish topic, and the quoted topic of every message path."""
+    found: set[str] = set()
+    if isinstance(node, dict):
+        for key, value in node.items():
+            if key in ("topics", "annotations") and isinstance(value, dict):
+                found |= set(value)
+            elif key in ("imageTopic", "poseTopic"):
+                found.add(value)
+            elif key in ("value", "topicPath") and isinstance(value, str) and value[:1] == '"':
+                found.add(value.split('"')[1])
+            found |= named_topics(value)
+    elif isinstance(node, list):
+        for item in node:
+            found |= named_topics(item)
+    return found
+
+
+def test_every_topic_the_layout_names_is_a_channel_of_the_namespace(tmp_path: Path) -> None:
+    path = tmp_path / "session.mcap"
+    with SessionWriter(path, viewer=Viewer(ROBOT)) as writer:
+        for topic, message in one_of_each():
+            writer.write(topic.key(NAMESPACE), message, views=True)
+    channels = {c["key"] for c in info(path)["channels"]}
+    document = json.loads(layout(NAMESPACE).to_json())
+    named = named_topics(document)
+    publish = f"{NAMESPACE}/goal/request"  # the client's, not the namespace's
+    assert publish in named
+    assert named - {publish} <= channels, sorted(named - channels)
+    assert {f"{NAMESPACE}/{suffix}" for suffix in (
+        "camera/image/foxglove", "vision/markers/annotations", "robot/state/model",
+        "sim/truth/model", "supervisor/status/scene", "world/obstacles/foxglove",
+        "control/diagnostics", "supervisor/status")} <= named  # fmt: skip
+    panels = json.dumps(document)
+    for panel in ("ThreeDee", "Image", "Plot", "RawMessages", "Parameters"):
+        assert f'"panelType":"{panel}"' in panels.replace(" ", "")
+
+
+def test_parsimony_layout_prints_or_writes_it(tmp_path: Path) -> None:
+    profile = Path(__file__).parents[2] / "deploy" / "sim_station.yaml"
+    printed = parsimony("layout", str(profile))
+    assert printed.returncode == 0, printed.stderr
+    assert json.loads(printed.stdout) == json.loads(layout(NAMESPACE).to_json())
+    target = tmp_path / "station.json"
+    assert parsimony("layout", str(profile), "-o", str(target)).returncode == 0
+    assert json.loads(target.read_text()) == json.loads(printed.stdout)
+    again = parsimony("layout", str(profile), "-o", str(target))
+    assert again.returncode == 2 and "--force" in again.stderr
