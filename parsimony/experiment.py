@@ -42,6 +42,7 @@ from messages import codec, process, topics
 from messages.obstacles import Solids
 from messages.topics import CONTROL_DIAGNOSTICS, ROBOT_STATE, SIM_TRUTH, SUPERVISOR_STATUS
 from parsimony.kinematic_demo import LP_PARAMS
+from parsimony.outputs import written_whole
 from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import Profile, ProfileError, load_profile
@@ -228,7 +229,8 @@ def run_experiment(options: Options) -> dict[str, Any]:
     setup = scenario(options.name, robot, options.seed)
     options.out.mkdir(parents=True, exist_ok=True)
     profile_path = options.out / "profile.yaml"
-    profile_path.write_text(yaml.safe_dump(experiment_profile(options, base, setup)))
+    with written_whole(profile_path) as partial:  # whole once it exists: others wait on it
+        partial.write_text(yaml.safe_dump(experiment_profile(options, base, setup)))
     profile = load_profile(profile_path)
     started = time.monotonic()
     with (options.out / "launch.log").open("w") as log,\
