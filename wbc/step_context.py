@@ -14,7 +14,8 @@ Array = np.ndarray
 
 @dataclass(frozen=True)
 class StepContext:
-    """The state of one control step: configuration, task error and its rate, goal, obstacles."""
+    """The state of one control step: configuration, task error and its rate, goal, obstacles,
+    and the u the law gave at its previous step."""
 
     robot: MobileManipulator
     q: Array
@@ -27,3 +28,6 @@ class StepContext:
     """The goal's end-effector pose for a pose task; None for a position task."""
     dt: float = 0.0
     """The step's period, s (0 where no step is taken, as in a test of one term)."""
+    previous_u: Array | None = None
+    """The u the law returned at its previous step (u_prev), read-only; None at the first step
+    after the law was made or reset (a new task)."""
