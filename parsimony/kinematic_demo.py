@@ -11,6 +11,7 @@ import dataclasses
 import functools
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -20,6 +21,7 @@ from wbc import dq
 from wbc.cascade_law import CascadeLaw
 from wbc.kinematic_run import Run, control_effort, integrate
 from wbc.lp_law import LPLaw, LPParams
+from wbc.objectives.input_change import InputChangeGains
 from wbc.obstacles import Circle
 from wbc.pinv_law import PseudoinverseLaw
 from wbc.robot import MobileManipulator
@@ -55,6 +57,18 @@ def supervised_params() -> LPParams:
     controller = load_profile(SUPERVISED_PROFILE).component("controller")
     return LPParams(**{f.name: controller.params[f.name] for f in dataclasses.fields(LPParams)
                        if f.name in controller.params})  # fmt: skip
+
+
+SMOOTH_PROFILE = Path(__file__).resolve().parents[1] / "deploy" / "sim_smooth.yaml"
+"""The profile of the LP with its input change term on, which declares that term's gains."""
+
+
+@functools.cache
+def input_change_gains() -> dict[str, Any]:
+    """The input change term's gains (wbc.objectives.input_change) as ``SMOOTH_PROFILE`` gives
+    its controller: what turns the term on in any LPParams (``dataclasses.replace``)."""
+    controller = load_profile(SMOOTH_PROFILE).component("controller")
+    return {f.name: controller.params[f.name] for f in dataclasses.fields(InputChangeGains)}
 
 
 LP_PARAMS = {

@@ -1,0 +1,123 @@
+"""The LP with and without its input change term (future work 1 of 7.2), on the same goals.
+
+Run as ``python -m bench.input_change [--goals N] [--workers W] [--variants A,B] [--json]``.
+Each variant of the LP law (``VARIANTS``: the default law, the same law with the input change
+term of deploy/sim_smooth.yaml, and the term's ``change`` form at two weights) is run on the
+'ahead' goals of ``parsimony bench`` (``parsimony.goal_sets``: the same seed, the same runs of
+60 s at 50 Hz), for the pose task and the position task of each goal. Printed per variant and
+task: the share of goals reached inside every limit, the median nonzero entries of u while
+moving (||e|| > 0.05) and over the last 2 s, and the medians of table 6.1's metrics 1 to 4 over
+the goals that every variant reached, from the first command (as table 6.1 takes them) and, for
+metrics 3 and 4, from rest (u = 0 before the first command, so the jump from rest counts).
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import json
+import math
+import multiprocessing
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from parsimony.goal_sets import FAMILIES, Attempt, attempt, goals, parsimony, shares
+from parsimony.kinematic_demo import ROBOT_FILE, input_change_gains
+from parsimony.output import emit, result_only_stdout, table
+from wbc.lp_law import LPLaw, LPParams
+from wbc.robot import MobileManipulator
+
+VARIANTS: dict[str, dict[str, Any]] = {
+    "lp": {},
+    "lp with input change": input_change_gains(),
+    "lp change w=0.01": {"input_change": 0.01, "input_change_form": "change"},
+    "lp change w=0.05": {"input_change": 0.05, "input_change_form": "change"},
+}
+"""The laws compared, LPParams() with these gains changed (names without commas): the default
+LP (the term off), the term as deploy/sim_smooth.yaml declares it, and the term's ``change``
+form, w ||u - u_prev||_1, at two weights."""
+TASKS = ("pose", "position")
+
+
+def _attempt_one(job: tuple[dict[str, Any], Path, np.ndarray, np.ndarray, bool]) -> Attempt:
+    gains, robot_file, start, goal, position = job
+    robot = MobileManipulator.from_yaml(robot_file)
+    return attempt(LPLaw(robot, LPParams(**gains)), robot, start, goal, position=position)
+
+
+def measure(names: list[str], count: int, workers: int, robot_file: Path = ROBOT_FILE
+            ) -> dict[str, dict[str, list[Attempt]]]:  # fmt: skip
+    """Every variant's attempts at the 'ahead' goals, per task."""
+    robot = MobileManipulator.from_yaml(robot_file)
+    pairs = goals(FAMILIES["ahead"], count, robot)
+    found: dict[str, dict[str, list[Attempt]]] = {task: {} for task in TASKS}
+    with multiprocessing.get_context("spawn").Pool(workers) as pool:
+        for task in TASKS:
+            for name in names:
+                print(f"bench: {name}, {task} task, {count} goals", file=sys.stderr, flush=True)
+                jobs = [(VARIANTS[name], robot_file, start, goal, task == "position")
+                        for start, goal in pairs]  # fmt: skip
+                found[task][name] = pool.map(_attempt_one, jobs, chunksize=1)
+    return found
+
+
+def summary(found: dict[str, dict[str, list[Attempt]]], dof: int) -> list[dict[str, Any]]:
+    """One row per task and variant (see the module's docstring)."""
+    rows = []
+    for task, variants in found.items():
+        reached_by_all = np.all([[a.within_all_limits for a in attempts]
+                                 for attempts in variants.values()], axis=0)  # fmt: skip
+        for name, attempts in variants.items():
+            counts = parsimony(attempts, dof)
+            common = [a for a, mine in zip(attempts, reached_by_all, strict=True) if mine]
+            median = functools.partial(_median_effort, common)
+            rows.append({
+                "task": task, "law": name,
+                "reached inside every limit": shares(attempts)["within_joint_and_speed_limits"],
+                "nonzero moving": counts["median_nonzero_moving"],
+                "nonzero last 2 s": counts["median_nonzero_settling"],
+                "goals compared": len(common),
+                "metric 1": median("velocity_l1"), "metric 2": median("velocity_l2"),
+                "metric 3": median("acceleration_l1"), "metric 4": median("acceleration_l2"),
+                "metric 3 from rest": median("acceleration_l1", True),
+                "metric 4 from rest": median("acceleration_l2", True),
+            })  # fmt: skip
+    return rows
+
+
+def _median_effort(attempts: list[Attempt], field: str, from_rest: bool = False) -> float:
+    """The median of one metric (a ``ControlEffort`` field) over ``attempts``."""
+    values = [getattr(a.effort_from_rest if from_rest else a.effort, field) for a in attempts]
+    return float(np.median(values)) if values else math.nan
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--goals", type=int, default=100, help="'ahead' goals (default 100)")
+    parser.add_argument("--workers", type=int, default=2, help="processes (default 2)")
+    parser.add_argument("--variants", default=",".join(VARIANTS),
+                        help=f"comma-separated laws among {', '.join(VARIANTS)}")  # fmt: skip
+    parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    args = parser.parse_args(argv)
+    names = args.variants.split(",")
+    unknown = [name for name in names if name not in VARIANTS]
+    if unknown or args.goals < 1 or args.workers < 1:
+        print(f"bench.input_change: unknown variants {unknown}, or --goals or --workers below 1",
+              file=sys.stderr)  # fmt: skip
+        return 2
+    found = measure(names, args.goals, args.workers)
+    rows = summary(found, MobileManipulator.from_yaml(ROBOT_FILE).dof)
+    if args.json:
+        emit(json.dumps({"bench": "input_change", "goals": args.goals, "rows": rows}))
+    else:
+        emit(table(rows, floatfmt=".3g"))
+    return 0
+
+
+if __name__ == "__main__":
+    with result_only_stdout():
+        code = main()
+    sys.exit(code)
