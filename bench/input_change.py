@@ -6,15 +6,15 @@ term of deploy/sim_smooth.yaml, and the term's ``change`` form at two weights) i
 'ahead' goals of ``parsimony bench`` (``parsimony.goal_sets``: the same seed, the same runs of
 60 s at 50 Hz), for the pose task and the position task of each goal. Printed per variant and
 task: the share of goals reached inside every limit, the median nonzero entries of u while
-moving (||e|| > 0.05) and over the last 2 s, and the medians of table 6.1's metrics 1 to 4 over
-the goals that every variant reached, from the first command (as table 6.1 takes them) and, for
-metrics 3 and 4, from rest (u = 0 before the first command, so the jump from rest counts).
+moving (||e|| > 0.05) and over the last 2 s, and on the goals both the variant and the default
+LP reached, the medians of table 6.1's metrics 1 to 4 from the first command (as table 6.1
+takes them) and of 3 and 4 from rest (u = 0 before the first command, so the jump from rest
+counts), each beside the median of its ratio to the default LP's, goal by goal.
 """
 
 from __future__ import annotations
 
 import argparse
-import functools
 import json
 import math
 import multiprocessing
@@ -64,33 +64,45 @@ def measure(names: list[str], count: int, workers: int, robot_file: Path = ROBOT
     return found
 
 
+REFERENCE = "lp"
+"""The variant every other is compared with, goal by goal."""
+FIELDS = {"metric 1": ("velocity_l1", False), "metric 2": ("velocity_l2", False),
+          "metric 3": ("acceleration_l1", False), "metric 4": ("acceleration_l2", False),
+          "metric 3 from rest": ("acceleration_l1", True),
+          "metric 4 from rest": ("acceleration_l2", True)}  # fmt: skip
+"""The figures of each run compared: a ``ControlEffort`` field, from rest or not."""
+
+
 def summary(found: dict[str, dict[str, list[Attempt]]], dof: int) -> list[dict[str, Any]]:
-    """One row per task and variant (see the module's docstring)."""
+    """One row per task and variant: its share reached, its nonzero entries, and on the goals
+    both it and ``REFERENCE`` reached inside every limit, each metric's median and the median
+    of its ratio to the reference's, goal by goal."""
     rows = []
     for task, variants in found.items():
-        reached_by_all = np.all([[a.within_all_limits for a in attempts]
-                                 for attempts in variants.values()], axis=0)  # fmt: skip
+        reference = variants.get(REFERENCE)
         for name, attempts in variants.items():
             counts = parsimony(attempts, dof)
-            common = [a for a, mine in zip(attempts, reached_by_all, strict=True) if mine]
-            median = functools.partial(_median_effort, common)
-            rows.append({
-                "task": task, "law": name,
-                "reached inside every limit": shares(attempts)["within_joint_and_speed_limits"],
-                "nonzero moving": counts["median_nonzero_moving"],
-                "nonzero last 2 s": counts["median_nonzero_settling"],
-                "goals compared": len(common),
-                "metric 1": median("velocity_l1"), "metric 2": median("velocity_l2"),
-                "metric 3": median("acceleration_l1"), "metric 4": median("acceleration_l2"),
-                "metric 3 from rest": median("acceleration_l1", True),
-                "metric 4 from rest": median("acceleration_l2", True),
-            })  # fmt: skip
+            pairs = [(a, b) for a, b in zip(attempts, reference or attempts, strict=True)
+                     if a.within_all_limits and b.within_all_limits]  # fmt: skip
+            row = {"task": task, "law": name,
+                   "reached inside every limit": shares(attempts)["within_joint_and_speed_limits"],
+                   "nonzero moving": counts["median_nonzero_moving"],
+                   "nonzero last 2 s": counts["median_nonzero_settling"],
+                   "goals compared": len(pairs)}  # fmt: skip
+            for label, (field, from_rest) in FIELDS.items():
+                mine = [_metric(a, field, from_rest) for a, _ in pairs]
+                theirs = [_metric(b, field, from_rest) for _, b in pairs]
+                row[label] = _median(mine)
+                row[f"{label} / {REFERENCE}"] = _median(list(np.divide(mine, theirs)))
+            rows.append(row)
     return rows
 
 
-def _median_effort(attempts: list[Attempt], field: str, from_rest: bool = False) -> float:
-    """The median of one metric (a ``ControlEffort`` field) over ``attempts``."""
-    values = [getattr(a.effort_from_rest if from_rest else a.effort, field) for a in attempts]
+def _metric(attempt_: Attempt, field: str, from_rest: bool) -> float:
+    return getattr(attempt_.effort_from_rest if from_rest else attempt_.effort, field)
+
+
+def _median(values: list[float]) -> float:
     return float(np.median(values)) if values else math.nan
 
 
@@ -113,7 +125,11 @@ def main(argv: list[str] | None = None) -> int:
     if args.json:
         emit(json.dumps({"bench": "input_change", "goals": args.goals, "rows": rows}))
     else:
-        emit(table(rows, floatfmt=".3g"))
+        shown = ("task", "law", "reached inside every limit", "nonzero moving",
+                 "nonzero last 2 s")  # fmt: skip
+        emit(table([{k: row[k] for k in shown} for row in rows], floatfmt=".3g"))
+        emit(table([{k: v for k, v in row.items() if k not in shown[2:]} for row in rows],
+                   floatfmt=".3g"))  # fmt: skip
     return 0
 
 
