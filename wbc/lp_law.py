@@ -115,7 +115,8 @@ class LPLaw:
     commanded rate e' = -eta e. It remembers the u it returned too (``StepContext.previous_u``,
     read by the input change term), zero before its first step (a robot no law has commanded
     yet stands still: its drivers stop it when commands stop), and keeps it across ``reset``:
-    the robot does not stop because its task changed.
+    the robot does not stop because its task changed. Where a controller sends zero without
+    stepping the law (a stale state, no goal), u_prev is still the law's last u.
     """
 
     robot: MobileManipulator

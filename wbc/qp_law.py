@@ -55,7 +55,7 @@ price on |u| is a dead zone (a lasso), where the task's pull, eta e, no longer b
 pose goal of 6.2.1 the QP with them stalls at ||e|| = 0.006 (0.001 without). So is the input
 change term (wbc.objectives.input_change): its free band is a 1-norm construct, and squared its
 two rows pull u towards the middle of the band; its ``change`` form squared,
-w^2 ||u - u_prev||^2, is the usual rate penalty of a QP, there to be turned on."""
+(w^2 / 2) ||u - u_prev||^2, is the usual rate penalty of a QP, there to be turned on."""
 QPParams = composed(
     "QPParams",
     "Gains of the QP law: the LP's, each declared by the term that reads it, and the damping.",

@@ -29,5 +29,5 @@ class StepContext:
     dt: float = 0.0
     """The step's period, s (0 where no step is taken, as in a test of one term)."""
     previous_u: Array | None = None
-    """The u the law returned at its previous step (u_prev), read-only; None at the first step
-    after the law was made or reset (a new task)."""
+    """The u the law returned at its previous step (u_prev), read-only: zero before a law's
+    first step; None where no law steps (a term tested alone)."""
