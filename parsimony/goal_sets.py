@@ -18,7 +18,7 @@ import numpy as np
 from parsimony.kinematic_demo import supervised_params
 from wbc import dq
 from wbc.cascade_law import CascadeLaw
-from wbc.kinematic_run import integrate, integrate_supervised
+from wbc.kinematic_run import ControlEffort, control_effort, integrate, integrate_supervised
 from wbc.law_output import Law, entry_mask
 from wbc.lp_law import LPLaw, LPParams
 from wbc.qp_law import QPLaw
@@ -106,6 +106,10 @@ class Attempt:
     """How long each staging plan took (supervised runs only)."""
     every_step_optimal: bool = True
     """Every command was an optimal solution of its step's program."""
+    effort: ControlEffort | None = None
+    """Table 6.1's metrics of the run's commands, from the first (as table 6.1 takes them)."""
+    effort_from_rest: ControlEffort | None = None
+    """The same with u = 0 before the first command: the jump from rest counts."""
 
     @property
     def seconds(self) -> float:
@@ -149,7 +153,8 @@ def attempt(law: Law, robot: MobileManipulator, start: Array, goal: Array,
                    tuple(entry_mask(out.u) for out in outputs),
                    tuple(entry_mask(out.u, True) for out in outputs),
                    tuple(out.error_norm for out in outputs), planning,
-                   all(out.ok for out in run.outputs))  # fmt: skip
+                   all(out.ok for out in run.outputs), control_effort(run),
+                   control_effort(run, from_rest=True))  # fmt: skip
 
 
 def _logged(supervisor: StagingSupervisor, tasks: list[object]) -> StagingSupervisor:

@@ -11,6 +11,7 @@ import dataclasses
 import functools
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -21,6 +22,7 @@ from wbc.arm_clearance import PenetrationCount, part_clearances
 from wbc.cascade_law import CascadeLaw
 from wbc.kinematic_run import Run, control_effort, integrate
 from wbc.lp_law import LPLaw, LPParams
+from wbc.objectives.input_change import InputChangeGains
 from wbc.obstacles import Obstacle, split
 from wbc.pinv_law import PseudoinverseLaw
 from wbc.robot import MobileManipulator
@@ -73,6 +75,18 @@ TABLE_PARAMS = LPParams(eta=0.6, beta=15.0)
 wbc.constraints.arm_obstacles keep the arm and the base clear of the table."""
 WITHOUT_ARM_ROWS = replace(TABLE_PARAMS, arm_obstacles=False)
 """The same law blind to the table, for comparison."""
+
+SMOOTH_PROFILE = Path(__file__).resolve().parents[1] / "deploy" / "sim_smooth.yaml"
+"""The profile of the LP with its input change term on, which declares that term's gains."""
+
+
+@functools.cache
+def input_change_gains() -> dict[str, Any]:
+    """The input change term's gains (wbc.objectives.input_change) as ``SMOOTH_PROFILE`` gives
+    its controller: what turns the term on in any LPParams (``dataclasses.replace``)."""
+    controller = load_profile(SMOOTH_PROFILE).component("controller")
+    return {f.name: controller.params[f.name] for f in dataclasses.fields(InputChangeGains)}
+
 
 LP_PARAMS = {
     "pose": LPParams(eta=0.6, beta=15.0),

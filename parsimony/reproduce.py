@@ -13,7 +13,7 @@ the report's own figures (``record.report``) and a note of what the dissertation
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -29,7 +29,7 @@ from messages.obstacles import Obstacles
 from messages.state import RobotState
 from parsimony.benchmark import UNBOUNDED_SPEED, convergence_test
 from parsimony.goal_sets import MOVING_ERROR, SETTLING_S
-from parsimony.kinematic_demo import BORDER_PARAMS, LP_PARAMS
+from parsimony.kinematic_demo import BORDER_PARAMS, LP_PARAMS, input_change_gains
 from parsimony.output import table
 from record.report import write_report
 from wbc import dq
@@ -122,6 +122,7 @@ def experiments(robot: MobileManipulator) -> dict[str, Experiment]:
             "PINV under 5.11": PseudoinverseLaw(robot, PinvParams(eta=params.eta,
                                                                   nonholonomic=True)),
             "QP": QPLaw(robot, QPParams(eta=params.eta, beta=params.beta)),
+            WITH_INPUT_CHANGE: LPLaw(robot, replace(params, **input_change_gains())),
         })  # fmt: skip
         eta = matched_eta(robot, task, len(found[name].runs["LP"].outputs))
         found[name].runs["PINV, same time"] = integrate(
@@ -201,6 +202,8 @@ def rows(robot: MobileManipulator, found: dict[str, Experiment]) -> list[Row]:
         out += effort_rows(experiment)
     for experiment in (pose, position):
         out += qp_rows(experiment)
+    for experiment in (pose, position):
+        out += input_change_rows(experiment)
     for label, run in found["obstacle"].runs.items():
         q = np.array(run.configurations)
         gap = np.hypot(q[:, 0] - OBSTACLE.x, q[:, 1] - OBSTACLE.y) - OBSTACLE.radius
@@ -264,6 +267,31 @@ def qp_rows(experiment: Experiment) -> list[Row]:
         out.append(Row("7.2 (5)", f"{experiment.name}: LP against QP, metric {index + 1}",
                        "not done", {"LP": efforts["LP"][metric], "QP": efforts["QP"][metric],
                                     "LP/QP": efforts["LP"][metric] / efforts["QP"][metric]}))
+    return out
+
+
+WITH_INPUT_CHANGE = "LP with the input change term"
+"""The LP of each task with the input change term of deploy/sim_smooth.yaml on."""
+
+
+def input_change_rows(experiment: Experiment) -> list[Row]:
+    """Future work 1 (7.2): the LP with its input change term against the LP, on one run each:
+    iterations, nonzero entries (while moving, last 2 s) and table 6.1's metrics as it takes
+    them, then 3 and 4 from rest (u = 0 before the first command, as in a recording)."""
+    runs = {"with": experiment.runs[WITH_INPUT_CHANGE], "LP": experiment.runs["LP"]}
+    title = f"{experiment.name}: LP with the input change term against without"
+    out = [Row("7.2 (1)", f"{title}, iterations; nonzero entries while moving, last 2 s",
+               "not done", {label: [len(run.outputs), counts(run)["moving"],
+                                    counts(run)["settling"]] for label, run in runs.items()},
+               "the same entries")]  # fmt: skip
+    measures = [(index, metric, False) for index, metric in enumerate(METRICS)]
+    measures += [(index, METRICS[index], True) for index in (2, 3)]
+    for index, metric, from_rest in measures:
+        values = {name: getattr(control_effort(run, from_rest), metric)
+                  for name, run in runs.items()}  # fmt: skip
+        out.append(Row("7.2 (1)", f"{title}, metric {index + 1}{' from rest' * from_rest}",
+                       "not done", {**values, "with/LP": values["with"] / values["LP"]},
+                       "with lower" if index >= 2 else ""))  # fmt: skip
     return out
 
 

@@ -32,16 +32,21 @@ def parsimony(*arguments: str, timeout: float = 300) -> subprocess.CompletedProc
                           capture_output=True, text=True, timeout=timeout)  # fmt: skip
 
 
+SMOOTH_PROFILE = Path(__file__).resolve().parents[1] / "deploy" / "sim_smooth.yaml"
+
+
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
-    """The pose experiment of one seed with each law, recorded."""
+    """The pose experiment of one seed with each law, and with the LP's input change term on
+    (deploy/sim_smooth.yaml), recorded."""
     found = {}
-    for law in ("lp", "cascade"):
-        out = tmp_path_factory.mktemp(law)
-        done = parsimony("experiment", "pose", "--controller", law, "--seed", "6",
-                         "--out", str(out))  # fmt: skip
+    for name, arguments in (("lp", ("--controller", "lp")),
+                            ("cascade", ("--controller", "cascade")),
+                            ("lp smooth", ("--profile", str(SMOOTH_PROFILE)))):  # fmt: skip
+        out = tmp_path_factory.mktemp(name.replace(" ", "_"))
+        done = parsimony("experiment", "pose", *arguments, "--seed", "6", "--out", str(out))
         assert done.returncode == 0, done.stderr[-2000:]
-        found[law] = out
+        found[name] = out
     return found
 
 
@@ -200,14 +205,17 @@ def test_replay_republishes_the_sensors_with_headers_as_recorded(runs, tmp_path:
 
 
 
-def test_rerun_of_the_recorded_law_reproduces_its_commands(runs, tmp_path: Path) -> None:
+@pytest.mark.parametrize("run", ["lp", "lp smooth"])
+def test_rerun_of_the_recorded_law_reproduces_its_commands(runs, run: str, tmp_path: Path
+                                                           ) -> None:  # fmt: skip
     """The LP run offline on a lockstep recording's states, goals and obstacles, with the
-    gains its diagnostics carry, is the controller that ran: every command bit for bit."""
+    gains its diagnostics carry, is the controller that ran: every command bit for bit; with
+    the input change term on too, whose u_prev the law keeps from step to step."""
     out = tmp_path / "rerun.mcap"
-    done = parsimony("rerun", str(runs["lp"] / "session.mcap"), "--controller", "lp",
+    done = parsimony("rerun", str(runs[run] / "session.mcap"), "--controller", "lp",
                      "-o", str(out))  # fmt: skip
     assert done.returncode == 0, done.stderr
-    recorded = load_session(runs["lp"] / "session.mcap")
+    recorded = load_session(runs[run] / "session.mcap")
     rerun = load_session(out)
     for topic, fields in (("arm/command", ("joint_velocities",)),
                           ("base/command", ("forward_velocity", "angular_velocity"))):
@@ -220,3 +228,13 @@ def test_rerun_of_the_recorded_law_reproduces_its_commands(runs, tmp_path: Path)
     assert all(statuses[d.header.stamp_ns] == d.status for d in recorded["control/diagnostics"])
     keys = {c["key"] for c in info(out)["channels"]}
     assert any(key.endswith("/arm/command/recorded") for key in keys)
+
+
+def test_the_input_change_term_lowers_metric_4_of_the_simulated_run(runs) -> None:
+    """The same seed of the pose experiment on the whole simulated loop, the LP with and
+    without its input change term: both converge, and table 6.1's metric 4 of the commands
+    (from the zero commands before the goal on) is lower with it."""
+    reports = {name: json.loads((runs[name] / "report.json").read_text())
+               for name in ("lp", "lp smooth")}  # fmt: skip
+    assert all(report["converged"] for report in reports.values())
+    assert reports["lp smooth"]["effort"]["metric4"] < reports["lp"]["effort"]["metric4"]

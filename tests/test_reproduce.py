@@ -19,6 +19,9 @@ RESULTS = {
               "fig. 6.17, the vector-field", "fig. 6.17, 5.28"),
     "6.3": ("test 1 (holonomic): iterations", "test 1: ms per iteration",
             "test 2 (nonholonomic): iterations", "test 2: ms per iteration"),
+    "7.2 (1)": ("pose: LP with the input change term against without, iterations",
+                "pose: LP with the input change term against without, metric 4 from rest",
+                "position: LP with the input change term against without, metric 3"),
 }  # fmt: skip
 
 

@@ -116,9 +116,14 @@ class ControlEffort:
     """sqrt(int ||q''||_2^2 dt)"""
 
 
-def control_effort(run: Run) -> ControlEffort:
-    """Table 6.1's metrics of a run's velocities."""
-    return effort_of(run.velocities(), run.dt)
+def control_effort(run: Run, from_rest: bool = False) -> ControlEffort:
+    """Table 6.1's metrics of a run's velocities; ``from_rest``, with u = 0 before the first
+    step (the robot stood still before its first command, so the jump to it counts, as it does
+    in a recorded run, where the commands before the goal are zero)."""
+    velocities = run.velocities()
+    if from_rest and len(velocities):
+        velocities = np.vstack((np.zeros_like(velocities[:1]), velocities))
+    return effort_of(velocities, run.dt)
 
 
 def effort_of(velocity: Array, dt: float) -> ControlEffort:

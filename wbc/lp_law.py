@@ -22,6 +22,7 @@ from wbc.law_output import LawOutput, summarise
 from wbc.linear_program import WarmStartedLP
 from wbc.objectives.base import ObjectiveTerm, ResidualCost
 from wbc.objectives.base_target import BaseTarget
+from wbc.objectives.input_change import InputChange
 from wbc.objectives.obstacle_circulation import ObstacleCirculation
 from wbc.objectives.velocity_cost import LeastVelocity
 from wbc.objectives.waist_centring import WaistCentring
@@ -41,7 +42,8 @@ CONSTRAINTS: tuple[type[Constraint], ...] = (Nonholonomic, JointLimits, ErrorBou
 """The constraints of 5.29, in the order of their rows; each builds itself from the gains it
 declares (``of``), or stays out."""
 OBJECTIVES: tuple[type[ObjectiveTerm], ...] = (LeastVelocity, WaistHold, WaistCentring,
-                                               ObstacleCirculation, BaseTarget)  # fmt: skip
+                                               ObstacleCirculation, BaseTarget,
+                                               InputChange)  # fmt: skip
 """The terms added to the task residual of 5.29, likewise."""
 
 
@@ -73,12 +75,15 @@ def default_objectives(params: LPParams) -> list[ObjectiveTerm]:
 def program(robot: MobileManipulator, q: Array, task: Task, dt: float,
             obstacles: Sequence[Obstacle], eta: float, last: tuple[Task, Array] | None,
             constraints: Sequence[Constraint], objectives: Sequence[ObjectiveTerm],
+            previous_u: Array | None = None,
             ) -> tuple[list, list, Array, tuple[Task, Array]]:  # fmt: skip
     """One step's program of 5.29: the inputs checked (``NonFiniteInputError``, dt > 0), e
     and e' measured (e' = (e - e_last) / dt against the ``last`` error of the same task, else
     the commanded -eta e), the costs (the task's first, ||J u + eta e||) and the rows; with e
     and the new ``last``. ``obstacles`` mixes circles for the base and solids in 3-D
-    (``wbc.obstacles.split``). The LP and the QP (``wbc.qp_law``) solve the same one."""
+    (``wbc.obstacles.split``). ``previous_u`` is the u the law gave at its previous step, for
+    the terms and rows that read it (``StepContext.previous_u``). The LP and the QP
+    (``wbc.qp_law``) solve the same one."""
     q = require_finite("configuration q", q)
     dt = float(dt)
     if not math.isfinite(dt):
@@ -96,7 +101,7 @@ def program(robot: MobileManipulator, q: Array, task: Task, dt: float,
         error_rate = -eta * error
     goal_pose = task.pose if isinstance(task, PoseTask) else None
     context = StepContext(robot, q, error, error_rate, task.goal_position[:2], circles,
-                          goal_pose, dt, solids)  # fmt: skip
+                          goal_pose, dt, solids, previous_u)  # fmt: skip
     rows = [constraint.rows(context) for constraint in constraints]  # first: a term may read
     costs = [ResidualCost("task", task_jacobian, eta * error)]  # what a row engaged
     costs += [term.cost(context) for term in objectives]
@@ -110,7 +115,11 @@ class LPLaw:
     ``step`` never raises for a solver failure: it returns u = 0 with HiGHS's status. Inputs
     that are not finite raise NonFiniteInputError before any solve. The law remembers the last
     error to measure e' = (e_k - e_{k-1}) / dt; on the first step of a task it uses the
-    commanded rate e' = -eta e.
+    commanded rate e' = -eta e. It remembers the u it returned too (``StepContext.previous_u``,
+    read by the input change term), zero before its first step (a robot no law has commanded
+    yet stands still: its drivers stop it when commands stop), and keeps it across ``reset``:
+    the robot does not stop because its task changed. Where a controller sends zero without
+    stepping the law (a stale state, no goal), u_prev is still the law's last u.
     """
 
     robot: MobileManipulator
@@ -119,8 +128,10 @@ class LPLaw:
     objectives: list[ObjectiveTerm] | None = None
     _lp: WarmStartedLP = field(default_factory=WarmStartedLP, init=False, repr=False)
     _last: tuple[Task, Array] | None = field(default=None, init=False, repr=False)
+    _previous_u: Array = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        self._previous_u = np.zeros(self.robot.dof)
         self._explicit_constraints = self.constraints is not None
         self._explicit_objectives = self.objectives is not None
 
@@ -133,7 +144,8 @@ class LPLaw:
             self.objectives = None
 
     def reset(self) -> None:
-        """Forget the previous error, basis and terms' state, as for a new task."""
+        """Forget the previous error, basis and terms' state, as for a new task (not the
+        previous u: the robot is still moving)."""
         self._last = None
         self._lp.reset()
         for term in self.objectives or ():
@@ -150,8 +162,10 @@ class LPLaw:
             self.objectives = default_objectives(self.params)
         costs, rows, error, self._last = program(
             self.robot, q, task, dt, obstacles, self.params.eta, self._last,
-            self.constraints, self.objectives)  # fmt: skip
+            self.constraints, self.objectives, self._previous_u)  # fmt: skip
         solution = self._lp.solve(costs, rows)
-        return summarise(
+        output = summarise(
             solution.u, solution.status, solution.objective, solution.active, error, start
         )
+        self._previous_u = output.u
+        return output

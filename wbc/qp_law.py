@@ -49,10 +49,13 @@ class DampingGains:
                           doc="lambda of lambda ||u||^2: keeps the QP strictly convex")
 
 
-QP_DEFAULTS = {"velocity_cost": 0.0, "waist_hold": 0.0}
+QP_DEFAULTS = {"velocity_cost": 0.0, "waist_hold": 0.0, "input_change": 0.0}
 """The LP's 1-norm velocity terms are off in the QP: beside a squared task residual, a constant
 price on |u| is a dead zone (a lasso), where the task's pull, eta e, no longer beats it; on the
-pose goal of 6.2.1 the QP with them stalls at ||e|| = 0.006 (0.001 without)."""
+pose goal of 6.2.1 the QP with them stalls at ||e|| = 0.006 (0.001 without). So is the input
+change term (wbc.objectives.input_change): its free band is a 1-norm construct, and squared its
+two rows pull u towards the middle of the band; its ``change`` form squared,
+(w^2 / 2) ||u - u_prev||^2, is the usual rate penalty of a QP, there to be turned on."""
 QPParams = composed(
     "QPParams",
     "Gains of the QP law: the LP's, each declared by the term that reads it, and the damping.",
@@ -67,7 +70,8 @@ class QPLaw:
     """u = argmin of the quadratic program above, solved by HiGHS.
 
     ``step`` never raises for a solver failure: it returns u = 0 with HiGHS's status. The error
-    rate e' is measured as the LP measures it (the rows are the LP's).
+    rate e' is measured as the LP measures it (the rows are the LP's), and the previous u is
+    kept as the LP keeps it.
     """
 
     robot: MobileManipulator
@@ -76,6 +80,10 @@ class QPLaw:
     _constraints: list[Constraint] | None = field(default=None, init=False, repr=False)
     _objectives: list[ObjectiveTerm] | None = field(default=None, init=False, repr=False)
     _qp: WarmStartedQP = field(default_factory=lambda: WarmStartedQP(), init=False, repr=False)
+    _previous_u: Array = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self._previous_u = np.zeros(self.robot.dof)
 
     def set_params(self, params: QPParams) -> None:
         self.params, self._constraints, self._objectives = params, None, None
@@ -94,9 +102,11 @@ class QPLaw:
             self._objectives = default_objectives(self.params)
         costs, rows, error, self._last = program(
             self.robot, q, task, dt, obstacles, self.params.eta, self._last,
-            self._constraints, self._objectives)  # fmt: skip
+            self._constraints, self._objectives, self._previous_u)  # fmt: skip
         u, status, objective = self._qp.solve(self.robot.dof, costs, rows, self.params.damping)
-        return summarise(u, status, objective, (), error, start)
+        output = summarise(u, status, objective, (), error, start)
+        self._previous_u = output.u
+        return output
 
 
 @dataclass

@@ -15,7 +15,8 @@ Array = np.ndarray
 
 @dataclass(frozen=True)
 class StepContext:
-    """The state of one control step: configuration, task error and its rate, goal, obstacles."""
+    """The state of one control step: configuration, task error and its rate, goal, obstacles,
+    and the u the law gave at its previous step."""
 
     robot: MobileManipulator
     q: Array
@@ -31,3 +32,6 @@ class StepContext:
     """The step's period, s (0 where no step is taken, as in a test of one term)."""
     solids: tuple[Solid, ...] = ()
     """The obstacles in 3-D the robot's collision parts keep clear of (wbc.obstacles3d)."""
+    previous_u: Array | None = None
+    """The u the law returned at its previous step (u_prev), read-only: zero before a law's
+    first step; None where no law steps (a term tested alone)."""
