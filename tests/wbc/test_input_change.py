@@ -27,7 +27,8 @@ POSITION = LPParams(eta=1.0, beta=10.0)  # section 6.2.2
 
 
 def context(previous: np.ndarray | None) -> StepContext:
-    return StepContext(MODEL, HOME, np.zeros(8), np.zeros(8), np.zeros(2), (), None, DT, previous)
+    return StepContext(MODEL, HOME, np.zeros(8), np.zeros(8), np.zeros(2), (), None, DT,
+                       previous_u=previous)
 
 
 def term_cost(term: InputChange, previous: np.ndarray, u: np.ndarray) -> float:
