@@ -119,7 +119,14 @@ class ControlStep:
         self.gains = gains
 
     def step(self, state: RobotState, now_ns: int, stale_timeout_s: float) -> Step:
-        """The commands answering ``state`` at ``now_ns``, stamped with its stamp."""
+        """The commands answering ``state`` at ``now_ns``, stamped with its stamp; where they
+        are zero instead of the law's u, the law is told (``Law.stopped``)."""
+        step = self._commands(state, now_ns, stale_timeout_s)
+        if step.status != "optimal":
+            self.law.stopped()
+        return step
+
+    def _commands(self, state: RobotState, now_ns: int, stale_timeout_s: float) -> Step:
         stamp = state.header.stamp_ns
         dt = FIRST_DT_S if self.last_stamp_ns is None else (stamp - self.last_stamp_ns) / 1e9
         self.last_stamp_ns = stamp

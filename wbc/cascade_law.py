@@ -75,6 +75,9 @@ class CascadeLaw:
         self._reference = None
         self._task = None
 
+    def stopped(self) -> None:
+        """Nothing to forget: its reference base advances only when it steps."""
+
     def step(self, q: Array, task: Task, dt: float, obstacles: Sequence[Obstacle] = ()
              ) -> LawOutput:  # fmt: skip
         """One step; the reference base advances by the outer loop's u_b over ``dt``."""

@@ -53,6 +53,10 @@ class Law(Protocol):
 
     def reset(self) -> None: ...
 
+    def stopped(self) -> None:
+        """The robot was told to stand still without this law's step (a held controller):
+        its next step starts from rest."""
+
 
 def entry_mask(u: Array, practical: bool = False) -> int:
     """Bit i set where u_i counts as nonzero: |u_i| > ZERO_THRESHOLD, or, ``practical``, where

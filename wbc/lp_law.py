@@ -118,8 +118,8 @@ class LPLaw:
     commanded rate e' = -eta e. It remembers the u it returned too (``StepContext.previous_u``,
     read by the input change term), zero before its first step (a robot no law has commanded
     yet stands still: its drivers stop it when commands stop), and keeps it across ``reset``:
-    the robot does not stop because its task changed. Where a controller sends zero without
-    stepping the law (a stale state, no goal), u_prev is still the law's last u.
+    the robot does not stop because its task changed; ``stopped`` sets it to zero where a
+    controller sent zero instead of the law's u (a stale state, no goal, a held output).
     """
 
     robot: MobileManipulator
@@ -150,6 +150,10 @@ class LPLaw:
         self._lp.reset()
         for term in self.objectives or ():
             term.reset()
+
+    def stopped(self) -> None:
+        """The robot was told to stand still: u_prev = 0."""
+        self._previous_u = np.zeros(self.robot.dof)
 
     def step(
         self, q: Array, task: Task, dt: float, obstacles: Sequence[Obstacle] = ()

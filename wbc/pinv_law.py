@@ -66,6 +66,9 @@ class PseudoinverseLaw:
     def reset(self) -> None:
         """Stateless: nothing to forget."""
 
+    def stopped(self) -> None:
+        """Stateless: nothing to forget."""
+
     def step(
         self, q: Array, task: Task, dt: float, obstacles: Sequence[Obstacle] = ()
     ) -> LawOutput:

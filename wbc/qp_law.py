@@ -94,6 +94,10 @@ class QPLaw:
         for term in self._objectives or ():
             term.reset()
 
+    def stopped(self) -> None:
+        """The robot was told to stand still: u_prev = 0."""
+        self._previous_u = np.zeros(self.robot.dof)
+
     def step(self, q: Array, task: Task, dt: float, obstacles: Sequence[Obstacle] = ()
              ) -> LawOutput:  # fmt: skip
         start = time.perf_counter()
