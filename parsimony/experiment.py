@@ -26,7 +26,7 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
@@ -91,20 +91,35 @@ class Options:
     realtime: bool = False
     time_limit_s: float = TIME_LIMIT_S
     hide_base_marker: tuple[float, float] | None = None
+    gains: Mapping[str, Any] = dataclasses.field(default_factory=dict)
+    """LP gains (``LPParams``' names) that replace the experiment's: another law on the same
+    set-up, such as another obstacle constraint (``obstacle_mode``)."""
 
 
 def law_overrides(options: Options) -> dict[str, Any]:
-    """The LP gains of the experiment that differ from the LP's defaults, for the LP and the QP
-    (which reads the same gains; the cascade's defaults are the dissertation's; an experiment
-    under the supervisor takes its profile's)."""
-    if options.controller not in ("lp", "qp") or options.name not in LP_PARAMS:
+    """The LP gains of the experiment that differ from the LP's defaults, then ``gains``, for
+    the LP and the QP (which reads the same gains; the cascade's defaults are the
+    dissertation's; an experiment under the supervisor takes its profile's). ``ProfileError``
+    naming a gain that is not the LP's, or a value its declaration refuses."""
+    given = dict(options.gains)
+    if options.controller not in ("lp", "qp"):
+        if given:
+            raise ProfileError(f"the {options.controller} law reads no LP gain "
+                               f"({', '.join(given)})")  # fmt: skip
         return {}
-    wanted, default = LP_PARAMS[options.name], LPParams()
-    return {
-        f.name: getattr(wanted, f.name)
-        for f in dataclasses.fields(LPParams)
-        if getattr(wanted, f.name) != getattr(default, f.name)
-    }
+    names = [f.name for f in dataclasses.fields(LPParams)]
+    for name in given:
+        if name not in names:
+            raise ProfileError(f"no LP gain {name!r}; the LP's gains are {', '.join(names)}")
+    try:  # each value checked against its declaration, then the gains together
+        wanted = dataclasses.replace(LP_PARAMS.get(options.name, LPParams()), **given)
+    except ValueError as error:
+        raise ProfileError(f"gain {error}") from None
+    if options.name not in LP_PARAMS:
+        return {name: getattr(wanted, name) for name in given}
+    default = LPParams()
+    return {name: getattr(wanted, name) for name in names
+            if getattr(wanted, name) != getattr(default, name) or name in given}
 
 
 def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict[str, Any]:
