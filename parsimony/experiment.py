@@ -213,9 +213,10 @@ def run_experiment(options: Options) -> dict[str, Any]:
     base_profile = load_profile(base)
     robot = MobileManipulator.from_yaml(base_profile.robot)
     setup = scenario(options.name, robot, options.seed)
-    options.out.mkdir(parents=True, exist_ok=True)
+    composed = experiment_profile(options, base, setup)  # a bad gain is refused before
+    options.out.mkdir(parents=True, exist_ok=True)  # anything is written
     profile_path = options.out / "profile.yaml"
-    profile_path.write_text(yaml.safe_dump(experiment_profile(options, base, setup)))
+    profile_path.write_text(yaml.safe_dump(composed))
     profile = load_profile(profile_path)
     started = time.monotonic()
     with (options.out / "launch.log").open("w") as log,\
