@@ -152,14 +152,19 @@ def summary(loop: str, variant: str, found: Sequence[Outcome | None],
         "nonzero_moving": float(np.median(moving)) if moving else math.nan,
         "converge_s_median": round(float(np.median(times)), 1) if times else math.nan,
         "converge_s_p99": round(float(np.percentile(times, 99)), 1) if times else math.nan,
-        "not_converged": " ".join(f"{o.seed}({o.final_error:.2f})"
-                                  for o in runs if not o.converged),  # fmt: skip
+        "not_converged": [f"{o.seed}({o.final_error:.2f})" for o in runs if not o.converged],
     }
     for seed in held_out:
         run = next((o for o in found if o is not None and o.seed == seed), None)
         row[f"seed_{seed}"] = ("-" if run is None else f"{run.seconds:.1f} s" if run.converged
                                else f"no ({run.final_error:.2f})")  # fmt: skip
     return row
+
+
+def brief(seeds: list[str], shown: int = 5) -> str:
+    """The first ``shown`` seeds that did not converge, and how many more."""
+    more = f" +{len(seeds) - shown} more" if len(seeds) > shown else ""
+    return " ".join(seeds[:shown]) + more
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -189,7 +194,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.json:
         emit(json.dumps({"bench": "obstacle_constraints", "study": study, "variants": rows}))
     else:
-        emit(table(rows))
+        emit(table([{**row, "not_converged": brief(row["not_converged"])} for row in rows]))
         emit(" ".join(f"{k}={v}" for k, v in study.items()))
     return 0
 
