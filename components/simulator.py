@@ -53,12 +53,10 @@ from messages.obstacles import Solids
 from messages.odometry import BaseOdometry
 from messages.truth import SimTruth
 from profiles.scene import Scene
-from sim2d.scenarios import SEED_MAX
+from sim2d.scenarios import SEED_MAX, goal_above
 from sim2d.world import World, WorldSettings, wheel_distance_per_count
-from wbc import dq
 from wbc.base_motion import dead_reckoning
 from wbc.obstacles import Circle
-from wbc.planar import offset_pose, planar_pose
 from wbc.robot import MobileManipulator
 
 JOINT_NAMES = tuple(f"q{i}" for i in range(1, ARM_JOINTS + 1))
@@ -408,9 +406,7 @@ class Simulator(Component):
         out again only when ``goal_marker`` changes."""
         placed = self.node.params["goal_marker"]
         if self.goal_of[0] != placed:
-            gx, gy, gyaw = placed
-            marker = planar_pose(gx, gy, gyaw, self.scene.goal.height_m)
-            goal = dq.normalize(dq.mul(marker, offset_pose(*self.scene.goal.offset)))
+            goal = goal_above(placed, self.scene.goal.height_m, self.scene.goal.offset)
             self.goal_of = (placed, tuple(goal.tolist()))
         return self.goal_of[1]
 

@@ -26,7 +26,7 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
@@ -94,24 +94,35 @@ class Options:
     realtime: bool = False
     time_limit_s: float = TIME_LIMIT_S
     hide_base_marker: tuple[float, float] | None = None
-    arm_obstacles: bool = True
-    """False: the law's rows that keep the arm clear of solids in 3-D are off."""
+    gains: Mapping[str, Any] = dataclasses.field(default_factory=dict)
+    """LP gains (``LPParams``' names) that replace the experiment's: another law on the same
+    set-up, such as another obstacle constraint (``obstacle_mode``)."""
 
 
 def law_overrides(options: Options) -> dict[str, Any]:
-    """The LP gains of the experiment that differ from the LP's defaults, for the LP and the QP
-    (which reads the same gains; the cascade's defaults are the dissertation's; an experiment
-    under the supervisor takes its profile's), and ``arm_obstacles`` off when asked."""
+    """The LP gains of the experiment that differ from the LP's defaults, then ``gains``, for
+    the LP and the QP (which reads the same gains; the cascade's defaults are the
+    dissertation's; an experiment under the supervisor takes its profile's). ``ProfileError``
+    naming a gain that is not the LP's, or a value its declaration refuses."""
+    given = dict(options.gains)
     if options.controller not in ("lp", "qp"):
+        if given:
+            raise ProfileError(f"the {options.controller} law reads no LP gain "
+                               f"({', '.join(given)})")  # fmt: skip
         return {}
-    overrides = {}
-    if options.name in LP_PARAMS:
-        wanted, default = LP_PARAMS[options.name], LPParams()
-        overrides = {f.name: getattr(wanted, f.name) for f in dataclasses.fields(LPParams)
-                     if getattr(wanted, f.name) != getattr(default, f.name)}  # fmt: skip
-    if not options.arm_obstacles:
-        overrides["arm_obstacles"] = False
-    return overrides
+    names = [f.name for f in dataclasses.fields(LPParams)]
+    for name in given:
+        if name not in names:
+            raise ProfileError(f"no LP gain {name!r}; the LP's gains are {', '.join(names)}")
+    try:  # each value checked against its declaration, then the gains together
+        wanted = dataclasses.replace(LP_PARAMS.get(options.name, LPParams()), **given)
+    except ValueError as error:
+        raise ProfileError(f"gain {error}") from None
+    if options.name not in LP_PARAMS:
+        return {name: getattr(wanted, name) for name in given}
+    default = LPParams()
+    return {name: getattr(wanted, name) for name in names
+            if getattr(wanted, name) != getattr(default, name) or name in given}
 
 
 def scene_overrides(setup: SimScenario, reference_pose: tuple[float, float, float]
@@ -217,9 +228,6 @@ def progress_line(session: dict[str, list], origin: float, wall_s: float) -> str
 
 def run_experiment(options: Options) -> dict[str, Any]:
     """Run one experiment; return its report (also written to ``out/report.json``)."""
-    if not options.arm_obstacles and options.controller == "cascade":
-        raise ProfileError("the cascade keeps nothing clear of obstacles in 3-D: "
-                           "--no-arm-obstacles is for the LP and the QP")  # fmt: skip
     if options.name in SUPERVISED and options.controller != "lp":
         raise ProfileError(f"the {options.name} experiment runs the LP under the staging "
                            "supervisor; the cascade cannot follow its drive tasks")  # fmt: skip
@@ -227,10 +235,11 @@ def run_experiment(options: Options) -> dict[str, Any]:
     base_profile = load_profile(base)
     robot = MobileManipulator.from_yaml(base_profile.robot)
     setup = scenario(options.name, robot, options.seed)
-    options.out.mkdir(parents=True, exist_ok=True)
+    composed = experiment_profile(options, base, setup)  # a bad gain is refused before
+    options.out.mkdir(parents=True, exist_ok=True)  # anything is written
     profile_path = options.out / "profile.yaml"
     with written_whole(profile_path) as partial:  # whole once it exists: others wait on it
-        partial.write_text(yaml.safe_dump(experiment_profile(options, base, setup)))
+        partial.write_text(yaml.safe_dump(composed))
     profile = load_profile(profile_path)
     started = time.monotonic()
     with (options.out / "launch.log").open("w") as log,\
@@ -268,7 +277,7 @@ def run_experiment(options: Options) -> dict[str, Any]:
         "durations_us": durations(counters),
         "cpu_s": {name: round(found["run_cpu_ms"] / 1e3, 3)
                   for name, found in sorted(counters.items())},  # fmt: skip
-        "arm_obstacles": options.arm_obstacles,
+        "gains": dict(options.gains),
         "scenario": dataclasses.asdict(setup) | {"obstacles": setup.sim_params()["obstacles"]},
         "recording": recording_check(facts, (start_ns, end_ns)),
     }  # fmt: skip

@@ -41,18 +41,18 @@ from wbc.task import PoseTask, PositionTask, Task
 
 ROBOT_FILE = Path(__file__).resolve().parents[1] / "deploy" / "robots" / "little_john.yaml"
 STEPS = 4000
-OBSTACLE_PARAMS = LPParams(obstacle_mode="vector_field", base_target=0.0, waist_hold=0.0,
-                           waist_centring=0.02, error_bound="error")
-"""The obstacle experiment's law (6.2.3): the vector-field inequality of
-wbc.constraints.obstacle_vector_field instead of 5.28 (on 40 seeds of the simulated experiment
-it converged on every one, 5.28 on 38: its switched equality chatters on the border), the
-circulation term that takes the base round an obstacle it stalled by, and no base target term,
-whose straight-line heading towards where the base should stand fights the detour. The waist is
-centred through the self-motion instead of held: with the base alone taking the task's yaw, the
-base overran the goal after its detour (error 0.18 after 80 s); the self-motion costs an entry,
-and figure 6.17 shows all 8 in use too. ||u||_1 is bounded by the error (5.7), not by its rate
-(5.10): when the base stands still by the obstacle, e' is 0, 5.10 allows no motion at all and
-the circulation could not start it again (seed 1: error 0.65 after 60 s)."""
+OBSTACLE_PARAMS = LPParams(base_target=0.0, waist_hold=0.0, waist_centring=0.02,
+                           error_bound="error")
+"""The obstacle experiment's law (6.2.3): the default obstacle constraint, the vector-field
+inequality of wbc.constraints.obstacle_vector_field, in place of 5.28 (python -m
+bench.obstacle_constraints compares them), the circulation term that takes the base round an
+obstacle it stalled by, and no base target term, whose straight-line heading towards where the
+base should stand fights the detour. The waist is centred through the self-motion instead of
+held: with the base alone taking the task's yaw, the base overran the goal after its detour
+(error 0.18 after 80 s); the self-motion costs an entry, and figure 6.17 shows all 8 in use too.
+||u||_1 is bounded by the error (5.7), not by its rate (5.10): when the base stands still by
+the obstacle, e' is 0, 5.10 allows no motion at all and the circulation could not start it
+again (seed 1: error 0.65 after 60 s)."""
 
 BORDER_PARAMS = replace(OBSTACLE_PARAMS, obstacle_mode="border")
 """The same law with the dissertation's border constraint 5.28, for comparison."""

@@ -17,6 +17,7 @@ across it: the base must stop short of the table).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,7 +25,7 @@ import numpy as np
 from wbc import dq
 from wbc.obstacles import Circle
 from wbc.obstacles3d import Solid
-from wbc.planar import offset_of, planar_of, planar_pose
+from wbc.planar import offset_of, offset_pose, planar_of, planar_pose
 from wbc.robot import MobileManipulator
 from wbc.scenarios import HOME, OBSTACLE, REACH_GOAL, TABLE, TABLE_GOAL, TABLE_START
 
@@ -79,6 +80,19 @@ class SimScenario:
             "goal_marker": [round(float(v), 6) for v in self.bin],
             "obstacles": [[float(c.x), float(c.y), float(c.radius)] for c in self.obstacles],
         }
+
+    def goal(self, height_m: float, offset: Sequence[float]) -> np.ndarray:
+        """This set-up's x_d (``goal_above``), for the bin marker at ``height_m`` and the
+        scene's ``offset`` x_d^2: the goal of a kinematic run of the set-up."""
+        return goal_above(self.bin, height_m, offset)
+
+
+def goal_above(bin_pose: Sequence[float], height_m: float, offset: Sequence[float]
+               ) -> np.ndarray:  # fmt: skip
+    """x_d = x_2 x_d^2 (eq. 6.3): the bin marker's pose (x, y, yaw) at ``height_m`` times the
+    scene's offset (x, y, z, yaw, pitch, roll), a unit dual quaternion."""
+    marker = planar_pose(*bin_pose, height_m)
+    return dq.normalize(dq.mul(marker, offset_pose(*offset)))
 
 
 def scenario(name: str, robot: MobileManipulator, seed: int | None = None) -> SimScenario:

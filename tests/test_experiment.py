@@ -17,6 +17,7 @@ import pytest
 
 from deploy import query
 from parsimony.experiment import DEPLOY, connect
+from parsimony.sessions import load_session
 from profiles.profile import load_profile
 
 ONE_DEGREE = math.radians(1.0)
@@ -92,11 +93,32 @@ def test_two_lockstep_runs_of_one_seed_send_bit_identical_commands(tmp_path: Pat
     assert other["commands_digest"] != first["commands_digest"]
 
 
-def test_obstacle_experiment_with_the_lp_goes_round_the_obstacle(tmp_path: Path) -> None:
-    code, report = experiment(tmp_path, "obstacle", "--controller", "lp")
+def obstacle_rows(out: Path) -> tuple[set[str], set[str]]:
+    """The obstacle modes the recorded controller ran with, and the obstacle rows it engaged."""
+    diagnostics = load_session(out / "session.mcap", {"control/diagnostics"})
+    steps = diagnostics["control/diagnostics"]
+    modes = {d.parameters["obstacle_mode"] for d in steps}
+    return modes, {c for d in steps for c in d.active_constraints if c.startswith("obstacle")}
+
+
+def test_obstacle_experiment_with_the_lp_goes_round_the_obstacle_on_the_saddle_seed(
+    tmp_path: Path,
+) -> None:
+    """Seed 772: start, obstacle and bin near one line, where 5.28 stalled by the obstacle.
+    The default obstacle constraint, the vector-field inequality, takes the base round."""
+    code, report = experiment(tmp_path, "obstacle", "--controller", "lp", "--seed", "772")
     assert code == 0
     assert_sound(report)
     assert report["min_obstacle_clearance_m"] > 0.0
+    assert obstacle_rows(tmp_path) == ({"vector_field"}, {"obstacle_vector_field"})
+
+
+def test_an_experiment_runs_the_obstacle_constraint_it_is_given(tmp_path: Path) -> None:
+    """--gain obstacle_mode=border: the controller runs 5.28 instead, and goes round too."""
+    code, report = experiment(tmp_path, "obstacle", "--gain", "obstacle_mode=border")
+    assert code == 0
+    assert_sound(report)
+    assert obstacle_rows(tmp_path) == ({"border"}, {"obstacle_border"})
 
 
 def test_table_experiment_reaches_over_the_edge_without_touching_the_table(tmp_path: Path
@@ -111,8 +133,8 @@ def test_table_experiment_reaches_over_the_edge_without_touching_the_table(tmp_p
     assert report["arm_penetrations"] == 0
     assert min(report["arm_clearance_m"].values()) > 0.0
     assert report["scenario"]["solids"][0]["name"] == "table"
-    code, blind = experiment(tmp_path / "blind", "table", "--no-arm-obstacles")
-    assert code == 0 and blind["converged"] and not blind["arm_obstacles"]
+    code, blind = experiment(tmp_path / "blind", "table", "--gain", "arm_obstacles=false")
+    assert code == 0 and blind["converged"] and blind["gains"] == {"arm_obstacles": False}
     assert blind["arm_penetrations"] > 0 and min(blind["arm_clearance_m"].values()) < -0.01
 
 
@@ -189,6 +211,13 @@ def test_a_killed_vision_tracker_is_restarted_and_the_run_converges(tmp_path: Pa
     (["pose", "--profile", str(DEPLOY / "emulated.yaml")], "add --realtime"),
     (["jump"], "invalid choice: 'jump'"),
     (["pose"], "the following arguments are required: --out"),
+    (["obstacle", "--gain", "obstacle_mode"], "--gain: expected NAME=VALUE"),
+    (["obstacle", "--gain", "obstacle_mode=around"],
+     "LPParams.obstacle_mode: expected a str in {'border', 'vector_field', 'conservative'"),
+    (["obstacle", "--gain", "obstacle_radius=1"], "no LP gain 'obstacle_radius'"),
+    (["obstacle", "--gain", "obstacle_gain=-1"], "LPParams.obstacle_gain: expected a float in"),
+    (["obstacle", "--controller", "cascade", "--gain", "obstacle_gain=1"],
+     "the cascade law reads no LP gain (obstacle_gain)"),
 ])  # fmt: skip
 def test_usage_errors_exit_2_and_say_why(bad: list[str], why: str, tmp_path: Path) -> None:
     extra = [] if bad == ["pose"] else ["--out", str(tmp_path)]
@@ -196,6 +225,7 @@ def test_usage_errors_exit_2_and_say_why(bad: list[str], why: str, tmp_path: Pat
     done = subprocess.run(command, capture_output=True, text=True, timeout=60)
     assert done.returncode == 2 and why in done.stderr, done.stderr
     assert done.stdout == "" and "Traceback" not in done.stderr
+    assert not any(tmp_path.iterdir())  # refused before anything was written
 
 
 def test_an_experiment_does_not_write_over_a_directory_that_holds_files(tmp_path: Path) -> None:

@@ -8,6 +8,8 @@ import math
 import sys
 from pathlib import Path
 
+import yaml
+
 from deploy.query import QueryError
 from parsimony.experiment import PROFILES, TIME_LIMIT_S, Options, dumps, run_experiment
 from parsimony.output import emit
@@ -51,6 +53,17 @@ def time_limit(text: str) -> float:
     return value
 
 
+def gain_setting(text: str) -> tuple[str, object]:
+    """``NAME=VALUE``, the value read as a YAML scalar (``0.2``, ``border``, ``true``)."""
+    name, equals, value = text.partition("=")
+    if not (equals and name and value):
+        raise argparse.ArgumentTypeError(f"expected NAME=VALUE, got {text!r}")
+    try:
+        return name, yaml.safe_load(value)
+    except yaml.YAMLError:
+        raise argparse.ArgumentTypeError(f"{name}: cannot read the value {value!r}") from None
+
+
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
         "experiment",
@@ -71,9 +84,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
                         help="simulated seconds before giving up")  # fmt: skip
     parser.add_argument("--hide-base-marker", type=seconds_window, metavar="FROM,TO",
                         help="hide the base marker from the camera then (sim s)")  # fmt: skip
-    parser.add_argument("--no-arm-obstacles", action="store_true",
-                        help="switch off the LP's rows that keep the arm clear of the scene's "
-                             "planes and cylinders, to see what they prevent")  # fmt: skip
+    parser.add_argument("--gain", type=gain_setting, action="append", default=[],
+                        metavar="NAME=VALUE", help="an LP gain in place of the experiment's "
+                        "(repeatable), e.g. obstacle_mode=border")  # fmt: skip
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
     return parser
 
@@ -87,7 +100,7 @@ def run(args: argparse.Namespace) -> int:
     options = Options(
         name=args.name, controller=args.controller, out=args.out, seed=args.seed,
         profile=args.profile, realtime=args.realtime, time_limit_s=args.time_limit,
-        hide_base_marker=args.hide_base_marker, arm_obstacles=not args.no_arm_obstacles,
+        hide_base_marker=args.hide_base_marker, gains=dict(args.gain),
     )  # fmt: skip
     try:
         report = run_experiment(options)

@@ -118,6 +118,27 @@ def test_an_obstacle_constraint_goes_round_the_obstacle_to_the_goal(params, cons
     assert run.final_error < 1e-3
 
 
+def test_the_default_obstacle_constraint_lets_the_base_near_no_faster_than_its_bound():
+    """The vector-field inequality, the default obstacle constraint, in the closed loop of
+    6.2.3: at every step the distance d of the base's point from the obstacle's grown circle
+    changes by (d_{k+1} - d_k) / dt >= -eta_d d_k (a finite difference along the step taken),
+    so d stays positive; every program is solved, and the run converges."""
+    params = OBSTACLE_PARAMS
+    run = integrate(LPLaw(MODEL, params), HOME, pose_task(MODEL, OBSTACLE_GOAL), 4000,
+                    obstacles=[OBSTACLE])  # fmt: skip
+    q = np.array(run.configurations)
+    ahead = params.obstacle_lookahead
+    points = q[:, :2] + ahead * np.column_stack((np.cos(q[:, 2]), np.sin(q[:, 2])))
+    grown = OBSTACLE.radius + MODEL.base.body_radius + params.obstacle_margin + ahead
+    d = np.hypot(points[:, 0] - OBSTACLE.x, points[:, 1] - OBSTACLE.y) - grown
+    slack = np.diff(d) / DT + params.obstacle_gain * d[:-1]
+    assert slack.min() >= -1e-9
+    assert slack.min() < 1e-3  # the bound was reached: the inequality held the base
+    assert d.min() > 0.0
+    assert any("obstacle_vector_field" in out.active_constraints for out in run.outputs)
+    assert all(out.ok for out in run.outputs) and run.final_error < 1e-3
+
+
 def test_conservative_constraint_stops_the_base_before_the_obstacle():
     law = LPLaw(MODEL, LPParams(obstacle_mode="conservative"))
     run = integrate(law, HOME, pose_task(MODEL, OBSTACLE_GOAL), 3000, obstacles=[OBSTACLE])

@@ -34,14 +34,25 @@ def test_nan_obstacle_and_non_positive_dt_are_rejected():
 
 def test_an_infeasible_program_gives_zero_velocity_and_the_status():
     """At the goal (e = 0) the original bound 5.7 forces u = 0, while the engaged border
-    constraint demands an outward velocity: no u satisfies both."""
+    constraint 5.28 demands an outward velocity: no u satisfies both."""
     at_goal = PoseTask(MODEL.fkm(HOME))
     obstacle = Circle(0.3, 0.0, 0.1)  # the base is inside its extended disc
-    law = LPLaw(MODEL, LPParams(error_bound="error"))
+    law = LPLaw(MODEL, LPParams(error_bound="error", obstacle_mode="border"))
     out = law.step(HOME, at_goal, DT, [obstacle])
     assert out.status == "infeasible"
     assert np.array_equal(out.u, np.zeros(MODEL.dof))
     assert out.nonzero == 0
+
+
+def test_the_default_obstacle_constraint_keeps_standing_still_feasible():
+    """Where 5.28 leaves no feasible u (above), the default law's obstacle row, the
+    vector-field inequality, is an inequality that u = 0 meets: the program is solved and the
+    robot, at its goal, stands still."""
+    at_goal = PoseTask(MODEL.fkm(HOME))
+    obstacle = Circle(0.3, 0.0, 0.1)
+    out = LPLaw(MODEL, LPParams(error_bound="error")).step(HOME, at_goal, DT, [obstacle])
+    assert out.status == "optimal" and "obstacle_vector_field" in out.active_constraints
+    assert np.array_equal(out.u, np.zeros(MODEL.dof))
 
 
 def test_error_derivative_is_measured_between_steps_of_the_same_task():

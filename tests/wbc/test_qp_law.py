@@ -57,10 +57,11 @@ def test_the_qp_reaches_the_pose_goal_of_6_2_1_inside_the_joint_limits() -> None
 
 
 def test_an_infeasible_program_gives_zero_velocity_and_the_status() -> None:
-    """At the goal (e = 0) the bound 5.7 forces u = 0, while the engaged border constraint
+    """At the goal (e = 0) the bound 5.7 forces u = 0, while the engaged border constraint 5.28
     demands an outward velocity: no u satisfies both (the LP's own test, on the QP)."""
     at_goal = PoseTask(MODEL.fkm(HOME))
     obstacle = Circle(0.3, 0.0, 0.1)  # the base is inside its extended disc
-    output = QPLaw(MODEL, QPParams(error_bound="error")).step(HOME, at_goal, DT, [obstacle])
+    params = QPParams(error_bound="error", obstacle_mode="border")
+    output = QPLaw(MODEL, params).step(HOME, at_goal, DT, [obstacle])
     assert output.status == "infeasible"
     assert not output.u.any() and output.nonzero == 0
