@@ -11,6 +11,7 @@ import math
 import multiprocessing
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
+from multiprocessing.pool import Pool
 from pathlib import Path
 
 import numpy as np
@@ -354,22 +355,28 @@ def obstacle_report(robot_file: Path, count: int, processes: int = 2,
                     seed: int | None = None) -> dict:  # fmt: skip
     """For every family of OBSTACLE_FAMILIES, the LP under the staging supervisor: the shares
     reached, the failures by reason, the contacts and the planning times."""
+    with multiprocessing.get_context("spawn").Pool(processes) as pool:
+        return _obstacle_rows(pool, robot_file, count, seed)
+
+
+def _obstacle_rows(pool: Pool, robot_file: Path, count: int, seed: int | None = None
+                   ) -> dict:  # fmt: skip
     robot = MobileManipulator.from_yaml(robot_file)
     report: dict = {}
-    with multiprocessing.get_context("spawn").Pool(processes) as pool:
-        for family in OBSTACLE_FAMILIES.values():
-            triples = obstacle_goals(family, count, robot, seed)
-            jobs = [(SUPERVISED, robot_file, start, goal, False, (circle,))
-                    for start, goal, circle in triples]  # fmt: skip
-            attempts = pool.map(_attempt_one, jobs, chunksize=1)
-            row = {**shares(attempts), **failures(attempts), **planning(attempts)}
-            report[f"{family.name} pose"] = {"goals": count, "laws": {SUPERVISED: row}}
+    for family in OBSTACLE_FAMILIES.values():
+        jobs = [(SUPERVISED, robot_file, start, goal, False, (circle,))
+                for start, goal, circle in obstacle_goals(family, count, robot, seed)]  # fmt: skip
+        attempts = pool.map(_attempt_one, jobs, chunksize=1)
+        row = {**shares(attempts), **parsimony(attempts, robot.dof), **failures(attempts),
+               **planning(attempts)}
+        report[f"{family.name} pose"] = {"goals": count, "laws": {SUPERVISED: row}}
     return report
 
 
 def goal_report(robot_file: Path, count: int, processes: int = 2) -> dict:
     """For every family and law: the shares reached and the parsimony of u, for the pose task
-    and, with the laws of POSITION_LAWS, for the position task of the same goals."""
+    and, with the laws of POSITION_LAWS, for the position task of the same goals; and the LP
+    under the supervisor on the goals of OBSTACLE_FAMILIES (``obstacle_report``)."""
     robot = MobileManipulator.from_yaml(robot_file)
     report: dict = {}
     with multiprocessing.get_context("spawn").Pool(processes) as pool:
@@ -385,4 +392,5 @@ def goal_report(robot_file: Path, count: int, processes: int = 2) -> dict:
                     if law_name == SUPERVISED:
                         rows[law_name].update(planning(attempts))
                 report[f"{family.name} {task}"] = {"goals": count, "laws": rows}
+        report.update(_obstacle_rows(pool, robot_file, count))
     return report
