@@ -62,6 +62,10 @@ class SupervisorParams:
     face_turn: float = math.pi / 3
     """A drive leg starts by turning the base in place to face its waypoint when it faces
     further away than this, rad (above the way's corners, at most pi/4)."""
+    face_tolerance: float = 0.3
+    """That turn ends with the base facing its waypoint this closely, rad: the leg's point
+    task steers out the rest as it drives (the turn's last tenths of a radian, at the task
+    gain's exponential rate, took seconds)."""
     approach_tolerance: float = 0.005
     """The approach ends with its point this close to the candidate's, m."""
     turn_tolerance: float = 0.05
@@ -274,7 +278,7 @@ class StagingSupervisor:
     def _met(self, error: Array) -> bool:
         p = self.params
         if self.phase is Phase.DRIVE and self.facing:
-            return bool(abs(error[0]) < p.turn_tolerance)
+            return bool(abs(error[0]) < p.face_tolerance)
         if self.phase is Phase.DRIVE:
             tolerance = p.leg_tolerance if self._last_leg else p.waypoint_tolerance
             return bool(np.linalg.norm(error[:2]) < tolerance)
