@@ -49,8 +49,8 @@ FREE = [0, 1, 2, 4, 5, 6, 7]
 """The entries of q the search moves: the base and every arm joint but the waist."""
 
 NEAR_HEADING = 0.3
-"""A base within a final leg of its candidate and this close to its heading (rad), with the
-straight way there clear, goes straight to the approach."""
+"""A base within a final leg of its candidate, facing it this closely and this close to its
+heading (rad), with the straight way there clear, goes straight to the approach."""
 
 
 @dataclass(frozen=True)
@@ -92,12 +92,13 @@ class StagingParams:
     border the LP's obstacle constraint 5.28 demands the base move out faster than its speed
     bounds allow, and the program has no solution."""
     max_distance: float = 10.0
-    """A goal farther than this from the base is refused, m: a staging plan drives straight,
-    and the search's residual loses its precision far from the origin (a goal 100 m away
-    took 2.1 s to fail)."""
+    """A goal farther than this from the base is refused, m: the search's residual loses its
+    precision far from the origin (a goal 100 m away took 2.1 s to fail)."""
     budget_s: float = 2.0
     """CPU seconds of the planning thread a search may take (its own work, whatever else
-    the machine does): no new start is tried past it. Plans take 0.05 s median, 0.2 s p99."""
+    the machine does): no new start is tried past it. Plans take 0.1 s median, 0.4 s p99
+    on the goals 'anywhere', 0.34 and 0.86 s with an obstacle near the way (`parsimony
+    bench`)."""
     seed: int = 0
 
 
@@ -328,6 +329,11 @@ def _final_leg(q: Array, obstacles: Sequence[Circle], body: float,
     return None
 
 
+def same_kind(a: Array, b: Array) -> bool:
+    """The bases within 0.1 m and 0.3 rad of each other."""
+    return bool(math.hypot(*(a[:2] - b[:2])) < 0.1 and abs(wrap(a[2] - b[2])) < 0.3)
+
+
 def same_configuration(a: Array, b: Array) -> bool:
     """Every entry within 0.02 (m or rad, headings wrapped)."""
     return bool(np.max(np.abs(np.concatenate((a[:2] - b[:2], [wrap(a[2] - b[2])],
@@ -335,8 +341,12 @@ def same_configuration(a: Array, b: Array) -> bool:
 
 
 def _near(q_now: Array, q: Array, final_leg: float) -> bool:
-    return bool(math.hypot(*(q[:2] - q_now[:2])) < final_leg
-                and abs(wrap(q[2] - q_now[2])) < NEAR_HEADING)  # fmt: skip
+    """q's base within ``final_leg`` of the base now, ahead of it, both headings within
+    ``NEAR_HEADING``: the straight approach gets there without swinging the base round."""
+    offset = q[:2] - q_now[:2]
+    distance = math.hypot(*offset)
+    ahead = distance < 0.01 or abs(wrap(math.atan2(offset[1], offset[0]) - q_now[2])) < NEAR_HEADING
+    return bool(distance < final_leg and ahead and abs(wrap(q[2] - q_now[2])) < NEAR_HEADING)
 
 
 def _scored(robot: MobileManipulator, q_now: Array, q: Array, way: Way | None,

@@ -40,7 +40,7 @@ from wbc.drive_tasks import HeadingTask, PointTask
 from wbc.obstacles import Circle
 from wbc.planar import wrap
 from wbc.robot import MobileManipulator
-from wbc.staging import Candidate, Plan, StagingParams, plan, same_configuration
+from wbc.staging import Candidate, Plan, StagingParams, plan, same_configuration, same_kind
 from wbc.supervisor_phase import Phase
 from wbc.task import PoseTask, Task
 
@@ -183,6 +183,9 @@ class StagingSupervisor:
         self.planning_cpu_s.append(found.cpu_s)
         fresh = [c for c in found.candidates
                  if not any(same_configuration(c.q, o.q) for o in self.tried)]  # fmt: skip
+        # After a stall, another kind of configuration first: the neighbours of one that
+        # stalled stall alike (same base within 0.1 m and 0.3 rad).
+        fresh.sort(key=lambda c: any(same_kind(c.q, o.q) for o in self.tried))
         if not fresh:
             self._give_up(t, found.reason or "every staging candidate was tried")
             return
