@@ -146,14 +146,17 @@ class WayPlanner:
     def __init__(self, start: Array, obstacles: Sequence[Circle], clearance: float,
                  slack: float = 0.0, max_turn: float = math.pi / 4,
                  target: Array | None = None) -> None:  # fmt: skip
-        self.start = require_finite("start", start)[:2]
+        self.origin = require_finite("start", start)[:2]
         self.obstacles = tuple(obstacles)
         self.clearance, self.slack, self.max_turn = clearance, slack, max_turn
         self.reason = ""
         for index, c in enumerate(self.obstacles, start=1):
             require_finite(f"obstacle {index}", (c.x, c.y, c.radius))
-            if math.hypot(self.start[0] - c.x, self.start[1] - c.y) < c.radius:
+            if math.hypot(self.origin[0] - c.x, self.origin[1] - c.y) < c.radius:
                 self.reason = f"the base stands inside obstacle {index} at ({c.x:.2f}, {c.y:.2f})"
+        self.start = self.origin if self.reason else self._escape()
+        """Where the way round the discs begins: the origin, or the point straight out of the
+        slack of the disc it stands in."""
         near = [self.start] if target is None else [self.start, target]
         self.centres = np.array([(c.x, c.y) for c in self.obstacles], dtype=float).reshape(-1, 2)
         self.radii = np.array([max(c.radius, min([c.radius + clearance + slack] + [
@@ -183,7 +186,7 @@ class WayPlanner:
                                   f"within {self.clearance:g} m of obstacle {index} at "
                                   f"({c.x:.2f}, {c.y:.2f})")  # fmt: skip
         if np.any(gaps < self.radii) and not self.shrunk_for_target:
-            return WayPlanner(self.start, self.obstacles, self.clearance, self.slack,
+            return WayPlanner(self.origin, self.obstacles, self.clearance, self.slack,
                               self.max_turn, target).to(target)  # fmt: skip
         best: tuple[float, list[tuple[int, float | None]], Array | None] = (math.inf, [], None)
         if _clear(self.start, target, self.centres, self.radii):
@@ -205,7 +208,30 @@ class WayPlanner:
         return self._way(target, *best)
 
     def _none(self, target: Array, reason: str) -> Way:
-        return Way(self.start, target, (), (), math.inf, reason, ())
+        return Way(self.origin, target, (), (), math.inf, reason, ())
+
+    def _escape(self) -> Array:
+        """The point straight out of the grown disc (r + clearance + slack) the origin stands
+        in, just outside it, where the segment there keeps the clearance from the others and
+        the point stands in no other; else the origin. Inside that disc the LP's obstacle
+        constraint 5.28 may leave no solution for a leg that passes the obstacle, while one
+        that moves straight away from it does not engage the constraint at all."""
+        full = [c.radius + self.clearance + self.slack for c in self.obstacles]
+        inside = [(float(np.hypot(self.origin[0] - c.x, self.origin[1] - c.y)), index)
+                  for index, c in enumerate(self.obstacles)]  # fmt: skip
+        inside = [(d, i) for d, i in inside if d < full[i]]
+        if not inside:
+            return self.origin
+        distance, index = min(inside)
+        c = self.obstacles[index]
+        out = np.array([c.x, c.y]) + (self.origin - [c.x, c.y]) / distance * (full[index] + ROOM)
+        others = [o for i, o in enumerate(self.obstacles) if i != index]
+        if segment_clear(self.origin, out, others, self.clearance) and all(
+            np.hypot(out[0] - o.x, out[1] - o.y) >= full[i]
+            for i, o in enumerate(self.obstacles) if i != index
+        ):  # fmt: skip
+            return out
+        return self.origin
 
     def _disc(self, disc: int) -> tuple[Array, float]:
         return self.centres[disc], float(self.radii[disc])
@@ -319,6 +345,10 @@ class WayPlanner:
         points = [self.nodes[n].point if n >= 0 else tangent for n, _ in path]
         arcs: list[Arc] = []
         waypoints: list[Array] = []
+        if self.start is not self.origin:
+            points.insert(0, self.origin)
+            waypoints.append(self.start)
+            length += float(np.hypot(*(self.start - self.origin)))
         for (a, _), (_, sweep) in zip(path, path[1:], strict=False):
             if sweep is None or abs(sweep) < TOUCH:
                 continue
@@ -328,7 +358,7 @@ class WayPlanner:
             arcs.append(arc)
             waypoints += arc.corners(self.max_turn)
         waypoints.append(target)
-        return Way(self.start, target, (*points, target), tuple(arcs), length, "",
+        return Way(self.origin, target, (*points, target), tuple(arcs), length, "",
                    tuple(waypoints))
 
 

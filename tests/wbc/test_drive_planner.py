@@ -99,15 +99,19 @@ def test_a_target_within_the_clearance_or_a_start_inside_an_obstacle_is_named() 
     assert "the base stands inside obstacle 1" in inside.reason
 
 
-def test_a_start_in_the_slack_leaves_by_the_way_that_clears_the_rest() -> None:
-    """A base that stands closer than clearance + slack (the start of a re-plan beside the
-    obstacle) is not walled in: the disc shrinks to where it stands, and only the slack is
-    given up."""
+def test_a_start_in_the_slack_first_leaves_it_straight_away_from_the_obstacle() -> None:
+    """A base that stands closer than clearance + slack (a goal's start, or a re-plan beside
+    the obstacle) first moves straight out of the slack, then takes the way round with the
+    slack kept."""
     circle = Circle(0.0, 0.0, 0.1)
     start = np.array([0.0, -0.36])
     way = plan_way(start, np.array([0.0, 1.0]), [circle], CLEARANCE, 0.1)
     assert way.found
+    np.testing.assert_allclose(way.waypoints[0], [0.0, -0.415], atol=1e-3)
     assert_clear(way, [circle], CLEARANCE)
+    rest = polyline(way)[1:]
+    for a, b in zip(rest, rest[1:], strict=False):
+        assert distance_to_segment(np.zeros(2), a, b) >= circle.radius + CLEARANCE + 0.1 - 1e-9
 
 
 def test_segment_clear_keeps_the_clearance() -> None:
