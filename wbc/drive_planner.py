@@ -34,16 +34,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from wbc.disc_geometry import TAU, TOUCH, bitangents, clear, covered, overlaps, segment_clear
 from wbc.obstacles import Circle
 from wbc.validation import require_finite
 
 Array = np.ndarray
 
-TOUCH = 1e-7
-"""How far a segment or a node may reach into a disc and still count as outside, m."""
 ROOM = 1e-4
 """How far inside a start's or target's distance from a centre its disc shrinks to, m."""
-TAU = 2.0 * math.pi
 
 
 @dataclass(frozen=True)
@@ -112,13 +110,6 @@ def _bearing(a: Array, b: Array) -> float:
     return math.atan2(float(b[1] - a[1]), float(b[0] - a[0]))
 
 
-def segment_clear(a: Array, b: Array, obstacles: Sequence[Circle], clearance: float) -> bool:
-    """The segment a-b keeps ``clearance`` from every obstacle's circle."""
-    centres = np.array([(c.x, c.y) for c in obstacles], dtype=float).reshape(-1, 2)
-    radii = np.array([c.radius + clearance for c in obstacles], dtype=float)
-    return _clear(np.asarray(a, dtype=float)[:2], np.asarray(b, dtype=float)[:2], centres, radii)
-
-
 def plan_way(start: Array, target: Array, obstacles: Sequence[Circle], clearance: float,
              slack: float = 0.0, max_turn: float = math.pi / 4) -> Way:  # fmt: skip
     """The shortest way from ``start`` (x, y) to ``target`` (x, y) for a point that keeps
@@ -169,7 +160,7 @@ class WayPlanner:
         for disc in discs:
             self._tangents(0, disc)
             for other in range(disc + 1, len(self.obstacles)):
-                for a, b in _bitangents(self._disc(disc), self._disc(other)):
+                for a, b in bitangents(self._disc(disc), self._disc(other)):
                     self._link(self._node(disc, a), self._node(other, b))
         self._on = [self._link_arcs(disc) for disc in discs]
         self.distance, self.previous = self._search()
@@ -189,12 +180,12 @@ class WayPlanner:
             return WayPlanner(self.origin, self.obstacles, self.clearance, self.slack,
                               self.max_turn, target).to(target)  # fmt: skip
         best: tuple[float, list[tuple[int, float | None]], Array | None] = (math.inf, [], None)
-        if _clear(self.start, target, self.centres, self.radii):
+        if clear(self.start, target, self.centres, self.radii):
             best = (float(np.hypot(*(target - self.start))), [(0, None)], None)
         for disc in range(len(self.obstacles)):
             for angle in self._tangent_angles(target, disc):
                 point = self._point(disc, angle)
-                if self._inside_another(point, disc) or not _clear(point, target, self.centres,
+                if self._inside_another(point, disc) or not clear(point, target, self.centres,
                                                                    self.radii):  # fmt: skip
                     continue
                 for node, sweep in self._arcs_into(disc, angle):
@@ -266,7 +257,7 @@ class WayPlanner:
     def _link(self, a: int | None, b: int | None) -> None:
         if a is None or b is None:
             return
-        if not _clear(self.nodes[a].point, self.nodes[b].point, self.centres, self.radii):
+        if not clear(self.nodes[a].point, self.nodes[b].point, self.centres, self.radii):
             return
         length = float(np.hypot(*(self.nodes[a].point - self.nodes[b].point)))
         self.edges[a].append((b, length, None))
@@ -277,8 +268,8 @@ class WayPlanner:
         centre, radius = self._disc(disc)
         for other in range(len(self.obstacles)):
             if other != disc:
-                interval = _covered(centre, radius, *self._disc(other))
-                if interval is not None and _overlaps(start, sweep, interval):
+                interval = covered(centre, radius, *self._disc(other))
+                if interval is not None and overlaps(start, sweep, interval):
                     return True
         return False
 
@@ -360,56 +351,3 @@ class WayPlanner:
         waypoints.append(target)
         return Way(self.origin, target, (*points, target), tuple(arcs), length, "",
                    tuple(waypoints))
-
-
-def _bitangents(first: tuple[Array, float], second: tuple[Array, float]
-                ) -> list[tuple[float, float]]:  # fmt: skip
-    """The angles on each disc of their common tangents: outer (same angle on both), inner
-    (opposite angles), those that exist."""
-    (c1, r1), (c2, r2) = first, second
-    offset = c2 - c1
-    distance = float(np.hypot(*offset))
-    theta = math.atan2(offset[1], offset[0])
-    pairs = []
-    if distance > abs(r1 - r2):
-        alpha = math.acos((r1 - r2) / distance)
-        pairs += [(theta + alpha, theta + alpha), (theta - alpha, theta - alpha)]
-    if distance > r1 + r2:
-        beta = math.acos((r1 + r2) / distance)
-        pairs += [(theta + beta, theta + beta + math.pi), (theta - beta, theta - beta + math.pi)]
-    return pairs
-
-
-def _clear(a: Array, b: Array, centres: Array, radii: Array) -> bool:
-    """No disc's interior (centres (n, 2), radii (n,)) meets the segment a-b."""
-    direction = b - a
-    squared = float(direction @ direction)
-    t = np.zeros(len(radii)) if squared == 0.0 else np.clip((centres - a) @ direction / squared,
-                                                            0.0, 1.0)  # fmt: skip
-    nearest = a + t[:, None] * direction - centres
-    return bool(np.all(np.hypot(nearest[:, 0], nearest[:, 1]) >= radii - TOUCH))
-
-
-def _covered(centre: Array, radius: float, other: Array, other_radius: float
-             ) -> tuple[float, float] | None:  # fmt: skip
-    """The angles (from, width) of the circle (centre, radius) inside the other disc, or
-    None where they do not meet."""
-    offset = other - centre
-    distance = float(np.hypot(*offset))
-    if distance >= radius + other_radius or distance + other_radius <= radius:
-        return None
-    if distance + radius <= other_radius:
-        return 0.0, TAU
-    cosine = (radius**2 + distance**2 - other_radius**2) / (2.0 * radius * distance)
-    half = math.acos(max(-1.0, min(1.0, cosine)))
-    return (math.atan2(offset[1], offset[0]) - half) % TAU, 2.0 * half
-
-
-def _overlaps(start: float, sweep: float, interval: tuple[float, float]) -> bool:
-    """The counter-clockwise arc (start, sweep) and the interval (from, width) share more than
-    an end point."""
-    begin, width = interval
-    if width >= TAU:
-        return True
-    shift = (begin - start) % TAU
-    return shift < sweep - TOUCH or shift + width > TAU + TOUCH

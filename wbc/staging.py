@@ -36,7 +36,8 @@ from scipy.optimize import least_squares
 
 from wbc import dq
 from wbc.conditioning import smallest_singular_value
-from wbc.drive_planner import Way, WayPlanner, segment_clear
+from wbc.disc_geometry import segment_clear
+from wbc.drive_planner import Way, WayPlanner
 from wbc.lp_law import LPParams
 from wbc.objectives.base_target import gripper_heading
 from wbc.obstacles import Circle

@@ -24,7 +24,7 @@ from sim2d.scenarios import (
     scenario,
 )
 from wbc import dq
-from wbc.drive_planner import segment_clear
+from wbc.disc_geometry import segment_clear
 from wbc.lp_law import LPParams
 from wbc.planar import offset_pose, planar_of, planar_pose
 from wbc.robot import BASE_DOF, MobileManipulator

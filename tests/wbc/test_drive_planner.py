@@ -8,7 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from wbc.drive_planner import WayPlanner, plan_way, segment_clear
+from wbc.disc_geometry import segment_clear
+from wbc.drive_planner import WayPlanner, plan_way
 from wbc.obstacles import Circle
 
 CLEARANCE = 0.215
