@@ -317,5 +317,11 @@ def format_report(report: dict) -> str:
             if "plans_per_run" in row:
                 parts.append(f"{law}: {row['plans_per_run']:.2f} plans per run, a plan takes "
                              f"{row['plan_median_ms']:.0f} ms median, "
-                             f"{row['plan_p99_ms']:.0f} ms p99")  # fmt: skip
+                             f"{row['plan_p99_ms']:.0f} ms p99 "
+                             f"({row['plan_cpu_median_ms']:.0f} and "
+                             f"{row['plan_cpu_p99_ms']:.0f} ms of its thread's CPU time)")
+            if "failures" in row:
+                parts.append(f"{law}: {row['contacts']} runs with a contact, least clearance "
+                             f"{row['least_clearance_m']:.3f} m; not reached, by reason:")
+                parts += [f"  {n} x {reason}" for reason, n in row["failures"].items()]
     return "\n".join(parts)

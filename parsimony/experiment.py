@@ -67,7 +67,7 @@ DEPLOY = Path(__file__).resolve().parents[1] / "deploy"
 PROFILES = {"lp": DEPLOY / "sim.yaml", "cascade": DEPLOY / "sim_cascade.yaml",
             "qp": DEPLOY / "sim_qp.yaml"}
 """The profile each controller runs in unless ``--profile`` names another."""
-SUPERVISED = {"anywhere": DEPLOY / "sim_supervised.yaml"}
+SUPERVISED = {name: DEPLOY / "sim_supervised.yaml" for name in ("anywhere", "blocked")}
 """Experiments whose LP runs under the staging supervisor (components/supervisor.py)."""
 MODULES = {c.law_name: c.__module__.rsplit(".", 1)[-1]
            for c in (LPController, CascadeController, QPController)}

@@ -31,10 +31,11 @@ from wbc.scenarios import HOME, OBSTACLE, REACH_GOAL, TABLE, TABLE_GOAL, TABLE_S
 
 SEED_MAX = 2**31
 """Seeds of a set-up and of the simulator's noise: 0 to SEED_MAX (numpy's RandomState bound)."""
-NAMES = ("pose", "position", "obstacle", "anywhere", "table")
-"""The experiments of section 6.2, 'anywhere': a pose goal behind the robot, past an obstacle,
-which the LP law reaches only under the staging supervisor (deploy/sim_supervised), and
-'table': a pose goal over a table's edge, which the arm reaches without touching it."""
+NAMES = ("pose", "position", "obstacle", "anywhere", "blocked", "table")
+"""The experiments of section 6.2; 'anywhere': a pose goal behind the robot, past an obstacle,
+which the LP law reaches only under the staging supervisor (deploy/sim_supervised); 'blocked':
+the same goal from farther away, with the obstacle on the straight way to it; 'table': a pose
+goal over a table's edge, which the arm reaches without touching it."""
 
 ANYWHERE_START = (1.3, 0.2, 0.0)
 """The base of 'anywhere' (x, y, phi): at the far side of the camera's view, facing away."""
@@ -43,6 +44,11 @@ ANYWHERE_BIN = (0.35, 0.0)
 experiment's bin, so the gripper must point back along -x."""
 ANYWHERE_OBSTACLE = Circle(0.8, -0.3, 0.1)
 """Beside the way back."""
+BLOCKED_START = (1.9, 0.1, 0.0)
+"""The base of 'blocked': at the edge of the camera's view, facing away from the bin."""
+BLOCKED_OBSTACLE = Circle(1.45, 0.08, 0.1)
+"""On the straight way from 'blocked''s start to where the base stands for the bin, clear of
+the start's body and of the staging point's by the LP's margin."""
 
 OBSTACLE_SHIFT = (0.75, 0.25)
 """Where the obstacle experiment's bin stands from the pose experiment's, m: past the obstacle."""
@@ -105,10 +111,10 @@ def scenario(name: str, robot: MobileManipulator, seed: int | None = None) -> Si
     if name == "obstacle":
         x, y = x + OBSTACLE_SHIFT[0], y + OBSTACLE_SHIFT[1]
         obstacles = (OBSTACLE,)
-    if name == "anywhere":
+    if name in ("anywhere", "blocked"):
         (x, y), yaw = ANYWHERE_BIN, yaw + np.pi
-        start[:3] = ANYWHERE_START
-        obstacles = (ANYWHERE_OBSTACLE,)
+        start[:3] = ANYWHERE_START if name == "anywhere" else BLOCKED_START
+        obstacles = (ANYWHERE_OBSTACLE if name == "anywhere" else BLOCKED_OBSTACLE,)
     if name == "table":
         return _table(robot, seed)
     bin_pose = np.array([x, y, yaw])

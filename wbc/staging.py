@@ -9,14 +9,19 @@ with fkm(q_c) = x_d, found by a bounded inverse-kinematics search from several s
 each arm joint kept a margin inside the LP's joint box b_l [q-, q+] (5.14), so that the
 pose task started from q_c has room on every joint. The waist is held at 0: it turns the arm
 exactly as phi does (the arm stands on the base's turning axis), so the base's heading carries
-the arm's yaw. Candidates whose base or staging point comes within reach of an obstacle are
-left out. Each candidate is scored, lower first:
+the arm's yaw. The starts place the base all round the goal, at reaches from behind the
+gripper to over the arm's back: with the wrist rolled, the base of a configuration of the goal
+may face any way from the gripper's heading, and the arm folded back puts the gripper behind
+the base. Candidates whose base, staging point or final leg comes within reach of an obstacle
+are left out, and so are those with no way round the obstacles to their staging point
+(wbc.drive_planner). Each candidate is scored, lower first:
 
     travel + heading_weight * turning + conditioning_weight * max(0, 1 - sigma_6 / sigma_floor)
 
-with travel the base's distance to q_c, turning the heading changes of the drive that gets
-there (face the staging point, then turn to phi_c) and sigma_6 the conditioning of q_c
-(wbc.conditioning): near a singularity the last metres of the pose task stall.
+with travel the length of the way to the staging point and of the final leg, turning the
+heading changes of the drive that gets there (face the way's first leg, its arcs, then turn to
+phi_c) and sigma_6 the conditioning of q_c (wbc.conditioning): near a singularity the last
+metres of the pose task stall.
 """
 
 from __future__ import annotations
@@ -31,6 +36,8 @@ from scipy.optimize import least_squares
 
 from wbc import dq
 from wbc.conditioning import smallest_singular_value
+from wbc.disc_geometry import segment_clear
+from wbc.drive_planner import Way, WayPlanner
 from wbc.lp_law import LPParams
 from wbc.objectives.base_target import gripper_heading
 from wbc.obstacles import Circle
@@ -42,6 +49,10 @@ Array = np.ndarray
 FREE = [0, 1, 2, 4, 5, 6, 7]
 """The entries of q the search moves: the base and every arm joint but the waist."""
 
+NEAR_HEADING = 0.3
+"""A base within a final leg of its candidate, facing it this closely and this close to its
+heading (rad), with the straight way there clear, goes straight to the approach."""
+
 
 @dataclass(frozen=True)
 class StagingParams:
@@ -49,12 +60,19 @@ class StagingParams:
 
     safety_factor: float = LPParams().safety_factor
     """b_l of the LP's joint limits."""
-    joint_margins: tuple[float, ...] = (0.15, 0.05)
+    joint_margins: tuple[float, ...] = (0.15, 0.05, 0.0)
     """Each arm joint of a candidate stays this far inside b_l [q-, q+], rad: the first margin
-    that gives any candidate is kept."""
-    starts: int = 16
-    reaches: tuple[float, ...] = (0.2, 0.35, 0.5)
-    """Distances behind the goal, along the gripper's heading, the search starts the base at."""
+    that gives any candidate is kept (the last, 0, finds a goal whose only configurations
+    lie at the box's edge: 'anywhere' draws its goals from the whole box)."""
+    starts: int = 24
+    turns: tuple[float, ...] = (0.0, math.pi, 0.5 * math.pi, -0.5 * math.pi, 0.25 * math.pi,
+                                -0.75 * math.pi, -0.25 * math.pi, 0.75 * math.pi)
+    """The start's heading from the gripper's heading psi, rad (each with U(-0.2, 0.2) added),
+    taken in turn: the base all round the goal."""
+    reaches: tuple[float, ...] = (0.35, 0.15, -0.15)
+    """The gripper's distance ahead of the start's base along its heading, m, taken in turn
+    (negative: the arm folded over the base's back): over the goals 'anywhere' it spans -0.3
+    to 0.45 m, median 0.16."""
     residual_tolerance: float = 1e-6
     heading_weight: float = 0.1
     """m of travel one radian of turning is worth."""
@@ -63,15 +81,25 @@ class StagingParams:
     """m of travel a singular candidate is worth (scaled down to 0 at sigma_floor)."""
     clearance: float = LPParams().obstacle_margin
     """Extra distance between the base's body and an obstacle, m: the LP's margin."""
-    final_leg: float = 0.4
-    """The straight drive into the candidate's pose starts this far behind it, m."""
+    slack: float = LPParams().obstacle_lookahead
+    """Further room the way to a staging point keeps round obstacles where it can, m: the
+    LP's obstacle constraint acts on a point this far ahead of the axle."""
+    final_legs: tuple[float, ...] = (0.4, -0.4, 0.2, -0.2, 0.0)
+    """The straight drive into the candidate's pose, m, the first of these whose staging
+    point and leg keep clear of obstacles: forward from this far behind the pose (negative:
+    backwards from ahead of it; 0: the base turns into the pose where it stands)."""
+    crowding_weight: float = 1.0
+    """m of travel a candidate that is not roomy (``Candidate.roomy``) is worth: near its
+    border the LP's obstacle constraint 5.28 demands the base move out faster than its speed
+    bounds allow, and the program has no solution."""
     max_distance: float = 10.0
-    """A goal farther than this from the base is refused, m: a staging plan drives straight,
-    and the search's residual loses its precision far from the origin (a goal 100 m away
-    took 2.1 s to fail)."""
+    """A goal farther than this from the base is refused, m: the search's residual loses its
+    precision far from the origin (a goal 100 m away took 2.1 s to fail)."""
     budget_s: float = 2.0
     """CPU seconds of the planning thread a search may take (its own work, whatever else
-    the machine does): no new start is tried past it. Plans take 0.05 s median, 0.2 s p99."""
+    the machine does): no new start is tried past it. Plans take 0.07 s median, 0.28 s p99
+    on the goals 'anywhere', 0.21 and 0.77 s with an obstacle near the way (`parsimony
+    bench`)."""
     seed: int = 0
 
 
@@ -84,6 +112,16 @@ class Candidate:
     turning: float
     sigma: float
     score: float
+    way: Way | None
+    """The base's way from where the plan began to the staging point; None where the base
+    stood near enough to go straight to the approach (``NEAR_HEADING``)."""
+    final_leg: float
+    """The straight leg into the pose: the staging point stands this far behind the base on
+    its heading, m (ahead where negative)."""
+    roomy: bool = True
+    """The LP's obstacle constraint leaves the pose task alone at q_c and the turn at the
+    staging point: the point ``slack`` ahead of q_c's axle keeps clearance + slack from
+    every obstacle, and so does the staging point."""
 
     @property
     def base(self) -> Array:
@@ -93,13 +131,15 @@ class Candidate:
     def arm(self) -> Array:
         return self.q[BASE_DOF:]
 
-    def staging_point(self, final_leg: float) -> Array:
-        return staging_point(self.base, final_leg)
+    @property
+    def staging(self) -> Array:
+        """Where the final leg starts."""
+        return staging_point(self.base, self.final_leg)
 
 
 def staging_point(base: Array, final_leg: float) -> Array:
     """Where the final straight leg into a base pose (x, y, phi) starts: ``final_leg`` behind
-    it, on its heading."""
+    it, on its heading (ahead where negative)."""
     x, y, phi = base
     return np.array([x - final_leg * math.cos(phi), y - final_leg * math.sin(phi)])
 
@@ -149,38 +189,66 @@ class Plan:
     reason: str
     """Why there is no candidate; empty when there are."""
     elapsed_s: float
+    cpu_s: float = 0.0
+    """The planning thread's CPU time, s (``elapsed_s`` also counts what else ran)."""
 
 
 def plan(robot: MobileManipulator, q_now: Array, goal_pose: Array,
          obstacles: Sequence[Circle] = (), params: StagingParams = StagingParams()
          ) -> Plan:  # fmt: skip
-    """Every distinct configuration of the goal pose the search finds, with the widest joint
-    margin that gives any; with none, the reason: the goal refused at once (``refusal``), the
-    CPU budget spent, every configuration found too near an obstacle, or none found. Pure
-    but for the clocks: callable from any thread."""
-    started = time.perf_counter()
+    """Every distinct configuration of the goal pose the search finds, each with its way,
+    from the widest joint margin on until one is roomy (or the margins run out); with none,
+    the reason: the goal refused at once (``refusal``), the CPU budget spent, every
+    configuration found too near an obstacle or with no way to it, or none found. Pure but
+    for the clocks: callable from any thread."""
+    started, cpu_started = time.perf_counter(), time.thread_time()
 
     def done(found: Sequence[Candidate], reason: str = "") -> Plan:
-        return Plan(tuple(found), reason, time.perf_counter() - started)
+        return Plan(tuple(sorted(found, key=lambda c: c.score)), reason,
+                    time.perf_counter() - started, time.thread_time() - cpu_started)
 
     refused = refusal(q_now, goal_pose, obstacles, params)
     if refused:
         return done((), refused)
     budget_end = time.thread_time() + params.budget_s
-    blocked = 0
+    left_out = _LeftOut()
+    ways = WayPlanner(q_now[:2], obstacles, robot.base.body_radius + params.clearance,
+                      params.slack)  # fmt: skip
+    found: list[Candidate] = []
     for margin in params.joint_margins:
-        found, near_obstacles, finished = _search(robot, q_now, goal_pose, obstacles, params,
-                                                  margin, budget_end)  # fmt: skip
-        if found:
+        more, finished = _search(robot, q_now, goal_pose, ways, params, margin, budget_end,
+                                 left_out)  # fmt: skip
+        found += [c for c in more if not any(same_configuration(c.q, o.q) for o in found)]
+        if any(c.roomy for c in found):
             return done(found)
-        blocked += near_obstacles
         if not finished:
-            return done((), "no whole-body configuration found within the planning budget "
-                        f"of {params.budget_s:g} s of CPU time")  # fmt: skip
-    if blocked:
-        return done((), f"every whole-body configuration found that reaches the goal ({blocked}) "
-                    f"brings the base within {params.clearance:g} m of an obstacle")  # fmt: skip
+            return done(found, "" if found else "no whole-body configuration found within "
+                        f"the planning budget of {params.budget_s:g} s of CPU time")  # fmt: skip
+    if found:
+        return done(found)
+    if left_out.near or left_out.no_way:
+        return done((), left_out.reason(params.clearance))
     return done((), "no whole-body configuration inside the joint box reaches the goal")
+
+
+@dataclass
+class _LeftOut:
+    """The configurations of the goal a search left out, and why."""
+
+    near: int = 0
+    """Base, staging point or final leg within the clearance of an obstacle."""
+    no_way: int = 0
+    """No way round the obstacles to the staging point."""
+    way_reason: str = ""
+
+    def reason(self, clearance: float) -> str:
+        parts = []
+        if self.near:
+            parts.append(f"{self.near} bring the base within {clearance:g} m of an obstacle")
+        if self.no_way:
+            parts.append(f"{self.no_way} have no way to their staging point ({self.way_reason})")
+        return (f"every whole-body configuration found that reaches the goal "
+                f"({self.near + self.no_way}) is left out: {'; '.join(parts)}")
 
 
 def refusal(q_now: Array, goal_pose: Array, obstacles: Sequence[Circle],
@@ -199,11 +267,23 @@ def refusal(q_now: Array, goal_pose: Array, obstacles: Sequence[Circle],
     return ""
 
 
-def _search(robot: MobileManipulator, q_now: Array, goal_pose: Array,
-            obstacles: Sequence[Circle], params: StagingParams, margin: float,
-            budget_end: float) -> tuple[list[Candidate], int, bool]:  # fmt: skip
-    """The candidates of one margin, how many were left out near obstacles, and whether every
-    start was tried before the CPU budget ran out."""
+def _start(rng: np.random.Generator, index: int, goal_xy: Array, psi: float,
+           params: StagingParams, arm: tuple[Array, Array]) -> Array:  # fmt: skip
+    """The ``index``-th start: the base ``reach`` behind the goal along a heading ``turn``
+    from the gripper's, the arm uniform in its box."""
+    yaw = psi + params.turns[index % len(params.turns)] + rng.uniform(-0.2, 0.2)
+    reach = params.reaches[index % len(params.reaches)]
+    base = goal_xy - reach * np.array([math.cos(yaw), math.sin(yaw)])
+    return np.concatenate((base, [yaw], rng.uniform(*arm)))
+
+
+def _search(robot: MobileManipulator, q_now: Array, goal_pose: Array, ways: WayPlanner,
+            params: StagingParams, margin: float, budget_end: float, left_out: _LeftOut
+            ) -> tuple[list[Candidate], bool]:  # fmt: skip
+    """The candidates of one margin, best first (those left out are counted in
+    ``left_out``), each with its way from ``ways``, and whether every start was tried
+    before the CPU budget ran out."""
+    obstacles = ways.obstacles
     rng = np.random.default_rng(params.seed)
     low, high = arm_box(robot, params.safety_factor, margin)
     inf = np.full(BASE_DOF, np.inf)
@@ -212,25 +292,47 @@ def _search(robot: MobileManipulator, q_now: Array, goal_pose: Array,
     goal_xy = dq.translation(goal_pose)[1:3]
     body = robot.base.body_radius + params.clearance
     found: list[Candidate] = []
-    blocked = 0
+    seen: list[Array] = []
     for index in range(params.starts):
         if time.thread_time() > budget_end:
-            return sorted(found, key=lambda c: c.score), blocked, False
-        yaw = psi + (math.pi if index % 4 == 3 else rng.uniform(-0.5, 0.5))
-        reach = params.reaches[index % len(params.reaches)]
-        start = np.concatenate((goal_xy - reach * np.array([math.cos(yaw), math.sin(yaw)]),
-                                [yaw], rng.uniform(low, high)))  # fmt: skip
+            return sorted(found, key=lambda c: c.score), False
+        start = _start(rng, index, goal_xy, psi, params, (low, high))
         q = solve_ik(robot, goal_pose, start, bounds, params.residual_tolerance)
-        if q is None or any(same_configuration(q, c.q) for c in found):
+        if q is None or any(same_configuration(q, other) for other in seen):
             continue
-        candidate = _scored(robot, q_now, q, params)
-        if clear_of(obstacles, candidate.base, body) and clear_of(
-            obstacles, candidate.staging_point(params.final_leg), body
-        ):
-            found.append(candidate)
-        else:
-            blocked += 1
-    return sorted(found, key=lambda c: c.score), blocked, True
+        seen.append(q)
+        final_leg = _final_leg(q, obstacles, body, params.final_legs)
+        if final_leg is None:
+            left_out.near += 1
+            continue
+        if _near(q_now, q, params.final_legs[0]) and segment_clear(q_now, q, obstacles, body):
+            found.append(_scored(robot, q_now, q, None, final_leg, obstacles, params))
+            continue
+        way = ways.to(staging_point(q[:BASE_DOF], final_leg))
+        if not way.found:
+            left_out.no_way += 1
+            left_out.way_reason = way.reason
+            continue
+        found.append(_scored(robot, q_now, q, way, final_leg, obstacles, params))
+    return sorted(found, key=lambda c: c.score), True
+
+
+def _final_leg(q: Array, obstacles: Sequence[Circle], body: float,
+               legs: Sequence[float]) -> float | None:  # fmt: skip
+    """The first of ``legs`` whose staging point and straight leg into q's base keep ``body``
+    from every obstacle, None when the base itself does not or none does."""
+    if not clear_of(obstacles, q, body):
+        return None
+    for leg in legs:
+        staging = staging_point(q[:BASE_DOF], leg)
+        if clear_of(obstacles, staging, body) and segment_clear(staging, q, obstacles, body):
+            return leg
+    return None
+
+
+def same_kind(a: Array, b: Array) -> bool:
+    """The bases within 0.1 m and 0.3 rad of each other."""
+    return bool(math.hypot(*(a[:2] - b[:2])) < 0.1 and abs(wrap(a[2] - b[2])) < 0.3)
 
 
 def same_configuration(a: Array, b: Array) -> bool:
@@ -239,15 +341,32 @@ def same_configuration(a: Array, b: Array) -> bool:
                                               a[BASE_DOF:] - b[BASE_DOF:])))) < 0.02)  # fmt: skip
 
 
-def _scored(robot: MobileManipulator, q_now: Array, q: Array, params: StagingParams) -> Candidate:
-    travel = float(math.hypot(q[0] - q_now[0], q[1] - q_now[1]))
-    staging = staging_point(q[:BASE_DOF], params.final_leg)
-    bearing = math.atan2(staging[1] - q_now[1], staging[0] - q_now[0])
-    # The base may drive its first leg backwards: turning is counted modulo a half turn.
-    face = abs(wrap(2.0 * (bearing - q_now[2]))) / 2.0
-    turning = face + abs(wrap(q[2] - bearing))
+def _near(q_now: Array, q: Array, final_leg: float) -> bool:
+    """q's base within ``final_leg`` of the base now, ahead of it, both headings within
+    ``NEAR_HEADING``: the straight approach gets there without swinging the base round."""
+    offset = q[:2] - q_now[:2]
+    distance = math.hypot(*offset)
+    ahead = distance < 0.01 or abs(wrap(math.atan2(offset[1], offset[0]) - q_now[2])) < NEAR_HEADING
+    return bool(distance < final_leg and ahead and abs(wrap(q[2] - q_now[2])) < NEAR_HEADING)
+
+
+def _scored(robot: MobileManipulator, q_now: Array, q: Array, way: Way | None,
+            final_leg: float, obstacles: Sequence[Circle], params: StagingParams
+            ) -> Candidate:  # fmt: skip
+    """The candidate q reached by ``way`` and the final leg, or straight (``way`` None)."""
+    if way is None:
+        travel = float(math.hypot(*(q[:2] - q_now[:2])))
+        turning = abs(wrap(q[2] - q_now[2]))
+    else:
+        travel = way.length + abs(final_leg)
+        turning = (abs(wrap(way.first_bearing() - q_now[2])) + way.turning
+                   + abs(wrap(q[2] - way.last_bearing())))  # fmt: skip
     sigma = smallest_singular_value(robot, q)
     penalty = params.conditioning_weight * max(0.0, 1.0 - sigma / params.sigma_floor)
+    room = robot.base.body_radius + params.clearance + params.slack
+    ahead = q[:2] + params.slack * np.array([math.cos(q[2]), math.sin(q[2])])
+    roomy = (clear_of(obstacles, ahead, room)
+             and clear_of(obstacles, staging_point(q[:BASE_DOF], final_leg), room))  # fmt: skip
     score = travel + params.heading_weight * turning + penalty
-    return Candidate(q, travel, turning, sigma, score)
-
+    score += 0.0 if roomy else params.crowding_weight
+    return Candidate(q, travel, turning, sigma, score, way, final_leg, roomy)

@@ -5,19 +5,25 @@ law one task per phase, every command still one LP step:
 
     planning  no task: the caller holds the robot while the plan of ``pending`` runs, on
               any thread (``PlanRequest.run``), and hands it back (``take``)
-    drive     PointTask: the point d ahead of the axle to the staging point's (a final leg
-              behind q_c's base, on its heading), the arm to q_c's arm
+    drive     legs along the candidate's way round the obstacles (wbc.drive_planner),
+              waypoint by waypoint, the last to the staging point (a final leg behind q_c's
+              base on its heading, or ahead of it), the arm going to q_c's: each leg a
+              PointTask of the point d ahead of the axle, after a HeadingTask that turns the
+              base to face the waypoint where it stands if it faces more than ``face_turn``
+              away (so the base keeps to the way instead of curving off it)
     turn      HeadingTask: the base to q_c's heading where it stands, the arm held at q_c's
     approach  PointTask: the straight final leg to q_c's base
     align     HeadingTask: the base turned to q_c's heading again, the arm held: a point task
               leaves the heading free, and a leg that corrects a sideways offset ends turned
     pose      PoseTask(x_d): the ordinary LP pose task, which starts with room on every joint
 
-A phase ends when its error is within its tolerance; phases already met are skipped. A phase
-stalls when ||e|| falls by less than ``stall_reduction`` of itself over ``stall_window_s``:
-the supervisor then re-plans from where the robot is, with the best candidate not yet tried,
-at most ``max_replans`` times; after that, or when no candidate exists, the goal is
-unreachable, the reason is kept, and the supervisor gives no task (the robot stops).
+A phase ends when its error is within its tolerance (a drive leg before the last, when its
+point passes within ``waypoint_tolerance`` of its waypoint); phases already met are skipped;
+a candidate the base stood near is approached straight. A phase (or leg) stalls when ||e||
+falls by less than ``stall_reduction`` of itself over ``stall_window_s``: the supervisor then
+re-plans from where the robot is, with the best candidate not yet tried, at most
+``max_replans`` times; after that, or when no candidate exists, the goal is unreachable, the
+reason is kept, and the supervisor gives no task (the robot stops).
 ``step`` plans in line, for a caller with no other thread (the kinematic loop).
 """
 
@@ -34,16 +40,11 @@ from wbc.drive_tasks import HeadingTask, PointTask
 from wbc.obstacles import Circle
 from wbc.planar import wrap
 from wbc.robot import MobileManipulator
-from wbc.staging import Candidate, Plan, StagingParams, plan, same_configuration
+from wbc.staging import Candidate, Plan, StagingParams, plan, same_configuration, same_kind
 from wbc.supervisor_phase import Phase
 from wbc.task import PoseTask, Task
 
 Array = np.ndarray
-
-
-NEAR_HEADING = 0.3
-"""A base within a final leg of its candidate and this close to its heading (rad) goes
-straight to the approach."""
 
 
 @dataclass(frozen=True)
@@ -54,7 +55,17 @@ class SupervisorParams:
     ends turned by; the smaller d, the straighter the base stands at its candidate (0.1 m
     reached 0.7 of the goals 'anywhere', 0.05 m 0.9 and 0.03 m 0.95, on 40 goals)."""
     leg_tolerance: float = 0.03
-    """The first drive leg ends with its point this close to the target, m."""
+    """The drive ends with its point this close to the staging point's, m."""
+    waypoint_tolerance: float = 0.1
+    """A drive leg before the last ends with its point this close to its waypoint, m: the
+    base turns towards the next one without slowing to a stop."""
+    face_turn: float = math.pi / 3
+    """A drive leg starts by turning the base in place to face its waypoint when it faces
+    further away than this, rad (above the way's corners, at most pi/4)."""
+    face_tolerance: float = 0.3
+    """That turn ends with the base facing its waypoint this closely, rad: the leg's point
+    task steers out the rest as it drives (the turn's last tenths of a radian, at the task
+    gain's exponential rate, took seconds)."""
     approach_tolerance: float = 0.005
     """The approach ends with its point this close to the candidate's, m."""
     turn_tolerance: float = 0.05
@@ -111,10 +122,17 @@ class StagingSupervisor:
     reason: str = field(default="", init=False)
     events: list[Event] = field(default_factory=list, init=False)
     planning_s: list[float] = field(default_factory=list, init=False)
+    """How long each plan took, s (wall clock)."""
+    planning_cpu_s: list[float] = field(default_factory=list, init=False)
+    """The CPU time of each plan's thread, s."""
     tried: list[Candidate] = field(default_factory=list, init=False)
     """The candidates driven to so far, the current one last."""
     pending: PlanRequest | None = field(default=None, init=False)
     """The plan to run and ``take`` while the phase is PLANNING."""
+    leg: int = field(default=0, init=False)
+    """The drive's leg: the index of its waypoint in the candidate's way."""
+    facing: bool = field(default=False, init=False)
+    """The drive's leg turns to face its waypoint before it drives there."""
     _task: Task | None = field(default=None, init=False)
     _history: collections.deque = field(default_factory=collections.deque, init=False)
     _pose_task: PoseTask = field(init=False)
@@ -153,7 +171,7 @@ class StagingSupervisor:
             error = self._error(q)
             if self.phase is Phase.REACHED or not self._met(error):
                 break
-            self._advance(t)
+            self._advance(q, t)
         norm = float(np.linalg.norm(error))
         if self.phase is not Phase.REACHED and self._stalled(t, norm):
             self.events.append(Event(t, "stall", f"{self.phase} error {norm:.3g}"))
@@ -174,8 +192,12 @@ class StagingSupervisor:
         if request is None or self.phase is not Phase.PLANNING:
             return
         self.planning_s.append(found.elapsed_s)
+        self.planning_cpu_s.append(found.cpu_s)
         fresh = [c for c in found.candidates
                  if not any(same_configuration(c.q, o.q) for o in self.tried)]  # fmt: skip
+        # After a stall, another kind of configuration first: the neighbours of one that
+        # stalled stall alike (same base within 0.1 m and 0.3 rad).
+        fresh.sort(key=lambda c: any(same_kind(c.q, o.q) for o in self.tried))
         if not fresh:
             self._give_up(t, found.reason or "every staging candidate was tried")
             return
@@ -185,10 +207,7 @@ class StagingSupervisor:
         self.events.append(Event(t, "plan", f"candidate {len(self.tried)} of "
                                  f"{len(found.candidates)}: base ({base}) score "
                                  f"{fresh[0].score:.2f} sigma {fresh[0].sigma:.3f}"))  # fmt: skip
-        q = request.q
-        near = (math.hypot(*(fresh[0].base[:2] - q[:2])) < self.staging.final_leg
-                and abs(wrap(fresh[0].base[2] - q[2])) < NEAR_HEADING)  # fmt: skip
-        self._enter(Phase.APPROACH if near else Phase.DRIVE, t)
+        self._enter(Phase.APPROACH if fresh[0].way is None else Phase.DRIVE, request.q, t)
 
     def _replan(self, q: Array, t: float) -> None:
         if self.replans >= self.params.max_replans:
@@ -204,12 +223,44 @@ class StagingSupervisor:
         self.phase, self._task = Phase.UNREACHABLE, None
         self.events.append(Event(t, "unreachable", reason))
 
-    def _advance(self, t: float) -> None:
-        """Enter the phase declared after this one (``Phase`` lists them in order)."""
+    def _advance(self, q: Array, t: float) -> None:
+        """Drive to the leg's waypoint once facing it, or drive the next leg of the way, or
+        enter the phase declared after this one (``Phase`` lists them in order)."""
+        if self.phase is Phase.DRIVE and (self.facing or not self._last_leg):
+            self.leg += 0 if self.facing else 1
+            self._drive(q, t, turn_first=not self.facing)
+            return
         order = list(Phase)
-        self._enter(order[order.index(self.phase) + 1], t)
+        self._enter(order[order.index(self.phase) + 1], q, t)
 
-    def _enter(self, phase: Phase, t: float) -> None:
+    @property
+    def _last_leg(self) -> bool:
+        way = self.candidate.way if self.candidate is not None else None
+        return way is None or self.leg >= len(way.waypoints) - 1
+
+    def _drive(self, q: Array, t: float, turn_first: bool = True) -> None:
+        """The task of the current leg: the turn to face its waypoint (``face_turn``), then
+        the point task to it; for the last leg, to the staging point, the point d ahead of it
+        on the candidate's heading."""
+        candidate, d = self.candidate, self.params.lookahead
+        assert candidate is not None and candidate.way is not None
+        self._history.clear()
+        if self._last_leg:
+            phi = candidate.base[2]
+            point = candidate.staging + d * np.array([math.cos(phi), math.sin(phi)])
+        else:
+            point = candidate.way.waypoints[self.leg]
+        bearing = math.atan2(point[1] - q[1], point[0] - q[0])
+        self.facing = turn_first and abs(wrap(bearing - q[2])) > self.params.face_turn
+        if self.facing:
+            self._task = HeadingTask(bearing, candidate.arm, np.array(q[:2], dtype=float))
+        else:
+            self._task = PointTask(point, candidate.arm, d)
+        legs = len(candidate.way.waypoints)
+        self.events.append(Event(t, "phase", f"drive, leg {self.leg + 1} of {legs}"
+                                 + (", facing it" if self.facing else "")))  # fmt: skip
+
+    def _enter(self, phase: Phase, q: Array, t: float) -> None:
         self.phase = phase
         self._history.clear()
         candidate, d = self.candidate, self.params.lookahead
@@ -217,11 +268,12 @@ class StagingSupervisor:
         x, y, phi = candidate.base
         heading = np.array([math.cos(phi), math.sin(phi)])
         if phase is Phase.DRIVE:
-            point = candidate.staging_point(self.staging.final_leg) + d * heading
-            self._task = PointTask(point, candidate.arm, d)
-        elif phase is Phase.TURN:
-            position = candidate.staging_point(self.staging.final_leg)
-            self._task = HeadingTask(float(phi), candidate.arm, position)
+            self.leg = 0
+            self._drive(q, t)
+            return
+        self.facing = False
+        if phase is Phase.TURN:
+            self._task = HeadingTask(float(phi), candidate.arm, candidate.staging)
         elif phase is Phase.APPROACH:
             self._task = PointTask(np.array([x, y]) + d * heading, candidate.arm, d)
         elif phase is Phase.ALIGN:
@@ -240,8 +292,11 @@ class StagingSupervisor:
 
     def _met(self, error: Array) -> bool:
         p = self.params
+        if self.phase is Phase.DRIVE and self.facing:
+            return bool(abs(error[0]) < p.face_tolerance)
         if self.phase is Phase.DRIVE:
-            return bool(np.linalg.norm(error[:2]) < p.leg_tolerance)
+            tolerance = p.leg_tolerance if self._last_leg else p.waypoint_tolerance
+            return bool(np.linalg.norm(error[:2]) < tolerance)
         if self.phase is Phase.TURN:
             return bool(abs(error[0]) < p.turn_tolerance)
         if self.phase is Phase.APPROACH:

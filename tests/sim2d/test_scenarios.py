@@ -16,6 +16,7 @@ from sim2d.scenarios import (
     ANYWHERE_OBSTACLE,
     ANYWHERE_START,
     BIN_RANGE,
+    BLOCKED_START,
     NAMES,
     OBSTACLE_SHIFT,
     START_RANGE,
@@ -25,9 +26,12 @@ from sim2d.scenarios import (
 )
 from wbc import dq
 from wbc.arm_clearance import part_clearances
+from wbc.disc_geometry import segment_clear
+from wbc.lp_law import LPParams
 from wbc.planar import offset_pose, planar_of, planar_pose
 from wbc.robot import BASE_DOF, MobileManipulator
 from wbc.scenarios import HOME, OBSTACLE, REACH_GOAL, TABLE, TABLE_GOAL, TABLE_START
+from wbc.staging import plan
 
 REPO = Path(__file__).resolve().parents[2]
 ROBOT = MobileManipulator.from_yaml(REPO / "deploy/robots/little_john.yaml")
@@ -54,13 +58,13 @@ def test_the_default_goal_is_the_dissertations_reach_goal() -> None:
 
 @pytest.mark.parametrize("name", NAMES)
 def test_the_default_set_up_starts_at_home(name: str) -> None:
-    """Every set-up but 'table' starts with HOME's arm; all but 'anywhere' at HOME's base
-    too; 'table' at TABLE_START."""
+    """Every set-up but 'table' starts with HOME's arm; all but 'anywhere', 'blocked' and
+    'table' at HOME's base too; 'table' at TABLE_START."""
     setup = scenario(name, ROBOT)
     assert setup.name == name
     home = TABLE_START.copy() if name == "table" else HOME.copy()
-    if name == "anywhere":
-        home[:BASE_DOF] = ANYWHERE_START
+    if name in ("anywhere", "blocked"):
+        home[:BASE_DOF] = ANYWHERE_START if name == "anywhere" else BLOCKED_START
     assert np.array_equal(setup.start, home)
 
 
@@ -70,6 +74,22 @@ def test_the_anywhere_set_up_puts_the_goal_behind_the_robot_past_an_obstacle() -
     bearing = math.atan2(setup.bin[1] - y, setup.bin[0] - x) - phi
     assert abs(math.remainder(bearing, 2 * math.pi)) > 0.9 * math.pi
     assert setup.task == "pose" and setup.obstacles == (ANYWHERE_OBSTACLE,)
+
+
+def test_the_blocked_set_up_puts_its_obstacle_on_the_straight_way_clear_of_both_ends() -> None:
+    """The obstacle cuts the segment from the start's base to where the staging planner puts
+    the base for the bin, by more than the base's body and the LP's margin; both ends stand
+    clear of it."""
+    setup = scenario("blocked", ROBOT)
+    (circle,) = setup.obstacles
+    goal = dq.mul(planar_pose(*setup.bin, scene().goal.height_m), offset_pose(*scene().goal.offset))
+    best = plan(ROBOT, np.array(setup.start), goal).candidates[0]
+    body = ROBOT.base.body_radius + LPParams().obstacle_margin
+    start = np.array(setup.start[:2])
+    for end in (best.base[:2], best.staging):
+        assert not segment_clear(start, end, [circle], body)
+        assert segment_clear(end, end, [circle], body)
+    assert segment_clear(start, start, [circle], body)
 
 
 def test_the_pose_set_up_puts_the_bin_under_the_reach_goal_without_obstacles() -> None:

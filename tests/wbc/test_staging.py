@@ -9,6 +9,7 @@ import pytest
 from wbc_scenarios import robot
 
 from parsimony.goal_sets import FAMILIES, goals
+from parsimony.kinematic_demo import supervised_params
 from wbc import dq
 from wbc.conditioning import smallest_singular_value
 from wbc.drive_tasks import HeadingTask, PointTask, offset_point
@@ -18,7 +19,7 @@ from wbc.obstacles import Circle
 from wbc.planar import planar_pose
 from wbc.scenarios import DT, HOME
 from wbc.staging import StagingParams, arm_box, plan
-from wbc.staging_supervisor import Phase, StagingSupervisor
+from wbc.staging_supervisor import Phase, StagingSupervisor, SupervisorParams
 from wbc.task import PoseTask
 
 MODEL = robot()
@@ -124,7 +125,7 @@ def test_a_goal_no_configuration_reaches_is_reported_at_once_and_gives_no_task()
     assert "no whole-body configuration" in supervisor.reason
 
 
-def test_a_walled_off_goal_is_given_up_after_the_bounded_re_plans_and_the_robot_stops() -> None:
+def test_a_walled_off_goal_is_reported_at_once_with_no_way_and_the_robot_never_moves() -> None:
     goal_q = np.array([2.0, 0.0, 0.0, 0.0, -0.3, -0.4, 0.2, 0.3])
     goal = MODEL.fkm(goal_q)
     # A ring of posts 0.9 m round the goal, too close together for the base to pass.
@@ -132,11 +133,44 @@ def test_a_walled_off_goal_is_given_up_after_the_bounded_re_plans_and_the_robot_
             for a in np.linspace(0.0, 2.0 * math.pi, 30, endpoint=False)]  # fmt: skip
     supervisor = StagingSupervisor(MODEL, goal, ring)
     run = integrate_supervised(LPLaw(MODEL), supervisor, HOME, DT, STEPS, ring)
+    assert supervisor.phase is Phase.UNREACHABLE and not run.converged and not run.outputs
+    assert "have no way to their staging point" in supervisor.reason, supervisor.reason
+    assert "no way round the obstacles from (0.00, 0.00)" in supervisor.reason
+
+
+def test_stalls_are_re_planned_a_bounded_number_of_times_and_then_the_robot_stops() -> None:
+    goal = MODEL.fkm(np.array([-0.7, 0.3, math.pi - 0.4, 0.2, -0.3, -0.4, 0.2, 0.3]))
+    # Every phase must shed 90 % of its error in 0.1 s: none does, so each one stalls.
+    hasty = SupervisorParams(stall_window_s=0.1, stall_reduction=0.9)
+    supervisor = StagingSupervisor(MODEL, goal, params=hasty)
+    run = integrate_supervised(LPLaw(MODEL), supervisor, HOME, DT, STEPS)
     assert supervisor.phase is Phase.UNREACHABLE and not run.converged
-    assert supervisor.replans == supervisor.params.max_replans
-    assert "stalled" in supervisor.reason
-    assert sum(e.kind == "stall" for e in supervisor.events) == supervisor.params.max_replans + 1
+    assert supervisor.replans == hasty.max_replans
+    assert supervisor.reason.startswith("stalled in") or "was tried" in supervisor.reason
+    assert sum(e.kind == "stall" for e in supervisor.events) == supervisor.replans + 1
     assert len(run.outputs) < STEPS
+
+
+def test_the_supervisor_drives_round_a_circle_on_the_straight_way_without_contact() -> None:
+    """The goal's base 1.4 m ahead, a post of 0.1 m half way: the base drives the planned way
+    round it, every command one LP step with the obstacle constraint on, and the base's body
+    never comes within the LP's margin of the post."""
+    goal = MODEL.fkm(np.array([1.4, 0.0, 0.0, 0.0, -0.3, -0.4, 0.2, 0.3]))
+    post = Circle(0.7, 0.02, 0.1)
+    law = LPLaw(MODEL, supervised_params())
+    supervisor = StagingSupervisor(MODEL, goal, [post])
+    run = integrate_supervised(law, supervisor, HOME, DT, STEPS, [post])
+    assert run.converged and supervisor.phase is Phase.REACHED, supervisor.events
+    way = supervisor.tried[0].way
+    assert way is not None and way.arcs and len(way.waypoints) >= 2
+    legs = [e.detail for e in supervisor.events if e.detail.startswith("drive, leg")]
+    assert len(legs) >= 2
+    q = np.array(run.configurations)
+    gap = np.hypot(q[:, 0] - post.x, q[:, 1] - post.y) - post.radius - MODEL.base.body_radius
+    assert gap.min() > 0.0
+    assert all(out.status == "optimal" for out in run.outputs)
+    x = MODEL.fkm(run.configurations[-1])
+    assert np.linalg.norm(x - dq.nearest_equivalent(goal, x)) < 1e-3
 
 
 def test_the_pose_task_alone_is_what_runs_once_the_base_stands_at_its_candidate() -> None:
