@@ -44,12 +44,13 @@ the arm's reach."""
 WALL_SIDE_M = 3.0
 """The side of the square a plane without a footprint is drawn as: the workspace round F0."""
 WALL_THICKNESS_M = 0.03
-OBSTACLE_COLOR = fox.Color(r=0.6, g=0.4, b=0.3, a=0.8)
-"""Every obstacle's colour: apart from the robots' (blue, green, orange), and not the red of
-a penetration (``record.penetration_scene``)."""
-FACE_COLOR = fox.Color(r=0.6, g=0.4, b=0.3, a=0.7)
+OBSTACLE_RGB = (0.6, 0.4, 0.3)
+"""Every obstacle's colour (here and in the report's figures): apart from the robots' (blue,
+green, orange), and not the red of a penetration (``record.penetration_scene``)."""
+OBSTACLE_COLOR = fox.Color(r=OBSTACLE_RGB[0], g=OBSTACLE_RGB[1], b=OBSTACLE_RGB[2], a=0.8)
+FACE_COLOR = fox.Color(r=OBSTACLE_RGB[0], g=OBSTACLE_RGB[1], b=OBSTACLE_RGB[2], a=0.7)
 """A solid's face: the plane the robot keeps clear of."""
-BODY_COLOR = fox.Color(r=0.6, g=0.4, b=0.3, a=0.2)
+BODY_COLOR = fox.Color(r=OBSTACLE_RGB[0], g=OBSTACLE_RGB[1], b=OBSTACLE_RGB[2], a=0.2)
 """A solid's sides, faint: the arm's parts inside it stay visible."""
 EDGE_COLOR = fox.Color(r=0.35, g=0.22, b=0.15, a=1.0)
 EDGE_THICKNESS_PX = 2.0
