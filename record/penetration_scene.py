@@ -33,8 +33,10 @@ def configuration(truth: SimTruth) -> np.ndarray:
 def penetrating(robot: MobileManipulator, truth: SimTruth) -> tuple[str, ...]:
     """The names of the collision parts inside a solid now (none unless the truth says one
     is)."""
+    if not truth.arm_penetrating or not robot.collision.names:
+        return ()
     solids = truth.solids.solids()
-    if not truth.arm_penetrating or not solids or not robot.collision.names:
+    if not solids:
         return ()
     inside = part_clearances(robot, configuration(truth), solids).min(axis=1) < 0.0
     return tuple(name for name, found in zip(robot.collision.names, inside, strict=True)
