@@ -34,9 +34,9 @@ panels open a recording (or a live view) with no plugin:
 
 The robot, its frames and its model are ``record.robot_scene``'s; the plan's
 ``record.plan_views``'; the annotations ``record.marker_annotations``'; the obstacles'
-``record.obstacle_scene``'; the penetrations' ``record.penetration_scene``'. Each view is protobuf,
-encoded by foxglove-sdk with its schema, and goes on the channel ``<key>/<suffix>``
-(``View.channel``): ``foxglove`` for the transforms, images and obstacles, the name above for
+``record.obstacle_scene``'; the penetrations' ``record.penetration_scene``'. Each view is
+protobuf, encoded by foxglove-sdk with its schema, and goes on the channel ``<key>/<suffix>``
+(``View.channel``): ``foxglove`` for the transforms, images and circles, the name above for
 the others, so no two views of a key share a channel.
 """
 
