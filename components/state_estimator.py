@@ -23,9 +23,10 @@ known from), just before its state.
 The goal is the pose x_d^0 = x_2^0 x_d^2 of eq. 6.3 with x_d^2 the scene's goal offset (its
 translation for a ``position`` task), once the bin marker F2 has been seen; the obstacles, a
 circle of the scene's radius at every obstacle marker (the controller adds the robot's radius,
-section 5.5), for every frame, seen or not, with the planes and cylinders the scene declares
-(``scene.arm_obstacles``, already in F0). So what the controller is given, and when, does
-not depend on when a frame's markers arrive within the latency.
+section 5.5), its top as high as the marker lies, for every frame, seen or not, with the
+planes and cylinders the scene declares (``scene.arm_obstacles``, already in F0). So what the
+controller is given, and when, does not depend on when a frame's markers arrive within the
+latency.
 """
 
 from __future__ import annotations
@@ -211,8 +212,9 @@ class StateEstimator(Component):
         self.goal.put(goal)
 
     def _publish_obstacles(self, frame: Frame, stamp_ns: int) -> None:
-        radius = self.scene.obstacles.radius_m
-        circles = tuple(Circle(x=x, y=y, radius=radius) for x, y in frame.obstacles)
+        radius, height = self.scene.obstacles.radius_m, self.scene.obstacles.height_m or None
+        circles = tuple(Circle(x=x, y=y, radius=radius, height=height)
+                        for x, y in frame.obstacles)  # fmt: skip
         header = self.node.header(WORLD_FRAME, stamp_ns, self.obstacles.next_seq)
         self.obstacles.put(Obstacles(header=header, circles=circles,
                                      solids=self.scene.arm_obstacles))  # fmt: skip

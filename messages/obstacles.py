@@ -11,11 +11,13 @@ from wbc import obstacles, obstacles3d
 
 
 class Circle(Message):
-    """A circular obstacle: centre ``(x, y)`` and ``radius``, in m."""
+    """A circular obstacle: centre ``(x, y)`` and ``radius``, in m, which the base clears at any
+    height; its top's ``height`` above the floor (where its marker lies), m, where known."""
 
     x: Finite
     y: Finite
     radius: Positive
+    height: Positive | None = None
 
 
 MAX_CIRCLES = 256

@@ -5,7 +5,8 @@ foxglove-sdk's layout support (``foxglove.layouts``): it opens ready on the chan
     +---------------------------+---------------------+
     | 3-D: the robot (estimate  | the camera image,   |
     | solid, truth ghost), the  | each marker's       |
-    | goal, the plan; publish   | outline and id      |
+    | goal, the plan, the       | outline and id      |
+    | obstacles; publish        |                     |
     | pose -> goal/request      +---------------------+
     |                           | task error | nonzero|
     +-------------+-------------+------------+--------+
@@ -25,7 +26,9 @@ from record.foxglove_views import (
     ANNOTATIONS_SUFFIX,
     CHANNEL_SUFFIX,
     MODEL_SUFFIX,
+    PENETRATIONS_SUFFIX,
     SCENE_SUFFIX,
+    SOLIDS_SUFFIX,
 )
 
 FIXED_FRAME = "world"
@@ -43,10 +46,11 @@ def path(namespace: str, topic: topics.Topic, field: str) -> str:
 
 
 def three_d(namespace: str) -> fl.ThreeDeePanel:
-    """The robot, estimate and truth, the obstacles and the plan, in F0; the publish-pose tool
-    sends to goal/request."""
+    """The robot, estimate and truth (its parts inside a solid red), the obstacles (circles and
+    solids) and the plan, in F0; the publish-pose tool sends to goal/request."""
     scenes = [(topics.ROBOT_STATE, MODEL_SUFFIX), (topics.SIM_TRUTH, MODEL_SUFFIX),
-              (topics.SUPERVISOR_STATUS, SCENE_SUFFIX), (topics.WORLD_OBSTACLES, CHANNEL_SUFFIX)]
+              (topics.SIM_TRUTH, PENETRATIONS_SUFFIX), (topics.SUPERVISOR_STATUS, SCENE_SUFFIX),
+              (topics.WORLD_OBSTACLES, CHANNEL_SUFFIX), (topics.WORLD_OBSTACLES, SOLIDS_SUFFIX)]
     shown = {channel(namespace, topic, suffix): fl.BaseRendererSceneUpdateTopicSettings(
         visible=True) for topic, suffix in scenes}  # fmt: skip
     return fl.ThreeDeePanel(title="Robot", config=fl.ThreeDeeConfig(

@@ -14,6 +14,8 @@ panels open a recording (or a live view) with no plugin:
                                                         -> truth/base ..., truth/end_effector,
                                                         truth/goal
                            -> foxglove.SceneUpdate      the robot's model (``model``)
+                           -> foxglove.SceneUpdate      the parts inside a solid, red
+                                                        (``penetrations``)
     MarkerDetections       -> foxglove.FrameTransforms  camera -> marker_<id> (vision/markers),
                                                         world -> estimate/marker_<id>
                                                         (world/markers)
@@ -21,16 +23,20 @@ panels open a recording (or a live view) with no plugin:
                                                         image (vision/markers, ``annotations``)
     Goal (pose task)       -> foxglove.FrameTransforms  world -> goal (control/goal, goal/request),
                                                         world -> estimate/goal (world/goal)
-    Obstacles              -> foxglove.SceneUpdate      one cylinder per circle, frame "world"
+    Obstacles              -> foxglove.SceneUpdate      one cylinder per circle, in the
+                                                        message's frame ("world")
+                           -> foxglove.SceneUpdate      its planes and cylinders in 3-D
+                                                        (``solids``)
     SupervisorStatus       -> foxglove.FrameTransforms  world -> candidate/base -> ... (its
                                                         staging candidate)
                            -> foxglove.SceneUpdate      its way and the candidate's ghost
                                                         (``scene``)
 
 The robot, its frames and its model are ``record.robot_scene``'s; the plan's
-``record.plan_views``'; the annotations ``record.marker_annotations``'. Each view is protobuf,
-encoded by foxglove-sdk with its schema, and goes on the channel ``<key>/<suffix>``
-(``View.channel``): ``foxglove`` for the transforms, images and obstacles, the name above for
+``record.plan_views``'; the annotations ``record.marker_annotations``'; the obstacles'
+``record.obstacle_scene``'; the penetrations' ``record.penetration_scene``'. Each view is
+protobuf, encoded by foxglove-sdk with its schema, and goes on the channel ``<key>/<suffix>``
+(``View.channel``): ``foxglove`` for the transforms, images and circles, the name above for
 the others, so no two views of a key share a channel.
 """
 
@@ -55,6 +61,8 @@ from messages.supervisor import SupervisorStatus
 from messages.truth import SimTruth
 from record.foxglove_frames import planar_transform, pose_transform, timestamp
 from record.marker_annotations import marker_annotations
+from record.obstacle_scene import circle_scene, solid_scene
+from record.penetration_scene import penetrating, penetration_scene
 from record.plan_views import CANDIDATE_COLOR, CANDIDATE_PREFIX, plan_scene, plan_transforms
 from record.robot_scene import RobotDrawing
 from wbc.planar import inverse
@@ -64,15 +72,15 @@ CHANNEL_SUFFIX = "foxglove"
 """A view of the message on key K goes on the channel ``K/foxglove`` unless it says another."""
 MODEL_SUFFIX, ANNOTATIONS_SUFFIX, SCENE_SUFFIX = "model", "annotations", "scene"
 """The channels of a robot's model, a frame's marker annotations, the supervisor's plan."""
+SOLIDS_SUFFIX, PENETRATIONS_SUFFIX = "solids", "penetrations"
+"""The channels of the obstacles in 3-D and of the robot's parts inside them."""
 MODEL_EVERY = 25
 """A robot's model goes with one state in this many, by its sequence number (twice a second
-at 50 Hz), and the supervisor's plan when it changes and as often: a client that joins late,
-or a file opened anywhere, has them within that; the frames move them in between."""
+at 50 Hz), and the supervisor's plan and the solids when they change and as often: a client
+that joins late, or a file opened anywhere, has them within that; the frames move them in
+between."""
 ESTIMATE_COLOR = fox.Color(r=0.25, g=0.5, b=0.95, a=1.0)
 TRUTH_COLOR = fox.Color(r=0.3, g=0.85, b=0.35, a=0.45)
-OBSTACLE_HEIGHT_M = 0.3
-"""How tall the 3D panel draws an obstacle, m."""
-OBSTACLE_COLOR = fox.Color(r=0.8, g=0.2, b=0.2, a=0.8)
 
 
 @dataclass(frozen=True)
@@ -161,23 +169,6 @@ def goal_frame(frame: str) -> Callable[[Goal], fox.FrameTransforms | None]:
     return make
 
 
-def obstacle_scene(obstacles: Obstacles) -> fox.SceneUpdate:
-    """Every obstacle as a cylinder standing on the floor; the update first deletes all the
-    entities of the previous one, so obstacles that are gone disappear."""
-    stamp = timestamp(obstacles.header.stamp_ns)
-    entities = [fox.SceneEntity(
-        timestamp=stamp, frame_id="world", id=f"obstacle_{index}",
-        cylinders=[fox.CylinderPrimitive(
-            pose=fox.Pose(position=fox.Vector3(x=c.x, y=c.y, z=OBSTACLE_HEIGHT_M / 2),
-                          orientation=fox.Quaternion(w=1.0)),
-            size=fox.Vector3(x=2 * c.radius, y=2 * c.radius, z=OBSTACLE_HEIGHT_M),
-            bottom_scale=1.0, top_scale=1.0, color=OBSTACLE_COLOR,
-        )],
-    ) for index, c in enumerate(obstacles.circles)]  # fmt: skip
-    deletion = fox.SceneEntityDeletion(timestamp=stamp, type=fox.SceneEntityDeletionType.All)
-    return fox.SceneUpdate(deletions=[deletion], entities=entities)
-
-
 def state_frames(drawing: RobotDrawing | None, state: RobotState) -> fox.FrameTransforms:
     """The estimate's frames: its base and links (with a robot to draw, else the base alone)
     and the end effector as the estimator gives it."""
@@ -246,8 +237,8 @@ class Viewer:
     """The views of every topic's messages (the table of the module docstring). Given the
     robot description, the estimate and the truth are drawn as robots and the supervisor's
     staging candidate as a ghost (``record.robot_scene``); without it, their bases and end
-    effectors alone. A ``Viewer`` remembers the last plan of each key, to send it when it
-    changes: one writer or server uses one."""
+    effectors alone. A ``Viewer`` remembers the last plan, solids and penetrating parts of each
+    key, to send them when they change: one writer or server uses one."""
 
     def __init__(self, robot: MobileManipulator | None = None) -> None:
         self.robot = robot
@@ -255,7 +246,10 @@ class Viewer:
         estimate = drawing("estimate/", ESTIMATE_COLOR) if drawing else None
         truth = drawing("truth/", TRUTH_COLOR, "truth/world") if drawing else None
         self._candidate = drawing(CANDIDATE_PREFIX, CANDIDATE_COLOR) if drawing else None
+        self._truth_world = truth.parent if truth else ""
         self._plans: dict[str, tuple] = {}
+        self._solids: dict[str, tuple] = {}
+        self._penetrating: dict[str, tuple[str, ...]] = {}
         frames, scene = fox.FrameTransforms, fox.SceneUpdate
         goal = maker(CHANNEL_SUFFIX, frames, goal_frame("goal"))
         self._makers: dict[str, tuple[ViewMaker, ...]] = {
@@ -265,7 +259,9 @@ class Viewer:
                 *([maker(MODEL_SUFFIX, scene, robot_model(estimate))] if estimate else [])),
             topics.SIM_TRUTH.name: (
                 maker(CHANNEL_SUFFIX, frames, functools.partial(truth_frames, truth)),
-                *([maker(MODEL_SUFFIX, scene, robot_model(truth))] if truth else [])),
+                *([maker(MODEL_SUFFIX, scene, robot_model(truth)),
+                   ViewMaker(PENETRATIONS_SUFFIX, scene,
+                             functools.partial(self._penetrations, robot))] if truth else [])),
             topics.VISION_MARKERS.name: (
                 maker(CHANNEL_SUFFIX, frames, marker_frames("")),
                 maker(ANNOTATIONS_SUFFIX, fox.ImageAnnotations, marker_annotations)),
@@ -274,7 +270,8 @@ class Viewer:
             topics.CONTROL_GOAL.name: (goal,),
             topics.GOAL_REQUEST.name: (goal,),
             topics.WORLD_GOAL.name: (maker(CHANNEL_SUFFIX, frames, goal_frame("estimate/goal")),),
-            topics.WORLD_OBSTACLES.name: (maker(CHANNEL_SUFFIX, scene, obstacle_scene),),
+            topics.WORLD_OBSTACLES.name: (maker(CHANNEL_SUFFIX, scene, circle_scene),
+                                          ViewMaker(SOLIDS_SUFFIX, scene, self._solid_scene)),
             topics.SUPERVISOR_STATUS.name: (
                 maker(CHANNEL_SUFFIX, frames, self._plan_frames),
                 ViewMaker(SCENE_SUFFIX, scene, self._plan_scene)),
@@ -314,6 +311,25 @@ class Viewer:
             return None
         self._plans[key] = plan
         return plan_scene(self._candidate, status)
+
+    def _solid_scene(self, key: str, obstacles: Obstacles) -> fox.SceneUpdate | None:
+        """The solids when they (or their frame) changed, and every ``MODEL_EVERY``
+        messages."""
+        solids = (obstacles.header.frame, obstacles.solids)
+        if self._solids.get(key) == solids and obstacles.header.seq % MODEL_EVERY:
+            return None
+        self._solids[key] = solids
+        return solid_scene(obstacles)
+
+    def _penetrations(self, robot: MobileManipulator, key: str, truth: SimTruth
+                      ) -> fox.SceneUpdate | None:  # fmt: skip
+        """The parts inside a solid, with every truth while there are some; an empty scene
+        with the first truth and when they are gone."""
+        parts = penetrating(robot, truth)
+        if not parts and self._penetrating.get(key) == ():
+            return None
+        self._penetrating[key] = parts
+        return penetration_scene(robot, self._truth_world, truth, parts)
 
 
 PLAIN = Viewer()

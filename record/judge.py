@@ -215,15 +215,26 @@ def clearance(truth: Sequence, robot: MobileManipulator) -> float | None:
     return round(float(np.min(gaps)), 4)
 
 
-def arm_clearance(truth: Sequence, robot: MobileManipulator) -> dict[str, float] | None:
-    """The least clearance of each collision part of the robot from the solids in 3-D over
-    the run, m (negative: the deepest penetration), from the true configurations
-    (``wbc.arm_clearance``); None without the truth or solids."""
+def arm_clearances(truth: Sequence, robot: MobileManipulator) -> Array | None:
+    """(samples, parts): the clearance of each collision part of the robot (``robot.collision
+    .names``) from the nearest solid in 3-D at each ground-truth sample, m (negative: the depth
+    of a penetration), from the true configurations (``wbc.arm_clearance``); None without the
+    truth or solids."""
     if not truth or not truth[-1].solids.solids() or not robot.collision.names:
         return None
     solids = truth[-1].solids.solids()
-    least = np.min([part_clearances(robot, np.array([*t.base_pose, *t.arm_joints]), solids)
-                    .min(axis=1) for t in truth], axis=0)  # fmt: skip
+    return np.array([part_clearances(robot, np.array([*t.base_pose, *t.arm_joints]), solids)
+                     .min(axis=1) for t in truth])  # fmt: skip
+
+
+def arm_clearance(truth: Sequence, robot: MobileManipulator) -> dict[str, float] | None:
+    """The least clearance of each collision part from the solids in 3-D over the run, m
+    (negative: the deepest penetration; ``arm_clearances``); None without the truth or
+    solids."""
+    found = arm_clearances(truth, robot)
+    if found is None:
+        return None
+    least = found.min(axis=0)
     return {name: round(float(value), 4)
             for name, value in zip(robot.collision.names, least, strict=True)}  # fmt: skip
 

@@ -17,7 +17,12 @@ Times are in s from the session's first command.
     error.png              e = x - x_d of the end effector, or p - p_d for a position task (6.9)
     joints.png             q1..q5 against their limits, dashed green (6.10)
     end_effector_path.png  x-y of the end effector and the goal (6.14)
-    base_path.png          x-y of the base and the obstacles
+    base_path.png          x-y of the base and the obstacles: the circles, each table's (or
+                           underside's) footprint, each pole, each wall where it meets the floor
+    arm_clearance.png      each collision part's clearance from the nearest solid in 3-D over
+                           time, from the ground truth (``record.judge.arm_clearances``, whose
+                           least is the judge's ``arm_clearance_m``); written when a session's
+                           truth has solids
     effort.json, effort.md the four metrics of table 6.1 (``record.judge.effort_of_inputs``)
 """
 
@@ -32,9 +37,10 @@ from typing import Any
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
-from matplotlib.patches import Circle
+from matplotlib.patches import Circle, Polygon
 
 from messages.goal import Goal
+from messages.obstacles import Cylinder, Plane
 from messages.topics import (
     CONTROL_DIAGNOSTICS,
     CONTROL_GOAL,
@@ -43,7 +49,16 @@ from messages.topics import (
     SIM_TRUTH,
     WORLD_OBSTACLES,
 )
-from record.judge import Array, Session, commands, effort_of_inputs, messages, required
+from record.judge import (
+    Array,
+    Session,
+    arm_clearances,
+    commands,
+    effort_of_inputs,
+    messages,
+    required,
+)
+from record.obstacle_scene import OBSTACLE_RGB
 from wbc import dq
 from wbc.planar import in_frame, planar_pose
 from wbc.robot import MobileManipulator
@@ -55,6 +70,9 @@ FORMULAS: Mapping[str, str] = {
     "metric4": r"$\sqrt{\int \lVert\ddot{q}\rVert_2^2\,dt}$",
 }
 """Table 6.1's metrics (``record.judge.METRICS``) as formulas."""
+
+UNIT_TOLERANCE = 1e-9
+"""Under this squared horizontal length a plane's normal is vertical."""
 
 INPUT_NAMES = ("x'", "y'", "phi'", "q1'", "q2'", "q3'", "q4'", "q5'")
 """The entries of u, in order."""
@@ -87,14 +105,15 @@ def write_report(
         raise ValueError(f"a report compares one or two sessions, got {len(sessions)}")
     if len(set(labels)) != len(labels):
         raise ValueError(f"session labels must differ, got {labels}")
-    recordings = [_recording(label, session, truth_frame) for label, session in sessions]
+    recordings = [_recording(label, session, truth_frame, robot) for label, session in sessions]
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     figures = []
     for name, draw in _FIGURES.items():
         figure = draw(recordings, robot)
-        figure.savefig(out / name, dpi=100)
-        figures.append(out / name)
+        if figure is not None:
+            figure.savefig(out / name, dpi=100)
+            figures.append(out / name)
     efforts = {rec.label: effort_of_inputs(rec.stamps_ns, rec.u) for rec in recordings}
     if short := [label for label, found in efforts.items() if found is None]:
         raise ValueError(f"{', '.join(short)}: the control effort needs two commands or more")
@@ -115,6 +134,8 @@ class _Recording:
     diagnostics: list
     obstacles: list
     truth: list
+    arm_clearance: tuple[Array, Array] | None
+    """(t, (samples, parts) clearances) of the ground truth (``record.judge.arm_clearances``)."""
 
     def seconds(self, messages: Sequence[Any]) -> Array:
         """The stamps of ``messages`` in s from the first command."""
@@ -134,10 +155,16 @@ def _in_frame(truth: Any, frame: tuple[float, float, float]) -> Any:
 
 
 def _recording(
-    label: str, session: Session, truth_frame: tuple[float, float, float] | None
+    label: str,
+    session: Session,
+    truth_frame: tuple[float, float, float] | None,
+    robot: MobileManipulator,
 ) -> _Recording:
     stamps, u = commands(session)
-    truth = messages(session, SIM_TRUTH) if truth_frame is not None else []
+    recorded = messages(session, SIM_TRUTH)
+    truth = recorded if truth_frame is not None else []
+    clearance = arm_clearances(recorded, robot)  # the same in any frame: no truth_frame needed
+    stamped = np.array([t.header.stamp_ns for t in recorded], dtype=np.int64)
     return _Recording(
         label=label,
         stamps_ns=stamps,
@@ -147,6 +174,7 @@ def _recording(
         diagnostics=required(session, CONTROL_DIAGNOSTICS),
         obstacles=messages(session, WORLD_OBSTACLES),
         truth=[_in_frame(t, truth_frame) for t in truth],
+        arm_clearance=None if clearance is None else ((stamped - stamps[0]) * 1e-9, clearance),
     )
 
 
@@ -279,8 +307,60 @@ def _base_path_figure(recordings: Sequence[_Recording], robot: MobileManipulator
         for index, (cx, cy, radius) in enumerate(sorted(circles)):
             label = "obstacle" if index == 0 else None
             ax.add_patch(Circle((cx, cy), radius, color="red", alpha=0.4, label=label))
+        _solids_on_the_floor(ax, rec)
         ax.autoscale_view()
         ax.legend(fontsize="small")
+    return figure
+
+
+def _solids(rec: _Recording) -> tuple[list[Plane], list[Cylinder]]:
+    """Every distinct plane and cylinder the session's obstacles messages carried."""
+    planes = dict.fromkeys(p for message in rec.obstacles for p in message.solids.planes)
+    cylinders = dict.fromkeys(c for message in rec.obstacles for c in message.solids.cylinders)
+    return list(planes), list(cylinders)
+
+
+def _solids_on_the_floor(ax: Axes, rec: _Recording) -> None:
+    """The solids seen from above: a table's (or an underside's) footprint, each pole's disc,
+    each wall's line where it meets the floor (a horizontal plane without a footprint, which
+    covers the whole floor, is not drawn); each labelled with its height."""
+    planes, cylinders = _solids(rec)
+    for plane in planes:
+        solid = plane.solid()
+        nx, ny, _ = plane.normal
+        if plane.footprint:
+            kind = "top" if solid.side > 0 else "underside"
+            ax.add_patch(Polygon(solid.footprint, closed=True, color=OBSTACLE_RGB, alpha=0.35,
+                                 hatch="//", label=f"{plane.name} ({kind} at "
+                                 f"{plane.offset * solid.side:.2f} m)"))  # fmt: skip
+        elif nx * nx + ny * ny > UNIT_TOLERANCE:
+            along = plane.offset / (nx * nx + ny * ny)  # the floor's point nearest F0
+            ax.axline((along * nx, along * ny), (along * nx - ny, along * ny + nx),
+                      color=OBSTACLE_RGB, linewidth=2.0, label=f"{plane.name} (at the floor)")
+    for cylinder in cylinders:
+        top = "no top" if cylinder.height is None else f"{cylinder.height:.2f} m high"
+        ax.add_patch(Circle((cylinder.x, cylinder.y), cylinder.radius, color=OBSTACLE_RGB,
+                            alpha=0.6, hatch="xx", label=f"{cylinder.name} ({top})"))  # fmt: skip
+
+
+def _arm_clearance_figure(recordings: Sequence[_Recording], robot: MobileManipulator
+                          ) -> Figure | None:  # fmt: skip
+    """Each collision part's clearance from the nearest solid over time, 0 (contact) dashed
+    black; None when no session's truth has solids."""
+    if all(rec.arm_clearance is None for rec in recordings):
+        return None
+    figure, axes = _panels(recordings, 1, 4.0, sharey=True)
+    for ax, rec in zip(axes[0], recordings, strict=True):
+        if rec.arm_clearance is None:
+            ax.text(0.5, 0.5, "no solids in the ground truth", ha="center", va="center",
+                    transform=ax.transAxes)  # fmt: skip
+            continue
+        t, clearance = rec.arm_clearance
+        for column, name in enumerate(robot.collision.names):
+            ax.plot(t, clearance[:, column], label=name, linewidth=1.0)
+        ax.axhline(0.0, color="black", linestyle="--", linewidth=1.0, label="contact")
+        ax.set(xlabel="t (s)", ylabel="clearance from the nearest solid (m)")
+        ax.legend(ncols=4, fontsize="small")
     return figure
 
 
@@ -293,12 +373,13 @@ def _path(ax: Axes, points: Sequence[Sequence[float]], label: str, **style: Any)
     ax.set(xlabel="x (m)", ylabel="y (m)", aspect="equal", adjustable="datalim")
 
 
-_FIGURES: Mapping[str, Callable[[Sequence[_Recording], MobileManipulator], Figure]] = {
+_FIGURES: Mapping[str, Callable[[Sequence[_Recording], MobileManipulator], Figure | None]] = {
     "control_inputs.png": _control_inputs_figure,
     "nonzero_entries.png": _nonzero_figure,
     "error.png": _error_figure,
     "joints.png": _joints_figure,
     "end_effector_path.png": _end_effector_path_figure,
     "base_path.png": _base_path_figure,
+    "arm_clearance.png": _arm_clearance_figure,
 }
-"""Every figure of the report, by file name."""
+"""Every figure of the report, by file name (None: the sessions have nothing to draw in it)."""

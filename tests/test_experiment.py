@@ -13,12 +13,19 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
+from mcap.reader import make_reader
 
 from deploy import query
-from parsimony.experiment import DEPLOY, connect
+from messages.obstacles import Plane
+from parsimony.experiment import DEPLOY, PROFILES, connect
 from parsimony.sessions import load_session
 from profiles.profile import load_profile
+from record.foxglove_views import MODEL_EVERY, View
+from record.session_reader import info
+from tests.record.test_foxglove_views import decode, vector
+from wbc.planar import inverse
 
 ONE_DEGREE = math.radians(1.0)
 
@@ -136,6 +143,40 @@ def test_table_experiment_reaches_over_the_edge_without_touching_the_table(tmp_p
     code, blind = experiment(tmp_path / "blind", "table", "--gain", "arm_obstacles=false")
     assert code == 0 and blind["converged"] and blind["gains"] == {"arm_obstacles": False}
     assert blind["arm_penetrations"] > 0 and min(blind["arm_clearance_m"].values()) < -0.01
+    # What a user opening the runs sees: the table in Foxglove's 3-D panel, where the scene
+    # puts it, sent at a low rate; the blind run's parts inside it in red; the clearance figure.
+    # The scenario's table is in the simulator's world; the 3-D panel stands in F0 ("world").
+    in_f0 = Plane.model_validate(report["scenario"]["solids"][0]).solid().moved(
+        *inverse(load_profile(PROFILES["lp"]).scene.reference_pose))
+    guarded = tmp_path / "guarded" / "session.mcap"
+    solids = scenes(guarded, "/world/obstacles/solids")
+    obstacles = next(c["messages"] for c in info(guarded)["channels"]
+                     if c["key"].endswith("/world/obstacles"))  # fmt: skip
+    assert 0 < len(solids) <= obstacles // MODEL_EVERY + 1, (len(solids), obstacles)
+    for update in solids:
+        (entity,) = update["entities"]
+        top = np.array([vector(p, "xyz") for p in entity["triangles"][0]["points"]])
+        assert entity["frame_id"] == "world"  # F0, where the scene declares it
+        np.testing.assert_allclose(sorted(map(tuple, top[:, :2])), sorted(in_f0.footprint),
+                                   atol=1e-9)  # fmt: skip
+        assert top[:, 2] == pytest.approx(in_f0.offset)
+    assert not any(u.get("entities") for u in scenes(guarded, "/sim/truth/penetrations"))
+    inside = [u for u in scenes(tmp_path / "blind" / "session.mcap", "/sim/truth/penetrations")
+              if u.get("entities")]  # fmt: skip
+    assert inside and all(u["entities"][0]["frame_id"] == "truth/world" for u in inside)
+    for run in (report, blind):
+        assert any(Path(f).name == "arm_clearance.png" and Path(f).stat().st_size > 10_000
+                   for f in run["figures"])  # fmt: skip
+
+
+def scenes(path: Path, suffix: str) -> list[dict]:
+    """Every message of a recording's channel ending in ``suffix``, decoded with nothing but
+    the schema written beside it."""
+    with path.open("rb") as file:
+        return [decode(View(suffix, schema.name, schema.encoding, schema.data,
+                            channel.message_encoding, message.data))
+                for schema, channel, message in make_reader(file).iter_messages()
+                if channel.topic.endswith(suffix)]  # fmt: skip
 
 
 def test_position_experiment_with_the_cascade_converges(tmp_path: Path) -> None:

@@ -25,7 +25,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser = subparsers.add_parser(
         "report", help="figures like 6.6 to 6.14 and table 6.1 of one or two recordings",
         description="Write PNG figures (control inputs, nonzero entries, the error's eight "
-        "coefficients, joints against their limits, end-effector and base paths) and the four "
+        "coefficients, joints against their limits, end-effector and base paths with the "
+        "obstacles, the arm's clearance from the solids in 3-D) and the four "
         "effort metrics of table 6.1 (JSON and Markdown) into DIR; two files side by side.",
     )  # fmt: skip
     parser.add_argument("files", type=Path, nargs="+", metavar="FILE", help="MCAP sessions")

@@ -89,8 +89,9 @@ def test_every_topic_the_layout_names_is_a_channel_of_the_namespace(tmp_path: Pa
     assert named - {publish} <= channels, sorted(named - channels)
     assert {f"{NAMESPACE}/{suffix}" for suffix in (
         "camera/image/foxglove", "vision/markers/annotations", "robot/state/model",
-        "sim/truth/model", "supervisor/status/scene", "world/obstacles/foxglove",
-        "control/diagnostics", "supervisor/status")} <= named  # fmt: skip
+        "sim/truth/model", "sim/truth/penetrations", "supervisor/status/scene",
+        "world/obstacles/foxglove", "world/obstacles/solids", "control/diagnostics",
+        "supervisor/status")} <= named  # fmt: skip
     panels = json.dumps(document)
     for panel in ("ThreeDee", "Image", "Plot", "RawMessages", "Parameters"):
         assert f'"panelType":"{panel}"' in panels.replace(" ", "")

@@ -21,10 +21,9 @@ from messages.commands import BaseCommand
 from messages.goal import Goal
 from messages.header import Header
 from messages.markers import MarkerDetection, MarkerDetections
-from messages.obstacles import Circle, Obstacles
 from messages.state import RobotState
 from messages.truth import SimTruth
-from record.foxglove_views import OBSTACLE_HEIGHT_M, View, carried, views_of
+from record.foxglove_views import View, carried, views_of
 from record.session_file import SessionWriter
 from vision.images import jpeg
 from wbc import dq
@@ -108,8 +107,14 @@ def decode(view: View) -> dict[str, Any]:
 
     def read(type_name: str, data: bytes) -> dict[str, Any]:
         out: dict[str, Any] = {}
-        for number, _, raw in wire_fields(data):
+        for number, wire, raw in wire_fields(data):
             name, label, kind, nested = types[type_name][number]
+            if label == REPEATED and kind in FIXED_WIDTH and wire == 2:  # packed
+                width = struct.calcsize(FIXED_WIDTH[kind])
+                out.setdefault(name, []).extend(
+                    struct.unpack(FIXED_WIDTH[kind], raw[i : i + width])[0]
+                    for i in range(0, len(raw), width))  # fmt: skip
+                continue
             if kind == MESSAGE:
                 value = read(nested, raw)
             elif kind == STRING:
@@ -253,27 +258,6 @@ def test_a_pose_goal_is_a_frame_and_a_position_goal_has_no_view() -> None:
     assert vector(frame["translation"], "xyz") == pytest.approx([0.3, -0.1, 0.6])
     position = Goal(header=HEADER, task="position", position=(0.3, -0.1, 0.6))
     assert views_of(topics.CONTROL_GOAL.name, "sim/control/goal", position) == []
-
-
-def test_obstacles_are_one_cylinder_each_and_replace_the_previous_ones() -> None:
-    circles = (Circle(x=1.0, y=1.5, radius=0.3), Circle(x=-2.0, y=0.5, radius=0.25))
-    (view,) = views_of(topics.WORLD_OBSTACLES.name, "sim/world/obstacles",
-                       Obstacles(header=HEADER, circles=circles))  # fmt: skip
-    assert view.schema_name == "foxglove.SceneUpdate"
-    update = decode(view)
-    assert [d.get("type") for d in update["deletions"]] == [1]  # ALL
-    entities = update["entities"]
-    assert len(entities) == len(circles)
-    for entity, circle in zip(entities, circles, strict=True):
-        assert entity["frame_id"] == "world"
-        (cylinder,) = entity["cylinders"]
-        assert vector(cylinder["size"], "xyz") == [2 * circle.radius, 2 * circle.radius,
-                                                   OBSTACLE_HEIGHT_M]  # fmt: skip
-        position = cylinder["pose"]["position"]
-        assert vector(position, "xyz") == [circle.x, circle.y, OBSTACLE_HEIGHT_M / 2]
-    (none,) = views_of(topics.WORLD_OBSTACLES.name, "sim/world/obstacles",
-                       Obstacles(header=HEADER))  # fmt: skip
-    assert "entities" not in decode(none)
 
 
 def test_topics_without_a_well_known_schema_have_no_view() -> None:

@@ -12,7 +12,7 @@ from messages.commands import ArmCommand, BaseCommand
 from messages.diagnostics import ControllerDiagnostics
 from messages.goal import Goal
 from messages.header import Header
-from messages.obstacles import Circle, Obstacles
+from messages.obstacles import Circle, Cylinder, Obstacles, Plane, Solids
 from messages.state import RobotState
 from messages.topics import (
     ARM_COMMAND,
@@ -24,6 +24,7 @@ from messages.topics import (
     WORLD_OBSTACLES,
 )
 from messages.truth import SimTruth
+from record.judge import arm_clearance, arm_clearances
 from record.report import control_inputs, write_report
 from wbc import dq, scenarios
 from wbc.base_motion import unicycle, wheel_speeds
@@ -211,3 +212,51 @@ def test_obstacles_truth_and_a_position_goal_render(runs, tmp_path):
     assert (tmp_path / "base_path.png").read_bytes().startswith(b"\x89PNG")
     assert len(result["figures"]) == len(FIGURES)
     assert list(result["effort"]) == ["LP"]
+
+
+POLE = Cylinder(name="pole", x=0.2, y=-0.5, radius=0.05, height=0.6)
+WALL = Plane(name="wall", normal=(0.0, 1.0, 0.0), offset=-0.8)
+"""The solid behind y = -0.8: everything south of it."""
+
+
+def with_solids(recorded: dict[str, list]) -> dict[str, list]:
+    """The session with the reach's table, a pole and a wall declared on world/obstacles, and a
+    ground truth that carries them."""
+    session = dict(recorded)
+    solids = Solids(planes=(Plane.of(scenarios.TABLE), WALL), cylinders=(POLE,))
+    session[WORLD_OBSTACLES.name] = [
+        Obstacles(header=header(START_NS, "world", 0), solids=solids)
+    ]
+    session[SIM_TRUTH.name] = [
+        SimTruth(
+            header=state.header,
+            base_pose=state.base_pose,
+            arm_joints=state.arm_joints,
+            end_effector=state.end_effector,
+            contacts=0,
+            in_contact=False,
+            solids=solids,
+        )
+        for state in recorded[ROBOT_STATE.name]
+    ]
+    return session
+
+
+def test_solids_in_the_truth_give_the_arms_clearance_by_part_over_time(runs, tmp_path):
+    """The base path shows the table's footprint, the pole and the wall; the clearance figure
+    is drawn for a session whose truth has solids, beside one without (a panel that says so),
+    and not at all when no session has any."""
+    session = with_solids(runs["LP"][1])
+    truth = session[SIM_TRUTH.name]
+    clearances = arm_clearances(truth, ROBOT)
+    assert clearances.shape == (len(truth), len(ROBOT.collision.names))
+    assert dict(zip(ROBOT.collision.names, clearances.min(axis=0).round(4), strict=True)) == (
+        arm_clearance(truth, ROBOT))
+    result = write_report([("with solids", session), ("cascade", runs["cascade"][1])], ROBOT,
+                          tmp_path)  # fmt: skip
+    assert [path.name for path in result["figures"]] == [*FIGURES, "arm_clearance.png"]
+    for name in ("base_path.png", "arm_clearance.png"):
+        data = (tmp_path / name).read_bytes()
+        assert data.startswith(b"\x89PNG\r\n\x1a\n") and len(data) > 10_000, name
+    alone = write_report([("with solids", session)], ROBOT, tmp_path / "alone")
+    assert (tmp_path / "alone" / "arm_clearance.png").exists() and len(alone["figures"]) == 7
