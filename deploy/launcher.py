@@ -16,7 +16,7 @@ per component (``messages.process.PARAMS_FILE_ENV``) that its next start reads.
 
 Children run in their own session, so a Ctrl-C reaches the launcher alone and
 the stop order holds; a child whose launcher dies stops by itself
-(``messages.process.LAUNCHER_PID_ENV``).
+(``messages.process.PARENT_PID_ENV``).
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ import zenoh
 
 from deploy.query import statuses
 from messages import process, topics
-from messages.process import EXIT_CONFIG_ERROR, EXIT_FOR_GOOD, LAUNCHER_PID_ENV, PARAMS_FILE_ENV
+from messages.process import EXIT_CONFIG_ERROR, EXIT_FOR_GOOD, PARAMS_FILE_ENV, PARENT_PID_ENV
 from profiles.profile import ROLES, ComponentSpec, Profile
 
 POLL_S = 0.05
@@ -178,11 +178,20 @@ class Launcher:
             if self._starting_until is not None:
                 self._check_startup(now)
             self._kill_hung(now)
+            if self._orphaned():
+                self._stop_reason = "the process that started it is gone"
+                break
             if all(child.done for child in self.children):
                 self._stop_reason = self._stop_reason or "no component left running"
                 break
             time.sleep(POLL_S)
         self.output.say(f"stopping ({self._stop_reason})")
+
+    @staticmethod
+    def _orphaned() -> bool:
+        """Started by a process that named itself (``PARENT_PID_ENV``), which is gone."""
+        parent = os.environ.get(PARENT_PID_ENV)
+        return parent is not None and os.getppid() != int(parent)
 
     def _watch(self, router: zenoh.Session) -> None:
         """Watchdog thread: ask every component for its status, twice per ``watchdog_s``; an
@@ -240,7 +249,7 @@ class Launcher:
         spec = child.spec
         command = process.command(spec.module_path, self.profile_path, spec.name)
         env = dict(os.environ, PYTHONUNBUFFERED="1", **{
-            LAUNCHER_PID_ENV: str(os.getpid()),
+            PARENT_PID_ENV: str(os.getpid()),
             PARAMS_FILE_ENV: str(self._kept_params / f"{spec.name}.json"),
         })  # fmt: skip
         child.process = subprocess.Popen(

@@ -26,8 +26,11 @@ EXIT_FOR_GOOD = 3
 """Exit code of a component that cannot go on (a recorder whose disk is full); the launcher
 never restarts it."""
 
-LAUNCHER_PID_ENV = "PARSIMONY_LAUNCHER_PID"
-"""Set by the launcher; a component whose parent is no longer that pid stops."""
+PARENT_PID_ENV = "PARSIMONY_PARENT_PID"
+"""Set by whoever starts a process of ours as its child (the launcher its components,
+``parsimony record`` its recorder, ``parsimony experiment`` its launcher): a child whose parent
+is no longer that pid stops (a launcher stops its components first), so nothing runs on
+after its parent is killed."""
 
 PARAMS_FILE_ENV = "PARSIMONY_PARAMS_FILE"
 """Set by the launcher: a JSON file where a component keeps the parameters set while it runs,

@@ -303,6 +303,7 @@ def launched(profile_path: Path, log: IO[str] | int = subprocess.DEVNULL,
         [sys.executable, "-m", "parsimony.cli", "launch", str(profile_path)],
         stdout=log,
         stderr=subprocess.STDOUT,
+        env={**os.environ, process.PARENT_PID_ENV: str(os.getpid())},  # it stops if we die
     )
     try:
         yield launcher

@@ -24,6 +24,7 @@ from parsimony.sessions import load_session
 from profiles.profile import load_profile
 from record.foxglove_views import MODEL_EVERY, View
 from record.session_reader import info
+from tests.processes import process_gone
 from tests.record.test_foxglove_views import decode, vector
 from wbc.planar import inverse
 
@@ -202,25 +203,52 @@ def kill_during_run(tmp_path: Path, component: str, name: str = "pose"
     process = subprocess.Popen([*command, "--out", str(tmp_path)], stdout=subprocess.PIPE,
                                stderr=subprocess.DEVNULL, text=True)  # fmt: skip
     try:
-        # No wall-clock deadline: the experiment ends by itself (its simulated time limit).
-        while not (tmp_path / "profile.yaml").exists():
-            assert process.poll() is None
-            time.sleep(0.1)  # the experiment writes its profile before it launches
-        target = query.Target.from_profile(tmp_path / "profile.yaml")
-        with connect(load_profile(tmp_path / "profile.yaml"), process) as session:
-            while True:
-                assert process.poll() is None
-                found = query.statuses(session, target.namespace, 0.5)
-                steps = found.get("controller")
-                moving = steps and steps.counters.get("published.arm/command", 0) > 200
-                if moving and component in found:  # a busy one may answer after 0.5 s
-                    break
-            os.kill(found[component].pid, signal.SIGKILL)
+        found = statuses_while_moving(tmp_path, process, {component})
+        os.kill(found[component].pid, signal.SIGKILL)
         stdout, _ = process.communicate(timeout=300)
     finally:
         if process.poll() is None:
             process.kill()
     return process.returncode, json.loads(stdout), (tmp_path / "launch.log").read_text()
+
+
+def statuses_while_moving(out: Path, process: subprocess.Popen, wanted: set[str]) -> dict:
+    """The statuses of the experiment writing into ``out``, once its controller has run 200
+    steps and each of ``wanted`` has answered."""
+    # No wall-clock deadline: the experiment ends by itself (its simulated time limit).
+    while not (out / "profile.yaml").exists():
+        assert process.poll() is None
+        time.sleep(0.1)  # the experiment writes its profile before it launches
+    target = query.Target.from_profile(out / "profile.yaml")
+    with connect(load_profile(out / "profile.yaml"), process) as session:
+        while True:
+            assert process.poll() is None
+            found = query.statuses(session, target.namespace, 0.5)
+            steps = found.get("controller")
+            moving = steps and steps.counters.get("published.arm/command", 0) > 200
+            if moving and wanted <= set(found):  # a busy one may answer after 0.5 s
+                return found
+
+
+def test_a_killed_experiment_leaves_no_process_behind(tmp_path: Path) -> None:
+    """`parsimony experiment` killed with -9 mid-run: its launcher sees it gone, stops every
+    component in order (the recorder writes its footer) and exits; nothing runs on."""
+    command = [sys.executable, "-m", "parsimony.cli", "experiment", "pose", "--json"]
+    process = subprocess.Popen([*command, "--out", str(tmp_path)], stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)  # fmt: skip
+    try:
+        found = statuses_while_moving(tmp_path, process, {"recorder", "simulator"})
+        children = Path(f"/proc/{process.pid}/task/{process.pid}/children").read_text()
+        pids = [int(pid) for pid in children.split()] + [s.pid for s in found.values()]
+        process.kill()
+        process.wait()
+        for pid in pids:
+            while not process_gone(pid):
+                time.sleep(0.1)  # the test fails by hanging if one runs on
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert info(tmp_path / "session.mcap")["complete"], "the recorder wrote its footer"
 
 
 def test_a_killed_estimator_stops_the_robot_is_restarted_and_the_run_converges(

@@ -16,7 +16,7 @@ from pathlib import Path
 import yaml
 
 from deploy.query import QueryError, Target
-from messages.process import LAUNCHER_PID_ENV
+from messages.process import PARENT_PID_ENV
 from messages.topics import topics_matching
 from parsimony.experiment import RECORDER_STOP_S
 from parsimony.output import emit
@@ -75,14 +75,14 @@ def run(args: argparse.Namespace) -> int:
 def record(profile: str) -> int:
     """Run the recorder of ``profile`` (YAML text) until it stops; SIGINT and SIGTERM are
     passed on to it (it writes all that waits, then its footer), and it stops by itself if
-    this process dies (it watches its parent, ``LAUNCHER_PID_ENV``). The profile is a file in
+    this process dies (it watches its parent, ``PARENT_PID_ENV``). The profile is a file in
     memory (``memfd_create``) the child inherits, so nothing is left behind whatever kills
     this process."""
     descriptor = os.memfd_create("record.yaml")
     os.write(descriptor, profile.encode())
     command = [sys.executable, "-m", "components.recorder", "--profile",
                f"/proc/self/fd/{descriptor}", "--name", "recorder"]  # fmt: skip
-    env = {**os.environ, LAUNCHER_PID_ENV: str(os.getpid())}
+    env = {**os.environ, PARENT_PID_ENV: str(os.getpid())}
     process = subprocess.Popen(command, env=env, start_new_session=True, pass_fds=(descriptor,))
     os.close(descriptor)
 
