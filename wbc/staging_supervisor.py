@@ -145,15 +145,16 @@ class StagingSupervisor:
         return self.phase is Phase.REACHED
 
     def way(self) -> tuple[Array, ...]:
-        """Where the base has still to pass, in order, (x, y) each: the staging point and the
-        candidate's base while it drives, the candidate's base while it turns and approaches,
-        nothing before a candidate or once the base stands at it."""
+        """Where the base has still to pass, in order, (x, y) each: while it drives, the
+        waypoints of its way from the current leg's (the staging point last), then the
+        candidate's base; the candidate's base while it turns and approaches; nothing before
+        a candidate or once the base stands at it."""
         candidate = self.candidate
         if candidate is None or self.phase not in (Phase.DRIVE, Phase.TURN, Phase.APPROACH):
             return ()
         base = np.array(candidate.base[:2])
-        if self.phase is Phase.DRIVE:
-            return (candidate.staging_point(self.staging.final_leg), base)
+        if self.phase is Phase.DRIVE and candidate.way is not None:
+            return (*candidate.way.waypoints[self.leg:], base)
         return (base,)
 
     def update(self, q: Array, t: float) -> Task | None:

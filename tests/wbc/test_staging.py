@@ -223,13 +223,19 @@ def test_a_supervisor_waits_for_its_plan_and_holds_meanwhile() -> None:
     assert supervisor.update(HOME, 0.06) is not None
 
 
-def test_the_way_is_the_staging_point_then_the_candidates_base() -> None:
+def test_the_way_is_the_planned_waypoints_then_the_candidates_base() -> None:
+    """What the view draws of the plan: round an obstacle on the straight way, the drive's
+    waypoints (each outside the obstacle's grown disc), the staging point, the base."""
     goal = MODEL.fkm(np.array([-0.7, 0.3, math.pi - 0.4, 0.2, -0.3, -0.4, 0.2, 0.3]))
-    supervisor = StagingSupervisor(MODEL, goal)
+    obstacle = Circle(-0.35, 0.15, 0.1)
+    supervisor = StagingSupervisor(MODEL, goal, (obstacle,))
     assert supervisor.way() == ()  # no candidate yet
     supervisor.step(HOME, 0.0)
     assert supervisor.phase is Phase.DRIVE
     candidate = supervisor.candidate
-    staging, base = supervisor.way()
-    assert np.allclose(staging, candidate.staging_point(supervisor.staging.final_leg))
-    assert np.allclose(base, candidate.base[:2])
+    *waypoints, staging, base = supervisor.way()
+    assert np.allclose(staging, candidate.staging) and np.allclose(base, candidate.base[:2])
+    ahead = candidate.way.waypoints[supervisor.leg : -1]  # the legs not yet driven
+    assert waypoints and [tuple(p) for p in waypoints] == [tuple(p) for p in ahead]
+    grown = obstacle.radius + MODEL.base.body_radius + supervisor.staging.clearance
+    assert all(math.hypot(p[0] - obstacle.x, p[1] - obstacle.y) >= grown for p in waypoints)
