@@ -123,7 +123,7 @@ def arm_row_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str,
 def lp_breakdown(robot: MobileManipulator, repeats: int) -> dict[str, float]:
     """Median microseconds of one LP step spent in each part, the rest being Python glue.
 
-    The law's own objects are wrapped with timers: the kinematics (fkm and J), the rows of
+    The law's own objects are wrapped with timers: the forward pass (fkm and J), the rows of
     the constraints and objective terms, the vertex (the kept basis tested, or the calls into
     HiGHS: model update, basis, run, solution) and HiGHS alone; ``highs_runs`` is the share of
     steps that called HiGHS.
@@ -144,7 +144,7 @@ def lp_breakdown(robot: MobileManipulator, repeats: int) -> dict[str, float]:
         return wrapper
 
     law.robot = copy.copy(robot)
-    law.robot.kinematics = timed("kinematics", robot.kinematics)  # type: ignore[method-assign]
+    law.robot.forward = timed("kinematics", robot.forward)  # type: ignore[method-assign]
     for item in [*law.constraints, *law.objectives]:  # type: ignore[misc]
         method = "rows" if hasattr(item, "rows") else "cost"
         setattr(item, method, timed("rows", getattr(item, method)))

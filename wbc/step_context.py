@@ -8,7 +8,7 @@ import numpy as np
 
 from wbc.obstacles import Circle
 from wbc.obstacles3d import Solid
-from wbc.robot import MobileManipulator
+from wbc.robot import Chain, MobileManipulator
 
 Array = np.ndarray
 
@@ -31,3 +31,6 @@ class StepContext:
     """The step's period, s (0 where no step is taken, as in a test of one term)."""
     solids: tuple[Solid, ...] = ()
     """The obstacles in 3-D the robot's collision parts keep clear of (wbc.obstacles3d)."""
+    chain: Chain | None = None
+    """The forward kinematics at q (``MobileManipulator.forward``), shared by the task and the
+    rows that need every frame; None where a context is built by hand (they then compute it)."""
