@@ -23,7 +23,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from wbc import dq
-from wbc.collision_model import AXES, CollisionModel, offset_pose
+from wbc.collision_model import AXES, offset_pose
 from wbc.distance_jacobians import Vector
 from wbc.robot import Chain, MobileManipulator, translation_jacobian
 
@@ -94,12 +94,6 @@ def _rotated(pose: Sequence[float], vector: Sequence[float]) -> Vector:
             vz + 2.0 * (w * cz + ax * cy - ay * cx))  # fmt: skip
 
 
-@functools.cache
-def _frames(model: CollisionModel) -> tuple[int, ...]:
-    """The frames that hold a part of ``model``."""
-    return tuple(sorted({p.frame for p in model.points} | {s.frame for s in model.segments}))
-
-
 class PrimitiveKinematics:
     """Where the parts are at one configuration (Python floats, and arrays when asked), and
     their Jacobians J_t and J_l (4.18 and DQ Robotics' line Jacobian) when asked. The rows of
@@ -109,7 +103,10 @@ class PrimitiveKinematics:
         model = robot.collision
         self.robot, self.chain = robot, chain
         poses = chain.poses.tolist()
-        origins = {i: _translation(poses[i]) for i in _frames(model)}
+        origins: dict[int, Vector] = {}
+        for part in (*model.points, *model.segments):
+            if part.frame not in origins:
+                origins[part.frame] = _translation(poses[part.frame])
         self.positions: list[Vector] = []
         """Each point (x, y, z): the origin of its frame moved by r offset r*."""
         for point in model.points:

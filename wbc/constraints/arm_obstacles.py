@@ -145,7 +145,7 @@ class ArmObstacles:
     def rows(self, context: StepContext) -> LinearRows:
         robot, solids = context.robot, context.solids
         model = robot.collision
-        if not solids or not model.names:
+        if not solids or not (model.points or model.segments):
             empty = np.zeros(0)
             return LinearRows(self.name, np.zeros((0, robot.dof)), empty, empty, engaged=False)
         rows = _Rows(self, primitive_kinematics(robot, context.q, context.chain))
