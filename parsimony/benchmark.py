@@ -105,10 +105,11 @@ def arm_row_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str,
     cpu: dict[str, list[float]] = {name: [] for name in names}
 
     def timed(name: str, call: Callable[[], object]) -> None:
-        start, start_cpu = time.perf_counter(), time.process_time()
+        start_cpu = time.process_time()  # a system call: outside the wall clock's interval
+        start = time.perf_counter()
         call()
-        cpu[name].append(time.process_time() - start_cpu)
         wall[name].append(time.perf_counter() - start)
+        cpu[name].append(time.process_time() - start_cpu)
 
     rows = ArmObstacles(TABLE_PARAMS.arm_obstacle_gain, TABLE_PARAMS.arm_obstacle_margin)
     position = 0
