@@ -36,8 +36,11 @@ def test_bench_prints_step_times_and_the_convergence_test_as_json():
         assert 0.0 < report["step"][law]["median_us"] <= report["step"][law]["p99_us"]
     assert report["ratios"]["lp_over_classic"] > 0.0 and report["ratios"]["qp_over_classic"] > 0
     for name in ("lp_with_arm_rows", "lp_without_arm_rows", "arm_rows"):
-        assert 0.0 < report["arm_rows"][name]["median_us"] <= report["arm_rows"][name]["p99_us"]
+        figures = report["arm_rows"][name]
+        assert 0.0 < figures["median_us"] <= figures["p99_us"]
+        assert 0.0 < figures["cpu_median_us"] <= figures["cpu_p99_us"]
     assert report["ratios"]["lp_with_arm_rows_over_without"] > 0.0
+    assert report["ratios"]["lp_with_arm_rows_over_without_cpu"] > 0.0
     parts = report["lp_breakdown_us"]
     assert {"kinematics", "rows", "vertex", "highs", "glue", "highs_runs"} <= parts.keys()
     assert min(parts["kinematics"], parts["rows"], parts["vertex"]) > 0.0

@@ -93,15 +93,15 @@ def program(robot: MobileManipulator, q: Array, task: Task, dt: float,
     circles, solids = split(obstacles)  # a solid checked its numbers when it was made
     for index, obstacle in enumerate(circles):
         require_finite(f"obstacle {index}", (obstacle.x, obstacle.y, obstacle.radius))
-    pose, jacobian = robot.kinematics(q)
-    error, task_jacobian = task.error(pose, jacobian, q)
+    chain = robot.forward(q)  # one pass for the task and the collision parts' rows
+    error, task_jacobian = task.error(chain.pose, chain.jacobian, q)
     if last is not None and same_task(last[0], task):
         error_rate = (error - last[1]) / dt
     else:
         error_rate = -eta * error
     goal_pose = task.pose if isinstance(task, PoseTask) else None
     context = StepContext(robot, q, error, error_rate, task.goal_position[:2], circles,
-                          goal_pose, dt, solids, previous_u)  # fmt: skip
+                          goal_pose, dt, solids, previous_u=previous_u, chain=chain)  # fmt: skip
     rows = [constraint.rows(context) for constraint in constraints]  # first: a term may read
     costs = [ResidualCost("task", task_jacobian, eta * error)]  # what a row engaged
     costs += [term.cost(context) for term in objectives]

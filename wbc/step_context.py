@@ -8,7 +8,7 @@ import numpy as np
 
 from wbc.obstacles import Circle
 from wbc.obstacles3d import Solid
-from wbc.robot import MobileManipulator
+from wbc.robot import Chain, MobileManipulator
 
 Array = np.ndarray
 
@@ -35,3 +35,6 @@ class StepContext:
     previous_u: Array | None = None
     """The u the law returned at its previous step (u_prev), read-only: zero before a law's
     first step; None where no law steps (a term tested alone)."""
+    chain: Chain | None = None
+    """The forward kinematics at q (``MobileManipulator.forward``), shared by the task and the
+    rows that need every frame; None where a context is built by hand (they then compute it)."""

@@ -30,6 +30,13 @@ both (the segment, the edge's extent, the cylinder's height) and they are not ne
 length * ``SKEW_MIN``); else the row is off (0 u <= inf). Of a solid's edges, the nearest such
 is kept. So every (part, obstacle) pair has one row, whatever the state: the LP keeps its shape.
 Not guarded: a segment cutting the rim of a cylinder's top, both ends clear of it.
+
+Each row is -J_d = -w^T J for the weights w of its distance's rate (``wbc.distance_jacobians``)
+and its part's Jacobian J, formed as the wrench of w on the twists of the step's forward pass
+(``wbc.wrench_rows``), the task's own: every row of a step in one product. The geometry of a
+step (a few points, lines and features) is Python float arithmetic, where numpy's call overhead
+outweighs the work: the pairing of the segments with a table's 8 lines costs 11 us so, 33 us in
+masked arrays (`parsimony bench`'s states of the reach over the table, CPU time, one run).
 """
 
 from __future__ import annotations
@@ -43,20 +50,18 @@ import numpy as np
 
 from wbc.constraints.base import LinearRows
 from wbc.distance_jacobians import (
-    line_to_line_distance_jacobian,
-    line_to_line_squared_distance,
-    point_to_line_distance_jacobian,
-    point_to_line_squared_distance,
-    point_to_plane_distance,
-    point_to_plane_distance_jacobian,
-    point_to_point_distance_jacobian,
-    point_to_point_squared_distance,
+    Vector,
+    line_to_line,
+    point_to_line,
+    point_to_plane,
+    point_to_point,
 )
 from wbc.gains import gain
-from wbc.obstacles3d import CORNER, EDGE, FACE, RIM, SIDE, Cylinder, Edge, Plane, Solid
-from wbc.plucker import closest_parameters
+from wbc.obstacles3d import CORNER, EDGE, FACE, RIM, Cylinder, Edge, Solid
+from wbc.plucker import foot
 from wbc.robot_primitives import PrimitiveKinematics, primitive_kinematics
 from wbc.step_context import StepContext
+from wbc.wrench_rows import line_wrench, point_wrench, wrench_rows
 
 Array = np.ndarray
 
@@ -77,41 +82,44 @@ class ArmObstacleGains:
                                           "obstacle in 3-D, m")
 
 
-@functools.cache
-def _faces(obstacle: Solid) -> Array:
-    """The faces (k, 8) of ``obstacle`` (``faces``)."""
-    return np.array(obstacle.faces()).reshape(-1, 8)
-
-
-@functools.cache
-def _corners(obstacle: Plane) -> Array:
-    """The corners (k, 4) of ``obstacle`` as pure quaternions (``Plane.corners``)."""
-    return np.hstack((np.zeros((len(obstacle.footprint), 1)), obstacle.corners()))
-
-
 @dataclass(frozen=True)
-class Lines:
-    """The lines a segment is held from, of one obstacle: Plücker lines (k, 8), the extent
-    [low, high] of each along itself, and the radius round each (a cylinder's, 0 for an
-    edge)."""
+class Features:
+    """What a solid holds a part from, as Python floats: its faces (vec8 planes), corners
+    (x, y, z) and lines (vec8: a cylinder's axis, a footprint's edges), each line's extent
+    [low, high] along itself and the radius round it (a cylinder's, 0 for an edge); and
+    ``pairing``, whose product with a robot's line gives the terms of its closest points to
+    each of the lines (``_Rows.add_segments``)."""
 
-    lines: Array
-    low: Array
-    high: Array
-    reach: Array
+    faces: tuple[Vector, ...]
+    corners: tuple[Vector, ...]
+    lines: tuple[Vector, ...]
+    low: tuple[float, ...]
+    high: tuple[float, ...]
+    reach: tuple[float, ...]
+    pairing: Array
+    """(9, 4 k): [l, m, p] (p = l x m, the robot line's foot) times it gives, for each of the
+    k lines l_z + eps m_z of foot p_z, the blocks <l, l_z>, <l, m_z> + <m, l_z>, <p, l_z>,
+    <l, p_z>."""
 
 
 @functools.cache
-def lines_of(obstacle: Solid) -> Lines:
-    """A cylinder's axis up to its top, or a footprint's edges (``wbc.obstacles3d``)."""
+def features(obstacle: Solid) -> Features:
+    """A cylinder's axis up to its top, or a footprint's edges and corners
+    (``wbc.obstacles3d``)."""
     if isinstance(obstacle, Cylinder):
         top = math.inf if obstacle.height is None else obstacle.height
-        edges, reach = [Edge(obstacle.axis, -math.inf, top)], obstacle.radius
+        edges, reach, corners = [Edge(obstacle.axis, -math.inf, top)], obstacle.radius, ()
     else:
         edges, reach = list(obstacle.edges()), 0.0
-    return Lines(np.array([e.line for e in edges]).reshape(-1, 8),
-                 np.array([e.low for e in edges]), np.array([e.high for e in edges]),
-                 np.full(len(edges), reach))  # fmt: skip
+        corners = tuple(map(tuple, obstacle.corners().tolist())) if obstacle.footprint else ()
+    lines = np.array([e.line for e in edges]).reshape(-1, 8)
+    zero = np.zeros((3, len(edges)))
+    directions, moments, feet = lines[:, 1:4].T, lines[:, 5:8].T, foot(lines).T
+    pairing = np.block([[directions, moments, zero, feet], [zero, directions, zero, zero],
+                        [zero, zero, directions, zero]])  # fmt: skip
+    return Features(tuple(tuple(f.tolist()) for f in obstacle.faces()), corners,
+                    tuple(map(tuple, lines.tolist())), tuple(e.low for e in edges),
+                    tuple(e.high for e in edges), (reach,) * len(edges), pairing)  # fmt: skip
 
 
 class ArmObstacles:
@@ -137,100 +145,128 @@ class ArmObstacles:
     def rows(self, context: StepContext) -> LinearRows:
         robot, solids = context.robot, context.solids
         model = robot.collision
-        if not solids or not model.names:
+        if not solids or not (model.points or model.segments):
             empty = np.zeros(0)
             return LinearRows(self.name, np.zeros((0, robot.dof)), empty, empty, engaged=False)
-        parts = primitive_kinematics(robot, context.q)
-        safe = np.array([p.radius for p in model.points]) + self.margin
-        matrices, uppers = [], []
+        rows = _Rows(self, primitive_kinematics(robot, context.q, context.chain))
         for obstacle in solids:
-            matrix, upper = self._point_rows(parts, safe, obstacle)
-            matrices.append(matrix)
-            uppers.append(upper)
-            if len(lines_of(obstacle).lines) and model.segments:
-                matrix, upper = self._segment_rows(parts, obstacle, context)
-                matrices.append(matrix)
-                uppers.append(upper)
-        upper = np.concatenate(uppers)
-        return LinearRows(self.name, np.vstack(matrices), np.full(upper.size, -np.inf), upper)
+            found = features(obstacle)
+            rows.add_points(obstacle, found)
+            if found.lines and model.segments:
+                rows.add_segments(found)
+        return LinearRows(self.name, *rows.stacked())
 
-    def _point_rows(self, parts: PrimitiveKinematics, safe: Array, obstacle: Solid
-                    ) -> tuple[Array, Array]:  # fmt: skip
+
+class _Rows:
+    """The rows of one step, in the constraint's order: for each obstacle its points', then
+    its segments' (if it has lines). A row that is on is the wrench of its distance's weights
+    on its part's frame and the bound eta max(d - d_safe, 0); every such row is multiplied out
+    at the end, all in one product (``wbc.wrench_rows``)."""
+
+    def __init__(self, constraint: ArmObstacles, parts: PrimitiveKinematics) -> None:
+        model = parts.robot.collision
+        self.gain, self.parts = constraint.gain, parts
+        self.safe = [p.radius + constraint.margin for p in model.points]
+        self.segment_safe = [s.radius + constraint.margin for s in model.segments]
+        self.upper: list[float] = []
+        self.on: list[int] = []
+        self.wrenches: list[Vector] = []
+        self.frames: list[int] = []
+
+    def add(self, distance: float, safe: float, wrench: Vector, frame: int) -> None:
+        self.on.append(len(self.upper))
+        self.upper.append(self.gain * max(distance - safe, 0.0))
+        self.wrenches.append(wrench)
+        self.frames.append(frame)
+
+    def add_points(self, obstacle: Solid, found: Features) -> None:
         """Each point's row on the distance from the feature of ``obstacle`` nearest it
-        (module docstring), and its bound; ``safe`` is each point's radius plus the margin.
-        The points are taken kind by kind, each kind's distance once for all of its points."""
-        points, jacobians = parts.points, parts.point_jacobians
-        kind, index = obstacle.nearest(points[:, 1:])
-        rows, upper = np.empty((len(points), jacobians.shape[2])), np.empty(len(points))
-        faces = kind == FACE
-        if faces.any():
-            face = _faces(obstacle)[index[faces]]
-            rows[faces] = -point_to_plane_distance_jacobian(jacobians[faces], face)
-            upper[faces] = point_to_plane_distance(points[faces], face) - safe[faces]
-        edges = kind == EDGE
-        if edges.any():
-            edge = lines_of(obstacle).lines[index[edges]]
-            rows[edges] = -point_to_line_distance_jacobian(jacobians[edges], points[edges], edge)
-            upper[edges] = (point_to_line_squared_distance(points[edges], edge)
-                            - safe[edges] ** 2)  # fmt: skip
-        corners = kind == CORNER
-        if corners.any():
-            corner = _corners(obstacle)[index[corners]]
-            rows[corners] = -point_to_point_distance_jacobian(jacobians[corners],
-                                                              points[corners], corner)
-            upper[corners] = (point_to_point_squared_distance(points[corners], corner)
-                              - safe[corners] ** 2)  # fmt: skip
-        pole = (kind == SIDE) | (kind == RIM)
-        if pole.any():
-            rows[pole], upper[pole] = self._pole_rows(points[pole], jacobians[pole], safe[pole],
-                                                      obstacle, kind[pole] == RIM)  # fmt: skip
-        return rows, self.gain * np.maximum(upper, 0.0)
+        (module docstring); ``found`` are its features."""
+        parts = self.parts
+        kinds, indices = obstacle.nearest(parts.positions)
+        for i, (point, kind, index) in enumerate(zip(parts.positions, kinds.tolist(),
+                                                     indices.tolist(), strict=True)):  # fmt: skip
+            safe = self.safe[i]
+            if kind == FACE:
+                distance, weights = point_to_plane(point, found.faces[index])
+            elif kind == CORNER:
+                distance, weights = point_to_point(point, found.corners[index])
+                safe *= safe
+            elif kind == EDGE:
+                distance, weights = point_to_line(point, found.lines[index])
+                safe *= safe
+            else:
+                assert isinstance(obstacle, Cylinder)
+                distance, weights, safe = _pole(point, obstacle, found.lines[0], safe,
+                                                kind == RIM)  # fmt: skip
+            self.add(distance, safe, point_wrench(point, weights), parts.point_frames[i])
 
-    @staticmethod
-    def _pole_rows(points: Array, jacobians: Array, safe: Array, pole: Cylinder, rim: Array
-                   ) -> tuple[Array, Array]:  # fmt: skip
-        """Rows and distances less the safe ones beside a cylinder: its side, the squared
-        distance D from the axis held from (R + safe)^2; its rim, d = sqrt((sqrt(D) - R)^2 +
-        (z - h)^2) held from safe, whose row is the chain rule of the two,
-        J_d = ((sqrt(D) - R) J_D / (2 sqrt(D)) + (z - h) J_z) / d."""
-        squared = point_to_line_squared_distance(points, pole.axis)
-        rows = -point_to_line_distance_jacobian(jacobians, points, pole.axis)
-        gaps = squared - (pole.radius + safe) ** 2
-        if rim.any():
-            radial = np.sqrt(squared[rim])
-            beside, above = radial - pole.radius, points[rim, 3] - pole.height
-            distance = np.hypot(beside, above)
-            rows[rim] = (beside / (2.0 * radial))[:, None] * rows[rim]
-            rows[rim] -= above[:, None] * jacobians[rim, 3]
-            rows[rim] /= distance[:, None]
-            gaps[rim] = distance - safe[rim]
-        return rows, gaps
-
-    def _segment_rows(self, parts: PrimitiveKinematics, obstacle: Solid, context: StepContext
-                      ) -> tuple[Array, Array]:  # fmt: skip
+    def add_segments(self, found: Features) -> None:
         """Each segment's line-to-line row against the cylinder's axis or the nearest of the
-        solid's edges that it faces (module docstring), and its bound; 0 u <= inf for a
-        segment that faces none."""
-        found = lines_of(obstacle)
-        s, t, skew = closest_parameters(parts.lines, found.lines)  # (segments, lines)
-        a = parts.lines[:, 1:4] @ found.lines[:, 5:8].T + parts.lines[:, 5:8] @ found.lines[
-            :, 1:4].T  # fmt: skip
-        facing = ((skew >= SKEW_MIN**2) & (parts.ends.min(axis=1)[:, None] <= s)
-                  & (s <= parts.ends.max(axis=1)[:, None]) & (found.low <= t)
-                  & (t <= found.high))  # fmt: skip
-        with np.errstate(divide="ignore", invalid="ignore"):
-            gap = np.where(facing, np.abs(a) / np.sqrt(skew) - found.reach, np.inf)
-        segments = context.robot.collision.segments
-        matrix, upper = np.zeros((len(segments), context.robot.dof)), np.full(len(segments),
-                                                                              np.inf)
-        for i in np.flatnonzero(facing.any(axis=1)):
-            nearest = int(np.argmin(gap[i]))
-            other, reach = found.lines[nearest], float(found.reach[nearest])
-            line = parts.lines[i]
-            matrix[i] = -line_to_line_distance_jacobian(parts.line_jacobians[i], line, other)
-            squared = line_to_line_squared_distance(line, other)
-            upper[i] = self._bound(squared, (reach + segments[i].radius + self.margin) ** 2)
-        return matrix, upper
+        solid's edges that it faces (of the solid's ``found`` features; module docstring);
+        0 u <= inf for a segment that faces none. The closest points p + s l and p_z + t l_z
+        of a segment's line and a line (p and p_z their feet, as in
+        ``wbc.plucker.closest_parameters``) are at
+        s = (b e + f) / c and t = (e + b f) / c, with b = <l, l_z>, e = <p, l_z>,
+        f = <l, p_z> and c = 1 - b^2 = ||l x l_z||^2 (each foot is orthogonal to its line);
+        the distance between the lines is |<l, m_z> + <m, l_z>| / sqrt(c)."""
+        parts = self.parts
+        count = len(found.lines)
+        robot_lines = [(*line[1:4], *line[5:8], *line_foot(line)) for line in parts.line_list]
+        pairs = (np.array(robot_lines) @ found.pairing).tolist()
+        for i, (terms, ends) in enumerate(zip(pairs, parts.end_list, strict=True)):
+            low, high = min(ends), max(ends)
+            gap, nearest = math.inf, -1
+            for j in range(count):
+                b = terms[j]
+                skew = 1.0 - b * b
+                if skew < SKEW_MIN**2:
+                    continue
+                e, f = terms[2 * count + j], terms[3 * count + j]
+                if not low <= (b * e + f) / skew <= high:
+                    continue
+                if not found.low[j] <= (e + b * f) / skew <= found.high[j]:
+                    continue
+                between = abs(terms[count + j]) / math.sqrt(skew) - found.reach[j]
+                if between < gap:
+                    gap, nearest = between, j
+            if nearest < 0:
+                self.upper.append(math.inf)
+                continue
+            line = parts.line_list[i]
+            distance, weights = line_to_line(line, found.lines[nearest])
+            safe = (found.reach[nearest] + self.segment_safe[i]) ** 2
+            self.add(distance, safe, line_wrench(line, weights), parts.segment_frames[i])
 
-    def _bound(self, distance: float, safe: float) -> float:
-        return self.gain * max(distance - safe, 0.0)
+    def stacked(self) -> tuple[Array, Array, Array]:
+        """(matrix, lower, upper) of every pair's row: -J_d for a row that is on, 0 <= inf for
+        one that is off."""
+        upper = np.array(self.upper)
+        matrix = np.zeros((upper.size, self.parts.robot.dof))
+        if self.on:
+            matrix[self.on] = -wrench_rows(self.parts.chain, self.wrenches, self.frames)
+        return matrix, np.full(upper.size, -np.inf), upper
+
+
+def line_foot(line: Vector) -> Vector:
+    """l x m: the point of the line l + eps m (vec8) nearest the origin, as (x, y, z)."""
+    lx, ly, lz, mx, my, mz = (line[i] for i in (1, 2, 3, 5, 6, 7))
+    return (ly * mz - lz * my, lz * mx - lx * mz, lx * my - ly * mx)
+
+
+def _pole(point: Vector, pole: Cylinder, axis: Vector, safe: float, rim: bool
+          ) -> tuple[float, Vector, float]:  # fmt: skip
+    """(distance, weights, safe) beside a cylinder: its side, the squared distance D from the
+    axis held from (R + safe)^2; its rim, d = sqrt((sqrt(D) - R)^2 + (z - h)^2) held from
+    safe, whose weights are the chain rule of the two,
+    w = ((sqrt(D) - R) w_D / (2 sqrt(D)) + (z - h) k) / d."""
+    squared, weights = point_to_line(point, axis)
+    if not rim:
+        return squared, weights, (pole.radius + safe) ** 2
+    assert pole.height is not None
+    radial = math.sqrt(squared)
+    beside, above = radial - pole.radius, point[2] - pole.height
+    distance = math.hypot(beside, above)
+    scale = beside / (2.0 * radial * distance)
+    return distance, (scale * weights[0], scale * weights[1],
+                      scale * weights[2] + above / distance), safe  # fmt: skip
