@@ -81,17 +81,18 @@ class StagingParams:
     """m of travel a singular candidate is worth (scaled down to 0 at sigma_floor)."""
     clearance: float = LPParams().obstacle_margin
     """Extra distance between the base's body and an obstacle, m: the LP's margin."""
-    slack: float = LPParams().obstacle_lookahead
-    """Further room the way to a staging point keeps round obstacles where it can, m: the
-    LP's obstacle constraint acts on a point this far ahead of the axle."""
+    slack: float = 0.1
+    """Further room the way to a staging point keeps round obstacles where it can, and a
+    roomy candidate keeps, m: near an obstacle the LP's obstacle row holds the base back."""
     final_legs: tuple[float, ...] = (0.4, -0.4, 0.2, -0.2, 0.0)
     """The straight drive into the candidate's pose, m, the first of these whose staging
     point and leg keep clear of obstacles: forward from this far behind the pose (negative:
     backwards from ahead of it; 0: the base turns into the pose where it stands)."""
     crowding_weight: float = 1.0
-    """m of travel a candidate that is not roomy (``Candidate.roomy``) is worth: near its
-    border the LP's obstacle constraint 5.28 demands the base move out faster than its speed
-    bounds allow, and the program has no solution."""
+    """m of travel a candidate that is not roomy (``Candidate.roomy``) is worth: beside an
+    obstacle the LP's obstacle row holds the base back from the pose (the vector-field
+    inequality lets it near the margin no faster than eta_d d; 5.28 there demands the base move
+    out faster than its speed bounds allow, and the program has no solution)."""
     max_distance: float = 10.0
     """A goal farther than this from the base is refused, m: the search's residual loses its
     precision far from the origin (a goal 100 m away took 2.1 s to fail)."""
