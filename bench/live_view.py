@@ -62,11 +62,14 @@ SAMPLE_S = 0.5
 CLOCK_TICKS = os.sysconf("SC_CLK_TCK")
 
 
-def bench_profile(directory: Path) -> Path:
-    path = directory / "bench.yaml"
+def lockstep_profile(directory: Path, base: Path = DEPLOY / "sim_supervised.yaml",
+                     name: str = "liveview") -> Path:
+    """``base`` on a namespace and port of its own, in lockstep (paused until everything is
+    up), with a recorder writing ``directory``/session.mcap: the system a view watches."""
+    path = directory / f"{name}.yaml"
     path.write_text(yaml.safe_dump({
-        "extends": str(DEPLOY / "sim_supervised.yaml"),
-        "namespace": f"liveview{os.getpid()}",
+        "extends": str(base),
+        "namespace": f"{name}{os.getpid()}",
         "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
         "startup_timeout_s": 60.0,
         "components": [
@@ -248,7 +251,7 @@ def measure(runs: int) -> dict:
         raise SystemExit(f"bench.live_view: {missing()}")
     with tempfile.TemporaryDirectory() as tmp:
         directory = Path(tmp)
-        path = bench_profile(directory)
+        path = lockstep_profile(directory)
         profile = load_profile(path)
         rounds = []
         with (directory / "launch.log").open("w") as log, launched(path, log) as launcher,\

@@ -33,14 +33,14 @@ from typing import Any
 
 import numpy as np
 
-from deploy.query import QueryError
+from bench.sim_experiments import experiment_or_none
 from messages.topics import CONTROL_DIAGNOSTICS, SUPERVISOR_STATUS
-from parsimony.experiment import PROFILES, TIME_LIMIT_S, Options, run_experiment
+from parsimony.experiment import PROFILES, TIME_LIMIT_S, Options
 from parsimony.goal_sets import MOVING_ERROR
 from parsimony.kinematic_demo import LP_PARAMS
 from parsimony.output import emit, result_only_stdout, table
 from parsimony.sessions import load_session
-from profiles.profile import ProfileError, load_profile
+from profiles.profile import load_profile
 from record.judge import CONVERGED_ERROR, JUDGED, converged_at, messages, origin_s, the_run
 from sim2d.scenarios import scenario
 from wbc.kinematic_run import integrate
@@ -107,11 +107,8 @@ def sim_run(variant: str, seed: int, directory: Path) -> Outcome | None:
     judged from its recording (deleted after); None when it could not run (said, with why)."""
     out = directory / f"{list(VARIANTS).index(variant)}-{seed}"
     options = Options(name="obstacle", seed=seed, out=out, gains=VARIANTS[variant])
-    try:
-        report = run_experiment(options)
-    except (OSError, RuntimeError, QueryError, ProfileError) as error:
-        print(f"[bench] {variant} seed {seed}: did not run: {error}", file=sys.stderr,
-              flush=True)  # fmt: skip
+    report = experiment_or_none(options, f"{variant} seed {seed}")
+    if report is None:
         return None
     run, _ = the_run(load_session(out / "session.mcap", JUDGED), TIME_LIMIT_S)
     shutil.rmtree(out, ignore_errors=True)

@@ -53,15 +53,21 @@ def run_one(name: str, controller: str, seed: int, directory: Path) -> dict | No
     when it could not run (said, with why)."""
     options = Options(name=name, controller=controller, seed=seed,
                       out=directory / f"{name}-{controller}-{seed}")  # fmt: skip
-    try:
-        report = run_experiment(options)
-    except (OSError, RuntimeError, QueryError, ProfileError) as error:
-        print(f"[bench] {name} {controller} seed {seed}: did not run: {error}", file=sys.stderr,
-              flush=True)  # fmt: skip
-        return None
-    print(f"[bench] {name} {controller} seed {seed}: converged={report['converged']} "
-          f"rtf={report['real_time_factor']}", file=sys.stderr, flush=True)  # fmt: skip
+    report = experiment_or_none(options, f"{name} {controller} seed {seed}")
+    if report is not None:
+        print(f"[bench] {name} {controller} seed {seed}: converged={report['converged']} "
+              f"rtf={report['real_time_factor']}", file=sys.stderr, flush=True)  # fmt: skip
     return report
+
+
+def experiment_or_none(options: Options, label: str) -> dict | None:
+    """``run_experiment(options)``'s report, or None when it could not run (said on stderr,
+    with why, under ``label``)."""
+    try:
+        return run_experiment(options)
+    except (OSError, RuntimeError, QueryError, ProfileError) as error:
+        print(f"[bench] {label}: did not run: {error}", file=sys.stderr, flush=True)
+        return None
 
 
 def median_of(reports: list[dict], component: str, counter: str) -> int:

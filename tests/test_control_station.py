@@ -10,7 +10,6 @@ from __future__ import annotations
 import base64
 import json
 import math
-import os
 import signal
 import subprocess
 import sys
@@ -20,9 +19,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 import zenoh
 
+from bench.live_view import lockstep_profile
 from deploy import query
 from messages import codec
 from messages.goal import Goal
@@ -56,31 +55,11 @@ class Station:
         return f"{self.profile.namespace}/{suffix}"
 
 
-def station_profile(directory: Path) -> Path:
-    """deploy/sim_station.yaml on a namespace and port of its own, in lockstep (paused until
-    everything is up), with a recorder."""
-    path = directory / "station.yaml"
-    path.write_text(yaml.safe_dump({
-        "extends": str(DEPLOY / "sim_station.yaml"),
-        "namespace": f"station{os.getpid()}",
-        "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
-        "startup_timeout_s": 60.0,
-        "components": [
-            {"name": "simulator",
-             "params": {"lockstep": True, "real_time_factor": 0.0, "paused": True}},
-            {"name": "recorder", "module": "recorder", "role": "recorder",
-             "restart": {"policy": "never"},
-             "params": {"path": str(directory / "session.mcap")}},
-        ],
-    }))  # fmt: skip
-    return path
-
-
 @pytest.fixture(scope="module")
 def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Station]:
     assert not missing(), missing()
     directory = tmp_path_factory.mktemp("station")
-    path = station_profile(directory)
+    path = lockstep_profile(directory, DEPLOY / "sim_station.yaml", "station")
     profile = load_profile(path)
     with (directory / "launch.log").open("w") as log, launched(path, log) as launcher,\
             connect(profile, launcher) as session:  # fmt: skip

@@ -4,17 +4,23 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from test_foxglove_views import KEY, STAMP_NS, decode, pose_dq, transforms_of, vector
+from test_foxglove_views import (
+    KEY,
+    STAMP_NS,
+    decode,
+    pose_dq,
+    robot_state,
+    transforms_of,
+    vector,
+)
 
 from messages import topics
 from messages.header import Header
 from messages.markers import MarkerDetection, MarkerDetections
-from messages.state import RobotState
 from messages.supervisor import SupervisorStatus
 from record.foxglove_views import MODEL_EVERY, Viewer
 from record.session_file import SessionWriter
@@ -24,14 +30,6 @@ from wbc.robot import MobileManipulator
 
 ROBOT = MobileManipulator.from_yaml(Path(__file__).parents[2] / "deploy" / "robots"
                                     / "little_john.yaml")  # fmt: skip
-ARM = (0.1, -0.2, 0.3, -0.4, 0.5)
-
-
-def robot_state(seq: int = 3) -> RobotState:
-    header = Header(stamp_ns=STAMP_NS, frame="world", seq=seq, source="test")
-    return RobotState(header=header, base_pose=(1.5, -2.0, 0.6), arm_joints=ARM,
-                      end_effector=pose_dq(math.pi / 2, (0.7, 0.2, 0.45)), valid=True,
-                      age_s=0.01)  # fmt: skip
 
 
 def pose_of(transform: dict[str, Any]) -> np.ndarray:
