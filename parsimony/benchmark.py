@@ -9,7 +9,7 @@ from __future__ import annotations
 import copy
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +21,7 @@ from wbc import dq
 from wbc.cascade_law import CascadeLaw, CascadeParams
 from wbc.constraints.arm_obstacles import ArmObstacles
 from wbc.kinematic_run import integrate
+from wbc.law_output import Law
 from wbc.lp_law import LPLaw, LPParams
 from wbc.pinv_law import PinvParams, PseudoinverseLaw
 from wbc.qp_law import QPLaw
@@ -60,6 +61,22 @@ BLOCK = 100
 drift of the machine's speed reaches every law alike."""
 
 
+def blocks(
+    trajectory: Sequence[np.ndarray], repeats: int, laws: Iterable[Law]
+) -> Iterator[Sequence[np.ndarray]]:
+    """``repeats`` states of ``trajectory`` in slices of BLOCK, wrapping round to its start,
+    where every law is reset."""
+    position = done = 0
+    while done < repeats:
+        if position == 0:
+            for law in laws:
+                law.reset()
+        block = trajectory[position : position + min(BLOCK, repeats - done)]
+        yield block
+        done += len(block)
+        position = (position + len(block)) % len(trajectory)
+
+
 def step_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str, float]]:
     """Whole control steps (model, Jacobian, rows, solve) along a recorded LP trajectory.
 
@@ -70,18 +87,12 @@ def step_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str, fl
     laws = {"lp": LPLaw(robot), "qp": QPLaw(robot), "classic": PseudoinverseLaw(robot),
             "cascade": CascadeLaw(robot)}  # fmt: skip
     samples: dict[str, list[float]] = {name: [] for name in laws}
-    position = 0
-    while len(samples["lp"]) < repeats:
-        if position == 0:
-            for law in laws.values():
-                law.reset()
-        block = trajectory[position : position + min(BLOCK, repeats - len(samples["lp"]))]
+    for block in blocks(trajectory, repeats, laws.values()):
         for name, law in laws.items():
             for q in block:
                 start = time.perf_counter()
                 law.step(q, task, DT)
                 samples[name].append(time.perf_counter() - start)
-        position = (position + len(block)) % len(trajectory)
     results = {name: percentiles(values) for name, values in samples.items()}
     results["kinematics"] = percentiles(time_calls(lambda: robot.kinematics(GOAL), repeats))
     return results
@@ -112,12 +123,7 @@ def arm_row_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str,
         cpu[name].append(time.process_time() - start_cpu)
 
     rows = ArmObstacles(TABLE_PARAMS.arm_obstacle_gain, TABLE_PARAMS.arm_obstacle_margin)
-    position = 0
-    while len(wall["arm_rows"]) < repeats:
-        if position == 0:
-            for law in laws.values():
-                law.reset()
-        block = trajectory[position : position + min(BLOCK, repeats - len(wall["arm_rows"]))]
+    for block in blocks(trajectory, repeats, laws.values()):
         for name, law in laws.items():
             for q in block:
                 timed(name, lambda law=law, q=q: law.step(q, task, DT, obstacles))
@@ -125,7 +131,6 @@ def arm_row_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str,
             context = StepContext(robot, q, np.zeros(8), np.zeros(8), np.zeros(2), (), None, DT,
                                   obstacles, chain=robot.forward(q))  # fmt: skip
             timed("arm_rows", lambda context=context: rows.rows(context))
-        position = (position + len(block)) % len(trajectory)
     return {name: {**percentiles(wall[name]),
                    **{f"cpu_{key}": value for key, value in percentiles(cpu[name]).items()}}
             for name in names}  # fmt: skip

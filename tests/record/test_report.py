@@ -186,24 +186,9 @@ def test_a_missing_or_empty_topic_is_named(runs, tmp_path, topic, empty):
 
 
 def test_obstacles_truth_and_a_position_goal_render(runs, tmp_path):
-    recorded = runs["LP"][1]
-    session = dict(recorded)
     obstacle = scenarios.OBSTACLE
     circle = Circle(x=obstacle.x, y=obstacle.y, radius=obstacle.radius)
-    session[WORLD_OBSTACLES.name] = [
-        Obstacles(header=header(START_NS, "world", 0), circles=(circle,))
-    ]
-    session[SIM_TRUTH.name] = [
-        SimTruth(
-            header=state.header,
-            base_pose=state.base_pose,
-            arm_joints=state.arm_joints,
-            end_effector=state.end_effector,
-            contacts=0,
-            in_contact=False,
-        )
-        for state in recorded[ROBOT_STATE.name]
-    ]
+    session = with_obstacles(runs["LP"][1], circles=(circle,))
     position = dq.translation(ROBOT.fkm(scenarios.REACH_GOAL))[1:]
     session[CONTROL_GOAL.name] = [
         Goal(header=header(START_NS, "world", 0), task="position", position=tuple(position))
@@ -222,10 +207,18 @@ WALL = Plane(name="wall", normal=(0.0, 1.0, 0.0), offset=-0.8)
 def with_solids(recorded: dict[str, list]) -> dict[str, list]:
     """The session with the reach's table, a pole and a wall declared on world/obstacles, and a
     ground truth that carries them."""
-    session = dict(recorded)
     solids = Solids(planes=(Plane.of(scenarios.TABLE), WALL), cylinders=(POLE,))
+    return with_obstacles(recorded, solids=solids)
+
+
+def with_obstacles(
+    recorded: dict[str, list], circles: tuple[Circle, ...] = (), solids: Solids | None = None
+) -> dict[str, list]:
+    """The session with ``circles`` and ``solids`` declared on world/obstacles, and a ground
+    truth of its states that carries the solids."""
+    session, solids = dict(recorded), solids or Solids()
     session[WORLD_OBSTACLES.name] = [
-        Obstacles(header=header(START_NS, "world", 0), solids=solids)
+        Obstacles(header=header(START_NS, "world", 0), circles=circles, solids=solids)
     ]
     session[SIM_TRUTH.name] = [
         SimTruth(
