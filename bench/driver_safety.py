@@ -34,7 +34,7 @@ from pathlib import Path
 import yaml
 
 from bench.figures import run_bench, spread
-from deploy import query
+from deploy import DEPLOY, query
 from messages import codec, topics
 from messages.commands import ArmCommand, BaseCommand
 from messages.header import Header
@@ -47,7 +47,6 @@ from protocols import create_oi
 from sim2d.devices.ax_servos import AXChainEmulator, IntegratingJoints
 from sim2d.devices.create2 import Create2Emulator
 
-DEPLOY = Path(__file__).resolve().parents[1] / "deploy"
 METRES_PER_COUNT = create_oi.mm_per_count(0.072) / 1000.0
 RESET_AFTER_S = 1.0
 STEP_S = 0.01

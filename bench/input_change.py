@@ -24,8 +24,9 @@ from typing import Any
 
 import numpy as np
 
+from deploy import ROBOT_FILE
 from parsimony.goal_sets import FAMILIES, Attempt, attempt, goals, parsimony, shares
-from parsimony.kinematic_demo import ROBOT_FILE, input_change_gains
+from parsimony.kinematic_demo import input_change_gains
 from parsimony.output import emit, result_only_stdout, table
 from wbc.lp_law import LPLaw, LPParams
 from wbc.robot import MobileManipulator

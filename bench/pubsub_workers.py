@@ -13,11 +13,11 @@ import threading
 import time
 from dataclasses import dataclass
 from multiprocessing.queues import Queue
-from pathlib import Path
 from typing import Any
 
 import zenoh
 
+from deploy import ROBOT_FILE
 from messages import codec, topics
 from messages.base import IDENTITY_POSE
 from messages.camera import CameraFrame, CameraIntrinsics
@@ -30,7 +30,6 @@ from wbc.robot import MobileManipulator
 from wbc.scenarios import NEAR_START, REACH_GOAL
 
 NAMESPACE = "bench"
-ROBOT = Path(__file__).resolve().parents[1] / "deploy" / "robots" / "little_john.yaml"
 START = NEAR_START
 GOAL_Q = REACH_GOAL
 WIDTH, HEIGHT = 640, 480
@@ -63,7 +62,7 @@ def message(kind: str, index: int, count: int, image: bytes) -> tuple[topics.Top
         circles = tuple(Circle(x=0.5 + 0.01 * i, y=0.2, radius=0.1) for i in range(FLOOD_CIRCLES))
         return topics.WORLD_OBSTACLES, Obstacles(header=header, circles=circles)
     if kind == "goal":
-        pose = tuple(MobileManipulator.from_yaml(ROBOT).fkm(GOAL_Q).tolist())
+        pose = tuple(MobileManipulator.from_yaml(ROBOT_FILE).fkm(GOAL_Q).tolist())
         return topics.CONTROL_GOAL, Goal(header=header, task="pose", pose=pose)
     q = START + 0.5 * (index / max(count, 1)) * (GOAL_Q - START)
     state = RobotState(

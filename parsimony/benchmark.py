@@ -14,8 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
+from deploy import ROBOT_FILE
 from parsimony.goal_sets import goal_report
-from parsimony.kinematic_demo import ROBOT_FILE, TABLE_PARAMS, WITHOUT_ARM_ROWS
+from parsimony.kinematic_demo import TABLE_PARAMS, WITHOUT_ARM_ROWS
 from parsimony.output import table
 from wbc import dq
 from wbc.cascade_law import CascadeLaw, CascadeParams

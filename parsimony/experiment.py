@@ -37,7 +37,7 @@ import zenoh
 from components.cascade_controller import CascadeController
 from components.lp_controller import LPController
 from components.qp_controller import QPController
-from deploy import query
+from deploy import DEPLOY, query
 from messages import codec, process, topics
 from messages.obstacles import Solids
 from messages.topics import CONTROL_DIAGNOSTICS, ROBOT_STATE, SIM_TRUTH, SUPERVISOR_STATUS
@@ -63,7 +63,6 @@ from wbc.lp_law import LPParams
 from wbc.planar import inverse
 from wbc.robot import MobileManipulator
 
-DEPLOY = Path(__file__).resolve().parents[1] / "deploy"
 PROFILES = {"lp": DEPLOY / "sim.yaml", "cascade": DEPLOY / "sim_cascade.yaml",
             "qp": DEPLOY / "sim_qp.yaml"}
 """The profile each controller runs in unless ``--profile`` names another."""

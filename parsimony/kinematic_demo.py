@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from deploy import DEPLOY, ROBOT_FILE
 from parsimony.output import table
 from profiles.profile import load_profile
 from wbc import dq
@@ -39,7 +40,6 @@ from wbc.scenarios import (
 )
 from wbc.task import PoseTask, PositionTask, Task
 
-ROBOT_FILE = Path(__file__).resolve().parents[1] / "deploy" / "robots" / "little_john.yaml"
 STEPS = 4000
 OBSTACLE_PARAMS = LPParams(base_target=0.0, waist_hold=0.0, waist_centring=0.02,
                            error_bound="error")
@@ -57,7 +57,7 @@ again (seed 1: error 0.65 after 60 s)."""
 BORDER_PARAMS = replace(OBSTACLE_PARAMS, obstacle_mode="border")
 """The same law with the dissertation's border constraint 5.28, for comparison."""
 
-SUPERVISED_PROFILE = Path(__file__).resolve().parents[1] / "deploy" / "sim_supervised.yaml"
+SUPERVISED_PROFILE = DEPLOY / "sim_supervised.yaml"
 """The profile of the LP under the staging supervisor, which declares that LP's gains."""
 
 
@@ -76,7 +76,7 @@ wbc.constraints.arm_obstacles keep the arm and the base clear of the table."""
 WITHOUT_ARM_ROWS = replace(TABLE_PARAMS, arm_obstacles=False)
 """The same law blind to the table, for comparison."""
 
-SMOOTH_PROFILE = Path(__file__).resolve().parents[1] / "deploy" / "sim_smooth.yaml"
+SMOOTH_PROFILE = DEPLOY / "sim_smooth.yaml"
 """The profile of the LP with its input change term on, which declares that term's gains."""
 
 

@@ -15,14 +15,12 @@ from pathlib import Path
 import pytest
 import yaml
 
-from deploy import query
+from deploy import DEPLOY, query
 from messages import codec, topics
 from parsimony.experiment import connect, launched
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from profiles.profile_files import read_profile_data
-
-DEPLOY = Path(__file__).resolve().parents[1] / "deploy"
 
 
 def components(path: Path) -> dict[str, dict]:

@@ -2,8 +2,7 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
+from deploy import ROBOT_FILE
 from parsimony.goal_sets import (
     FAMILIES,
     LAWS,
@@ -16,9 +15,7 @@ from parsimony.goal_sets import (
 )
 from wbc.robot import MobileManipulator
 
-ROBOT = MobileManipulator.from_yaml(
-    Path(__file__).resolve().parents[1] / "deploy" / "robots" / "little_john.yaml"
-)
+ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 HELD_OUT_SEED = 3
 """A set of goals the secondary terms were not tuned on (they were tuned on seed 1)."""
 

@@ -17,7 +17,7 @@ import yaml
 import zenoh
 from mcap.reader import make_reader
 
-from deploy import query
+from deploy import DEPLOY, query
 from messages import codec, process, topics
 from messages.process import EXIT_FOR_GOOD
 from parsimony.experiment import connect
@@ -32,7 +32,7 @@ def parsimony(*arguments: str, timeout: float = 300) -> subprocess.CompletedProc
                           capture_output=True, text=True, timeout=timeout)  # fmt: skip
 
 
-SMOOTH_PROFILE = Path(__file__).resolve().parents[1] / "deploy" / "sim_smooth.yaml"
+SMOOTH_PROFILE = DEPLOY / "sim_smooth.yaml"
 
 
 @pytest.fixture(scope="module")
@@ -202,7 +202,6 @@ def test_replay_republishes_the_sensors_with_headers_as_recorded(runs, tmp_path:
             time.sleep(0.05)  # waiting for the last samples in flight, up to a deadline
     assert len(received) >= 0.95 * len(recorded)
     assert [m.header for m in received[:50]] == [m.header for m in recorded[:50]]
-
 
 
 @pytest.mark.parametrize("run", ["lp", "lp smooth"])

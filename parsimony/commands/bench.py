@@ -6,7 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
-from parsimony.benchmark import ROBOT_FILE, format_report, run_bench
+from deploy import ROBOT_FILE
+from parsimony.benchmark import format_report, run_bench
 from parsimony.output import emit
 
 

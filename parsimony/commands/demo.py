@@ -6,7 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
-from parsimony.kinematic_demo import ROBOT_FILE, format_table, run_demo
+from deploy import ROBOT_FILE
+from parsimony.kinematic_demo import format_table, run_demo
 from parsimony.output import emit
 
 

@@ -10,6 +10,7 @@ import json
 import sys
 from pathlib import Path
 
+from deploy import ROBOT_FILE
 from parsimony.commands.launch import positive_seconds
 from parsimony.output import emit
 from parsimony.sessions import load_session
@@ -17,8 +18,6 @@ from profiles.profile import ProfileError, load_profile
 from record.judge import JUDGED, judge, the_run
 from record.report import write_report
 from wbc.robot import MobileManipulator
-
-ROBOT = Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -32,7 +31,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("files", type=Path, nargs="+", metavar="FILE", help="MCAP sessions")
     parser.add_argument("--labels", help="comma-separated labels (default: the law's name)")
     parser.add_argument("--out", type=Path, required=True, help="directory of the figures")
-    parser.add_argument("--robot", type=Path, default=ROBOT, help="robot description")
+    parser.add_argument("--robot", type=Path, default=ROBOT_FILE, help="robot description")
     parser.add_argument("--profile", type=Path,
                         help="the recorded profile: truth drawn in F0's frame")  # fmt: skip
     parser.add_argument("--time-limit", type=positive_seconds, metavar="S",

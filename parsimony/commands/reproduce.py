@@ -9,7 +9,7 @@ import sys
 from dataclasses import asdict
 from pathlib import Path
 
-from parsimony.kinematic_demo import ROBOT_FILE
+from deploy import ROBOT_FILE
 from parsimony.output import emit
 from parsimony.reproduce import format_rows, reproduce, write_figures
 from wbc.robot import MobileManipulator

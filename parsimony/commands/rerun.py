@@ -22,6 +22,7 @@ from components.control_step import ControlStep, Step, gains_of
 from components.controller import Controller, diagnostics_of
 from components.lp_controller import LPController
 from components.qp_controller import QPController
+from deploy import ROBOT_FILE
 from messages.commands import ArmCommand, BaseCommand
 from messages.header import Header
 from messages.obstacles import obstacles_of
@@ -31,7 +32,6 @@ from record.session_file import Recorded, SessionWriter
 from record.session_reader import read_groups
 from wbc.robot import MobileManipulator
 
-ROBOT = Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"
 LAWS: dict[str, type[Controller]] = {
     c.law_name: c for c in (LPController, CascadeController, QPController)}
 """The controllers whose law can be run again, by law name."""
@@ -48,7 +48,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("file", type=Path, help="MCAP session")
     parser.add_argument("--controller", choices=tuple(LAWS), required=True)
     parser.add_argument("-o", "--output", type=Path, required=True, help="the MCAP to write")
-    parser.add_argument("--robot", type=Path, default=ROBOT, help="robot description")
+    parser.add_argument("--robot", type=Path, default=ROBOT_FILE, help="robot description")
     parser.add_argument("--force", action="store_true", help="replace an existing output")
     return parser
 

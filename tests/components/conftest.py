@@ -17,6 +17,7 @@ import yaml
 import zenoh
 from pydantic import BaseModel
 
+from deploy import DEPLOY
 from messages import codec, topics
 from profiles.endpoints import free_port
 from profiles.profile import Profile, load_profile
@@ -26,10 +27,6 @@ M = TypeVar("M", bound=BaseModel)
 
 DEADLINE_S = 10.0
 """Generous limit for anything that involves starting a process on a loaded machine."""
-
-DEPLOY = Path(__file__).resolve().parents[2] / "deploy"
-"""The directory of the project's profiles and robot descriptions."""
-
 
 
 def _wait_until(condition: Callable[[], bool], what: str, timeout_s: float = DEADLINE_S) -> None:

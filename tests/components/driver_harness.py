@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 import yaml
 
-from deploy import query
+from deploy import DEPLOY, query
 from messages.status import ComponentStatus
 from profiles.profile_files import read_profile_data
 from protocols import create_oi
@@ -17,8 +17,6 @@ from sim2d.devices.pty_link import PtyLink
 
 if TYPE_CHECKING:
     from conftest import System
-
-DEPLOY = Path(__file__).resolve().parents[2] / "deploy"
 
 
 def driver_system(deployed, tmp_path: Path, name: str, port: Path, **params: object) -> System:

@@ -11,8 +11,9 @@ from pathlib import Path
 
 import pytest
 from conftest import System
-from driver_harness import DEPLOY, driver_system, status
+from driver_harness import driver_system, status
 
+from deploy import ROBOT_FILE
 from messages import codec, topics
 from messages.commands import ArmCommand
 from messages.header import Header
@@ -21,7 +22,7 @@ from protocols.dynamixel_v1 import Address, StatusFault
 from sim2d.devices.ax_servos import AXChainEmulator, IntegratingJoints
 from wbc.robot import MobileManipulator
 
-ROBOT = MobileManipulator.from_yaml(DEPLOY / "robots" / "little_john.yaml")
+ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 LOW, HIGH = ROBOT.q_min[3:], ROBOT.q_max[3:]
 STEP_S = 0.01
 

@@ -9,10 +9,11 @@ import dataclasses
 import numpy as np
 
 from components.control_step import ControlStep
+from deploy import ROBOT_FILE
 from messages.goal import Goal
 from messages.header import Header
 from messages.state import RobotState
-from parsimony.kinematic_demo import ROBOT_FILE, input_change_gains
+from parsimony.kinematic_demo import input_change_gains
 from wbc.lp_law import LPLaw, LPParams
 from wbc.robot import MobileManipulator
 from wbc.scenarios import DT, HOME, REACH_GOAL

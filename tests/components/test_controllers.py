@@ -21,7 +21,7 @@ import yaml
 
 from components.lp_controller import LPController
 from components.runtime import Node
-from deploy import query
+from deploy import DEPLOY, ROBOT_FILE, query
 from messages import codec, topics
 from messages.commands import ArmCommand, BaseCommand
 from messages.diagnostics import ControllerDiagnostics
@@ -36,7 +36,6 @@ from wbc.scenarios import NEAR_START, REACH_GOAL
 if TYPE_CHECKING:
     from tests.components.conftest import System
 
-DEPLOY = Path(__file__).resolve().parents[2] / "deploy"
 LP_PROFILE = DEPLOY / "controllers.yaml"
 CASCADE_PROFILE = DEPLOY / "controllers_cascade.yaml"
 
@@ -49,7 +48,7 @@ START = tuple(NEAR_START.tolist())
 GOAL_Q = tuple(REACH_GOAL.tolist())
 """The configuration whose end-effector pose is the profile's goal."""
 
-ROBOT = MobileManipulator.from_yaml(DEPLOY / "robots" / "little_john.yaml")
+ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 GOAL_POSE = tuple(ROBOT.fkm(np.array(GOAL_Q)).tolist())
 
 STALE_TIMEOUT_S = 0.5

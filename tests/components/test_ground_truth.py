@@ -3,11 +3,8 @@ estimator and controller, so they see the world only through the sensors."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
+from deploy import DEPLOY
 from messages import topics
-
-DEPLOY = Path(__file__).resolve().parents[2] / "deploy"
 
 
 def test_no_estimator_or_controller_may_read_the_ground_truth(deployed) -> None:

@@ -9,11 +9,12 @@ from collections.abc import Callable
 import msgpack
 import numpy as np
 import pytest
-from conftest import DEADLINE_S, DEPLOY, System
+from conftest import DEADLINE_S, System
 from driver_harness import status as component_status
 
 from components.control_step import task_of
 from components.controller import goal_of
+from deploy import ROBOT_FILE
 from messages import codec, topics
 from messages.goal import Goal
 from messages.header import Header
@@ -27,7 +28,7 @@ from wbc.robot import MobileManipulator
 from wbc.scenarios import HOME, REACH_GOAL
 from wbc.task import PoseTask, PositionTask, same_task
 
-MODEL = MobileManipulator.from_yaml(DEPLOY / "robots" / "little_john.yaml")
+MODEL = MobileManipulator.from_yaml(ROBOT_FILE)
 
 PROFILE = """
 namespace: supervised

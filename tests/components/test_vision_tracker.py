@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import yaml
 
-from deploy import query
+from deploy import DEPLOY, query
 from messages import codec, topics
 from messages.camera import CameraFrame, CameraIntrinsics
 from messages.header import Header
@@ -31,8 +31,6 @@ from wbc.planar import planar_pose
 
 if TYPE_CHECKING:
     from tests.components.conftest import System
-
-DEPLOY = Path(__file__).resolve().parents[2] / "deploy"
 
 
 def scene_image(system: System, seed: int = 0) -> tuple[np.ndarray, PinholeCamera, list]:

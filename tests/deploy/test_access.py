@@ -11,7 +11,7 @@ import pytest
 import yaml
 import zenoh
 
-from deploy import query
+from deploy import ROBOT_FILE, query
 from messages import codec, topics
 from messages.goal import Goal
 from messages.header import Header
@@ -21,15 +21,13 @@ from tests.deploy.conftest import free_port
 if TYPE_CHECKING:
     from tests.deploy.conftest import LaunchFixture
 
-ROBOT = Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"
-
 
 def access_profile(directory: Path) -> Path:
     (directory / "credentials.txt").write_text(
         "# user:password\noperator:op-secret\nviewer:view-secret\nctl:ctl-secret\n")
     profile = {
         "namespace": "test",
-        "robot": str(ROBOT),
+        "robot": str(ROBOT_FILE),
         "zenoh": {"mode": "client", "router": [f"tcp/127.0.0.1:{free_port()}"],
                   "access": {"credentials": "credentials.txt",
                              "writers": {"control/goal": ["operator"]}}},

@@ -9,10 +9,9 @@ from pathlib import Path
 
 import pytest
 
+from deploy import DEPLOY
 from deploy.graph import dataflow
 from profiles.profile import ProfileError, load_profile
-
-DEPLOY = Path(__file__).resolve().parents[2] / "deploy"
 
 
 def test_the_controllers_profile_wires_the_publisher_to_the_controller() -> None:

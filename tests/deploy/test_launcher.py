@@ -10,14 +10,12 @@ from typing import TYPE_CHECKING
 
 import yaml
 
-from deploy import query
+from deploy import ROBOT_FILE, query
 from tests.deploy.conftest import free_port
 from tests.processes import process_gone
 
 if TYPE_CHECKING:
     from tests.deploy.conftest import LaunchFixture, ProfileWriter
-
-ROBOT = Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"
 
 
 def publisher(name: str, role: str = "tool", **fields: object) -> dict[str, object]:
@@ -96,7 +94,7 @@ def test_the_launcher_warns_of_a_topic_read_and_never_written(
 ) -> None:
     """A controller alone waits for robot/state that nothing in the profile publishes."""
     controller = {"name": "ctl", "module": "lp_controller", "role": "controller"}
-    profile = write_profile([controller], robot=str(ROBOT))
+    profile = write_profile([controller], robot=str(ROBOT_FILE))
     launched = launch(profile, "--duration", "1.0")
     launched.wait_for(r"\[launch\] warning: test/robot/state is read by ctl and written by "
                       r"no component")  # fmt: skip

@@ -19,9 +19,9 @@ from pathlib import Path
 import pytest
 import yaml
 
+from deploy import DEPLOY, ROBOT_FILE
 from tests.deploy.conftest import LAUNCH
 
-DEPLOY = Path(__file__).resolve().parents[2] / "deploy"
 ROBOT_ADDRESS, STATION_ADDRESS = "10.213.0.1", "10.213.0.2"
 
 pytestmark = pytest.mark.skipif(
@@ -74,7 +74,7 @@ def lab_profile(name: str, directory: Path) -> Path:
     """deploy/lab/NAME.yaml with its certificates taken from ``directory``."""
     data = yaml.safe_load((DEPLOY / "lab" / f"{name}.yaml").read_text())
     if "robot" in data:
-        data["robot"] = str(DEPLOY / "robots" / "little_john.yaml")
+        data["robot"] = str(ROBOT_FILE)
     data["zenoh"]["tls"] = {key: str(directory / Path(value).name)
                             for key, value in data["zenoh"]["tls"].items()}  # fmt: skip
     path = directory / f"{name}.yaml"

@@ -11,6 +11,7 @@ import numpy as np
 from test_foxglove_views import pose_dq
 from test_robot_scene import ROBOT, robot_state
 
+from deploy import DEPLOY
 from messages import topics
 from messages.camera import CameraFrame
 from messages.diagnostics import ControllerDiagnostics
@@ -98,7 +99,7 @@ def test_every_topic_the_layout_names_is_a_channel_of_the_namespace(tmp_path: Pa
 
 
 def test_parsimony_layout_prints_or_writes_it(tmp_path: Path) -> None:
-    profile = Path(__file__).parents[2] / "deploy" / "sim_station.yaml"
+    profile = DEPLOY / "sim_station.yaml"
     printed = parsimony("layout", str(profile))
     assert printed.returncode == 0, printed.stderr
     assert json.loads(printed.stdout) == json.loads(layout(NAMESPACE).to_json())

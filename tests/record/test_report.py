@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from deploy import ROBOT_FILE
 from messages.commands import ArmCommand, BaseCommand
 from messages.diagnostics import ControllerDiagnostics
 from messages.goal import Goal
@@ -34,9 +35,7 @@ from wbc.lp_law import LPLaw, LPParams
 from wbc.robot import MobileManipulator
 from wbc.task import PoseTask
 
-ROBOT = MobileManipulator.from_yaml(
-    Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"
-)
+ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 DT = scenarios.DT
 DT_NS = round(DT * 1e9)
 START_NS = 1_000_000_000

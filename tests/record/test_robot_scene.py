@@ -18,6 +18,7 @@ from test_foxglove_views import (
     vector,
 )
 
+from deploy import ROBOT_FILE
 from messages import topics
 from messages.header import Header
 from messages.markers import MarkerDetection, MarkerDetections
@@ -28,8 +29,7 @@ from record.session_reader import info
 from wbc import dq
 from wbc.robot import MobileManipulator
 
-ROBOT = MobileManipulator.from_yaml(Path(__file__).parents[2] / "deploy" / "robots"
-                                    / "little_john.yaml")  # fmt: skip
+ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 
 
 def pose_of(transform: dict[str, Any]) -> np.ndarray:
@@ -83,8 +83,6 @@ def test_the_model_goes_with_one_state_in_model_every() -> None:
     points = [vector(p, "xyz") for p in line["points"]]
     assert points[-1] == [0.0, 0.0, 0.0]
     assert np.allclose(points[0], ROBOT.link_outline(2)[0])
-
-
 
 
 def status(seq: int, **fields: Any) -> SupervisorStatus:

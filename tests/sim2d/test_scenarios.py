@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from components.simulator import Simulator
+from deploy import ROBOT_FILE
 from profiles.profile import load_profile
 from profiles.scene import Scene
 from sim2d.camera import PinholeCamera, ceiling_camera
@@ -34,7 +35,7 @@ from wbc.scenarios import HOME, OBSTACLE, REACH_GOAL, TABLE, TABLE_GOAL, TABLE_S
 from wbc.staging import plan
 
 REPO = Path(__file__).resolve().parents[2]
-ROBOT = MobileManipulator.from_yaml(REPO / "deploy/robots/little_john.yaml")
+ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 SCENE = load_profile(REPO / "deploy/sim.yaml").scene
 SEEDS = range(50)
 DEFAULT_BIN = np.array(planar_of(ROBOT.fkm(REACH_GOAL)))

@@ -3,19 +3,17 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from deploy import ROBOT_FILE
 from sim2d.world import World, WorldSettings, wheel_distance_per_count
 from wbc.obstacles import Circle
 from wbc.obstacles3d import Plane
 from wbc.robot import MobileManipulator
 
-ROBOT = MobileManipulator.from_yaml(
-    Path(__file__).resolve().parents[2] / "deploy/robots/little_john.yaml"
-)
+ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 DT = 0.01
 STILL_ARM = np.zeros(5)
 INSTANT_WHEELS = WorldSettings(wheel_acceleration_max=1e3)

@@ -7,10 +7,10 @@ the same, step by step and along the reach over the table."""
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 
+from deploy import ROBOT_FILE
 from parsimony.kinematic_demo import TABLE_PARAMS
 from wbc.constraints.arm_obstacles import SKEW_MIN, ArmObstacles
 from wbc.constraints.base import LinearRows
@@ -34,8 +34,7 @@ from wbc.scenarios import DT, TABLE, TABLE_GOAL, TABLE_START
 from wbc.step_context import StepContext
 from wbc.task import PoseTask
 
-ROBOT = MobileManipulator.from_yaml(
-    Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml")
+ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 GAIN, MARGIN = 2.0, 0.03
 SHELF = Plane((0.0, 0.0, -1.0), -0.45, ((0.3, 0.2), (0.7, 0.2), (0.7, 0.6), (0.3, 0.6)),
               "shelf")  # fmt: skip

@@ -4,11 +4,11 @@
 from __future__ import annotations
 
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from deploy import ROBOT_FILE
 from parsimony.kinematic_demo import TABLE_PARAMS, WITHOUT_ARM_ROWS
 from wbc.arm_clearance import PenetrationCount, part_clearances
 from wbc.constraints.arm_obstacles import ArmObstacles
@@ -21,8 +21,7 @@ from wbc.scenarios import DT, HOME, REACH_GOAL, TABLE, TABLE_GOAL, TABLE_START
 from wbc.step_context import StepContext
 from wbc.task import PoseTask
 
-ROBOT = MobileManipulator.from_yaml(
-    Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml")
+ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 POLE = Cylinder(0.45, 0.05, 0.04, 0.5, "pole")
 WALL = Plane((-1.0, 0.0, 0.0), -0.7, name="wall")  # the solid is x > 0.7
 TALL_POLE = Cylinder(0.4, -0.2, 0.05, name="tall pole")

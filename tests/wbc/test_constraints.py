@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from deploy import ROBOT_FILE
 from wbc.constraints.base import LinearRows, OneNormBound, VelocityBounds
 from wbc.constraints.error_bound import ErrorBound
 from wbc.constraints.joint_limits import JointLimits
@@ -21,9 +21,7 @@ from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
 from wbc.step_context import StepContext
 
-ROBOT = MobileManipulator.from_yaml(
-    Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"
-)
+ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 NO_DEADLINE = settings(deadline=None)
 finite = st.floats(-5.0, 5.0)
 angles = st.floats(-math.pi, math.pi)

@@ -5,7 +5,6 @@ Robotics' DQ_Kinematics and DQ_Geometry, which have the same ones."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,6 +17,7 @@ from dqrobotics.robot_modeling import (
 )
 from dqrobotics.utils import DQ_Geometry
 
+from deploy import ROBOT_FILE
 from wbc import dq
 from wbc.distance_jacobians import (
     ParallelLinesError,
@@ -39,8 +39,7 @@ from wbc.robot_primitives import (
     translations,
 )
 
-ROBOT = MobileManipulator.from_yaml(
-    Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml")
+ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 STEP = 1e-6
 FD_TOL = 1e-7
 ORACLE_TOL = 1e-12

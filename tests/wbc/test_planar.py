@@ -3,20 +3,18 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from deploy import ROBOT_FILE
 from sim2d.world import World, WorldSettings, wheel_distance_per_count
 from wbc import dq
 from wbc.base_motion import dead_reckoning
 from wbc.planar import height_of, planar_of, planar_pose, tilt_of
 from wbc.robot import MobileManipulator
 
-ROBOT = MobileManipulator.from_yaml(
-    Path(__file__).resolve().parents[2] / "deploy/robots/little_john.yaml"
-)
+ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 WHEEL_BASE = ROBOT.base.wheel_base
 
 

@@ -16,10 +16,10 @@ from dqrobotics.robot_modeling import (
     DQ_WholeBody,
 )
 
+from deploy import ROBOT_FILE
 from wbc import dq
 from wbc.robot import MobileManipulator, RobotDescriptionError, translation_jacobian
 
-ROBOT_FILE = Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"
 ORACLE_TOL = 1e-12
 FINITE_DIFFERENCE_STEP = 1e-6
 FINITE_DIFFERENCE_TOL = 1e-7

@@ -7,7 +7,6 @@ with an offset in its frame included. The shared forward pass gives the task wha
 from __future__ import annotations
 
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,14 +18,14 @@ from dqrobotics.robot_modeling import (
     DQ_WholeBody,
 )
 
+from deploy import ROBOT_FILE
 from wbc import dq
 from wbc.collision_model import AXES, CollisionModel, CollisionPoint
 from wbc.robot import MobileManipulator
 from wbc.robot_primitives import primitive_kinematics
 from wbc.wrench_rows import line_wrench, point_wrench, wrench_rows
 
-ROBOT = MobileManipulator.from_yaml(
-    Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml")
+ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 ORACLE_TOL = 1e-12
 
 

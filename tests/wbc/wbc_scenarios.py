@@ -3,17 +3,15 @@ shared by the closed-loop tests."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
+from deploy import ROBOT_FILE
 from wbc import dq, kinematic_run
 from wbc.kinematic_run import Run
 from wbc.robot import MobileManipulator
 from wbc.scenarios import DT
 from wbc.task import PoseTask, PositionTask
 
-ROBOT_FILE = Path(__file__).resolve().parents[2] / "deploy" / "robots" / "little_john.yaml"
 
 def robot() -> MobileManipulator:
     return MobileManipulator.from_yaml(ROBOT_FILE)
