@@ -5,6 +5,7 @@ Robotics' DQ_Kinematics and DQ_Geometry, which have the same ones."""
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 import pytest
@@ -156,55 +157,56 @@ def test_segments_run_along_their_lines_from_end_to_end() -> None:
 # --- Distances and their Jacobians ------------------------------------------------------------
 
 
-@pytest.mark.parametrize("part", range(POINTS))
-def test_point_to_plane_jacobian_is_the_derivative_and_dqrobotics(part: int) -> None:
-    for index, q in enumerate(configurations(20, seed=20 + part)):
-        workspace_plane, _ = workspace(index)
-        parts = primitive_kinematics(ROBOT, q)
-        point, jacobian = parts.points[part], parts.point_jacobians[part]
-        row = point_to_plane_distance_jacobian(jacobian, workspace_plane)
-        np.testing.assert_allclose(row, central_difference(
-            lambda c, w=workspace_plane: point_to_plane_distance(
-                primitive_kinematics(ROBOT, c).points[part], w), q), atol=FD_TOL)  # fmt: skip
-        oracle = DQ_Kinematics.point_to_plane_distance_jacobian(jacobian, DQ(point),
-                                                                DQ(workspace_plane))  # fmt: skip
-        np.testing.assert_allclose(row, oracle.ravel(), atol=ORACLE_TOL)
-        assert point_to_plane_distance(point, workspace_plane) == pytest.approx(
-            DQ_Geometry.point_to_plane_distance(DQ(point), DQ(workspace_plane)), abs=1e-12)
+def corner(seed: int) -> np.ndarray:
+    """A random point of the workspace, vec4."""
+    return np.r_[0.0, np.random.default_rng(seed).uniform(-1.0, 1.0, 3)]
+
+
+@dataclass(frozen=True)
+class PointDistance:
+    """A distance from a robot's point to a workspace primitive, its Jacobian (ours, from the
+    point's Jacobian, the point and the primitive) and DQ Robotics' of both."""
+
+    seed: int
+    primitive: Callable[[int], np.ndarray]
+    distance: Callable[[np.ndarray, np.ndarray], float]
+    jacobian: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+    oracle_jacobian: Callable[..., np.ndarray]
+    oracle_distance: Callable[..., float]
+
+
+POINT_DISTANCES = {
+    "plane": PointDistance(20, lambda i: workspace(i)[0], point_to_plane_distance,
+                           lambda jacobian, _, w: point_to_plane_distance_jacobian(jacobian, w),
+                           DQ_Kinematics.point_to_plane_distance_jacobian,
+                           DQ_Geometry.point_to_plane_distance),
+    "line": PointDistance(30, lambda i: workspace(i)[1], point_to_line_squared_distance,
+                          point_to_line_distance_jacobian,
+                          DQ_Kinematics.point_to_line_distance_jacobian,
+                          DQ_Geometry.point_to_line_squared_distance),
+    "point": PointDistance(50, corner, point_to_point_squared_distance,
+                           point_to_point_distance_jacobian,
+                           DQ_Kinematics.point_to_point_distance_jacobian,
+                           DQ_Geometry.point_to_point_squared_distance),
+}  # fmt: skip
 
 
 @pytest.mark.parametrize("part", range(POINTS))
-def test_point_to_line_jacobian_is_the_derivative_and_dqrobotics(part: int) -> None:
-    for index, q in enumerate(configurations(20, seed=30 + part)):
-        _, workspace_line = workspace(index)
+@pytest.mark.parametrize("kind", POINT_DISTANCES)
+def test_point_distance_jacobians_are_the_derivatives_and_dqrobotics(kind: str, part: int) -> None:
+    d = POINT_DISTANCES[kind]
+    for index, q in enumerate(configurations(20, seed=d.seed + part)):
+        primitive = d.primitive(index)
         parts = primitive_kinematics(ROBOT, q)
         point, jacobian = parts.points[part], parts.point_jacobians[part]
-        row = point_to_line_distance_jacobian(jacobian, point, workspace_line)
+        row = d.jacobian(jacobian, point, primitive)
         np.testing.assert_allclose(row, central_difference(
-            lambda c, w=workspace_line: point_to_line_squared_distance(
-                primitive_kinematics(ROBOT, c).points[part], w), q), atol=FD_TOL)  # fmt: skip
-        oracle = DQ_Kinematics.point_to_line_distance_jacobian(jacobian, DQ(point),
-                                                               DQ(workspace_line))  # fmt: skip
+            lambda c, w=primitive: d.distance(primitive_kinematics(ROBOT, c).points[part], w),
+            q), atol=FD_TOL)  # fmt: skip
+        oracle = d.oracle_jacobian(jacobian, DQ(point), DQ(primitive))
         np.testing.assert_allclose(row, oracle.ravel(), atol=ORACLE_TOL)
-        assert point_to_line_squared_distance(point, workspace_line) == pytest.approx(
-            DQ_Geometry.point_to_line_squared_distance(DQ(point), DQ(workspace_line)), abs=1e-12)
-
-
-@pytest.mark.parametrize("part", range(POINTS))
-def test_point_to_point_jacobian_is_the_derivative_and_dqrobotics(part: int) -> None:
-    rng = np.random.default_rng(part)
-    for q in configurations(20, seed=50 + part):
-        corner = np.r_[0.0, rng.uniform(-1.0, 1.0, 3)]
-        parts = primitive_kinematics(ROBOT, q)
-        point, jacobian = parts.points[part], parts.point_jacobians[part]
-        row = point_to_point_distance_jacobian(jacobian, point, corner)
-        np.testing.assert_allclose(row, central_difference(
-            lambda c, w=corner: point_to_point_squared_distance(
-                primitive_kinematics(ROBOT, c).points[part], w), q), atol=FD_TOL)  # fmt: skip
-        oracle = DQ_Kinematics.point_to_point_distance_jacobian(jacobian, DQ(point), DQ(corner))
-        np.testing.assert_allclose(row, oracle.ravel(), atol=ORACLE_TOL)
-        assert point_to_point_squared_distance(point, corner) == pytest.approx(
-            DQ_Geometry.point_to_point_squared_distance(DQ(point), DQ(corner)), abs=1e-12)
+        assert d.distance(point, primitive) == pytest.approx(
+            d.oracle_distance(DQ(point), DQ(primitive)), abs=1e-12)
 
 
 @pytest.mark.parametrize("segment", range(len(ROBOT.collision.segments)))
