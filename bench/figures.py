@@ -4,12 +4,11 @@ line."""
 from __future__ import annotations
 
 import argparse
-import json
 from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 
-from parsimony.output import emit
+from parsimony.output import emit, json_text
 
 
 def spread(values: Sequence[float], digits: int = 1) -> dict[str, float | int | None]:
@@ -31,6 +30,6 @@ def run_bench(doc: str, measure: Callable[[int], dict], lines: Callable[[dict], 
     parser.add_argument("--json", action="store_true", help="print JSON instead of lines")
     args = parser.parse_args(argv)
     report = measure(args.runs)
-    for line in [json.dumps(report)] if args.json else lines(report):
+    for line in [json_text(report)] if args.json else lines(report):
         emit(line)
     return 0

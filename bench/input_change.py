@@ -15,7 +15,6 @@ counts), each beside the median of its ratio to the default LP's, goal by goal.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import multiprocessing
 import sys
@@ -27,7 +26,7 @@ import numpy as np
 from deploy import ROBOT_FILE
 from parsimony.goal_sets import FAMILIES, Attempt, attempt, goals, parsimony, shares
 from parsimony.kinematic_demo import input_change_gains
-from parsimony.output import emit, result_only_stdout, table
+from parsimony.output import emit, json_text, result_only_stdout, table
 from wbc.lp_law import LPLaw, LPParams
 from wbc.robot import MobileManipulator
 
@@ -124,7 +123,7 @@ def main(argv: list[str] | None = None) -> int:
     found = measure(names, args.goals, args.workers)
     rows = summary(found, MobileManipulator.from_yaml(ROBOT_FILE).dof)
     if args.json:
-        emit(json.dumps({"bench": "input_change", "goals": args.goals, "rows": rows}))
+        emit(json_text({"bench": "input_change", "goals": args.goals, "rows": rows}))
     else:
         shown = ("task", "law", "reached inside every limit", "nonzero moving",
                  "nonzero last 2 s")  # fmt: skip

@@ -18,7 +18,6 @@ converged), and the seeds that did not converge with their final error. Nothing 
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import shutil
@@ -38,7 +37,7 @@ from messages.topics import CONTROL_DIAGNOSTICS, SUPERVISOR_STATUS
 from parsimony.experiment import PROFILES, TIME_LIMIT_S, Options
 from parsimony.goal_sets import MOVING_ERROR
 from parsimony.kinematic_demo import LP_PARAMS
-from parsimony.output import emit, result_only_stdout, table
+from parsimony.output import emit, json_text, result_only_stdout, table
 from parsimony.sessions import load_session
 from profiles.profile import load_profile
 from record.judge import CONVERGED_ERROR, JUDGED, converged_at, messages, origin_s, the_run
@@ -189,7 +188,7 @@ def main(argv: list[str] | None = None) -> int:
              "workers": args.workers,
              "minutes": round((time.monotonic() - started) / 60.0, 1)}  # fmt: skip
     if args.json:
-        emit(json.dumps({"bench": "obstacle_constraints", "study": study, "variants": rows}))
+        emit(json_text({"bench": "obstacle_constraints", "study": study, "variants": rows}))
     else:
         emit(table([{**row, "not_converged": brief(row["not_converged"])} for row in rows]))
         emit(" ".join(f"{k}={v}" for k, v in study.items()))

@@ -30,7 +30,6 @@ goes to stderr.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import signal
 import statistics
@@ -60,7 +59,7 @@ from messages.header import Header
 from messages.joints import JointStates
 from messages.odometry import BaseOdometry
 from parsimony.experiment import PROFILES, SESSION_FILE, TIME_LIMIT_S, Options, run_experiment
-from parsimony.output import emit, result_only_stdout, table
+from parsimony.output import emit, json_text, result_only_stdout, table
 from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import Profile, ZenohSettings, load_profile
@@ -388,7 +387,7 @@ def main(argv: list[str] | None = None) -> int:
     report = {"bench": "recording", "quick": args.quick, "cpus": os.cpu_count(),
               "duration_s": round(time.monotonic() - started, 1), **report}  # fmt: skip
     if args.json:
-        emit(json.dumps(report))
+        emit(json_text(report))
         return 0
     emit(table(report["record"]))
     for name, counters in report["recorder_counters"].items():

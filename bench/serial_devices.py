@@ -10,7 +10,6 @@ Direct written until the wheels take it, and the mean period of the encoder stre
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from collections.abc import Sequence
@@ -19,7 +18,7 @@ import numpy as np
 import serial
 from dynamixel_sdk import COMM_SUCCESS, GroupSyncWrite, PacketHandler, PortHandler
 
-from parsimony.output import emit, result_only_stdout
+from parsimony.output import emit, json_text, result_only_stdout
 from protocols import create_oi
 from protocols import dynamixel_v1 as dxl
 from sim2d.devices.ax_servos import AXChainEmulator
@@ -111,7 +110,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     report = {"bench": "serial_devices", "servos": servo_bus(), "create": create_link()}
     if args.json:
-        emit(json.dumps(report))
+        emit(json_text(report))
     else:
         for device in ("servos", "create"):
             for name, value in report[device].items():

@@ -15,7 +15,6 @@ Last, the speed of the camera's parts per frame in this process, on the scene of
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import statistics
 import sys
@@ -28,7 +27,7 @@ import numpy as np
 
 from deploy.query import QueryError
 from parsimony.experiment import PROFILES, SUPERVISED, Options, run_experiment
-from parsimony.output import emit, result_only_stdout, table
+from parsimony.output import emit, json_text, result_only_stdout, table
 from profiles.profile import ProfileError, load_profile
 from sim2d.camera import ImageNoise, PlacedMarker, Renderer, ceiling_camera
 from sim2d.scenarios import NAMES, scenario
@@ -173,7 +172,7 @@ def main(argv: list[str] | None = None) -> int:
              "experiments_per_minute": round(len(runs) * args.seeds / minutes, 1)}  # fmt: skip
     speed = vision_speed()
     if args.json:
-        emit(json.dumps({"bench": "sim_experiments", "study": study, "experiments": rows,
+        emit(json_text({"bench": "sim_experiments", "study": study, "experiments": rows,
                          "vision": speed}))  # fmt: skip
     else:
         emit(table(rows))

@@ -26,7 +26,6 @@ Prints a table, or ``--json``. Runs in about 30 s.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import multiprocessing as mp
 import os
@@ -55,7 +54,7 @@ from components.runtime import Node
 from deploy import query
 from messages import topics
 from messages.process import stop
-from parsimony.output import emit, result_only_stdout, table
+from parsimony.output import emit, json_text, result_only_stdout, table
 from profiles.endpoints import free_port
 from profiles.profile import ZenohSettings, load_profile
 
@@ -291,7 +290,7 @@ def main(argv: list[str] | None = None) -> int:
     report |= {"results": [asdict(r) for r in results], "controller_counters": counters}
     report |= {"flood": flood}
     if args.json:
-        emit(json.dumps(report))
+        emit(json_text(report))
     else:
         emit(table([asdict(r) for r in results]))
         emit("lp_controller counters: "

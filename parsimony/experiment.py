@@ -42,6 +42,7 @@ from messages import codec, process, topics
 from messages.obstacles import Solids
 from messages.topics import CONTROL_DIAGNOSTICS, ROBOT_STATE, SIM_TRUTH, SUPERVISOR_STATUS
 from parsimony.kinematic_demo import LP_PARAMS
+from parsimony.output import json_text
 from parsimony.outputs import written_whole
 from parsimony.sessions import load_session
 from profiles.endpoints import free_port
@@ -395,6 +396,5 @@ def durations(counters: dict[str, dict[str, int]]) -> dict[str, dict[str, int]]:
 
 
 def dumps(report: dict) -> str:
-    import json
 
-    return json.dumps(report, indent=2)
+    return json_text(report, indent=2)

@@ -9,6 +9,8 @@ original standard output.
 from __future__ import annotations
 
 import contextlib
+import json
+import math
 import os
 import sys
 from collections.abc import Iterator, Sequence
@@ -24,6 +26,24 @@ def table(rows: Sequence, headers: Sequence[str] | str = "keys", **style: Any) -
     table, numbers right-aligned: the one table style of every command and benchmark
     (``tabulate``; ``style`` passes ``floatfmt`` and the like on)."""
     return tabulate(rows, headers=headers, tablefmt="plain", missingval="-", **style)
+
+
+def json_text(value: Any, **style: Any) -> str:
+    """``value`` as standard JSON (``style`` passes ``indent`` and the like to ``json.dumps``): a
+    NaN or an infinity, such as the median of no steps, is written null."""
+    return json.dumps(finite(value), allow_nan=False, **style)
+
+
+def finite(value: Any) -> Any:
+    """``value`` with every float that is not finite replaced by None, in lists, tuples and
+    dicts at any depth."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, list | tuple):
+        return [finite(v) for v in value]
+    if isinstance(value, dict):
+        return {k: finite(v) for k, v in value.items()}
+    return value
 
 
 def emit(text: str) -> None:

@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
 from deploy import ROBOT_FILE
 from parsimony.benchmark import format_report, run_bench
-from parsimony.output import emit
+from parsimony.output import emit, json_text
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -24,5 +23,5 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
 
 def run(args: argparse.Namespace) -> int:
     report = run_bench(args.repeats, args.trials, args.goals, args.robot)
-    emit(json.dumps(report, indent=2) if args.json else format_report(report))
+    emit(json_text(report, indent=2) if args.json else format_report(report))
     return 0

@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
 from deploy import ROBOT_FILE
 from parsimony.kinematic_demo import format_table, run_demo
-from parsimony.output import emit
+from parsimony.output import emit, json_text
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -22,7 +21,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
 
 def run(args: argparse.Namespace) -> int:
     rows = run_demo(args.robot)
-    emit(json.dumps(rows, indent=2) if args.json else format_table(rows))
+    emit(json_text(rows, indent=2) if args.json else format_table(rows))
     expected = all(
         row["converged"] != (row["law"] in ("LP conservative",)) for row in rows
         if row["experiment"] != "joint limit"

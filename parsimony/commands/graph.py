@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import argparse
-import json
 import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 from deploy.graph import dataflow
-from parsimony.output import emit
+from parsimony.output import emit, json_text
 from profiles.profile import ProfileError, load_profile
 
 
@@ -38,7 +37,7 @@ def run(args: argparse.Namespace) -> int:
         return 2
     for warning in graph.warnings():
         print(warning, file=sys.stderr)
-    emit(json.dumps(graph.to_json(), indent=2) if args.json else graph.to_text())
+    emit(json_text(graph.to_json(), indent=2) if args.json else graph.to_text())
     if args.dot:
         args.dot.write_text(graph.to_dot() + "\n")
     if args.png:

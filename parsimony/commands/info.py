@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
-from parsimony.output import emit, table
+from parsimony.output import emit, json_text, table
 from record.session_reader import info
 
 
@@ -28,7 +27,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"info: {error}", file=sys.stderr)
         return 2
     if args.json:
-        emit(json.dumps(found, indent=2))
+        emit(json_text(found, indent=2))
         return 0
     rows = [{"channel": c["key"], "schema": c["schema"], "schema_bytes": c["schema_bytes"],
              "messages": c["messages"], "rate_hz": c["rate_hz"]} for c in found["channels"]]

@@ -7,7 +7,7 @@ import json
 
 from deploy.graph import component_class
 from deploy.query import QueryError, status_of
-from parsimony.output import emit
+from parsimony.output import emit, json_text
 from parsimony.target_options import fail, profile_and_target, target_options
 from profiles.profile import ProfileError
 
@@ -39,7 +39,7 @@ def run(args: argparse.Namespace) -> int:
         "parameters": status.parameters,
     }  # fmt: skip
     if args.json:
-        emit(json.dumps(info, indent=2))
+        emit(json_text(info, indent=2))
         return 0
     lines = [f"{info['name']} ({info['module']}, {info['role']}): {info['state']}, "
              f"pid {info['pid']}",

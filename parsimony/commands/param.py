@@ -10,7 +10,7 @@ import yaml
 
 from deploy.graph import component_class
 from deploy.query import QueryError, all_params, get_param, set_param, value_text
-from parsimony.output import emit
+from parsimony.output import emit, json_text
 from parsimony.target_options import fail, profile_and_target, target_options
 from profiles.profile import ProfileError
 
@@ -65,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         if args.action == "describe":
             rows = describe(args)
-            emit(json.dumps(rows, indent=2) if args.json else "\n".join(
+            emit(json_text(rows, indent=2) if args.json else "\n".join(
                 f"{r['name']}: {r['type']} = {r['default']!r}"
                 + (f" in [{r['low']}, {r['high']}]" if r["low"] is not None
                    or r["high"] is not None else "")
@@ -93,7 +93,7 @@ def run(args: argparse.Namespace) -> int:
     except (ProfileError, QueryError, KeyError, LookupError, OSError, ValueError) as error:
         return fail(error)
     if args.json:
-        emit(json.dumps(values, indent=2))
+        emit(json_text(values, indent=2))
     elif args.action == "dump":
         emit(yaml.safe_dump(values, sort_keys=False).rstrip())
     else:

@@ -6,13 +6,12 @@ file."""
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
 from deploy import ROBOT_FILE
 from parsimony.commands.launch import positive_seconds
-from parsimony.output import emit
+from parsimony.output import emit, json_text
 from parsimony.sessions import load_session
 from profiles.profile import ProfileError, load_profile
 from record.judge import JUDGED, judge, the_run
@@ -61,9 +60,9 @@ def run(args: argparse.Namespace) -> int:
     except (OSError, ValueError, ProfileError) as error:
         print(f"report: {error}", file=sys.stderr)
         return 2
-    (args.out / "judged.json").write_text(json.dumps(judged, indent=2) + "\n")
+    (args.out / "judged.json").write_text(json_text(judged, indent=2) + "\n")
     result = {**result, "figures": [str(p) for p in result["figures"]], "judged": judged}
-    emit(json.dumps(result, indent=2) if args.json else "\n".join(result["figures"]))
+    emit(json_text(result, indent=2) if args.json else "\n".join(result["figures"]))
     return 0
 
 

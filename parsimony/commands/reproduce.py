@@ -3,14 +3,12 @@
 from __future__ import annotations
 
 import argparse
-import json
-import math
 import sys
 from dataclasses import asdict
 from pathlib import Path
 
 from deploy import ROBOT_FILE
-from parsimony.output import emit
+from parsimony.output import emit, json_text
 from parsimony.reproduce import format_rows, reproduce, write_figures
 from wbc.robot import MobileManipulator
 
@@ -38,19 +36,8 @@ def run(args: argparse.Namespace) -> int:
     figures = write_figures(robot, found, args.out)
     print(f"reproduce: {len(figures)} figures and notes in {args.out}", file=sys.stderr)
     if args.json:
-        emit(json.dumps({"rows": [_finite(asdict(row)) for row in rows],
+        emit(json_text({"rows": [asdict(row) for row in rows],
                          "figures": [str(path) for path in figures]}))  # fmt: skip
     else:
         emit(format_rows(rows))
     return 0
-
-
-def _finite(value: object) -> object:
-    """NaN (a median of no steps) as null, so the JSON is standard."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, list):
-        return [_finite(v) for v in value]
-    if isinstance(value, dict):
-        return {k: _finite(v) for k, v in value.items()}
-    return value

@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
 from messages.schema import export_schemas, schema_index
-from parsimony.output import emit
+from parsimony.output import emit, json_text
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -27,7 +26,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
 
 def run(args: argparse.Namespace) -> int:
     if args.out is None:
-        emit(json.dumps(schema_index(), indent=2))
+        emit(json_text(schema_index(), indent=2))
         return 0
     for path in export_schemas(args.out):
         emit(str(path))

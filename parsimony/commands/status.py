@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -16,7 +15,7 @@ from deploy.query import (
     statuses,
 )
 from messages.status import ComponentStatus
-from parsimony.output import emit, table
+from parsimony.output import emit, json_text, table
 from parsimony.target_options import fail
 from profiles.profile import ProfileError
 
@@ -72,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
             {"name": name, "status": found[name].model_dump(mode="json") if name in found else None}
             for name in names
         ]
-        emit(json.dumps(rows, indent=2))
+        emit(json_text(rows, indent=2))
     else:
         emit(format_table([(name, found.get(name)) for name in names]))
     if not names:

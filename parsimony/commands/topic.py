@@ -18,7 +18,7 @@ from deploy.graph import dataflow
 from deploy.query import QueryError
 from messages import codec, topics
 from messages.header import Header
-from parsimony.output import emit
+from parsimony.output import emit, json_text
 from parsimony.target_options import fail, profile_and_target, target_options
 from profiles.profile import ProfileError
 
@@ -87,9 +87,9 @@ def run(args: argparse.Namespace) -> int:
                     for name in names]  # fmt: skip
             if args.action == "info":
                 rows[0]["schema"] = topics.TOPICS[args.topic].type.model_json_schema()
-                emit(json.dumps(rows[0], indent=2))
+                emit(json_text(rows[0], indent=2))
             elif args.json:
-                emit(json.dumps(rows, indent=2))
+                emit(json_text(rows, indent=2))
             else:
                 emit("\n".join(f"{r['key']:<34} {r['type']:<22} "
                                f"{', '.join(r['writers']) or '-'} -> "
@@ -117,7 +117,7 @@ def echo(args: argparse.Namespace, session: zenoh.Session, target: Any) -> int:
             if isinstance(message, codec.DecodeError):
                 print(f"undecodable: {message}", flush=True, file=sys.stderr)
                 return
-            emit(json.dumps(printable(message)))
+            emit(json_text(printable(message)))
             printed += 1
             if args.count is not None and printed >= args.count:
                 done.set()
@@ -146,7 +146,7 @@ def hz(args: argparse.Namespace, session: zenoh.Session, target: Any) -> int:
               "period_min_s": float(periods.min()) if len(periods) else math.nan,
               "period_max_s": float(periods.max()) if len(periods) else math.nan}  # fmt: skip
     if args.json:
-        emit(json.dumps(report))
+        emit(json_text(report))
     else:
         emit(f"{args.topic}: {report['rate_hz']:.1f} Hz over {args.window} s "
              f"({len(arrivals)} messages), period median {report['period_median_s']:.4f} s, "
@@ -178,7 +178,7 @@ def pub(args: argparse.Namespace, session: zenoh.Session, target: Any) -> int:
         publisher.put(codec.encode(message))
         if seq + 1 < args.count:
             time.sleep(1.0 / args.rate)
-    emit(json.dumps({"topic": args.topic, "published": args.count,
+    emit(json_text({"topic": args.topic, "published": args.count,
                      "subscribers": publisher.matching_status.matching}))  # fmt: skip
     publisher.undeclare()
     return 0

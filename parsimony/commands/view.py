@@ -11,7 +11,6 @@ the handler's times)."""
 from __future__ import annotations
 
 import argparse
-import json
 import logging
 import os
 import signal
@@ -23,7 +22,7 @@ from deploy.control_station import ControlStation
 from deploy.query import QueryError, Target
 from messages.topics import topics_matching
 from parsimony.commands.layout import write_layout
-from parsimony.output import emit
+from parsimony.output import emit, json_text
 from parsimony.target_options import exit_code
 from profiles.profile import ProfileError, load_profile
 from record.foxglove_views import Viewer
@@ -118,6 +117,6 @@ def _serve(view: LiveView, station: ControlStation, namespace: str, as_json: boo
           f"{handler['median']} us median, {handler['p99']} us p99 over {handler['samples']}; "
           f"{station.goals_sent} goals sent", file=sys.stderr)  # fmt: skip
     if as_json:
-        emit(json.dumps({"shown": view.shown, "unwatched": view.unwatched,
+        emit(json_text({"shown": view.shown, "unwatched": view.unwatched,
                          "malformed": view.malformed, "failed": view.failed,
                          "handler_us": handler, "goals_sent": station.goals_sent}))  # fmt: skip
