@@ -150,14 +150,20 @@ def pose_phase_since(statuses: Sequence) -> float | None:
 
 def end_of_run(session: Session, time_limit_s: float | None, origin: float) -> tuple[int, bool]:
     """The stamp (ns) the run ends at, ``HOLD_S`` after it converged, else ``time_limit_s``
-    after ``origin`` (a simulated time: two lockstep runs of one set-up judge the same steps),
-    else its last step; and whether it converged."""
-    diagnostics = messages(session, CONTROL_DIAGNOSTICS)
-    since = converged_at(diagnostics, messages(session, SUPERVISOR_STATUS))
+    after ``origin``, else its last step; and whether it converged. The limit is a simulated
+    time, and what came after it is not looked at: two lockstep runs of one set-up judge the
+    same steps, however long each went on before it was stopped."""
+    limited = time_limit_s is not None and math.isfinite(origin)
+    limit_ns = round((origin + time_limit_s) * 1e9) if limited else None
+    within = session if limit_ns is None else until(
+        {t.name: session.get(t.name) or [] for t in (CONTROL_DIAGNOSTICS, SUPERVISOR_STATUS)},
+        limit_ns)  # fmt: skip
+    diagnostics = messages(within, CONTROL_DIAGNOSTICS)
+    since = converged_at(diagnostics, messages(within, SUPERVISOR_STATUS))
     if since is not None and diagnostics[-1].header.stamp_ns / 1e9 - since >= HOLD_S:
         return round((since + HOLD_S) * 1e9), True
-    if time_limit_s is not None and math.isfinite(origin):
-        return round((origin + time_limit_s) * 1e9), False
+    if limit_ns is not None:
+        return limit_ns, False
     return (diagnostics[-1].header.stamp_ns if diagnostics else 0), False
 
 

@@ -9,7 +9,7 @@ import pytest
 from messages.obstacles import Circle, Plane, Solids
 from messages.topics import CONTROL_DIAGNOSTICS, ROBOT_STATE, SIM_TRUTH
 from messages.truth import SimTruth
-from record.judge import HOLD_S, commands, effort, judge, the_run
+from record.judge import HOLD_S, commands, effort, judge, origin_s, the_run
 from tests.record.test_report import ROBOT, START_NS, runs  # noqa: F401 - the fixture
 from wbc import scenarios
 from wbc.kinematic_run import effort_of
@@ -73,6 +73,24 @@ def test_a_time_limit_ends_a_run_that_did_not_converge_at_the_limit(runs):  # no
     assert not judged["converged"]
     last = the_run(early, 1.0)[0][CONTROL_DIAGNOSTICS.name][-1].header.stamp_ns
     assert last <= START_NS + 10**9 < last + 30_000_000
+
+
+def test_a_run_that_converged_only_after_its_time_limit_is_judged_as_it_stood_at_the_limit(
+    runs,  # noqa: F811
+):
+    """A lockstep run whose stop came late (the machine was busy) went on past its limit and
+    converged there: it is judged on the same steps as a run stopped in time, not converged."""
+    _, session = runs["LP"]
+    origin = origin_s(session)
+    converged_s = the_run(session)[0][CONTROL_DIAGNOSTICS.name][-1].header.stamp_ns / 1e9
+    limit_s = converged_s - origin - 0.5
+    in_time = {name: [m for m in messages if m.header.stamp_ns / 1e9 <= origin + limit_s]
+               for name, messages in session.items()}  # fmt: skip
+    late, stopped = judge(session, ROBOT, time_limit_s=limit_s), judge(in_time, ROBOT, limit_s)
+    assert judge(session, ROBOT)["converged"]
+    assert not late["converged"] and not stopped["converged"]
+    assert late["commands_digest"] == stopped["commands_digest"]
+    assert late["iterations"] == stopped["iterations"] < len(session[CONTROL_DIAGNOSTICS.name])
 
 
 def test_the_arms_clearance_and_penetrations_are_judged_from_the_truth(runs):  # noqa: F811
