@@ -289,7 +289,7 @@ def run_experiment(options: Options) -> dict[str, Any]:
     figures = write_report([(label, run)], robot, options.out,
                            profile.scene.reference_pose)["figures"]  # fmt: skip
     report["figures"] = [str(path) for path in figures]
-    (options.out / "report.json").write_text(dumps(report))
+    (options.out / "report.json").write_text(json_text(report, indent=2))
     return report
 
 
@@ -393,8 +393,3 @@ def durations(counters: dict[str, dict[str, int]]) -> dict[str, dict[str, int]]:
         name: {k: v for k, v in sorted(found.items()) if k.endswith(("_us_median", "_us_p99"))}
         for name, found in sorted(counters.items())
     }
-
-
-def dumps(report: dict) -> str:
-
-    return json_text(report, indent=2)

@@ -11,8 +11,8 @@ from pathlib import Path
 import yaml
 
 from deploy.query import QueryError
-from parsimony.experiment import PROFILES, TIME_LIMIT_S, Options, dumps, run_experiment
-from parsimony.output import emit
+from parsimony.experiment import PROFILES, TIME_LIMIT_S, Options, run_experiment
+from parsimony.output import emit, json_text
 from profiles.profile import ProfileError
 from sim2d.scenarios import NAMES, SEED_MAX
 
@@ -108,7 +108,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"experiment: {error}", file=sys.stderr)
         return EXIT_USAGE
     if args.json:
-        emit(dumps(report))
+        emit(json_text(report, indent=2))
     else:
         keys = ("converged", "final_error", "sim_time_s", "wall_time_s", "real_time_factor",
                 "contacts", "arm_penetrations")  # fmt: skip
