@@ -118,6 +118,40 @@ def test_a_goal_behind_the_robot_is_planned_off_the_handler_thread_then_driven_t
     assert drive.task == "heading"  # the base faces away from the way: it turns to face it
 
 
+def take_obstacles(operator: Operator, circles: tuple[Circle, ...]) -> None:
+    """Publish ``circles`` until the supervisor has received them."""
+    deadline = time.monotonic() + DEADLINE_S
+    while component_status(operator.system, "supervisor").counters[
+        "received.world/obstacles"
+    ] == 0:  # fmt: skip
+        assert time.monotonic() < deadline, "the supervisor never took the obstacles"
+        operator.obstacles.put(codec.encode(Obstacles(header=header(), circles=circles)))
+
+
+def test_the_status_of_a_drive_round_an_obstacle_carries_its_whole_planned_way(
+    deployed: Callable[[str], System],
+) -> None:
+    """A post on the way to a goal behind the robot: the status of the drive names every
+    waypoint still to pass, round the post with the base's body clear of it, and the
+    candidate's base last."""
+    operator = supervised(deployed)
+    post = Circle(x=-0.4, y=0.1, radius=0.15)
+    take_obstacles(operator, (post,))
+    behind = operator.robot.fkm(np.concatenate(([-0.8, 0.2, 3.0], REACH_GOAL[3:])))
+    operator.ask(behind)
+    operator.send_state(HOME)
+    drive = operator.statuses.wait_for(lambda s: s.phase == "drive", "the drive's status")
+    assert len(drive.way) > 2, drive.way  # a way round the post, not straight at it
+    assert drive.candidate_base is not None
+    np.testing.assert_allclose(drive.way[-1], drive.candidate_base[:2])
+    points = np.array([HOME[:2], *drive.way])
+    centre = np.array([post.x, post.y])
+    for a, b in zip(points, points[1:], strict=False):
+        along = np.clip(np.dot(centre - a, b - a) / np.dot(b - a, b - a), 0.0, 1.0)
+        gap = np.linalg.norm(a + along * (b - a) - centre)
+        assert gap > post.radius + MODEL.base.body_radius, (a, b, gap)
+
+
 def unreachable(operator: Operator, pose: np.ndarray) -> SupervisorStatus:
     operator.ask(pose)
 
@@ -224,12 +258,7 @@ def test_status_queries_are_answered_while_a_plan_runs_on_the_planner_thread(
     operator = supervised(deployed)
     ring = tuple(Circle(x=2.0 + 0.9 * math.cos(a), y=0.9 * math.sin(a), radius=0.08)
                  for a in np.linspace(0.0, 2.0 * math.pi, 30, endpoint=False))  # fmt: skip
-    deadline = time.monotonic() + DEADLINE_S
-    while component_status(operator.system, "supervisor").counters[
-        "received.world/obstacles"
-    ] == 0:  # fmt: skip
-        assert time.monotonic() < deadline, "the supervisor never took the obstacles"
-        operator.obstacles.put(codec.encode(Obstacles(header=header(), circles=ring)))
+    take_obstacles(operator, ring)
     operator.ask(operator.robot.fkm(np.array([2.0, 0.0, 0.0, 0.0, -0.3, -0.4, 0.2, 0.3])))
     operator.send_state(HOME)
     operator.statuses.wait_for(lambda s: s.phase == "planning", "the plan handed over")
