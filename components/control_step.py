@@ -126,6 +126,12 @@ class ControlStep:
             self.law.stopped()
         return step
 
+    def zero(self, stamp_ns: int, status: str, reason: str) -> Step:
+        """Zero commands stamped ``stamp_ns``, for ``status`` and ``reason``, sent without a
+        step (no state, a stopped clock, a bad parameter); the law is told (``Law.stopped``)."""
+        self.law.stopped()
+        return Step.zero(stamp_ns, status, reason)
+
     def _commands(self, state: RobotState, now_ns: int, stale_timeout_s: float) -> Step:
         stamp = state.header.stamp_ns
         dt = FIRST_DT_S if self.last_stamp_ns is None else (stamp - self.last_stamp_ns) / 1e9

@@ -142,7 +142,7 @@ class Controller(Component):
             self.update_law()
         except ParamError as error:
             self.stepper.last_stamp_ns = state.header.stamp_ns
-            self.publish(Step.zero(state.header.stamp_ns, "error", str(error)))
+            self.publish(self.stepper.zero(state.header.stamp_ns, "error", str(error)))
             return
         step = self.stepper.step(state, self.node.clock.now_ns(),
                                  self.node.params["stale_timeout_s"])  # fmt: skip
@@ -162,11 +162,11 @@ class Controller(Component):
             if math.isinf(age_s)
             else f"no robot/state for {age_s:.2f} s (timeout {timeout_s} s)"
         )
-        self.publish(Step.zero(self.node.clock.now_ns(), "stale", reason))
+        self.publish(self.stepper.zero(self.node.clock.now_ns(), "stale", reason))
 
     def clock_stalled(self, stalled_s: float) -> None:
         """The simulated clock stopped: command zero and say why."""
-        self.publish(Step.zero(self.node.clock.now_ns(), "stale",
+        self.publish(self.stepper.zero(self.node.clock.now_ns(), "stale",
                                f"sim/clock has not moved for {stalled_s:.2f} s"))  # fmt: skip
 
     def update_law(self) -> None:

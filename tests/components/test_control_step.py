@@ -7,6 +7,7 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
+import pytest
 
 from components.control_step import ControlStep
 from deploy import ROBOT_FILE
@@ -29,10 +30,12 @@ def state(q: np.ndarray, stamp_ns: int) -> RobotState:
                       end_effector=tuple(ROBOT.fkm(q)), valid=True, age_s=0.0)  # fmt: skip
 
 
-def test_a_held_step_starts_the_law_again_from_rest() -> None:
-    """Moving under the input change term (w 3: its band a bound), then one stale state (zero
-    sent): the next u speeds up from 0 by at most s = v dt / T an entry, not from the u the law
-    gave before the hold."""
+@pytest.mark.parametrize("hold", ["a stale state", "a zero sent without a state"])
+def test_a_held_step_starts_the_law_again_from_rest(hold: str) -> None:
+    """Moving under the input change term (w 3: its band a bound), then zero sent, for a state
+    too old or with no state at all (the controller's timer, a stopped clock, a bad
+    parameter): the next u speeds up from 0 by at most s = v dt / T an entry, not from the u
+    the law gave before the hold."""
     smooth = input_change_gains()
     gains = dataclasses.replace(LPParams(eta=0.6, beta=15.0), **{**smooth, "input_change": 3.0})
     control = ControlStep("lp", LPLaw, ROBOT, gains)
@@ -47,8 +50,11 @@ def test_a_held_step_starts_the_law_again_from_rest() -> None:
     moving = step.output.u
     ramp = ROBOT.velocity_max * DT / smooth["input_change_ramp"]
     assert np.any(np.abs(moving) > ramp + 1e-6), "the run must be faster than one ramp step"
-    stamp += STEP_NS
-    held = control.step(state(q, stamp), stamp + int(2 * STALE_S * 1e9), STALE_S)
+    if hold == "a stale state":
+        stamp += STEP_NS
+        held = control.step(state(q, stamp), stamp + int(2 * STALE_S * 1e9), STALE_S)
+    else:  # the controller's timer, between two states
+        held = control.zero(stamp + STEP_NS // 2, "stale", "no robot/state for 0.51 s")
     assert held.status == "stale" and held.joints == (0.0,) * 5
     stamp += STEP_NS
     after = control.step(state(q, stamp), stamp, STALE_S)
