@@ -66,7 +66,6 @@ class ControlStation(ServerListener):
         self._server: WebSocketServer | None = None
         self._lock = threading.Lock()
         self._goal_channels: dict[tuple[int, int], ClientChannel] = {}
-        self._other_channels: set[tuple[int, int]] = set()
         self._q: np.ndarray | None = None
         self._obstacles: tuple[Circle, ...] = ()
         self._clock_ns: int | None = None
@@ -118,8 +117,6 @@ class ControlStation(ServerListener):
     def on_client_advertise(self, client: Client, channel: ClientChannel) -> None:
         key = (client.id, channel.id)
         if channel.topic not in (topics.GOAL_REQUEST.name, topics.GOAL_REQUEST.key(self.namespace)):
-            with self._lock:
-                self._other_channels.add(key)
             self._status(client, "publish", f"{channel.topic}: only {topics.GOAL_REQUEST.name} "
                          "may be published", StatusLevel.Error)  # fmt: skip
             return
@@ -134,7 +131,6 @@ class ControlStation(ServerListener):
     def on_client_unadvertise(self, client: Client, client_channel_id: int) -> None:
         with self._lock:
             self._goal_channels.pop((client.id, client_channel_id), None)
-            self._other_channels.discard((client.id, client_channel_id))
 
     def on_message_data(self, client: Client, client_channel_id: int, data: bytes) -> None:
         with self._lock:

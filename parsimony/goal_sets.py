@@ -356,21 +356,14 @@ def failures(attempts: Iterable[Attempt]) -> dict:
     }
 
 
-def obstacle_report(robot_file: Path, count: int, processes: int = 2,
-                    seed: int | None = None) -> dict:  # fmt: skip
+def _obstacle_rows(pool: Pool, robot_file: Path, count: int) -> dict:
     """For every family of OBSTACLE_FAMILIES, the LP under the staging supervisor: the shares
     reached, the failures by reason, the contacts and the planning times."""
-    with multiprocessing.get_context("spawn").Pool(processes) as pool:
-        return _obstacle_rows(pool, robot_file, count, seed)
-
-
-def _obstacle_rows(pool: Pool, robot_file: Path, count: int, seed: int | None = None
-                   ) -> dict:  # fmt: skip
     robot = MobileManipulator.from_yaml(robot_file)
     report: dict = {}
     for family in OBSTACLE_FAMILIES.values():
         jobs = [(SUPERVISED, robot_file, start, goal, False, (circle,))
-                for start, goal, circle in obstacle_goals(family, count, robot, seed)]  # fmt: skip
+                for start, goal, circle in obstacle_goals(family, count, robot)]  # fmt: skip
         attempts = pool.map(_attempt_one, jobs, chunksize=1)
         row = {**shares(attempts), **parsimony(attempts, robot.dof), **failures(attempts),
                **planning(attempts)}
@@ -381,7 +374,7 @@ def _obstacle_rows(pool: Pool, robot_file: Path, count: int, seed: int | None = 
 def goal_report(robot_file: Path, count: int, processes: int = 2) -> dict:
     """For every family and law: the shares reached and the parsimony of u, for the pose task
     and, with the laws of POSITION_LAWS, for the position task of the same goals; and the LP
-    under the supervisor on the goals of OBSTACLE_FAMILIES (``obstacle_report``)."""
+    under the supervisor on the goals of OBSTACLE_FAMILIES (``_obstacle_rows``)."""
     robot = MobileManipulator.from_yaml(robot_file)
     report: dict = {}
     with multiprocessing.get_context("spawn").Pool(processes) as pool:

@@ -241,7 +241,6 @@ class Viewer:
     key, to send them when they change: one writer or server uses one."""
 
     def __init__(self, robot: MobileManipulator | None = None) -> None:
-        self.robot = robot
         drawing = functools.partial(RobotDrawing, robot) if robot is not None else None
         estimate = drawing("estimate/", ESTIMATE_COLOR) if drawing else None
         truth = drawing("truth/", TRUTH_COLOR, "truth/world") if drawing else None

@@ -54,10 +54,6 @@ class Arc:
     start: float
     sweep: float
 
-    @property
-    def length(self) -> float:
-        return self.radius * abs(self.sweep)
-
     def corners(self, max_turn: float) -> list[Array]:
         """The corners of the polygon circumscribed about the arc, pieces of at most
         ``max_turn`` rad: the meeting points of the tangents at its ends and between them."""
@@ -75,9 +71,6 @@ class Way:
 
     start: Array
     target: Array
-    points: tuple[Array, ...]
-    """The tangent points of the way in order, from the start to the target: consecutive
-    points are joined by a segment or by one of ``arcs``."""
     arcs: tuple[Arc, ...]
     length: float
     """The exact length of the tangent segments and arcs, m (inf without a way)."""
@@ -179,9 +172,9 @@ class WayPlanner:
         if np.any(gaps < self.radii) and not self.shrunk_for_target:
             return WayPlanner(self.origin, self.obstacles, self.clearance, self.slack,
                               self.max_turn, target).to(target)  # fmt: skip
-        best: tuple[float, list[tuple[int, float | None]], Array | None] = (math.inf, [], None)
+        best: tuple[float, list[tuple[int, float | None]]] = (math.inf, [])
         if clear(self.start, target, self.centres, self.radii):
-            best = (float(np.hypot(*(target - self.start))), [(0, None)], None)
+            best = (float(np.hypot(*(target - self.start))), [(0, None)])
         for disc in range(len(self.obstacles)):
             for angle in self._tangent_angles(target, disc):
                 point = self._point(disc, angle)
@@ -192,14 +185,14 @@ class WayPlanner:
                     length = (self.distance[node] + self.radii[disc] * abs(sweep)
                               + float(np.hypot(*(target - point))))  # fmt: skip
                     if length < best[0]:
-                        best = (length, self._path(node) + [(-1, sweep)], point)
+                        best = (length, self._path(node) + [(-1, sweep)])
         if not math.isfinite(best[0]):
             return self._none(target, f"no way round the obstacles from ({self.start[0]:.2f}, "
                               f"{self.start[1]:.2f}) to ({target[0]:.2f}, {target[1]:.2f})")
         return self._way(target, *best)
 
     def _none(self, target: Array, reason: str) -> Way:
-        return Way(self.origin, target, (), (), math.inf, reason, ())
+        return Way(self.origin, target, (), math.inf, reason, ())
 
     def _escape(self) -> Array:
         """The point straight out of the grown disc (r + clearance + slack) the origin stands
@@ -329,15 +322,12 @@ class WayPlanner:
         path[-1] = (0, None)
         return path[::-1]
 
-    def _way(self, target: Array, length: float, path: list[tuple[int, float | None]],
-             tangent: Array | None) -> Way:  # fmt: skip
-        """The way along ``path`` (node -1: the target's tangent point ``tangent``), then
-        straight to ``target``."""
-        points = [self.nodes[n].point if n >= 0 else tangent for n, _ in path]
+    def _way(self, target: Array, length: float, path: list[tuple[int, float | None]]) -> Way:
+        """The way along ``path`` (node -1: the target's tangent point), then straight to
+        ``target``."""
         arcs: list[Arc] = []
         waypoints: list[Array] = []
         if self.start is not self.origin:
-            points.insert(0, self.origin)
             waypoints.append(self.start)
             length += float(np.hypot(*(self.start - self.origin)))
         for (a, _), (_, sweep) in zip(path, path[1:], strict=False):
@@ -349,5 +339,4 @@ class WayPlanner:
             arcs.append(arc)
             waypoints += arc.corners(self.max_turn)
         waypoints.append(target)
-        return Way(self.origin, target, (*points, target), tuple(arcs), length, "",
-                   tuple(waypoints))
+        return Way(self.origin, target, tuple(arcs), length, "", tuple(waypoints))

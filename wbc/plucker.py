@@ -14,8 +14,6 @@ import numpy as np
 
 Array = np.ndarray
 
-I4 = np.eye(4)
-
 
 def pure(vector: Array) -> Array:
     """The pure quaternion [0, v] of a 3-vector (a pure quaternion is returned as it is)."""
