@@ -26,15 +26,13 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, ClassVar
 
-import yaml
-
 from components.control_step import (
     ControlStep,
     Step,
     gain_values,
     gains_of,
 )
-from components.params import Param, ParamError
+from components.params import Param, ParamError, load_robot
 from components.pubsub import Input
 from components.runtime import Component, Node
 from messages import topics
@@ -204,14 +202,6 @@ class Controller(Component):
         if self.node.profile.robot is None:
             raise ParamError("robot: no robot description; set it or the profile's `robot`")
         return self.node.profile.robot
-
-
-def load_robot(path: Path) -> MobileManipulator:
-    """The robot described at ``path``, or ``ParamError`` saying why it cannot be loaded."""
-    try:
-        return MobileManipulator.from_yaml(path)
-    except (OSError, ValueError, yaml.YAMLError) as error:
-        raise ParamError(f"robot: cannot load {path}: {error}") from error
 
 
 def diagnostics_of(step: Step, law: str, gains: Any, header: Header) -> ControllerDiagnostics:

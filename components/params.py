@@ -17,8 +17,11 @@ from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import yaml
+
 from messages.process import ParamValue
 from wbc.gains import GainSpec, shown
+from wbc.robot import MobileManipulator
 
 log = logging.getLogger("components")
 
@@ -148,3 +151,11 @@ def keep_params(params: Parameters, path: Path) -> None:
     partial_file = path.with_suffix(".tmp")
     partial_file.write_text(json.dumps(params.changed))
     partial_file.replace(path)
+
+
+def load_robot(path: Path) -> MobileManipulator:
+    """The robot described at ``path``, or ``ParamError`` saying why it cannot be loaded."""
+    try:
+        return MobileManipulator.from_yaml(path)
+    except (OSError, ValueError, yaml.YAMLError) as error:
+        raise ParamError(f"robot: cannot load {path}: {error}") from error

@@ -24,9 +24,7 @@ from __future__ import annotations
 import fnmatch
 from pathlib import Path
 
-import yaml
-
-from components.params import Param, ParamError
+from components.params import Param, ParamError, load_robot
 from components.process_entry import run_component
 from components.pubsub import Input
 from components.runtime import Component, Node
@@ -77,10 +75,7 @@ class Recorder(Component):
         """The profile's robot, which the file draws (none: its bases and end effectors)."""
         if node.profile.robot is None or not node.params["views"]:
             return None
-        try:
-            return MobileManipulator.from_yaml(node.profile.robot)
-        except (OSError, ValueError, yaml.YAMLError) as error:
-            raise ParamError(f"robot: cannot read {node.profile.robot}: {error}") from error
+        return load_robot(node.profile.robot)
 
     def _writer_of(self, name: str, key: str):
         def write(message) -> None:

@@ -25,8 +25,8 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from components.controller import goal_of, load_robot
-from components.params import Param, ParamError
+from components.controller import goal_of
+from components.params import Param, ParamError, load_robot
 from components.process_entry import run_component
 from components.pubsub import Input
 from components.runtime import Component, Node
