@@ -21,7 +21,13 @@ import zenoh
 
 from components.params import ParamError
 from components.runtime import Component, Node
-from messages.process import EXIT_CONFIG_ERROR, EXIT_FOR_GOOD, PARAMS_FILE_ENV, PARENT_PID_ENV
+from messages.process import (
+    EXIT_CONFIG_ERROR,
+    EXIT_FOR_GOOD,
+    PARAMS_FILE_ENV,
+    PARENT_PID_ENV,
+    parent_gone,
+)
 from profiles.profile import ProfileError, load_profile
 
 log = logging.getLogger("components")
@@ -40,10 +46,9 @@ def _on_stop_signal(signum: int, _frame: object) -> None:
 def _wait_for_stop(node: Node) -> None:
     """Sleep until a stop signal, the node's ``fail``, or the end of the launcher that
     started us."""
-    launcher = os.environ.get(PARENT_PID_ENV)
     while not node.stop_requested.wait(1.0):
-        if launcher is not None and os.getppid() != int(launcher):
-            log.warning("launcher (pid %s) is gone; stopping", launcher)
+        if parent_gone():
+            log.warning("launcher (pid %s) is gone; stopping", os.environ[PARENT_PID_ENV])
             return
 
 

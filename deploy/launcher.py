@@ -37,7 +37,13 @@ import zenoh
 
 from deploy.query import statuses
 from messages import process, topics
-from messages.process import EXIT_CONFIG_ERROR, EXIT_FOR_GOOD, PARAMS_FILE_ENV, PARENT_PID_ENV
+from messages.process import (
+    EXIT_CONFIG_ERROR,
+    EXIT_FOR_GOOD,
+    PARAMS_FILE_ENV,
+    PARENT_PID_ENV,
+    parent_gone,
+)
 from profiles.profile import ROLES, ComponentSpec, Profile
 
 POLL_S = 0.05
@@ -178,7 +184,7 @@ class Launcher:
             if self._starting_until is not None:
                 self._check_startup(now)
             self._kill_hung(now)
-            if self._orphaned():
+            if parent_gone():
                 self._stop_reason = "the process that started it is gone"
                 break
             if all(child.done for child in self.children):
@@ -186,12 +192,6 @@ class Launcher:
                 break
             time.sleep(POLL_S)
         self.output.say(f"stopping ({self._stop_reason})")
-
-    @staticmethod
-    def _orphaned() -> bool:
-        """Started by a process that named itself (``PARENT_PID_ENV``), which is gone."""
-        parent = os.environ.get(PARENT_PID_ENV)
-        return parent is not None and os.getppid() != int(parent)
 
     def _watch(self, router: zenoh.Session) -> None:
         """Watchdog thread: ask every component for its status, twice per ``watchdog_s``; an

@@ -8,6 +8,7 @@ how a parameter's value travels in a query reply. The launcher (``deploy``) and 
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -31,6 +32,13 @@ PARENT_PID_ENV = "PARSIMONY_PARENT_PID"
 ``parsimony record`` its recorder, ``parsimony experiment`` its launcher): a child whose parent
 is no longer that pid stops (a launcher stops its components first), so nothing runs on
 after its parent is killed."""
+
+
+def parent_gone() -> bool:
+    """This process was started by one that named itself (``PARENT_PID_ENV``), which is gone
+    (the process is now another's child)."""
+    parent = os.environ.get(PARENT_PID_ENV)
+    return parent is not None and os.getppid() != int(parent)
 
 PARAMS_FILE_ENV = "PARSIMONY_PARAMS_FILE"
 """Set by the launcher: a JSON file where a component keeps the parameters set while it runs,
