@@ -39,6 +39,7 @@ import zenoh
 
 from bench.figures import run_bench
 from deploy import query
+from deploy.launcher import cpu_seconds
 from messages import codec, topics
 from messages.markers import MarkerDetections
 from messages.supervisor import SupervisorStatus
@@ -59,7 +60,6 @@ WARM_S = 3.0
 STALL_S = 20.0
 """How long the stalled client reads nothing."""
 SAMPLE_S = 0.5
-CLOCK_TICKS = os.sysconf("SC_CLK_TCK")
 
 
 def lockstep_profile(directory: Path, base: Path = DEPLOY / "sim_supervised.yaml",
@@ -106,11 +106,6 @@ class Counter:
     def read(self) -> tuple[int, int]:
         with self._lock:
             return self.clock_ns, self.states
-
-
-def cpu_s(pid: int) -> float:
-    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / CLOCK_TICKS
 
 
 def rss_mb(pid: int) -> float:
@@ -166,10 +161,10 @@ def window(counter: Counter, session: zenoh.Session, namespace: str, pid: int | 
     ``pid``."""
     time.sleep(WARM_S)
     (clock0, _), wall0 = counter.read(), time.monotonic()
-    loop0, cpu0 = loop_cpu_s(session, namespace), cpu_s(pid) if pid else 0.0
+    loop0, cpu0 = loop_cpu_s(session, namespace), cpu_seconds(pid) if pid else 0.0
     time.sleep(WINDOW_S)
     (clock1, _), wall1 = counter.read(), time.monotonic()
-    loop1, cpu1 = loop_cpu_s(session, namespace), cpu_s(pid) if pid else 0.0
+    loop1, cpu1 = loop_cpu_s(session, namespace), cpu_seconds(pid) if pid else 0.0
     sim_s = (clock1 - clock0) / 1e9
     found = {"rtf": round(sim_s / (wall1 - wall0), 3),
              "loop_cpu_per_sim_s": round((loop1 - loop0) / sim_s, 3)}  # fmt: skip
