@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from wbc.planar import compose
 from wbc.plucker import foot, line, plane
 
 Array = np.ndarray
@@ -179,10 +180,9 @@ class Plane:
 
     def moved(self, x: float, y: float, yaw: float) -> Plane:
         """This obstacle after the planar motion (rotation yaw about k, then (x, y, 0))."""
-        c, s = math.cos(yaw), math.sin(yaw)
-        nx, ny, nz = self.normal
-        normal = (c * nx - s * ny, s * nx + c * ny, nz)
-        footprint = tuple((x + c * px - s * py, y + s * px + c * py) for px, py in self.footprint)
+        nx, ny, _ = compose((0.0, 0.0, yaw), (self.normal[0], self.normal[1], 0.0))
+        normal = (nx, ny, self.normal[2])
+        footprint = tuple(compose((x, y, yaw), (px, py, 0.0))[:2] for px, py in self.footprint)
         return Plane(normal, self.offset + normal[0] * x + normal[1] * y, footprint, self.name)
 
     def clearance(self, points: Array) -> Array:
@@ -244,9 +244,8 @@ class Cylinder:
 
     def moved(self, x: float, y: float, yaw: float) -> Cylinder:
         """This obstacle after the planar motion (rotation yaw about k, then (x, y, 0))."""
-        c, s = math.cos(yaw), math.sin(yaw)
-        return Cylinder(x + c * self.x - s * self.y, y + s * self.x + c * self.y, self.radius,
-                        self.height, self.name)  # fmt: skip
+        cx, cy, _ = compose((x, y, yaw), (self.x, self.y, 0.0))
+        return Cylinder(cx, cy, self.radius, self.height, self.name)
 
     def clearance(self, points: Array) -> Array:
         """Signed distances (k,) of ``points`` (k, 3) from the solid, negative inside."""
