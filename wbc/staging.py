@@ -281,9 +281,9 @@ def _start(rng: np.random.Generator, index: int, goal_xy: Array, psi: float,
 def _search(robot: MobileManipulator, q_now: Array, goal_pose: Array, ways: WayPlanner,
             params: StagingParams, margin: float, budget_end: float, left_out: _LeftOut
             ) -> tuple[list[Candidate], bool]:  # fmt: skip
-    """The candidates of one margin, best first (those left out are counted in
-    ``left_out``), each with its way from ``ways``, and whether every start was tried
-    before the CPU budget ran out."""
+    """The candidates of one margin in the order found (``plan`` ranks them; those left out
+    are counted in ``left_out``), each with its way from ``ways``, and whether every start was
+    tried before the CPU budget ran out."""
     obstacles = ways.obstacles
     rng = np.random.default_rng(params.seed)
     low, high = arm_box(robot, params.safety_factor, margin)
@@ -296,7 +296,7 @@ def _search(robot: MobileManipulator, q_now: Array, goal_pose: Array, ways: WayP
     seen: list[Array] = []
     for index in range(params.starts):
         if time.thread_time() > budget_end:
-            return sorted(found, key=lambda c: c.score), False
+            return found, False
         start = _start(rng, index, goal_xy, psi, params, (low, high))
         q = solve_ik(robot, goal_pose, start, bounds, params.residual_tolerance)
         if q is None or any(same_configuration(q, other) for other in seen):
@@ -315,7 +315,7 @@ def _search(robot: MobileManipulator, q_now: Array, goal_pose: Array, ways: WayP
             left_out.way_reason = way.reason
             continue
         found.append(_scored(robot, q_now, q, way, final_leg, obstacles, params))
-    return sorted(found, key=lambda c: c.score), True
+    return found, True
 
 
 def _final_leg(q: Array, obstacles: Sequence[Circle], body: float,
