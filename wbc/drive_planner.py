@@ -147,6 +147,10 @@ class WayPlanner:
             float(np.hypot(*(p - centre))) - ROOM for p in near]))
             for c, centre in zip(self.obstacles, self.centres, strict=True)])  # fmt: skip
         self.shrunk_for_target = target is not None
+        self._covers = [[interval for other in range(len(self.obstacles)) if other != disc
+                         and (interval := covered(*self._disc(disc), *self._disc(other)))
+                         is not None] for disc in range(len(self.obstacles))]  # fmt: skip
+        """For each disc, the arcs of its circle that the other discs cover (``covered``)."""
         self.nodes = [_Node(self.start, -1, 0.0)]
         self.edges: Edges = {0: []}
         discs = range(0 if self.reason else len(self.obstacles))
@@ -258,13 +262,7 @@ class WayPlanner:
 
     def _blocked(self, disc: int, start: float, sweep: float) -> bool:
         """Another disc covers part of the counter-clockwise arc (start, sweep) of ``disc``."""
-        centre, radius = self._disc(disc)
-        for other in range(len(self.obstacles)):
-            if other != disc:
-                interval = covered(centre, radius, *self._disc(other))
-                if interval is not None and overlaps(start, sweep, interval):
-                    return True
-        return False
+        return any(overlaps(start, sweep, interval) for interval in self._covers[disc])
 
     def _link_arcs(self, disc: int) -> list[int]:
         """Join each node of ``disc`` to its counter-clockwise neighbour by the arc between
