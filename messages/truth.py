@@ -34,3 +34,7 @@ class SimTruth(Message):
     solids: Solids = Solids()
     arm_penetrations: Count = 0
     arm_penetrating: bool = False
+
+    def configuration(self) -> list[float]:
+        """The true whole-body configuration ``q = [x, y, phi, q1, ..., q5]``."""
+        return [*self.base_pose, *self.arm_joints]

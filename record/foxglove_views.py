@@ -191,7 +191,7 @@ def truth_frames(drawing: RobotDrawing | None, truth: SimTruth) -> fox.FrameTran
     if drawing is None:
         transforms.append(planar_transform(parent, "truth/base", truth.base_pose, stamp))
     else:
-        q = np.array([*truth.base_pose, *truth.arm_joints])
+        q = np.array(truth.configuration())
         transforms += drawing.transforms(q, stamp)
     transforms.append(pose_transform(parent, "truth/end_effector", truth.end_effector, stamp))
     if truth.goal is not None:

@@ -229,7 +229,7 @@ def arm_clearances(truth: Sequence, robot: MobileManipulator) -> Array | None:
     if not truth or not truth[-1].solids.solids() or not robot.collision.names:
         return None
     solids = truth[-1].solids.solids()
-    return np.array([part_clearances(robot, np.array([*t.base_pose, *t.arm_joints]), solids)
+    return np.array([part_clearances(robot, np.array(t.configuration()), solids)
                      .min(axis=1) for t in truth])  # fmt: skip
 
 

@@ -25,11 +25,6 @@ from wbc.robot import MobileManipulator
 PENETRATION_COLOR = fox.Color(r=1.0, g=0.0, b=0.0, a=1.0)
 
 
-def configuration(truth: SimTruth) -> np.ndarray:
-    """The true whole-body configuration q = [x, y, phi, q1..q5]."""
-    return np.array([*truth.base_pose, *truth.arm_joints])
-
-
 def penetrating(robot: MobileManipulator, truth: SimTruth) -> tuple[str, ...]:
     """The names of the collision parts inside a solid now (none unless the truth says one
     is)."""
@@ -38,7 +33,7 @@ def penetrating(robot: MobileManipulator, truth: SimTruth) -> tuple[str, ...]:
     solids = truth.solids.solids()
     if not solids:
         return ()
-    inside = part_clearances(robot, configuration(truth), solids).min(axis=1) < 0.0
+    inside = part_clearances(robot, np.array(truth.configuration()), solids).min(axis=1) < 0.0
     return tuple(name for name, found in zip(robot.collision.names, inside, strict=True)
                  if found)  # fmt: skip
 
@@ -49,7 +44,7 @@ def penetration_scene(robot: MobileManipulator, frame: str, truth: SimTruth,
     world), after deleting the last ones."""
     stamp = timestamp(truth.header.stamp_ns)
     model = robot.collision
-    positions = point_positions(robot.frames(configuration(truth)), model)
+    positions = point_positions(robot.frames(np.array(truth.configuration())), model)
     spheres = [_sphere(positions[i], p.radius) for i, p in enumerate(model.points)
                if p.name in parts]  # fmt: skip
     lines = []
