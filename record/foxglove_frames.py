@@ -15,6 +15,13 @@ def timestamp(stamp_ns: int) -> fox.Timestamp:
     return fox.Timestamp(stamp_ns // 1_000_000_000, stamp_ns % 1_000_000_000)
 
 
+def replacing(stamp: fox.Timestamp, entities: list[fox.SceneEntity]) -> fox.SceneUpdate:
+    """A scene update that deletes every entity its topic drew before, then draws
+    ``entities``."""
+    deletion = fox.SceneEntityDeletion(timestamp=stamp, type=fox.SceneEntityDeletionType.All)
+    return fox.SceneUpdate(deletions=[deletion], entities=entities)
+
+
 def planar_transform(
     parent: str, child: str, base_pose: tuple[float, ...], stamp_ns: int
 ) -> fox.FrameTransform:

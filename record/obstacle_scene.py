@@ -33,7 +33,7 @@ import numpy as np
 from foxglove import messages as fox
 
 from messages.obstacles import Cylinder, Obstacles, Plane
-from record.foxglove_frames import timestamp
+from record.foxglove_frames import replacing, timestamp
 from record.robot_scene import at
 
 CIRCLE_HEIGHT_M = 0.3
@@ -59,11 +59,6 @@ LABEL_LIFT_M = 0.05
 """A label stands this far above (or in front of) its solid."""
 
 
-def _deleting_all(stamp: fox.Timestamp, entities: list[fox.SceneEntity]) -> fox.SceneUpdate:
-    deletion = fox.SceneEntityDeletion(timestamp=stamp, type=fox.SceneEntityDeletionType.All)
-    return fox.SceneUpdate(deletions=[deletion], entities=entities)
-
-
 def _label(name: str, position: np.ndarray) -> fox.TextPrimitive:
     return fox.TextPrimitive(pose=at(*map(float, position)), billboard=True,
                              font_size=LABEL_SIZE_PX, scale_invariant=True, color=EDGE_COLOR,
@@ -85,7 +80,7 @@ def circle_scene(obstacles: Obstacles) -> fox.SceneUpdate:
         timestamp=stamp, frame_id=obstacles.header.frame, id=f"obstacle_{index}",
         cylinders=[_upright(c.x, c.y, c.radius, c.height or CIRCLE_HEIGHT_M, OBSTACLE_COLOR)],
     ) for index, c in enumerate(obstacles.circles)]  # fmt: skip
-    return _deleting_all(stamp, entities)
+    return replacing(stamp, entities)
 
 
 def solid_scene(obstacles: Obstacles) -> fox.SceneUpdate:
@@ -101,7 +96,7 @@ def solid_scene(obstacles: Obstacles) -> fox.SceneUpdate:
                                  metadata=[fox.KeyValuePair(key="name", value=cylinder.name)],
                                  **cylinder_primitives(cylinder))
                  for index, cylinder in enumerate(obstacles.solids.cylinders)]  # fmt: skip
-    return _deleting_all(stamp, entities)
+    return replacing(stamp, entities)
 
 
 def cylinder_primitives(cylinder: Cylinder) -> dict[str, list]:

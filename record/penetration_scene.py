@@ -16,7 +16,7 @@ import numpy as np
 from foxglove import messages as fox
 
 from messages.truth import SimTruth
-from record.foxglove_frames import timestamp
+from record.foxglove_frames import replacing, timestamp
 from record.robot_scene import at, point
 from wbc.arm_clearance import part_clearances
 from wbc.collision_model import point_positions
@@ -59,8 +59,7 @@ def penetration_scene(robot: MobileManipulator, frame: str, truth: SimTruth,
     entities = [fox.SceneEntity(timestamp=stamp, frame_id=frame, id="penetrating",
                                 metadata=[fox.KeyValuePair(key="parts", value=", ".join(parts))],
                                 spheres=spheres, lines=lines)] if parts else []  # fmt: skip
-    deletion = fox.SceneEntityDeletion(timestamp=stamp, type=fox.SceneEntityDeletionType.All)
-    return fox.SceneUpdate(deletions=[deletion], entities=entities)
+    return replacing(stamp, entities)
 
 
 def _sphere(centre: np.ndarray, radius: float) -> fox.SpherePrimitive:

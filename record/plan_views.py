@@ -11,7 +11,7 @@ import numpy as np
 from foxglove import messages as fox
 
 from messages.supervisor import SupervisorStatus
-from record.foxglove_frames import timestamp
+from record.foxglove_frames import replacing, timestamp
 from record.robot_scene import RobotDrawing, at
 
 CANDIDATE_PREFIX = "candidate/"
@@ -57,5 +57,4 @@ def plan_scene(drawing: RobotDrawing | None, status: SupervisorStatus) -> fox.Sc
         ))  # fmt: skip
     if drawing is not None and candidate_of(status) is not None:
         entities += drawing.model(status.header.stamp_ns)
-    deletion = fox.SceneEntityDeletion(timestamp=stamp, type=fox.SceneEntityDeletionType.All)
-    return fox.SceneUpdate(deletions=[deletion], entities=entities)
+    return replacing(stamp, entities)
