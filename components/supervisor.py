@@ -32,7 +32,7 @@ from components.pubsub import Input
 from components.runtime import Component, Node
 from messages import topics
 from messages.goal import Goal
-from messages.obstacles import Obstacles
+from messages.obstacles import Obstacles, circles_of
 from messages.state import RobotState
 from messages.supervisor import SupervisorStatus
 from wbc.drive_tasks import PointTask, offset_point
@@ -92,7 +92,7 @@ class Supervisor(Component):
         node.subscribe(topics.ROBOT_STATE, self.on_state)
 
     def on_obstacles(self, message: Obstacles) -> None:
-        self.obstacles = tuple(Circle(c.x, c.y, c.radius) for c in message.circles)
+        self.obstacles = circles_of(message)
 
     def on_request(self, goal: Goal) -> None:
         """A new goal replaces the supervisor; the same goal measured again keeps it."""

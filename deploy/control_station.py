@@ -38,6 +38,7 @@ from deploy.client_goals import ENCODING, SCHEMAS, GoalRefused, client_goal
 from deploy.foxglove_params import running_parameters, set_parameters
 from messages import codec, topics
 from messages.header import Header
+from messages.obstacles import circles_of
 from profiles.access import tool_user
 from profiles.profile import Profile
 from wbc import dq
@@ -108,7 +109,7 @@ class ControlStation(ServerListener):
                 if topic is topics.ROBOT_STATE and message.valid:
                     self._q = np.array(message.configuration())
                 elif topic is topics.WORLD_OBSTACLES:
-                    self._obstacles = tuple(Circle(c.x, c.y, c.radius) for c in message.circles)
+                    self._obstacles = circles_of(message)
                 elif topic is topics.SIM_CLOCK:
                     self._clock_ns = message.stamp_ns
 

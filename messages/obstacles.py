@@ -98,7 +98,11 @@ class Obstacles(Message):
     solids: Solids = Solids()
 
 
+def circles_of(message: Obstacles) -> tuple[obstacles.Circle, ...]:
+    """The ``wbc`` circles a message carries, for the base."""
+    return tuple(obstacles.Circle(c.x, c.y, c.radius) for c in message.circles)
+
+
 def obstacles_of(message: Obstacles) -> tuple[obstacles.Obstacle, ...]:
     """The ``wbc`` obstacles a message carries: its circles, then its solids."""
-    circles = (obstacles.Circle(c.x, c.y, c.radius) for c in message.circles)
-    return (*circles, *message.solids.solids())
+    return (*circles_of(message), *message.solids.solids())
