@@ -22,7 +22,7 @@ from wbc.cascade_law import CascadeLaw
 from wbc.kinematic_run import ControlEffort, control_effort, integrate, integrate_supervised
 from wbc.law_output import Law, entry_mask
 from wbc.lp_law import LPLaw, LPParams
-from wbc.obstacles import Circle
+from wbc.obstacles import Circle, least_clearance
 from wbc.qp_law import QPLaw
 from wbc.robot import BASE_DOF, MobileManipulator
 from wbc.scenarios import ARM_BOX, DT, HOME
@@ -224,15 +224,7 @@ def attempt(law: Law, robot: MobileManipulator, start: Array, goal: Array,
                    tuple(out.error_norm for out in outputs), planning, planning_cpu,
                    all(out.ok for out in run.outputs), control_effort(run),
                    control_effort(run, from_rest=True), "" if run.converged else reason,
-                   least_clearance(robot, q, obstacles))  # fmt: skip
-
-
-def least_clearance(robot: MobileManipulator, q: Array, obstacles: Sequence[Circle]) -> float:
-    """min over the configurations q (one per row) and the circles of ||(x, y) - c|| - r -
-    body radius, m: the gap between the base's body and an obstacle (below 0, a contact)."""
-    gaps = [np.hypot(q[:, 0] - c.x, q[:, 1] - c.y) - c.radius - robot.base.body_radius
-            for c in obstacles]  # fmt: skip
-    return float(np.min(gaps)) if gaps else math.inf
+                   least_clearance(q[:, :2], obstacles, robot.base.body_radius))  # fmt: skip
 
 
 def _logged(supervisor: StagingSupervisor, tasks: list[object]) -> StagingSupervisor:

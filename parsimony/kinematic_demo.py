@@ -24,7 +24,7 @@ from wbc.cascade_law import CascadeLaw
 from wbc.kinematic_run import Run, control_effort, integrate
 from wbc.lp_law import LPLaw, LPParams
 from wbc.objectives.input_change import InputChangeGains
-from wbc.obstacles import Obstacle, split
+from wbc.obstacles import Obstacle, least_clearance, split
 from wbc.pinv_law import PseudoinverseLaw
 from wbc.robot import MobileManipulator
 from wbc.scenarios import (
@@ -70,7 +70,9 @@ def supervised_params() -> LPParams:
                        if f.name in controller.params})  # fmt: skip
 
 
-TABLE_PARAMS = LPParams(eta=0.6, beta=15.0)
+POSE_PARAMS = LPParams(eta=0.6, beta=15.0)
+"""The LP law's gains of the pose experiment (6.2.1 gives eta 0.6 and beta 15)."""
+TABLE_PARAMS = POSE_PARAMS
 """Reaching over a table (future work 3 of 7.2): the pose experiment's law, whose rows of
 wbc.constraints.arm_obstacles keep the arm and the base clear of the table."""
 WITHOUT_ARM_ROWS = replace(TABLE_PARAMS, arm_obstacles=False)
@@ -89,13 +91,13 @@ def input_change_gains() -> dict[str, Any]:
 
 
 LP_PARAMS = {
-    "pose": LPParams(eta=0.6, beta=15.0),
+    "pose": POSE_PARAMS,
     "position": LPParams(eta=1.0, beta=10.0),
     "obstacle": OBSTACLE_PARAMS,
     "table": TABLE_PARAMS,
 }
-"""The LP law's gains in each experiment of section 6.2 (6.2.1 gives eta 0.6 and beta 15);
-an experiment under the supervisor takes its profile's (``supervised_params``)."""
+"""The LP law's gains in each experiment of section 6.2; an experiment under the supervisor
+takes its profile's (``supervised_params``)."""
 
 
 @dataclass(frozen=True)
@@ -172,11 +174,9 @@ def summary_row(experiment: Experiment, law_name: str, run: Run, robot: MobileMa
         "median_step_us": float(np.median([out.solve_time_s for out in run.outputs]) * 1e6),
     }
     circles, solids = split(experiment.obstacles)
-    for obstacle in circles:
-        gap = np.hypot(configurations[:, 0] - obstacle.x, configurations[:, 1] - obstacle.y)
-        row["min_obstacle_clearance"] = float(
-            (gap - obstacle.radius - robot.base.body_radius).min()
-        )
+    if circles:
+        row["min_obstacle_clearance"] = least_clearance(configurations[:, :2], circles,
+                                                        robot.base.body_radius)  # fmt: skip
     if solids:
         count = PenetrationCount()
         least = np.inf

@@ -39,6 +39,7 @@ from messages.topics import (
 from wbc import dq
 from wbc.arm_clearance import part_clearances
 from wbc.kinematic_run import effort_of
+from wbc.obstacles import least_clearance
 from wbc.planar import in_frame, wrap
 from wbc.robot import MobileManipulator
 from wbc.supervisor_phase import Phase
@@ -215,10 +216,8 @@ def clearance(truth: Sequence, robot: MobileManipulator) -> float | None:
     """The least distance between the base's disc and an obstacle, m (None without either)."""
     if not truth or not truth[-1].obstacles:
         return None
-    base = np.array([t.base_pose[:2] for t in truth])
-    gaps = [np.hypot(base[:, 0] - o.x, base[:, 1] - o.y) - o.radius - robot.base.body_radius
-            for o in truth[-1].obstacles]  # fmt: skip
-    return round(float(np.min(gaps)), 4)
+    bases = np.array([t.base_pose[:2] for t in truth])
+    return round(least_clearance(bases, truth[-1].obstacles, robot.base.body_radius), 4)
 
 
 def arm_clearances(truth: Sequence, robot: MobileManipulator) -> Array | None:

@@ -4,8 +4,10 @@ handles."""
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+
+import numpy as np
 
 from wbc.obstacles3d import Cylinder, Plane, Solid
 
@@ -36,3 +38,13 @@ def split(obstacles: Iterable[Obstacle]) -> tuple[tuple[Circle, ...], tuple[Soli
             raise TypeError(f"an obstacle is a Circle, Plane or Cylinder, got "
                             f"{type(obstacle).__name__}")  # fmt: skip
     return tuple(circles), tuple(solids)
+
+
+def least_clearance(bases: np.ndarray, circles: Sequence[Circle], body_radius: float) -> float:
+    """min over the base positions (one (x, y) per row) and the circles of ||(x, y) - c|| - r
+    - body radius, m: the least gap between the base's body and an obstacle (below 0, a
+    contact); inf without circles."""
+    bases = np.asarray(bases, dtype=float).reshape(-1, 2)
+    gaps = [np.hypot(bases[:, 0] - c.x, bases[:, 1] - c.y) - c.radius - body_radius
+            for c in circles]  # fmt: skip
+    return float(np.min(gaps)) if gaps else float("inf")

@@ -14,8 +14,8 @@ from deploy import ROBOT_FILE
 from messages.goal import Goal
 from messages.header import Header
 from messages.state import RobotState
-from parsimony.kinematic_demo import input_change_gains
-from wbc.lp_law import LPLaw, LPParams
+from parsimony.kinematic_demo import LP_PARAMS, input_change_gains
+from wbc.lp_law import LPLaw
 from wbc.robot import MobileManipulator
 from wbc.scenarios import DT, HOME, REACH_GOAL
 
@@ -37,7 +37,7 @@ def test_a_held_step_starts_the_law_again_from_rest(hold: str) -> None:
     parameter): the next u speeds up from 0 by at most s = v dt / T an entry, not from the u
     the law gave before the hold."""
     smooth = input_change_gains()
-    gains = dataclasses.replace(LPParams(eta=0.6, beta=15.0), **{**smooth, "input_change": 3.0})
+    gains = dataclasses.replace(LP_PARAMS["pose"], **{**smooth, "input_change": 3.0})
     control = ControlStep("lp", LPLaw, ROBOT, gains)
     header = Header(stamp_ns=0, frame="world", seq=0, source="test")
     control.take_goal(Goal(header=header, task="pose", pose=tuple(ROBOT.fkm(REACH_GOAL))))

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from wbc_scenarios import integrate, pose_task, position_task, robot
 
-from parsimony.kinematic_demo import BORDER_PARAMS, OBSTACLE_PARAMS
+from parsimony.kinematic_demo import BORDER_PARAMS, LP_PARAMS, OBSTACLE_PARAMS
 from wbc import dq
 from wbc.cascade_law import CascadeLaw
 from wbc.lp_law import LPLaw, LPParams
@@ -18,8 +18,7 @@ from wbc.scenarios import DT, HOME, JOINT_LIMIT_GOAL, OBSTACLE, OBSTACLE_GOAL, S
 from wbc.task import PoseTask, PositionTask
 
 MODEL = robot()
-POSE_PARAMS = LPParams(eta=0.6, beta=15.0)  # section 6.2.1
-POSITION_PARAMS = LPParams(eta=1.0, beta=10.0)  # section 6.2.2
+POSE_PARAMS, POSITION_PARAMS = LP_PARAMS["pose"], LP_PARAMS["position"]
 
 
 def nonholonomic_residual(q: np.ndarray, u: np.ndarray) -> float:

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 from wbc_scenarios import integrate, robot
 
-from parsimony.kinematic_demo import input_change_gains
+from parsimony.kinematic_demo import LP_PARAMS, input_change_gains
 from wbc import dq
 from wbc.kinematic_run import control_effort
-from wbc.lp_law import LPLaw, LPParams
+from wbc.lp_law import LPLaw
 from wbc.objectives.input_change import InputChange
 from wbc.scenarios import DT, HOME, JOINT_LIMIT_GOAL, REACH_GOAL
 from wbc.step_context import StepContext
@@ -22,8 +22,7 @@ from wbc.task import PoseTask, PositionTask
 MODEL = robot()
 SMOOTH = input_change_gains()
 RAMP_S = SMOOTH["input_change_ramp"]
-POSE = LPParams(eta=0.6, beta=15.0)  # section 6.2.1
-POSITION = LPParams(eta=1.0, beta=10.0)  # section 6.2.2
+POSE, POSITION = LP_PARAMS["pose"], LP_PARAMS["position"]
 
 
 def context(previous: np.ndarray | None) -> StepContext:
