@@ -212,10 +212,8 @@ class _Rows:
         the distance between the lines is |<l, m_z> + <m, l_z>| / sqrt(c)."""
         parts = self.parts
         count = len(found.lines)
-        robot_lines = [(*line[1:4], *line[5:8], *line_foot(line)) for line in parts.line_list]
-        pairs = (np.array(robot_lines) @ found.pairing).tolist()
-        for i, (terms, ends) in enumerate(zip(pairs, parts.end_list, strict=True)):
-            low, high = min(ends), max(ends)
+        pairs = (self._segment_lines @ found.pairing).tolist()
+        for i, (terms, (low, high)) in enumerate(zip(pairs, self._segment_spans, strict=True)):
             gap, nearest = math.inf, -1
             for j in range(count):
                 b = terms[j]
@@ -237,6 +235,18 @@ class _Rows:
             distance, weights = line_to_line(line, found.lines[nearest])
             safe = (found.reach[nearest] + self.segment_safe[i]) ** 2
             self.add(distance, safe, line_wrench(line, weights), parts.segment_frames[i])
+
+    @functools.cached_property
+    def _segment_lines(self) -> Array:
+        """Each segment's line as (l, m, l x m): what ``add_segments`` pairs with every solid's
+        lines, the same for all of them."""
+        return np.array([(*line[1:4], *line[5:8], *line_foot(line))
+                         for line in self.parts.line_list])  # fmt: skip
+
+    @functools.cached_property
+    def _segment_spans(self) -> list[tuple[float, float]]:
+        """Each segment's parameters along its line, lowest first."""
+        return [(min(ends), max(ends)) for ends in self.parts.end_list]
 
     def stacked(self) -> tuple[Array, Array, Array]:
         """(matrix, lower, upper) of every pair's row: -J_d for a row that is on, 0 <= inf for
