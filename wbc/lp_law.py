@@ -131,7 +131,7 @@ class LPLaw:
     _previous_u: Array = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        self._previous_u = np.zeros(self.robot.dof)
+        self.stopped()
         self._explicit_constraints = self.constraints is not None
         self._explicit_objectives = self.objectives is not None
 

@@ -67,9 +67,9 @@ QPParams = composed(
 
 @dataclass
 class QPLaw:
-    """u = argmin of the quadratic program above, solved by HiGHS.
+    """u = argmin of the quadratic program above, solved by DAQP (``WarmStartedQP``).
 
-    ``step`` never raises for a solver failure: it returns u = 0 with HiGHS's status. The error
+    ``step`` never raises for a solver failure: it returns u = 0 with DAQP's exit status. The error
     rate e' is measured as the LP measures it (the rows are the LP's), and the previous u is
     kept as the LP keeps it.
     """
@@ -83,7 +83,7 @@ class QPLaw:
     _previous_u: Array = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        self._previous_u = np.zeros(self.robot.dof)
+        self.stopped()
 
     def set_params(self, params: QPParams) -> None:
         self.params, self._constraints, self._objectives = params, None, None
