@@ -29,6 +29,7 @@ from record.foxglove_views import (
     PENETRATIONS_SUFFIX,
     SCENE_SUFFIX,
     SOLIDS_SUFFIX,
+    view_channel,
 )
 
 FIXED_FRAME = "world"
@@ -37,7 +38,8 @@ FIXED_FRAME = "world"
 
 def channel(namespace: str, topic: topics.Topic, suffix: str = "") -> str:
     """The live view's (and a recording's) channel of ``topic``, or of its view ``suffix``."""
-    return topic.key(namespace) + (f"/{suffix}" if suffix else "")
+    key = topic.key(namespace)
+    return view_channel(key, suffix) if suffix else key
 
 
 def path(namespace: str, topic: topics.Topic, field: str) -> str:

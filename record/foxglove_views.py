@@ -83,6 +83,11 @@ ESTIMATE_COLOR = fox.Color(r=0.25, g=0.5, b=0.95, a=1.0)
 TRUTH_COLOR = fox.Color(r=0.3, g=0.85, b=0.35, a=0.45)
 
 
+def view_channel(key: str, suffix: str) -> str:
+    """The channel a view with ``suffix`` of the messages on ``key`` goes on, beside it."""
+    return f"{key}/{suffix}"
+
+
 @dataclass(frozen=True)
 class View:
     """One message in a well-known schema, ready for an MCAP channel or a live server."""
@@ -100,7 +105,7 @@ class View:
     def channel(self, key: str) -> tuple[str, str, str, bytes, str, bytes]:
         """The channel, schema, message encoding and data of the view of the message on
         ``key`` (``record.session_file.Entry``)."""
-        return (f"{key}/{self.channel_suffix}", self.schema_name, self.schema_encoding,
+        return (view_channel(key, self.channel_suffix), self.schema_name, self.schema_encoding,
                 self.schema_data, self.message_encoding, self.data)  # fmt: skip
 
 

@@ -38,7 +38,7 @@ import zenoh
 from foxglove.websocket import Capability
 
 from messages import codec, topics
-from record.foxglove_views import Viewer, everything
+from record.foxglove_views import Viewer, everything, view_channel
 from record.session_file import Entry, entries, stamp_of
 
 HOST = "127.0.0.1"
@@ -172,9 +172,9 @@ class LiveView:
         """After a key's first message: open every view channel it may have, so that a client
         can read one before its first view comes (a robot's model, the plan's scene)."""
         for suffix, kind in self._viewer.channels(topic.name):
-            if f"{key}/{suffix}" not in self._by_name:
+            if view_channel(key, suffix) not in self._by_name:
                 schema = kind.get_schema()
-                self._open(key, f"{key}/{suffix}", foxglove.Schema(
+                self._open(key, view_channel(key, suffix), foxglove.Schema(
                     name=schema.name, encoding=schema.encoding, data=bytes(schema.data)),
                     "protobuf", {})  # fmt: skip
         with self._lock:

@@ -31,7 +31,7 @@ from pydantic import BaseModel
 
 from messages import topics
 from messages.schema import json_schema
-from record.foxglove_views import PLAIN, Viewer, everything
+from record.foxglove_views import PLAIN, Viewer, everything, view_channel
 
 MESSAGE_ENCODING = "json"
 """The message encoding of the project's own channels."""
@@ -124,7 +124,7 @@ def entries(
     metadata. Only the channels ``wanted`` (by name) are made: a live view leaves out those no
     client reads."""
     topic = topic_of(key, type(message).__name__) if views else None
-    found = viewer(topic.name, key, message, lambda suffix: wanted(f"{key}/{suffix}")
+    found = viewer(topic.name, key, message, lambda suffix: wanted(view_channel(key, suffix))
                    ) if topic is not None else []  # fmt: skip
     carrier = viewer.carrier(topic.name) if topic is not None else None
     made: list[Entry] = []
@@ -132,7 +132,7 @@ def entries(
         left_out, metadata = "", ()
         if carrier is not None:
             left_out, suffix = carrier
-            metadata = ((CARRIED_FIELD, left_out), (CARRIER, f"{key}/{suffix}"))
+            metadata = ((CARRIED_FIELD, left_out), (CARRIER, view_channel(key, suffix)))
         made.append(Entry(key, type(message).__name__, SCHEMA_ENCODING,
                           schema_of(type(message), left_out), MESSAGE_ENCODING,
                           to_json(message, left_out), metadata))  # fmt: skip
