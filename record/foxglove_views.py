@@ -311,19 +311,15 @@ class Viewer:
     def _plan_scene(self, key: str, status: SupervisorStatus) -> fox.SceneUpdate | None:
         """The plan's scene when it changed, and every ``MODEL_EVERY`` statuses."""
         plan = (status.candidate_base, status.candidate_arm, status.way)
-        if self._plans.get(key) == plan and status.header.seq % MODEL_EVERY:
-            return None
-        self._plans[key] = plan
-        return plan_scene(self._candidate, status)
+        due = _due(self._plans, key, plan, status.header.seq)
+        return plan_scene(self._candidate, status) if due else None
 
     def _solid_scene(self, key: str, obstacles: Obstacles) -> fox.SceneUpdate | None:
         """The solids when they (or their frame) changed, and every ``MODEL_EVERY``
         messages."""
         solids = (obstacles.header.frame, obstacles.solids)
-        if self._solids.get(key) == solids and obstacles.header.seq % MODEL_EVERY:
-            return None
-        self._solids[key] = solids
-        return solid_scene(obstacles)
+        due = _due(self._solids, key, solids, obstacles.header.seq)
+        return solid_scene(obstacles) if due else None
 
     def _penetrations(self, robot: MobileManipulator, key: str, truth: SimTruth
                       ) -> fox.SceneUpdate | None:  # fmt: skip
@@ -334,6 +330,15 @@ class Viewer:
             return None
         self._penetrating[key] = parts
         return penetration_scene(robot, self._truth_world, truth, parts)
+
+
+def _due(sent: dict[str, tuple], key: str, value: tuple, seq: int) -> bool:
+    """Whether to send ``value`` on ``key``: it differs from what was sent last, or ``seq``
+    is a multiple of ``MODEL_EVERY``; if so it is noted as sent."""
+    if sent.get(key) == value and seq % MODEL_EVERY:
+        return False
+    sent[key] = value
+    return True
 
 
 PLAIN = Viewer()
