@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from wbc_scenarios import configurations, context
 
 from deploy import ROBOT_FILE
 from parsimony.kinematic_demo import TABLE_PARAMS
@@ -43,13 +44,9 @@ SOLIDS = (TABLE, Cylinder(0.45, 0.05, 0.04, 0.5, "pole"), Plane((-1.0, 0.0, 0.0)
           name="wall"), Cylinder(0.4, -0.2, 0.05, name="tall pole"), SHELF)  # fmt: skip
 
 
-def configurations(count: int, seed: int, half_width: float) -> np.ndarray:
-    """The base within ``half_width`` of (0.05, 0) facing anywhere, the arm over its box."""
-    rng = np.random.default_rng(seed)
-    base = rng.uniform([0.05 - half_width, -half_width, -np.pi],
-                       [0.05 + half_width, half_width, np.pi], (count, 3))  # fmt: skip
-    arm = rng.uniform(ROBOT.q_min[3:], ROBOT.q_max[3:], (count, ROBOT.arm_dof))
-    return np.hstack((base, arm))
+def around(half_width: float) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """The base within ``half_width`` of (0.05, 0) facing anywhere (``configurations``)."""
+    return (0.05 - half_width, -half_width, -np.pi), (0.05 + half_width, half_width, np.pi)
 
 
 def reference_rows(q: np.ndarray, solids: tuple[Solid, ...]) -> tuple[np.ndarray, np.ndarray]:
@@ -116,17 +113,13 @@ def reference_rows(q: np.ndarray, solids: tuple[Solid, ...]) -> tuple[np.ndarray
     return np.array(matrix), np.array(upper)
 
 
-def context(q: np.ndarray, solids: tuple[Solid, ...]) -> StepContext:
-    return StepContext(ROBOT, q, np.zeros(8), np.zeros(8), np.zeros(2), (), None, DT, solids)
-
-
 def test_the_rows_are_those_of_the_parts_jacobians_near_and_far() -> None:
     """Random states near the solids and far from them (the base up to 3 m away): every row
     equal to the reference, its bound too, and the same rows off."""
     kinds = set()
     for half_width, seed in ((0.3, 1), (3.0, 2)):
-        for q in configurations(150, seed, half_width):
-            rows = ArmObstacles(GAIN, MARGIN).rows(context(q, SOLIDS))
+        for q in configurations(ROBOT, 150, seed, *around(half_width)):
+            rows = ArmObstacles(GAIN, MARGIN).rows(context(ROBOT, q, SOLIDS))
             matrix, upper = reference_rows(q, SOLIDS)
             assert np.array_equal(np.isinf(rows.upper), np.isinf(upper))
             finite = np.isfinite(upper)
@@ -173,7 +166,7 @@ def test_the_lp_commands_the_same_u_on_random_states_among_the_solids() -> None:
     """One step from random states near the solids, towards a goal among them, cold: the
     same u with either rows."""
     rng = np.random.default_rng(7)
-    for q in configurations(40, seed=8, half_width=0.3):
+    for q in configurations(ROBOT, 40, 8, *around(0.3)):
         goal = q + rng.normal(scale=0.3, size=q.size)
         task = PoseTask(ROBOT.fkm(goal))
         ours = LPLaw(ROBOT, TABLE_PARAMS).step(q, task, DT, SOLIDS)

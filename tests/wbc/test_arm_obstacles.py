@@ -7,6 +7,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from wbc_scenarios import configurations, context
 
 from deploy import ROBOT_FILE
 from parsimony.kinematic_demo import TABLE_PARAMS, WITHOUT_ARM_ROWS
@@ -18,10 +19,11 @@ from wbc.obstacles import Circle
 from wbc.obstacles3d import Cylinder, Plane
 from wbc.robot import MobileManipulator
 from wbc.scenarios import DT, HOME, REACH_GOAL, TABLE, TABLE_GOAL, TABLE_START
-from wbc.step_context import StepContext
 from wbc.task import PoseTask
 
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
+NEAR_LOW, NEAR_HIGH = (-0.2, -0.2, -0.5), (0.3, 0.2, 0.5)
+"""The base near the origin, facing within 0.5 rad of x."""
 POLE = Cylinder(0.45, 0.05, 0.04, 0.5, "pole")
 WALL = Plane((-1.0, 0.0, 0.0), -0.7, name="wall")  # the solid is x > 0.7
 TALL_POLE = Cylinder(0.4, -0.2, 0.05, name="tall pole")
@@ -29,20 +31,8 @@ SOLIDS = (TABLE, POLE, WALL, TALL_POLE)
 GAIN, MARGIN = 2.0, 0.03
 
 
-def context(q: np.ndarray, solids: tuple = SOLIDS) -> StepContext:
-    return StepContext(ROBOT, q, np.zeros(8), np.zeros(8), np.zeros(2), (), None, DT, solids)
-
-
-def configurations(count: int, seed: int) -> np.ndarray:
-    """The base near the origin, the arm anywhere in its joint box."""
-    rng = np.random.default_rng(seed)
-    base = rng.uniform([-0.2, -0.2, -0.5], [0.3, 0.2, 0.5], (count, 3))
-    arm = rng.uniform(ROBOT.q_min[3:], ROBOT.q_max[3:], (count, ROBOT.arm_dof))
-    return np.hstack((base, arm))
-
-
 def test_no_solids_no_rows_and_the_rows_are_on_by_default() -> None:
-    rows = ArmObstacles().rows(context(TABLE_START, ()))
+    rows = ArmObstacles().rows(context(ROBOT, TABLE_START, ()))
     assert rows.matrix.shape == (0, ROBOT.dof) and not rows.engaged
     assert any(isinstance(c, ArmObstacles) for c in default_constraints(LPParams()))
     assert not any(isinstance(c, ArmObstacles)
@@ -54,23 +44,23 @@ def test_one_row_per_pair_whatever_the_state() -> None:
     table's edges, the poles' axes; not the wall): the LP keeps its shape from step to step."""
     points, segments = len(ROBOT.collision.points), len(ROBOT.collision.segments)
     expected = 4 * points + 3 * segments
-    for q in configurations(30, seed=1):
-        rows = ArmObstacles(GAIN, MARGIN).rows(context(q))
+    for q in configurations(ROBOT, 30, 1, NEAR_LOW, NEAR_HIGH):
+        rows = ArmObstacles(GAIN, MARGIN).rows(context(ROBOT, q, SOLIDS))
         assert rows.matrix.shape == (expected, ROBOT.dof) and rows.engaged
         assert np.all(np.isneginf(rows.lower))
 
 
 def test_zero_velocity_always_meets_the_rows() -> None:
     """u = 0 is feasible in every configuration, inside an obstacle too (5.8's argument)."""
-    for q in configurations(200, seed=2):
-        rows = ArmObstacles(GAIN, MARGIN).rows(context(q))
+    for q in configurations(ROBOT, 200, 2, NEAR_LOW, NEAR_HIGH):
+        rows = ArmObstacles(GAIN, MARGIN).rows(context(ROBOT, q, SOLIDS))
         assert np.all(rows.upper >= 0.0)
 
 
 def bound_rate(q: np.ndarray, u: np.ndarray, step: float = 1e-6) -> np.ndarray:
     """d/dt of each row's bound eta (d - d_safe) along u, by central differences."""
-    plus = ArmObstacles(GAIN, MARGIN).rows(context(q + step * u)).upper
-    minus = ArmObstacles(GAIN, MARGIN).rows(context(q - step * u)).upper
+    plus = ArmObstacles(GAIN, MARGIN).rows(context(ROBOT, q + step * u, SOLIDS)).upper
+    minus = ArmObstacles(GAIN, MARGIN).rows(context(ROBOT, q - step * u, SOLIDS)).upper
     with np.errstate(invalid="ignore"):  # inf - inf: a segment's row off on both sides
         return (plus - minus) / (2.0 * step)
 
@@ -81,8 +71,8 @@ def test_each_row_is_minus_the_rate_of_its_distance() -> None:
     line stays the one chosen (the rate is then finite)."""
     rng = np.random.default_rng(3)
     checked = 0
-    for q in configurations(60, seed=4):
-        rows = ArmObstacles(GAIN, MARGIN).rows(context(q))
+    for q in configurations(ROBOT, 60, 4, NEAR_LOW, NEAR_HIGH):
+        rows = ArmObstacles(GAIN, MARGIN).rows(context(ROBOT, q, SOLIDS))
         u = rng.uniform(-ROBOT.velocity_max, ROBOT.velocity_max)
         rate = bound_rate(q, u)
         live = np.isfinite(rows.upper) & (rows.upper > 1e-3) & np.isfinite(rate)
@@ -97,11 +87,11 @@ def test_segment_rows_engage_across_a_table_edge_and_a_pole() -> None:
     """The forearm held over the table's near rim, and across a pole's axis: the line row is on
     there, and off (0 u <= inf) where the segment faces no edge."""
     over_the_rim = np.array([0.33, 0.0, 0.0, 0.0, -0.6, 0.2, -1.0, 0.4])
-    rows = ArmObstacles(GAIN, MARGIN).rows(context(over_the_rim, (TABLE,)))
+    rows = ArmObstacles(GAIN, MARGIN).rows(context(ROBOT, over_the_rim, (TABLE,)))
     forearm = len(ROBOT.collision.points)
     assert np.isfinite(rows.upper[forearm]) and np.any(rows.matrix[forearm])
     far = np.array([-1.0, 0.0, np.pi, 0.0, -0.2, 0.2, 0.0, 0.0])  # turned away from the table
-    rows = ArmObstacles(GAIN, MARGIN).rows(context(far, (TABLE,)))
+    rows = ArmObstacles(GAIN, MARGIN).rows(context(ROBOT, far, (TABLE,)))
     assert np.isinf(rows.upper[forearm]) and not np.any(rows.matrix[forearm])
 
 
@@ -109,7 +99,7 @@ def test_a_point_is_held_by_the_feature_nearest_it() -> None:
     """The gripper above the table top is held by the top (its row lifts it: -J_t's z row),
     the base beside the near edge by the edge (its row pushes it back along -x)."""
     parts = ROBOT.collision.names
-    rows = ArmObstacles(GAIN, MARGIN).rows(context(TABLE_GOAL, (TABLE,)))
+    rows = ArmObstacles(GAIN, MARGIN).rows(context(ROBOT, TABLE_GOAL, (TABLE,)))
     base, gripper = parts.index("base"), parts.index("gripper")
     np.testing.assert_allclose(rows.matrix[base], [1.0, 0, 0, 0, 0, 0, 0, 0], atol=1e-12)
     translation = ROBOT.translation_jacobian(TABLE_GOAL)

@@ -10,13 +10,9 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 from dqrobotics import DQ
-from dqrobotics.robot_modeling import (
-    DQ_HolonomicBase,
-    DQ_Kinematics,
-    DQ_SerialManipulatorDH,
-    DQ_WholeBody,
-)
+from dqrobotics.robot_modeling import DQ_Kinematics
 from dqrobotics.utils import DQ_Geometry
+from wbc_scenarios import central_difference, configurations, oracle_chain
 
 from deploy import ROBOT_FILE
 from wbc import dq
@@ -41,30 +37,10 @@ from wbc.robot_primitives import (
 )
 
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
-STEP = 1e-6
 FD_TOL = 1e-7
 ORACLE_TOL = 1e-12
 NAMES = ROBOT.collision.names
 POINTS = len(ROBOT.collision.points)
-
-
-def configurations(count: int, seed: int) -> np.ndarray:
-    """Base anywhere in a 4 m square facing anywhere, the arm over its joint box."""
-    rng = np.random.default_rng(seed)
-    base = rng.uniform([-2.0, -2.0, -np.pi], [2.0, 2.0, np.pi], (count, 3))
-    arm = rng.uniform(ROBOT.q_min[3:], ROBOT.q_max[3:], (count, ROBOT.arm_dof))
-    return np.hstack((base, arm))
-
-
-def central_difference(function: Callable[[np.ndarray], np.ndarray | float],
-                       q: np.ndarray) -> np.ndarray:  # fmt: skip
-    columns = []
-    for i in range(q.size):
-        step = np.zeros_like(q)
-        step[i] = STEP
-        columns.append((np.asarray(function(q + step)) - np.asarray(function(q - step)))
-                       / (2.0 * STEP))  # fmt: skip
-    return np.stack(columns, axis=-1)
 
 
 def workspace(seed: int) -> tuple[np.ndarray, np.ndarray]:
@@ -75,23 +51,13 @@ def workspace(seed: int) -> tuple[np.ndarray, np.ndarray]:
             line(rng.normal(size=3), rng.uniform(-1.0, 1.0, 3)))  # fmt: skip
 
 
-def oracle_chain(frame: int) -> DQ_WholeBody:
-    """DQ Robotics' whole body up to DH frame ``frame``: the base, its height and the first
-    ``frame`` links (``frame`` >= 1)."""
-    base = DQ_HolonomicBase()
-    base.set_frame_displacement(DQ(dq.pose(dq.ONE[:4], [0.0, 0.0, ROBOT.base_height])))
-    body = DQ_WholeBody(base)
-    body.add(DQ_SerialManipulatorDH(np.array(ROBOT.dh)[:, :frame]))
-    return body
-
-
 # --- Frames and parts -------------------------------------------------------------------------
 
 
 @pytest.mark.parametrize("frame", range(1, 6))
 def test_frame_poses_and_jacobians_match_dqrobotics_chains(frame: int) -> None:
-    body = oracle_chain(frame)
-    for q in configurations(30, seed=frame):
+    body = oracle_chain(ROBOT, frame)
+    for q in configurations(ROBOT, 30, seed=frame):
         poses, jacobians = ROBOT.frame_kinematics(q)
         moving = 3 + frame
         np.testing.assert_allclose(poses[frame], body.fkm(q[:moving]).vec8(), atol=ORACLE_TOL)
@@ -101,14 +67,14 @@ def test_frame_poses_and_jacobians_match_dqrobotics_chains(frame: int) -> None:
 
 
 def test_frame_jacobians_are_the_derivatives_of_the_frames() -> None:
-    for q in configurations(10, seed=11):
+    for q in configurations(ROBOT, 10, seed=11):
         _, jacobians = ROBOT.frame_kinematics(q)
         expected = central_difference(lambda c: ROBOT.frame_kinematics(c)[0], q)
         np.testing.assert_allclose(jacobians, expected, atol=FD_TOL)
 
 
 def test_part_jacobians_are_the_derivatives_of_the_parts() -> None:
-    for q in configurations(10, seed=12):
+    for q in configurations(ROBOT, 10, seed=12):
         parts = primitive_kinematics(ROBOT, q)
         points = central_difference(lambda c: primitive_kinematics(ROBOT, c).points, q)
         lines = central_difference(lambda c: primitive_kinematics(ROBOT, c).lines, q)
@@ -127,7 +93,7 @@ def line_of(pose: np.ndarray, jacobian: np.ndarray, axis: np.ndarray
 
 
 def test_line_jacobian_matches_dqrobotics() -> None:
-    for q in configurations(50, seed=13):
+    for q in configurations(ROBOT, 50, seed=13):
         poses, jacobians = ROBOT.frame_kinematics(q)
         for frame in range(6):
             for axis in (dq.I_, dq.J_, dq.K_):
@@ -143,7 +109,7 @@ def test_line_jacobian_matches_dqrobotics() -> None:
 def test_segments_run_along_their_lines_from_end_to_end() -> None:
     """The forearm is the elbow-wrist segment on z of frame 3, the hand the wrist-gripper one
     on x of frame 5; their ends' parameters along the line are 0.1225 and 0.17 m apart."""
-    for q in configurations(10, seed=14):
+    for q in configurations(ROBOT, 10, seed=14):
         parts = primitive_kinematics(ROBOT, q)
         for i, segment in enumerate(ROBOT.collision.segments):
             start, end = parts.points[segment.start, 1:], parts.points[segment.end, 1:]
@@ -195,7 +161,7 @@ POINT_DISTANCES = {
 @pytest.mark.parametrize("kind", POINT_DISTANCES)
 def test_point_distance_jacobians_are_the_derivatives_and_dqrobotics(kind: str, part: int) -> None:
     d = POINT_DISTANCES[kind]
-    for index, q in enumerate(configurations(20, seed=d.seed + part)):
+    for index, q in enumerate(configurations(ROBOT, 20, seed=d.seed + part)):
         primitive = d.primitive(index)
         parts = primitive_kinematics(ROBOT, q)
         point, jacobian = parts.points[part], parts.point_jacobians[part]
@@ -211,7 +177,7 @@ def test_point_distance_jacobians_are_the_derivatives_and_dqrobotics(kind: str, 
 
 @pytest.mark.parametrize("segment", range(len(ROBOT.collision.segments)))
 def test_line_to_line_jacobian_is_the_derivative_and_dqrobotics(segment: int) -> None:
-    for index, q in enumerate(configurations(20, seed=40 + segment)):
+    for index, q in enumerate(configurations(ROBOT, 20, seed=40 + segment)):
         _, workspace_line = workspace(100 + index)
         parts = primitive_kinematics(ROBOT, q)
         robot_line, jacobian = parts.lines[segment], parts.line_jacobians[segment]

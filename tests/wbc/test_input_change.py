@@ -8,7 +8,7 @@ import dataclasses
 
 import numpy as np
 import pytest
-from wbc_scenarios import integrate, robot
+from wbc_scenarios import context, integrate, robot
 
 from parsimony.kinematic_demo import LP_PARAMS, input_change_gains
 from wbc import dq
@@ -16,7 +16,6 @@ from wbc.kinematic_run import control_effort
 from wbc.lp_law import LPLaw
 from wbc.objectives.input_change import InputChange
 from wbc.scenarios import DT, HOME, JOINT_LIMIT_GOAL, REACH_GOAL
-from wbc.step_context import StepContext
 from wbc.task import PoseTask, PositionTask
 
 MODEL = robot()
@@ -25,14 +24,9 @@ RAMP_S = SMOOTH["input_change_ramp"]
 POSE, POSITION = LP_PARAMS["pose"], LP_PARAMS["position"]
 
 
-def context(previous: np.ndarray | None) -> StepContext:
-    return StepContext(MODEL, HOME, np.zeros(8), np.zeros(8), np.zeros(2), (), None, DT,
-                       previous_u=previous)
-
-
 def term_cost(term: InputChange, previous: np.ndarray, u: np.ndarray) -> float:
     """What the LP adds for u: weight * ||A u + b||_1 of the term's residual cost."""
-    cost = term.cost(context(previous))
+    cost = term.cost(context(MODEL, HOME, previous_u=previous))
     return cost.weight * float(np.abs(cost.matrix @ u + cost.offset).sum())
 
 
@@ -63,7 +57,7 @@ def test_speeding_up_costs_w_times_the_speed_gained_beyond_the_ramp_and_stopping
 
 
 def test_without_a_previous_u_the_term_is_idle() -> None:
-    assert InputChange(0.3).cost(context(None)).weight == 0.0
+    assert InputChange(0.3).cost(context(MODEL, HOME)).weight == 0.0
 
 
 def test_invalid_term_parameters_are_refused() -> None:

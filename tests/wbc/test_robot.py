@@ -15,13 +15,13 @@ from dqrobotics.robot_modeling import (
     DQ_SerialManipulatorDH,
     DQ_WholeBody,
 )
+from wbc_scenarios import central_difference
 
 from deploy import ROBOT_FILE
 from wbc import dq
 from wbc.robot import MobileManipulator, RobotDescriptionError, translation_jacobian
 
 ORACLE_TOL = 1e-12
-FINITE_DIFFERENCE_STEP = 1e-6
 FINITE_DIFFERENCE_TOL = 1e-7
 
 
@@ -107,15 +107,6 @@ def test_translation_jacobian_matches_dqrobotics(
 
 
 # --- Consistency ------------------------------------------------------------------------------
-
-
-def central_difference(function, q: np.ndarray) -> np.ndarray:
-    columns = []
-    for i in range(q.size):
-        step = np.zeros_like(q)
-        step[i] = FINITE_DIFFERENCE_STEP
-        columns.append((function(q + step) - function(q - step)) / (2 * FINITE_DIFFERENCE_STEP))
-    return np.stack(columns, axis=1)
 
 
 def test_pose_jacobian_is_the_derivative_of_fkm(robot: MobileManipulator) -> None:

@@ -11,12 +11,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from dqrobotics import DQ
-from dqrobotics.robot_modeling import (
-    DQ_HolonomicBase,
-    DQ_Kinematics,
-    DQ_SerialManipulatorDH,
-    DQ_WholeBody,
-)
+from dqrobotics.robot_modeling import DQ_Kinematics
+from wbc_scenarios import configurations, oracle_chain
 
 from deploy import ROBOT_FILE
 from wbc import dq
@@ -40,26 +36,10 @@ def with_offsets(robot: MobileManipulator) -> MobileManipulator:
                              robot.name, collision)  # fmt: skip
 
 
-def configurations(count: int, seed: int) -> np.ndarray:
-    rng = np.random.default_rng(seed)
-    base = rng.uniform([-2.0, -2.0, -np.pi], [2.0, 2.0, np.pi], (count, 3))
-    arm = rng.uniform(ROBOT.q_min[3:], ROBOT.q_max[3:], (count, ROBOT.arm_dof))
-    return np.hstack((base, arm))
-
-
-def oracle_chain(frame: int) -> DQ_WholeBody:
-    """DQ Robotics' whole body up to DH frame ``frame`` (>= 1)."""
-    base = DQ_HolonomicBase()
-    base.set_frame_displacement(DQ(dq.pose(dq.ONE[:4], [0.0, 0.0, ROBOT.base_height])))
-    body = DQ_WholeBody(base)
-    body.add(DQ_SerialManipulatorDH(np.array(ROBOT.dh)[:, :frame]))
-    return body
-
-
 def test_point_rows_are_the_weights_times_the_translation_jacobian() -> None:
     robot = with_offsets(ROBOT)
     rng = np.random.default_rng(1)
-    for q in configurations(40, seed=2):
+    for q in configurations(ROBOT, 40, seed=2):
         chain = robot.forward(q)
         parts = primitive_kinematics(robot, q, chain)
         weights = rng.normal(size=(len(parts.positions), 3))
@@ -72,7 +52,7 @@ def test_point_rows_are_the_weights_times_the_translation_jacobian() -> None:
 
 def test_point_positions_with_offsets_are_the_translations_of_their_poses() -> None:
     robot = with_offsets(ROBOT)
-    for q in configurations(20, seed=3):
+    for q in configurations(ROBOT, 20, seed=3):
         parts = primitive_kinematics(robot, q)
         frames = robot.frames(q)
         for point, position in zip(robot.collision.points, parts.positions, strict=True):
@@ -84,9 +64,9 @@ def test_point_positions_with_offsets_are_the_translations_of_their_poses() -> N
 def test_rows_of_a_frame_match_dqrobotics_jacobians(frame: int) -> None:
     """At frame i's origin and on its axis lines, the wrench rows equal the weights times DQ
     Robotics' translation_jacobian and line_jacobian of the chain up to frame i."""
-    body, rng = oracle_chain(frame), np.random.default_rng(frame)
+    body, rng = oracle_chain(ROBOT, frame), np.random.default_rng(frame)
     moving = 3 + frame
-    for q in configurations(20, seed=10 + frame):
+    for q in configurations(ROBOT, 20, seed=10 + frame):
         chain = ROBOT.forward(q)
         pose, jacobian = body.fkm(q[:moving]), body.pose_jacobian(q[:moving])
         origin = dq.translation(chain.poses[frame])[1:]
@@ -107,7 +87,7 @@ def test_rows_of_a_frame_match_dqrobotics_jacobians(frame: int) -> None:
 
 def test_segment_rows_are_the_weights_times_the_line_jacobian() -> None:
     rng = np.random.default_rng(4)
-    for q in configurations(40, seed=5):
+    for q in configurations(ROBOT, 40, seed=5):
         chain = ROBOT.forward(q)
         parts = primitive_kinematics(ROBOT, q, chain)
         weights = rng.normal(size=(len(parts.line_list), 8)) * [0, 1, 1, 1, 0, 1, 1, 1]
@@ -120,7 +100,7 @@ def test_segment_rows_are_the_weights_times_the_line_jacobian() -> None:
 
 def test_the_shared_forward_pass_gives_the_task_what_kinematics_gives() -> None:
     """Bit for bit: runs without solids in 3-D keep their commands."""
-    for q in configurations(20, seed=6):
+    for q in configurations(ROBOT, 20, seed=6):
         chain = ROBOT.forward(q)
         pose, jacobian = ROBOT.kinematics(q)
         assert np.array_equal(chain.pose, pose) and np.array_equal(chain.jacobian, jacobian)
@@ -133,5 +113,5 @@ def test_a_model_without_parts_has_no_positions() -> None:
     robot = MobileManipulator(np.array(ROBOT.dh), ROBOT.base, ROBOT.q_min[3:].copy(),
                               ROBOT.q_max[3:].copy(), ROBOT.velocity_max[3:].copy(),
                               collision=CollisionModel())  # fmt: skip
-    parts = primitive_kinematics(robot, configurations(1, seed=7)[0])
+    parts = primitive_kinematics(robot, configurations(ROBOT, 1, seed=7)[0])
     assert parts.points.shape == (0, 4) and parts.lines.shape == (0, 8)
