@@ -31,6 +31,7 @@ from profiles.profile import Profile, load_profile
 from record.session_reader import info
 from sim2d.scenarios import scenario
 from tests.foxglove_client.client import FoxgloveClient, decode, missing
+from tests.record.test_foxglove_views import chain, pose_of
 from wbc import dq
 from wbc.planar import in_frame, offset_pose, planar_pose
 from wbc.robot import MobileManipulator
@@ -111,12 +112,6 @@ def same_time(client: FoxgloveClient, first: str, second: str, found=lambda a, b
     return pair[0]
 
 
-def pose_of(transform: dict) -> np.ndarray:
-    t, r = transform.get("translation", {}), transform.get("rotation", {})
-    rotation = np.array([r.get(k, 0.0) for k in "wxyz"])
-    return dq.pose(rotation, np.array([t.get(k, 0.0) for k in "xyz"]))
-
-
 def test_the_robot_links_arrive_and_match_the_kinematics(
     station: Station, client: FoxgloveClient
 ) -> None:
@@ -127,12 +122,8 @@ def test_the_robot_links_arrive_and_match_the_kinematics(
     state, frames = same_time(client, state_key, frames_key)
     by_child = {t["child_frame_id"]: t for t in frames["transforms"]}
     # world -> base -> link_0 -> ... -> link_5, each in the one before, as the DH chain.
-    pose, parent = dq.ONE.copy(), "world"
-    composed = []
-    for name in ["estimate/base", *(f"estimate/link_{i}" for i in range(robot.arm_dof + 1))]:
-        assert by_child[name]["parent_frame_id"] == parent
-        pose, parent = dq.mul(pose, pose_of(by_child[name])), name
-        composed.append(pose)
+    links = [f"estimate/link_{i}" for i in range(robot.arm_dof + 1)]
+    composed = chain(by_child, ["estimate/base", *links], "world")
     q = np.array([*state["base_pose"], *state["arm_joints"]])
     for found, expected in zip(composed[1:], robot.frames(q), strict=True):
         assert np.allclose(found * np.sign(found[0] or 1), expected * np.sign(expected[0] or 1),

@@ -136,6 +136,22 @@ def vector(message: dict[str, Any], names: str) -> list[float]:
     return [message.get(n, 0.0) for n in names]
 
 
+def pose_of(transform: dict[str, Any]) -> np.ndarray:
+    """The pose (unit dual quaternion) of a FrameTransform as JSON."""
+    rotation = np.array(vector(transform.get("rotation", {}), "wxyz"))
+    return dq.pose(rotation, np.array(vector(transform.get("translation", {}), "xyz")))
+
+
+def chain(frames: dict[str, dict[str, Any]], names: list[str], root: str) -> list[np.ndarray]:
+    """Each named frame's pose in ``root``, composing every transform from its parent."""
+    poses, pose, parent = [], dq.ONE.copy(), root
+    for name in names:
+        assert frames[name]["parent_frame_id"] == parent
+        pose, parent = dq.mul(pose, pose_of(frames[name])), name
+        poses.append(pose)
+    return poses
+
+
 # ---- the views ------------------------------------------------------------------------------
 
 
@@ -222,8 +238,7 @@ def test_the_truth_stands_in_the_simulators_world_under_the_estimates() -> None:
     assert {frames[n]["parent_frame_id"] for n in frames if n != "truth/world"} == {"truth/world"}
     # F0 stands at (0.75, 0.85, 0.3) in the simulator's world: there is its origin.
     world = frames["truth/world"]
-    f0 = dq.pose(np.array(vector(world["rotation"], "wxyz")),
-                 np.array(vector(world["translation"], "xyz")))  # fmt: skip
+    f0 = pose_of(world)
     assert np.allclose(dq.translation(dq.conj(f0))[1:], [0.75, 0.85, 0.0], atol=1e-12)
     assert vector(frames["truth/base"]["translation"], "xyz") == [1.5, -2.0, 0.0]
 

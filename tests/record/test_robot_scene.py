@@ -11,6 +11,7 @@ import numpy as np
 from test_foxglove_views import (
     KEY,
     STAMP_NS,
+    chain,
     decode,
     pose_dq,
     robot_state,
@@ -26,25 +27,9 @@ from messages.supervisor import SupervisorStatus
 from record.foxglove_views import MODEL_EVERY, Viewer
 from record.session_file import SessionWriter
 from record.session_reader import info
-from wbc import dq
 from wbc.robot import MobileManipulator
 
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
-
-
-def pose_of(transform: dict[str, Any]) -> np.ndarray:
-    rotation = np.array(vector(transform.get("rotation", {}), "wxyz"))
-    return dq.pose(rotation, np.array(vector(transform.get("translation", {}), "xyz")))
-
-
-def chain(frames: dict[str, dict[str, Any]], names: list[str], root: str) -> list[np.ndarray]:
-    """Each named frame's pose in ``root``, composing every transform from its parent."""
-    poses, pose, parent = [], dq.ONE.copy(), root
-    for name in names:
-        assert frames[name]["parent_frame_id"] == parent
-        pose, parent = dq.mul(pose, pose_of(frames[name])), name
-        poses.append(pose)
-    return poses
 
 
 def same_pose(a: np.ndarray, b: np.ndarray) -> bool:
