@@ -24,7 +24,6 @@ from __future__ import annotations
 import contextlib
 import json
 import os
-import signal
 import statistics
 import subprocess
 import sys
@@ -50,7 +49,7 @@ from profiles.profile import load_profile
 from record.foxglove_views import ANNOTATIONS_SUFFIX, SCENE_SUFFIX, Viewer
 from record.session_file import SessionWriter, entries
 from record.session_reader import info, read_session
-from tests.foxglove_client.client import FoxgloveClient, missing
+from tests.foxglove_client.client import FoxgloveClient, missing, running_view
 from wbc.robot import MobileManipulator
 
 WINDOW_S = 20.0
@@ -129,24 +128,16 @@ def viewing(profile_path: Path, namespace: str, reads: dict
     """A `parsimony view` and one counting client that reads the channels ``reads`` says
     (``LAYOUT_CLIENT``, ``EVERY_CHANNEL``); at the end the view's own summary fills the
     dict."""
-    port, summary = free_port(), {}
-    view = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "view", str(profile_path),
-                             "--port", str(port), "--json"], text=True,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)  # fmt: skip
-    assert view.stderr is not None
-    line = view.stderr.readline()
-    if "live at" not in line:
-        raise RuntimeError(f"the view did not start: {line}{view.stderr.read(2000)}")
-    try:
-        with FoxgloveClient(f"ws://127.0.0.1:{port}", count=True) as client:
+    summary: dict = {}
+    with running_view(profile_path, "--json") as view:
+        if "live at" not in view.live_line:
+            raise RuntimeError(f"the view did not start: {view.live_line}")
+        with FoxgloveClient(view.address, count=True) as client:
             client.server_info()
             keys = [f"{namespace}/{topic}" for topic in reads.get("topics", ())]
             client.send("subscribeAll", **{**reads, "topics": keys})
-            yield view, client, summary
-    finally:
-        view.send_signal(signal.SIGTERM)
-        out, _ = view.communicate(timeout=60)
-        summary.update(json.loads(out) if out.strip() else {})
+            yield view.process, client, summary
+    summary.update(json.loads(view.out) if view.out.strip() else {})
 
 
 def loop_cpu_s(session: zenoh.Session, namespace: str) -> float:

@@ -10,9 +10,6 @@ from __future__ import annotations
 import base64
 import json
 import math
-import signal
-import subprocess
-import sys
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,11 +23,10 @@ from deploy import query
 from messages import codec
 from messages.goal import Goal
 from parsimony.experiment import DEPLOY, connect, launched, wait_alive, wait_reached
-from profiles.endpoints import free_port
 from profiles.profile import Profile, load_profile
 from record.session_reader import info
 from sim2d.scenarios import scenario
-from tests.foxglove_client.client import FoxgloveClient, decode, missing
+from tests.foxglove_client.client import FoxgloveClient, decode, missing, running_view
 from tests.record.test_foxglove_views import chain, pose_of
 from wbc import dq
 from wbc.planar import in_frame, offset_pose, planar_pose
@@ -66,21 +62,12 @@ def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Station]:
             connect(profile, launcher) as session:  # fmt: skip
         wait_alive(session, profile, launcher)
         wait_reached(session, profile, launcher)
-        port = free_port()
-        view = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "view", str(path),
-                                 "--port", str(port), "--json"], text=True,
-                                stdout=subprocess.PIPE, stderr=subprocess.PIPE)  # fmt: skip
-        try:
-            assert view.stderr is not None
-            line = view.stderr.readline()  # the first line says where it listens
-            assert f"ws://127.0.0.1:{port}" in line, line + view.stderr.read(2000)
+        with running_view(path, "--json", timeout_s=READY_S) as view:
+            assert view.address in view.live_line, view.live_line  # where it listens
             query.set_param(session, profile.namespace, "simulator", "paused", "false")
-            yield Station(profile, f"ws://127.0.0.1:{port}", directory / "session.mcap", session)
-        finally:
-            view.send_signal(signal.SIGTERM)
-            out, err = view.communicate(timeout=READY_S)
-    assert view.returncode == 0, err[-2000:]
-    summary = json.loads(out)
+            yield Station(profile, view.address, directory / "session.mcap", session)
+    assert view.process.returncode == 0, view.err[-2000:]
+    summary = json.loads(view.out)
     assert summary["shown"] > 0 and summary["malformed"] == 0, summary
 
 

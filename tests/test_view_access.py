@@ -4,10 +4,8 @@ offers it."""
 
 from __future__ import annotations
 
+import contextlib
 import os
-import signal
-import subprocess
-import sys
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -17,7 +15,13 @@ import zenoh
 
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
-from tests.foxglove_client.client import DEADLINE_S, FoxgloveClient, missing
+from tests.foxglove_client.client import (
+    DEADLINE_S,
+    FoxgloveClient,
+    RunningView,
+    missing,
+    running_view,
+)
 
 NAMESPACE = "guarded"
 
@@ -39,28 +43,18 @@ def guarded(tmp_path: Path) -> Iterator[Path]:
         yield path
 
 
-def view_as(user: str, profile: Path) -> tuple[subprocess.Popen, str, str]:
-    """``parsimony view`` run by ``user``, its address and the line that says it listens."""
-    port = free_port()
-    view = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "view", str(profile),
-                             "--port", str(port)], text=True, stderr=subprocess.PIPE,
-                            env={**os.environ, "PARSIMONY_USER": user})  # fmt: skip
-    assert view.stderr is not None
-    return view, f"ws://127.0.0.1:{port}", view.stderr.readline()
-
-
-def stop(view: subprocess.Popen) -> None:
-    view.send_signal(signal.SIGTERM)
-    _, err = view.communicate(timeout=DEADLINE_S)
-    assert view.returncode == 0, err
+def view_as(user: str, profile: Path) -> contextlib.AbstractContextManager[RunningView]:
+    """``parsimony view`` run by ``user``."""
+    return running_view(profile, env={**os.environ, "PARSIMONY_USER": user},
+                        timeout_s=DEADLINE_S)  # fmt: skip
 
 
 def test_a_view_whose_user_may_not_write_goals_offers_no_publishing(guarded: Path) -> None:
     assert not missing(), missing()
-    view, address, line = view_as("viewer", guarded)
-    try:
+    with view_as("viewer", guarded) as view:
+        line = view.live_line
         assert "no publishing: viewer may not write goal/request" in line, line
-        with FoxgloveClient(address) as client:
+        with FoxgloveClient(view.address) as client:
             info = client.server_info()
             assert "clientPublish" not in info["capabilities"]
             assert "parameters" in info["capabilities"]
@@ -68,12 +62,9 @@ def test_a_view_whose_user_may_not_write_goals_offers_no_publishing(guarded: Pat
                         schemaName="foxglove.PoseInFrame")  # fmt: skip
             refused = client.wait_for(lambda e: e["event"] == "status", "the server's answer")
             assert "does not support clientPublish" in refused["message"]
-    finally:
-        stop(view)
-    view, address, line = view_as("operator", guarded)
-    try:
-        assert "goals from clients on goal/request" in line, line
-        with FoxgloveClient(address) as client:
+    assert view.process.returncode == 0, view.err
+    with view_as("operator", guarded) as view:
+        assert "goals from clients on goal/request" in view.live_line, view.live_line
+        with FoxgloveClient(view.address) as client:
             assert "clientPublish" in client.server_info()["capabilities"]
-    finally:
-        stop(view)
+    assert view.process.returncode == 0, view.err

@@ -6,16 +6,22 @@
 from __future__ import annotations
 
 import base64
+import contextlib
 import functools
 import json
 import shutil
+import signal
 import subprocess
+import sys
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from google.protobuf import descriptor_pb2, descriptor_pool, json_format, message_factory
+
+from profiles.endpoints import free_port
 
 HERE = Path(__file__).resolve().parent
 SCRIPT = HERE / "client.mjs"
@@ -31,6 +37,41 @@ def missing() -> str:
     if not INSTALLED.is_dir():
         return f"{INSTALLED} is not installed: run `make foxglove-client`"
     return ""
+
+
+@dataclass
+class RunningView:
+    """A ``parsimony view`` process, where it listens, and the line that says so (and whether
+    clients may publish); once it stopped, the rest of its output."""
+
+    process: subprocess.Popen
+    address: str
+    live_line: str
+    out: str = ""
+    err: str = ""
+
+
+@contextlib.contextmanager
+def running_view(profile: Path, *flags: str, env: dict[str, str] | None = None,
+                 timeout_s: float = DEADLINE_S) -> Iterator[RunningView]:  # fmt: skip
+    """``parsimony view PROFILE --port P FLAGS`` on a free port of 127.0.0.1, once it has said
+    that it is live (or has ended: ``live_line`` is then its last line); stopped with SIGTERM
+    at the end, its output and exit status kept (``out``, ``err``, ``process.returncode``)."""
+    port = free_port()
+    process = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "view", str(profile),
+                                "--port", str(port), *flags], text=True, env=env,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE)  # fmt: skip
+    assert process.stderr is not None
+    line = said = process.stderr.readline()
+    while said and " live at " not in line:
+        said = process.stderr.readline()
+        line = said or line
+    view = RunningView(process, f"ws://127.0.0.1:{port}", line)
+    try:
+        yield view
+    finally:
+        process.send_signal(signal.SIGTERM)
+        view.out, view.err = process.communicate(timeout=timeout_s)
 
 
 class FoxgloveClient:
