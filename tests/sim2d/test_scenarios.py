@@ -25,11 +25,10 @@ from sim2d.scenarios import (
     SimScenario,
     scenario,
 )
-from wbc import dq
 from wbc.arm_clearance import part_clearances
 from wbc.disc_geometry import segment_clear
 from wbc.lp_law import LPParams
-from wbc.planar import offset_pose, planar_of, planar_pose
+from wbc.planar import planar_of
 from wbc.robot import BASE_DOF, MobileManipulator
 from wbc.scenarios import HOME, OBSTACLE, REACH_GOAL, TABLE, TABLE_GOAL, TABLE_START
 from wbc.staging import plan
@@ -83,7 +82,7 @@ def test_the_blocked_set_up_puts_its_obstacle_on_the_straight_way_clear_of_both_
     clear of it."""
     setup = scenario("blocked", ROBOT)
     (circle,) = setup.obstacles
-    goal = dq.mul(planar_pose(*setup.bin, scene().goal.height_m), offset_pose(*scene().goal.offset))
+    goal = setup.goal(scene().goal.height_m, scene().goal.offset)
     best = plan(ROBOT, np.array(setup.start), goal).candidates[0]
     body = ROBOT.base.body_radius + LPParams().obstacle_margin
     start = np.array(setup.start[:2])
@@ -120,7 +119,7 @@ def test_the_table_set_up_puts_its_goal_over_the_table_edge() -> None:
     setup = scenario("table", ROBOT)
     assert setup.task == "pose" and setup.solids == (TABLE,) and setup.obstacles == ()
     assert setup.goal_height == TABLE.offset
-    x_d = dq.mul(planar_pose(*setup.bin, setup.goal_height), offset_pose(*setup.goal_offset))
+    x_d = setup.goal(setup.goal_height, setup.goal_offset)
     expected = ROBOT.fkm(TABLE_GOAL)
     assert min(np.abs(x_d - expected).max(), np.abs(x_d + expected).max()) < 1e-8
     assert TABLE.clearance(np.array([*setup.bin[:2], TABLE.offset]))[0] == 0.0  # on its top
