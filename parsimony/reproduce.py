@@ -280,15 +280,17 @@ def input_change_rows(experiment: Experiment) -> list[Row]:
     them, then 3 and 4 from rest (u = 0 before the first command, as in a recording)."""
     runs = {"with": experiment.runs[WITH_INPUT_CHANGE], "LP": experiment.runs["LP"]}
     title = f"{experiment.name}: LP with the input change term against without"
+    nonzero = {label: counts(run) for label, run in runs.items()}
     out = [Row("7.2 (1)", f"{title}, iterations; nonzero entries while moving, last 2 s",
-               "not done", {label: [len(run.outputs), counts(run)["moving"],
-                                    counts(run)["settling"]] for label, run in runs.items()},
+               "not done", {label: [len(run.outputs), nonzero[label]["moving"],
+                                    nonzero[label]["settling"]] for label, run in runs.items()},
                "the same entries")]  # fmt: skip
+    efforts = {(label, from_rest): control_effort(run, from_rest)
+               for label, run in runs.items() for from_rest in (False, True)}  # fmt: skip
     measures = [(index, metric, False) for index, metric in enumerate(METRICS)]
     measures += [(index, METRICS[index], True) for index in (2, 3)]
     for index, metric, from_rest in measures:
-        values = {name: getattr(control_effort(run, from_rest), metric)
-                  for name, run in runs.items()}  # fmt: skip
+        values = {label: getattr(efforts[label, from_rest], metric) for label in runs}
         out.append(Row("7.2 (1)", f"{title}, metric {index + 1}{' from rest' * from_rest}",
                        "not done", {**values, "with/LP": values["with"] / values["LP"]},
                        "with lower" if index >= 2 else ""))  # fmt: skip
