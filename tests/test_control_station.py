@@ -20,7 +20,7 @@ import zenoh
 
 from bench.live_view import lockstep_profile
 from deploy import query
-from messages import codec
+from messages import codec, topics
 from messages.goal import Goal
 from parsimony.experiment import DEPLOY, connect, launched, wait_alive, wait_reached
 from profiles.profile import Profile, load_profile
@@ -47,6 +47,9 @@ class Station:
     address: str
     recording: Path
     session: zenoh.Session
+    goals: list[Goal]
+    """Every goal on goal/request, from a subscriber declared before the view started (its
+    route is set up before any goal is sent)."""
 
     def key(self, suffix: str) -> str:
         return f"{self.profile.namespace}/{suffix}"
@@ -60,12 +63,17 @@ def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Station]:
     profile = load_profile(path)
     with (directory / "launch.log").open("w") as log, launched(path, log) as launcher,\
             connect(profile, launcher) as session:  # fmt: skip
-        wait_alive(session, profile, launcher)
+        goals: list[Goal] = []
+        watcher = session.declare_subscriber(topics.GOAL_REQUEST.key(profile.namespace),
+                                             lambda sample: goals.append(codec.decode(
+                                                 sample.payload.to_bytes(), Goal)))  # fmt: skip
+        wait_alive(session, profile, launcher)  # answered after the router has the watcher
         wait_reached(session, profile, launcher)
         with running_view(path, "--json", timeout_s=READY_S) as view:
             assert view.address in view.live_line, view.live_line  # where it listens
             query.set_param(session, profile.namespace, "simulator", "paused", "false")
-            yield Station(profile, view.address, directory / "session.mcap", session)
+            yield Station(profile, view.address, directory / "session.mcap", session, goals)
+        watcher.undeclare()
     assert view.process.returncode == 0, view.err[-2000:]
     summary = json.loads(view.out)
     assert summary["shown"] > 0 and summary["malformed"] == 0, summary
@@ -228,17 +236,14 @@ def test_a_goal_from_the_client_reaches_the_supervisor_and_the_robot_goes_there(
     assert "frame_id 'camera'" in refused["message"] and refused["level"] == 2
     assert any("only goal/request may be published" in e.get("message", "")
                for e in client.events if e["event"] == "status")  # fmt: skip
-    sent: list[Goal] = []
-    watcher = station.session.declare_subscriber(request, lambda sample: sent.append(
-        codec.decode(sample.payload.to_bytes(), Goal)))  # fmt: skip
+    already = len(station.goals)
     start = len(client.events)
     client.send("publish", channel=channel, text=json.dumps(message))
     client.wait_for(lambda e: e["event"] == "status" and "sent" in e["message"], "the goal sent")
     # The supervisor has it: the goal is x_d = x_2 x_d^2 (eq. 6.3) at the published pose.
     client.wait_for(json_message(status_key, lambda status: status["plans"] >= 1),
                     "the supervisor's plan of the client's goal", start)  # fmt: skip
-    watcher.undeclare()
-    (goal,) = sent
+    (goal,) = station.goals[already:]
     f0 = planar_pose(*station.profile.scene.reference_pose,
                      station.profile.scene.reference.height_m)  # fmt: skip
     assert goal.header.source == "view" and goal.task == "pose"
