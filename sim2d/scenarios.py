@@ -105,6 +105,8 @@ def scenario(name: str, robot: MobileManipulator, seed: int | None = None) -> Si
     """The set-up of experiment ``name`` (one of ``NAMES``); a ``seed`` draws a variant."""
     if name not in NAMES:
         raise ValueError(f"no experiment {name!r}; choose one of {', '.join(NAMES)}")
+    if name == "table":
+        return _table(robot, seed)
     x, y, yaw = planar_of(robot.fkm(REACH_GOAL))
     obstacles: tuple[Circle, ...] = ()
     start = HOME.copy()
@@ -115,13 +117,7 @@ def scenario(name: str, robot: MobileManipulator, seed: int | None = None) -> Si
         (x, y), yaw = ANYWHERE_BIN, yaw + np.pi
         start[:3] = ANYWHERE_START if name == "anywhere" else BLOCKED_START
         obstacles = (ANYWHERE_OBSTACLE if name == "anywhere" else BLOCKED_OBSTACLE,)
-    if name == "table":
-        return _table(robot, seed)
-    bin_pose = np.array([x, y, yaw])
-    if seed is not None:
-        rng = np.random.default_rng(seed)
-        start = start + rng.uniform(-START_RANGE, START_RANGE)
-        bin_pose = bin_pose + rng.uniform(-BIN_RANGE, BIN_RANGE)
+    start, bin_pose = _drawn(start, np.array([x, y, yaw]), seed, BIN_RANGE)
     task = "position" if name == "position" else "pose"
     return SimScenario(name, task, tuple(start.tolist()), tuple(bin_pose.tolist()), obstacles)
 
@@ -133,10 +129,17 @@ def _table(robot: MobileManipulator, seed: int | None) -> SimScenario:
     height = TABLE.offset
     x, y, yaw = planar_of(goal)
     offset = offset_of(dq.mul(dq.conj(planar_pose(x, y, yaw, height)), goal))
-    start, bin_pose = TABLE_START.copy(), np.array([x, y, yaw])
-    if seed is not None:
-        rng = np.random.default_rng(seed)
-        start = start + rng.uniform(-START_RANGE, START_RANGE)
-        bin_pose = bin_pose + rng.uniform(-TABLE_BIN_RANGE, TABLE_BIN_RANGE)
+    start, bin_pose = _drawn(TABLE_START.copy(), np.array([x, y, yaw]), seed, TABLE_BIN_RANGE)
     return SimScenario("table", "pose", tuple(start.tolist()), tuple(bin_pose.tolist()), (),
                        (TABLE,), height, tuple(round(v, 9) for v in offset))  # fmt: skip
+
+
+def _drawn(start: np.ndarray, bin_pose: np.ndarray, seed: int | None, bin_range: np.ndarray
+           ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """The start and the bin, each moved by a draw of ``seed`` within ``START_RANGE`` and
+    ``bin_range`` (as they are without a seed)."""
+    if seed is None:
+        return start, bin_pose
+    rng = np.random.default_rng(seed)
+    moved = start + rng.uniform(-START_RANGE, START_RANGE)  # the start's draw first
+    return moved, bin_pose + rng.uniform(-bin_range, bin_range)
