@@ -69,9 +69,10 @@ QPParams = composed(
 class QPLaw:
     """u = argmin of the quadratic program above, solved by DAQP (``WarmStartedQP``).
 
-    ``step`` never raises for a solver failure: it returns u = 0 with DAQP's exit status. The error
-    rate e' is measured as the LP measures it (the rows are the LP's), and the previous u is
-    kept as the LP keeps it.
+    ``step`` never raises for a solver failure: it returns u = 0 with DAQP's exit status, or
+    ``non-finite`` (a u that is not finite is never ``optimal``). The error rate e' is measured
+    as the LP measures it (the rows are the LP's), and the previous u is kept as the LP keeps
+    it.
     """
 
     robot: MobileManipulator
@@ -126,18 +127,14 @@ class WarmStartedQP:
 
     def solve(self, n: int, costs: list, rows: list, damping: float
               ) -> tuple[Array, str, float | None]:  # fmt: skip
-        """u, the status and the objective."""
+        """u, the status and the objective: u = 0 with the status ``non-finite`` where the
+        program's numbers overflow (a configuration of 1e300 m) or DAQP's solution is not
+        finite; never ``optimal`` with a u that is not."""
         split = np.hstack((np.eye(n), -np.eye(n)))
-        hessian = 2.0 * damping * np.eye(2 * n)
-        linear = np.zeros(2 * n)
-        for cost in costs:
-            if isinstance(cost, ResidualCost):
-                a = cost.matrix @ split
-                weight = cost.weight**2
-                hessian += 2.0 * weight * (a.T @ a)
-                linear += 2.0 * weight * (a.T @ cost.offset)
-            elif isinstance(cost, VelocityCost):
-                linear += np.concatenate((cost.weights, cost.negative_weights))
+        with np.errstate(over="ignore", invalid="ignore"):  # tested just below
+            hessian, linear = _objective(split, costs, damping)
+        if not (np.isfinite(hessian).all() and np.isfinite(linear).all()):
+            return np.zeros(n), NON_FINITE, None
         matrix, lower, upper = [split], [np.full(n, -INF)], [np.full(n, INF)]
         for row in rows:
             if isinstance(row, VelocityBounds):
@@ -166,11 +163,32 @@ class WarmStartedQP:
         if flag < 1:
             self._active = None
             return np.zeros(n), EXIT_FLAGS.get(flag, f"daqp exit {flag}"), None
-        self._active = np.where(np.abs(np.asarray(info["lam"])) > 0, ACTIVE, 0)
         g = np.asarray(g)
+        if not np.isfinite(g).all():
+            self._active = None
+            return np.zeros(n), NON_FINITE, None
+        self._active = np.where(np.abs(np.asarray(info["lam"])) > 0, ACTIVE, 0)
         return g[:n] - g[n:], "optimal", float(objective)
 
 
+def _objective(split: Array, costs: list, damping: float) -> tuple[Array, Array]:
+    """H and c of the QP over g = [u_P, u_N] (see ``WarmStartedQP``)."""
+    size = split.shape[1]
+    hessian = 2.0 * damping * np.eye(size)
+    linear = np.zeros(size)
+    for cost in costs:
+        if isinstance(cost, ResidualCost):
+            a = cost.matrix @ split
+            weight = cost.weight**2
+            hessian += 2.0 * weight * (a.T @ a)
+            linear += 2.0 * weight * (a.T @ cost.offset)
+        elif isinstance(cost, VelocityCost):
+            linear += np.concatenate((cost.weights, cost.negative_weights))
+    return hessian, linear
+
+
+NON_FINITE = "non-finite"
+"""The status of a step whose program or solution is not finite."""
 EQUALITY, ACTIVE = 5, 1
 """DAQP's senses: an equality row, and an inequality taken as active (a warm start)."""
 EXIT_FLAGS = {-1: "infeasible", -2: "cycling", -3: "unbounded", -4: "iteration limit",

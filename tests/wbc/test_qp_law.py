@@ -65,3 +65,14 @@ def test_an_infeasible_program_gives_zero_velocity_and_the_status() -> None:
     output = QPLaw(MODEL, params).step(HOME, at_goal, DT, [obstacle])
     assert output.status == "infeasible"
     assert not output.u.any() and output.nonzero == 0
+
+
+def test_a_program_whose_numbers_overflow_is_never_optimal() -> None:
+    """At a base pose of (1e300, -1e300, 1e300) the program's costs overflow: DAQP's u was all
+    NaN with the status "optimal". A u that is not finite is reported as such, as zero."""
+    q = HOME.copy()
+    q[:3] = (1e300, -1e300, 1e300)
+    with np.errstate(over="ignore", invalid="ignore"):  # e's norm overflows, as it should
+        output = QPLaw(MODEL).step(q, PoseTask(MODEL.fkm(REACH_GOAL)), DT)
+    assert output.status == "non-finite"
+    assert not output.u.any() and output.nonzero == 0
