@@ -8,8 +8,8 @@ clock, shared by the controller process (``components.controller``) and ``parsim
 with ``dt`` the difference of consecutive state stamps, clamped to [1 ms, 0.2 s] (0.02 s at
 the first step). The step commands zero, and says why (``status``, ``reason``), whenever its
 output cannot be trusted: the state is older than the stale timeout, it is not ``valid``,
-there is no goal, the law raises or returns a status other than ``optimal``, or a command
-would not be finite.
+there is no goal (none yet, or the last one was refused), the law raises or returns a status
+other than ``optimal``, or a command would not be finite.
 """
 
 from __future__ import annotations
@@ -85,11 +85,14 @@ class ControlStep:
         self.task: Task | None = None
         self.obstacles: tuple[Obstacle, ...] = ()
         self.last_stamp_ns: int | None = None
+        self.refusal = ""
+        """Why the last goal was refused, while no goal holds."""
 
     def take_goal(self, goal: Goal) -> None:
-        """Follow ``goal``; a goal the law cannot take (``ValueError``: its ``eta`` or ``beta``
-        outside the bounds the gains declare, or a task the law refuses) drops the current
-        one."""
+        """Follow ``goal``; a goal the law cannot take (``ValueError``, naming the field and
+        what it must be: its ``eta`` or ``beta`` outside the bounds the gains declare, or a
+        task the law refuses) drops the current one, and the steps until the next goal say
+        why (status ``goal refused``)."""
         try:
             declared = {spec.name: spec for spec in gain_specs(type(self.gains))}
             for name in GOAL_OVERRIDES:
@@ -97,9 +100,11 @@ class ControlStep:
                 if value is not None and name in declared:
                     declared[name].check(value)
             task = task_of(goal)
-        except ValueError:
+        except ValueError as error:
             self.goal = self.task = None
+            self.refusal = f"control/goal refused: {error}"
             raise
+        self.refusal = ""
         if self.task is None or not same_task(self.task, task, MEASUREMENT_TOLERANCE):
             self.law.reset()
         self.goal, self.task = goal, task
@@ -143,6 +148,8 @@ class ControlStep:
         if not state.valid:
             return Step.zero(stamp, "invalid state",
                              "robot/state is not valid (the estimator has no fix)")  # fmt: skip
+        if self.task is None and self.refusal:
+            return Step.zero(stamp, "goal refused", self.refusal)
         if self.task is None:
             return Step.zero(stamp, "no goal", "no control/goal received yet")
         try:
@@ -157,11 +164,16 @@ class ControlStep:
         if u.shape != (3 + ARM_JOINTS,):
             return Step.zero(stamp, "error", f"u has shape {u.shape}; the arm command takes "
                                              f"{ARM_JOINTS} joints")  # fmt: skip
-        base = wheel_speeds(*unicycle(u[0], u[1], u[2], state.base_pose[2]), self.robot.base)
-        wheels = (base.forward, base.angular, base.left_wheel, base.right_wheel)
-        if not (np.all(np.isfinite(u)) and all(math.isfinite(w) for w in wheels)):
-            return Step.zero(stamp, "non-finite", f"the {self.name} law gave a non-finite "
-                                                  f"command {u}")  # fmt: skip
+        if not np.all(np.isfinite(u)):  # before any conversion, which would raise
+            return Step.zero(stamp, "non-finite", f"the {self.name} law reported optimal with "
+                                                  f"a non-finite u {u} (a law error)")  # fmt: skip
+        speeds, wheels = unicycle(u[0], u[1], u[2], state.base_pose[2]), (math.nan,) * 4
+        if all(math.isfinite(v) for v in speeds):  # v may overflow where u does not
+            base = wheel_speeds(*speeds, self.robot.base)
+            wheels = (base.forward, base.angular, base.left_wheel, base.right_wheel)
+        if not all(math.isfinite(w) for w in wheels):
+            return Step.zero(stamp, "non-finite", f"the {self.name} law's u {u} gives "
+                                                  "non-finite base speeds")  # fmt: skip
         return Step(stamp, wheels, tuple(u[3:].tolist()), "optimal", "", output)
 
 

@@ -8,7 +8,7 @@ control step (``components.control_step``, the same step ``parsimony rerun`` run
 The controller commands zero, and says why in the diagnostics' ``status`` and ``reason``,
 whenever it cannot trust its output (``ControlStep.step``), and also while states stop
 arriving (a 10 Hz timer checks); a law that raises is counted as ``law_errors``, a command
-that would not be finite as ``non_finite_commands``.
+that would not be finite as ``non_finite_commands``, a goal it refuses as ``refused_goals``.
 
 Commands and diagnostics carry the stamp of the state they answer, so their age on
 arrival measures the whole loop; zeros sent by the timer carry the current time.
@@ -114,6 +114,7 @@ class Controller(Component):
         self._seen = (node.params.version, None)  # the parameters and goal the gains are of
         node.counters["non_finite_commands"] = 0
         node.counters["law_errors"] = 0
+        node.counters["refused_goals"] = 0
         self.state_input = node.subscribe(topics.ROBOT_STATE, self.on_state)
         node.subscribe(topics.CONTROL_GOAL, self.on_goal)
         node.subscribe(topics.WORLD_OBSTACLES, self.on_obstacles)
@@ -124,11 +125,17 @@ class Controller(Component):
         return self.stepper.robot
 
     def on_goal(self, goal: Goal) -> None:
-        """Take a goal (``ControlStep.take_goal``). A goal the law refuses (ValueError, counted
-        in ``errors.control/goal``) drops the current one: no goal, zero commands. The goal's
-        ``eta`` and ``beta`` must lie in the bounds of the gains they override, the bounds of
-        their parameters too (``parsimony param set``)."""
-        self.stepper.take_goal(goal)
+        """Take a goal (``ControlStep.take_goal``). A goal the law refuses (counted in
+        ``refused_goals``, one line logged) drops the current one: zero commands, and the
+        diagnostics say why (``goal refused``) until the next goal. The goal's ``eta`` and
+        ``beta`` must lie in the bounds of the gains they override, the bounds of their
+        parameters too (``parsimony param set``)."""
+        try:
+            self.stepper.take_goal(goal)
+        except ValueError:
+            self.node.count("refused_goals")
+            self.node.warn("refused_goals", f"{self.stepper.refusal}; zero sent until the "
+                                            "next goal")  # fmt: skip
 
     def on_obstacles(self, message: Obstacles) -> None:
         """Take the obstacles every following step avoids."""

@@ -1,6 +1,7 @@
-"""The control step (components/control_step.py) and the u its law remembers: a step that
-commands zero instead of the law's u tells the law, so a law that prices the change of u
-(the input change term) starts again from rest, as the robot does."""
+"""The control step (components/control_step.py): a step that commands zero instead of the
+law's u tells the law, so a law that prices the change of u (the input change term) starts
+again from rest, as the robot does; a u that is not finite and a goal whose gains leave their
+bounds command zero and say why, never raise."""
 
 from __future__ import annotations
 
@@ -15,7 +16,10 @@ from messages.goal import Goal
 from messages.header import Header
 from messages.state import RobotState
 from parsimony.kinematic_demo import LP_PARAMS, input_change_gains
-from wbc.lp_law import LPLaw
+from wbc.cascade_law import CascadeLaw, CascadeParams
+from wbc.gains import gain_specs
+from wbc.lp_law import LPLaw, LPParams
+from wbc.qp_law import QPLaw, QPParams
 from wbc.robot import MobileManipulator
 from wbc.scenarios import DT, HOME, REACH_GOAL
 
@@ -24,10 +28,12 @@ STEP_NS = int(DT * 1e9)
 STALE_S = 0.5
 
 
-def state(q: np.ndarray, stamp_ns: int) -> RobotState:
+def state(q: np.ndarray, stamp_ns: int, end_effector: np.ndarray | None = None) -> RobotState:
+    """A valid state at ``q``, its end effector's pose ``fkm(q)`` unless given."""
+    pose = ROBOT.fkm(q) if end_effector is None else end_effector
     return RobotState(header=Header(stamp_ns=stamp_ns, frame="world", seq=0, source="test"),
                       base_pose=tuple(q[:3]), arm_joints=tuple(q[3:]),
-                      end_effector=tuple(ROBOT.fkm(q)), valid=True, age_s=0.0)  # fmt: skip
+                      end_effector=tuple(pose), valid=True, age_s=0.0)  # fmt: skip
 
 
 @pytest.mark.parametrize("hold", ["a stale state", "a zero sent without a state"])
@@ -60,3 +66,50 @@ def test_a_held_step_starts_the_law_again_from_rest(hold: str) -> None:
     after = control.step(state(q, stamp), stamp, STALE_S)
     assert after.status == "optimal"
     assert np.all(np.abs(after.output.u) <= ramp + 1e-9)
+
+
+LAWS = {"lp": (LPLaw, LPParams), "qp": (QPLaw, QPParams), "cascade": (CascadeLaw, CascadeParams)}
+HEADER = Header(stamp_ns=0, frame="world", seq=0, source="test")
+GOAL = Goal(header=HEADER, task="pose", pose=tuple(ROBOT.fkm(REACH_GOAL)))
+FAR = (1e300, -1e300, 1e300)
+"""A base pose whose program overflows: the QP law's u was all NaN, reported optimal."""
+
+
+@pytest.mark.parametrize("law", LAWS)
+def test_a_base_pose_of_1e300_commands_zero_or_a_finite_u_and_never_raises(law: str) -> None:
+    """The QP's NaN went to ``wheel_speeds`` before the step's own check: ValueError, and no
+    command at all for that state. Now: zero, status ``non-finite`` (the LP's HiGHS gives up,
+    the cascade's u is finite)."""
+    law_type, gains_type = LAWS[law]
+    control = ControlStep(law, law_type, ROBOT, gains_type())
+    control.take_goal(GOAL)
+    q = HOME.copy()
+    q[:3] = FAR
+    with np.errstate(over="ignore", invalid="ignore"):  # e's norm overflows, as it should
+        step = control.step(state(q, STEP_NS, ROBOT.fkm(HOME)), STEP_NS, STALE_S)
+    assert all(np.isfinite((*step.wheels, *step.joints))), step
+    if step.status != "optimal":
+        assert step.wheels == (0.0,) * 4 and step.joints == (0.0,) * 5
+    if law == "qp":
+        assert step.status == "non-finite", step
+
+
+@pytest.mark.parametrize("value", [1e300, 1e-300])
+@pytest.mark.parametrize("name", ["eta", "beta"])
+def test_a_goal_whose_gain_leaves_its_bounds_is_refused_naming_the_field_and_them(
+    name: str, value: float
+) -> None:
+    """eta or beta of 1e300 or 1e-300 passes the goal's schema (a positive number): refused
+    (ValueError), and every step until the next goal commands zero with the status ``goal
+    refused`` and the gain's bounds, as ``wbc.gains`` declares them."""
+    control = ControlStep("lp", LPLaw, ROBOT, LPParams())
+    control.take_goal(GOAL)
+    with pytest.raises(ValueError, match=name):
+        control.take_goal(GOAL.model_copy(update={name: value}))
+    spec = next(spec for spec in gain_specs(LPParams) if spec.name == name)
+    for stamp in (STEP_NS, 2 * STEP_NS):
+        step = control.step(state(HOME, stamp), stamp, STALE_S)
+        assert step.status == "goal refused" and step.joints == (0.0,) * 5
+        assert f"{name}: expected {spec.expected()}" in step.reason, step.reason
+    control.take_goal(GOAL)
+    assert control.step(state(HOME, 3 * STEP_NS), 3 * STEP_NS, STALE_S).status == "optimal"

@@ -87,12 +87,13 @@ class Operator:
         self._stamps.add(stamp)
         return stamp
 
-    def send_state(self, valid: bool = True, age_s: float = 0.0) -> int:
-        """Publish a state at ``START``; return its stamp."""
+    def send_state(self, valid: bool = True, age_s: float = 0.0,
+                   base_pose: tuple[float, float, float] = START[:3]) -> int:  # fmt: skip
+        """Publish a state at ``START`` (or its arm at ``base_pose``); return its stamp."""
         stamp = self.stamp(age_s)
         state = RobotState(
             header=Header(stamp_ns=stamp, frame="world", seq=0, source="test"),
-            base_pose=START[:3],
+            base_pose=base_pose,
             arm_joints=START[3:],
             end_effector=GOAL_POSE,
             valid=valid,
@@ -101,18 +102,23 @@ class Operator:
         self.state.put(codec.encode(state))
         return stamp
 
-    def send_goal(self, eta: float | None = None) -> None:
+    def send_goal(self, eta: float | None = None, beta: float | None = None) -> None:
         """Publish a pose goal and wait until the controller has taken it.
 
         (Zenoh calls each subscription's handler on its own thread: a goal published
         before a state may still be handled after it.)
         """
         taken = self.counters()["received.control/goal"]
-        header = Header(stamp_ns=self.stamp(), frame="world", seq=0, source="test")
-        self.goal.put(codec.encode(Goal(header=header, task="pose", pose=GOAL_POSE, eta=eta)))
+        self.put_goal(eta, beta)
         deadline = time.monotonic() + DEADLINE_S
         while self.counters()["received.control/goal"] == taken:
             assert time.monotonic() < deadline, "the controller did not take the goal"
+
+    def put_goal(self, eta: float | None = None, beta: float | None = None) -> None:
+        """Publish a pose goal with these gains."""
+        header = Header(stamp_ns=self.stamp(), frame="world", seq=0, source="test")
+        goal = Goal(header=header, task="pose", pose=GOAL_POSE, eta=eta, beta=beta)
+        self.goal.put(codec.encode(goal))
 
     def answer(self, stamp: int) -> tuple[ControllerDiagnostics, BaseCommand, ArmCommand]:
         """The diagnostics and commands that answer the state stamped ``stamp``."""
@@ -300,15 +306,71 @@ def test_a_robot_parameter_that_cannot_load_is_refused_and_the_controller_goes_o
 
 
 def test_a_goal_whose_gains_leave_the_parameter_bounds_is_refused(operator: Operator) -> None:
-    """eta = 1e300 on a goal is checked like `param set`: refused, counted, zero commands."""
+    """eta = 1e300 on a goal is checked like `param set`: refused, counted, zero commands, and
+    the diagnostics say which gain and its bounds."""
     operator.send_goal()
     assert operator.step()[0].status == "optimal"
     operator.send_goal(eta=1e300)
-    diagnostics = operator.step()[0]
-    assert diagnostics.status == "no goal", diagnostics
-    assert operator.counters()["errors.control/goal"] >= 1
+    diagnostics, base, arm = operator.step()
+    assert diagnostics.status == "goal refused" and is_zero(base, arm), diagnostics
+    assert diagnostics.reason.startswith("control/goal refused: eta: expected a float in [0.001, "
+                                         "100.0], got 1e+300"), diagnostics.reason  # fmt: skip
+    assert operator.counters()["refused_goals"] == 1
     operator.send_goal(eta=1.5)
     assert operator.step()[0].parameters["eta"] == 1.5
+
+
+FAR = (1e300, -1e300, 1e300)
+"""A base pose whose program overflows (the QP law's u was all NaN, reported optimal)."""
+FLOOD = 200
+"""Messages of each kind in a flood."""
+
+
+@pytest.mark.parametrize("module", ["lp_controller", "qp_controller", "cascade_controller"])
+def test_a_flood_of_states_far_away_and_of_goals_out_of_bounds_is_answered_without_a_traceback(
+    deployed: Callable[[str], System], module: str
+) -> None:
+    """States at (1e300, -1e300, 1e300), then goals with eta or beta of 1e300 or 1e-300: every
+    state handled is answered (the QP's NaN raised in ``wheel_speeds``: nothing was published
+    for it), by a finite command, zero unless optimal; every goal is refused in one line naming
+    the gain and its bounds; no traceback; the controller then follows a good goal again."""
+    system = deployed(LP_PROFILE.read_text().replace("lp_controller", module))
+    system.start("controller")
+    operator = Operator(system)
+    operator.wait_connected()
+    operator.send_goal()
+    stamps = [operator.send_state(base_pose=FAR) for _ in range(FLOOD)]
+    operator.answer(stamps[-1])  # the newest state is always handled, and answered last
+    counters = operator.counters()
+    answered = [m for m in operator.diagnostics.messages if m.header.stamp_ns in set(stamps)]
+    assert len(answered) == counters["received.robot/state"] >= 1
+    assert counters["received.robot/state"] + counters["overwritten.robot/state"] == FLOOD
+    for diagnostics in answered:
+        _, base, arm = operator.answer(diagnostics.header.stamp_ns)
+        assert diagnostics.status == "optimal" or is_zero(base, arm), diagnostics
+        assert diagnostics.status == "non-finite" or module != "qp_controller", diagnostics
+
+    gains = [("eta", 1e300), ("beta", 1e-300), ("beta", 1e300), ("eta", 1e-300)]
+    taken = counters["received.control/goal"] + counters["overwritten.control/goal"]
+    for index in range(FLOOD):
+        name, value = gains[index % len(gains)]
+        operator.put_goal(**{name: value})
+    deadline = time.monotonic() + DEADLINE_S
+    while sum(operator.counters()[f"{kind}.control/goal"]
+              for kind in ("received", "overwritten")) < taken + FLOOD:  # fmt: skip
+        assert time.monotonic() < deadline, "the controller did not take every goal"
+    diagnostics, base, arm = operator.step()  # the last goal sent: eta 1e-300
+    assert diagnostics.status == "goal refused" and is_zero(base, arm), diagnostics
+    assert "eta: expected a float in [0.001, 100.0], got 1e-300" in diagnostics.reason
+    counters = operator.counters()
+    assert counters["refused_goals"] >= 1
+    assert counters["errors.robot/state"] == counters["errors.control/goal"] == 0
+    assert "Traceback" not in system.log("controller")
+
+    operator.send_goal()
+    assert operator.step()[0].status == "optimal"
+    assert system.processes[0].poll() is None
+    operator.assert_every_command_finite()
 
 
 def test_a_robot_description_that_cannot_be_loaded_is_a_configuration_error(
