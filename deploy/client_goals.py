@@ -6,11 +6,14 @@ frame as JSON: a ``foxglove.PoseInFrame`` or a ``foxglove.Pose``, or in the shap
 ROS), whose frame is in its header. It is taken as the
 place of a goal marker F2, so the goal is the one the state estimator would measure there,
 x_d = x_2 x_d^2 (eq. 6.3), with the scene's offset x_d^2 (the gripper over the bin), a pose
-task. It is refused, with the reason, when its JSON is not of those schemas, a number is
-missing or not finite, its frame is not ``world`` (F0, where the estimate is), its
-orientation is not a unit quaternion (within ``messages.base.UNIT_TOLERANCE``, as a goal's
-pose is checked), the goal lies below the floor, or the supervisor would refuse it at once
-(``wbc.staging.refusal``: in an obstacle, farther than a plan may cover from the base).
+task. It is refused, with the reason, when it is larger than a goal can be
+(``deploy.client_limits``), its JSON is not of those schemas (an object missing, a number
+not finite, or out of range: a coordinate beyond ``FARTHEST_M``, checked before anything is
+computed from it), its frame is not ``world`` (F0, where the estimate is), its orientation is
+not a unit quaternion (within ``messages.base.UNIT_TOLERANCE``, as a goal's pose is checked),
+the goal lies below the floor, or the supervisor would refuse it at once
+(``wbc.staging.refusal``: in an obstacle, farther than a plan may cover from the base). A
+refusal repeats at most ``client_limits.ECHO_CHARS`` of any string the client sent.
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ from collections.abc import Sequence
 import numpy as np
 from pydantic import ValidationError
 
+from deploy.client_limits import ECHO_CHARS, GOAL_BYTES, cut, echo
 from messages.base import UNIT_TOLERANCE
 from messages.goal import Goal
 from messages.header import Header
@@ -38,45 +42,69 @@ ENCODING = "json"
 """How it may encode it."""
 FRAME = "world"
 """The frame a PoseInFrame must be in (an empty frame is taken as it)."""
+FARTHEST_M = 1000.0
+"""No coordinate of a client's position lies farther from F0's origin, m. The supervisor
+refuses a goal more than 10 m from the base anyway; this bound is checked first, so that no
+arithmetic on a client's number overflows into a misleading refusal."""
 
 
 class GoalRefused(ValueError):
     """A client's goal that is not passed on; the text says why."""
 
 
-def _number(fields: dict, path: str) -> float:
-    """The finite number at ``path`` (``"position.x"``); a missing one is 0, as protobuf's."""
-    value: object = fields
-    for name in path.split("."):
-        if not isinstance(value, dict):
-            raise GoalRefused(f"{path}: expected an object at {name!r}")
-        value = value.get(name, 0.0)
+def _object(fields: dict, name: str, prefix: str = "") -> dict:
+    """The object ``name`` of ``fields`` (``prefix`` names ``fields`` in a refusal)."""
+    value = fields.get(name)
+    if value is None:
+        raise GoalRefused(f"{prefix}{name} is missing: a goal needs it")
+    if not isinstance(value, dict):
+        raise GoalRefused(f"{prefix}{name}: expected an object, got {echo(value)}")
+    return value
+
+
+def _number(fields: dict, name: str, prefix: str, limit: float, what: str) -> float:
+    """The finite number ``name`` of ``fields``, within ``limit`` of 0 (``what`` says why);
+    a missing one is 0, as protobuf's."""
+    value = fields.get(name, 0.0)
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise GoalRefused(f"{path}: expected a number, got {json.dumps(value)}")
-    if not math.isfinite(value):
-        raise GoalRefused(f"{path}: expected a finite number, got {value}")
+        raise GoalRefused(f"{prefix}{name}: expected a number, got {echo(value)}")
+    if isinstance(value, float) and not math.isfinite(value):
+        raise GoalRefused(f"{prefix}{name}: expected a finite number, got {value}")
+    if abs(value) > limit:
+        raise GoalRefused(f"{prefix}{name} = {echo(value)} is out of range: {what}")
     return float(value)
 
 
 def marker_pose(schema_name: str, data: bytes) -> np.ndarray:
     """The pose (a unit dual quaternion) a client's message of ``SCHEMAS`` gives, or
-    ``GoalRefused``."""
+    ``GoalRefused``. Sizes and magnitudes are checked before anything is computed."""
     if schema_name not in SCHEMAS:
-        raise GoalRefused(f"schema {schema_name!r}: goal/request takes {' or '.join(SCHEMAS)}")
+        raise GoalRefused(f"schema {echo(schema_name)}: goal/request takes "
+                          f"{' or '.join(SCHEMAS)}")  # fmt: skip
+    if len(data) > GOAL_BYTES:
+        raise GoalRefused(f"a message of {len(data)} bytes: a goal is at most {GOAL_BYTES}")
     try:
         fields = json.loads(data)
+    except RecursionError:
+        raise GoalRefused("not a goal: its JSON is nested too deeply") from None
     except (UnicodeDecodeError, ValueError) as error:
-        raise GoalRefused(f"not JSON: {error}") from None
+        raise GoalRefused(f"not JSON: {cut(str(error), ECHO_CHARS)}") from None
     if not isinstance(fields, dict):
-        raise GoalRefused(f"expected a {schema_name} object, got {json.dumps(fields)[:40]}")
+        raise GoalRefused(f"expected a {schema_name} object, got {echo(fields)}")
+    prefix = ""
     if schema_name in (*IN_FRAME, *STAMPED):
-        header = fields.get("header", {}) if schema_name in STAMPED else fields
-        frame = header.get("frame_id", "") if isinstance(header, dict) else None
+        header = _object(fields, "header") if schema_name in STAMPED else fields
+        frame = header.get("frame_id", "")
         if frame not in ("", FRAME):
-            raise GoalRefused(f"frame_id {frame!r}: a goal is given in {FRAME!r} (F0)")
-        fields = fields.get("pose", {})
-    position = [_number(fields, f"position.{axis}") for axis in "xyz"]
-    w, x, y, z = (_number(fields, f"orientation.{axis}") for axis in "wxyz")
+            raise GoalRefused(f"frame_id {echo(frame)}: a goal is given in {FRAME!r} (F0)")
+        fields, prefix = _object(fields, "pose"), "pose."
+    far = f"a goal lies within {FARTHEST_M:g} m of F0"
+    where = _object(fields, "position", prefix)
+    position = [_number(where, axis, f"{prefix}position.", FARTHEST_M, far) for axis in "xyz"]
+    unit = f"a unit quaternion's components lie in [-1, 1] (tolerance {UNIT_TOLERANCE:g})"
+    turn = _object(fields, "orientation", prefix)
+    w, x, y, z = (_number(turn, axis, f"{prefix}orientation.", 1.0 + UNIT_TOLERANCE, unit)
+                  for axis in "wxyz")  # fmt: skip
     norm = math.sqrt(w * w + x * x + y * y + z * z)
     if abs(norm - 1.0) > UNIT_TOLERANCE:
         raise GoalRefused(f"orientation has norm {norm:.9g}, expected 1 (tolerance "

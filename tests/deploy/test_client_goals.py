@@ -54,9 +54,11 @@ def test_a_pose_alone_and_a_stamped_pose_give_the_same_goal(schema: str) -> None
     ("foxglove.PoseInFrame", pose_in_frame(math.nan, -0.2, 0.4),
      "position.x: expected a finite number, got nan"),
     ("foxglove.PoseInFrame", pose_in_frame(0.6, -0.2, 0.4, position={"x": "far"}),
-     'position.x: expected a number, got "far"'),
+     "position.x: expected a number, got 'far'"),
+    ("foxglove.PoseInFrame", pose_in_frame(0.6, -0.2, 0.4, orientation={"w": 0.5}),
+     "orientation has norm 0.5, expected 1"),
     ("foxglove.PoseInFrame", pose_in_frame(0.6, -0.2, 0.4, orientation={"w": 2.0}),
-     "orientation has norm 2, expected 1"),
+     "pose.orientation.w = 2 is out of range: a unit quaternion's components lie in [-1, 1]"),
     ("foxglove.PoseInFrame", pose_in_frame(12.0, 0.0, 0.0),
      "farther than the 10 m a plan may cover"),
     ("foxglove.PoseInFrame", pose_in_frame(1.0, 1.0, 0.0),
@@ -80,3 +82,36 @@ def test_before_the_robot_is_known_only_the_message_is_checked() -> None:
     goal = client_goal("foxglove.PoseInFrame", far, OFFSET, HEADER, None)
     assert np.allclose(dq.translation(np.array(goal.pose))[1:3], [12.0, 0.0])
     assert np.allclose(marker_pose("foxglove.PoseInFrame", far), planar_pose(12.0, 0.0, 0.0))
+
+
+def raw_pose(position: object, frame: object = "world") -> bytes:
+    """A PoseInFrame whose position is ``position`` as given (JSON text or a value)."""
+    text = position if isinstance(position, str) else json.dumps(position)
+    return (f'{{"frame_id": {json.dumps(frame)}, "pose": {{"position": {text}, '
+            '"orientation": {"w": 1.0}}}').encode()  # fmt: skip
+
+
+@pytest.mark.parametrize(("data", "reason"), [
+    (raw_pose('{"x": 1' + "0" * 400 + "}"),
+     "pose.position.x = an integer of 401 digits is out of range: a goal lies within "
+     "1000 m of F0"),
+    (raw_pose("[" * 5000 + "]" * 5000), "not a goal: its JSON is nested too deeply"),
+    (raw_pose({"x": 1e154, "y": 1e154, "z": 0.0}),
+     "pose.position.x = 1e+154 is out of range: a goal lies within 1000 m of F0"),
+    (raw_pose({"x": 0.5, "y": -1e300}), "pose.position.y = -1e+300 is out of range"),
+    (b'{"frame_id": "world", "pose": {"orientation": {"w": 1.0}}}',
+     "pose.position is missing: a goal needs it"),
+    (b'{"frame_id": "world"}', "pose is missing: a goal needs it"),
+    (raw_pose([1, 2]), "pose.position: expected an object, got a list of 2 entries"),
+    (raw_pose({"x": "x" * 5000}), "pose.position.x: expected a number, got 'xxxx"),
+    (raw_pose({"x": 0.5}, frame="c" * 5000), "frame_id 'cccc"),
+    (raw_pose({"x": 0.5}, frame="c" * 20_000), "a message of 20"),
+])  # fmt: skip
+def test_a_hostile_goal_is_refused_in_a_few_words(data: bytes, reason: str) -> None:
+    """Magnitudes are checked before anything is computed from them, and nothing the client
+    sent comes back longer than a few words (a refusal goes to every client)."""
+    for q_now in (HOME, None):
+        with pytest.raises(GoalRefused) as refused:
+            client_goal("foxglove.PoseInFrame", data, OFFSET, HEADER, q_now)
+        assert reason in str(refused.value)
+        assert len(str(refused.value)) < 150, str(refused.value)
