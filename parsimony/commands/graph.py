@@ -30,6 +30,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
 
 
 def run(args: argparse.Namespace) -> int:
+    dot = shutil.which("dot") if args.png else None
+    if args.png and dot is None:
+        print("graph: --png needs Graphviz's dot (install it: apt-get install graphviz, "
+              "brew install graphviz); --dot FILE writes the graph without it", file=sys.stderr)
+        return 2
     try:
         graph = dataflow(load_profile(args.profile), args.profile)
     except (ProfileError, LookupError) as error:
@@ -40,12 +45,7 @@ def run(args: argparse.Namespace) -> int:
     emit(json_text(graph.to_json(), indent=2) if args.json else graph.to_text())
     if args.dot:
         args.dot.write_text(graph.to_dot() + "\n")
-    if args.png:
-        dot = shutil.which("dot")
-        if dot is None:
-            print("--png needs Graphviz's dot (apt-get install graphviz); --dot writes the "
-                  "graph without it", file=sys.stderr)  # fmt: skip
-            return 1
+    if dot is not None:
         subprocess.run([dot, "-Tpng", "-o", str(args.png)], input=graph.to_dot(), text=True,
                        check=True)  # fmt: skip
     return 0

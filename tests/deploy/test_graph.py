@@ -68,6 +68,21 @@ def test_parsimony_graph_prints_json_alone_and_writes_dot(tmp_path: Path) -> Non
     assert dot.read_text().startswith('digraph "parsimony" {')
 
 
+def test_graph_png_without_graphviz_prints_only_how_to_install_it(tmp_path: Path) -> None:
+    """Before, it printed the whole text graph, then the hint, and exited 1."""
+    result = subprocess.run(
+        [sys.executable, "-m", "parsimony.cli", "graph", str(DEPLOY / "controllers.yaml"),
+         "--png", str(tmp_path / "graph.png")],
+        capture_output=True, text=True, timeout=120, env={"PATH": str(tmp_path)},
+    )  # fmt: skip
+    assert result.returncode == 2
+    assert result.stdout == ""
+    assert result.stderr.splitlines() == [
+        "graph: --png needs Graphviz's dot (install it: apt-get install graphviz, brew install "
+        "graphviz); --dot FILE writes the graph without it"]
+    assert not (tmp_path / "graph.png").exists()
+
+
 def test_a_module_without_one_component_class_is_refused(tmp_path: Path) -> None:
     path = tmp_path / "profile.yaml"
     path.write_text("namespace: t\ncomponents:\n  - {name: x, module: params, role: tool}\n")
