@@ -23,12 +23,17 @@ a grown disc, or walled off, has no way, and the reason says which. The way is h
 drive as waypoints: each arc becomes the corners of the polygon circumscribed about it
 (corners at R_i / cos(delta / 2), at most ``max_turn`` apart), so every leg between waypoints
 is tangent to, and outside of, the grown discs.
+
+The graph of n discs has O(n^2) nodes and its edges take O(n^3) work (256 discs: 70,000
+nodes, seconds of CPU), so a planner given a ``deadline`` on its thread's CPU clock raises
+``OutOfBudget`` as soon as it finds it passed, wherever it is in the work.
 """
 
 from __future__ import annotations
 
 import heapq
 import math
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -42,6 +47,13 @@ Array = np.ndarray
 
 ROOM = 1e-4
 """How far inside a start's or target's distance from a centre its disc shrinks to, m."""
+
+SEARCH_CHECK = 1024
+"""Dijkstra's search looks at the CPU clock once per this many nodes it settles."""
+
+
+class OutOfBudget(Exception):
+    """A ``WayPlanner``'s CPU deadline passed before its work was done."""
 
 
 @dataclass(frozen=True)
@@ -125,11 +137,14 @@ neighbour (rad, counter-clockwise > 0), None for a segment."""
 
 class WayPlanner:
     """Shortest ways from one start round ``obstacles``: the graph of the start and the discs
-    is searched once (Dijkstra from the start), and ``to`` joins each target to it."""
+    is searched once (Dijkstra from the start), and ``to`` joins each target to it. Past
+    ``deadline`` (a ``time.thread_time()``, s) building the graph or a way raises
+    ``OutOfBudget``."""
 
     def __init__(self, start: Array, obstacles: Sequence[Circle], clearance: float,
                  slack: float = 0.0, max_turn: float = math.pi / 4,
-                 target: Array | None = None) -> None:  # fmt: skip
+                 target: Array | None = None, deadline: float = math.inf) -> None:  # fmt: skip
+        self.deadline = deadline
         self.origin = require_finite("start", start)[:2]
         self.obstacles = tuple(obstacles)
         self.clearance, self.slack, self.max_turn = clearance, slack, max_turn
@@ -147,14 +162,20 @@ class WayPlanner:
             float(np.hypot(*(p - centre))) - ROOM for p in near]))
             for c, centre in zip(self.obstacles, self.centres, strict=True)])  # fmt: skip
         self.shrunk_for_target = target is not None
-        self._covers = [[interval for other in range(len(self.obstacles)) if other != disc
-                         and (interval := covered(*self._disc(disc), *self._disc(other)))
-                         is not None] for disc in range(len(self.obstacles))]  # fmt: skip
+        self._covers: list[list[tuple[float, float]]] = []
         """For each disc, the arcs of its circle that the other discs cover (``covered``)."""
+        for disc in range(len(self.obstacles)):
+            self._check_budget()
+            arcs = (covered(*self._disc(disc), *self._disc(other))
+                    for other in range(len(self.obstacles)) if other != disc)  # fmt: skip
+            self._covers.append([arc for arc in arcs if arc is not None])
         self.nodes = [_Node(self.start, -1, 0.0)]
         self.edges: Edges = {0: []}
+        self._of_disc: dict[int, list[int]] = {}
+        """The nodes on each disc."""
         discs = range(0 if self.reason else len(self.obstacles))
         for disc in discs:
+            self._check_budget()
             self._tangents(0, disc)
             for other in range(disc + 1, len(self.obstacles)):
                 for a, b in bitangents(self._disc(disc), self._disc(other)):
@@ -175,11 +196,12 @@ class WayPlanner:
                                   f"({c.x:.2f}, {c.y:.2f})")  # fmt: skip
         if np.any(gaps < self.radii) and not self.shrunk_for_target:
             return WayPlanner(self.origin, self.obstacles, self.clearance, self.slack,
-                              self.max_turn, target).to(target)  # fmt: skip
+                              self.max_turn, target, self.deadline).to(target)  # fmt: skip
         best: tuple[float, list[tuple[int, float | None]]] = (math.inf, [])
         if clear(self.start, target, self.centres, self.radii):
             best = (float(np.hypot(*(target - self.start))), [(0, None)])
         for disc in range(len(self.obstacles)):
+            self._check_budget()
             for angle in self._tangent_angles(target, disc):
                 point = self._point(disc, angle)
                 if self._inside_another(point, disc) or not clear(point, target, self.centres,
@@ -194,6 +216,10 @@ class WayPlanner:
             return self._none(target, f"no way round the obstacles from ({self.start[0]:.2f}, "
                               f"{self.start[1]:.2f}) to ({target[0]:.2f}, {target[1]:.2f})")
         return self._way(target, *best)
+
+    def _check_budget(self) -> None:
+        if time.thread_time() > self.deadline:
+            raise OutOfBudget(f"the way round {len(self.obstacles)} obstacles took it all")
 
     def _none(self, target: Array, reason: str) -> Way:
         return Way(self.origin, target, (), math.inf, reason, ())
@@ -244,8 +270,10 @@ class WayPlanner:
         if self._inside_another(point, disc):
             return None
         self.nodes.append(_Node(point, disc, angle % TAU))
-        self.edges[len(self.nodes) - 1] = []
-        return len(self.nodes) - 1
+        node = len(self.nodes) - 1
+        self.edges[node] = []
+        self._of_disc.setdefault(disc, []).append(node)
+        return node
 
     def _tangents(self, end: int, disc: int) -> None:
         for angle in self._tangent_angles(self.nodes[end].point, disc):
@@ -267,8 +295,8 @@ class WayPlanner:
     def _link_arcs(self, disc: int) -> list[int]:
         """Join each node of ``disc`` to its counter-clockwise neighbour by the arc between
         them, where no other disc covers it; the nodes of ``disc`` by angle."""
-        on = sorted((n for n, node in enumerate(self.nodes) if node.disc == disc),
-                    key=lambda n: self.nodes[n].angle)  # fmt: skip
+        self._check_budget()
+        on = sorted(self._of_disc.get(disc, []), key=lambda n: self.nodes[n].angle)
         for a, b in zip(on, on[1:] + on[:1], strict=True):
             sweep = (self.nodes[b].angle - self.nodes[a].angle) % TAU
             if a == b or self._blocked(disc, self.nodes[a].angle, sweep):
@@ -301,10 +329,14 @@ class WayPlanner:
         previous: list[tuple[int, float | None]] = [(-1, None)] * len(self.nodes)
         distance[0] = 0.0
         queue = [(0.0, 0)]
+        settled = 0
         while queue:
             d, n = heapq.heappop(queue)
             if d > distance[n]:
                 continue
+            settled += 1
+            if settled % SEARCH_CHECK == 0:
+                self._check_budget()
             for m, length, sweep in self.edges[n]:
                 if d + length < distance[m]:
                     distance[m], previous[m] = d + length, (n, sweep)

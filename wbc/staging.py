@@ -37,7 +37,7 @@ from scipy.optimize import least_squares
 from wbc import dq
 from wbc.conditioning import smallest_singular_value
 from wbc.disc_geometry import segment_clear
-from wbc.drive_planner import Way, WayPlanner
+from wbc.drive_planner import OutOfBudget, Way, WayPlanner
 from wbc.lp_law import LPParams
 from wbc.objectives.base_target import gripper_heading
 from wbc.obstacles import Circle
@@ -97,10 +97,10 @@ class StagingParams:
     """A goal farther than this from the base is refused, m: the search's residual loses its
     precision far from the origin (a goal 100 m away took 2.1 s to fail)."""
     budget_s: float = 2.0
-    """CPU seconds of the planning thread a search may take (its own work, whatever else
-    the machine does): no new start is tried past it. Plans take 0.07 s median, 0.28 s p99
-    on the goals 'anywhere', 0.21 and 0.77 s with an obstacle near the way (`parsimony
-    bench`)."""
+    """CPU seconds of the planning thread a whole plan may take (its own work, whatever else
+    the machine does): building the way's graph (``WayPlanner``'s deadline) and the search
+    both stop at it. Plans take 0.07 s median, 0.28 s p99 on the goals 'anywhere', 0.21 and
+    0.77 s with an obstacle near the way (`parsimony bench`)."""
     seed: int = 0
 
 
@@ -212,10 +212,15 @@ def plan(robot: MobileManipulator, q_now: Array, goal_pose: Array,
     if refused:
         return done((), refused)
     budget_end = time.thread_time() + params.budget_s
+    spent = (f"no whole-body configuration found within the planning budget of "
+             f"{params.budget_s:g} s of CPU time")  # fmt: skip
     left_out = _LeftOut()
-    ways = WayPlanner(q_now[:2], obstacles, robot.base.body_radius + params.clearance,
-                      params.slack)  # fmt: skip
     found: list[Candidate] = []
+    try:
+        ways = WayPlanner(q_now[:2], obstacles, robot.base.body_radius + params.clearance,
+                          params.slack, deadline=budget_end)  # fmt: skip
+    except OutOfBudget as error:
+        return done((), f"{spent} ({error})")
     for margin in params.joint_margins:
         more, finished = _search(robot, q_now, goal_pose, ways, params, margin, budget_end,
                                  left_out)  # fmt: skip
@@ -223,8 +228,7 @@ def plan(robot: MobileManipulator, q_now: Array, goal_pose: Array,
         if any(c.roomy for c in found):
             return done(found)
         if not finished:
-            return done(found, "" if found else "no whole-body configuration found within "
-                        f"the planning budget of {params.budget_s:g} s of CPU time")  # fmt: skip
+            return done(found, "" if found else spent)
     if found:
         return done(found)
     if left_out.near or left_out.no_way:
@@ -309,7 +313,10 @@ def _search(robot: MobileManipulator, q_now: Array, goal_pose: Array, ways: WayP
         if _near(q_now, q, params.final_legs[0]) and segment_clear(q_now, q, obstacles, body):
             found.append(_scored(robot, q_now, q, None, final_leg, obstacles, params))
             continue
-        way = ways.to(staging_point(q[:BASE_DOF], final_leg))
+        try:
+            way = ways.to(staging_point(q[:BASE_DOF], final_leg))
+        except OutOfBudget:
+            return found, False
         if not way.found:
             left_out.no_way += 1
             left_out.way_reason = way.reason
