@@ -133,6 +133,24 @@ class Scene(_Strict):
             seen[marker_id] = field
         return self
 
+    @model_validator(mode="after")
+    def _cylinders_are_solids(self) -> Scene:
+        """Each cylinder a solid of ``wbc.obstacles3d``, its sizes within the scene's extent
+        (``EXTENT_M``), as each plane's message checks itself; the error names the field."""
+        for index, cylinder in enumerate(self.arm_obstacles.cylinders):
+            try:
+                cylinder.solid()
+            except ValueError as error:
+                raise ValueError(f"arm_obstacles.cylinders[{index}].{error}") from None
+        return self
+
+    def solid_labels(self) -> tuple[str, ...]:
+        """Each solid of ``arm_obstacles.solids()`` (planes first) by its name and field."""
+        planes = self.arm_obstacles.planes
+        return (*(f"{p.name!r} (scene.arm_obstacles.planes[{i}])" for i, p in enumerate(planes)),
+                *(f"{c.name!r} (scene.arm_obstacles.cylinders[{i}])"
+                  for i, c in enumerate(self.arm_obstacles.cylinders)))  # fmt: skip
+
     @property
     def dictionary_id(self) -> int:
         """The OpenCV predefined dictionary id."""

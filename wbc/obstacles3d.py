@@ -38,14 +38,26 @@ Array = np.ndarray
 
 UNIT_TOLERANCE = 1e-6
 """How far a plane's normal may stray from unit length."""
+EXTENT_M = 100.0
+"""No number of a solid (a coordinate, an offset, a radius, a height) exceeds this, m: a scene
+is a few metres across, and a cylinder of radius 1e300 is a mistake whose rows overflow."""
 FACE, EDGE, CORNER, SIDE, RIM = range(5)
 """The kinds of feature ``nearest`` names: a face, an edge, a corner; a cylinder's side (its
 axis and radius) and rim (the circle round its top)."""
 
 
-def _finite(field: str, *values: float) -> None:
-    if not all(math.isfinite(v) for v in values):
-        raise ValueError(f"{field}: expected finite numbers, got {list(values)}")
+def _within(field: str, *values: float) -> None:
+    """``ValueError`` naming ``field`` unless every value is finite and within the scene's
+    extent (``EXTENT_M``)."""
+    if not all(math.isfinite(v) and abs(v) <= EXTENT_M for v in values):
+        raise ValueError(f"{field}: expected finite numbers within +-{EXTENT_M:g} m, got "
+                         f"{list(values)}")  # fmt: skip
+
+
+def _size(field: str, value: float) -> None:
+    """``ValueError`` naming ``field`` unless 0 < ``value`` <= ``EXTENT_M``."""
+    if not (math.isfinite(value) and 0.0 < value <= EXTENT_M):
+        raise ValueError(f"{field}: expected a number > 0 and <= {EXTENT_M:g} m, got {value}")
 
 
 @dataclass(frozen=True)
@@ -69,8 +81,8 @@ class Plane:
     name: str = "plane"
 
     def __post_init__(self) -> None:
-        _finite("normal", *self.normal)
-        _finite("offset", self.offset)
+        _within("normal", *self.normal)
+        _within("offset", self.offset)
         norm = math.sqrt(sum(v * v for v in self.normal))
         if abs(norm - 1.0) > UNIT_TOLERANCE:
             raise ValueError(f"normal: expected a unit vector, got {list(self.normal)} "
@@ -208,11 +220,10 @@ class Cylinder:
     name: str = "cylinder"
 
     def __post_init__(self) -> None:
-        _finite("x, y", self.x, self.y)
-        if not (math.isfinite(self.radius) and self.radius > 0.0):
-            raise ValueError(f"radius: expected a finite number > 0, got {self.radius}")
-        if self.height is not None and not (math.isfinite(self.height) and self.height > 0.0):
-            raise ValueError(f"height: expected a finite number > 0 or none, got {self.height}")
+        _within("x, y", self.x, self.y)
+        _size("radius", self.radius)
+        if self.height is not None:
+            _size("height", self.height)
 
     @property
     def axis(self) -> Array:
@@ -268,7 +279,7 @@ def _convex_ccw(footprint: tuple[tuple[float, float], ...]) -> tuple[tuple[float
     vertices = np.array(footprint, dtype=float)
     if vertices.ndim != 2 or vertices.shape[0] < 3 or vertices.shape[1] != 2:
         raise ValueError(f"footprint: expected at least 3 (x, y) vertices, got {footprint!r}")
-    _finite("footprint", *vertices.ravel())
+    _within("footprint", *vertices.ravel())
     edges = np.roll(vertices, -1, axis=0) - vertices
     turns = edges[:, 0] * np.roll(edges, -1, axis=0)[:, 1] - edges[:, 1] * np.roll(edges, -1,
                                                                                    axis=0)[:, 0]

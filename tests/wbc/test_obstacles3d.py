@@ -14,7 +14,7 @@ from wbc.distance_jacobians import (
     point_to_plane_distance,
     point_to_point_squared_distance,
 )
-from wbc.obstacles3d import CORNER, EDGE, FACE, RIM, SIDE, Cylinder, Plane
+from wbc.obstacles3d import CORNER, EDGE, EXTENT_M, FACE, RIM, SIDE, Cylinder, Plane
 from wbc.plucker import foot
 
 TABLE = Plane((0.0, 0.0, 1.0), 0.4, ((0.5, -0.4), (1.1, -0.4), (1.1, 0.4), (0.5, 0.4)), "table")
@@ -134,10 +134,24 @@ def test_a_shelf_underside_holds_the_solid_above() -> None:
     (lambda: Cylinder(0.0, 0.0, 0.0), "radius"),
     (lambda: Cylinder(0.0, 0.0, 0.1, -1.0), "height"),
     (lambda: Cylinder(math.nan, 0.0, 0.1), "x, y"),
+    (lambda: Cylinder(0.0, 0.0, 1e300), "radius"),
+    (lambda: Cylinder(0.0, 0.0, 0.1, 1e300), "height"),
+    (lambda: Cylinder(-1e300, 0.0, 0.1), "x, y"),
+    (lambda: Plane((0.0, 0.0, 1.0), -1e300), "offset"),
+    (lambda: Plane((0.0, 0.0, 1.0), 0.3, ((0, 0), (1e300, 0), (0, 1))), "footprint"),
 ])  # fmt: skip
 def test_bad_obstacles_are_refused_naming_the_field(make, field: str) -> None:
     with pytest.raises(ValueError, match=f"^{re.escape(field)}:"):
         make()
+
+
+def test_a_solid_larger_than_a_scene_is_refused_with_the_bound() -> None:
+    """A scene is a few metres: a number beyond EXTENT_M (100 m) is a mistake, said so."""
+    with pytest.raises(ValueError, match=r"^radius: expected a number > 0 and <= 100 m, got "
+                                         r"1e\+300$"):  # fmt: skip
+        Cylinder(0.0, 0.0, 1e300)
+    assert Cylinder(0.0, 0.0, EXTENT_M, EXTENT_M).radius == EXTENT_M
+    assert Plane((0.0, 0.0, 1.0), -EXTENT_M).offset == -EXTENT_M
 
 
 
