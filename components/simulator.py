@@ -13,6 +13,8 @@ camera publish on the real robot, every ``step_s`` of simulated time::
                        into the scene's solids in 3-D (tests and reports only)
 
 It stops the robot when no command has arrived for ``command_timeout_s`` of simulated time.
+A ``start`` with a part of the robot inside one of the scene's solids is warned of, one line
+per solid naming it and saying what the robot will do (``wbc.start_inside``).
 
 Time: ``real_time_factor`` 1 runs as fast as the wall clock, 2 twice as fast, 0 as fast as it
 can. With ``lockstep`` each step waits until the loop has answered it, acknowledged by stamps:
@@ -58,6 +60,7 @@ from sim2d.world import World, WorldSettings, wheel_distance_per_count
 from wbc.base_motion import dead_reckoning
 from wbc.obstacles import Circle
 from wbc.robot import MobileManipulator
+from wbc.start_inside import inside_at_start
 
 JOINT_NAMES = tuple(f"q{i}" for i in range(1, ARM_JOINTS + 1))
 LOCKSTEP_CHECK_S = 0.05
@@ -159,6 +162,9 @@ class Simulator(Component):
             wheel_slip=p["wheel_slip"],
         )
         start = np.array(p["start"])
+        for index, line in enumerate(inside_at_start(self.robot, start, solids,
+                                                     self.scene.solid_labels())):  # fmt: skip
+            node.warn(f"starts_inside.{index}", line)
         self.world = World(self.robot, start, self.obstacles, settings, seed=p["seed"],
                            solids=solids)  # fmt: skip
         self.step_ns = round(p["step_s"] * 1e9)
