@@ -221,6 +221,10 @@ class ComponentSpec(StrictModel):
     remap: dict[str, str] = {}
     """Topic name -> topic name: the component reads or writes the second where its code says
     the first (as ROS 2 remaps a node's topics). Both must carry the same message type."""
+    after: list[Identifier] = []
+    """Components of this role or an earlier one that the launcher waits to see alive before
+    it starts this one (a driver after the emulator that makes its device); they stop after
+    it."""
 
     @model_validator(mode="after")
     def _remaps_keep_the_message_type(self) -> ComponentSpec:
@@ -287,6 +291,35 @@ class Profile(StrictModel):
                 )
             seen[spec.name] = index
         return self
+
+    @model_validator(mode="after")
+    def _starts_after_enabled_components(self) -> Profile:
+        specs = {spec.name: spec for spec in self.components}
+        for index, spec in enumerate(self.components):
+            for name in spec.after if spec.enabled else ():
+                other = specs.get(name)
+                if other is None:
+                    why = f"names no component (have {', '.join(specs)})"
+                elif other is spec or not other.enabled:
+                    why = "is itself" if other is spec else "is not enabled"
+                elif ROLES.index(other.role) > ROLES.index(spec.role):
+                    why = f"is a {other.role}, whose role starts after a {spec.role}'s"
+                else:
+                    continue
+                raise ValueError(f"components[{index}].after: {name!r} {why}")
+        for spec in self.components:
+            if spec.enabled:
+                self.start_depth(spec)  # a circle raises
+        return self
+
+    def start_depth(self, spec: ComponentSpec, chain: tuple[str, ...] = ()) -> int:
+        """0 for a component that waits for none, else 1 + the deepest it waits for;
+        ``ValueError`` for components that wait for each other in a circle."""
+        if spec.name in chain:
+            circle = " -> ".join((*chain, spec.name))
+            raise ValueError(f"components: they wait for each other in a circle ({circle})")
+        return max((1 + self.start_depth(self.component(name), (*chain, spec.name))
+                    for name in spec.after), default=0)  # fmt: skip
 
     def component(self, name: str) -> ComponentSpec:
         """The component called ``name``; ``KeyError`` if the profile has none."""

@@ -81,6 +81,17 @@ def test_a_minimal_profile_gets_safe_defaults(tmp_path: Path) -> None:
         ({"clock": "sundial"}, "clock", "'wall' or 'sim'"),
         ({"robot": "missing.yaml"}, "robot", "no robot description"),
         ({"zenoh": {"mode": "router"}}, "zenoh.mode", "'client' or 'peer'"),
+        ({"components": [{**PUB, "after": ["nobody"]}]}, "components[0].after",
+         "'nobody' names no component (have pub)"),
+        ({"components": [{**PUB, "after": ["pub"]}]}, "components[0].after", "'pub' is itself"),
+        ({"components": [PUB, {**PUB, "name": "b", "after": ["pub"], "enabled": False},
+                         {**PUB, "name": "c", "after": ["b"]}]},
+         "components[2].after", "'b' is not enabled"),
+        ({"components": [PUB, {**PUB, "name": "drv", "role": "driver", "after": ["pub"]}]},
+         "components[1].after", "'pub' is a tool, whose role starts after a driver's"),
+        ({"components": [{**PUB, "after": ["b"]}, {**PUB, "name": "b", "after": ["c"]},
+                         {**PUB, "name": "c", "after": ["pub"]}]},
+         "components", "wait for each other in a circle (pub -> b -> c -> pub)"),
     ],
 )
 def test_invalid_profiles_name_the_field(
@@ -246,6 +257,16 @@ def test_start_order_is_by_role_and_skips_disabled_components(tmp_path: Path) ->
     ]
     profile = load_profile(write(tmp_path, {"namespace": "sim", "components": components}))
     assert [spec.name for spec in profile.start_order()] == ["drv", "est", "ctrl", "tool"]
+
+
+def test_a_component_may_wait_for_others_of_its_role_or_an_earlier_one(tmp_path: Path) -> None:
+    components = [
+        {**PUB, "name": "emu", "role": "driver"},
+        {**PUB, "name": "drv", "role": "driver", "after": ["emu"]},
+        {**PUB, "name": "est", "role": "estimator", "after": ["drv", "emu"]},
+    ]
+    profile = load_profile(write(tmp_path, {"namespace": "sim", "components": components}))
+    assert [profile.start_depth(spec) for spec in profile.components] == [0, 1, 2]
 
 
 def test_a_profile_extends_another_and_says_only_what_differs(tmp_path: Path) -> None:
