@@ -1,9 +1,10 @@
 """The launcher: one Zenoh router and one supervised process per component of a profile.
 
 It opens the router the components connect to, starts the enabled components
-(drivers, estimators, controllers, tools), prefixes every line they print with
-``[name]``, restarts the ones that exit according to their restart policy,
-reports liveliness changes, and on SIGINT, SIGTERM or the end of the duration
+(drivers, estimators, controllers, tools; one that waits for others, ``after``, once they are
+alive), prefixes every line they print with the time and ``[name]``, restarts the ones that
+exit according to their restart policy, reports liveliness changes and each change of a
+component's ``state`` (its status), and on SIGINT, SIGTERM or the end of the duration
 stops them in the reverse order: SIGTERM, then SIGKILL after each one's ``stop_timeout_s``
 (for a recorder, which stops last, ``stop_timeout_s`` without progress: it drains its backlog
 however long that takes, and is killed only when it has spent no CPU time for that long).
@@ -30,6 +31,8 @@ import tempfile
 import threading
 import time
 from dataclasses import dataclass
+from datetime import datetime
+from itertools import groupby
 from pathlib import Path
 from typing import IO
 
@@ -51,6 +54,10 @@ POLL_S = 0.05
 
 CLEAN_STOP_CODES = (0, -signal.SIGTERM)
 """Exit codes that count as a clean stop after SIGTERM."""
+QUIET_WAIT_S = 1.0
+"""A stopping component slower than this is said to be waited for."""
+UNREPORTED_STATES = ("starting", "stopping")
+"""States a component passes through that the launcher's own lines already say."""
 
 
 class Output:
@@ -62,9 +69,10 @@ class Output:
         self._lock = threading.Lock()
 
     def line(self, stream: IO[str], prefix: str, text: str) -> None:
-        """Write ``[prefix] text`` as one line and flush it."""
+        """Write ``HH:MM:SS.mmm [prefix] text`` as one line (the local time) and flush it."""
+        stamp = datetime.now().strftime("%H:%M:%S.%f")[:-3]
         with self._lock:
-            stream.write(f"[{prefix}] {text.rstrip()}\n")
+            stream.write(f"{stamp} [{prefix}] {text.rstrip()}\n")
             stream.flush()
 
     def say(self, text: str) -> None:
@@ -78,6 +86,8 @@ class Child:
 
     spec: ComponentSpec
     process: subprocess.Popen[str] | None = None
+    waiting: bool = True
+    """Not started yet: it waits for the components it starts ``after``."""
     started_at: float = 0.0
     restarts: int = 0
     restart_at: float | None = None
@@ -87,6 +97,10 @@ class Child:
     """Whether the current process's liveliness token is present."""
     answered_at: float = 0.0
     """When it last answered a status query, or came alive (the watchdog's reference)."""
+    state: str = "running"
+    """Its ``state`` as last reported (a component comes alive running)."""
+    stopping: bool = False
+    """Sent SIGTERM by the stop: its token going is no loss."""
 
 
 def cpu_seconds(pid: int) -> float:
@@ -119,6 +133,7 @@ class Launcher:
         self._seen_alive: set[str] = set()
         """Components whose liveliness token the router has seen at least once."""
         self._starting_until: float | None = None
+        self._duration_s: float | None = None
 
     def run(self, duration_s: float | None = None) -> int:
         """Run until a stop signal, the duration, or no component is left; return 0 or 1.
@@ -128,6 +143,7 @@ class Launcher:
         for stop_signal in (signal.SIGINT, signal.SIGTERM):
             signal.signal(stop_signal, self._on_signal)
         endpoints = ", ".join(self.profile.zenoh.router)
+        self._duration_s = duration_s
         self._kept_params = Path(tempfile.mkdtemp(prefix="parsimony-params-"))
         with zenoh.open(self.profile.zenoh.router_config(self.profile.namespace)) as router:
             self.output.say(f"router listening on {endpoints}, namespace {self.profile.namespace}")
@@ -137,9 +153,14 @@ class Launcher:
                 history=True,
             )
             try:
+                self._start_ready()
                 for child in self.children:
-                    self._start(child)
+                    if child.waiting:
+                        self.output.say(f"{child.spec.name} starts once "
+                                        f"{' and '.join(child.spec.after)} alive")  # fmt: skip
                 self._starting_until = time.monotonic() + self.profile.startup_timeout_s
+                self.output.say(f"waiting for {len(self.children)} component(s) to come alive "
+                                f"(at most {self.profile.startup_timeout_s:g} s)")  # fmt: skip
                 threading.Thread(target=self._watch, args=(router,), daemon=True).start()
                 self._supervise(None if duration_s is None else time.monotonic() + duration_s)
             finally:
@@ -166,11 +187,16 @@ class Launcher:
         for child in self.children:
             if child.spec.name == name:
                 child.alive, child.answered_at = alive, time.monotonic()
+                if alive:
+                    child.state = "running"
+                elif child.stopping:
+                    return  # no loss: the stop's own lines say what becomes of it
         self.output.say(f"{name} {'alive' if alive else 'lost'}")
 
     def _supervise(self, deadline: float | None) -> None:
         """Poll the children until a stop is asked, the deadline passes or none is left."""
         while self._stop_reason is None:
+            self._start_ready()
             now = time.monotonic()
             if deadline is not None and now >= deadline:
                 self._stop_reason = "end of duration"
@@ -205,9 +231,18 @@ class Launcher:
                 answered = {}
             now = time.monotonic()
             for child in self.children:
-                if child.spec.name in answered:
+                status = answered.get(child.spec.name)
+                if status is not None:
                     child.answered_at = now
+                    self._report_state(child, status.state)
             time.sleep(max(0.0, period - (now - started)))
+
+    def _report_state(self, child: Child, state: str) -> None:
+        """Say a change of a component's ``state`` (a driver holding, a clock stalled...)."""
+        if state == child.state or state in UNREPORTED_STATES or self._stop_reason is not None:
+            return
+        self.output.say(f"{child.spec.name} {state} (was {child.state})")
+        child.state = state
 
     def _kill_hung(self, now: float) -> None:
         """Kill a component seen alive that answered no status query for ``watchdog_s``; its
@@ -231,11 +266,17 @@ class Launcher:
             self._fail_startup(f"{', '.join(refused)} failed during start-up", refused)
         elif not waiting:
             self._starting_until = None
-            self.output.say(f"all {len(self.children)} components alive")
+            until = "Ctrl-C" if self._duration_s is None else \
+                f"the end of the {self._duration_s:g} s duration"  # fmt: skip
+            self.output.say(f"all {len(self.children)} components alive; running until {until}")
         elif now >= self._starting_until:
             timeout = self.profile.startup_timeout_s
+            unstarted = [f"{c.spec.name} waited for {', '.join(c.spec.after)}"
+                         for c in self.children if c.waiting]  # fmt: skip
+            more = f"; never started: {'; '.join(unstarted)}" if unstarted else ""
             self._fail_startup(f"{', '.join(waiting)} not alive after {timeout:.1f} s "
-                               "(check its zenoh endpoints and its log)", waiting)  # fmt: skip
+                               f"(check its zenoh endpoints and its log){more}",
+                               waiting)  # fmt: skip
 
     def _fail_startup(self, why: str, names: list[str]) -> None:
         self._starting_until = None
@@ -244,9 +285,17 @@ class Launcher:
                 child.failed = True
         self._stop_reason = f"start-up failed: {why}"
 
+    def _start_ready(self) -> None:
+        """Start the children not started yet whose ``after`` components have all been
+        alive."""
+        for child in self.children:
+            if child.waiting and self._seen_alive.issuperset(child.spec.after):
+                self._start(child)
+
     def _start(self, child: Child) -> None:
         """Start a child's process and the threads that forward its output."""
         spec = child.spec
+        child.waiting = False
         command = process.command(spec.module_path, self.profile_path, spec.name)
         env = dict(os.environ, PYTHONUNBUFFERED="1", **{
             PARENT_PID_ENV: str(os.getpid()),
@@ -309,33 +358,31 @@ class Launcher:
         )
 
     def _stop_all(self) -> None:
-        """Stop the running children role by role, tools first and drivers last."""
+        """Stop the running children role by role, tools first and drivers last, and in a role
+        each before the components it started ``after``."""
         for child in self.children:
             if child.restart_at is not None:
                 child.failed = True
                 self.output.say(f"{child.spec.name} was waiting to restart; counted as failed")
-        for role in reversed(ROLES):
-            group = [c for c in self.children if c.spec.role == role and c.process is not None]
+
+        def order(child: Child) -> tuple[int, int]:
+            return ROLES.index(child.spec.role), self.profile.start_depth(child.spec)
+
+        running = sorted((c for c in self.children if c.process is not None), key=order,
+                         reverse=True)  # fmt: skip
+        for _, wave in groupby(running, key=order):
+            group = list(wave)
             for child in group:
+                child.stopping = True
                 child.process.send_signal(signal.SIGTERM)
             stopped_at = time.monotonic()
             for child in group:
                 self._reap(child, child.process, stopped_at + child.spec.stop_timeout_s)
 
     def _reap(self, child: Child, process: subprocess.Popen[str], deadline: float) -> None:
-        """Wait for a child sent SIGTERM until ``deadline``, then kill it; a recorder's
-        deadline moves on while it spends CPU time."""
-        try:
-            while True:
-                spent = cpu_seconds(process.pid)
-                try:
-                    code = process.wait(max(0.0, deadline - time.monotonic()))
-                    break
-                except subprocess.TimeoutExpired:
-                    if child.spec.role != "recorder" or cpu_seconds(process.pid) <= spent:
-                        raise
-                    deadline = time.monotonic() + child.spec.stop_timeout_s
-        except subprocess.TimeoutExpired:
+        """Wait for a child sent SIGTERM until ``deadline``, then kill it."""
+        code = self._wait_stopped(child, process, deadline)
+        if code is None:
             process.kill()
             process.wait()
             self.output.say(f"{child.spec.name} did not stop in {child.spec.stop_timeout_s:g} s; "
@@ -345,3 +392,26 @@ class Launcher:
             child.failed = child.failed or code not in CLEAN_STOP_CODES
             self.output.say(f"{child.spec.name} stopped ({code})")
         child.process = None
+
+    def _wait_stopped(self, child: Child, process: subprocess.Popen[str], deadline: float
+                      ) -> int | None:  # fmt: skip
+        """Its exit code, or None once ``deadline`` passed; a recorder's deadline moves on
+        while it spends CPU time. A wait longer than ``QUIET_WAIT_S`` is said."""
+        spent, said = cpu_seconds(process.pid), False
+        while True:
+            left = max(0.0, deadline - time.monotonic())
+            try:
+                return process.wait(left if said else min(left, QUIET_WAIT_S))
+            except subprocess.TimeoutExpired:
+                pass
+            if not said:
+                said = True
+                if time.monotonic() < deadline:
+                    progress = " without progress" if child.spec.role == "recorder" else ""
+                    self.output.say(f"waiting for {child.spec.name} to stop (killed after "
+                                    f"{child.spec.stop_timeout_s:g} s{progress})")  # fmt: skip
+                    continue
+            now_spent = cpu_seconds(process.pid)
+            if child.spec.role != "recorder" or now_spent <= spent:
+                return None
+            spent, deadline = now_spent, time.monotonic() + child.spec.stop_timeout_s

@@ -17,7 +17,7 @@ import yaml
 
 from deploy import DEPLOY, query
 from messages import codec, topics
-from parsimony.experiment import connect, launched
+from parsimony.experiment import connect, launched, wait_alive
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from profiles.profile_files import read_profile_data
@@ -38,6 +38,8 @@ def test_emulated_differs_from_hardware_by_device_paths_and_camera_source_only()
     for driver in ("base_driver", "arm_driver"):
         params = (emulated[driver]["params"], hardware[driver]["params"])
         assert {k for k in params[0] if params[0][k] != params[1].get(k)} == {"port"}
+        # Started once the emulated robot, which makes their devices, is alive.
+        assert changed[driver] == {"params", "after"} and emulated[driver]["after"] == ["simulator"]
     camera = (emulated["vision_tracker"]["params"], hardware["vision_tracker"]["params"])
     assert {k for k in camera[0] if camera[0][k] != camera[1].get(k)} <= {"device", "calibration"}
     assert {name for name, keys in changed.items() if keys} == {
@@ -67,22 +69,48 @@ def test_the_pose_experiment_converges_through_the_emulated_devices(
     assert report["estimator_error"]["position_m"] < 0.02
 
 
-def test_a_killed_controller_leaves_the_robot_stopped_by_its_drivers(tmp_path: Path) -> None:
-    """The Create keeps its last Drive command for ever; the base driver's timeout stops it."""
+def emulated_profile(tmp_path: Path, namespace: str, *components: dict) -> Path:
+    """deploy/emulated.yaml on a free port, its devices in ``tmp_path``."""
     data = {
         "extends": str(DEPLOY / "emulated.yaml"),
-        "namespace": "killtest",
+        "namespace": namespace,
         "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
         "components": [
             {"name": "simulator", "params": {"create_link": str(tmp_path / "create2"),
                                              "servo_link": str(tmp_path / "servos")}},
             {"name": "base_driver", "params": {"port": str(tmp_path / "create2")}},
             {"name": "arm_driver", "params": {"port": str(tmp_path / "servos")}},
-            {"name": "controller", "restart": {"policy": "never"}},
+            *components,
         ],
     }  # fmt: skip
     path = tmp_path / "profile.yaml"
     path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def test_the_emulated_profile_starts_and_stops_without_a_word_of_failure(tmp_path: Path) -> None:
+    """Before, the base driver started before its emulated device existed and logged `cannot
+    open .../create2: No such file` at every start (and the arm driver its servos silent), and
+    a clean stop logged `controller lost` before `controller stopped (0)`."""
+    path = emulated_profile(tmp_path, "quiettest")
+    profile = load_profile(path)
+    log_path = tmp_path / "launch.log"
+    with log_path.open("w") as log, launched(path, log) as launcher:
+        with connect(profile, launcher) as session:
+            wait_alive(session, profile, launcher)
+    text = log_path.read_text()
+    assert launcher.returncode == 0, text
+    for noise in ("cannot open", "No such file", "silent answer", " lost"):
+        assert noise not in text, text
+    for name in ("simulator", "base_driver", "arm_driver", "controller"):
+        assert f"[launch] {name} stopped (0)" in text
+    assert text.index("[launch] simulator alive") < text.index("[launch] started base_driver")
+
+
+def test_a_killed_controller_leaves_the_robot_stopped_by_its_drivers(tmp_path: Path) -> None:
+    """The Create keeps its last Drive command for ever; the base driver's timeout stops it."""
+    path = emulated_profile(tmp_path, "killtest", {"name": "controller",
+                                                   "restart": {"policy": "never"}})
     profile = load_profile(path)
     truth: list = []
     with launched(path) as launcher:

@@ -64,10 +64,11 @@ def run(args: argparse.Namespace) -> int:
     except (ProfileError, LookupError) as error:
         print(error, file=sys.stderr)
         return EXIT_INVALID_PROFILE
+    launcher = Launcher(profile, args.profile)
     for warning in graph.warnings():
-        print(f"[launch] {warning}", file=sys.stderr)
+        launcher.output.say(warning)
     try:
-        return Launcher(profile, args.profile).run(args.duration)
+        return launcher.run(args.duration)
     except zenoh.ZError as error:
         print(f"{args.profile}: cannot open the router: {zenoh_error_text(error)}",
               file=sys.stderr)  # fmt: skip

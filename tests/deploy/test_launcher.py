@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import signal
 import time
 from pathlib import Path
@@ -77,6 +78,51 @@ def test_sigint_stops_in_reverse_role_order(
     stops = [text.index(f"[launch] {name} stopped (0)") for name in ("arm", "lp", "est", "base")]
     assert starts == sorted(starts) and stops == sorted(stops)
     assert "INFO arm stopping on SIGTERM" in text
+    assert " lost" not in text  # a clean stop says "stopped", not "lost" (it did both)
+
+
+def test_every_line_of_the_launch_says_when_and_what_it_waits_for(
+    write_profile: ProfileWriter, launch: LaunchFixture
+) -> None:
+    """The launcher's lines and its components' alike; it says what it waits for."""
+    controller = {"name": "ctl", "module": "lp_controller", "role": "controller"}
+    launched = launch(write_profile([publisher("pub"), controller], robot=str(ROBOT_FILE)))
+    launched.wait_for(r"\[launch\] waiting for 2 component\(s\) to come alive \(at most 10 s\)")
+    launched.wait_for(r"\[launch\] all 2 components alive; running until Ctrl-C")
+    assert launched.stop() == 0
+    lines = launched.text().splitlines()
+    stamped = re.compile(r"^\d\d:\d\d:\d\d\.\d{3} \[(launch|pub|ctl)\] ")
+    assert [line for line in lines if not stamped.match(line)] == []
+    assert any(" [pub] INFO pub running" in line for line in lines)
+
+
+def test_a_component_starts_once_those_it_waits_for_are_alive_and_stops_before_them(
+    write_profile: ProfileWriter, launch: LaunchFixture
+) -> None:
+    """An emulated device's driver waits for the emulator (before, a driver opened a device
+    that did not exist yet and said so at every start)."""
+    profile = write_profile([publisher("drv", role="driver", after=["emu"]),
+                             publisher("emu", role="driver")])  # fmt: skip
+    launched = launch(profile)
+    waits, _, _ = launched.wait_for(r"\[launch\] drv starts once emu alive")
+    alive, _, _ = launched.wait_for(r"\[launch\] emu alive")
+    started, _, _ = launched.wait_for(r"\[launch\] started drv ")
+    assert waits < alive < started
+    launched.wait_for(r"\[launch\] all 2 components alive", after=started)
+    assert launched.stop() == 0
+    text = launched.text()
+    assert text.index("[launch] drv stopped (0)") < text.index("INFO emu stopping on SIGTERM")
+
+
+def test_a_change_of_a_components_state_is_said(
+    write_profile: ProfileWriter, launch: LaunchFixture
+) -> None:
+    """On simulated time with no simulator, its clock stalls: the launcher says so."""
+    profile = write_profile([publisher("pub")], clock="sim", clock_timeout_s=0.2, watchdog_s=1.0)
+    launched = launch(profile)
+    alive, _, _ = launched.wait_for(r"\[launch\] pub alive")
+    launched.wait_for(r"\[launch\] pub clock stalled \(was running\)", after=alive)
+    assert launched.stop() == 0
 
 
 def test_duration_ends_the_launch_cleanly(
@@ -96,8 +142,8 @@ def test_the_launcher_warns_of_a_topic_read_and_never_written(
     controller = {"name": "ctl", "module": "lp_controller", "role": "controller"}
     profile = write_profile([controller], robot=str(ROBOT_FILE))
     launched = launch(profile, "--duration", "1.0")
-    launched.wait_for(r"\[launch\] warning: test/robot/state is read by ctl and written by "
-                      r"no component")  # fmt: skip
+    launched.wait_for(r"^\d\d:\d\d:\d\d\.\d{3} \[launch\] warning: test/robot/state is read "
+                      r"by ctl and written by no component")  # fmt: skip
     assert launched.process.wait(10.0) == 0
     assert "test/base/command is read" not in launched.text()
 
