@@ -1,6 +1,7 @@
-"""What a tool asks a running system: who is alive, their status, their parameters.
+"""What a tool asks a running system: who is alive, their status, their parameters, who
+writes a topic.
 
-Used by ``parsimony status`` and ``parsimony param``. A ``Target`` says which
+Used by ``parsimony status``, ``param``, ``topic`` and ``goal``. A ``Target`` says which
 namespace to look at and how to reach its router; each question is a Zenoh
 query with a timeout on a client session.
 """
@@ -13,11 +14,12 @@ from pathlib import Path
 
 import zenoh
 
+from deploy.graph import dataflow
 from deploy.zenoh_error import zenoh_error_text
 from messages import codec, topics
 from messages.process import ParamValue, decode_value
 from messages.status import ComponentStatus
-from profiles.profile import ZenohSettings, load_profile
+from profiles.profile import Profile, ZenohSettings, load_profile
 
 DEFAULT_ROUTER = "tcp/127.0.0.1:7447"
 """Where tools look for the router when given a namespace and no endpoint."""
@@ -75,6 +77,28 @@ def live_components(
         if reply.ok is not None
     }
     return sorted(names)
+
+
+def live_writers(
+    session: zenoh.Session, profile: Profile, topic: str, timeout_s: float = DEFAULT_TIMEOUT_S
+) -> list[str]:
+    """The components of ``profile`` that declare they write ``topic`` (``deploy.graph``, its
+    remaps too) and whose liveliness token is present: what a tool publishes there, they
+    overwrite with their next message."""
+    writers = dataflow(profile).writers(topic)
+    if not writers:
+        return []
+    alive = set(live_components(session, profile.namespace, timeout_s))
+    return [name for name in writers if name in alive]
+
+
+def overwritten_by(writers: list[str], key: str) -> str:
+    """What a message a tool publishes on ``key`` meets when ``writers`` (running components,
+    ``live_writers``) write it too, in words: their next message replaces it."""
+    one = len(writers) == 1
+    return (f"{', '.join(writers)} {'writes' if one else 'write'} {key} in this profile and "
+            f"{'is' if one else 'are'} running: {'its' if one else 'their'} next message "
+            "replaces what is published here")  # fmt: skip
 
 
 def statuses(

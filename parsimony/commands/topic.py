@@ -15,12 +15,17 @@ import zenoh
 from pydantic import BaseModel, ValidationError
 
 from deploy.graph import dataflow
-from deploy.query import QueryError
+from deploy.query import QueryError, live_writers, overwritten_by
+from deploy.tool_clock import ToolClock
 from messages import codec, topics
-from messages.header import Header
 from parsimony.output import emit, json_text
 from parsimony.target_options import fail, profile_and_target, target_options
-from profiles.profile import ProfileError
+from profiles.profile import Profile, ProfileError
+
+SOURCE = "parsimony"
+"""The source named in the header of a message the command makes."""
+NOTE_AFTER_S = 1.0
+"""`echo` says what it waits for once this long has passed with no message."""
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -30,15 +35,21 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     actions = parser.add_subparsers(dest="action", required=True)
     actions.add_parser("list", parents=[common], help="every topic: key, type, who uses it")
     info = actions.add_parser("info", parents=[common], help="a topic's key, schema and users")
-    echo = actions.add_parser("echo", parents=[common], help="print each message, decoded")
+    # Its own copy of the common options: "resolve" takes --timeout out of the copy's action.
+    echo = actions.add_parser("echo", parents=[target_options()], conflict_handler="resolve",
+                              help="print each message, decoded")  # fmt: skip
     echo.add_argument("--count", type=int, help="stop after this many messages")
+    echo.add_argument("--timeout", type=float, metavar="S",
+                      help="stop with exit 1 and 'no message in S s on TOPIC' when S seconds "
+                           "pass with no message (default: wait until --count or Ctrl-C)")
     hz = actions.add_parser("hz", parents=[common], help="measure a topic's rate")
     hz.add_argument("--window", type=float, default=2.0, metavar="S", help="seconds to listen")
     pub = actions.add_parser("pub", parents=[common], help="publish a message given as JSON")
     for action in (info, echo, hz, pub):
         action.add_argument("topic", choices=list(topics.TOPICS), metavar="TOPIC",
                             help="a topic of the table: " + ", ".join(topics.TOPICS))  # fmt: skip
-    pub.add_argument("message", help="the message's fields as JSON; a missing header is made")
+    pub.add_argument("message", help="the message's fields as JSON; a missing header is made, "
+                     "stamped on the profile's clock (the simulator's on a sim-clock profile)")
     pub.add_argument("--count", type=int, default=1, help="how many times (default 1)")
     pub.add_argument("--rate", type=float, default=10.0, metavar="HZ")
     return parser
@@ -96,22 +107,23 @@ def run(args: argparse.Namespace) -> int:
                                f"{', '.join(r['readers']) or '-'}" for r in rows))  # fmt: skip
             return 0
         with target.open() as session:
-            return {"echo": echo, "hz": hz, "pub": pub}[args.action](args, session, target)
+            return {"echo": echo, "hz": hz, "pub": pub}[args.action](args, session, profile)
     except (ProfileError, QueryError, LookupError, ValueError) as error:
         return fail(error)
 
 
-def echo(args: argparse.Namespace, session: zenoh.Session, target: Any) -> int:
-    """Print each message as one line of JSON until --count of them, or Ctrl-C."""
+def echo(args: argparse.Namespace, session: zenoh.Session, profile: Profile) -> int:
+    """Print each message as one line of JSON until --count of them, Ctrl-C, or --timeout
+    seconds with no message (exit 1)."""
     topic = topics.TOPICS[args.topic]
-    key = topic.key(target.namespace)
+    key = topic.key(profile.namespace)
     done = threading.Event()
+    changed = threading.Condition()
     printed = 0
-    lock = threading.Lock()
 
     def on_message(message: Any, _at: float) -> None:
         nonlocal printed
-        with lock:
+        with changed:
             if done.is_set():
                 return
             if isinstance(message, codec.DecodeError):
@@ -121,21 +133,36 @@ def echo(args: argparse.Namespace, session: zenoh.Session, target: Any) -> int:
             printed += 1
             if args.count is not None and printed >= args.count:
                 done.set()
+            changed.notify_all()
 
-    with listen(session, key, topic, done, on_message):
+    with listen(session, key, topic, done, on_message), changed:
+        seen, since, noted = 0, time.monotonic(), False
         try:
-            done.wait()
+            while not done.is_set():
+                silent_s = time.monotonic() - since
+                if args.timeout is not None and silent_s >= args.timeout:
+                    done.set()
+                    print(f"no message in {args.timeout:g} s on {key}", file=sys.stderr)
+                    return 1
+                if not noted and printed == 0 and silent_s >= NOTE_AFTER_S:
+                    noted = True
+                    print(f"waiting for messages on {key} (Ctrl-C to stop)", file=sys.stderr)
+                limits = [args.timeout - silent_s] if args.timeout is not None else []
+                limits += [] if noted else [NOTE_AFTER_S - silent_s]
+                changed.wait(max(0.0, min(limits)) if limits else None)
+                if printed != seen:
+                    seen, since = printed, time.monotonic()
         except KeyboardInterrupt:
             done.set()
     return 0
 
 
-def hz(args: argparse.Namespace, session: zenoh.Session, target: Any) -> int:
+def hz(args: argparse.Namespace, session: zenoh.Session, profile: Profile) -> int:
     """Listen for --window seconds; print the rate and the periods' median, min, max."""
     topic = topics.TOPICS[args.topic]
     arrivals: list[float] = []
     done = threading.Event()
-    with listen(session, topic.key(target.namespace), topic, done,
+    with listen(session, topic.key(profile.namespace), topic, done,
                 lambda message, at: arrivals.append(at)):  # fmt: skip
         time.sleep(args.window)
         done.set()
@@ -154,31 +181,39 @@ def hz(args: argparse.Namespace, session: zenoh.Session, target: Any) -> int:
     return 0 if arrivals else 1
 
 
-def pub(args: argparse.Namespace, session: zenoh.Session, target: Any) -> int:
-    """Validate the JSON as the topic's message (a header is made if missing) and publish it."""
+def pub(args: argparse.Namespace, session: zenoh.Session, profile: Profile) -> int:
+    """Validate the JSON as the topic's message (a header is made if missing, stamped on the
+    profile's clock) and publish it; warn when a running component of the profile writes the
+    topic too (it overwrites what is published here)."""
     topic = topics.TOPICS[args.topic]
+    key = topic.key(profile.namespace)
     try:
         fields = json.loads(args.message)
     except json.JSONDecodeError as error:
         raise ValueError(f"message: not JSON ({error})") from None
-    publisher = session.declare_publisher(topic.key(target.namespace))
+    writers = live_writers(session, profile, args.topic, args.timeout)
+    if writers:
+        print(f"warning: {overwritten_by(writers, key)}", file=sys.stderr)
+    publisher = session.declare_publisher(key)
     deadline = time.monotonic() + max(args.timeout, 2.0)
     while not publisher.matching_status.matching and time.monotonic() < deadline:
         time.sleep(0.01)
-    for seq in range(args.count):
-        values = dict(fields)
-        if "header" in topic.type.model_fields and "header" not in values:
-            values["header"] = Header(stamp_ns=time.time_ns(), frame="world", seq=seq,
-                                      source="parsimony").model_dump()  # fmt: skip
-        try:
-            message = topic.type.model_validate(values)
-        except ValidationError as error:
-            raise ValueError(f"{args.topic}: {error.errors()[0]['loc']}: "
-                             f"{error.errors()[0]['msg']}") from None  # fmt: skip
-        publisher.put(codec.encode(message))
-        if seq + 1 < args.count:
-            time.sleep(1.0 / args.rate)
+    with ToolClock(session, profile) as clock:
+        for seq in range(args.count):
+            values = dict(fields)
+            if "header" in topic.type.model_fields and "header" not in values:
+                values["header"] = clock.header(seq, SOURCE, args.timeout).model_dump()
+            try:
+                message = topic.type.model_validate(values)
+            except ValidationError as error:
+                raise ValueError(f"{args.topic}: {error.errors()[0]['loc']}: "
+                                 f"{error.errors()[0]['msg']}") from None  # fmt: skip
+            publisher.put(codec.encode(message))
+            if seq + 1 < args.count:
+                time.sleep(1.0 / args.rate)
     emit(json_text({"topic": args.topic, "published": args.count,
-                     "subscribers": publisher.matching_status.matching}))  # fmt: skip
+                     "subscribers": publisher.matching_status.matching,
+                     "live_writers": writers}))  # fmt: skip
     publisher.undeclare()
     return 0
+

@@ -146,12 +146,42 @@ def test_topic_list_info_and_pub(running_pub: Path) -> None:
                      '"radius": 0.1}]}', "--profile", str(running_pub))  # fmt: skip
         assert result.returncode == 0, result.stderr
         assert json.loads(result.stdout)["published"] == 1
+        assert "warning" not in result.stderr  # no component of the profile writes it
         deadline = time.monotonic() + 10.0
         while not received:
             assert time.monotonic() < deadline, "the published message did not arrive"
             time.sleep(0.01)
     bad = cli("topic", "pub", "control/goal", '{"task": "pose"}', "--profile", str(running_pub))
     assert bad.returncode == 2 and "a pose task needs a pose" in bad.stderr
+
+
+def test_topic_echo_gives_up_at_its_timeout_on_a_silent_topic(running_pub: Path) -> None:
+    """Nothing writes world/obstacles here: echo says so and exits 1, instead of waiting on."""
+    result = cli("topic", "echo", "world/obstacles", "--timeout", "1",
+                 "--profile", str(running_pub))  # fmt: skip
+    assert result.returncode == 1, result.stderr
+    assert result.stdout == ""
+    assert "no message in 1 s on test/world/obstacles" in result.stderr
+    helped = cli("topic", "echo", "--help")
+    assert "--timeout S" in helped.stdout and "no message in S s" in helped.stdout
+
+
+def test_topic_echo_counts_its_timeout_from_the_last_message(running_pub: Path) -> None:
+    """A live topic within the timeout is echoed to its count and exits 0."""
+    result = cli("topic", "echo", "robot/state", "--count", "2", "--timeout", "30",
+                 "--profile", str(running_pub))  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert len(result.stdout.splitlines()) == 2
+
+
+def test_topic_pub_warns_when_a_running_component_writes_the_topic(running_pub: Path) -> None:
+    """pub writes control/goal in this profile: what the user publishes there is replaced by
+    its next goal, and the user is told so."""
+    result = cli("topic", "pub", "control/goal", '{"task": "position", "position": [0.5, 0, 0.4]}',
+                 "--profile", str(running_pub))  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert "warning: pub writes test/control/goal in this profile and is running" in result.stderr
+    assert json.loads(result.stdout)["live_writers"] == ["pub"]
 
 
 def test_param_list_describe_dump_and_load(running_pub: Path, tmp_path: Path) -> None:
