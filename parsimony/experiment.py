@@ -48,6 +48,7 @@ from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import Profile, ProfileError, load_profile
 from record.judge import (
+    CONVERGED_ERROR,
     HOLD_S,
     JUDGED,
     commands_csv,
@@ -215,6 +216,11 @@ class Follower:
             return {n: list(ms) for n, ms in self.session.items()}, list(self.truth_ns)
 
 
+def say(text: str) -> None:
+    """A line of progress on stderr."""
+    print(f"[experiment] {text}", file=sys.stderr, flush=True)
+
+
 def progress_line(session: dict[str, list], origin: float, wall_s: float) -> str:
     diagnostics = session[CONTROL_DIAGNOSTICS.name]
     if not diagnostics:
@@ -231,6 +237,7 @@ def run_experiment(options: Options) -> dict[str, Any]:
     if options.name in SUPERVISED and options.controller != "lp":
         raise ProfileError(f"the {options.name} experiment runs the LP under the staging "
                            "supervisor; the cascade cannot follow its drive tasks")  # fmt: skip
+    say(f"setting up the {options.name} experiment")
     base = options.profile or SUPERVISED.get(options.name) or PROFILES[options.controller]
     base_profile = load_profile(base)
     robot = MobileManipulator.from_yaml(base_profile.robot)
@@ -242,17 +249,25 @@ def run_experiment(options: Options) -> dict[str, Any]:
         partial.write_text(yaml.safe_dump(composed))
     profile = load_profile(profile_path)
     started = time.monotonic()
+    names = [spec.name for spec in profile.start_order()]
+    say(f"starting {len(names)} processes (their log: {options.out / 'launch.log'})")
     with (options.out / "launch.log").open("w") as log,\
             launched(profile_path, log, None) as launcher,\
             connect(profile, launcher) as session:  # fmt: skip
         follower = Follower(session, profile.namespace)
+        say(f"waiting for {', '.join(names)} to come alive")
         wait_alive(session, profile, launcher)
+        say("waiting for every component to receive the paused simulator's clock")
         wait_reached(session, profile, launcher)
         before = component_counters(session, profile.namespace)
         query.set_param(session, profile.namespace, "simulator", "paused", "false")
+        say(f"running until the error stays under {CONVERGED_ERROR} for {HOLD_S:g} s, at most "
+            f"{options.time_limit_s:g} s of simulated time")  # fmt: skip
         started = time.monotonic()
         (followed, truth_ns), wall_s = follow(follower, options, started)
         counters = component_counters(session, profile.namespace)
+        say("stopping the processes (the recorder writes all it holds)")
+    say("judging the recording")
     counters = {name: {**found, "run_cpu_ms": found["cpu_ms"] - before.get(name, found)["cpu_ms"]}
                 for name, found in counters.items()}  # fmt: skip
     ran_s = (truth_ns[-1] - truth_ns[0]) / 1e9 if truth_ns else 0.0  # simulated s, as followed
@@ -262,8 +277,7 @@ def run_experiment(options: Options) -> dict[str, Any]:
     facts = info(path)
     if not facts["complete"]:
         saved = make_whole(path)
-        print(f"[experiment] the recording had no footer: {saved} messages kept",
-              file=sys.stderr)  # fmt: skip
+        say(f"the recording had no footer: {saved} messages kept")
     recorded = load_session(path, JUDGED)
     start_ns = min((s.header.stamp_ns for s in recorded.get(ROBOT_STATE.name, [])),
                    default=end_ns)  # fmt: skip
@@ -284,6 +298,7 @@ def run_experiment(options: Options) -> dict[str, Any]:
     run, _ = the_run(recorded, options.time_limit_s)
     (options.out / "commands.csv").write_text(commands_csv(run))
     label = options.controller
+    say("drawing the figures")
     if report["recording"]["missing"]:
         label += " (RECORDING CUT SHORT: " + "; ".join(report["recording"]["missing"]) + ")"
     figures = write_report([(label, run)], robot, options.out,

@@ -32,12 +32,15 @@ from wbc.supervisor_phase import Phase
 ONE_DEGREE = math.radians(1.0)
 
 
-def experiment(out: Path, *arguments: str) -> tuple[int, dict]:
-    """Run `parsimony experiment ... --json`; its exit status and the report on its stdout."""
+def experiment(out: Path, *arguments: str, stderr: list[str] | None = None) -> tuple[int, dict]:
+    """Run `parsimony experiment ... --json`; its exit status and the report on its stdout
+    (its stderr's lines added to ``stderr``)."""
     command = [sys.executable, "-m", "parsimony.cli", "experiment", *arguments, "--json"]
     done = subprocess.run([*command, "--out", str(out)], capture_output=True, text=True,
                           timeout=300)  # fmt: skip
     assert done.stdout.strip(), done.stderr[-2000:]
+    if stderr is not None:
+        stderr += done.stderr.splitlines()
     report = json.loads(done.stdout)
     assert report == json.loads((out / "report.json").read_text())
     return done.returncode, report
@@ -55,9 +58,20 @@ def assert_sound(report: dict) -> None:
 
 
 def test_pose_experiment_with_the_lp_reaches_the_goal_seen_by_the_camera(tmp_path: Path) -> None:
-    code, report = experiment(tmp_path, "pose", "--controller", "lp", "--seed", "1")
+    said: list[str] = []
+    code, report = experiment(tmp_path, "pose", "--controller", "lp", "--seed", "1", stderr=said)
     assert code == 0
     assert_sound(report)
+    # Each wait says what it waits for (before, 15-20 s of starting and stopping said nothing).
+    steps = ["setting up the pose experiment", "starting 5 processes (their log: ",
+             "waiting for recorder, simulator, vision_tracker, state_estimator, controller to "
+             "come alive", "waiting for every component to receive the paused simulator's clock",
+             "running until the error stays under 0.01 for 2 s, at most 60 s of simulated time",
+             "stopping the processes", "judging the recording", "drawing the figures",
+             "report: "]  # fmt: skip
+    found = [next((i for i, line in enumerate(said) if line.startswith(f"[experiment] {step}")),
+                  None) for step in steps]  # fmt: skip
+    assert None not in found and found == sorted(found), said
     assert report["mode"] == "lockstep" and report["lockstep_timeouts"] == 0
     # Section 5.7: 6 task DOF + the nonholonomic equality, plus one per active constraint.
     histogram = {int(k): v for k, v in report["nonzero_entries"].items()}
