@@ -13,18 +13,27 @@ CLIENT_STAMP := $(FOXGLOVE_CLIENT)/node_modules/.installed
 
 .PHONY: demo test bench lint lock clean foxglove-client
 
+# Each step that takes more than a second says what it does first (pip itself is quiet).
 $(STAMP): $(LOCK) pyproject.toml
+	@echo "[make] building $(VENV) from $(LOCK), which it is older than or missing"
 	rm -rf $(VENV)
 	$(PYTHON) -m venv $(VENV)
+	@echo "[make] installing the $$(grep -cE '^[A-Za-z0-9_.-]+==' $(LOCK)) packages pinned in" \
+		"$(LOCK), hashes checked (about a minute the first time, quiet meanwhile)"
 	$(VENV)/bin/python -m pip install --quiet --require-hashes --no-deps -r $(LOCK)
+	@echo "[make] installing parsimony itself into $(VENV) (editable)"
 	$(VENV)/bin/python -m pip install --quiet --no-deps --no-build-isolation -e .
 	touch $(STAMP)
+	@echo "[make] $(VENV) is ready"
 
 # The pose experiment of section 6.2.1 on the whole simulated loop, in real time.
 demo: $(STAMP)
+	@echo "[make] the pose experiment in real time (about half a minute; its progress follows)"
 	$(VENV)/bin/parsimony experiment pose --controller lp --realtime --out runs/demo --force
 
 $(CLIENT_STAMP): $(FOXGLOVE_CLIENT)/package.json $(FOXGLOVE_CLIENT)/package-lock.json
+	@echo "[make] installing Foxglove's WebSocket client for the tests as" \
+		"$(FOXGLOVE_CLIENT)/package-lock.json pins it (npm ci)"
 	cd $(FOXGLOVE_CLIENT) && npm ci --no-audit --no-fund --loglevel=error
 	touch $(CLIENT_STAMP)
 
