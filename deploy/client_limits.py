@@ -41,7 +41,7 @@ def echo(value: object) -> str:
             return str(value)
         return f"an integer of {int(math.log10(abs(value))) + 1} digits"
     if isinstance(value, float):
-        return f"{value:.6g}"
+        return repr(value)
     if isinstance(value, bytes):
         return f"{len(value)} bytes"
     if isinstance(value, dict | list | tuple):
@@ -61,7 +61,7 @@ class Rate:
         return f"{self.per_s:g} goal/s ({self.burst} at once)"
 
 
-GOAL_RATE = Rate(per_s=1.0, burst=3)
+GOAL_RATE = Rate(per_s=1.0, burst=5)
 """How often one client may send a goal: the supervisor plans anew from each (up to 2 s of
 CPU), and a person clicking a pose sends a few a second at most."""
 TOLD_EVERY_S = 1.0

@@ -7,21 +7,31 @@ The listener of the live view's server (``record.live_view``):
   panel's publish-pose tool); each message is checked (``deploy.client_goals``) and put on
   goal/request, stamped on the namespace's clock. Only when the view's user may write
   goal/request (the profile's ``zenoh.access``): otherwise the capability is not advertised,
-  and the server itself refuses any advertisement.
+  and the server itself refuses any advertisement. A client sends at most
+  ``client_limits.GOAL_RATE``; a goal over it is dropped, and the client told so.
 - Parameters (``Parameters``): every running component's, as ``component.name``
   (``deploy.foxglove_params``); a set goes to the component, which checks it as it checks
-  ``parsimony param set``.
+  ``parsimony param set``, when the view's user may set that component's parameters
+  (``zenoh.access.parameters``). Foxglove's protocol has no read-only parameters: a view whose
+  user may set none still lists them, and refuses every set.
 
 What becomes of each goal and set is said in a status message naming the client it answers
 (foxglove-sdk 0.30's Python server sends a status to every client, not to one), and logged.
-A refusal is an error status that says why.
+A refusal is an error status that says why, at most ``client_limits.STATUS_CHARS`` long.
+
+A Zenoh error on the station's session (closed, or a panic in Zenoh) is logged as an error and
+counted (``session_errors``); the station opens a new session from the profile and goes on on
+it (``failed`` says why it could not).
 """
 
 from __future__ import annotations
 
+import functools
 import logging
 import threading
 import time
+from collections.abc import Callable
+from typing import Any, TypeVar
 
 import numpy as np
 import zenoh
@@ -35,7 +45,9 @@ from foxglove.websocket import (
 )
 
 from deploy.client_goals import ENCODING, SCHEMAS, GoalRefused, client_goal
+from deploy.client_limits import ECHO_CHARS, GOAL_RATE, STATUS_CHARS, Bucket, cut, echo
 from deploy.foxglove_params import running_parameters, set_parameters
+from deploy.zenoh_error import is_session_error, zenoh_error_text
 from messages import codec, topics
 from messages.header import Header
 from messages.obstacles import circles_of
@@ -49,6 +61,33 @@ SOURCE = "view"
 """The source named in the header of a goal the view passes on."""
 
 log = logging.getLogger("parsimony.view")
+T = TypeVar("T")
+
+
+class SessionFailed(Exception):
+    """The station's Zenoh session failed and no new one could be opened."""
+
+
+def _answering(about: str, nothing: Any = None) -> Callable:
+    """A listener callback that answers its client whatever happens: an error nobody foresaw
+    is logged in one line, counted (``errors``) and said to the client, and ``nothing`` is
+    returned (foxglove-sdk would log a traceback and answer nothing)."""
+
+    def wrap(method: Callable) -> Callable:
+        @functools.wraps(method)
+        def answered(self: ControlStation, client: Client, *args: Any) -> Any:
+            try:
+                return method(self, client, *args)
+            except Exception as error:
+                with self._lock:
+                    self.errors += 1
+                self._status(client, about, f"{about}: not done, the view failed: "
+                             f"{type(error).__name__}: {error}", StatusLevel.Error)  # fmt: skip
+                return nothing
+
+        return answered
+
+    return wrap
 
 
 class ControlStation(ServerListener):
@@ -57,28 +96,31 @@ class ControlStation(ServerListener):
     listens to; ``close`` undeclares what it declared."""
 
     def __init__(self, session: zenoh.Session, profile: Profile, user: str | None = None) -> None:
-        self.session, self.namespace = session, profile.namespace
+        self.session, self.namespace, self._profile = session, profile.namespace, profile
         self.user = tool_user(user)
         access = profile.zenoh.access
         self.may_publish = access is None or access.may_write(topics.GOAL_REQUEST.name, self.user)
+        self.may_set_any = access is None or any(
+            access.may_set(spec.name, self.user) for spec in profile.components)
         scene = profile.scene
         self._offset = offset_pose(*scene.goal.offset) if scene is not None else dq.ONE.copy()
         self._on_sim_clock = profile.clock == "sim"
         self._server: WebSocketServer | None = None
         self._lock = threading.Lock()
         self._goal_channels: dict[tuple[int, int], ClientChannel] = {}
+        self._buckets: dict[int, Bucket] = {}
         self._q: np.ndarray | None = None
         self._obstacles: tuple[Circle, ...] = ()
         self._clock_ns: int | None = None
-        self.goals_sent = 0
+        self.goals_sent = self.goals_refused = self.goals_dropped = 0
+        self.session_errors = self.errors = 0
+        self.failed = ""
+        """Why the station's session failed for good (a new one could not be opened)."""
         self._declared: list = []
-        self._goal_out = None
-        if self.may_publish:
-            self._goal_out = session.declare_publisher(topics.GOAL_REQUEST.key(self.namespace))
-            self._declared = [self._goal_out] + [
-                session.declare_subscriber(topic.key(self.namespace), self._taker(topic))
-                for topic in (topics.ROBOT_STATE, topics.WORLD_OBSTACLES, topics.SIM_CLOCK)
-            ]
+        self._opened: list[zenoh.Session] = []
+        """The sessions the station opened itself (after a failure), closed with it."""
+        self._goal_out: zenoh.Publisher | None = None
+        self._declare()
 
     @property
     def capabilities(self) -> list[Capability]:
@@ -93,13 +135,76 @@ class ControlStation(ServerListener):
         self._server = server
 
     def close(self) -> None:
+        self._undeclare()
+        for session in self._opened:
+            session.close()
+        self._opened = []
+
+    # -- the session ----------------------------------------------------------------------
+
+    def _declare(self) -> None:
+        if not self.may_publish:
+            return
+        self._goal_out = self.session.declare_publisher(topics.GOAL_REQUEST.key(self.namespace))
+        self._declared = [self._goal_out] + [
+            self.session.declare_subscriber(topic.key(self.namespace), self._taker(topic))
+            for topic in (topics.ROBOT_STATE, topics.WORLD_OBSTACLES, topics.SIM_CLOCK)
+        ]
+
+    def _undeclare(self) -> None:
         for declared in self._declared:
-            declared.undeclare()
+            try:
+                declared.undeclare()
+            except BaseException as error:
+                if not is_session_error(error):
+                    raise
         self._declared = []
+
+    def _on_session(self, operation: Callable[[zenoh.Session], T]) -> T:
+        """``operation`` on the station's session; after a Zenoh error, once more on a new
+        one (``SessionFailed`` if none can be opened, or it fails there too)."""
+        session = self.session
+        try:
+            return operation(session)
+        except BaseException as error:
+            if not is_session_error(error):
+                raise
+            self._reopen(session, error)
+        try:
+            return operation(self.session)
+        except BaseException as error:
+            if not is_session_error(error):
+                raise
+            raise SessionFailed(self._failure(zenoh_error_text(error))) from None
+
+    def _reopen(self, failed: zenoh.Session, error: BaseException) -> None:
+        """Say that ``failed`` failed, and open a new session in its place (unless another
+        thread did already)."""
+        with self._lock:
+            if self.session is not failed:
+                return
+            self.session_errors += 1
+            log.error("view: the control station's Zenoh session failed (%s); opening a new "
+                      "one", zenoh_error_text(error))  # fmt: skip
+            self._undeclare()
+            try:
+                self.session = zenoh.open(self._profile.zenoh.client_config(self.user))
+                self._opened.append(self.session)
+                self._declare()
+            except BaseException as opening:
+                if not is_session_error(opening):
+                    raise
+                raise SessionFailed(self._failure(zenoh_error_text(opening))) from None
+            log.warning("view: the control station goes on on a new Zenoh session")
+
+    def _failure(self, reason: str) -> str:
+        self.failed = f"the view's Zenoh session failed: {reason}"
+        log.error("view: %s", self.failed)
+        return self.failed
 
     # -- goals ----------------------------------------------------------------------------
 
-    def _taker(self, topic: topics.Topic):
+    def _taker(self, topic: topics.Topic) -> Callable[[zenoh.Sample], None]:
         def take(sample: zenoh.Sample) -> None:
             try:
                 message = codec.decode(sample.payload.to_bytes(), topic.type)
@@ -115,30 +220,48 @@ class ControlStation(ServerListener):
 
         return take
 
+    @_answering("publish")
     def on_client_advertise(self, client: Client, channel: ClientChannel) -> None:
         key = (client.id, channel.id)
         if channel.topic not in (topics.GOAL_REQUEST.name, topics.GOAL_REQUEST.key(self.namespace)):
-            self._status(client, "publish", f"{channel.topic}: only {topics.GOAL_REQUEST.name} "
-                         "may be published", StatusLevel.Error)  # fmt: skip
+            self._status(client, "publish", f"{echo(channel.topic)}: only "
+                         f"{topics.GOAL_REQUEST.name} may be published",
+                         StatusLevel.Error)  # fmt: skip
             return
         if channel.encoding != ENCODING or channel.schema_name not in SCHEMAS:
-            self._status(client, "goal", f"goal/request in {channel.encoding} "
-                         f"{channel.schema_name!r} refused: it takes {ENCODING} "
+            self._status(client, "goal", f"goal/request in {echo(channel.encoding)} "
+                         f"{echo(channel.schema_name)} refused: it takes {ENCODING} "
                          f"{' or '.join(SCHEMAS)}", StatusLevel.Error)  # fmt: skip
             return
         with self._lock:
             self._goal_channels[key] = channel
+            self._buckets.setdefault(client.id, Bucket(GOAL_RATE))
 
+    @_answering("publish")
     def on_client_unadvertise(self, client: Client, client_channel_id: int) -> None:
         with self._lock:
             self._goal_channels.pop((client.id, client_channel_id), None)
+            if not any(id_ == client.id for id_, _ in self._goal_channels):
+                self._buckets.pop(client.id, None)
 
+    @_answering("goal")
     def on_message_data(self, client: Client, client_channel_id: int, data: bytes) -> None:
+        now_s = time.monotonic()
         with self._lock:
             channel = self._goal_channels.get((client.id, client_channel_id))
+            bucket = self._buckets.get(client.id)
             q, obstacles, clock_ns = self._q, self._obstacles, self._clock_ns
-        if channel is None or self._goal_out is None:
-            return  # refused when advertised, and said then
+            if channel is None or bucket is None or self._goal_out is None:
+                return  # refused when advertised, and said then
+            within = bucket.take(now_s)
+            told = 0 if within else bucket.tell(now_s)
+            self.goals_dropped += 0 if within else 1
+        if told:
+            self._status(client, "goal", f"goal/request dropped: more than {GOAL_RATE} from "
+                         f"this client ({told} dropped); the next is taken in "
+                         f"{bucket.wait_s():.1f} s", StatusLevel.Warning)  # fmt: skip
+        if not within:
+            return
         try:
             stamp_ns = clock_ns if self._on_sim_clock else time.time_ns()
             if stamp_ns is None:
@@ -147,34 +270,71 @@ class ControlStation(ServerListener):
                             source=SOURCE)  # fmt: skip
             goal = client_goal(channel.schema_name, data, self._offset, header, q, obstacles)
         except GoalRefused as error:
+            with self._lock:
+                self.goals_refused += 1
             self._status(client, "goal", f"goal/request refused: {error}", StatusLevel.Error)
             return
-        self._goal_out.put(codec.encode(goal))
-        self.goals_sent += 1
+        try:
+            self._on_session(lambda _: self._put(codec.encode(goal)))
+        except SessionFailed as error:
+            self._status(client, "goal", f"goal/request not sent: {error}", StatusLevel.Error)
+            return
+        with self._lock:
+            self.goals_sent += 1
         x, y, z = dq.translation(np.array(goal.pose))[1:]
         self._status(client, "goal", f"goal/request sent: the gripper to ({x:.3f}, {y:.3f}, "
                      f"{z:.3f}) in world", StatusLevel.Info)  # fmt: skip
 
+    def _put(self, payload: bytes) -> None:
+        assert self._goal_out is not None
+        self._goal_out.put(payload)
+
     # -- parameters -----------------------------------------------------------------------
 
+    def _may_set(self, component: str) -> str:
+        """Why the view's user may not set ``component``'s parameters, or empty."""
+        access = self._profile.zenoh.access
+        if access is None or access.may_set(component, self.user):
+            return ""
+        return f"{self.user} may not set {component}'s parameters (zenoh.access.parameters)"
+
+    @_answering("parameters", [])
     def on_get_parameters(self, client: Client, param_names: list[str],
                           request_id: str | None = None) -> list[Parameter]:  # fmt: skip
-        found = running_parameters(self.session, self.namespace)
-        return [p for p in found if not param_names or p.name in param_names]
+        wanted = set(param_names)
+        try:
+            found = self._on_session(lambda s: running_parameters(s, self.namespace))
+        except SessionFailed as error:
+            self._status(client, "parameters", str(error), StatusLevel.Error)
+            return []
+        return [p for p in found if not wanted or p.name in wanted]
 
+    @_answering("parameters", [])
     def on_set_parameters(self, client: Client, parameters: list[Parameter],
                           request_id: str | None = None) -> list[Parameter]:  # fmt: skip
-        values, refusals = set_parameters(self.session, self.namespace, parameters)
+        if not self.may_set_any:
+            self._status(client, "parameters", f"parameters are read-only in this view: "
+                         f"{self.user} may set no component's (zenoh.access.parameters)",
+                         StatusLevel.Error)  # fmt: skip
+            return self.on_get_parameters(client, [p.name for p in parameters], request_id)
+        try:
+            values, refusals = self._on_session(
+                lambda s: set_parameters(s, self.namespace, parameters, self._may_set))
+        except SessionFailed as error:
+            self._status(client, "parameters", str(error), StatusLevel.Error)
+            return []
         for refusal in refusals:
             self._status(client, "parameters", refusal, StatusLevel.Error)
         if values and not refusals:
             self._status(client, "parameters", "set: " + ", ".join(
-                f"{p.name} = {p.get_value()!r}" for p in values), StatusLevel.Info)  # fmt: skip
+                f"{p.name} = {cut(repr(p.get_value()), ECHO_CHARS)}" for p in values),
+                StatusLevel.Info)  # fmt: skip
         return values
 
     def _status(self, client: Client, about: str, text: str, level: StatusLevel) -> None:
-        """A status to the clients, naming the one it answers; logged too."""
-        message = f"client {client.id}: {text}"
+        """A status to the clients, naming the one it answers, cut to ``STATUS_CHARS``;
+        logged too."""
+        message = cut(f"client {client.id}: {text}", STATUS_CHARS - ECHO_CHARS)
         log.log(logging.WARNING if level == StatusLevel.Error else logging.INFO, "%s", message)
         if self._server is not None:
             self._server.publish_status(message, level, id=f"{about}/client{client.id}")

@@ -1,7 +1,8 @@
 """Who may connect and who may publish what: Zenoh user/password authentication and ACL.
 
 A profile that says ``zenoh.access`` names a credentials file (``user:password`` per line,
-the router's dictionary) and, per topic, the users who may write it::
+the router's dictionary), per topic the users who may write it, and per component the users
+who may set its parameters (``"*"``: every component not named)::
 
     zenoh:
       mode: client
@@ -9,11 +10,15 @@ the router's dictionary) and, per topic, the users who may write it::
         credentials: credentials.txt
         writers:
           control/goal: [operator]
+        parameters:
+          "*": [operator]
 
 A session without a user and password of the file is refused by the router. Every component
 authenticates as its own name; tools as ``$PARSIMONY_USER`` (default ``operator``). A put on a
 listed topic from any other user is dropped by the router's access control. The rules act in
 the router, so the profile must run in ``client`` mode (peers would link directly, past them).
+A parameter is read and set by one query, which the router cannot tell apart: the tools that
+set parameters (the live view's clients) obey ``parameters`` themselves.
 """
 
 from __future__ import annotations
@@ -30,6 +35,8 @@ from messages import topics
 USER_ENV = "PARSIMONY_USER"
 """The user a tool (``parsimony status``, ``topic``, ``param`` ...) authenticates as."""
 DEFAULT_TOOL_USER = "operator"
+EVERY_COMPONENT = "*"
+"""In ``parameters``: every component the profile's rules do not name."""
 
 
 def tool_user(user: str | None = None) -> str:
@@ -52,12 +59,15 @@ def read_credentials(path: Path) -> dict[str, str]:
 
 
 class AccessSettings(BaseModel):
-    """The credentials file and, per topic of the table, the users who may write it."""
+    """The credentials file, per topic of the table the users who may write it, and per
+    component (``EVERY_COMPONENT``: those not named) the users who may set its parameters;
+    a topic or component not named is free to every user."""
 
     model_config = ConfigDict(extra="forbid", frozen=True)
 
     credentials: Path
     writers: dict[str, list[str]] = {}
+    parameters: dict[str, list[str]] = {}
 
     @model_validator(mode="after")
     def _known_topics_and_users(self) -> AccessSettings:
@@ -73,6 +83,10 @@ class AccessSettings(BaseModel):
             unknown = sorted(set(writers) - set(users))
             if unknown:
                 raise ValueError(f"writers.{topic}: {unknown} not in {self.credentials}")
+        for component, setters in self.parameters.items():
+            unknown = sorted(set(setters) - set(users))
+            if unknown:
+                raise ValueError(f"parameters.{component}: {unknown} not in {self.credentials}")
         return self
 
     def users(self) -> dict[str, str]:
@@ -102,6 +116,13 @@ class AccessSettings(BaseModel):
         """Whether ``user`` (a tool's: ``$PARSIMONY_USER``) may put on ``topic``: the topic
         names no writers, or names the user."""
         return topic not in self.writers or tool_user(user) in self.writers[topic]
+
+    def may_set(self, component: str, user: str | None) -> bool:
+        """Whether ``user`` (a tool's: ``$PARSIMONY_USER``) may set ``component``'s parameters:
+        ``parameters`` names neither the component nor ``EVERY_COMPONENT``, or names the user
+        where it names the component (else under ``EVERY_COMPONENT``)."""
+        setters = self.parameters.get(component, self.parameters.get(EVERY_COMPONENT))
+        return setters is None or tool_user(user) in setters
 
     def session_json(self, user: str | None) -> dict[str, Any]:
         """A session's credentials: ``user`` (a tool's: ``$PARSIMONY_USER``) and its password."""

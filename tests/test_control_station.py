@@ -20,6 +20,7 @@ import zenoh
 
 from bench.live_view import lockstep_profile
 from deploy import query
+from deploy.client_limits import GOAL_RATE, STATUS_CHARS
 from messages import codec, topics
 from messages.goal import Goal
 from parsimony.experiment import DEPLOY, connect, launched, wait_alive, wait_reached
@@ -75,6 +76,7 @@ def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Station]:
             yield Station(profile, view.address, directory / "session.mcap", session, goals)
         watcher.undeclare()
     assert view.process.returncode == 0, view.err[-2000:]
+    assert "Callback failed" not in view.err and "Traceback" not in view.err, view.err[-2000:]
     summary = json.loads(view.out)
     assert summary["shown"] > 0 and summary["malformed"] == 0, summary
 
@@ -256,6 +258,39 @@ def test_a_goal_from_the_client_reaches_the_supervisor_and_the_robot_goes_there(
 
     client.message(truth, near, f"the true gripper within {REACHED_M} m of the client's goal")
     client.send("unsubscribe", topics=[truth, status_key])
+
+
+HOSTILE_GOALS = [
+    ('{"frame_id": "world", "pose": {"position": {"x": 1' + "0" * 400 + '}, '
+     '"orientation": {"w": 1}}}', "pose.position.x = an integer of 401 digits is out of range"),
+    ('{"frame_id": "world", "pose": ' + "[" * 5000 + "]" * 5000 + "}",
+     "not a goal: its JSON is nested too deeply"),
+    ('{"frame_id": "world", "pose": {"position": {"x": 1e154, "y": 1e154}, "orientation": '
+     '{"w": 1}}}', "pose.position.x = 1e+154 is out of range: a goal lies within 1000 m of F0"),
+    ('{"frame_id": "world", "pose": {"orientation": {"w": 1}}}', "pose.position is missing"),
+    (json.dumps({"frame_id": "f" * 1_000_000}),
+     "a message of 1000016 bytes: a goal is at most 16384"),
+]  # fmt: skip
+"""Goals the campaign sent, and what the station answers each: the first two got no answer
+(the view raised), the third was '1.86e137 m below the floor', the last a 1 MB status."""
+
+
+def test_each_hostile_goal_gets_a_short_refusal_and_none_reaches_the_supervisor(
+    station: Station, client: FoxgloveClient
+) -> None:
+    assert len(HOSTILE_GOALS) <= GOAL_RATE.burst  # none dropped for its rate
+    request = station.key("goal/request")
+    client.send("advertise", topic=request, encoding="json", schemaName="foxglove.PoseInFrame")
+    channel = client.wait_for(lambda e: e["event"] == "advertised", "the channel")["channel"]
+    already = len(station.goals)
+    for text, reason in HOSTILE_GOALS:
+        start = len(client.events)
+        client.send("publish", channel=channel, text=text)
+        status = client.wait_for(lambda e: e["event"] == "status" and "goal/request" in
+                                 e["message"], f"the answer to {reason!r}", start)  # fmt: skip
+        assert reason in status["message"] and status["level"] == 2, status
+        assert len(status["message"]) <= STATUS_CHARS
+    assert len(station.goals) == already
 
 
 def json_message(topic: str, found: Callable[[dict], bool]) -> Callable[[dict], bool]:

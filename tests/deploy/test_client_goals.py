@@ -58,7 +58,7 @@ def test_a_pose_alone_and_a_stamped_pose_give_the_same_goal(schema: str) -> None
     ("foxglove.PoseInFrame", pose_in_frame(0.6, -0.2, 0.4, orientation={"w": 0.5}),
      "orientation has norm 0.5, expected 1"),
     ("foxglove.PoseInFrame", pose_in_frame(0.6, -0.2, 0.4, orientation={"w": 2.0}),
-     "pose.orientation.w = 2 is out of range: a unit quaternion's components lie in [-1, 1]"),
+     "pose.orientation.w = 2.0 is out of range: a unit quaternion's components lie in [-1, 1]"),
     ("foxglove.PoseInFrame", pose_in_frame(12.0, 0.0, 0.0),
      "farther than the 10 m a plan may cover"),
     ("foxglove.PoseInFrame", pose_in_frame(1.0, 1.0, 0.0),
