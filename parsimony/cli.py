@@ -14,7 +14,8 @@ from parsimony.output import result_only_stdout
 from parsimony.target_options import exit_code
 
 COMMANDS = (
-    "demo", "experiment", "bench", "launch", "status", "param", "node", "topic", "graph", "schema",
+    "demo", "experiment", "bench", "launch", "status", "param", "node", "topic", "goal", "graph",
+    "schema",
     "record", "info", "replay", "rerun", "report", "view", "layout", "reproduce",
 )  # fmt: skip
 

@@ -137,3 +137,20 @@ def test_zenoh_errors_reach_the_user_as_one_readable_line():
     assert result.returncode == 2
     assert "cannot reach a router at tcp/127.0.0.1:1" in result.stderr
     assert ".rs:" not in result.stderr and len(result.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    ("argv", "error"),
+    [
+        (("0.5", "nan", "0.4"), "argument Y: expected a finite number, got 'nan'"),
+        (("0.5", "0", "0.4", "--position", "--yaw", "30"), "--position takes no --yaw or --rpy"),
+        (("0.5", "0", "0.4", "--yaw", "10", "--rpy", "0", "0", "10"), "not allowed with"),
+        (("0.5", "0", "0.4", "--wait", "--profile", "deploy/sim.yaml"),
+         "--wait follows supervisor/status, and no component of deploy/sim.yaml writes it"),
+    ],
+)  # fmt: skip
+def test_goal_refuses_input_it_cannot_use_with_exit_2(argv: tuple[str, ...], error: str) -> None:
+    """Before anything is sent, and with no running system to ask."""
+    result = run_cli("goal", *argv)
+    assert result.returncode == 2, result.stderr
+    assert error in result.stderr and "Traceback" not in result.stderr

@@ -4,17 +4,24 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
+import zenoh
 
 from deploy import query
+from messages import codec
+from messages.goal import Goal
 from parsimony.commands import param, status
 from parsimony.target_options import PROFILE_ENV
+from wbc import dq
 
 
 def command(module: object, *argv: str) -> int:
@@ -182,6 +189,33 @@ def test_topic_pub_warns_when_a_running_component_writes_the_topic(running_pub: 
     assert result.returncode == 0, result.stderr
     assert "warning: pub writes test/control/goal in this profile and is running" in result.stderr
     assert json.loads(result.stdout)["live_writers"] == ["pub"]
+
+
+def test_goal_goes_to_control_goal_where_no_supervisor_takes_requests(running_pub: Path) -> None:
+    """Nothing reads goal/request here: the goal goes to control/goal, stamped on the wall
+    clock of this profile, and the user is told that pub writes it too."""
+    sent: list[Goal] = []
+    arrived = threading.Event()
+
+    def on_goal(sample: zenoh.Sample) -> None:
+        goal = codec.decode(sample.payload.to_bytes(), Goal)
+        if goal.header.source == "parsimony":
+            sent.append(goal)
+            arrived.set()
+
+    with query.Target.from_profile(running_pub).open() as session:
+        session.declare_subscriber("test/control/goal", on_goal)
+        before = time.time_ns()
+        result = cli("goal", "0.5", "0", "0.4", "--yaw", "90", "--json",
+                     "--profile", str(running_pub))  # fmt: skip
+        assert result.returncode == 0, result.stderr
+        assert arrived.wait(10.0), "the goal did not arrive"
+    assert json.loads(result.stdout)["topic"] == "control/goal"
+    assert "warning: pub writes test/control/goal" in result.stderr
+    (goal,) = sent
+    assert before <= goal.header.stamp_ns <= time.time_ns()
+    expected = dq.pose(dq.rotation_quaternion(math.pi / 2, dq.K_[1:]), np.array([0.5, 0, 0.4]))
+    assert goal.task == "pose" and np.allclose(goal.pose, expected, atol=1e-12)
 
 
 def test_param_list_describe_dump_and_load(running_pub: Path, tmp_path: Path) -> None:

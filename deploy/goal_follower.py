@@ -1,0 +1,126 @@
+"""What the staging supervisor makes of a goal a tool sends, followed on ``supervisor/status``.
+
+A status does not name the goal it is about, so the goal's arrival is read from the
+supervisor's own counters: its status is answered on the thread that takes requests, so once
+it counts one more request on ``goal/request`` (or one more refused), every
+``supervisor/status`` published after is about that goal. Used by ``parsimony goal --wait``.
+"""
+
+from __future__ import annotations
+
+import queue
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import zenoh
+
+from deploy.query import QueryError, status_of
+from messages import codec, topics
+from messages.supervisor import SupervisorStatus
+
+POLL_S = 0.05
+"""How often (host seconds) the supervisor's counters are asked while the goal is on its way."""
+DONE = {"reached": "reached", "unreachable": "unreachable"}
+"""The phases that end a goal, and the outcome each is."""
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """How a goal ended: ``result`` is ``reached``, ``unreachable`` or ``refused`` (the
+    request was malformed), ``reason`` why it was not reached, ``status`` the last status."""
+
+    result: str
+    reason: str
+    status: SupervisorStatus | None
+
+    @property
+    def reached(self) -> bool:
+        return self.result == "reached"
+
+
+class GoalFollower:
+    """The statuses of the supervisor ``component`` of ``namespace``, on ``session``: declare
+    it before the goal is sent, ``sent`` once it is, then ``follow``."""
+
+    def __init__(self, session: zenoh.Session, namespace: str, component: str,
+                 timeout_s: float) -> None:  # fmt: skip
+        self.session, self.namespace, self.component = session, namespace, component
+        self.timeout_s = timeout_s
+        self._key = topics.SUPERVISOR_STATUS.key(namespace)
+        self._statuses: queue.Queue[SupervisorStatus] = queue.Queue()
+        self._errors: list[float] = []
+        self._lock = threading.Lock()
+        self._subscribers = [
+            session.declare_subscriber(self._key, self._on_status),
+            session.declare_subscriber(topics.CONTROL_DIAGNOSTICS.key(namespace),
+                                       self._on_diagnostics),  # fmt: skip
+        ]
+        self._before = self._requests()
+        self._refused = False
+
+    def _on_status(self, sample: zenoh.Sample) -> None:
+        try:
+            self._statuses.put(codec.decode(sample.payload.to_bytes(), SupervisorStatus,
+                                            self._key))  # fmt: skip
+        except codec.DecodeError:
+            pass  # the supervisor's own counters say it published; a bad one is no answer
+
+    def _on_diagnostics(self, sample: zenoh.Sample) -> None:
+        try:
+            diagnostics = codec.decode(sample.payload.to_bytes(), topics.CONTROL_DIAGNOSTICS.type)
+        except codec.DecodeError:
+            return
+        if diagnostics.error_norm is not None:
+            with self._lock:
+                self._errors[:] = [diagnostics.error_norm]
+
+    def _requests(self) -> tuple[int, int]:
+        """The requests on goal/request the supervisor has taken and refused so far."""
+        counters = status_of(self.session, self.namespace, self.component, self.timeout_s).counters
+        name = topics.GOAL_REQUEST.name
+        return counters.get(f"received.{name}", 0), counters.get(f"rejected.{name}", 0)
+
+    def error(self) -> float | None:
+        """The task error of the controller's latest step (the current phase's task)."""
+        with self._lock:
+            return self._errors[0] if self._errors else None
+
+    def sent(self) -> None:
+        """Wait until the supervisor has the goal just sent (``QueryError`` after
+        ``timeout_s``); the statuses published before are dropped."""
+        deadline = time.monotonic() + self.timeout_s
+        taken, refused = self._before
+        while True:
+            now_taken, now_refused = self._requests()
+            if now_taken > taken or now_refused > refused:
+                self._refused = now_refused > refused
+                break
+            if time.monotonic() > deadline:
+                raise QueryError(f"{self.component} did not take the goal in "
+                                 f"{self.timeout_s:g} s")  # fmt: skip
+            time.sleep(POLL_S)  # asking again: the supervisor answers on its handler thread
+        while not self._statuses.empty():
+            self._statuses.get_nowait()
+
+    def follow(self, progress: Callable[[SupervisorStatus], None]) -> Outcome:
+        """Hand each status to ``progress`` until the goal is reached, found unreachable or
+        refused (malformed: the status says why in ``last_refusal``); ``QueryError`` when
+        ``timeout_s`` pass with no status."""
+        while True:
+            try:
+                status = self._statuses.get(timeout=self.timeout_s)
+            except queue.Empty:
+                raise QueryError(f"no {self._key} in {self.timeout_s:g} s (is the simulator "
+                                 "paused, or the state invalid?)") from None  # fmt: skip
+            if self._refused:
+                return Outcome("refused", status.last_refusal, status)
+            progress(status)
+            if status.phase in DONE:
+                return Outcome(DONE[status.phase], status.reason, status)
+
+    def close(self) -> None:
+        for subscriber in self._subscribers:
+            subscriber.undeclare()
+        self._subscribers = []
