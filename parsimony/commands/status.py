@@ -1,4 +1,5 @@
-"""`parsimony status`: the live components of a namespace and their counters."""
+"""`parsimony status`: the live components of a namespace, a summary line each (messages in
+and out, CPU time, the counters of faults that are not zero), and every counter on demand."""
 
 from __future__ import annotations
 
@@ -19,7 +20,13 @@ from parsimony.output import emit, json_text, table
 from parsimony.target_options import fail
 from profiles.profile import ProfileError
 
-COLUMNS = ("NAME", "MODULE", "STATE", "PID", "COUNTERS (non-zero)")
+COLUMNS = ("NAME", "MODULE", "STATE", "PID", "IN", "OUT", "CPU S", "FAULTS (non-zero)")
+LEGEND = ("IN, OUT: messages received and published; FAULTS: counts of what was refused, "
+          "failed, stalled, held or lost; --counters lists every counter")  # fmt: skip
+FAULT_WORDS = ("rejected", "error", "overflowed", "fail", "bad_", "refus", "stall", "timeout",
+               "lost", "non_finite", "implausible", "unreachable", "contacts", "penetrations",
+               "undecodable", "out_of_limits", "fault", "degraded", "holds", "reconnects")
+"""A counter whose name holds one of these counts faults; the summary shows it when not 0."""
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -39,7 +46,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         default=DEFAULT_ROUTER,
         help=f"router endpoint for a namespace target (default {DEFAULT_ROUTER})",
     )
-    parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    parser.add_argument("--json", action="store_true",
+                        help="print JSON instead of a table (every counter)")  # fmt: skip
+    parser.add_argument("-v", "--counters", action="store_true",
+                        help="list every counter of each component under the table")  # fmt: skip
     parser.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="S")
     return parser
 
@@ -73,7 +83,10 @@ def run(args: argparse.Namespace) -> int:
         ]
         emit(json_text(rows, indent=2))
     else:
-        emit(format_table([(name, found.get(name)) for name in names]))
+        rows = [(name, found.get(name)) for name in names]
+        emit(format_table(rows) + (format_counters(rows) if args.counters else ""))
+        if names and not args.counters:
+            print(LEGEND, file=sys.stderr)
     if not names:
         print(f"no live component in namespace {target.namespace!r}", file=sys.stderr)
     return 0 if names else 1
@@ -84,8 +97,24 @@ def format_table(rows: list[tuple[str, ComponentStatus | None]]) -> str:
     cells = []
     for name, status in rows:
         if status is None:
-            cells.append((name, "?", "?", "?", ""))
+            cells.append((name, "?", "?", "?", "?", "?", "?", ""))
             continue
-        counters = " ".join(f"{k}={v}" for k, v in sorted(status.counters.items()) if v)
-        cells.append((name, status.module, status.state, str(status.pid), counters))
-    return table(cells, COLUMNS, disable_numparse=True)
+        counters = status.counters
+        faults = " ".join(f"{k}={v}" for k, v in sorted(counters.items())
+                          if v and any(word in k for word in FAULT_WORDS))  # fmt: skip
+        received = sum(v for k, v in counters.items() if k.startswith("received."))
+        published = sum(v for k, v in counters.items() if k.startswith("published."))
+        cpu_s = f"{counters.get('cpu_ms', 0) / 1e3:.1f}"
+        cells.append((name, status.module, status.state, str(status.pid), str(received),
+                      str(published), cpu_s, faults))  # fmt: skip
+    return table(cells, COLUMNS, disable_numparse=True, colalign=("left",) * 4 + ("right",) * 3)
+
+
+def format_counters(rows: list[tuple[str, ComponentStatus | None]]) -> str:
+    """Every counter of each component that answered, one a line, under its name."""
+    lines = []
+    for name, status in rows:
+        if status is not None:
+            lines += ["", name]
+            lines += [f"  {k:<40} {v}" for k, v in sorted(status.counters.items())]
+    return "\n".join(lines)
