@@ -5,9 +5,9 @@ The listener of the live view's server (``record.live_view``):
 - Goals (``ClientPublish``): a client advertises a channel on goal/request (its key in the
   namespace, or its name) in JSON, a ``foxglove.PoseInFrame`` or ``foxglove.Pose`` (the 3-D
   panel's publish-pose tool); each message is checked (``deploy.client_goals``) and put on
-  goal/request, stamped on the namespace's clock. Only when the view's user may write
-  goal/request (the profile's ``zenoh.access``): otherwise the capability is not advertised,
-  and the server itself refuses any advertisement. A client sends at most
+  goal/request, stamped on the namespace's clock (``deploy.tool_clock``). Only when the view's
+  user may write goal/request (the profile's ``zenoh.access``): otherwise the capability is
+  not advertised, and the server itself refuses any advertisement. A client sends at most
   ``client_limits.GOAL_RATE``; a goal over it is dropped, and the client told so.
 - Parameters (``Parameters``): every running component's, as ``component.name``
   (``deploy.foxglove_params``); a set goes to the component, which checks it as it checks
@@ -47,6 +47,7 @@ from foxglove.websocket import (
 from deploy.client_goals import ENCODING, SCHEMAS, GoalRefused, client_goal
 from deploy.client_limits import ECHO_CHARS, GOAL_RATE, STATUS_CHARS, Bucket, cut, echo
 from deploy.foxglove_params import running_parameters, set_parameters
+from deploy.tool_clock import ToolClock
 from deploy.zenoh_error import is_session_error, zenoh_error_text
 from messages import codec, topics
 from messages.header import Header
@@ -104,14 +105,12 @@ class ControlStation(ServerListener):
             access.may_set(spec.name, self.user) for spec in profile.components)
         scene = profile.scene
         self._offset = offset_pose(*scene.goal.offset) if scene is not None else dq.ONE.copy()
-        self._on_sim_clock = profile.clock == "sim"
         self._server: WebSocketServer | None = None
         self._lock = threading.Lock()
         self._goal_channels: dict[tuple[int, int], ClientChannel] = {}
         self._buckets: dict[int, Bucket] = {}
         self._q: np.ndarray | None = None
         self._obstacles: tuple[Circle, ...] = ()
-        self._clock_ns: int | None = None
         self.goals_sent = self.goals_refused = self.goals_dropped = 0
         self.session_errors = self.errors = 0
         self.failed = ""
@@ -120,6 +119,7 @@ class ControlStation(ServerListener):
         self._opened: list[zenoh.Session] = []
         """The sessions the station opened itself (after a failure), closed with it."""
         self._goal_out: zenoh.Publisher | None = None
+        self._clock: ToolClock | None = None
         self._declare()
 
     @property
@@ -146,15 +146,19 @@ class ControlStation(ServerListener):
         if not self.may_publish:
             return
         self._goal_out = self.session.declare_publisher(topics.GOAL_REQUEST.key(self.namespace))
-        self._declared = [self._goal_out] + [
+        self._clock = ToolClock(self.session, self._profile)
+        self._declared = [self._goal_out, self._clock] + [
             self.session.declare_subscriber(topic.key(self.namespace), self._taker(topic))
-            for topic in (topics.ROBOT_STATE, topics.WORLD_OBSTACLES, topics.SIM_CLOCK)
+            for topic in (topics.ROBOT_STATE, topics.WORLD_OBSTACLES)
         ]
 
     def _undeclare(self) -> None:
         for declared in self._declared:
             try:
-                declared.undeclare()
+                if isinstance(declared, ToolClock):
+                    declared.close()
+                else:
+                    declared.undeclare()
             except BaseException as error:
                 if not is_session_error(error):
                     raise
@@ -215,8 +219,6 @@ class ControlStation(ServerListener):
                     self._q = np.array(message.configuration())
                 elif topic is topics.WORLD_OBSTACLES:
                     self._obstacles = circles_of(message)
-                elif topic is topics.SIM_CLOCK:
-                    self._clock_ns = message.stamp_ns
 
         return take
 
@@ -250,8 +252,8 @@ class ControlStation(ServerListener):
         with self._lock:
             channel = self._goal_channels.get((client.id, client_channel_id))
             bucket = self._buckets.get(client.id)
-            q, obstacles, clock_ns = self._q, self._obstacles, self._clock_ns
-            if channel is None or bucket is None or self._goal_out is None:
+            q, obstacles, clock = self._q, self._obstacles, self._clock
+            if channel is None or bucket is None or clock is None:
                 return  # refused when advertised, and said then
             within = bucket.take(now_s)
             told = 0 if within else bucket.tell(now_s)
@@ -263,7 +265,7 @@ class ControlStation(ServerListener):
         if not within:
             return
         try:
-            stamp_ns = clock_ns if self._on_sim_clock else time.time_ns()
+            stamp_ns = clock.now_ns()
             if stamp_ns is None:
                 raise GoalRefused("the simulator's clock has not reached the view yet")
             header = Header(stamp_ns=stamp_ns, frame="world", seq=self.goals_sent,

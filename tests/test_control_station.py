@@ -37,6 +37,8 @@ READY_S = 120.0
 """Host seconds the view may take to say where it listens (a loaded machine)."""
 REACHED_M = 0.03
 """The true gripper this close to the client's goal counts as reached."""
+SIM_CLOCK_LAG_NS = 1_000_000_000
+"""How far behind the truth the view's copy of the simulator's clock may be, in simulated ns."""
 GOAL_SHIFT_M = (-0.05, 0.08)
 """The client's goal stands this far from the bin (x, y in F0): the robot goes where the client
 says, not where the bin is."""
@@ -256,8 +258,12 @@ def test_a_goal_from_the_client_reaches_the_supervisor_and_the_robot_goes_there(
         hand = dq.translation(np.array(json.loads(payload)["end_effector"]))[1:]
         return float(np.linalg.norm(hand - target)) < REACHED_M
 
-    client.message(truth, near, f"the true gripper within {REACHED_M} m of the client's goal")
+    reached, _ = client.message(truth, near, f"the true gripper within {REACHED_M} m of the "
+                                "client's goal")  # fmt: skip
     client.send("unsubscribe", topics=[truth, status_key])
+    # Stamped on the simulator's clock, as the truth is (not on the wall clock).
+    first = min(t for t, _ in client.messages(truth))
+    assert first - SIM_CLOCK_LAG_NS <= goal.header.stamp_ns <= reached, (first, reached)
 
 
 HOSTILE_GOALS = [
