@@ -9,7 +9,6 @@ it counts one more request on ``goal/request`` (or one more refused), every
 from __future__ import annotations
 
 import queue
-import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -22,14 +21,16 @@ from messages.supervisor import SupervisorStatus
 
 POLL_S = 0.05
 """How often (host seconds) the supervisor's counters are asked while the goal is on its way."""
-DONE = {"reached": "reached", "unreachable": "unreachable"}
-"""The phases that end a goal, and the outcome each is."""
+DONE = ("reached", "unreachable", "refused", "aborted")
+"""The phases that end a goal (the supervisor's ``messages.supervisor.ENDED`` among them, when
+it has them): each is the goal's outcome."""
 
 
 @dataclass(frozen=True)
 class Outcome:
-    """How a goal ended: ``result`` is ``reached``, ``unreachable`` or ``refused`` (the
-    request was malformed), ``reason`` why it was not reached, ``status`` the last status."""
+    """How a goal ended: ``result`` is the phase it ended in (``DONE``), or ``refused`` for a
+    request refused as malformed; ``reason`` why it was not reached, ``status`` the last
+    status."""
 
     result: str
     reason: str
@@ -50,13 +51,8 @@ class GoalFollower:
         self.timeout_s = timeout_s
         self._key = topics.SUPERVISOR_STATUS.key(namespace)
         self._statuses: queue.Queue[SupervisorStatus] = queue.Queue()
-        self._errors: list[float] = []
-        self._lock = threading.Lock()
-        self._subscribers = [
-            session.declare_subscriber(self._key, self._on_status),
-            session.declare_subscriber(topics.CONTROL_DIAGNOSTICS.key(namespace),
-                                       self._on_diagnostics),  # fmt: skip
-        ]
+        self._subscriber: zenoh.Subscriber | None = session.declare_subscriber(
+            self._key, self._on_status)  # fmt: skip
         self._before = self._requests()
         self._refused = False
 
@@ -67,25 +63,11 @@ class GoalFollower:
         except codec.DecodeError:
             pass  # the supervisor's own counters say it published; a bad one is no answer
 
-    def _on_diagnostics(self, sample: zenoh.Sample) -> None:
-        try:
-            diagnostics = codec.decode(sample.payload.to_bytes(), topics.CONTROL_DIAGNOSTICS.type)
-        except codec.DecodeError:
-            return
-        if diagnostics.error_norm is not None:
-            with self._lock:
-                self._errors[:] = [diagnostics.error_norm]
-
     def _requests(self) -> tuple[int, int]:
         """The requests on goal/request the supervisor has taken and refused so far."""
         counters = status_of(self.session, self.namespace, self.component, self.timeout_s).counters
         name = topics.GOAL_REQUEST.name
         return counters.get(f"received.{name}", 0), counters.get(f"rejected.{name}", 0)
-
-    def error(self) -> float | None:
-        """The task error of the controller's latest step (the current phase's task)."""
-        with self._lock:
-            return self._errors[0] if self._errors else None
 
     def sent(self) -> None:
         """Wait until the supervisor has the goal just sent (``QueryError`` after
@@ -118,9 +100,9 @@ class GoalFollower:
                 return Outcome("refused", status.last_refusal, status)
             progress(status)
             if status.phase in DONE:
-                return Outcome(DONE[status.phase], status.reason, status)
+                return Outcome(status.phase, status.reason, status)
 
     def close(self) -> None:
-        for subscriber in self._subscribers:
-            subscriber.undeclare()
-        self._subscribers = []
+        if self._subscriber is not None:
+            self._subscriber.undeclare()
+            self._subscriber = None

@@ -5,8 +5,9 @@ unit quaternion, above the floor, not inside an obstacle nor farther than a plan
 from the robot), stamped on the profile's clock (``deploy.tool_clock``) and sent the way the
 profile takes goals: on ``goal/request`` where a component (the staging supervisor) reads it,
 else on ``control/goal``. With --wait it follows ``supervisor/status``
-(``deploy.goal_follower``), its phases and the task error on stderr, until the goal is reached
-(exit 0) or found unreachable or refused (exit 1). Input that cannot be used exits 2.
+(``deploy.goal_follower``), its phases and the goal's error on stderr, until the goal is
+reached (exit 0) or ends otherwise: unreachable, refused, aborted (exit 1). Input that cannot
+be used exits 2.
 """
 
 from __future__ import annotations
@@ -82,7 +83,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
                              "floor")  # fmt: skip
     parser.add_argument("--wait", action="store_true",
                         help="follow supervisor/status until the goal is reached or refused, "
-                             "its phases and the task error on stderr")  # fmt: skip
+                             "its phases and the goal's error on stderr")  # fmt: skip
     parser.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="S",
                         help="seconds to wait for the clock, the robot's state, the "
                              f"supervisor's answer and, with --wait, each status (default "
@@ -107,9 +108,6 @@ def run(args: argparse.Namespace) -> int:
         if args.wait and supervisor is None:
             raise ValueError(f"--wait follows {topics.SUPERVISOR_STATUS.name}, and no component "
                              f"of {args.profile} writes it")  # fmt: skip
-        if args.wait and args.position:
-            raise ValueError("--wait follows the staging of a pose goal; a position goal "
-                             "passes through the supervisor unstaged")  # fmt: skip
         with target.open() as session:
             return send(args, session, profile, topic, supervisor)
     except GoalRefused as error:  # a ValueError, but of the goal, not of the input
@@ -147,7 +145,7 @@ def send(args: argparse.Namespace, session: zenoh.Session, profile: Profile,
                  if args.json else f"sent: {where}")  # fmt: skip
             return 0
         follower.sent()
-        outcome = follower.follow(Progress(follower, header.stamp_ns))
+        outcome = follower.follow(Progress(header.stamp_ns))
     finally:
         if follower is not None:
             follower.close()
@@ -197,19 +195,17 @@ def described(goal: Goal) -> str:
 
 
 class Progress:
-    """Says on stderr each phase and event of the goal as it comes, and while the robot moves
-    the controller's task error, again whenever it has halved."""
+    """Says on stderr each phase and event of the goal as it comes, and the goal's error
+    (``SupervisorStatus.error_norm``, where the supervisor gives it), again whenever it has
+    halved."""
 
-    STILL = ("idle", "planning", "reached", "unreachable")
-    """Phases with no task of their own (the robot held, or done): no error is shown."""
-
-    def __init__(self, follower: GoalFollower, sent_ns: int) -> None:
-        self.follower, self.sent_ns = follower, sent_ns
+    def __init__(self, sent_ns: int) -> None:
+        self.sent_ns = sent_ns
         self.said: tuple[str, str] | None = None
         self.error_said = math.inf
 
     def __call__(self, status: SupervisorStatus) -> None:
-        error = None if status.phase in self.STILL else self.follower.error()
+        error = status.error_norm
         news = (status.phase, status.last_event)
         if news == self.said and not (error is not None and error < self.error_said / 2):
             return
