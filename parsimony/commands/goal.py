@@ -24,7 +24,7 @@ import zenoh
 from deploy.client_goals import GoalRefused, client_goal
 from deploy.goal_follower import GoalFollower, Outcome
 from deploy.graph import dataflow
-from deploy.query import DEFAULT_TIMEOUT_S, QueryError, live_writers, overwritten_by
+from deploy.query import QueryError, live_writers, overwritten_by
 from deploy.tool_clock import ToolClock
 from messages import codec, topics
 from messages.goal import Goal
@@ -41,6 +41,9 @@ from wbc.planar import offset_pose, planar_pose
 
 SOURCE = "parsimony"
 """The source named in the goal's header."""
+TIMEOUT_S = 10.0
+"""How long the command waits for each answer by default: longer than a query's (a loaded
+machine's simulation may leave a second between two statuses)."""
 FRAMES = ("world", "base")
 
 
@@ -84,10 +87,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("--wait", action="store_true",
                         help="follow supervisor/status until the goal is reached or refused, "
                              "its phases and the goal's error on stderr")  # fmt: skip
-    parser.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="S",
+    parser.add_argument("--timeout", type=float, default=TIMEOUT_S, metavar="S",
                         help="seconds to wait for the clock, the robot's state, the "
                              f"supervisor's answer and, with --wait, each status (default "
-                             f"{DEFAULT_TIMEOUT_S:g})")  # fmt: skip
+                             f"{TIMEOUT_S:g})")  # fmt: skip
     return parser
 
 
@@ -138,12 +141,12 @@ def send(args: argparse.Namespace, session: zenoh.Session, profile: Profile,
         args.wait and supervisor is not None) else None  # fmt: skip
     try:
         put(session, key, goal, args.timeout)
-        where = described(goal)
-        print(f"goal: sent on {key}: {where}", file=sys.stderr)
+        sent = f"sent on {key}: {described(goal)}"
         if follower is None:
             emit(json_text({"topic": topic.name, "key": key, "goal": goal.model_dump()})
-                 if args.json else f"sent: {where}")  # fmt: skip
+                 if args.json else sent)  # fmt: skip
             return 0
+        print(f"goal: {sent}", file=sys.stderr)
         follower.sent()
         outcome = follower.follow(Progress(header.stamp_ns))
     finally:
