@@ -82,6 +82,8 @@ def _answering(about: str, nothing: Any = None) -> Callable:
             except Exception as error:
                 with self._lock:
                     self.errors += 1
+                log.error("view: %s failed: %s: %s", method.__name__, type(error).__name__,
+                          cut(str(error), STATUS_CHARS))  # fmt: skip
                 self._status(client, about, f"{about}: not done, the view failed: "
                              f"{type(error).__name__}: {error}", StatusLevel.Error)  # fmt: skip
                 return nothing
@@ -199,6 +201,7 @@ class ControlStation(ServerListener):
                 if not is_session_error(opening):
                     raise
                 raise SessionFailed(self._failure(zenoh_error_text(opening))) from None
+            self.failed = ""
             log.warning("view: the control station goes on on a new Zenoh session")
 
     def _failure(self, reason: str) -> str:

@@ -5,6 +5,9 @@ A parameter is named ``<component>.<name>`` (``controller.eta``). The values com
 of every component's parameter queryables; a set is the component's own set
 (``deploy.query.set_param``): the component parses and checks the value against its
 declaration (type, bounds, choices) and answers the value it now has, or why it refused it.
+Before that, ``checked`` refuses what must not reach Zenoh or the component (a name no running
+component has, or too long: a key of 64 KiB panics Zenoh; a value of no parameter's type, or
+too long) and a set the view's user may not make (``zenoh.access.parameters``).
 """
 
 from __future__ import annotations

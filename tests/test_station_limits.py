@@ -41,6 +41,7 @@ class View:
     station: ControlStation
     address: str
     node: Node
+    router: zenoh.Session
     goals: list[Goal]
     """Every goal on goal/request, heard on the router's session."""
 
@@ -72,7 +73,7 @@ def view(tmp_path: Path) -> Iterator[View]:
         with LiveView(viewing, NAMESPACE, [], 0, listener=station,
                       capabilities=station.capabilities, encodings=station.encodings) as live:
             station.attach(live.server)
-            yield View(profile, station, live.address, node, goals)
+            yield View(profile, station, live.address, node, router, goals)
         station.close()
         watcher.undeclare()
         if station.session is own:  # else Zenoh panicked in it: it cannot even close
@@ -129,11 +130,9 @@ def test_each_malformed_set_is_refused_saying_why_and_the_station_goes_on(view: 
 def test_after_its_session_fails_the_station_says_so_and_goes_on_on_a_new_one(
     view: View, caplog: pytest.LogCaptureFixture
 ) -> None:
-    """A key of more than 64 KiB panics Zenoh's transmission pipeline, and the session answers
-    nothing again (the station bounds what clients send, so here the test does it)."""
+    """After a panic in Zenoh, the session answers nothing again."""
     failed = view.station.session
-    with pytest.raises(BaseException, match="DidntWrite"):  # noqa: B017 - pyo3's PanicException
-        list(failed.get(topics.param_key(NAMESPACE, "ctl", "x" * 65536), timeout=1.0))
+    poison(failed)
     with caplog.at_level(logging.WARNING, "parsimony.view"), \
             FoxgloveClient(view.address) as client:  # fmt: skip
         client.server_info()
@@ -151,6 +150,31 @@ def test_after_its_session_fails_the_station_says_so_and_goes_on_on_a_new_one(
     assert [g.header.source for g in view.goals] == ["view"]
     errors = [r.getMessage() for r in caplog.records if r.levelno == logging.ERROR]
     assert len(errors) == 1 and "the control station's Zenoh session failed" in errors[0]
+
+
+def poison(session: zenoh.Session) -> None:
+    """Make Zenoh panic in ``session``: a key of more than 64 KiB (the station bounds what
+    clients send, so only a test can)."""
+    with pytest.raises(BaseException, match="DidntWrite"):  # noqa: B017 - pyo3's PanicException
+        list(session.get(topics.param_key(NAMESPACE, "ctl", "x" * 65536), timeout=1.0))
+
+
+def test_when_no_new_session_can_be_opened_each_goal_and_set_says_so(view: View) -> None:
+    with FoxgloveClient(view.address) as client:
+        client.server_info()
+        client.send("advertise", topic=topics.GOAL_REQUEST.name, encoding="json",
+                    schemaName="foxglove.PoseInFrame")  # fmt: skip
+        channel = client.wait_for(lambda e: e["event"] == "advertised", "the channel")["channel"]
+        view.station.session.close()
+        view.router.close()  # and no router to open a new session with
+        client.send("publish", channel=channel, text=GOAL)
+        said = client.wait_for(lambda e: e["event"] == "status", "the goal's answer")["message"]
+        assert "goal/request not sent: the view's Zenoh session failed: Unable to connect" in said
+        _, said_then = answer(client, [{"name": "ctl.eta", "value": 0.7, "type": "float64"}],
+                              "set")  # fmt: skip
+        assert len(said_then) == 1 and "the view's Zenoh session failed" in said_then[0]
+    assert view.station.failed.startswith("the view's Zenoh session failed: Unable to connect")
+    assert view.station.session_errors == 2 and not view.goals
 
 
 def test_a_client_sending_goals_faster_than_their_rate_is_told_its_goals_are_dropped(
