@@ -118,7 +118,7 @@ def test_a_change_of_a_components_state_is_said(
     write_profile: ProfileWriter, launch: LaunchFixture
 ) -> None:
     """On simulated time with no simulator, its clock stalls: the launcher says so."""
-    profile = write_profile([publisher("pub")], clock="sim", clock_timeout_s=0.2, watchdog_s=1.0)
+    profile = write_profile([publisher("pub")], clock="sim", clock_timeout_s=0.2)
     launched = launch(profile)
     alive, _, _ = launched.wait_for(r"\[launch\] pub alive")
     launched.wait_for(r"\[launch\] pub clock stalled \(was running\)", after=alive)
@@ -128,11 +128,12 @@ def test_a_change_of_a_components_state_is_said(
 def test_duration_ends_the_launch_cleanly(
     write_profile: ProfileWriter, launch: LaunchFixture
 ) -> None:
+    """Whether or not pub was alive by then (on a loaded machine it may not be in 1.5 s): a
+    SIGTERM before its handler is set is a clean stop too."""
     launched = launch(write_profile([publisher("pub")]), "--duration", "1.5")
-    launched.wait_for(r"\[launch\] pub alive")
     assert launched.process.wait(10.0) == 0
     launched.wait_for(r"\[launch\] stopping \(end of duration\)")
-    launched.wait_for(r"\[launch\] pub stopped \(0\)")
+    launched.wait_for(r"\[launch\] pub stopped \((0|-15)\)")
 
 
 def test_the_launcher_warns_of_a_topic_read_and_never_written(
