@@ -106,6 +106,9 @@ def run(args: argparse.Namespace) -> int:
                                f"{', '.join(r['writers']) or '-'} -> "
                                f"{', '.join(r['readers']) or '-'}" for r in rows))  # fmt: skip
             return 0
+        if args.timeout is not None and not (math.isfinite(args.timeout) and args.timeout > 0):
+            raise ValueError(f"--timeout: expected a finite number of seconds > 0, got "
+                             f"{args.timeout}")  # fmt: skip
         with target.open() as session:
             return {"echo": echo, "hz": hz, "pub": pub}[args.action](args, session, profile)
     except (ProfileError, QueryError, LookupError, ValueError) as error:
