@@ -14,7 +14,9 @@ gripper to over the arm's back: with the wrist rolled, the base of a configurati
 may face any way from the gripper's heading, and the arm folded back puts the gripper behind
 the base. Candidates whose base, staging point or final leg comes within reach of an obstacle
 are left out, and so are those with no way round the obstacles to their staging point
-(wbc.drive_planner). Each candidate is scored, lower first:
+(wbc.drive_planner), and those whose base, staging point or way leaves the ``region`` the base
+must keep to (the floor the camera sees, where the base keeps its fixes). Each candidate is
+scored, lower first:
 
     travel + heading_weight * turning + conditioning_weight * max(0, 1 - sigma_6 / sigma_floor)
 
@@ -93,6 +95,9 @@ class StagingParams:
     obstacle the LP's obstacle row holds the base back from the pose (the vector-field
     inequality lets it near the margin no faster than eta_d d; 5.28 there demands the base move
     out faster than its speed bounds allow, and the program has no solution)."""
+    region: tuple[tuple[float, float, float], ...] = ()
+    """Where the base's axle must keep to, as half-planes (a, b, c), a x + b y <= c (a convex
+    region: the floor the camera sees, ``sim2d.floor_view``); empty: anywhere."""
     max_distance: float = 10.0
     """A goal farther than this from the base is refused, m: the search's residual loses its
     precision far from the origin (a goal 100 m away took 2.1 s to fail)."""
@@ -231,7 +236,7 @@ def plan(robot: MobileManipulator, q_now: Array, goal_pose: Array,
             return done(found, "" if found else spent)
     if found:
         return done(found)
-    if left_out.near or left_out.no_way:
+    if left_out.any:
         return done((), left_out.reason(params.clearance))
     return done((), "no whole-body configuration inside the joint box reaches the goal")
 
@@ -245,6 +250,12 @@ class _LeftOut:
     no_way: int = 0
     """No way round the obstacles to the staging point."""
     way_reason: str = ""
+    outside: int = 0
+    """Base, staging point or way outside the region."""
+
+    @property
+    def any(self) -> bool:
+        return bool(self.near or self.no_way or self.outside)
 
     def reason(self, clearance: float) -> str:
         parts = []
@@ -252,8 +263,10 @@ class _LeftOut:
             parts.append(f"{self.near} bring the base within {clearance:g} m of an obstacle")
         if self.no_way:
             parts.append(f"{self.no_way} have no way to their staging point ({self.way_reason})")
+        if self.outside:
+            parts.append(f"{self.outside} take the base where the camera cannot see it")
         return (f"every whole-body configuration found that reaches the goal "
-                f"({self.near + self.no_way}) is left out: {'; '.join(parts)}")
+                f"({self.near + self.no_way + self.outside}) is left out: {'; '.join(parts)}")
 
 
 def refusal(q_now: Array, goal_pose: Array, obstacles: Sequence[Circle],
@@ -310,6 +323,9 @@ def _search(robot: MobileManipulator, q_now: Array, goal_pose: Array, ways: WayP
         if final_leg is None:
             left_out.near += 1
             continue
+        if not within(params.region, q, staging_point(q[:BASE_DOF], final_leg)):
+            left_out.outside += 1
+            continue
         if _near(q_now, q, params.final_legs[0]) and segment_clear(q_now, q, obstacles, body):
             found.append(_scored(robot, q_now, q, None, final_leg, obstacles, params))
             continue
@@ -320,6 +336,9 @@ def _search(robot: MobileManipulator, q_now: Array, goal_pose: Array, ways: WayP
         if not way.found:
             left_out.no_way += 1
             left_out.way_reason = way.reason
+            continue
+        if not within(params.region, *way.waypoints):
+            left_out.outside += 1
             continue
         found.append(_scored(robot, q_now, q, way, final_leg, obstacles, params))
     return found, True
@@ -336,6 +355,12 @@ def _final_leg(q: Array, obstacles: Sequence[Circle], body: float,
         if clear_of(obstacles, staging, body) and segment_clear(staging, q, obstacles, body):
             return leg
     return None
+
+
+def within(region: Sequence[tuple[float, float, float]], *points: Array) -> bool:
+    """Every point's (x, y) inside ``region`` (``StagingParams.region``): between two of
+    them, the segment too, the region being convex."""
+    return all(a * p[0] + b * p[1] <= c for p in points for a, b, c in region)
 
 
 def same_kind(a: Array, b: Array) -> bool:

@@ -9,6 +9,10 @@ import numpy as np
 
 from messages.obstacles import MAX_CIRCLES
 
+CHECK_GAP_S = 0.1
+"""CPU time a plan may run past its budget: the work between two looks at the clock (the
+way's graph looks once per disc it joins, at most 25 ms of work with 256 circles)."""
+
 CLEAR_M = 0.8
 """No circle's centre comes this close to a point kept clear, m."""
 

@@ -7,11 +7,11 @@ import time
 
 import numpy as np
 import pytest
-from crowd import crowd
 from wbc_scenarios import robot
 
 from parsimony.goal_sets import FAMILIES, goals
 from parsimony.kinematic_demo import supervised_params
+from tests.wbc.crowd import CHECK_GAP_S, crowd
 from wbc import dq
 from wbc.conditioning import smallest_singular_value
 from wbc.drive_tasks import HeadingTask, PointTask, offset_point
@@ -202,11 +202,6 @@ def test_a_search_stops_at_its_cpu_budget_and_says_so() -> None:
     assert not spent.candidates and "planning budget" in spent.reason
 
 
-CHECK_GAP_S = 0.1
-"""CPU time a plan may run past its budget: the work between two looks at the clock (the
-way's graph looks once per disc it joins, at most 25 ms with 256 circles)."""
-
-
 def test_a_plan_round_the_most_circles_a_message_holds_keeps_to_its_cpu_budget() -> None:
     """256 circles: building the way's graph alone took 3.3-4.8 s of CPU past a budget of 2,
     and the plan 6.1 s here. The budget now holds for the whole plan, graph included, and the
@@ -220,6 +215,23 @@ def test_a_plan_round_the_most_circles_a_message_holds_keeps_to_its_cpu_budget()
     cpu_s = time.thread_time() - started
     assert cpu_s <= params.budget_s + CHECK_GAP_S, cpu_s
     assert not spent.candidates and "planning budget of 0.3 s" in spent.reason, spent.reason
+
+
+def test_candidates_whose_base_would_leave_the_region_are_left_out_and_named_so() -> None:
+    """The region is the floor the camera sees: a base driven out of it loses its fixes (in
+    a soak the state went invalid so and stayed). Every candidate kept stands, stages and
+    drives inside it; with none inside, the reason says so."""
+    goal = MODEL.fkm(np.array([0.6, 0.1, 0.2, 0.0, -0.3, -0.4, 0.2, 0.3]))
+    best = plan(MODEL, HOME, goal).candidates[0]
+    region = ((0.0, 1.0, float(best.base[1]) - 0.005),)  # y <= just under the best's
+    kept = plan(MODEL, HOME, goal, params=StagingParams(region=region))
+    assert kept.candidates and not kept.reason
+    for c in kept.candidates:
+        points = [c.base, c.staging, *(c.way.waypoints if c.way else ())]
+        assert all(p[1] <= region[0][2] for p in points), points
+    nowhere = plan(MODEL, HOME, goal, params=StagingParams(region=((1.0, 0.0, -0.5),)))
+    assert not nowhere.candidates
+    assert "take the base where the camera cannot see it" in nowhere.reason, nowhere.reason
 
 
 def test_candidates_all_blocked_by_obstacles_are_named_as_such() -> None:
