@@ -28,7 +28,7 @@ from pydantic_core import PydanticCustomError
 
 from messages import topics
 from messages.process import ParamValue
-from profiles.access import AccessSettings, insert
+from profiles.access import EVERY_COMPONENT, AccessSettings, insert
 from profiles.endpoints import endpoint_problem
 from profiles.profile_files import ProfileError, read_profile_data
 from profiles.scene import Scene
@@ -269,7 +269,7 @@ class Profile(StrictModel):
     components: list[ComponentSpec] = Field(min_length=1)
 
     @model_validator(mode="after")
-    def _components_have_credentials(self) -> Profile:
+    def _access_fits_the_components(self) -> Profile:
         access = self.zenoh.access
         if access is not None:
             users = access.users()
@@ -278,6 +278,11 @@ class Profile(StrictModel):
                     raise ValueError(f"components[{index}].name: {spec.name!r} has no line in "
                                      f"{access.credentials}; each component authenticates "
                                      "as its name")  # fmt: skip
+            names = [spec.name for spec in self.components]
+            for name in access.parameters:
+                if name != EVERY_COMPONENT and name not in names:
+                    raise ValueError(f"zenoh.access.parameters.{name}: names no component of "
+                                     f"the profile (have {', '.join(names)})")  # fmt: skip
         return self
 
     @model_validator(mode="after")
