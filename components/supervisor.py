@@ -4,31 +4,45 @@ It reads the goal the operator (or the state estimator, remapped) gives on ``goa
 the robot state and the obstacles, and for a pose goal runs ``wbc.staging_supervisor``: it
 plans where the base should stand and publishes on ``control/goal`` the task of each phase
 (drive, turn, approach, then the pose task itself), with every robot state, so that the
-controller, which alone commands the robot, steps the LP on it.
+controller, which alone commands the robot, steps the LP on it. A goal of another kind (a
+position...) passes through as it is (phase ``direct``) until its task's error is within
+``pose_tolerance`` (``reached``).
 
 Plans run on a planner thread of their own, never on the handler thread that answers status
-queries (a plan is bounded by ``wbc.staging.StagingParams.budget_s`` of CPU time, and a goal
-too far or inside an obstacle is refused at once). While one runs, and once a goal is found
-unreachable, the supervisor publishes a ``point`` goal that holds the base and arm where they
-stood when it began, so the robot stops, and says why on ``supervisor/status``. A request
-refused as malformed (a NaN, a pose that is not a unit dual quaternion...) leaves the current
-goal as it is and is reported on the status with its reason (``refusals``, ``last_refusal``).
-Position goals pass through unchanged. A goal moved by more than ``MEASUREMENT_TOLERANCE`` is
-a new goal and is planned afresh; a restarted supervisor reports ``idle`` until a goal comes,
-and plans again from where the robot is.
+queries (a whole plan, its way round the obstacles included, is bounded by
+``planning_budget_s`` of CPU time, and a goal too far or inside an obstacle is refused at once).
+With the profile's scene, a plan keeps the base where the scene's ceiling camera sees its
+marker (``keep_in_view``), and a goal of another kind whose target lies out of that sight,
+or farther than a plan may cover, is refused. While a plan runs, and once a goal is found
+unreachable, refused or aborted, the supervisor publishes a ``point`` goal that holds the base
+and arm where they stood, so the robot stops, and says why on ``supervisor/status``.
+
+A goal is taken on the first robot state after it: without a valid one (no camera fix yet,
+or no state for ``STATE_TIMEOUT_S``) it is refused, and a goal under way when the state goes
+invalid is aborted (the robot does not drive off again on its own when a fix comes back; the
+same goal sent again is taken anew). A request refused as malformed (a NaN, a pose that is
+not a unit dual quaternion...) leaves the current goal as it is and is reported on the status
+with its reason (``refusals``, ``last_refusal``). A goal moved by more than
+``MEASUREMENT_TOLERANCE`` is a new goal and is planned afresh; a restarted supervisor reports
+``idle`` until a goal comes, and plans again from where the robot is. A status goes out with
+every robot state, with every request refused, and every ``STATUS_EVERY_S`` while neither
+comes.
 """
 
 from __future__ import annotations
 
 import logging
+import math
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+from components.control_step import task_of
 from components.controller import goal_of
 from components.params import Param, ParamError, load_robot
 from components.process_entry import run_component
 from components.pubsub import Input
+from components.robot_sight import RobotSight
 from components.runtime import Component, Node
 from messages import topics
 from messages.goal import Goal
@@ -37,7 +51,7 @@ from messages.state import RobotState
 from messages.supervisor import SupervisorStatus
 from wbc.drive_tasks import PointTask, offset_point
 from wbc.obstacles import Circle
-from wbc.staging import Plan
+from wbc.staging import Plan, StagingParams, within
 from wbc.staging_supervisor import PlanRequest, StagingSupervisor, SupervisorParams
 from wbc.task import MEASUREMENT_TOLERANCE, PoseTask, Task, same_task
 
@@ -46,6 +60,10 @@ log = logging.getLogger("components.supervisor")
 DEFAULTS = SupervisorParams()
 COUNTED = {"plan": "plans", "replan": "replans", "stall": "stalls", "unreachable": "unreachable"}
 """The supervisor's events that are counted, and their counters."""
+STATUS_EVERY_S = 0.5
+"""A status goes out at least this often (the profile's clock), states or none."""
+STATE_TIMEOUT_S = 1.0
+"""With no robot state for this long (the profile's clock) the supervisor has none."""
 
 
 class Supervisor(Component):
@@ -61,8 +79,14 @@ class Supervisor(Component):
         Param("max_replans", int, DEFAULTS.max_replans, low=0, high=20,
               doc="re-plans after stalls before the goal is reported unreachable"),
         Param("pose_tolerance", float, 5e-3, low=1e-5, high=0.5,
-              doc="||vec8(x - x_d)|| under which the pose goal counts as reached (looser "
-                  "than the kinematic bench's: a measured pose jitters)"),
+              doc="||e|| of the goal's task under which it counts as reached (||vec8(x - x_d)||"
+                  " for a pose: looser than the kinematic bench's, a measured pose jitters)"),
+        Param("planning_budget_s", float, StagingParams.budget_s, low=0.05, high=30.0,
+              doc="CPU seconds a plan may take, its way round the obstacles included"),
+        Param("keep_in_view", bool, True,
+              doc="plans keep the base where the scene's camera sees its marker, and goals "
+                  "out of its sight are refused (the scene's camera position and reference_pose "
+                  "must place the camera)"),
     )  # fmt: skip
 
     def __init__(self, node: Node) -> None:
@@ -72,7 +96,15 @@ class Supervisor(Component):
         self.robot = load_robot(node.profile.robot)
         self.goal_out = node.publisher(topics.CONTROL_GOAL)
         self.status_out = node.publisher(topics.SUPERVISOR_STATUS)
+        self.sight = RobotSight(node.profile.scene, STATE_TIMEOUT_S)
         self.request: Goal | None = None
+        self.fresh = False
+        """The request has met no robot state yet: it is taken (or refused) on the next."""
+        self.ended: tuple[str, str] | None = None
+        """(``refused`` or ``aborted``, why) where the current request was given up."""
+        self.reached = False
+        """A direct goal's task was met."""
+        self.error_norm: float | None = None
         self.supervisor: StagingSupervisor | None = None
         self.obstacles: tuple[Circle, ...] = ()
         self.planner = ThreadPoolExecutor(max_workers=1, thread_name_prefix="planner")
@@ -82,62 +114,134 @@ class Supervisor(Component):
         """The stamp of the latest state, s."""
         self._events_reported = 0
         self._hold: PointTask | None = None
-        """Where the robot stands still while a plan runs or after its goal was found
-        unreachable."""
+        """Where the robot stands still while a plan runs or after its goal was given up."""
+        self._published = 0
+        """Statuses published since the last tick of the status timer."""
         self.last_refusal = ""
-        for name in (*COUNTED.values(), "refusals"):
+        for name in (*COUNTED.values(), "refusals", "aborted"):
             node.counters[name] = 0
         node.subscribe(topics.GOAL_REQUEST, self.on_request, on_reject=self.on_refused)
         node.subscribe(topics.WORLD_OBSTACLES, self.on_obstacles)
         node.subscribe(topics.ROBOT_STATE, self.on_state)
+        node.timer(STATUS_EVERY_S, self.on_tick)
 
     def on_obstacles(self, message: Obstacles) -> None:
         self.obstacles = circles_of(message)
 
     def on_request(self, goal: Goal) -> None:
-        """A new goal replaces the supervisor; the same goal measured again keeps it."""
-        if self.request is not None and goal.task == self.request.task == "pose":
-            if same_task(PoseTask(np.array(self.request.pose)), PoseTask(np.array(goal.pose)),
-                         MEASUREMENT_TOLERANCE):  # fmt: skip
+        """A new goal replaces the current one, to be taken on the next state; the same goal
+        measured again keeps it (unless it was given up)."""
+        request = self.request
+        if request is not None and self.ended is None and goal.task == request.task:
+            if same_task(task_of(request), task_of(goal), MEASUREMENT_TOLERANCE):
                 return
-        self.request, self.supervisor, self._events_reported = goal, None, 0
+        self.request, self.fresh, self.ended = goal, True, None
+        self.supervisor, self._events_reported, self.reached = None, 0, False
         self._hold = self._planning = None
+        self.error_norm = None
 
     def on_refused(self, reason: str) -> None:
         """A malformed request: counted, and said on the status at once."""
         self.node.count("refusals")
         self.last_refusal = reason
-        self.status_out.put(self._status(self.node.clock.now_ns()))
+        self._publish(self.node.clock.now_ns())
 
     def on_state(self, state: RobotState) -> None:
-        """Advance the phases and publish the controller's goal and the status."""
-        request, stamp = self.request, state.header.stamp_ns
-        if request is None:
-            self.status_out.put(self._status(stamp))
-            return
-        if not state.valid:
-            return
-        if request.task != "pose":
-            self.goal_out.put(request.model_copy(update={"header": self.node.header()}))
-            return
-        q = np.array(state.configuration())
+        """Take a new goal, advance the phases, publish the controller's goal and the status."""
+        stamp, request = state.header.stamp_ns, self.request
         self._t = stamp / 1e9
+        self.sight.saw(state)
+        if not state.valid:
+            self._give_up(self.sight.missing(stamp))
+        elif request is not None:
+            q = np.array(state.configuration())
+            if self.fresh:
+                self._give_up(self._refusal(request, q))
+                self.fresh = False
+            if self.ended is not None:
+                self.goal_out.put(self._goal_of(self._held(q), request, stamp))
+            else:
+                pose, jacobian = self.robot.kinematics(q)
+                error = float(np.linalg.norm(task_of(request).error(pose, jacobian, q)[0]))
+                self.error_norm = error if math.isfinite(error) else None  # a goal at 1e300
+                if request.task == "pose":
+                    self.goal_out.put(self._goal_of(self._staged(request, q), request, stamp))
+                else:
+                    self._direct(request, stamp)
+        self._publish(stamp)
+
+    def on_tick(self) -> None:
+        """Timer: a status when none went out since the last tick; a goal not taken yet
+        refused when no state came for ``STATE_TIMEOUT_S`` (one under way is kept: the
+        controller stops on a stale state, and the status says there is none)."""
+        now = self.node.clock.now_ns()
+        if self.fresh and self.sight.stale(now):
+            self._give_up(self.sight.missing(now))
+        if self._published == 0:
+            self._publish(now)
+        self._published = 0
+
+    def _direct(self, request: Goal, stamp: int) -> None:
+        """A goal of another kind than a pose: passed on, and reached once its error is within
+        ``pose_tolerance``."""
+        self.goal_out.put(request.model_copy(update={"header": self.node.header(stamp_ns=stamp)}))
+        if not self.reached and self.error_norm is not None and (
+                self.error_norm < self.node.params["pose_tolerance"]):  # fmt: skip
+            self.reached = True
+            log.info("reached at %.2f s: %s goal, error %.3g", self._t, request.task,
+                     self.error_norm)  # fmt: skip
+
+    def _staged(self, request: Goal, q: np.ndarray) -> Task:
+        """The task of the pose goal's phase at q (a hold while it plans or once it is
+        unreachable), its plan handed to the planner thread when one is due."""
         if self.supervisor is None:
             self.supervisor = StagingSupervisor(self.robot, np.array(request.pose),
-                                                self.obstacles, self._params())  # fmt: skip
+                                                self.obstacles, self._params(),
+                                                self._staging())  # fmt: skip
         supervisor = self.supervisor
         task = supervisor.update(q, self._t)
         if supervisor.pending is not None and supervisor.pending is not self._planning:
             self._planning, self._hold = supervisor.pending, None
             self.planner.submit(self._plan, supervisor, supervisor.pending)
         self._report_events(supervisor)
-        if task is None:
-            if self._hold is None:
-                self._hold = PointTask(offset_point(q, DEFAULTS.lookahead), q[3:],
-                                       DEFAULTS.lookahead)  # fmt: skip
-            task = self._hold
-        self.goal_out.put(self._goal_of(task, request, stamp))
-        self.status_out.put(self._status(stamp))
+        return task if task is not None else self._held(q)
+
+    def _held(self, q: np.ndarray) -> PointTask:
+        """The robot held where it stood when the hold began."""
+        if self._hold is None:
+            self._hold = PointTask(offset_point(q, DEFAULTS.lookahead), q[3:], DEFAULTS.lookahead)
+        return self._hold
+
+    def _refusal(self, request: Goal, q: np.ndarray) -> str:
+        """Why a goal of another kind than a pose is refused at q: its target farther than a
+        plan may cover, or where the camera cannot see the base; else empty (a pose goal's
+        plan says so itself)."""
+        if request.task == "pose":
+            return ""
+        x, y = request.position[:2] if request.task == "position" else request.point
+        distance, limit = math.hypot(x - q[0], y - q[1]), StagingParams.max_distance
+        if not distance <= limit:
+            return (f"the {request.task} goal is {distance:.3g} m from the base, farther than "
+                    f"the {limit:g} m a goal may lie")  # fmt: skip
+        region = self._region()
+        if region and not within(region, (x, y)):
+            return (f"the {request.task} goal's ({x:.2f}, {y:.2f}) m lies where the camera "
+                    "cannot see the base (keep_in_view)")  # fmt: skip
+        return ""
+
+    def _give_up(self, reason: str) -> None:
+        """Refuse the goal not taken yet, or abort the one under way, for ``reason`` (empty:
+        neither)."""
+        if not reason or self.request is None or self.ended is not None:
+            return
+        phase = "refused" if self.fresh else "aborted"
+        self.ended, self.supervisor, self._planning = (phase, reason), None, None
+        if self.fresh:
+            self.node.count("refusals")
+            self.last_refusal = reason
+        else:
+            self.node.count("aborted")
+        self.node.warn(phase, f"goal {phase} at {self._t:.2f} s: {reason}")
 
     def _plan(self, supervisor: StagingSupervisor, request: PlanRequest) -> None:
         """Planner thread: run the plan, hand it to the handler thread."""
@@ -154,7 +258,7 @@ class Supervisor(Component):
             return
         supervisor.take(found, self._t)
         self._report_events(supervisor)
-        self.status_out.put(self._status(self.node.clock.now_ns()))
+        self._publish(self.node.clock.now_ns())
 
     def _params(self) -> SupervisorParams:
         p = self.node.params
@@ -162,6 +266,13 @@ class Supervisor(Component):
                                 stall_reduction=p["stall_reduction"],
                                 max_replans=p["max_replans"],
                                 pose_tolerance=p["pose_tolerance"])  # fmt: skip
+
+    def _staging(self) -> StagingParams:
+        return StagingParams(budget_s=self.node.params["planning_budget_s"],
+                             region=self._region())  # fmt: skip
+
+    def _region(self) -> tuple[tuple[float, float, float], ...]:
+        return self.sight.region if self.node.params["keep_in_view"] else ()
 
     def _goal_of(self, task: Task, request: Goal, stamp_ns: int) -> Goal:
         """The controller's goal for ``task``: the operator's own for the pose task (with its
@@ -180,19 +291,31 @@ class Supervisor(Component):
             log.log(level, "%s at %.2f s: %s", event.kind, event.t, event.detail)
         self._events_reported = len(supervisor.events)
 
+    def _publish(self, stamp_ns: int) -> None:
+        self.status_out.put(self._status(stamp_ns))
+        self._published += 1
+
     def _status(self, stamp_ns: int) -> SupervisorStatus:
-        """What the supervisor does now: ``idle`` with no goal, else its phase."""
-        header = self.node.header(stamp_ns=stamp_ns)
-        refused = {"refusals": self.node.counters["refusals"], "last_refusal": self.last_refusal}
-        supervisor = self.supervisor
+        """What the supervisor does now: ``idle`` with no goal, else the goal's phase."""
+        request, supervisor = self.request, self.supervisor
+        if request is None:
+            phase = "idle"
+            reason = self.sight.missing(stamp_ns) or "no goal on goal/request yet"
+        elif self.ended is not None:
+            phase, reason = self.ended
+        elif request.task != "pose":
+            phase, reason = ("reached" if self.reached else "direct"), ""
+        elif supervisor is None:
+            phase, reason = "planning", ""
+        else:
+            phase, reason = supervisor.phase.value, supervisor.reason
+        fields = dict(header=self.node.header(stamp_ns=stamp_ns), phase=phase, reason=reason,
+                      error_norm=self.error_norm, refusals=self.node.counters["refusals"],
+                      last_refusal=self.last_refusal, **self.sight.fields(stamp_ns))  # fmt: skip
         if supervisor is None:
-            return SupervisorStatus(header=header, phase="idle", candidate=0, plans=0, replans=0,
-                                    stalls=0, reason="no goal on goal/request yet",
-                                    **refused)  # fmt: skip
+            return SupervisorStatus(candidate=0, plans=0, replans=0, stalls=0, **fields)
         candidate = supervisor.candidate
         return SupervisorStatus(
-            header=header,
-            phase=supervisor.phase.value,
             candidate=len(supervisor.tried),
             candidate_base=None if candidate is None else tuple(candidate.base.tolist()),
             candidate_arm=None if candidate is None else tuple(candidate.arm.tolist()),
@@ -200,10 +323,11 @@ class Supervisor(Component):
             plans=len(supervisor.planning_s),
             replans=supervisor.replans,
             stalls=sum(e.kind == "stall" for e in supervisor.events),
-            reason=supervisor.reason,
             last_event=supervisor.events[-1].detail if supervisor.events else "",
             planning_ms=supervisor.planning_s[-1] * 1e3 if supervisor.planning_s else None,
-            **refused,
+            planning_cpu_ms=(supervisor.planning_cpu_s[-1] * 1e3
+                             if supervisor.planning_cpu_s else None),  # fmt: skip
+            **fields,
         )
 
     def shutdown(self) -> None:

@@ -9,23 +9,28 @@ from collections.abc import Callable
 import msgpack
 import numpy as np
 import pytest
+import yaml
 from conftest import DEADLINE_S, System
 from driver_harness import status as component_status
 
 from components.control_step import task_of
 from components.controller import goal_of
-from deploy import ROBOT_FILE
+from components.robot_sight import sight_region
+from deploy import DEPLOY, ROBOT_FILE
 from messages import codec, topics
 from messages.goal import Goal
 from messages.header import Header
 from messages.obstacles import Circle, Obstacles
 from messages.state import RobotState
 from messages.supervisor import SupervisorStatus
+from profiles.profile_files import read_profile_data
+from tests.wbc.crowd import CHECK_GAP_S, crowd
 from wbc import dq
-from wbc.drive_tasks import HeadingTask, PointTask
+from wbc.drive_tasks import HeadingTask, PointTask, offset_point
 from wbc.planar import planar_pose
 from wbc.robot import MobileManipulator
 from wbc.scenarios import HOME, REACH_GOAL
+from wbc.staging import within
 from wbc.task import PoseTask, PositionTask, same_task
 
 MODEL = MobileManipulator.from_yaml(ROBOT_FILE)
@@ -64,22 +69,31 @@ class Operator:
         fields = {"header": header().model_dump(), "task": "pose", **fields}
         self.request.put(msgpack.packb([codec.FORMAT_TAG, "Goal", fields], use_bin_type=True))
 
-    def send_state(self, q: np.ndarray) -> None:
+    def send_state(self, q: np.ndarray, valid: bool = True, age_s: float = 0.0) -> None:
         header = Header(stamp_ns=time.time_ns(), frame="world", seq=0, source="test")
         x = tuple(self.robot.fkm(q))
         state = RobotState(header=header, base_pose=tuple(q[:3]), arm_joints=tuple(q[3:]),
-                           end_effector=x, valid=True, age_s=0.0)  # fmt: skip
+                           end_effector=x, valid=valid, age_s=age_s)  # fmt: skip
         self.state.put(codec.encode(state))
+
+    def send_goal(self, goal: Goal) -> None:
+        self.request.put(codec.encode(goal))
+
+    def statuses_after(self, count: int, q: np.ndarray, what: str, **state: object
+                       ) -> SupervisorStatus:  # fmt: skip
+        """A state at q, and the first status of the supervisor's ``count``-th on."""
+        self.send_state(q, **state)
+        return self.statuses.wait_for(lambda s: self.statuses.messages.index(s) >= count, what)
 
 
 def header() -> Header:
     return Header(stamp_ns=time.time_ns(), frame="world", seq=0, source="test")
 
 
-def supervised(deployed: Callable[[str], System]) -> Operator:
+def supervised(deployed: Callable[[str], System], profile: str = PROFILE) -> Operator:
     """The supervisor process and the test as its operator; states go out until its first
     (idle) status comes back, so that its session knows the test's subscribers."""
-    system = deployed(PROFILE)
+    system = deployed(profile)
     system.start("supervisor")
     operator = Operator(system)
     deadline = time.monotonic() + DEADLINE_S
@@ -269,3 +283,152 @@ def test_status_queries_are_answered_while_a_plan_runs_on_the_planner_thread(
     assert "no way round the obstacles" in verdict.reason, verdict.reason
     after = component_status(operator.system, "supervisor")
     assert after is not None and after.counters["unreachable"] == 1
+
+
+def met_at(q: np.ndarray) -> dict[str, Goal]:
+    """A goal of each kind but the pose whose task is met at configuration q."""
+    d = 0.03
+    position = PositionTask(dq.translation(MODEL.fkm(q))[1:])
+    point = PointTask(offset_point(q, d), q[3:], d)
+    heading = HeadingTask(float(q[2]), q[3:], q[:2])
+    return {task.__class__.__name__: goal_of(task, header()) for task in (position, point, heading)}
+
+
+@pytest.mark.parametrize("kind", ["PositionTask", "PointTask", "HeadingTask"])
+def test_a_goal_of_every_kind_has_a_status_with_every_state_until_and_after_it_is_reached(
+    deployed: Callable[[str], System], kind: str
+) -> None:
+    """A position goal is passed on to the controller as it is: the status stopped there (its
+    counter stuck at 1501, `topic echo --count 1` hung). Each state now brings a status,
+    ``direct`` with the task's error, then ``reached``, and statuses go on after it."""
+    operator = supervised(deployed)
+    goal = met_at(REACH_GOAL)[kind]
+    operator.send_goal(goal)
+    operator.send_state(HOME)
+    direct = operator.statuses.wait_for(lambda s: s.phase == "direct", "the goal's first status")
+    assert direct.error_norm is not None and direct.error_norm > 0.01
+    passed = operator.goals.wait_for(lambda g: g.task == goal.task, "the goal passed on")
+    assert passed.model_dump(exclude={"header"}) == goal.model_dump(exclude={"header"})
+    count = len(operator.statuses.messages)
+    reached = operator.statuses_after(count, REACH_GOAL, "the status of the goal met")
+    assert reached.phase == "reached" and reached.error_norm < 1e-9, reached
+    for _ in range(3):
+        after = operator.statuses_after(len(operator.statuses.messages), REACH_GOAL, "one more")
+        assert after.phase == "reached"
+
+
+def test_an_invalid_state_aborts_the_goal_refuses_new_ones_and_the_status_says_why(
+    deployed: Callable[[str], System],
+) -> None:
+    """In a soak the state went invalid (no camera fix) and the supervisor went silent for
+    865 s, ignoring 88 goals with no word. Now every invalid state brings a status that says
+    why and since when; the goal under way is aborted, a new one refused with that reason,
+    and when the state is valid again the robot is held where it stands, not sent on."""
+    operator = supervised(deployed)
+    operator.ask(operator.robot.fkm(REACH_GOAL))
+    operator.send_state(HOME)
+    operator.statuses.wait_for(lambda s: s.phase not in ("idle", "planning"), "the plan")
+    aborted = operator.statuses_after(len(operator.statuses.messages), HOME, "the abort",
+                                      valid=False, age_s=12.0)  # fmt: skip
+    assert aborted.phase == "aborted" and aborted.state == "invalid", aborted
+    assert aborted.no_fix_s == 12.0 and aborted.state_since_s is not None
+    assert "no valid robot state for 0.0 s (no camera fix of the base for 12.0 s)" in (
+        aborted.reason), aborted.reason  # fmt: skip
+    goals = len(operator.goals.messages)
+    for _ in range(3):
+        later = operator.statuses_after(len(operator.statuses.messages), HOME, "a later status",
+                                        valid=False, age_s=13.0)  # fmt: skip
+        assert later.phase == "aborted" and later.no_fix_s == 13.0
+    operator.ask(operator.robot.fkm(REACH_GOAL))
+    refused = operator.statuses_after(len(operator.statuses.messages), HOME, "the refusal",
+                                      valid=False, age_s=14.0)  # fmt: skip
+    assert refused.phase == "refused" and refused.refusals == 1, refused
+    assert refused.reason == refused.last_refusal and "no camera fix of the base for 14.0 s" in (
+        refused.reason)  # fmt: skip
+    assert len(operator.goals.messages) == goals  # nothing for the controller meanwhile
+    back = operator.statuses_after(len(operator.statuses.messages), REACH_GOAL, "valid again")
+    assert back.phase == "refused" and back.state == "valid"
+    hold = operator.goals.wait_for(lambda g: operator.goals.messages.index(g) >= goals, "hold")
+    assert hold.task == "point"
+    np.testing.assert_allclose(hold.arm, REACH_GOAL[3:])
+
+
+def test_a_plan_round_256_circles_keeps_to_its_cpu_budget_and_says_it_ran_out(
+    deployed: Callable[[str], System],
+) -> None:
+    """256 circles, an obstacles message's limit: building the way's graph alone took 3.3 to
+    4.8 s of CPU past the budget, and one plan 17.1 s of wall time. The whole plan now keeps
+    to the budget (CPU time: the machine's load does not count), and the status says why the
+    goal is unreachable."""
+    system = yaml.safe_load(PROFILE)
+    system["components"][0]["params"] = {"planning_budget_s": 0.5}
+    operator = supervised(deployed, yaml.safe_dump(system))
+    goal = operator.robot.fkm(REACH_GOAL)
+    x, y = dq.translation(goal)[1:3]
+    take_obstacles(operator, tuple(Circle(x=cx, y=cy, radius=r)
+                                   for cx, cy, r in crowd(((HOME[0], HOME[1]), (x, y)))))
+    operator.ask(goal)
+    operator.send_state(HOME)
+    verdict = operator.statuses.wait_for(lambda s: s.phase == "unreachable", "the verdict",
+                                         timeout_s=60.0)  # fmt: skip
+    assert "planning budget of 0.5 s of CPU time" in verdict.reason, verdict.reason
+    assert verdict.planning_cpu_ms is not None
+    assert verdict.planning_cpu_ms <= 500.0 + 1e3 * CHECK_GAP_S, verdict.planning_cpu_ms
+
+
+def test_goals_that_would_take_the_base_out_of_the_cameras_sight_are_turned_down(
+    deployed: Callable[[str], System],
+) -> None:
+    """With the scene's ceiling camera (here right above F0, where the test's states put the
+    robot), a position goal whose target it cannot see is refused, a pose goal whose every
+    configuration stands out of its sight is unreachable for that reason, and one it sees is
+    planned with the base, staging point and way in sight."""
+    system = yaml.safe_load(PROFILE)
+    scene = read_profile_data(DEPLOY / "sim.yaml")["scene"]
+    system["scene"] = {**scene, "reference_pose": [*scene["camera"]["position"][:2], 0.0]}
+    operator = supervised(deployed, yaml.safe_dump(system))
+    region = sight_region(operator.system.profile.scene)
+    assert region and within(region, HOME[:2])
+    out_of_sight = np.concatenate(([3.5, 0.0, 0.0], REACH_GOAL[3:]))
+    assert not within(region, out_of_sight[:2])
+    target = dq.translation(operator.robot.fkm(out_of_sight))[1:]
+    operator.send_goal(Goal(header=header(), task="position", position=tuple(target)))
+    refused = operator.statuses_after(len(operator.statuses.messages), HOME, "the refusal")
+    assert refused.phase == "refused" and "the camera cannot see the base" in refused.reason
+    status = unreachable(operator, operator.robot.fkm(out_of_sight))
+    assert "take the base where the camera cannot see it" in status.reason, status.reason
+    operator.ask(operator.robot.fkm(REACH_GOAL))
+    operator.send_state(HOME)
+    drive = operator.statuses.wait_for(lambda s: s.plans == 1 and s.phase != "unreachable",
+                                       "the plan in sight")  # fmt: skip
+    assert drive.candidate_base is not None and within(region, *drive.way, drive.candidate_base)
+
+
+def test_with_no_state_the_status_still_goes_out_says_so_and_a_goal_is_refused(
+    deployed: Callable[[str], System],
+) -> None:
+    """`topic echo supervisor/status --count 1` hung once the statuses stopped: they go out
+    every half second while no state comes, and a goal that no state follows is refused."""
+    operator = supervised(deployed)
+    operator.ask(operator.robot.fkm(REACH_GOAL))
+    refused = operator.statuses.wait_for(lambda s: s.phase == "refused", "the refusal")
+    assert refused.state == "none" and "no robot state on robot/state for" in refused.reason
+    count = len(operator.statuses.messages)
+    later = operator.statuses.wait_for(lambda s: operator.statuses.messages.index(s) > count,
+                                       "two statuses more, with no state")  # fmt: skip
+    assert later.phase == "refused" and later.state == "none"
+
+
+def test_a_position_goal_too_far_is_refused_in_a_few_words_and_statuses_go_on(
+    deployed: Callable[[str], System],
+) -> None:
+    """A position goal at 1e300 m: its error is no float a status can carry; it is refused
+    like a pose goal that far, in a short reason, and the statuses go on."""
+    operator = supervised(deployed)
+    operator.send_goal(Goal(header=header(), task="position", position=(1e300, 0.0, 0.3)))
+    refused = operator.statuses_after(len(operator.statuses.messages), HOME, "the refusal")
+    assert refused.phase == "refused" and len(refused.reason) < 120, refused.reason
+    assert "farther than the 10 m a goal may lie" in refused.reason, refused.reason
+    after = operator.statuses_after(len(operator.statuses.messages), HOME, "one more")
+    assert after.phase == "refused"
+    assert operator.goals.messages[-1].task == "point"  # held where it stands
