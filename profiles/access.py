@@ -18,7 +18,8 @@ authenticates as its own name; tools as ``$PARSIMONY_USER`` (default ``operator`
 listed topic from any other user is dropped by the router's access control. The rules act in
 the router, so the profile must run in ``client`` mode (peers would link directly, past them).
 A parameter is read and set by one query, which the router cannot tell apart: the tools that
-set parameters (the live view's clients) obey ``parameters`` themselves.
+set parameters (``parsimony param set|load``, the live view's clients) obey ``parameters``
+themselves.
 """
 
 from __future__ import annotations
@@ -123,6 +124,13 @@ class AccessSettings(BaseModel):
         where it names the component (else under ``EVERY_COMPONENT``)."""
         setters = self.parameters.get(component, self.parameters.get(EVERY_COMPONENT))
         return setters is None or tool_user(user) in setters
+
+    def why_not_set(self, component: str, user: str | None) -> str:
+        """Why ``user`` (a tool's: ``$PARSIMONY_USER``) may not set ``component``'s parameters,
+        said alike by every tool that sets them; empty where it may."""
+        if self.may_set(component, user):
+            return ""
+        return f"{tool_user(user)} may not set {component}'s parameters (zenoh.access.parameters)"
 
     def session_json(self, user: str | None) -> dict[str, Any]:
         """A session's credentials: ``user`` (a tool's: ``$PARSIMONY_USER``) and its password."""

@@ -12,6 +12,7 @@ from deploy.graph import component_class
 from deploy.query import QueryError, all_params, get_param, set_param, value_text
 from parsimony.output import emit, json_text
 from parsimony.target_options import fail, profile_and_target, target_options
+from profiles.access import DEFAULT_TOOL_USER, USER_ENV
 from profiles.profile import ProfileError
 
 
@@ -21,7 +22,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         "param",
         help="read, change, describe, dump or load the parameters of a running component",
         description="Read or change the declared parameters of a running component. A value "
-        "the component refuses exits 1 with its error.",
+        "the component refuses exits 1 with its error, as does a set or load by a user "
+        f"(${USER_ENV}, default {DEFAULT_TOOL_USER}) the profile's zenoh.access.parameters does "
+        "not name for the component.",
     )
     common = target_options()
     actions = parser.add_subparsers(dest="action", required=True)
@@ -73,6 +76,11 @@ def run(args: argparse.Namespace) -> int:
                 for r in rows))  # fmt: skip
             return 0
         profile, target = profile_and_target(args)
+        access = profile.zenoh.access
+        why = access.why_not_set(args.component, None) if access is not None and \
+            args.action in ("set", "load") else ""  # fmt: skip
+        if why:
+            raise QueryError(f"param {args.action} refused: {why}; ${USER_ENV} names the user")
         with target.open() as session:
             ns, component = target.namespace, args.component
             if args.action == "get":

@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import json
+import os
+import subprocess
+import sys
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -30,7 +33,8 @@ def access_profile(directory: Path) -> Path:
         "robot": str(ROBOT_FILE),
         "zenoh": {"mode": "client", "router": [f"tcp/127.0.0.1:{free_port()}"],
                   "access": {"credentials": "credentials.txt",
-                             "writers": {"control/goal": ["operator"]}}},
+                             "writers": {"control/goal": ["operator"]},
+                             "parameters": {"ctl": ["operator"]}}},
         "components": [{"name": "ctl", "module": "lp_controller", "role": "controller"}],
     }  # fmt: skip
     path = directory / "profile.yaml"
@@ -75,6 +79,38 @@ def test_only_the_writers_of_a_topic_may_put_and_strangers_cannot_connect(
     wrong.insert_json5("transport/auth/usrpwd/password", json.dumps("guess"))
     with pytest.raises(zenoh.ZError):
         zenoh.open(wrong)
+    assert launched.stop() == 0
+
+
+def param(user: str, profile: Path, *argv: str) -> subprocess.CompletedProcess[str]:
+    """`parsimony param ARGV` run by ``user``."""
+    return subprocess.run([sys.executable, "-m", "parsimony.cli", "param", *argv, "--profile",
+                           str(profile)], capture_output=True, text=True, timeout=60,
+                          env={**os.environ, "PARSIMONY_USER": user})  # fmt: skip
+
+
+def test_only_the_users_a_rule_names_may_set_a_components_parameters(
+    tmp_path: Path, launch: LaunchFixture
+) -> None:
+    path = access_profile(tmp_path)
+    launched = launch(path)
+    launched.wait_for(r"\[launch\] ctl alive")
+    why = "viewer may not set ctl's parameters (zenoh.access.parameters)"
+
+    refused = param("viewer", path, "set", "ctl", "stale_timeout_s", "0.25")
+    assert refused.returncode == 1 and refused.stdout == "", refused
+    assert refused.stderr.startswith(f"param set refused: {why}") and \
+        len(refused.stderr.splitlines()) == 1, refused.stderr  # fmt: skip
+    (tmp_path / "ctl.yaml").write_text("stale_timeout_s: 0.25\n")
+    refused = param("viewer", path, "load", "ctl", str(tmp_path / "ctl.yaml"))
+    assert refused.returncode == 1 and f"param load refused: {why}" in refused.stderr, refused
+    unchanged = param("viewer", path, "get", "ctl", "stale_timeout_s")
+    assert unchanged.stdout.strip() == "ctl.stale_timeout_s = 0.5", unchanged
+
+    accepted = param("operator", path, "set", "ctl", "stale_timeout_s", "0.25")
+    assert accepted.stdout.strip() == "ctl.stale_timeout_s = 0.25", accepted
+    assert param("viewer", path, "get", "ctl", "stale_timeout_s").stdout.strip() == \
+        "ctl.stale_timeout_s = 0.25"  # fmt: skip
     assert launched.stop() == 0
 
 
