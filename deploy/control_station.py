@@ -299,9 +299,7 @@ class ControlStation(ServerListener):
     def _may_set(self, component: str) -> str:
         """Why the view's user may not set ``component``'s parameters, or empty."""
         access = self._profile.zenoh.access
-        if access is None or access.may_set(component, self.user):
-            return ""
-        return f"{self.user} may not set {component}'s parameters (zenoh.access.parameters)"
+        return "" if access is None else access.why_not_set(component, self.user)
 
     @_answering("parameters", [])
     def on_get_parameters(self, client: Client, param_names: list[str],
