@@ -8,24 +8,27 @@ clamped to the robot's velocity limit. It becomes, per joint, a goal position ah
 present one in the direction of motion (``lookahead_s`` of the commanded speed, at least
 ``min_step`` units) with the moving speed of the commanded speed (about 0.111 rpm per unit).
 A joint whose speed rounds to Moving Speed 0 (which would mean full speed) holds: its goal is
-the position it had when it stopped, kept while it stays stopped, so it does not creep. All
+its position read when it stops (not a reading from before: a joint still moving would move
+back to it after the stop), kept while it stays stopped, so it does not creep. All
 five goals and speeds go in one Sync Write, and every goal written lies inside the robot
 description's joint limits. With no command for ``command_timeout_s`` the arm holds.
 
-Each answer is checked (``protocols.dynamixel_v1.status_fault``): a servo that is silent, or
-answers a truncated packet, a bad checksum, another servo's id or the wrong length, is counted
-by that name (``servo_faults.<name>``); a reading outside the joint limits (by more than
-``limit_margin``) is counted (``out_of_limits``) and never published. Either way no joint state
-is published, the arm holds at the last good readings and refuses commands until every servo
-answers again with a reading inside its limits, and the component's state says why
-(``holding: servo 3 silent``); then every goal is set where its joint is and torque is enabled
-again on every servo. Status-packet error
-bits are counted by name (``servo_error.<bit>``) and logged.
+Each answer is checked (``protocols.dynamixel_v1.status_fault``): a servo that is silent (for
+``answer_timeout_s``, by default the SDK's packet timeout), or answers a truncated packet, a
+bad checksum, another servo's id or the wrong length, is counted by that name
+(``servo_faults.<name>``); a reading outside the joint limits (by more than ``limit_margin``)
+is counted (``out_of_limits``) and never published. Either way no joint state is published,
+the arm holds (each joint where it is read then, a faulty one at its last good reading) and
+refuses commands until every servo answers again with a reading inside its limits, and the
+component's state says why (``holding: servo 3 silent``); then every goal is set where its
+joint is and torque is enabled again on every servo. Status-packet error bits are counted by
+name (``servo_error.<bit>``) and logged.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Collection, Sequence
 
 from dynamixel_sdk import COMM_SUCCESS, GroupSyncWrite, PacketHandler, PortHandler
 
@@ -77,6 +80,8 @@ class ArmDriver(Component):
         Param("min_step", int, 8, low=1, high=100, doc="least goal step ahead, units"),
         Param("limit_margin", float, 0.02, low=0.0, high=0.5,
               doc="a reading this far outside a joint limit is refused, rad"),
+        Param("answer_timeout_s", float, 0.0, low=0.0, high=5.0,
+              doc="how long a servo's answer is awaited, s; 0: the SDK's (34 ms at 1 Mbit/s)"),
     )  # fmt: skip
 
     def __init__(self, node: Node) -> None:
@@ -151,6 +156,8 @@ class ArmDriver(Component):
         result = self.packet.readTx(self.port, servo, dxl.Address.PRESENT_POSITION, READ_BYTES)
         answer = b""
         if result == COMM_SUCCESS:
+            if self.node.params["answer_timeout_s"] > 0.0:
+                self.port.setPacketTimeoutMillis(self.node.params["answer_timeout_s"] * 1e3)
             rx, _ = self.packet.rxPacket(self.port)
             answer = bytes(rx)
         fault = dxl.status_fault(answer, servo, READ_BYTES)
@@ -173,29 +180,20 @@ class ArmDriver(Component):
         if not self.connected:
             self._connect()
             return
-        readings, faults = [], []
+        readings, faults = [], {}
         try:
-            for index, servo in enumerate(self.ids):
-                data, fault = self._read(servo)
-                if fault is not None:
-                    faults.append(f"servo {servo} {fault}")
-                    continue
-                position = dxl.angle_of_units(data[0] | data[1] << 8)
-                low, high = self.low[index], self.high[index]
-                margin = self.node.params["limit_margin"]
-                if not low - margin <= position <= high + margin:
-                    self.node.count("out_of_limits")
-                    faults.append(f"servo {servo} reads {position:.3f} rad, outside its "
-                                  f"limits [{low:.3f}, {high:.3f}]")  # fmt: skip
-                    continue
-                self.present[index] = position
-                readings.append((position, dxl.rad_s_of_speed_units(data[2] | data[3] << 8)))
+            for index in range(ARM_JOINTS):
+                reading = self._reading(index)
+                if isinstance(reading, str):
+                    faults[index] = reading
+                else:
+                    readings.append(reading)
         except (OSError, TypeError) as error:  # the port went away under the SDK
             self._lost(error)
             return
         self.node.count("reads", len(readings))
         if faults:
-            self._hold_for("; ".join(faults))
+            self._hold_for("; ".join(faults.values()), faults.keys())
             return
         if self.fault:
             self._recover()
@@ -208,6 +206,23 @@ class ArmDriver(Component):
             )
         )
 
+    def _reading(self, index: int) -> tuple[float, float] | str:
+        """Joint ``index``'s position (kept as ``present``) and speed, read now; or what is
+        wrong: a fault, or a position outside the joint's limits."""
+        servo = self.ids[index]
+        data, fault = self._read(servo)
+        if fault is not None:
+            return f"servo {servo} {fault}"
+        position = dxl.angle_of_units(data[0] | data[1] << 8)
+        low, high = self.low[index], self.high[index]
+        margin = self.node.params["limit_margin"]
+        if not low - margin <= position <= high + margin:
+            self.node.count("out_of_limits")
+            return (f"servo {servo} reads {position:.3f} rad, outside its limits "
+                    f"[{low:.3f}, {high:.3f}]")  # fmt: skip
+        self.present[index] = position
+        return position, dxl.rad_s_of_speed_units(data[2] | data[3] << 8)
+
     def _recover(self) -> None:
         """Every servo answers again: goals where the joints are now, then torque on."""
         self.node.warn("holding", f"every servo answers again (was: {self.fault})")
@@ -217,12 +232,12 @@ class ArmDriver(Component):
         self.hold()
         self._enable_torque()
 
-    def _hold_for(self, why: str) -> None:
+    def _hold_for(self, why: str, failed: Collection[int]) -> None:
         if why != self.fault:
             self.node.warn("holding", f"arm holding: {why}")
         self.fault = why
         self.node.state = f"holding: {why}"
-        self.hold()
+        self.hold(failed)
 
     def on_command(self, command: ArmCommand) -> None:
         """Goals ahead of the present positions at the commanded speeds, in one Sync Write."""
@@ -236,15 +251,15 @@ class ArmDriver(Component):
         if self.fault or not self.connected or any(p is None for p in self.present):
             self.node.count("refused_commands")
             return  # holding, or no position read yet to aim from
-        goals, speeds = [], []
+        limited = []
         for index, velocity in enumerate(velocities):
             limit = self.speed_max[index]
             if abs(velocity) > limit:
                 self.node.count("speed_limited")
                 velocity = math.copysign(limit, velocity)
-            goal, speed = self._goal(index, velocity)
-            goals.append(goal)
-            speeds.append(speed)
+            limited.append(velocity)
+        self._read_stopping([i for i, v in enumerate(limited) if dxl.moving_speed(v) is None])
+        goals, speeds = zip(*(self._goal(i, v) for i, v in enumerate(limited)), strict=True)
         self.holding = False
         self._sync_write(goals, speeds)
         self.timeout.set(self.node.params["command_timeout_s"])
@@ -261,8 +276,25 @@ class ArmDriver(Component):
                    self.node.params["min_step"] / dxl.POSITION_UNITS_PER_RAD)  # fmt: skip
         return self._inside_limits(index, present + math.copysign(step, velocity)), speed
 
+    def _read_stopping(self, joints: Sequence[int], failed: Collection[int] = ()) -> None:
+        """Read the ``joints`` that start to hold now (``present``), but those whose servo has
+        just ``failed`` to answer; read again those read before a servo that failed now (its
+        timeout passed since). A reading of the last cycle, or from before a timeout, lies
+        behind a joint still moving: held there, it moved back after the stop."""
+        stopping = [i for i in joints if self.held[i] is None and i not in failed]
+        try:
+            answered = [not isinstance(self._reading(i), str) for i in stopping]
+            if False in answered:
+                last = len(answered) - 1 - answered[::-1].index(False)
+                for index, ok in zip(stopping[:last], answered[:last], strict=True):
+                    if ok:
+                        self._reading(index)
+        except (OSError, TypeError) as error:  # the port went away under the SDK
+            self._lost(error)
+
     def _held(self, index: int) -> int:
-        """The goal joint ``index`` holds: where it was when it stopped."""
+        """The goal joint ``index`` holds: where it was read when it stopped (the last good
+        reading if its servo did not answer then), kept while it stays stopped."""
         if self.held[index] is None:
             present = self.present[index]
             assert present is not None
@@ -274,18 +306,23 @@ class ArmDriver(Component):
         units = dxl.position_units(angle)
         return min(max(units, self.goal_low[index]), self.goal_high[index])
 
-    def hold(self) -> None:
+    def hold(self, failed: Collection[int] = ()) -> None:
         """Every joint's goal where it stopped, slowly: the arm stops where it is. Written again
-        at each call, so a lost Sync Write is made good."""
+        at each call, so a lost Sync Write is made good. A joint that starts to hold is read
+        first (``_read_stopping``; not a servo that has just ``failed``: no second timeout
+        while the others move on)."""
         if not self.connected or any(p is None for p in self.present):
             return
         if not self.holding:
             self.holding = True
             self.node.count("holds")
         self.timeout.cancel()
+        self._read_stopping(range(ARM_JOINTS), failed)
         self._sync_write([self._held(i) for i in range(ARM_JOINTS)], [HOLD_SPEED] * ARM_JOINTS)
 
-    def _sync_write(self, goals: list[int], speeds: list[int]) -> None:
+    def _sync_write(self, goals: Sequence[int], speeds: Sequence[int]) -> None:
+        if not self.connected:  # a read on the way found the port gone
+            return
         group = GroupSyncWrite(self.port, self.packet, dxl.Address.GOAL_POSITION, 4)
         for index, (servo, goal, speed) in enumerate(zip(self.ids, goals, speeds, strict=True)):
             if not (self.goal_low[index] <= goal <= self.goal_high[index]

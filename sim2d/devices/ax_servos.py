@@ -315,6 +315,11 @@ class AXChainEmulator(SerialDevice):
         with self._lock:
             self._named(servo_id).corruption = fault
 
+    def words(self, address: int) -> list[int]:
+        """Every servo's word at ``address``, read at one moment (no Sync Write half done)."""
+        with self._lock:
+            return [servo.word(address) for servo in self.servos]
+
     def _named(self, servo_id: int) -> AXServo:
         servo = self._servo(servo_id)
         if servo is None:

@@ -44,8 +44,13 @@ class FakeLink(PtyLink):
         os.write(self.master, data)
 
 
+STATUS_TIMEOUT_S = 5.0
+"""A driver answers its status between two reads of its devices; an arm driver waiting for a
+silent servo's answer (the arm tests wait a second) answers it only after."""
+
+
 def status(system: System, name: str) -> ComponentStatus | None:
-    return query.statuses(system.router, system.profile.namespace, 0.5).get(name)
+    return query.statuses(system.router, system.profile.namespace, STATUS_TIMEOUT_S).get(name)
 
 
 def frame(left: int, right: int) -> bytes:

@@ -13,6 +13,7 @@ import pytest
 from conftest import System
 from driver_harness import driver_system, status
 
+from components.arm_driver import HOLD_SPEED
 from deploy import ROBOT_FILE
 from messages import codec, topics
 from messages.commands import ArmCommand
@@ -25,6 +26,10 @@ from wbc.robot import MobileManipulator
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 LOW, HIGH = ROBOT.q_min[3:], ROBOT.q_max[3:]
 STEP_S = 0.01
+ANSWER_TIMEOUT_S = 1.0
+"""The driver's wait for an answer: the SDK's 34 ms is less than a loaded machine may take to
+answer (every Moving Speed read 1, a hold, after such a timeout), so only a servo made silent
+is."""
 
 
 class Bench:
@@ -62,6 +67,10 @@ class Bench:
     def word(self, servo_index: int, address: int) -> int:
         return self.servos.servos[servo_index].word(address)
 
+    def speeds(self) -> list[int]:
+        """Every servo's Moving Speed, as one Sync Write left them."""
+        return self.servos.words(Address.MOVING_SPEED)
+
     def state(self) -> str:
         answer = status(self.system, "arm_driver")
         return "" if answer is None else answer.state
@@ -72,7 +81,8 @@ def bench(deployed, tmp_path: Path) -> Iterator[Bench]:
     arm = IntegratingJoints([0.0, -0.2, 0.2, 0.0, 0.5])
     link = tmp_path / "servos"
     with AXChainEmulator(arm, link=link) as servos:
-        system = driver_system(deployed, tmp_path, "arm_driver", link)
+        system = driver_system(deployed, tmp_path, "arm_driver", link,
+                               answer_timeout_s=ANSWER_TIMEOUT_S)  # fmt: skip
         bench = Bench(system, arm, servos)
         system.start("arm_driver")
         bench.joints.wait_for(lambda m: True, "a joint state")
@@ -113,11 +123,19 @@ def test_a_joint_commanded_to_exactly_zero_does_not_creep(bench: Bench, wait_unt
 def test_a_silent_servo_holds_the_whole_arm_until_it_answers_again(
     bench: Bench, wait_until
 ) -> None:
+    """The arm moves on while the driver waits for servo 3's answer (the test runs the world
+    then, after the driver has read servos 1 and 2): each joint is held where it is when the
+    arm holds, not where it was read before the wait (servo 1 moved back to that, 8 units
+    behind, at the hold's speed), and no command moves it until servo 3 answers again."""
     moving = (0.4, 0.3, -0.3, 0.4, -0.3)
     bench.written(moving, wait_until)
-    bench.run(0.1)
+    asked = bench.servos.counters["unanswered"]
     bench.servos.fail(3)
+    wait_until(lambda: bench.servos.counters["unanswered"] > asked, "the driver asking servo 3")
+    bench.run(0.1)  # while the driver waits for its answer (ANSWER_TIMEOUT_S)
     wait_until(lambda: bench.state() == "holding: servo 3 silent", "the arm holding")
+    wait_until(lambda: [bench.speeds()[i] for i in (0, 1, 3, 4)] == [HOLD_SPEED] * 4,
+               "the hold written to every servo that answers")  # fmt: skip
     held = list(bench.arm.angles)
     for _ in range(50):  # a second of commands that must not move it
         bench.send(moving)
@@ -160,10 +178,19 @@ def test_a_reading_outside_the_limits_is_refused_and_no_goal_leaves_them(
 
 
 def test_speeds_over_the_limit_go_out_at_the_limit(bench: Bench, wait_until) -> None:
-    bench.written((1e3, 1e300, 1e308, -1e3, 0.5), wait_until)
+    """Waits for the command's own Sync Write: not the fresh table's speeds (0), nor a hold's
+    (1), which a loaded machine's late answer may bring first."""
+    written: list[int] = []
+
+    def commanded() -> bool:
+        bench.send((1e3, 1e300, 1e308, -1e3, 0.5))
+        time.sleep(0.005)
+        written[:] = bench.speeds()
+        return written not in ([0] * 5, [HOLD_SPEED] * 5)
+
+    wait_until(commanded, "a Sync Write of the command")
     limit = dxl.moving_speed(ROBOT.velocity_max[3])
-    speeds = [bench.word(i, Address.MOVING_SPEED) for i in range(5)]
-    assert speeds == [limit] * 4 + [dxl.moving_speed(0.5)]
+    assert written == [limit] * 4 + [dxl.moving_speed(0.5)]
     counters = status(bench.system, "arm_driver").counters
     assert counters["speed_limited"] >= 4
     assert not any(v for k, v in counters.items() if k.startswith("errors."))
