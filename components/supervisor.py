@@ -48,11 +48,12 @@ from messages import topics
 from messages.goal import Goal
 from messages.obstacles import Obstacles, circles_of
 from messages.state import RobotState
-from messages.supervisor import SupervisorStatus
+from messages.supervisor import ENDED, SupervisorStatus
 from wbc.drive_tasks import PointTask, offset_point
 from wbc.obstacles import Circle
 from wbc.staging import Plan, StagingParams, within
 from wbc.staging_supervisor import PlanRequest, StagingSupervisor, SupervisorParams
+from wbc.supervisor_phase import Phase
 from wbc.task import MEASUREMENT_TOLERANCE, PoseTask, Task, same_task
 
 log = logging.getLogger("components.supervisor")
@@ -292,8 +293,11 @@ class Supervisor(Component):
         self._events_reported = len(supervisor.events)
 
     def _publish(self, stamp_ns: int) -> None:
-        self.status_out.put(self._status(stamp_ns))
+        status = self._status(stamp_ns)
+        self.status_out.put(status)
         self._published += 1
+        final = status.phase in (Phase.UNREACHABLE, *ENDED)
+        self.node.state = f"{status.phase}: {status.reason}" if final else status.phase
 
     def _status(self, stamp_ns: int) -> SupervisorStatus:
         """What the supervisor does now: ``idle`` with no goal, else the goal's phase."""

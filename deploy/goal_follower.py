@@ -17,13 +17,13 @@ import zenoh
 
 from deploy.query import QueryError, status_of
 from messages import codec, topics
-from messages.supervisor import SupervisorStatus
+from messages.supervisor import ENDED, SupervisorStatus
+from wbc.supervisor_phase import Phase
 
 POLL_S = 0.05
 """How often (host seconds) the supervisor's counters are asked while the goal is on its way."""
-DONE = ("reached", "unreachable", "refused", "aborted")
-"""The phases that end a goal (the supervisor's ``messages.supervisor.ENDED`` among them, when
-it has them): each is the goal's outcome."""
+DONE = (Phase.REACHED.value, Phase.UNREACHABLE.value, *ENDED)
+"""The phases that end a goal: each is the goal's outcome."""
 
 
 @dataclass(frozen=True)

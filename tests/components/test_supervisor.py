@@ -17,6 +17,7 @@ from components.control_step import task_of
 from components.controller import goal_of
 from components.robot_sight import sight_region
 from deploy import DEPLOY, ROBOT_FILE
+from deploy.query import status_of
 from messages import codec, topics
 from messages.goal import Goal
 from messages.header import Header
@@ -315,6 +316,9 @@ def test_a_goal_of_every_kind_has_a_status_with_every_state_until_and_after_it_i
     for _ in range(3):
         after = operator.statuses_after(len(operator.statuses.messages), REACH_GOAL, "one more")
         assert after.phase == "reached"
+    # The component's own state says the phase too: the launcher prints its every change.
+    namespace = operator.system.profile.namespace
+    assert status_of(operator.system.router, namespace, "supervisor").state == "reached"
 
 
 def test_an_invalid_state_aborts_the_goal_refuses_new_ones_and_the_status_says_why(
