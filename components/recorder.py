@@ -9,7 +9,9 @@ Foxglove's well-known schemas (``record.foxglove_views``: images as ``foxglove.R
 frames as ``foxglove.FrameTransforms``, obstacles and the robot of the profile's description
 as ``foxglove.SceneUpdate``, markers on the image as ``foxglove.ImageAnnotations``), so that
 Foxglove's 3D, Image and Plot panels open the file as it is. ``keys`` limits the recording to
-topics whose names match one of its comma-separated ``fnmatch`` patterns.
+topics whose names match one of its comma-separated ``fnmatch`` patterns. A message stamped
+far outside the session (``record.session_span``: a wall-clock stamp among simulated ones) is
+recorded, counted (``outside.<topic>``) and said once per topic.
 
 The current chunk is flushed every ``flush_s`` (SIGKILL loses at most that much and what
 waits); a clean stop writes all that waits, then the file's footer and index. A recorder stops
@@ -22,6 +24,7 @@ complete chunk.
 from __future__ import annotations
 
 import fnmatch
+import logging
 from pathlib import Path
 
 from components.params import Param, ParamError, load_robot
@@ -30,8 +33,11 @@ from components.pubsub import Input
 from components.runtime import Component, Node
 from messages import topics
 from record.foxglove_views import Viewer
-from record.session_file import DROPPED, SessionWriter
+from record.session_file import DROPPED, SessionWriter, stamp_of
+from record.session_span import Span, inside, outside_line
 from wbc.robot import MobileManipulator
+
+log = logging.getLogger("components")
 
 QUEUE = 10_000
 """Samples of one topic that may wait for the writer."""
@@ -68,6 +74,7 @@ class Recorder(Component):
             if any(fnmatch.fnmatch(topic.name, pattern) for pattern in patterns)
         ]
         self.dropped: dict[str, int] = {}
+        self.span = Span()
         node.timer(node.params["flush_s"], lambda: self._writing(self._flush))
 
     @staticmethod
@@ -81,8 +88,22 @@ class Recorder(Component):
         def write(message) -> None:
             if self._writing(self.writer.write, key, message, views=self.node.params["views"]):
                 self.node.counters["written"] += 1
+                self._place(name, stamp_of(message))
 
         return write
+
+    def _place(self, name: str, stamp_ns: int) -> None:
+        """Count a stamp into the session's span; one far outside it is counted
+        (``outside.<topic>``) and said, once per topic."""
+        self.span.add(stamp_ns)
+        session = self.span.session()
+        if inside(stamp_ns, session):
+            return
+        counter = f"outside.{name}"
+        if counter not in self.node.counters:
+            log.warning("%s: recorded, but %s; info, replay and report leave it out",
+                        self.node.name, outside_line({name: (1, stamp_ns)}, session))
+        self.node.count(counter)
 
     def _writing(self, operation, *args, **kwargs) -> bool:
         """Run a write of the file; on an OSError stop for good (once), saying why."""

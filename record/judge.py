@@ -36,6 +36,7 @@ from messages.topics import (
     WORLD_OBSTACLES,
     Topic,
 )
+from record.session_span import parted
 from wbc import dq
 from wbc.arm_clearance import part_clearances
 from wbc.kinematic_run import effort_of
@@ -55,6 +56,9 @@ JUDGED = frozenset(t.name for t in (ROBOT_STATE, CONTROL_GOAL, GOAL_REQUEST, BAS
                                     ARM_COMMAND, CONTROL_DIAGNOSTICS, WORLD_OBSTACLES, SIM_TRUTH,
                                     SUPERVISOR_STATUS))  # fmt: skip
 """The topics a run is judged (and its figures drawn) from: no images."""
+RERUN_SOURCE = "rerun_"
+"""The source of the commands ``parsimony rerun`` computes, before the law's name: offline, on
+a recording's states, which did not follow them."""
 METRICS: Mapping[str, str] = {
     "metric1": "velocity_l1",
     "metric2": "velocity_l2",
@@ -66,7 +70,11 @@ METRICS: Mapping[str, str] = {
 
 def judge(session: Session, robot: MobileManipulator, time_limit_s: float | None = None
           ) -> dict[str, Any]:  # fmt: skip
-    """Every figure of the run ``session`` holds, up to its end (``the_run``)."""
+    """Every figure of the run ``session`` holds, up to its end (``the_run``);
+    ``outside_session`` says in one line what was left out as stamped far outside the session
+    (``record.session_span``), None when nothing was; ``open_loop`` whether its commands were
+    computed offline by a rerun."""
+    outside = parted(session).line()
     run, converged = the_run(session, time_limit_s)
     truth, states = messages(run, SIM_TRUTH), messages(run, ROBOT_STATE)
     diagnostics = messages(run, CONTROL_DIAGNOSTICS)
@@ -95,12 +103,22 @@ def judge(session: Session, robot: MobileManipulator, time_limit_s: float | None
         "degraded_states": sum(s.degraded for s in states),
         "invalid_states": sum(not s.valid for s in states),
         "commands_digest": commands_digest(run),
+        "outside_session": outside,
+        "open_loop": open_loop(run),
     }
+
+
+def open_loop(session: Session) -> bool:
+    """Whether the session's commands were computed by ``parsimony rerun`` (``RERUN_SOURCE``)
+    on recorded states, not in a closed loop."""
+    return any(c.header.source.startswith(RERUN_SOURCE) for c in messages(session, BASE_COMMAND))
 
 
 def the_run(session: Session, time_limit_s: float | None = None) -> tuple[dict[str, list], bool]:
     """The messages of the run, up to its end (``end_of_run``), and whether it converged: what
-    is judged, and what a report draws."""
+    is judged, and what a report draws. Messages stamped far outside the session
+    (``record.session_span``) are left out."""
+    session = parted(session).kept
     end_ns, converged = end_of_run(session, time_limit_s, origin_s(session))
     return until(session, end_ns), converged
 

@@ -58,21 +58,25 @@ def sending_rank(topic_name: str) -> int:
 class Recording:
     """What a replay sends from a file: the topics it holds that ``wanted`` lets through and
     the log times of their first and last messages (from ``info``: one pass, nothing held);
-    ``groups`` streams their messages, one log time at a time, in sending order."""
+    ``groups`` streams their messages, one log time at a time, in sending order. Messages
+    logged far outside the session (``record.session_span``) are outside every window, so
+    never sent; ``outside`` says what they are in one line (None: there are none)."""
 
     path: Path
     names: frozenset[str]
     start_ns: int
     end_ns: int
+    outside: str | None = None
 
     @classmethod
     def of(cls, path: Path, wanted: Callable[[str], bool]) -> Recording:
         """The topics of ``path`` that ``wanted`` lets through, and their span."""
-        channels = [c for c in info(path)["channels"]
-                    if c["topic"] is not None and wanted(c["topic"])]  # fmt: skip
+        found = info(path)
+        channels = [c for c in found["channels"]
+                    if c["topic"] is not None and c["messages"] and wanted(c["topic"])]  # fmt: skip
         return cls(path, frozenset(c["topic"] for c in channels),
                    min((c["start_ns"] for c in channels), default=0),
-                   max((c["end_ns"] for c in channels), default=0))  # fmt: skip
+                   max((c["end_ns"] for c in channels), default=0), found["warning"])  # fmt: skip
 
     def window(self, start_offset_s: float, duration_s: float | None) -> tuple[int, int]:
         """The log times replayed: from ``start_offset_s`` after the first message, for

@@ -33,6 +33,7 @@ from record.session_file import (
     from_json,
     topic_of,
 )
+from record.session_span import FAR_NS, Span, inside, outside_line
 
 
 class _ExactReads:
@@ -262,34 +263,51 @@ def info(path: Path) -> dict[str, Any]:
     the samples its recorder lost, by counter, ``DROPPED``) and, per
     channel, its key, the project topic it carries (None for a view or a foreign channel),
     schema name, encoding and size in bytes, message count and bytes, first
-    and last log time and mean rate (Hz, (count - 1) / span)."""
+    and last log time and mean rate (Hz, (count - 1) / span).
+
+    Messages logged far outside the session (``record.session_span``) are left out of all
+    of that and counted in ``outside``, by key: messages and first log time; ``warning`` says
+    so in one line (None when there are none)."""
     scan = _Scan(path)
+    span = Span()
     channels: dict[int, dict[str, Any]] = {}
+    bins: dict[tuple[int, int], list[int]] = {}  # (channel, bin): messages, bytes, first, last
     for schema, channel, message in scan:
-        entry = channels.get(channel.id)
-        if entry is None:
+        if channel.id not in channels:
             topic = _project_topic(schema, channel)
-            entry = channels[channel.id] = {
+            channels[channel.id] = {
                 "key": channel.topic,
                 "topic": topic.name if topic is not None else None,
                 "schema": schema.name if schema is not None else "",
                 "schema_encoding": schema.encoding if schema is not None else "",
                 "schema_bytes": len(schema.data) if schema is not None else 0,
                 "encoding": channel.message_encoding,
-                "messages": 0,
-                "bytes": 0,
-                "start_ns": message.log_time,
-                "end_ns": message.log_time,
             }
-        entry["messages"] += 1
-        entry["bytes"] += len(message.data)
-        entry["start_ns"] = min(entry["start_ns"], message.log_time)
-        entry["end_ns"] = max(entry["end_ns"], message.log_time)
-    for entry in channels.values():
-        span_s = (entry["end_ns"] - entry["start_ns"]) / 1e9
-        entry["rate_hz"] = round((entry["messages"] - 1) / span_s, 2) if span_s > 0 else 0.0
-    start = min((c["start_ns"] for c in channels.values()), default=0)
-    end = max((c["end_ns"] for c in channels.values()), default=0)
+        span.add(message.log_time)
+        counted = bins.setdefault((channel.id, message.log_time // FAR_NS),
+                                  [0, 0, message.log_time, message.log_time])  # fmt: skip
+        counted[0] += 1
+        counted[1] += len(message.data)
+        counted[2] = min(counted[2], message.log_time)
+        counted[3] = max(counted[3], message.log_time)
+    session = span.session()
+    totals: dict[int, list[int]] = {}
+    outside: dict[str, list[int]] = {}
+    for (channel_id, _), (count, size, first, last) in bins.items():
+        if inside(first, session):  # a bin is wholly inside the session or wholly out
+            total = totals.setdefault(channel_id, [0, 0, first, last])
+            total[0] += count
+            total[1] += size
+            total[2], total[3] = min(total[2], first), max(total[3], last)
+        else:
+            far = outside.setdefault(channels[channel_id]["key"], [0, first])
+            far[0] += count
+            far[1] = min(far[1], first)
+    for channel_id, entry in channels.items():
+        count, size, first, last = totals.get(channel_id, [0, 0, 0, 0])
+        span_s = (last - first) / 1e9
+        entry.update(messages=count, bytes=size, start_ns=first, end_ns=last,
+                     rate_hz=round((count - 1) / span_s, 2) if span_s > 0 else 0.0)
     return {
         "path": str(path),
         "complete": scan.complete,
@@ -297,10 +315,13 @@ def info(path: Path) -> dict[str, Any]:
         "dropped": {key: int(n) for key, n in scan.metadata.get(DROPPED, {}).items()},
         "messages": sum(c["messages"] for c in channels.values()),
         "bytes": Path(path).stat().st_size,
-        "start_ns": start,
-        "end_ns": end,
-        "duration_s": round((end - start) / 1e9, 3),
+        "start_ns": session[0],
+        "end_ns": session[1],
+        "duration_s": round((session[1] - session[0]) / 1e9, 3),
         "channels": sorted(channels.values(), key=lambda c: c["key"]),
+        "outside": {key: {"messages": n, "first_ns": first} for key, (n, first) in outside.items()},
+        "warning": outside_line({k: tuple(v) for k, v in outside.items()}, session)
+        if outside else None,
     }
 
 

@@ -1,4 +1,5 @@
-"""`parsimony info FILE`: what a recorded session holds (see record.session_reader.info)."""
+"""`parsimony info FILE`: what a recorded session holds (see record.session_reader.info); what
+is stamped far outside the session (record.session_span) is said in one line on stderr."""
 
 from __future__ import annotations
 
@@ -26,6 +27,8 @@ def run(args: argparse.Namespace) -> int:
     except OSError as error:
         print(f"info: {error}", file=sys.stderr)
         return 2
+    if found["warning"] is not None:
+        print(f"info: left out of the span and rates, {found['warning']}", file=sys.stderr)
     if args.json:
         emit(json_text(found, indent=2))
         return 0

@@ -1,0 +1,128 @@
+"""A message stamped far outside its session (a goal stamped on the wall clock in a simulated
+session, as `topic pub` once did) is said in one line naming its topic by `info`, `replay`,
+`report` and the judge, and left out: `info` gives the session's true span, a replay ends, a
+report is written whole."""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+
+from messages import topics
+from messages.goal import Goal
+from messages.header import Header
+from messages.topics import CONTROL_GOAL, GOAL_REQUEST
+from parsimony.sessions import load_session
+from profiles.endpoints import free_port
+from record.judge import JUDGED, judge
+from record.session_file import SessionWriter
+from record.session_span import FAR_NS, Span
+from tests.processes import parsimony
+from tests.record.test_report import DT, FIGURES, ROBOT, START_NS, session_of
+from wbc import scenarios
+from wbc.kinematic_run import integrate
+from wbc.lp_law import LPLaw, LPParams
+from wbc.task import PoseTask
+
+NAMESPACE = "far"
+
+
+def write(path: Path, session: dict[str, list], poison: Goal | None = None) -> Path:
+    """``session`` as a recorder writes it, in stamp order, ``poison`` on goal/request half
+    way through (when it came)."""
+    recorded = sorted((m.header.stamp_ns, topic, m) for topic, found in session.items()
+                      for m in found)  # fmt: skip
+    with SessionWriter(path) as writer:
+        for index, (_, topic, message) in enumerate(recorded):
+            if poison is not None and index == len(recorded) // 2:
+                writer.write(GOAL_REQUEST.key(NAMESPACE), poison)
+            writer.write(topics.TOPICS[topic].key(NAMESPACE), message)
+    return path
+
+
+def header(stamp_ns: int, source: str) -> Header:
+    return Header(stamp_ns=stamp_ns, frame="world", seq=0, source=source)
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """(clean, poisoned): a simulated LP run of some 10 s under a staging supervisor (its
+    goals a drive leg to a point, a turn, then the pose), and the same with the operator's
+    goal on goal/request stamped on the wall clock, as `topic pub` stamped it."""
+    task = PoseTask(ROBOT.fkm(scenarios.REACH_GOAL))
+    session = session_of(integrate(LPLaw(ROBOT, LPParams()), scenarios.HOME, task, DT, 1500),
+                         "lp", task)  # fmt: skip
+    arm, start_ns = tuple(scenarios.HOME[3:].tolist()), START_NS
+    session[CONTROL_GOAL.name] = [
+        Goal(header=header(start_ns, "supervisor"), task="point", point=(0.5, 0.0),
+             arm=arm, lookahead=0.1),
+        Goal(header=header(start_ns + 10**9, "supervisor"), task="heading", heading=0.0,
+             arm=arm, point=(0.5, 0.0)),
+        Goal(header=header(start_ns + 2 * 10**9, "supervisor"), task="pose", pose=tuple(task.pose)),
+    ]  # fmt: skip
+    folder = tmp_path_factory.mktemp("far")
+    goal = Goal(header=header(time.time_ns(), "topic"), task="pose", pose=tuple(task.pose))
+    return write(folder / "clean.mcap", session), write(folder / "poisoned.mcap", session, goal)
+
+
+def said(stderr: str, what: str) -> list[str]:
+    return [line for line in stderr.splitlines() if what in line]
+
+
+def test_info_gives_the_true_span_and_names_the_far_stamp_in_one_line(files) -> None:
+    clean, poisoned = (parsimony("info", str(f), "--json") for f in files)
+    assert clean.returncode == poisoned.returncode == 0, poisoned.stderr
+    found, expected = json.loads(poisoned.stdout), json.loads(clean.stdout)
+    for field in ("start_ns", "end_ns", "duration_s", "messages"):
+        assert found[field] == expected[field], field
+    assert 10 < found["duration_s"] < 20
+    assert list(found["outside"]) == [GOAL_REQUEST.key(NAMESPACE)]
+    lines = said(poisoned.stderr, "far outside the session")
+    assert len(lines) == 1 and "1 message of far/goal/request" in lines[0], poisoned.stderr
+    assert found["warning"] in lines[0]
+    assert clean.stderr == "" and expected["warning"] is None
+
+
+def test_a_replay_of_it_ends_and_says_what_it_did_not_send(files, tmp_path: Path) -> None:
+    profile = tmp_path / "far.yaml"
+    profile.write_text(yaml.safe_dump({
+        "namespace": NAMESPACE, "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
+        "components": [{"name": "pub", "module": "scripted_publisher", "role": "tool"}],
+    }))  # fmt: skip  # never launched: the replay has no router to reach, and serves its own
+    clean = json.loads(parsimony("info", str(files[0]), "--json").stdout)
+    done = parsimony("replay", str(files[1]), "--profile", str(profile), "--rate", "20")
+    assert done.returncode == 0, done.stderr
+    assert f"/ {clean['duration_s']:.2f} s" in done.stderr
+    assert f"{clean['messages']} messages sent" in done.stderr
+    lines = said(done.stderr, "far outside the session")
+    assert len(lines) == 1 and "not sent" in lines[0] and "goal/request" in lines[0]
+
+
+def test_a_report_of_it_is_written_whole_and_says_what_it_left_out(files, tmp_path: Path
+                                                                     ) -> None:  # fmt: skip
+    out = tmp_path / "report"
+    done = parsimony("report", str(files[1]), "--out", str(out), "--json")
+    assert done.returncode == 0, done.stderr
+    assert "Traceback" not in done.stderr
+    assert {Path(f).name for f in json.loads(done.stdout)["figures"]} == set(FIGURES)
+    lines = said(done.stderr, "far outside the session")
+    assert len(lines) == 1 and "far/goal/request" not in lines[0] and "goal/request" in lines[0]
+    # The judge says so too, and judges the rest as it judges the clean recording.
+    judged = json.loads((out / "judged.json").read_text())["lp"]
+    assert "1 message of goal/request" in judged.pop("outside_session")
+    expected = judge(load_session(files[0], JUDGED), ROBOT)
+    assert expected.pop("outside_session") is None
+    assert judged == json.loads(json.dumps(expected))
+
+
+def test_the_session_is_the_stretch_without_a_days_gap_that_holds_the_most() -> None:
+    span = Span()
+    for stamp in (5, *range(FAR_NS * 3, FAR_NS * 3 + 100), 10 * FAR_NS):
+        span.add(stamp)
+    assert span.session() == (FAR_NS * 3, FAR_NS * 3 + 99)
+    span.add(FAR_NS * 3 + 99 + FAR_NS)  # a day later: the same session, one day longer
+    assert span.session() == (FAR_NS * 3, FAR_NS * 4 + 99)
