@@ -17,8 +17,10 @@ Times are in s from the session's first command.
     error.png              e = x - x_d of the end effector, or p - p_d for a position task (6.9)
     joints.png             q1..q5 against their limits, dashed green (6.10)
     end_effector_path.png  x-y of the end effector and the goal (6.14)
-    base_path.png          x-y of the base and the obstacles: the circles, each table's (or
-                           underside's) footprint, each pole, each wall where it meets the floor
+    base_path.png          x-y of the base from its first valid estimate (before the first
+                           camera fix the estimate is a placeholder at (0, 0)) and the
+                           obstacles: the circles, each table's (or underside's) footprint,
+                           each pole, each wall where it meets the floor
     arm_clearance.png      each collision part's clearance from the nearest solid in 3-D over
                            time, from the ground truth (``record.judge.arm_clearances``, whose
                            least is the judge's ``arm_clearance_m``); written when a session's
@@ -56,9 +58,11 @@ from record.judge import (
     commands,
     effort_of_inputs,
     messages,
+    open_loop,
     required,
 )
 from record.obstacle_scene import OBSTACLE_RGB
+from record.session_span import parted
 from wbc import dq
 from wbc.planar import in_frame, planar_pose
 from wbc.robot import MobileManipulator
@@ -73,6 +77,9 @@ FORMULAS: Mapping[str, str] = {
 
 UNIT_TOLERANCE = 1e-9
 """Under this squared horizontal length a plane's normal is vertical."""
+
+END_EFFECTOR_TASKS = ("pose", "position")
+"""The goals that give the end effector a target (a drive leg's aims the base)."""
 
 INPUT_NAMES = ("x'", "y'", "phi'", "q1'", "q2'", "q3'", "q4'", "q5'")
 """The entries of u, in order."""
@@ -98,7 +105,11 @@ def write_report(
     truth is drawn in F0's frame beside the estimate; None draws no truth.
 
     Every session is checked before anything is written; a missing or empty topic raises
-    ``ValueError`` naming it. Returns ``{"figures": [paths], "effort": {label: metrics}}``.
+    ``ValueError`` naming it. Messages stamped far outside a session are left out
+    (``record.session_span``). A figure the data cannot give (``ValueError``, an arithmetic
+    fault) is not written and said in ``gaps``; ``notes`` say what a reader must know to read
+    the figures (a rerun's commands, ``record.judge.open_loop``). Returns ``{"figures":
+    [paths], "effort": {label: metrics}, "gaps": {figure: why}, "notes": [lines]}``.
     """
     labels = [label for label, _ in sessions]
     if not 1 <= len(sessions) <= 2:
@@ -106,20 +117,32 @@ def write_report(
     if len(set(labels)) != len(labels):
         raise ValueError(f"session labels must differ, got {labels}")
     recordings = [_recording(label, session, truth_frame, robot) for label, session in sessions]
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    figures = []
-    for name, draw in _FIGURES.items():
-        figure = draw(recordings, robot)
-        if figure is not None:
-            figure.savefig(out / name, dpi=100)
-            figures.append(out / name)
     efforts = {rec.label: effort_of_inputs(rec.stamps_ns, rec.u) for rec in recordings}
     if short := [label for label, found in efforts.items() if found is None]:
         raise ValueError(f"{', '.join(short)}: the control effort needs two commands or more")
+    notes = [OPEN_LOOP_NOTE.format(label=label) for label, session in sessions
+             if open_loop(session)]  # fmt: skip
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    figures, gaps = [], {}
+    for name, draw in _FIGURES.items():
+        try:
+            figure = draw(recordings, robot)
+            if figure is not None:
+                figure.savefig(out / name, dpi=100)
+                figures.append(out / name)
+        except (ValueError, ArithmeticError) as error:
+            (out / name).unlink(missing_ok=True)
+            gaps[name] = str(error).splitlines()[0] if str(error) else type(error).__name__
     (out / "effort.json").write_text(json.dumps(efforts, indent=2) + "\n")
-    (out / "effort.md").write_text(_effort_table(efforts))
-    return {"figures": figures, "effort": efforts}
+    (out / "effort.md").write_text(_effort_table(efforts, notes))
+    return {"figures": figures, "effort": efforts, "gaps": gaps, "notes": notes}
+
+
+OPEN_LOOP_NOTE = ("{label}: its commands were computed by `parsimony rerun` on the recording's "
+                  "states, not in a closed loop (the states did not follow them): its effort "
+                  "is not that of a run of its law")
+"""What a report says of a session whose commands a rerun computed."""
 
 
 @dataclass(frozen=True)
@@ -160,7 +183,12 @@ def _recording(
     truth_frame: tuple[float, float, float] | None,
     robot: MobileManipulator,
 ) -> _Recording:
+    session = parted(session).kept
     stamps, u = commands(session)
+    states = required(session, ROBOT_STATE)
+    if len(states[0].arm_joints) != robot.arm_dof:
+        raise ValueError(f"the robot description has {robot.arm_dof} arm joints, the "
+                         f"recording's states {len(states[0].arm_joints)}")  # fmt: skip
     recorded = messages(session, SIM_TRUTH)
     truth = recorded if truth_frame is not None else []
     clearance = arm_clearances(recorded, robot)  # the same in any frame: no truth_frame needed
@@ -169,7 +197,7 @@ def _recording(
         label=label,
         stamps_ns=stamps,
         u=u,
-        states=required(session, ROBOT_STATE),
+        states=states,
         goals=messages(session, GOAL_REQUEST) or required(session, CONTROL_GOAL),
         diagnostics=required(session, CONTROL_DIAGNOSTICS),
         obstacles=messages(session, WORLD_OBSTACLES),
@@ -178,7 +206,7 @@ def _recording(
     )
 
 
-def _effort_table(efforts: Mapping[str, Mapping[str, float]]) -> str:
+def _effort_table(efforts: Mapping[str, Mapping[str, float]], notes: Sequence[str] = ()) -> str:
     labels = [label.replace("|", r"\|") for label in efforts]
     lines = [
         "Control effort (table 6.1)",
@@ -189,6 +217,7 @@ def _effort_table(efforts: Mapping[str, Mapping[str, float]]) -> str:
     for number, (name, formula) in enumerate(FORMULAS.items(), start=1):
         values = " | ".join(f"{metrics[name]:.4g}" for metrics in efforts.values())
         lines.append(f"| {number} | {formula} | {values} |")
+    lines.extend(f"\nNote: {note}." for note in notes)
     return "\n".join(lines) + "\n"
 
 
@@ -230,7 +259,11 @@ def _nonzero_figure(recordings: Sequence[_Recording], _: MobileManipulator) -> F
 def _error_figure(recordings: Sequence[_Recording], _: MobileManipulator) -> Figure:
     figure, axes = _panels(recordings, 1, 4.0, sharey=True)
     for ax, rec in zip(axes[0], recordings, strict=True):
-        t, error, names = _task_error(rec)
+        found = _task_error(rec)
+        if found is None:
+            _nothing(ax, "no end-effector goal (pose or position) in force at any state")
+            continue
+        t, error, names = found
         for column, name in enumerate(names):
             ax.plot(t, error[:, column], label=name, linewidth=1.0)
         ax.set(xlabel="t (s)", ylabel="error")
@@ -238,29 +271,43 @@ def _error_figure(recordings: Sequence[_Recording], _: MobileManipulator) -> Fig
     return figure
 
 
-def _task_error(rec: _Recording) -> tuple[Array, Array, tuple[str, ...]]:
-    """(t, rows of e, names) of the states with a goal in force: the 8 coefficients of
-    x - x_d when every goal is a pose, else the translation error p - p_d."""
+def _legend(ax: Axes) -> None:
+    """The legend of what a panel drew, if it drew anything labelled."""
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize="small")
+
+
+def _nothing(ax: Axes, why: str) -> None:
+    """A panel that has nothing to draw says why."""
+    ax.text(0.5, 0.5, why, ha="center", va="center", wrap=True, transform=ax.transAxes)
+
+
+def _task_error(rec: _Recording) -> tuple[Array, Array, tuple[str, ...]] | None:
+    """(t, rows of e, names) of the states with an end-effector goal in force: the 8
+    coefficients of x - x_d when every such goal is a pose, else the translation error
+    p - p_d; None when no state has one (a drive leg's goal aims the base)."""
     goal_stamps = np.array([g.header.stamp_ns for g in rec.goals], dtype=np.int64)
-    pose_only = all(g.task == "pose" for g in rec.goals)
-    used, rows = [], []
+    in_force = []
     for state in rec.states:
         index = int(np.searchsorted(goal_stamps, state.header.stamp_ns, side="right")) - 1
-        if index < 0:
-            continue
-        x, goal = np.array(state.end_effector), rec.goals[index]
+        if index >= 0 and rec.goals[index].task in END_EFFECTOR_TASKS:
+            in_force.append((state, rec.goals[index]))
+    if not in_force:
+        return None
+    pose_only = all(goal.task == "pose" for _, goal in in_force)
+    rows = []
+    for state, goal in in_force:
+        x = np.array(state.end_effector)
         if pose_only:
             rows.append(x - dq.nearest_equivalent(np.array(goal.pose), x))
         else:
             rows.append(dq.translation(x)[1:] - _goal_position(goal))
-        used.append(state)
-    if not rows:
-        raise ValueError(f"no {ROBOT_STATE.name!r} message comes after the first goal")
     names = tuple(f"e{i}" for i in range(1, 9)) if pose_only else ("e_x", "e_y", "e_z")
-    return rec.seconds(used), np.array(rows), names
+    return rec.seconds([state for state, _ in in_force]), np.array(rows), names
 
 
 def _goal_position(goal: Goal) -> Array:
+    """The end effector's goal position of a pose or position goal."""
     if goal.task == "pose":
         return dq.translation(np.array(goal.pose))[1:]
     return np.array(goal.position)
@@ -281,35 +328,53 @@ def _joints_figure(recordings: Sequence[_Recording], robot: MobileManipulator) -
     return figure
 
 
+def _estimated(states: Sequence[Any]) -> list:
+    """The states from the first valid one on: before its first fix the estimator's pose is
+    a placeholder (0, 0), not where the robot was."""
+    first = next((i for i, s in enumerate(states) if s.valid), len(states))
+    return list(states[first:])
+
+
+NO_FIX = "no valid state: the estimator never had a fix"
+
+
 def _end_effector_path_figure(recordings: Sequence[_Recording], _: MobileManipulator) -> Figure:
     figure, axes = _panels(recordings, 1, 5.0)
     for ax, rec in zip(axes[0], recordings, strict=True):
-        _path(ax, [dq.translation(np.array(s.end_effector))[1:3] for s in rec.states], "estimate")
+        if estimated := _estimated(rec.states):
+            _path(ax, [dq.translation(np.array(s.end_effector))[1:3] for s in estimated],
+                  "estimate")  # fmt: skip
+        else:
+            _nothing(ax, NO_FIX)
         if rec.truth:
             truth = [dq.translation(np.array(s.end_effector))[1:3] for s in rec.truth]
             _path(ax, truth, "truth", linestyle="--")
-        goals = np.array([_goal_position(g)[:2] for g in rec.goals])
+        goals = np.array([_goal_position(g)[:2] for g in rec.goals
+                          if g.task in END_EFFECTOR_TASKS]).reshape(-1, 2)  # fmt: skip
         ax.plot(goals[:, 0], goals[:, 1], "*", color="green", markersize=12, label="goal")
-        ax.legend(fontsize="small")
+        _legend(ax)
     return figure
 
 
 def _base_path_figure(recordings: Sequence[_Recording], robot: MobileManipulator) -> Figure:
     figure, axes = _panels(recordings, 1, 5.0)
     for ax, rec in zip(axes[0], recordings, strict=True):
-        _path(ax, [s.base_pose[:2] for s in rec.states], "estimate")
+        if estimated := _estimated(rec.states):
+            _path(ax, [s.base_pose[:2] for s in estimated], "estimate")
+            x, y = estimated[-1].base_pose[:2]
+            ax.add_patch(Circle((x, y), robot.base.body_radius, fill=False, color="gray",
+                                label="base body"))  # fmt: skip
+        else:
+            _nothing(ax, NO_FIX)
         if rec.truth:
             _path(ax, [s.base_pose[:2] for s in rec.truth], "truth", linestyle="--")
-        x, y = rec.states[-1].base_pose[:2]
-        body = Circle((x, y), robot.base.body_radius, fill=False, color="gray", label="base body")
-        ax.add_patch(body)
         circles = {(c.x, c.y, c.radius) for message in rec.obstacles for c in message.circles}
         for index, (cx, cy, radius) in enumerate(sorted(circles)):
             label = "obstacle" if index == 0 else None
             ax.add_patch(Circle((cx, cy), radius, color="red", alpha=0.4, label=label))
         _solids_on_the_floor(ax, rec)
         ax.autoscale_view()
-        ax.legend(fontsize="small")
+        _legend(ax)
     return figure
 
 
@@ -352,8 +417,7 @@ def _arm_clearance_figure(recordings: Sequence[_Recording], robot: MobileManipul
     figure, axes = _panels(recordings, 1, 4.0, sharey=True)
     for ax, rec in zip(axes[0], recordings, strict=True):
         if rec.arm_clearance is None:
-            ax.text(0.5, 0.5, "no solids in the ground truth", ha="center", va="center",
-                    transform=ax.transAxes)  # fmt: skip
+            _nothing(ax, "no solids in the ground truth")
             continue
         t, clearance = rec.arm_clearance
         for column, name in enumerate(robot.collision.names):

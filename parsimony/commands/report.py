@@ -9,13 +9,16 @@ import argparse
 import sys
 from pathlib import Path
 
+import yaml
+
 from deploy import ROBOT_FILE
 from parsimony.commands.launch import positive_seconds
 from parsimony.output import emit, json_text
 from parsimony.sessions import load_session
 from profiles.profile import ProfileError, load_profile
-from record.judge import JUDGED, judge, the_run
+from record.judge import JUDGED, judge, open_loop, the_run
 from record.report import write_report
+from record.session_span import parted
 from wbc.robot import MobileManipulator
 
 
@@ -44,31 +47,55 @@ def run(args: argparse.Namespace) -> int:
     if len(args.files) > 2:
         print("report: one or two files", file=sys.stderr)
         return 2
-    sessions = []
+    sessions, judged = [], {}
     try:
-        for index, path in enumerate(args.files):
-            session = the_run(load_session(path, JUDGED), args.time_limit)[0]
-            sessions.append((label_of(args.labels, index, session, path), session))
-        args.out.mkdir(parents=True, exist_ok=True)
+        labels = labels_given(args.labels, len(args.files))
+        robot = MobileManipulator.from_yaml(args.robot)
         frame = None
         if args.profile is not None:
             scene = load_profile(args.profile).scene
             frame = scene.reference_pose if scene is not None else None
-        robot = MobileManipulator.from_yaml(args.robot)
+        for index, path in enumerate(args.files):
+            loaded = load_session(path, JUDGED)
+            if outside := parted(loaded).line():
+                print(f"report: {path}: left out, {outside}", file=sys.stderr)
+            session = the_run(loaded, args.time_limit)[0]
+            label = labels[index] if labels else label_of(session, path)
+            sessions.append((label, session))
+            judged[label] = judge(loaded, robot, args.time_limit)
+        args.out.mkdir(parents=True, exist_ok=True)
         result = write_report(sessions, robot, args.out, frame)
-        judged = {label: judge(session, robot, args.time_limit) for label, session in sessions}
     except (OSError, ValueError, ProfileError) as error:
         print(f"report: {error}", file=sys.stderr)
         return 2
+    except yaml.YAMLError as error:  # the robot description's, which wbc.robot passes on
+        print(f"report: {args.robot}: not YAML: {str(error).splitlines()[0]}", file=sys.stderr)
+        return 2
+    for name, why in result["gaps"].items():
+        print(f"report: {name} not drawn: {why}", file=sys.stderr)
+    for note in result["notes"]:
+        print(f"report: note: {note}", file=sys.stderr)
     (args.out / "judged.json").write_text(json_text(judged, indent=2) + "\n")
     result = {**result, "figures": [str(p) for p in result["figures"]], "judged": judged}
     emit(json_text(result, indent=2) if args.json else "\n".join(result["figures"]))
     return 0
 
 
-def label_of(labels: str | None, index: int, session: dict, path: Path) -> str:
-    """The user's label, else the law that made the recording, else the file's name."""
-    if labels:
-        return labels.split(",")[index].strip()
+def labels_given(labels: str | None, files: int) -> list[str]:
+    """The user's labels, one per file (``ValueError`` otherwise); empty when not given."""
+    if labels is None:
+        return []
+    given = [label.strip() for label in labels.split(",")]
+    if len(given) != files or not all(given):
+        raise ValueError(f"--labels: expected {files} non-empty comma-separated label"
+                         f"{'s' * (files > 1)}, got {labels!r}")  # fmt: skip
+    return given
+
+
+def label_of(session: dict, path: Path) -> str:
+    """The law that made the recording (``(rerun)`` after it for a rerun's), else the file's
+    name."""
     diagnostics = session.get("control/diagnostics") or []
-    return diagnostics[0].law if diagnostics else path.stem
+    if not diagnostics:
+        return path.stem
+    return diagnostics[0].law + (" (rerun)" if open_loop(session) else "")

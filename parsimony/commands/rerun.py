@@ -28,6 +28,7 @@ from messages.header import Header
 from messages.obstacles import obstacles_of
 from parsimony.output import emit
 from parsimony.outputs import writable_output, written_whole
+from record.judge import RERUN_SOURCE
 from record.session_file import Recorded, SessionWriter
 from record.session_reader import read_groups
 from wbc.robot import MobileManipulator
@@ -112,7 +113,7 @@ class Offline:
 
 def write_step(out: SessionWriter, namespace: str, law: str, step: Step, gains) -> None:
     """The commands and diagnostics of one step, stamped with its state's stamp."""
-    header = Header(stamp_ns=step.stamp_ns, frame="world", seq=0, source=f"rerun_{law}")
+    header = Header(stamp_ns=step.stamp_ns, frame="world", seq=0, source=f"{RERUN_SOURCE}{law}")
     forward, angular, left, right = step.wheels
     out.write(f"{namespace}/base/command", BaseCommand(
         header=header, forward_velocity=forward, angular_velocity=angular, left_wheel=left,

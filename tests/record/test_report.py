@@ -22,11 +22,15 @@ from messages.topics import (
     CONTROL_GOAL,
     ROBOT_STATE,
     SIM_TRUTH,
+    TOPICS,
     WORLD_OBSTACLES,
 )
 from messages.truth import SimTruth
+from record import report as report_module
 from record.judge import arm_clearance, arm_clearances
 from record.report import control_inputs, write_report
+from record.session_file import SessionWriter
+from tests.processes import parsimony
 from wbc import dq, scenarios
 from wbc.base_motion import unicycle, wheel_speeds
 from wbc.cascade_law import CascadeLaw
@@ -252,3 +256,77 @@ def test_solids_in_the_truth_give_the_arms_clearance_by_part_over_time(runs, tmp
         assert data.startswith(b"\x89PNG\r\n\x1a\n") and len(data) > 10_000, name
     alone = write_report([("with solids", session)], ROBOT, tmp_path / "alone")
     assert (tmp_path / "alone" / "arm_clearance.png").exists() and len(alone["figures"]) == 7
+
+
+def legs(arm: tuple[float, ...]) -> list[Goal]:
+    """A staging supervisor's drive legs: to a point, then a turn; no end-effector goal."""
+    return [Goal(header=header(START_NS, "world", 0), task="point", point=(0.5, 0.0), arm=arm,
+                 lookahead=0.1),
+            Goal(header=header(START_NS + 10**9, "world", 1), task="heading", heading=0.0,
+                 arm=arm, point=(0.5, 0.0))]  # fmt: skip
+
+
+def test_odd_recordings_give_every_figure_never_an_error(runs, tmp_path):
+    """Drive legs before the pose (what failed with a TypeError), drive legs alone, no valid
+    state, the goal after every state: every figure is written; a panel with nothing to draw
+    says why."""
+    session = runs["LP"][1]
+    arm = session[ROBOT_STATE.name][0].arm_joints
+    pose = session[CONTROL_GOAL.name]
+    late = Goal(header=header(START_NS + 10**12, "world", 0), task="pose", pose=pose[0].pose)
+    invalid = [s.model_copy(update={"valid": False}) for s in session[ROBOT_STATE.name]]
+    odd = {
+        "legs, then the pose": {**session, CONTROL_GOAL.name: legs(arm) + pose},
+        "legs alone": {**session, CONTROL_GOAL.name: legs(arm)},
+        "no valid state": {**session, ROBOT_STATE.name: invalid},
+        "the goal after every state": {**session, CONTROL_GOAL.name: [late]},
+    }
+    for number, (label, recorded) in enumerate(odd.items()):
+        result = write_report([(label, recorded)], ROBOT, tmp_path / str(number))
+        assert [path.name for path in result["figures"]] == list(FIGURES), label
+        assert result["gaps"] == {} and result["notes"] == [], label
+
+
+def test_the_base_path_starts_at_the_first_valid_state(runs):
+    """Before its first camera fix the estimator says (0, 0), invalid: the path is drawn from
+    the first valid state, not with a line from there."""
+    states = runs["LP"][1][ROBOT_STATE.name]
+    moved = [s.model_copy(update={"base_pose": (s.base_pose[0] + 1.0, s.base_pose[1] + 2.0,
+                                                s.base_pose[2])}) for s in states]  # fmt: skip
+    before_fix = [s.model_copy(update={"base_pose": (0.0, 0.0, 0.0), "valid": False})
+                  for s in moved[:10]]  # fmt: skip
+    session = {**runs["LP"][1], ROBOT_STATE.name: before_fix + moved[10:]}
+    recording = report_module._recording("LP", session, None, ROBOT)
+    for name, where in (("base_path.png", moved[10].base_pose[:2]),
+                        ("end_effector_path.png", dq.translation(
+                            np.array(moved[10].end_effector))[1:3])):  # fmt: skip
+        figure = report_module._FIGURES[name]([recording], ROBOT)
+        estimate = next(line for line in figure.axes[0].lines if line.get_label() == "estimate")
+        np.testing.assert_array_equal(estimate.get_xydata()[0], where, err_msg=name)
+        assert len(estimate.get_xydata()) == len(states) - 10, name
+
+
+def test_labels_that_do_not_match_the_files_are_said_in_one_line(tmp_path):
+    done = parsimony("report", str(tmp_path / "a.mcap"), str(tmp_path / "b.mcap"),
+                     "--labels", "one", "--out", str(tmp_path / "out"))  # fmt: skip
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+    assert done.stderr == "report: --labels: expected 2 non-empty comma-separated labels, " \
+                          "got 'one'\n"
+
+
+def test_a_report_beside_a_rerun_says_its_commands_were_not_in_a_closed_loop(runs, tmp_path):
+    recording, rerun, out = tmp_path / "lp.mcap", tmp_path / "rerun.mcap", tmp_path / "out"
+    with SessionWriter(recording) as writer:
+        for topic, found in runs["LP"][1].items():
+            for message in found:
+                writer.write(TOPICS[topic].key("t"), message)
+    done = parsimony("rerun", str(recording), "--controller", "cascade", "-o", str(rerun))
+    assert done.returncode == 0, done.stderr
+    done = parsimony("report", str(recording), str(rerun), "--out", str(out))
+    assert done.returncode == 0, done.stderr
+    note = ("cascade (rerun): its commands were computed by `parsimony rerun` on the "
+            "recording's states, not in a closed loop")  # fmt: skip
+    assert [line for line in done.stderr.splitlines() if note in line], done.stderr
+    assert f"Note: {note}" in (out / "effort.md").read_text()
+    judged = json.loads((out / "judged.json").read_text())
+    assert judged["cascade (rerun)"]["open_loop"] and not judged["LP"]["open_loop"]
