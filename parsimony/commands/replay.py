@@ -21,6 +21,7 @@ namespace of its own (``--namespace``) is the safe way. The engine is ``record.r
 from __future__ import annotations
 
 import argparse
+import contextlib
 import fnmatch
 import math
 import sys
@@ -29,13 +30,18 @@ from pathlib import Path
 import zenoh
 
 from deploy.graph import component_class
-from deploy.query import QueryError, live_components
+from deploy.query import NoRouter, QueryError, Target, live_components
+from deploy.zenoh_error import zenoh_error_text
 from messages import topics
 from parsimony.commands.launch import positive, positive_seconds
+from parsimony.commands.view import namespace_argument, port_number, serving, watched_profile
 from parsimony.target_options import fail, profile_and_target, target_options
+from profiles.endpoints import endpoint_problem
 from profiles.profile import Profile, ProfileError
+from record.live_view import DEFAULT_PORT
 from record.replay_keys import terminal_keys
 from record.replayer import ANSWERING, SENSORS, Player, Playing, Recording
+from wbc.robot import MobileManipulator
 
 COMMANDS = (topics.BASE_COMMAND.name, topics.ARM_COMMAND.name)
 """What moves a robot: never replayed into a namespace where anything is alive, unless
@@ -65,15 +71,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
                         help="start paused (in a terminal), else wait for Enter")  # fmt: skip
     parser.add_argument("--into-live", action="store_true",
                         help="send commands, and topics live components publish")  # fmt: skip
+    parser.add_argument("--view", action="store_true",
+                        help="serve a Foxglove live view of the replay, as parsimony view")
+    parser.add_argument("--port", type=port_number, default=DEFAULT_PORT,
+                        help=f"the view's, on 127.0.0.1 (default {DEFAULT_PORT}, 0: any free)")
     return parser
-
-
-def namespace_argument(text: str) -> str:
-    """A namespace a key can start with (``topics.check_namespace``), else an argument error."""
-    try:
-        return topics.check_namespace(text)
-    except ValueError as error:
-        raise argparse.ArgumentTypeError(str(error)) from None
 
 
 def wanted(args: argparse.Namespace, name: str) -> bool:
@@ -101,12 +103,16 @@ def run(args: argparse.Namespace) -> int:
         if args.lockstep and ANSWERING.keys() & recorded.names:
             raise ValueError(f"--lockstep: the replay would answer itself; leave out "
                              f"{', '.join(ANSWERING)} (or use --sensors)")  # fmt: skip
-        session = target.open()
+        watched = watched_profile(profile, args.namespace)
+        robot = MobileManipulator.from_yaml(profile.robot) if args.view and profile.robot else None
+        session, own_router = opened(target, profile)
     except (ProfileError, QueryError, OSError, ValueError) as error:
         print("replay: ", end="", file=sys.stderr)
         return fail(error)
-    namespace = args.namespace or profile.namespace
-    conflicts = [] if args.into_live else live_conflicts(
+    if recorded.outside is not None:
+        print(f"[replay] not sent, {recorded.outside}", file=sys.stderr)
+    namespace = watched.namespace
+    conflicts = [] if args.into_live or own_router else live_conflicts(
         session, profile, namespace, recorded.names)  # fmt: skip
     if conflicts:
         session.close()
@@ -115,13 +121,39 @@ def run(args: argparse.Namespace) -> int:
               "--into-live", file=sys.stderr)  # fmt: skip
         return 2
     try:
-        with session, terminal_keys() as keys:
+        view = serving(session, watched, topics.topics_matching(["*"]), args.port,
+                       robot) if args.view else contextlib.nullcontext()  # fmt: skip
+        with session, view, terminal_keys() as keys:
             playing = Playing(args.rate, args.start_offset, args.duration, args.loop,
                               args.clock, args.lockstep, args.start_paused)  # fmt: skip
             return Player(playing, session, namespace, recorded, keys).run()
+    except OSError as error:  # the view's port
+        print(f"replay: {error}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print("\n[replay] interrupted", file=sys.stderr, flush=True)
         return 130
+
+
+def opened(target: Target, profile: Profile) -> tuple[zenoh.Session, bool]:
+    """A session on the profile's router, and False; or, when none answers and the profile's
+    router endpoints are on this host, a router of the replay's own listening there (the
+    launcher's, without uplinks, so only local tools reach it), and True."""
+    try:
+        return target.open(), False
+    except NoRouter as error:
+        if any(endpoint_problem(e, needs_port=True) for e in profile.zenoh.router):
+            raise
+        settings = profile.zenoh.model_copy(update={"uplinks": []})
+        try:
+            session = zenoh.open(settings.router_config(profile.namespace))
+        except zenoh.ZError as failed:
+            raise NoRouter(f"{error}; nor could the replay's own router listen there: "
+                           f"{zenoh_error_text(failed)}") from failed  # fmt: skip
+    where = ", ".join(profile.zenoh.router)
+    print(f"[replay] no router at {where} (no system running): the replay serves its own "
+          f"there; `parsimony view` of the profile watches it", file=sys.stderr, flush=True)
+    return session, True
 
 
 def live_conflicts(session: zenoh.Session, profile: Profile, namespace: str,

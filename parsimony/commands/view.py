@@ -3,28 +3,32 @@
 opens as a live source, until Ctrl-C or SIGTERM. It draws the robot of the profile's
 description, lets its clients send goals on goal/request (when the user may write it) and set
 any running component's parameters. A replay into the profile's namespace is watched the same
-way. It runs ``--nice`` steps below the loop's priority (10 by default), so that on a busy
-machine the loop takes the CPU first. ``--layout FILE`` writes the Foxglove layout of the
-namespace (``parsimony layout``); ``--json`` prints what the view did when it stops (messages,
-the handler's times)."""
+way (``--namespace NS``: a replay into a namespace of its own). It runs ``--nice`` steps below
+the loop's priority (10 by default), so that on a busy machine the loop takes the CPU first.
+``--layout FILE`` writes the Foxglove layout of the namespace (``parsimony layout``);
+``--json`` prints what the view did when it stops (messages, the handler's times)."""
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import os
 import signal
 import sys
+from collections.abc import Iterator, Sequence
 from pathlib import Path
+
+import zenoh
 
 from components.rate_limited_log import RateLimitedLog
 from deploy.control_station import ControlStation
 from deploy.query import QueryError, Target
-from messages.topics import topics_matching
+from messages.topics import Topic, check_namespace, topics_matching
 from parsimony.commands.layout import write_layout
 from parsimony.output import emit, json_text
 from parsimony.target_options import exit_code
-from profiles.profile import ProfileError, load_profile
+from profiles.profile import Profile, ProfileError, load_profile
 from record.foxglove_views import Viewer
 from record.live_view import DEFAULT_PORT, LiveView
 from wbc.robot import MobileManipulator
@@ -41,6 +45,14 @@ def port_number(text: str) -> int:
     return port
 
 
+def namespace_argument(text: str) -> str:
+    """A namespace a key can start with (``topics.check_namespace``), else an argument error."""
+    try:
+        return check_namespace(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
+
+
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     parser = subparsers.add_parser("view", help="a Foxglove live view and control station",
                                    description=__doc__)  # fmt: skip
@@ -48,6 +60,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("--port", type=port_number, default=DEFAULT_PORT,
                         help=f"on 127.0.0.1 (default {DEFAULT_PORT}, 0: any free one)")  # fmt: skip
     parser.add_argument("--keys", nargs="*", default=["*"], help="topic name patterns")
+    parser.add_argument("--namespace", type=namespace_argument,
+                        help="watch this namespace instead of the profile's (a replay's)")
     parser.add_argument("--layout", type=Path, help="write the Foxglove layout to this file")
     parser.add_argument("--force", action="store_true", help="write over an existing layout")
     parser.add_argument("--nice", type=int, default=NICE, choices=range(0, 20), metavar="N",
@@ -67,7 +81,7 @@ def _interrupt(signum: int, frame: object) -> None:
 
 def run(args: argparse.Namespace) -> int:
     try:
-        profile = load_profile(args.profile)
+        profile = watched_profile(load_profile(args.profile), args.namespace)
         chosen = topics_matching(args.keys)
         robot = MobileManipulator.from_yaml(profile.robot) if profile.robot else None
         if args.layout is not None:
@@ -79,17 +93,9 @@ def run(args: argparse.Namespace) -> int:
     os.nice(args.nice)
     previous = signal.signal(signal.SIGTERM, _interrupt)
     try:
-        warnings = RateLimitedLog(logging.getLogger("parsimony.view"))
-        with target.open() as session:
-            station = ControlStation(session, profile)
-            try:
-                with LiveView(session, target.namespace, chosen, args.port, warnings.warning,
-                              Viewer(robot), station, station.capabilities,
-                              station.encodings) as view:  # fmt: skip
-                    station.attach(view.server)
-                    _serve(view, station, target.namespace, args.json)
-            finally:
-                station.close()
+        with target.open() as session, serving(session, profile, chosen, args.port,
+                                               robot) as (view, station):  # fmt: skip
+            _serve(view, station, args.json)
     except (QueryError, OSError) as error:
         print(f"view: {error}", file=sys.stderr)
         return exit_code(error)
@@ -100,12 +106,35 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _serve(view: LiveView, station: ControlStation, namespace: str, as_json: bool) -> None:
+def watched_profile(profile: Profile, namespace: str | None) -> Profile:
+    """``profile`` with the namespace watched (and given goals) in place of its own, if given."""
+    return profile if namespace is None else profile.model_copy(update={"namespace": namespace})
+
+
+@contextlib.contextmanager
+def serving(session: zenoh.Session, profile: Profile, chosen: Sequence[Topic], port: int,
+            robot: MobileManipulator | None
+            ) -> Iterator[tuple[LiveView, ControlStation]]:  # fmt: skip
+    """The live view and control station of ``profile``'s namespace on ``session``, served on
+    127.0.0.1:``port``, said on stderr once live (``parsimony view``'s, ``replay --view``'s)."""
+    warnings = RateLimitedLog(logging.getLogger("parsimony.view"))
+    station = ControlStation(session, profile)
+    try:
+        with LiveView(session, profile.namespace, chosen, port, warnings.warning,
+                      Viewer(robot), station, station.capabilities,
+                      station.encodings) as view:  # fmt: skip
+            station.attach(view.server)
+            publishing = "goals from clients on goal/request" if station.may_publish else (
+                f"no publishing: {station.user} may not write goal/request")  # fmt: skip
+            print(f"view: {profile.namespace} live at {view.address} ({publishing}; the "
+                  f"parameters of every running component)", file=sys.stderr, flush=True)
+            yield view, station
+    finally:
+        station.close()
+
+
+def _serve(view: LiveView, station: ControlStation, as_json: bool) -> None:
     """Serve until interrupted, then say what the view did."""
-    publishing = "goals from clients on goal/request" if station.may_publish else (
-        f"no publishing: {station.user} may not write goal/request")  # fmt: skip
-    print(f"view: {namespace} live at {view.address} ({publishing}; the parameters of every "
-          f"running component)", file=sys.stderr, flush=True)  # fmt: skip
     try:
         while True:
             signal.pause()

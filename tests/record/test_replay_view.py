@@ -1,0 +1,71 @@
+"""`parsimony replay` with no system running: it serves a router of its own on the profile's
+loopback endpoint, and the replay is watched in Foxglove as a live system is, through
+`replay --view` and through `parsimony view` of the same profile."""
+
+from __future__ import annotations
+
+import asyncio
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+from test_live_view import DEADLINE_S, StderrLines, state, watch, write_profile
+
+from messages import topics
+from messages.state import RobotState
+from profiles.endpoints import free_port
+from record.session_file import SessionWriter, from_json
+
+RECORDED = "rec"
+INTO = "other"
+STATES = 50
+
+
+def recording(path: Path) -> dict[int, RobotState]:
+    """A second of robot states at 50 Hz, recorded in ``RECORDED``; by stamp."""
+    states = {s.header.stamp_ns: s for s in map(state, range(STATES))}
+    with SessionWriter(path) as writer:
+        for message in states.values():
+            writer.write(topics.ROBOT_STATE.key(RECORDED), message)
+    return states
+
+
+def watched(address: str, channel: str) -> tuple[int, bytes]:
+    """The first (log time, payload) a Foxglove client subscribed to ``channel`` reads."""
+    return asyncio.run(watch(address, {channel}))[1][channel]
+
+
+def test_a_replay_with_no_system_serves_its_own_router_and_is_watched_live(tmp_path: Path
+                                                                           ) -> None:  # fmt: skip
+    profile = write_profile(tmp_path)  # its router's port is free: nothing is running
+    states = recording(tmp_path / "k.mcap")
+    port = free_port()
+    replay = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "replay",
+                               str(tmp_path / "k.mcap"), "--profile", str(profile), "--loop",
+                               "--namespace", INTO, "--view", "--port", str(port)],
+                              stdin=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                              text=True)  # fmt: skip
+    said = StderrLines(replay)
+    view = None
+    try:
+        assert "the replay serves its own there" in said.wait_for("no router at")
+        address = f"ws://127.0.0.1:{port}"
+        assert f"view: {INTO} live at {address}" in said.wait_for(" live at ")
+        channel = topics.ROBOT_STATE.key(INTO)
+        log_time, payload = watched(address, channel)
+        assert from_json(payload, RobotState) == states[log_time]
+        # `parsimony view` of the profile reaches the replay's router, and watches it too.
+        view = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "view", str(profile),
+                                 "--namespace", INTO, "--port", "0"], stderr=subprocess.PIPE,
+                                text=True)  # fmt: skip
+        line = StderrLines(view).wait_for(" live at ")
+        log_time, payload = watched(line.split(" live at ")[1].split()[0], channel)
+        assert from_json(payload, RobotState) == states[log_time]
+    finally:
+        for process in (view, replay):
+            if process is not None:
+                process.send_signal(signal.SIGINT)
+                process.wait(DEADLINE_S)
+    assert replay.returncode == 130 and "Traceback" not in said.all(), said.all()
+    assert view.returncode == 0
