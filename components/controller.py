@@ -115,6 +115,7 @@ class Controller(Component):
         node.counters["non_finite_commands"] = 0
         node.counters["law_errors"] = 0
         node.counters["refused_goals"] = 0
+        node.counters["refused_obstacles"] = 0
         self.state_input = node.subscribe(topics.ROBOT_STATE, self.on_state)
         node.subscribe(topics.CONTROL_GOAL, self.on_goal)
         node.subscribe(topics.WORLD_OBSTACLES, self.on_obstacles)
@@ -138,8 +139,17 @@ class Controller(Component):
                                             "next goal")  # fmt: skip
 
     def on_obstacles(self, message: Obstacles) -> None:
-        """Take the obstacles every following step avoids."""
-        self.stepper.take_obstacles(obstacles_of(message))
+        """Take the obstacles every following step avoids; a message with a solid the law
+        cannot take (``wbc.obstacles3d``: a cylinder of radius 1e300) is refused in one line
+        (``refused_obstacles``), and the last obstacles kept."""
+        try:
+            obstacles = obstacles_of(message)
+        except ValueError as error:
+            self.node.count("refused_obstacles")
+            self.node.warn("refused_obstacles", f"world/obstacles refused: {error}; the last "
+                                                "obstacles kept")  # fmt: skip
+            return
+        self.stepper.take_obstacles(obstacles)
 
     def on_state(self, state: RobotState) -> None:
         """One control step: publish its commands and diagnostics."""

@@ -320,6 +320,28 @@ def test_a_goal_whose_gains_leave_the_parameter_bounds_is_refused(operator: Oper
     assert operator.step()[0].parameters["eta"] == 1.5
 
 
+def test_obstacles_with_a_solid_larger_than_a_scene_are_refused_in_one_line(
+    operator: Operator,
+) -> None:
+    """A cylinder of radius 1e300 on world/obstacles (a scene refuses it; the message's own
+    schema does not): refused, counted, no traceback, the controller steps on."""
+    from messages.obstacles import Cylinder, Obstacles, Solids
+
+    operator.send_goal()
+    obstacles = operator.system.router.declare_publisher(
+        topics.WORLD_OBSTACLES.key(operator.namespace))
+    header = Header(stamp_ns=operator.stamp(), frame="world", seq=0, source="test")
+    huge = Solids(cylinders=(Cylinder(x=3.0, y=0.0, radius=1e300),))
+    obstacles.put(codec.encode(Obstacles(header=header, solids=huge)))
+    deadline = time.monotonic() + DEADLINE_S
+    while operator.counters()["refused_obstacles"] < 1:
+        assert time.monotonic() < deadline, "the obstacles were not refused"
+    assert operator.step()[0].status == "optimal"
+    log = operator.system.log("controller")
+    assert "world/obstacles refused: radius: expected a number > 0 and <= 100 m" in log
+    assert "Traceback" not in log and operator.counters()["errors.world/obstacles"] == 0
+
+
 FAR = (1e300, -1e300, 1e300)
 """A base pose whose program overflows (the QP law's u was all NaN, reported optimal)."""
 FLOOD = 200
