@@ -10,7 +10,10 @@ answered it, as the simulator's lockstep waits for its loop, so that they take a
 recording's inputs in its recorded order whatever the load. Progress goes to stderr. In a
 terminal, keys: space pauses and resumes, ``s`` or the right arrow sends the next message
 while paused, ``+`` and ``-`` double and halve the rate, ``q`` quits; ``--start-paused``
-starts paused (elsewhere it waits for Enter).
+starts paused (elsewhere it waits for Enter). With no system running (no router answers on
+the profile's loopback endpoint) the replay serves a router of its own there, which `parsimony
+view` of the profile reaches; ``--view`` serves that live view itself (on ``--port``). What is
+stamped far outside the session (``record.session_span``) is not sent, and said.
 
 Into a namespace where components are alive, a replay refuses, before it sends anything, to
 send commands (live drivers would move the robot) and any topic a live component publishes

@@ -47,7 +47,7 @@ def run(args: argparse.Namespace) -> int:
     if len(args.files) > 2:
         print("report: one or two files", file=sys.stderr)
         return 2
-    sessions, judged = [], {}
+    loaded, sessions = [], []
     try:
         labels = labels_given(args.labels, len(args.files))
         robot = MobileManipulator.from_yaml(args.robot)
@@ -56,15 +56,15 @@ def run(args: argparse.Namespace) -> int:
             scene = load_profile(args.profile).scene
             frame = scene.reference_pose if scene is not None else None
         for index, path in enumerate(args.files):
-            loaded = load_session(path, JUDGED)
-            if outside := parted(loaded).line():
+            loaded.append(load_session(path, JUDGED))
+            if outside := parted(loaded[-1]).line():
                 print(f"report: {path}: left out, {outside}", file=sys.stderr)
-            session = the_run(loaded, args.time_limit)[0]
-            label = labels[index] if labels else label_of(session, path)
-            sessions.append((label, session))
-            judged[label] = judge(loaded, robot, args.time_limit)
+            session = the_run(loaded[-1], args.time_limit)[0]
+            sessions.append((labels[index] if labels else label_of(session, path), session))
         args.out.mkdir(parents=True, exist_ok=True)
         result = write_report(sessions, robot, args.out, frame)
+        judged = {label: judge(whole, robot, args.time_limit)
+                  for (label, _), whole in zip(sessions, loaded, strict=True)}  # fmt: skip
     except (OSError, ValueError, ProfileError) as error:
         print(f"report: {error}", file=sys.stderr)
         return 2

@@ -27,7 +27,7 @@ from messages.topics import (
 )
 from messages.truth import SimTruth
 from record import report as report_module
-from record.judge import arm_clearance, arm_clearances
+from record.judge import arm_clearance, arm_clearances, judge
 from record.report import control_inputs, write_report
 from record.session_file import SessionWriter
 from tests.processes import parsimony
@@ -268,8 +268,8 @@ def legs(arm: tuple[float, ...]) -> list[Goal]:
 
 def test_odd_recordings_give_every_figure_never_an_error(runs, tmp_path):
     """Drive legs before the pose (what failed with a TypeError), drive legs alone, no valid
-    state, the goal after every state: every figure is written; a panel with nothing to draw
-    says why."""
+    state, the goal after every state: every figure is written (a panel with nothing to draw
+    says why), and the run is judged."""
     session = runs["LP"][1]
     arm = session[ROBOT_STATE.name][0].arm_joints
     pose = session[CONTROL_GOAL.name]
@@ -285,6 +285,7 @@ def test_odd_recordings_give_every_figure_never_an_error(runs, tmp_path):
         result = write_report([(label, recorded)], ROBOT, tmp_path / str(number))
         assert [path.name for path in result["figures"]] == list(FIGURES), label
         assert result["gaps"] == {} and result["notes"] == [], label
+        assert judge(recorded, ROBOT)["iterations"] > 0, label
 
 
 def test_the_base_path_starts_at_the_first_valid_state(runs):
