@@ -1,7 +1,8 @@
 """The launcher: one Zenoh router and one supervised process per component of a profile.
 
-It opens the router the components connect to, starts the enabled components
-(drivers, estimators, controllers, tools; one that waits for others, ``after``, once they are
+It opens the router the components connect to, starts the enabled components (a recorder
+first and the others once it is alive, so that it records them from their first message; then
+drivers, estimators, controllers, tools; one that waits for others, ``after``, once they are
 alive), prefixes every line they print with the time and ``[name]``, restarts the ones that
 exit according to their restart policy, reports liveliness changes and each change of a
 component's ``state`` (its status), and on SIGINT, SIGTERM or the end of the duration
@@ -121,11 +122,17 @@ class Launcher:
         profile_path: Path,
         out: IO[str] = sys.stdout,
         err: IO[str] = sys.stderr,
+        pass_fds: tuple[int, ...] = (),
     ) -> None:
+        """``profile`` as loaded from ``profile_path``, the file its components read; a file
+        in memory at ``/proc/self/fd/N`` (``parsimony launch --record``) is one of
+        ``pass_fds``, the descriptors the components inherit."""
         self.profile = profile
-        self.profile_path = Path(profile_path).resolve()
+        self.profile_path = Path(profile_path).absolute()
+        self.pass_fds = pass_fds
         self.output = Output(out, err)
         self.children = [Child(spec) for spec in profile.start_order()]
+        self.recorders = [c.spec.name for c in self.children if c.spec.role == "recorder"]
         self._stop_reason: str | None = None
         self._kept_params = Path()
         """A directory of one JSON file per component: the parameters set while it runs, kept
@@ -154,8 +161,11 @@ class Launcher:
             )
             try:
                 self._start_ready()
+                if self.recorders and len(self.recorders) < len(self.children):
+                    self.output.say(f"the others start once {' and '.join(self.recorders)} "
+                                    "alive, to be recorded from their first message")  # fmt: skip
                 for child in self.children:
-                    if child.waiting:
+                    if child.waiting and child.spec.after:
                         self.output.say(f"{child.spec.name} starts once "
                                         f"{' and '.join(child.spec.after)} alive")  # fmt: skip
                 self._starting_until = time.monotonic() + self.profile.startup_timeout_s
@@ -271,7 +281,7 @@ class Launcher:
             self.output.say(f"all {len(self.children)} components alive; running until {until}")
         elif now >= self._starting_until:
             timeout = self.profile.startup_timeout_s
-            unstarted = [f"{c.spec.name} waited for {', '.join(c.spec.after)}"
+            unstarted = [f"{c.spec.name} waited for {', '.join(self._awaited(c.spec))}"
                          for c in self.children if c.waiting]  # fmt: skip
             more = f"; never started: {'; '.join(unstarted)}" if unstarted else ""
             self._fail_startup(f"{', '.join(waiting)} not alive after {timeout:.1f} s "
@@ -285,11 +295,16 @@ class Launcher:
                 child.failed = True
         self._stop_reason = f"start-up failed: {why}"
 
+    def _awaited(self, spec: ComponentSpec) -> list[str]:
+        """The components that must have been alive before ``spec`` starts: its ``after``,
+        and the recorders unless it is one."""
+        return [*([] if spec.role == "recorder" else self.recorders), *spec.after]
+
     def _start_ready(self) -> None:
-        """Start the children not started yet whose ``after`` components have all been
+        """Start the children not started yet whose awaited components have all been
         alive."""
         for child in self.children:
-            if child.waiting and self._seen_alive.issuperset(child.spec.after):
+            if child.waiting and self._seen_alive.issuperset(self._awaited(child.spec)):
                 self._start(child)
 
     def _start(self, child: Child) -> None:
@@ -310,6 +325,7 @@ class Launcher:
             text=True,
             errors="replace",
             start_new_session=True,
+            pass_fds=self.pass_fds,
         )
         child.started_at = time.monotonic()
         child.restart_at = None

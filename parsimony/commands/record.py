@@ -11,6 +11,7 @@ import os
 import signal
 import subprocess
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 
 import yaml
@@ -18,7 +19,6 @@ import yaml
 from deploy.query import QueryError, Target
 from messages.process import PARENT_PID_ENV
 from messages.topics import topics_matching
-from parsimony.experiment import RECORDER_STOP_S
 from parsimony.output import emit
 from parsimony.outputs import writable_output, written_whole
 from profiles.profile import ProfileError
@@ -63,25 +63,47 @@ def run(args: argparse.Namespace) -> int:
     except (ProfileError, QueryError) as error:
         print(f"record: {error}", file=sys.stderr)
         return 2
-    params = {"path": str(args.output.resolve()), "keys": ",".join(args.keys)}
-    return record(yaml.safe_dump({
-        "extends": str(args.profile.resolve()),
-        "components": [{"name": "recorder", "module": "recorder", "role": "recorder",
-                        "stop_timeout_s": RECORDER_STOP_S, "params": params,
-                        "restart": {"policy": "never"}}],
-    }))  # fmt: skip
+    return record(with_recorder(args.profile, args.output, args.keys))
+
+
+RECORDER = "recorder"
+"""The name of the recorder component that ``record`` and ``launch --record`` add."""
+
+
+def recorder_component(output: Path, keys: Sequence[str] = ("*",)) -> dict[str, object]:
+    """A profile's recorder writing every topic matching one of ``keys`` to ``output``: role
+    ``recorder`` (it starts first and stops last, writing all that still waits), never
+    restarted (a new one would begin the file again; a killed one's file recovers)."""
+    from parsimony.experiment import RECORDER_STOP_S  # the laws and plots: only when needed
+
+    return {"name": RECORDER, "module": "recorder", "role": "recorder", "enabled": True,
+            "stop_timeout_s": RECORDER_STOP_S, "restart": {"policy": "never"},
+            "params": {"path": str(Path(output).resolve()), "keys": ",".join(keys)}}
+
+
+def with_recorder(profile: Path, output: Path, keys: Sequence[str] = ("*",)) -> str:
+    """The YAML text of a profile that extends ``profile`` with ``recorder_component``."""
+    components = [recorder_component(output, keys)]
+    return yaml.safe_dump({"extends": str(Path(profile).resolve()), "components": components})
+
+
+def memory_file(name: str, text: str) -> tuple[int, Path]:
+    """A file in memory (``memfd_create``) holding ``text``, and the path a child that
+    inherits its descriptor (``pass_fds``) reads it at: nothing is left behind, whatever kills
+    this process."""
+    descriptor = os.memfd_create(name)
+    os.write(descriptor, text.encode())
+    return descriptor, Path(f"/proc/self/fd/{descriptor}")
 
 
 def record(profile: str) -> int:
     """Run the recorder of ``profile`` (YAML text) until it stops; SIGINT and SIGTERM are
     passed on to it (it writes all that waits, then its footer), and it stops by itself if
-    this process dies (it watches its parent, ``PARENT_PID_ENV``). The profile is a file in
-    memory (``memfd_create``) the child inherits, so nothing is left behind whatever kills
-    this process."""
-    descriptor = os.memfd_create("record.yaml")
-    os.write(descriptor, profile.encode())
-    command = [sys.executable, "-m", "components.recorder", "--profile",
-               f"/proc/self/fd/{descriptor}", "--name", "recorder"]  # fmt: skip
+    this process dies (it watches its parent, ``PARENT_PID_ENV``). The profile is a
+    ``memory_file`` the child inherits."""
+    descriptor, path = memory_file("record.yaml", profile)
+    command = [sys.executable, "-m", "components.recorder", "--profile", str(path),
+               "--name", RECORDER]  # fmt: skip
     env = {**os.environ, PARENT_PID_ENV: str(os.getpid())}
     process = subprocess.Popen(command, env=env, start_new_session=True, pass_fds=(descriptor,))
     os.close(descriptor)
