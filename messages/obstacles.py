@@ -62,6 +62,11 @@ class Cylinder(Message):
     radius: Positive
     height: Positive | None = None
 
+    @model_validator(mode="after")
+    def _a_solid(self) -> Cylinder:
+        self.solid()  # ValueError naming the field: every size within the scene's extent
+        return self
+
     def solid(self) -> obstacles3d.Cylinder:
         return obstacles3d.Cylinder(self.x, self.y, self.radius, self.height, self.name)
 

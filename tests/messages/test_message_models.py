@@ -190,6 +190,8 @@ def test_a_plane_must_be_a_solid_wbc_accepts() -> None:
         Plane(normal=(1.0, 0.0, 0.0), offset=0.4, footprint=((0, 0), (1, 0), (1, 1)))
     with pytest.raises(ValidationError, match="radius"):
         Cylinder(x=0.0, y=0.0, radius=-0.1)
+    with pytest.raises(ValidationError, match="radius"):
+        Cylinder(x=0.0, y=0.0, radius=1e300)
 
 
 def test_solids_come_back_as_the_wbc_obstacles_they_were_made_of() -> None:
