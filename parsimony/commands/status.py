@@ -1,5 +1,6 @@
 """`parsimony status`: the live components of a namespace, a summary line each (messages in
-and out, CPU time, the counters of faults that are not zero), and every counter on demand."""
+and out, CPU time, the counters of faults that are not zero), and every counter on demand;
+with ``--wait``, once every component of a profile is alive."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from deploy.alive import wait_alive
 from deploy.query import (
     DEFAULT_ROUTER,
     DEFAULT_TIMEOUT_S,
@@ -16,9 +18,10 @@ from deploy.query import (
     statuses,
 )
 from messages.status import ComponentStatus
+from parsimony.commands.launch import positive_seconds
 from parsimony.output import emit, json_text, table
 from parsimony.target_options import fail
-from profiles.profile import ProfileError
+from profiles.profile import ProfileError, load_profile
 
 COLUMNS = ("NAME", "MODULE", "STATE", "PID", "IN", "OUT", "CPU S", "FAULTS (non-zero)")
 LEGEND = ("IN, OUT: messages received and published; FAULTS: counts of what was refused, "
@@ -27,6 +30,8 @@ FAULT_WORDS = ("rejected", "error", "overflowed", "fail", "bad_", "refus", "stal
                "lost", "non_finite", "implausible", "unreachable", "contacts", "penetrations",
                "undecodable", "out_of_limits", "fault", "degraded", "holds", "reconnects")
 """A counter whose name holds one of these counts faults; the summary shows it when not 0."""
+WAIT_TIMEOUT_S = 60.0
+"""How long ``--wait`` waits for every component by default."""
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -35,7 +40,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         "status",
         help="list the live components of a namespace",
         description="List the components whose liveliness token is present, with their "
-        "state and counters. Exits 1 when none is alive or the router cannot be reached.",
+        "state and counters. With --wait, first wait until every enabled component of the "
+        "profile is alive (and its router reachable), saying on stderr which are missing. "
+        "Exits 1 when none is alive, or with --wait when some are not in time; 2 when the "
+        "router cannot be reached.",
     )
     parser.add_argument(
         "target", nargs="?", help="a profile (YAML file) or a namespace such as 'sim'"
@@ -50,30 +58,57 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
                         help="print JSON instead of a table (every counter)")  # fmt: skip
     parser.add_argument("-v", "--counters", action="store_true",
                         help="list every counter of each component under the table")  # fmt: skip
-    parser.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="S")
+    parser.add_argument("--wait", action="store_true",
+                        help="wait until every component of the profile is alive")  # fmt: skip
+    parser.add_argument("--timeout", type=positive_seconds, metavar="S",
+                        help="seconds to wait for the components' answers (default "
+                        f"{DEFAULT_TIMEOUT_S:g}); with --wait, for all of them to be alive "
+                        f"(default {WAIT_TIMEOUT_S:g})")  # fmt: skip
     return parser
+
+
+def profile_of(args: argparse.Namespace) -> Path | None:
+    """The profile named by `--profile` or the positional target, if any."""
+    if args.profile is not None:
+        return args.profile
+    if args.target is not None and Path(args.target).is_file():
+        return Path(args.target)
+    return None
 
 
 def target_of(args: argparse.Namespace) -> Target:
     """The target named by `--profile`, or by the positional profile or namespace."""
-    if args.profile is not None:
-        return Target.from_profile(args.profile)
+    profile = profile_of(args)
+    if profile is not None:
+        return Target.from_profile(profile)
     if args.target is None:
         raise QueryError("name a profile or a namespace, or pass --profile")
-    if Path(args.target).is_file():
-        return Target.from_profile(args.target)
     if Path(args.target).suffix:
         raise ProfileError(f"{args.target}: no such profile file (a namespace has no '.')")
     return Target.from_namespace(args.target, args.router)
 
 
+def wait(args: argparse.Namespace, target: Target) -> None:
+    """Wait until every enabled component of the profile is alive (``--wait``)."""
+    profile = profile_of(args)
+    if profile is None:
+        raise ProfileError("--wait waits for the components of a profile: name one")
+    names = [spec.name for spec in load_profile(profile).start_order()]
+    timeout_s = WAIT_TIMEOUT_S if args.timeout is None else args.timeout
+    wait_alive(target, names, timeout_s, lambda text: print(f"status: {text}", file=sys.stderr,
+                                                             flush=True))  # fmt: skip
+
+
 def run(args: argparse.Namespace) -> int:
     """Print the live components and their status."""
+    timeout_s = DEFAULT_TIMEOUT_S if args.timeout is None or args.wait else args.timeout
     try:
         target = target_of(args)
+        if args.wait:
+            wait(args, target)
         with target.open() as session:
-            names = live_components(session, target.namespace, args.timeout)
-            found = statuses(session, target.namespace, args.timeout) if names else {}
+            names = live_components(session, target.namespace, timeout_s)
+            found = statuses(session, target.namespace, timeout_s) if names else {}
     except (ProfileError, QueryError, ValueError) as error:
         return fail(error)
     if args.json:

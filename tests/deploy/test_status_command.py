@@ -5,7 +5,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import subprocess
+import sys
 import time
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import pytest
@@ -15,6 +18,7 @@ from messages import topics
 from messages.header import Header
 from messages.status import ComponentStatus
 from parsimony.commands import status
+from profiles.endpoints import free_port
 
 if TYPE_CHECKING:
     from tests.deploy.conftest import LaunchFixture, ProfileWriter
@@ -80,3 +84,54 @@ def test_a_components_faults_are_told_apart_from_its_other_counters() -> None:
     (line,) = status.format_table([("drv", found)]).splitlines()[1:]
     assert line.split() == ["drv", "base_driver", "no", "port", "12", "10", "5", "2.5",
                             "clock_stalls=1", "port_errors=2"]  # fmt: skip
+
+
+def test_status_wait_started_before_the_launch_returns_once_every_component_is_alive(
+    write_profile: ProfileWriter, launch: LaunchFixture
+) -> None:
+    """As the README's first hour runs it: the launch in the background, `status --wait` at
+    once; it says what it waits for (the router first), then prints the status."""
+    pub = {"name": "pub", "module": "scripted_publisher", "role": "tool"}
+    ctl = {"name": "ctl", "module": "lp_controller", "role": "controller"}
+    profile = write_profile([pub, ctl], robot=str(ROBOT_FILE))
+    waiting = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "status", str(profile),
+                                "--wait"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               text=True)  # fmt: skip
+    try:
+        assert waiting.stderr is not None
+        first = waiting.stderr.readline()  # before the launch: nothing listens yet
+        assert first.startswith(f"status: waiting for the router at {router_of(profile)}"), first
+        launched = launch(profile)
+        out, err = waiting.communicate(timeout=120.0)  # a safety net: --wait ends in 60 s
+    finally:
+        waiting.kill()
+    assert waiting.returncode == 0, first + err
+    rows = {line.split()[0]: line.split() for line in out.splitlines()[1:]}
+    assert rows["pub"][2] == rows["ctl"][2] == "running"
+    assert "status: all 2 components alive" in err
+    assert launched.stop() == 0
+
+
+def test_status_wait_names_the_components_that_never_come(
+    running_pub: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """pub is alive; the profile also has a ghost, which nothing launched. And with no router
+    at all, every component is named."""
+    ghost = tmp_path / "ghost.yaml"
+    ghost.write_text(f"extends: {running_pub}\ncomponents:\n"
+                     "  - {name: ghost, module: scripted_publisher, role: tool}\n")  # fmt: skip
+    assert command(str(ghost), "--wait", "--timeout", "0.5") == 1
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert err.splitlines()[-1] == "not alive after 0.5 s: ghost (1 of 2 alive)"
+
+    nowhere = tmp_path / "nowhere.yaml"
+    router = f"tcp/127.0.0.1:{free_port()}"
+    nowhere.write_text(f"extends: {ghost}\nzenoh: {{router: ['{router}']}}\n")
+    assert command(str(nowhere), "--wait", "--timeout", "0.5") == 1
+    assert capsys.readouterr().err.splitlines()[-1] == (
+        f"no router at {router} after 0.5 s (is the profile launched?); not alive: pub, ghost")
+
+
+def router_of(profile: Path) -> str:
+    return query.Target.from_profile(profile).zenoh.router[0]
