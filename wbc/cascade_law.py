@@ -10,6 +10,10 @@ of the reference by input-output linearisation (Skaar 2007):
 
 and the base part of the output is (v cos phi, v sin phi, phi'), which obeys 5.11 exactly.
 The reference point is kept within ``max_lead`` of the real one (anti-windup).
+
+Appendix B bounds nothing. With ``saturate`` the output is what the robot would carry out
+(``saturated``): the bounds on u the LP obeys and the wheel speed limit, all read from the
+robot's description.
 """
 
 from __future__ import annotations
@@ -21,11 +25,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from wbc.base_motion import unicycle, wheel_speeds
 from wbc.gains import check_gains, gain
 from wbc.law_output import LawOutput, summarise
 from wbc.obstacles import Obstacle
 from wbc.pinv_law import pinv_velocity
-from wbc.robot import MobileManipulator
+from wbc.robot import BASE_DOF, MobileManipulator
 from wbc.task import MEASUREMENT_TOLERANCE, Task, same_task
 from wbc.validation import require_finite
 
@@ -48,9 +53,37 @@ class CascadeParams:
         "beyond it the reference is pulled back, so a base that cannot "
         "follow does not wind the inner loop up",
     )
+    saturate: bool = gain(
+        False,
+        doc="u as the robot carries it out: (v, omega) scaled together into the base's "
+        "velocity_max and the wheel speed limit, each joint clipped to its velocity_max "
+        "(False: unbounded, as appendix B)",
+    )
 
     def __post_init__(self) -> None:
         check_gains(self)
+
+
+def saturated(u: Array, phi: float, robot: MobileManipulator) -> Array:
+    """u as the robot carries it out at heading ``phi``, for u whose base part obeys 5.11 (a u
+    with a NaN or an infinity is returned as it is, for the caller to refuse, never clamped).
+
+    The base: (v, omega), v = x' cos phi + y' sin phi, scaled by one factor (the path's
+    curvature kept) until |x'|, |y'| and |phi'| lie inside ``robot.velocity_max`` (the LP's
+    bounds), then as ``wbc.base_motion.wheel_speeds`` scales it for ``wheel_speed_max``. Each
+    arm joint clipped to its ``velocity_max``, as the arm driver clips a command."""
+    u = np.array(u, dtype=float)
+    if not np.all(np.isfinite(u)):
+        return u
+    bounds = robot.velocity_max
+    base = np.abs(u[:BASE_DOF])
+    over = np.max(np.divide(base, bounds[:BASE_DOF], out=np.zeros(BASE_DOF), where=base > 0))
+    scale = 1.0 if over <= 1.0 else 1.0 / over
+    forward, angular = unicycle(u[0], u[1], u[2], phi)
+    wheels = wheel_speeds(scale * forward, scale * angular, robot.base)
+    u[:BASE_DOF] = wheels.forward * math.cos(phi), wheels.forward * math.sin(phi), wheels.angular
+    u[BASE_DOF:] = np.clip(u[BASE_DOF:], -bounds[BASE_DOF:], bounds[BASE_DOF:])
+    return u
 
 
 def offset_point(x: float, y: float, phi: float, d: float) -> tuple[float, float]:
@@ -120,4 +153,6 @@ class CascadeLaw:
         self._reference = self._reference + dt * reference_u[:3]
         u = reference_u.copy()
         u[:3] = forward * math.cos(phi), forward * math.sin(phi), angular
+        if self.params.saturate:
+            u = saturated(u, phi, self.robot)
         return summarise(u, "optimal", None, (), error, start)
