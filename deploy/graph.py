@@ -49,12 +49,16 @@ class Dataflow:
     def writers(self, topic: str) -> list[str]:
         return [c.name for c in self.components if topic in {t.name for t in c.writes}]
 
-    def readers(self, topic: str) -> list[str]:
-        return [c.name for c in self.components if topic in {i.topic.name for i in c.reads}]
+    def readers(self, topic: str, waiting: bool = False) -> list[str]:
+        """The components that read ``topic`` (``waiting``: but a recorder)."""
+        return [c.name for c in self.components if topic in {i.topic.name for i in c.reads}
+                and not (waiting and c.role == "recorder")]  # fmt: skip
 
     def read_never_written(self) -> list[str]:
-        """Topics some component waits for that no component of the profile publishes."""
-        return [name for name in self.topics() if not self.writers(name) and self.readers(name)]
+        """Topics some component waits for that no component of the profile publishes (a
+        recorder, which takes whatever comes, waits for none)."""
+        return [name for name in self.topics()
+                if not self.writers(name) and self.readers(name, waiting=True)]  # fmt: skip
 
     def warnings(self) -> list[str]:
         """One line per topic read and never written."""

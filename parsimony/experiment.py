@@ -41,6 +41,7 @@ from deploy import DEPLOY, query
 from messages import codec, process, topics
 from messages.obstacles import Solids
 from messages.topics import CONTROL_DIAGNOSTICS, ROBOT_STATE, SIM_TRUTH, SUPERVISOR_STATUS
+from parsimony.commands.record import recorder_component
 from parsimony.kinematic_demo import LP_PARAMS
 from parsimony.output import json_text
 from parsimony.outputs import written_whole
@@ -78,9 +79,6 @@ TIME_LIMIT_S = 60.0
 """Simulated seconds after which a run that has not converged stops."""
 STARTUP_S = 60.0
 """Host seconds the components may take to come up."""
-RECORDER_STOP_S = 10.0
-"""Host seconds a stopping recorder may go without progress before it is killed; it stops
-after everything else and writes all that still waits for it, however long that takes."""
 SESSION_FILE = "session.mcap"
 """The recording of a run, beside its report."""
 
@@ -152,12 +150,8 @@ def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict
     if options.hide_base_marker is not None:
         simulator["hide_base_marker"] = [list(options.hide_base_marker)]
     controller = {"module": MODULES[options.controller], "params": law_overrides(options)}
-    # Never restarted: a new recorder would begin the file again; a killed one's file recovers.
-    recorder = {"name": "recorder", "module": "recorder", "role": "recorder",
-                "stop_timeout_s": RECORDER_STOP_S, "restart": {"policy": "never"},
-                "params": {"path": str((options.out / SESSION_FILE).resolve())}}  # fmt: skip
     components = [
-        recorder,
+        recorder_component(options.out / SESSION_FILE),
         {"name": "simulator", "params": simulator},
         {"name": "state_estimator", "params": {"task": setup.task}},
         {"name": "controller", **controller},

@@ -67,15 +67,17 @@ def run(args: argparse.Namespace) -> int:
 
 
 RECORDER = "recorder"
-"""The name of the recorder component that ``record`` and ``launch --record`` add."""
+"""The name of the recorder component that ``record``, ``launch --record`` and ``experiment``
+add."""
+RECORDER_STOP_S = 10.0
+"""Host seconds a stopping recorder may go without progress before it is killed; it stops
+after everything else and writes all that still waits for it, however long that takes."""
 
 
 def recorder_component(output: Path, keys: Sequence[str] = ("*",)) -> dict[str, object]:
     """A profile's recorder writing every topic matching one of ``keys`` to ``output``: role
     ``recorder`` (it starts first and stops last, writing all that still waits), never
     restarted (a new one would begin the file again; a killed one's file recovers)."""
-    from parsimony.experiment import RECORDER_STOP_S  # the laws and plots: only when needed
-
     return {"name": RECORDER, "module": "recorder", "role": "recorder", "enabled": True,
             "stop_timeout_s": RECORDER_STOP_S, "restart": {"policy": "never"},
             "params": {"path": str(Path(output).resolve()), "keys": ",".join(keys)}}

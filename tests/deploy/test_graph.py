@@ -11,6 +11,7 @@ import pytest
 
 from deploy import DEPLOY
 from deploy.graph import dataflow
+from parsimony.commands.record import with_recorder
 from profiles.profile import ProfileError, load_profile
 
 
@@ -120,3 +121,15 @@ def test_a_parameter_no_component_would_take_is_refused_before_anything_starts(
                               capture_output=True, text=True)  # fmt: skip
         assert done.returncode == 2 and f"{path}: invalid profile" in done.stderr, done.stderr
         assert "[launch]" not in done.stderr  # refused before a component was started
+
+
+def test_a_recorder_reading_every_topic_makes_no_topic_read_and_never_written(
+    tmp_path: Path,
+) -> None:
+    """A recorder takes whatever comes: the topics only it reads are no warning (an experiment's
+    or a recorded launch's profile warned of every topic nothing wrote)."""
+    profile_file = tmp_path / "recorded.yaml"
+    profile_file.write_text(with_recorder(DEPLOY / "sim.yaml", tmp_path / "session.mcap"))
+    graph = dataflow(load_profile(profile_file))
+    assert "recorder" in graph.readers("goal/request")
+    assert graph.read_never_written() == [] and graph.warnings() == []
