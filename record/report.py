@@ -39,10 +39,9 @@ from typing import Any
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
-from matplotlib.patches import Circle, Polygon
+from matplotlib.patches import Circle
 
 from messages.goal import Goal
-from messages.obstacles import Cylinder, Plane
 from messages.topics import (
     CONTROL_DIAGNOSTICS,
     CONTROL_GOAL,
@@ -51,6 +50,7 @@ from messages.topics import (
     SIM_TRUTH,
     WORLD_OBSTACLES,
 )
+from record.floor_plan import draw_obstacles
 from record.judge import (
     Array,
     Session,
@@ -61,7 +61,6 @@ from record.judge import (
     open_loop,
     required,
 )
-from record.obstacle_scene import OBSTACLE_RGB
 from record.session_span import parted
 from wbc import dq
 from wbc.planar import in_frame, planar_pose
@@ -74,9 +73,6 @@ FORMULAS: Mapping[str, str] = {
     "metric4": r"$\sqrt{\int \lVert\ddot{q}\rVert_2^2\,dt}$",
 }
 """Table 6.1's metrics (``record.judge.METRICS``) as formulas."""
-
-UNIT_TOLERANCE = 1e-9
-"""Under this squared horizontal length a plane's normal is vertical."""
 
 END_EFFECTOR_TASKS = ("pose", "position")
 """The goals that give the end effector a target (a drive leg's aims the base)."""
@@ -368,44 +364,10 @@ def _base_path_figure(recordings: Sequence[_Recording], robot: MobileManipulator
             _nothing(ax, NO_FIX)
         if rec.truth:
             _path(ax, [s.base_pose[:2] for s in rec.truth], "truth", linestyle="--")
-        circles = {(c.x, c.y, c.radius) for message in rec.obstacles for c in message.circles}
-        for index, (cx, cy, radius) in enumerate(sorted(circles)):
-            label = "obstacle" if index == 0 else None
-            ax.add_patch(Circle((cx, cy), radius, color="red", alpha=0.4, label=label))
-        _solids_on_the_floor(ax, rec)
+        draw_obstacles(ax, rec.obstacles)
         ax.autoscale_view()
         _legend(ax)
     return figure
-
-
-def _solids(rec: _Recording) -> tuple[list[Plane], list[Cylinder]]:
-    """Every distinct plane and cylinder the session's obstacles messages carried."""
-    planes = dict.fromkeys(p for message in rec.obstacles for p in message.solids.planes)
-    cylinders = dict.fromkeys(c for message in rec.obstacles for c in message.solids.cylinders)
-    return list(planes), list(cylinders)
-
-
-def _solids_on_the_floor(ax: Axes, rec: _Recording) -> None:
-    """The solids seen from above: a table's (or an underside's) footprint, each pole's disc,
-    each wall's line where it meets the floor (a horizontal plane without a footprint, which
-    covers the whole floor, is not drawn); each labelled with its height."""
-    planes, cylinders = _solids(rec)
-    for plane in planes:
-        solid = plane.solid()
-        nx, ny, _ = plane.normal
-        if plane.footprint:
-            kind = "top" if solid.side > 0 else "underside"
-            ax.add_patch(Polygon(solid.footprint, closed=True, color=OBSTACLE_RGB, alpha=0.35,
-                                 hatch="//", label=f"{plane.name} ({kind} at "
-                                 f"{plane.offset * solid.side:.2f} m)"))  # fmt: skip
-        elif nx * nx + ny * ny > UNIT_TOLERANCE:
-            along = plane.offset / (nx * nx + ny * ny)  # the floor's point nearest F0
-            ax.axline((along * nx, along * ny), (along * nx - ny, along * ny + nx),
-                      color=OBSTACLE_RGB, linewidth=2.0, label=f"{plane.name} (at the floor)")
-    for cylinder in cylinders:
-        top = "no top" if cylinder.height is None else f"{cylinder.height:.2f} m high"
-        ax.add_patch(Circle((cylinder.x, cylinder.y), cylinder.radius, color=OBSTACLE_RGB,
-                            alpha=0.6, hatch="xx", label=f"{cylinder.name} ({top})"))  # fmt: skip
 
 
 def _arm_clearance_figure(recordings: Sequence[_Recording], robot: MobileManipulator
