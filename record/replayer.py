@@ -67,6 +67,8 @@ class Recording:
     start_ns: int
     end_ns: int
     outside: str | None = None
+    namespaces: frozenset[str] = frozenset()
+    """The namespaces its keys were recorded in."""
 
     @classmethod
     def of(cls, path: Path, wanted: Callable[[str], bool]) -> Recording:
@@ -74,9 +76,19 @@ class Recording:
         found = info(path)
         channels = [c for c in found["channels"]
                     if c["topic"] is not None and c["messages"] and wanted(c["topic"])]  # fmt: skip
+        namespaces = frozenset(c["key"].removesuffix(topics.TOPICS[c["topic"]].suffix)[:-1]
+                               for c in channels)  # fmt: skip
         return cls(path, frozenset(c["topic"] for c in channels),
                    min((c["start_ns"] for c in channels), default=0),
-                   max((c["end_ns"] for c in channels), default=0), found["warning"])  # fmt: skip
+                   max((c["end_ns"] for c in channels), default=0), found["warning"],
+                   namespaces)  # fmt: skip
+
+    def namespace(self) -> str:
+        """The one namespace it was recorded in; ``ValueError`` when it holds several."""
+        if len(self.namespaces) != 1:
+            raise ValueError(f"{self.path}: recorded in the namespaces "
+                             f"{', '.join(sorted(self.namespaces))}: give --namespace")
+        return topics.check_namespace(next(iter(self.namespaces)))
 
     def window(self, start_offset_s: float, duration_s: float | None) -> tuple[int, int]:
         """The log times replayed: from ``start_offset_s`` after the first message, for

@@ -10,10 +10,12 @@ answered it, as the simulator's lockstep waits for its loop, so that they take a
 recording's inputs in its recorded order whatever the load. Progress goes to stderr. In a
 terminal, keys: space pauses and resumes, ``s`` or the right arrow sends the next message
 while paused, ``+`` and ``-`` double and halve the rate, ``q`` quits; ``--start-paused``
-starts paused (elsewhere it waits for Enter). With no system running (no router answers on
-the profile's loopback endpoint) the replay serves a router of its own there, which `parsimony
-view` of the profile reaches; ``--view`` serves that live view itself (on ``--port``). What is
-stamped far outside the session (``record.session_span``) is not sent, and said.
+starts paused (elsewhere it waits for Enter). Without a profile it replays into the namespace
+it was recorded in, through the launcher's default router (tcp/127.0.0.1:7447). With no system
+running (no router answers on that loopback endpoint) the replay serves a router of its own
+there, which `parsimony view` of a profile on it reaches; ``--view`` serves that live view
+itself (on ``--port``). What is stamped far outside the session (``record.session_span``) is
+not sent, and said.
 
 Into a namespace where components are alive, a replay refuses, before it sends anything, to
 send commands (live drivers would move the robot) and any topic a live component publishes
@@ -38,9 +40,9 @@ from deploy.zenoh_error import zenoh_error_text
 from messages import topics
 from parsimony.commands.launch import positive, positive_seconds
 from parsimony.commands.view import namespace_argument, port_number, serving, watched_profile
-from parsimony.target_options import fail, profile_and_target, target_options
+from parsimony.target_options import fail, target_options
 from profiles.endpoints import endpoint_problem
-from profiles.profile import Profile, ProfileError
+from profiles.profile import Profile, ProfileError, load_profile
 from record.live_view import DEFAULT_PORT
 from record.replay_keys import terminal_keys
 from record.replayer import ANSWERING, SENSORS, Player, Playing, Recording
@@ -91,30 +93,21 @@ def wanted(args: argparse.Namespace, name: str) -> bool:
 
 def run(args: argparse.Namespace) -> int:
     try:  # what was asked is checked before the router is reached
-        profile, target = profile_and_target(args)
-        if not math.isfinite(args.start_offset) or args.start_offset < 0:
-            raise ValueError(f"--start-offset: expected seconds >= 0, got {args.start_offset}")
-        topics.topics_matching(args.keys)
-        recorded = Recording.of(args.file, lambda name: wanted(args, name))
-        if not recorded.names:
-            raise ValueError(f"{args.file}: nothing to replay (--keys, --exclude, --sensors)")
-        first, last = recorded.window(args.start_offset, args.duration)
-        if first > last:
-            raise ValueError(f"{args.file}: nothing in the window of --start-offset and "
-                             f"--duration (the recording spans "
-                             f"{(recorded.end_ns - recorded.start_ns) / 1e9:.2f} s)")  # fmt: skip
-        if args.lockstep and ANSWERING.keys() & recorded.names:
-            raise ValueError(f"--lockstep: the replay would answer itself; leave out "
-                             f"{', '.join(ANSWERING)} (or use --sensors)")  # fmt: skip
-        watched = watched_profile(profile, args.namespace)
+        recorded = recording(args)
+        profile = load_profile(args.profile) if args.profile is not None else None
+        namespace = args.namespace or (profile.namespace if profile else recorded.namespace())
+        if args.view and profile is None:
+            raise ValueError("--view: give the --profile the view draws the robot and takes "
+                             "goals as (or use parsimony view PROFILE)")  # fmt: skip
+        watched = watched_profile(profile, namespace) if profile else None
         robot = MobileManipulator.from_yaml(profile.robot) if args.view and profile.robot else None
-        session, own_router = opened(target, profile)
+        target = Target(namespace, profile.zenoh) if profile else Target.from_namespace(namespace)
+        session, own_router = opened(target)
     except (ProfileError, QueryError, OSError, ValueError) as error:
         print("replay: ", end="", file=sys.stderr)
         return fail(error)
     if recorded.outside is not None:
         print(f"[replay] not sent, {recorded.outside}", file=sys.stderr)
-    namespace = watched.namespace
     conflicts = [] if args.into_live or own_router else live_conflicts(
         session, profile, namespace, recorded.names)  # fmt: skip
     if conflicts:
@@ -125,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
         return 2
     try:
         view = serving(session, watched, topics.topics_matching(["*"]), args.port,
-                       robot) if args.view else contextlib.nullcontext()  # fmt: skip
+                       robot) if watched and args.view else contextlib.nullcontext()  # fmt: skip
         with session, view, terminal_keys() as keys:
             playing = Playing(args.rate, args.start_offset, args.duration, args.loop,
                               args.clock, args.lockstep, args.start_paused)  # fmt: skip
@@ -138,32 +131,52 @@ def run(args: argparse.Namespace) -> int:
         return 130
 
 
-def opened(target: Target, profile: Profile) -> tuple[zenoh.Session, bool]:
-    """A session on the profile's router, and False; or, when none answers and the profile's
-    router endpoints are on this host, a router of the replay's own listening there (the
-    launcher's, without uplinks, so only local tools reach it), and True."""
+def recording(args: argparse.Namespace) -> Recording:
+    """What the replay sends, checked against what was asked (``ValueError`` saying why)."""
+    if not math.isfinite(args.start_offset) or args.start_offset < 0:
+        raise ValueError(f"--start-offset: expected seconds >= 0, got {args.start_offset}")
+    topics.topics_matching(args.keys)
+    recorded = Recording.of(args.file, lambda name: wanted(args, name))
+    if not recorded.names:
+        raise ValueError(f"{args.file}: nothing to replay (--keys, --exclude, --sensors)")
+    first, last = recorded.window(args.start_offset, args.duration)
+    if first > last:
+        raise ValueError(f"{args.file}: nothing in the window of --start-offset and "
+                         f"--duration (the recording spans "
+                         f"{(recorded.end_ns - recorded.start_ns) / 1e9:.2f} s)")  # fmt: skip
+    if args.lockstep and ANSWERING.keys() & recorded.names:
+        raise ValueError(f"--lockstep: the replay would answer itself; leave out "
+                         f"{', '.join(ANSWERING)} (or use --sensors)")  # fmt: skip
+    return recorded
+
+
+def opened(target: Target) -> tuple[zenoh.Session, bool]:
+    """A session on the target's router, and False; or, when none answers and the router's
+    endpoints are on this host, a router of the replay's own listening there (a launcher's,
+    without uplinks, so only local tools reach it), and True."""
     try:
         return target.open(), False
     except NoRouter as error:
-        if any(endpoint_problem(e, needs_port=True) for e in profile.zenoh.router):
+        if any(endpoint_problem(e, needs_port=True) for e in target.zenoh.router):
             raise
-        settings = profile.zenoh.model_copy(update={"uplinks": []})
+        settings = target.zenoh.model_copy(update={"uplinks": []})
         try:
-            session = zenoh.open(settings.router_config(profile.namespace))
+            session = zenoh.open(settings.router_config(target.namespace))
         except zenoh.ZError as failed:
             raise NoRouter(f"{error}; nor could the replay's own router listen there: "
                            f"{zenoh_error_text(failed)}") from failed  # fmt: skip
-    where = ", ".join(profile.zenoh.router)
+    where = ", ".join(target.zenoh.router)
     print(f"[replay] no router at {where} (no system running): the replay serves its own "
-          f"there; `parsimony view` of the profile watches it", file=sys.stderr, flush=True)
+          f"there, into {target.namespace}; `parsimony view` of a profile on it watches it",
+          file=sys.stderr, flush=True)  # fmt: skip
     return session, True
 
 
-def live_conflicts(session: zenoh.Session, profile: Profile, namespace: str,
+def live_conflicts(session: zenoh.Session, profile: Profile | None, namespace: str,
                    sending: set[str]) -> list[str]:  # fmt: skip
     """What the replay may not send into ``namespace``: commands while anything there is alive,
-    and each topic a live component publishes (a live component the profile does not describe
-    might publish any). Empty when nothing there is alive."""
+    and each topic a live component publishes (a live component the profile, if any, does not
+    describe might publish any). Empty when nothing there is alive."""
     alive = live_components(session, namespace)
     if not alive:
         return []
@@ -172,8 +185,9 @@ def live_conflicts(session: zenoh.Session, profile: Profile, namespace: str,
         found.append(f"{', '.join(moving)} into {namespace}, where {', '.join(alive)} "
                      "are alive")  # fmt: skip
     for name in alive:
-        spec = next((s for s in profile.components if s.name == name), None)
-        if spec is None or namespace != profile.namespace:
+        specs = profile.components if profile and namespace == profile.namespace else []
+        spec = next((s for s in specs if s.name == name), None)
+        if spec is None:
             writes = set(topics.TOPICS)  # not described: it may publish anything
         else:
             writes = {spec.topic(t).name for t in component_class(spec).writes}

@@ -5,6 +5,7 @@ loopback endpoint, and the replay is watched in Foxglove as a live system is, th
 from __future__ import annotations
 
 import asyncio
+import os
 import signal
 import subprocess
 import sys
@@ -14,7 +15,9 @@ from test_live_view import DEADLINE_S, StderrLines, state, watch, write_profile
 
 from messages import topics
 from messages.state import RobotState
+from parsimony.target_options import PROFILE_ENV
 from profiles.endpoints import free_port
+from record.replayer import Recording
 from record.session_file import SessionWriter, from_json
 
 RECORDED = "rec"
@@ -69,3 +72,18 @@ def test_a_replay_with_no_system_serves_its_own_router_and_is_watched_live(tmp_p
                 process.wait(DEADLINE_S)
     assert replay.returncode == 130 and "Traceback" not in said.all(), said.all()
     assert view.returncode == 0
+
+
+def test_without_a_profile_a_replay_goes_into_its_recorded_namespace(tmp_path: Path) -> None:
+    recording(tmp_path / "one.mcap")
+    assert Recording.of(tmp_path / "one.mcap", lambda _: True).namespace() == RECORDED
+    with SessionWriter(tmp_path / "two.mcap") as writer:
+        for namespace in (RECORDED, INTO):
+            writer.write(topics.ROBOT_STATE.key(namespace), state(0))
+    done = subprocess.run([sys.executable, "-m", "parsimony.cli", "replay",
+                           str(tmp_path / "two.mcap")], capture_output=True, text=True,
+                          env={k: v for k, v in os.environ.items() if k != PROFILE_ENV},
+                          timeout=DEADLINE_S * 6)  # fmt: skip
+    assert done.returncode == 2, done.stderr
+    assert done.stderr == (f"replay: {tmp_path / 'two.mcap'}: recorded in the namespaces "
+                           f"{INTO}, {RECORDED}: give --namespace\n")
