@@ -49,13 +49,16 @@ bench.obstacle_constraints compares them), the circulation term that takes the b
 obstacle it stalled by, and no base target term, whose straight-line heading towards where the
 base should stand fights the detour. The waist is centred through the self-motion instead of
 held: with the base alone taking the task's yaw, the base overran the goal after its detour
-(error 0.18 after 80 s); the self-motion costs an entry, and figure 6.17 shows all 8 in use too.
+(error 0.18 after 80 s); the self-motion costs an entry (figure 6.17 shows 8 in use; this law
+uses 7 in most steps and never 8, ``parsimony reproduce``'s ``obstacle.entries.LP``).
 ||u||_1 is bounded by the error (5.7), not by its rate (5.10): when the base stands still by
 the obstacle, e' is 0, 5.10 allows no motion at all and the circulation could not start it
 again (seed 1: error 0.65 after 60 s)."""
 
 BORDER_PARAMS = replace(OBSTACLE_PARAMS, obstacle_mode="border")
-"""The same law with the dissertation's border constraint 5.28, for comparison."""
+"""The same law with the border constraint 5.28 in place of the vector-field inequality, for
+comparison: its circulation term, 5.7 and the point 0.1 m ahead of the axle kept, so not 5.29
+as written (``parsimony.reproduce.laws.bare_5_29`` is)."""
 
 SUPERVISED_PROFILE = DEPLOY / "sim_supervised.yaml"
 """The profile of the LP under the staging supervisor, which declares that LP's gains."""
