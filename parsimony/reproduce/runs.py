@@ -77,6 +77,7 @@ def experiments(robot: MobileManipulator) -> dict[str, Experiment]:
     pose = LP_PARAMS["pose"]
     found["joint_limit"] = run_laws("joint_limit", PoseTask(robot.fkm(JOINT_LIMIT_GOAL)), pose.eta,
                                     {L.LP: LPLaw(robot, pose),
+                                     L.LP_5_29: LPLaw(robot, L.bare_5_29(pose)),
                                      L.CASCADE: CascadeLaw(robot, CascadeParams(eta=pose.eta)),
                                      L.SATURATED: CascadeLaw(robot, CascadeParams(
                                          eta=pose.eta, saturate=True))})  # fmt: skip
