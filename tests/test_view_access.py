@@ -65,6 +65,7 @@ def test_a_view_whose_user_may_not_write_goals_offers_no_publishing(guarded: Pat
     with view_as("viewer", guarded) as view:
         line = view.live_line
         assert "no publishing: viewer may not write goal/request" in line, line
+        assert "parameters of every running component, read-only: viewer may set none" in line
         with FoxgloveClient(view.address) as client:
             info = client.server_info()
             assert "clientPublish" not in info["capabilities"]
@@ -76,6 +77,7 @@ def test_a_view_whose_user_may_not_write_goals_offers_no_publishing(guarded: Pat
     assert view.process.returncode == 0, view.err
     with view_as("operator", guarded) as view:
         assert "goals from clients on goal/request" in view.live_line, view.live_line
+        assert "read-only" not in view.live_line
         with FoxgloveClient(view.address) as client:
             assert "clientPublish" in client.server_info()["capabilities"]
     assert view.process.returncode == 0, view.err

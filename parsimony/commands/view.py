@@ -126,8 +126,10 @@ def serving(session: zenoh.Session, profile: Profile, chosen: Sequence[Topic], p
             station.attach(view.server)
             publishing = "goals from clients on goal/request" if station.may_publish else (
                 f"no publishing: {station.user} may not write goal/request")  # fmt: skip
+            setting = "" if station.may_set_any else f", read-only: {station.user} may set none"
             print(f"view: {profile.namespace} live at {view.address} ({publishing}; the "
-                  f"parameters of every running component)", file=sys.stderr, flush=True)
+                  f"parameters of every running component{setting})", file=sys.stderr,
+                  flush=True)  # fmt: skip
             yield view, station
     finally:
         station.close()
