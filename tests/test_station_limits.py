@@ -24,6 +24,7 @@ from deploy.client_limits import GOAL_RATE, STATUS_CHARS
 from deploy.control_station import ControlStation
 from messages import codec, topics
 from messages.goal import Goal
+from parsimony.commands.view import stopped
 from profiles.endpoints import free_port
 from profiles.profile import Profile, load_profile
 from record.live_view import LiveView
@@ -44,6 +45,7 @@ class View:
     router: zenoh.Session
     goals: list[Goal]
     """Every goal on goal/request, heard on the router's session."""
+    live: LiveView
 
 
 @pytest.fixture
@@ -73,7 +75,7 @@ def view(tmp_path: Path) -> Iterator[View]:
         with LiveView(viewing, NAMESPACE, [], 0, listener=station,
                       capabilities=station.capabilities, encodings=station.encodings) as live:
             station.attach(live.server)
-            yield View(profile, station, live.address, node, router, goals)
+            yield View(profile, station, live.address, node, router, goals, live)
         station.close()
         watcher.undeclare()
         if station.session is own:  # else Zenoh panicked in it: it cannot even close
@@ -147,6 +149,7 @@ def test_after_its_session_fails_the_station_says_so_and_goes_on_on_a_new_one(
         client.wait_for(lambda e: e["event"] == "status" and "sent" in e["message"], "the goal")
     assert view.station.session is not failed and view.station.session_errors == 1
     assert not view.station.failed
+    assert stopped(view.live, view.station, as_json=False) == 0  # the view goes on: exit 0
     assert [g.header.source for g in view.goals] == ["view"]
     errors = [r.getMessage() for r in caplog.records if r.levelno == logging.ERROR]
     assert len(errors) == 1 and "the control station's Zenoh session failed" in errors[0]
@@ -159,7 +162,10 @@ def poison(session: zenoh.Session) -> None:
         list(session.get(topics.param_key(NAMESPACE, "ctl", "x" * 65536), timeout=1.0))
 
 
-def test_when_no_new_session_can_be_opened_each_goal_and_set_says_so(view: View) -> None:
+def test_when_no_new_session_can_be_opened_each_goal_and_set_says_so(
+    view: View, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """And `parsimony view` says so when it stops, and exits 1."""
     with FoxgloveClient(view.address) as client:
         client.server_info()
         client.send("advertise", topic=topics.GOAL_REQUEST.name, encoding="json",
@@ -175,6 +181,15 @@ def test_when_no_new_session_can_be_opened_each_goal_and_set_says_so(view: View)
         assert len(said_then) == 1 and "the view's Zenoh session failed" in said_then[0]
     assert view.station.failed.startswith("the view's Zenoh session failed: Unable to connect")
     assert view.station.session_errors == 2 and not view.goals
+    capsys.readouterr()
+    assert stopped(view.live, view.station, as_json=True) == 1
+    out, err = capsys.readouterr()
+    done = json.loads(out)
+    assert (done["goals_sent"], done["goals_refused"], done["goals_dropped"]) == (0, 0, 0)
+    assert (done["session_errors"], done["errors"]) == (2, 0)
+    assert done["session_failed"] == view.station.failed
+    assert "0 goals sent, 0 refused, 0 dropped over their rate; 2 Zenoh session errors" in err
+    assert f"view: {view.station.failed}" in err
 
 
 def test_a_client_sending_goals_faster_than_their_rate_is_told_its_goals_are_dropped(

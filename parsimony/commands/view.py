@@ -6,7 +6,9 @@ any running component's parameters. A replay into the profile's namespace is wat
 way (``--namespace NS``: a replay into a namespace of its own). It runs ``--nice`` steps below
 the loop's priority (10 by default), so that on a busy machine the loop takes the CPU first.
 ``--layout FILE`` writes the Foxglove layout of the namespace (``parsimony layout``);
-``--json`` prints what the view did when it stops (messages, the handler's times)."""
+``--json`` prints what the view did when it stops (messages, the handler's times, the goals sent,
+refused and dropped, the station's errors), as it says on stderr. It exits 1 when the station's
+Zenoh session failed and no new one could be opened."""
 
 from __future__ import annotations
 
@@ -95,7 +97,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         with target.open() as session, serving(session, profile, chosen, args.port,
                                                robot) as (view, station):  # fmt: skip
-            _serve(view, station, args.json)
+            return _serve(view, station, args.json)
     except (QueryError, OSError) as error:
         print(f"view: {error}", file=sys.stderr)
         return exit_code(error)
@@ -135,19 +137,35 @@ def serving(session: zenoh.Session, profile: Profile, chosen: Sequence[Topic], p
         station.close()
 
 
-def _serve(view: LiveView, station: ControlStation, as_json: bool) -> None:
-    """Serve until interrupted, then say what the view did."""
+def _serve(view: LiveView, station: ControlStation, as_json: bool) -> int:
+    """Serve until interrupted, then say what the view did (``stopped``)."""
     try:
         while True:
             signal.pause()
     except KeyboardInterrupt:
         pass
+    return stopped(view, station, as_json)
+
+
+def stopped(view: LiveView, station: ControlStation, as_json: bool) -> int:
+    """Say on stderr what the view and its station did (as JSON on stdout if ``as_json``);
+    1 if the station's Zenoh session failed and no new one could be opened, else 0."""
     handler = view.handler_us()
+    done = {"goals_sent": station.goals_sent, "goals_refused": station.goals_refused,
+            "goals_dropped": station.goals_dropped, "session_errors": station.session_errors,
+            "errors": station.errors}  # fmt: skip
     print(f"view: {view.shown} messages shown, {view.malformed} malformed, {view.unwatched} "
           f"read by no client, {view.failed} without views; handler "
           f"{handler['median']} us median, {handler['p99']} us p99 over {handler['samples']}; "
-          f"{station.goals_sent} goals sent", file=sys.stderr)  # fmt: skip
+          f"{station.goals_sent} goals sent, {station.goals_refused} refused, "
+          f"{station.goals_dropped} dropped over their rate; {station.session_errors} Zenoh "
+          f"session errors, {station.errors} errors answering clients",
+          file=sys.stderr)  # fmt: skip
+    if station.failed:
+        print(f"view: {station.failed}", file=sys.stderr)
     if as_json:
         emit(json_text({"shown": view.shown, "unwatched": view.unwatched,
-                         "malformed": view.malformed, "failed": view.failed,
-                         "handler_us": handler, "goals_sent": station.goals_sent}))  # fmt: skip
+                        "malformed": view.malformed, "failed": view.failed,
+                        "handler_us": handler, **done,
+                        "session_failed": station.failed or None}))  # fmt: skip
+    return 1 if station.failed else 0
