@@ -105,11 +105,23 @@ def speeds(run: Run, robot: MobileManipulator) -> dict:
             "phi range": [float(phi.min()), float(phi.max())]}  # fmt: skip
 
 
+BINDING = {"nonholonomic": "5.12", "error_derivative_bound": "5.10", "error_bound": "5.7",
+           "obstacle_border": "5.28", "obstacle_vector_field": "the vector-field inequality"}
+"""The equation of each row group a law reports as active (``LawOutput.active_constraints``)."""
+
+
+def binding(name: str) -> str:
+    """An active row group by its equation; a bound of 5.15 with the entry it holds."""
+    if name.startswith("joint_limits["):
+        return f"5.15 on {ENTRIES[int(name[13:-1])]}"
+    return BINDING.get(name, name)
+
+
 def first_step(run: Run) -> dict:
     """u of the first step, its 2-norm and the rows that bind there (a law that reports them)."""
     out = run.outputs[0]
     return {"u": [round(float(v), 3) for v in out.u], "||u||_2": float(np.linalg.norm(out.u)),
-            "binding": list(out.active_constraints)}  # fmt: skip
+            "binding": [binding(name) for name in out.active_constraints]}  # fmt: skip
 
 
 def abruptness(run: Run) -> dict:
