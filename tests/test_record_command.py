@@ -145,6 +145,18 @@ def test_no_command_writes_over_its_input_or_an_existing_file(tmp_path: Path) ->
     assert info(other)["messages"] == info(recording)["messages"]
 
 
+def test_a_robot_file_that_is_no_description_is_one_line_from_report(tmp_path: Path) -> None:
+    """A robot file of YAML that is not a mapping is said as such (before: 'missing or invalid
+    field: list indices must be integers or slices, not str')."""
+    robot = tmp_path / "robot.yaml"
+    robot.write_text("- arm\n- base\n")
+    done = parsimony("report", str(tmp_path / "k.mcap"), "--out", str(tmp_path / "report"),
+                     "--robot", str(robot))  # fmt: skip
+    assert done.returncode == 2, done.stderr
+    assert done.stderr == (f"report: {robot}: a robot description is a mapping (arm:, base:, "
+                           "...), this file holds a list\n")  # fmt: skip
+
+
 def test_record_onto_a_full_disk_says_so_in_one_line_and_its_file_recovers(tmp_path: Path) -> None:
     """`parsimony record` onto a real 64 KiB tmpfs, mounted by the test in a mount namespace
     of its own (``unshare``): the recorder stops for good when the disk is full, the command

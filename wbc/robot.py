@@ -40,6 +40,25 @@ def _readonly(values: object, shape: tuple[int, ...], what: str, allow_inf: bool
     return array
 
 
+def _mapping(path: Path) -> dict:
+    """The YAML mapping in the file at ``path``; ``RobotDescriptionError`` naming the file if it
+    is not text, not YAML or not a mapping (``OSError`` if it cannot be read)."""
+    try:
+        data = yaml.safe_load(path.read_bytes().decode("utf-8"))
+    except UnicodeDecodeError as error:
+        raise RobotDescriptionError(f"{path}: not UTF-8 text (byte {error.start})") from None
+    except yaml.YAMLError as error:
+        mark = getattr(error, "problem_mark", None)
+        where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else str(path)
+        problem = getattr(error, "problem", None) or str(error).splitlines()[0]
+        raise RobotDescriptionError(f"{where}: not YAML: {problem}") from None
+    if not isinstance(data, dict):
+        found = "nothing" if data is None else f"a {type(data).__name__}"
+        raise RobotDescriptionError(f"{path}: a robot description is a mapping (arm:, base:, "
+                                    f"...), this file holds {found}")  # fmt: skip
+    return data
+
+
 def _dh_link(theta: float, d: float, a: float, alpha: float) -> Array:
     """r_theta p_d p_a r_alpha: one DH link Rz(theta) Tz(d) Tx(a) Rx(alpha) (4.4)."""
     r_theta = dq.from_parts(dq.rotation_quaternion(theta, [0, 0, 1]), np.zeros(4))
@@ -158,8 +177,8 @@ class MobileManipulator:
     def from_yaml(cls, path: str | Path) -> MobileManipulator:
         """Build the model from a robot description such as deploy/robots/little_john.yaml."""
         path = Path(path)
+        data = _mapping(path)
         try:
-            data = yaml.safe_load(path.read_text())
             arm, base = data["arm"], data["base"]
             table = arm["dh"]
             types = [REVOLUTE if t == "revolute" else -1.0 for t in table["type"]]

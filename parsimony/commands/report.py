@@ -9,8 +9,6 @@ import argparse
 import sys
 from pathlib import Path
 
-import yaml
-
 from deploy import ROBOT_FILE
 from parsimony.commands.launch import positive_seconds
 from parsimony.output import emit, json_text
@@ -67,9 +65,6 @@ def run(args: argparse.Namespace) -> int:
                   for (label, _), whole in zip(sessions, loaded, strict=True)}  # fmt: skip
     except (OSError, ValueError, ProfileError) as error:
         print(f"report: {error}", file=sys.stderr)
-        return 2
-    except yaml.YAMLError as error:  # the robot description's, which wbc.robot passes on
-        print(f"report: {args.robot}: not YAML: {str(error).splitlines()[0]}", file=sys.stderr)
         return 2
     for name, why in result["gaps"].items():
         print(f"report: {name} not drawn: {why}", file=sys.stderr)

@@ -218,6 +218,27 @@ MISSING_FIELDS = [
 ]
 
 
+@pytest.mark.parametrize(("text", "said"), [
+    (b"arm: [1.0, 2.0\n", ":2:1: not YAML: expected ',' or ']', but got '<stream end>'"),
+    (b"- arm\n- base\n", ": a robot description is a mapping (arm:, base:, ...), this file "
+                         "holds a list"),
+    (b"little john\n", ": a robot description is a mapping (arm:, base:, ...), this file holds "
+                       "a str"),
+    (b"", ": a robot description is a mapping (arm:, base:, ...), this file holds nothing"),
+    (b"\x89PNG\r\n\x1a\n\xff", ": not UTF-8 text (byte 0)"),
+], ids=["not-yaml", "list", "text", "empty", "binary"])  # fmt: skip
+def test_a_file_that_is_no_robot_description_is_one_line_naming_it(
+    tmp_path: Path, text: bytes, said: str
+) -> None:
+    """A ValueError that says what is wrong, as the commands print it (before, YAML's own error
+    or 'missing or invalid field: list indices must be integers')."""
+    path = tmp_path / "robot.yaml"
+    path.write_bytes(text)
+    with pytest.raises(RobotDescriptionError) as raised:
+        MobileManipulator.from_yaml(path)
+    assert str(raised.value) == f"{path}{said}"
+
+
 @pytest.mark.parametrize("field", MISSING_FIELDS, ids=".".join)
 def test_missing_field_names_file_and_field(
     tmp_path: Path, description: dict, field: tuple[str, ...]
