@@ -135,9 +135,14 @@ def origin_s(session: Session) -> float:
     return first[0].header.stamp_ns / 1e9 if first else math.inf
 
 
+CONVERGING = frozenset(("direct", Phase.POSE, Phase.REACHED))
+"""The supervisor's phases in which the controller steps on the goal's own task: a pose goal's
+pose phase, a goal of another kind passed on as it is (``direct``), and either once reached."""
+
+
 def converged_at(diagnostics: Sequence, statuses: Sequence) -> float | None:
     """The time since which every step's error stayed under ``CONVERGED_ERROR``; under a
-    supervisor (``statuses``), only the steps of its last pose phase count."""
+    supervisor (``statuses``), only the steps of its last run of ``CONVERGING`` phases count."""
     pose_since = pose_phase_since(statuses)
     if pose_since is None:
         return None
@@ -154,13 +159,13 @@ def converged_at(diagnostics: Sequence, statuses: Sequence) -> float | None:
 
 
 def pose_phase_since(statuses: Sequence) -> float | None:
-    """When the supervisor's last run of pose (or reached) phases began; 0 with no supervisor,
+    """When the supervisor's last run of ``CONVERGING`` phases began; 0 with no supervisor,
     None while it is in another phase."""
     if not statuses:
         return 0.0
     since = None
     for status in statuses:
-        if status.phase not in (Phase.POSE, Phase.REACHED):
+        if status.phase not in CONVERGING:
             since = None
         elif since is None:
             since = status.header.stamp_ns / 1e9

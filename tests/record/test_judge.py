@@ -1,18 +1,31 @@
 """record.judge on sessions of real kinematic runs of the LP (tests/record/test_report.py's):
-a run judged from its messages alone, with the truth and without it."""
+a run judged from its messages alone, with the truth and without it, and under a supervisor
+from the file a recorder writes."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
+from messages.goal import Goal
 from messages.obstacles import Circle, Plane, Solids
-from messages.topics import CONTROL_DIAGNOSTICS, ROBOT_STATE, SIM_TRUTH
+from messages.supervisor import SupervisorStatus
+from messages.topics import (
+    CONTROL_DIAGNOSTICS,
+    CONTROL_GOAL,
+    ROBOT_STATE,
+    SIM_TRUTH,
+    SUPERVISOR_STATUS,
+)
 from messages.truth import SimTruth
-from record.judge import HOLD_S, commands, effort, judge, origin_s, the_run
-from tests.record.test_report import ROBOT, START_NS, runs  # noqa: F401 - the fixture
-from wbc import scenarios
-from wbc.kinematic_run import effort_of
+from parsimony.sessions import load_session
+from record.judge import HOLD_S, JUDGED, commands, effort, judge, origin_s, the_run
+from tests.record.test_far_stamps import write
+from tests.record.test_report import ROBOT, START_NS, runs, session_of  # noqa: F401 - fixture
+from wbc import dq, scenarios
+from wbc.kinematic_run import effort_of, integrate
+from wbc.lp_law import LPLaw, LPParams
+from wbc.task import PoseTask, PositionTask
 
 
 def with_truth(session: dict[str, list], goal: np.ndarray, shift: float = 0.0) -> dict:
@@ -111,3 +124,34 @@ def test_the_arms_clearance_and_penetrations_are_judged_from_the_truth(runs):  #
     assert set(least) == set(ROBOT.collision.names)
     assert min(least.values()) < -0.01
     assert judge({**session, SIM_TRUTH.name: truth}, ROBOT)["arm_clearance_m"] is None
+
+
+@pytest.mark.parametrize("tolerance", [5e-3, 1e-5], ids=["reached", "never-reached"])
+def test_a_position_goal_passed_on_by_the_supervisor_converges_as_without_it(
+    tmp_path, tolerance: float
+) -> None:
+    """An LP run to a position, its goal passed on by the staging supervisor (phase ``direct``,
+    then ``reached`` within its pose_tolerance, the default 5e-3 or the least, which this run
+    never reaches), written and read as a recording: it converged when the error went under
+    0.01 in the direct phase, as it did with no supervisor (before, only pose and reached
+    phases counted: it converged HOLD_S after reached, or never)."""
+    position = dq.translation(ROBOT.fkm(scenarios.REACH_GOAL))[1:]
+    run = integrate(LPLaw(ROBOT, LPParams()), scenarios.HOME, PositionTask(position),
+                    scenarios.DT, 1500, tolerance=1e-4)  # fmt: skip
+    session = session_of(run, "lp", PoseTask(ROBOT.fkm(scenarios.REACH_GOAL)))
+    goal = session[CONTROL_GOAL.name][0]
+    session[CONTROL_GOAL.name] = [Goal(header=goal.header, task="position",
+                                       position=tuple(position))]  # fmt: skip
+    unsupervised = judge(load_session(write(tmp_path / "alone.mcap", session), JUDGED), ROBOT)
+    statuses = [SupervisorStatus(header=d.header.model_copy(update={"source": "supervisor"}),
+                                 phase="direct" if d.error_norm >= tolerance else "reached",
+                                 candidate=0, plans=0, replans=0, stalls=0,
+                                 error_norm=d.error_norm)
+                for d in session[CONTROL_DIAGNOSTICS.name]]  # fmt: skip
+    supervised = {**session, SUPERVISOR_STATUS.name: statuses}
+    judged = judge(load_session(write(tmp_path / "supervised.mcap", supervised), JUDGED), ROBOT)
+    assert unsupervised["converged"] and judged["converged"]
+    assert judged["iterations"] == unsupervised["iterations"]
+    first_small = next(i for i, d in enumerate(session[CONTROL_DIAGNOSTICS.name])
+                       if d.error_norm < 0.01)  # fmt: skip
+    assert judged["iterations"] == first_small + round(HOLD_S / scenarios.DT) + 1
