@@ -68,7 +68,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("--force", action="store_true", help="write over an existing layout")
     parser.add_argument("--nice", type=int, default=NICE, choices=range(0, 20), metavar="N",
                         help=f"run N steps below the loop's priority (default {NICE})")
-    parser.add_argument("--json", action="store_true", help="print what it did, as JSON")
+    parser.add_argument("--json", action="store_true",
+                        help="when it stops, print what it did as JSON")  # fmt: skip
     return parser
 
 
