@@ -39,10 +39,13 @@ class SimClock:
     def __init__(self) -> None:
         self._stamp_ns = 0
         self._moved_at_ns = time.monotonic_ns()
+        self.started = False
+        """Whether a ``sim/clock`` message has come."""
 
     def advance(self, stamp_ns: int, paused: bool = False) -> None:
         """Set the time to ``stamp_ns`` (it may go back when a replay restarts). A paused
         simulator holds its time on purpose: its clock does not count as stalled."""
+        self.started = True
         if stamp_ns != self._stamp_ns or paused:
             self._moved_at_ns = time.monotonic_ns()
         self._stamp_ns = stamp_ns

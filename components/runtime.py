@@ -51,6 +51,10 @@ the launcher kills the process) before the session closes anyway."""
 log = logging.getLogger("components")
 
 
+WAITING_FOR_CLOCK = "waiting for the clock"
+"""A recorder's state on simulated time before the clock's first tick."""
+
+
 class Node:
     """One component's runtime: session, parameters, clock, timers, counters, handler thread.
 
@@ -274,10 +278,18 @@ class Node:
             self._run(self._on_shutdown, "errors.shutdown")
 
     def _check_clock(self) -> None:
-        """On simulated time: say so, once, when the clock stops moving, and when it moves again."""
+        """On simulated time: say so, once, when the clock stops moving, and when it moves again.
+        A recorder, which starts before the simulator, is ``WAITING_FOR_CLOCK`` until its first
+        tick: a clock that has not started has not stalled."""
         clock = self.clock
         if not isinstance(clock, SimClock):
             return
+        if not clock.started and self.spec.role == "recorder":
+            if self.state == "running":
+                self.state = WAITING_FOR_CLOCK
+            return
+        if self.state == WAITING_FOR_CLOCK:
+            self.state = "running"
         stalled_s = clock.stalled_s()
         if stalled_s >= self.profile.clock_timeout_s and self.state == "running":
             self.state = "clock stalled"
