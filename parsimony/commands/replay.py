@@ -62,12 +62,15 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("--rate", type=positive("times the recorded speed"), default=1.0,
                         help="speed factor")  # fmt: skip
     parser.add_argument("--loop", action="store_true", help="start again at the end")
-    parser.add_argument("--start-offset", type=float, default=0.0, metavar="S")
-    parser.add_argument("--duration", type=positive_seconds, metavar="S")
+    parser.add_argument("--start-offset", type=float, default=0.0, metavar="S",
+                        help="start S s after the recording's first message")  # fmt: skip
+    parser.add_argument("--duration", type=positive_seconds, metavar="S",
+                        help="send S s of the recording (default: to its end)")  # fmt: skip
     parser.add_argument("--keys", nargs="*", default=["*"], help="topic name patterns to send")
     parser.add_argument("--exclude", nargs="*", default=[], help="topic name patterns to skip")
     parser.add_argument("--namespace", type=namespace_argument,
-                        help="publish under this namespace instead")  # fmt: skip
+                        help="publish under this namespace instead of the recorded one "
+                        "(or --profile's)")  # fmt: skip
     parser.add_argument("--sensors", action="store_true", help="only " + ", ".join(SENSORS))
     parser.add_argument("--clock", action="store_true", help="publish sim/clock as recorded")
     parser.add_argument("--lockstep", action="store_true",
@@ -77,9 +80,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("--into-live", action="store_true",
                         help="send commands, and topics live components publish")  # fmt: skip
     parser.add_argument("--view", action="store_true",
-                        help="serve a Foxglove live view of the replay, as parsimony view")
+                        help="serve a Foxglove live view of the replay, as parsimony view "
+                        "(needs --profile: the robot it draws)")  # fmt: skip
     parser.add_argument("--port", type=port_number, default=DEFAULT_PORT,
-                        help=f"the view's, on 127.0.0.1 (default {DEFAULT_PORT}, 0: any free)")
+                        help=f"--view's port on 127.0.0.1 (default {DEFAULT_PORT}, 0: any free)")
     return parser
 
 
