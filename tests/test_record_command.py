@@ -145,7 +145,9 @@ def test_no_command_writes_over_its_input_or_an_existing_file(tmp_path: Path) ->
     assert info(other)["messages"] == info(recording)["messages"]
 
 
-def test_a_robot_file_that_is_no_description_is_one_line_from_report(tmp_path: Path) -> None:
+def test_a_robot_file_that_is_no_description_is_one_line_from_report_and_rerun(
+    tmp_path: Path,
+) -> None:
     """A robot file of YAML that is not a mapping is said as such (before: 'missing or invalid
     field: list indices must be integers or slices, not str')."""
     robot = tmp_path / "robot.yaml"
@@ -154,6 +156,13 @@ def test_a_robot_file_that_is_no_description_is_one_line_from_report(tmp_path: P
                      "--robot", str(robot))  # fmt: skip
     assert done.returncode == 2, done.stderr
     assert done.stderr == (f"report: {robot}: a robot description is a mapping (arm:, base:, "
+                           "...), this file holds a list\n")  # fmt: skip
+    recording = tmp_path / "k.mcap"
+    recording.write_bytes(b"")
+    done = parsimony("rerun", str(recording), "--controller", "lp", "-o",
+                     str(tmp_path / "rerun.mcap"), "--robot", str(robot))  # fmt: skip
+    assert done.returncode == 2, done.stderr
+    assert done.stderr == (f"rerun: {robot}: a robot description is a mapping (arm:, base:, "
                            "...), this file holds a list\n")  # fmt: skip
 
 

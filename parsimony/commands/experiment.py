@@ -15,6 +15,7 @@ from parsimony.experiment import PROFILES, TIME_LIMIT_S, Options, run_experiment
 from parsimony.output import emit, json_text
 from profiles.profile import ProfileError
 from sim2d.scenarios import NAMES, SEED_MAX
+from wbc.robot import RobotDescriptionError
 
 EXIT_NOT_CONVERGED = 1
 EXIT_USAGE = 2
@@ -104,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
     )  # fmt: skip
     try:
         report = run_experiment(options)
-    except (ProfileError, OSError, QueryError, RuntimeError) as error:
+    except (ProfileError, RobotDescriptionError, OSError, QueryError, RuntimeError) as error:
         print(f"experiment: {error}", file=sys.stderr)
         return EXIT_USAGE
     if args.json:

@@ -31,7 +31,7 @@ from parsimony.outputs import writable_output, written_whole
 from record.judge import RERUN_SOURCE
 from record.session_file import Recorded, SessionWriter
 from record.session_reader import read_groups
-from wbc.robot import MobileManipulator
+from wbc.robot import MobileManipulator, RobotDescriptionError
 
 LAWS: dict[str, type[Controller]] = {
     c.law_name: c for c in (LPController, CascadeController, QPController)}
@@ -59,7 +59,11 @@ def run(args: argparse.Namespace) -> int:
     if problem:
         print(f"rerun: {problem}", file=sys.stderr)
         return 2
-    offline = Offline(LAWS[args.controller], MobileManipulator.from_yaml(args.robot))
+    try:
+        offline = Offline(LAWS[args.controller], MobileManipulator.from_yaml(args.robot))
+    except (OSError, RobotDescriptionError) as error:
+        print(f"rerun: {error}", file=sys.stderr)
+        return 2
     try:
         with written_whole(args.output) as partial, SessionWriter(partial) as out:
             for group in read_groups(args.file):  # streamed: memory does not grow with it
