@@ -323,22 +323,25 @@ def test_a_goal_whose_gains_leave_the_parameter_bounds_is_refused(operator: Oper
 def test_obstacles_with_a_solid_larger_than_a_scene_are_refused_in_one_line(
     operator: Operator,
 ) -> None:
-    """A cylinder of radius 1e300 on world/obstacles (a scene refuses it; the message's own
-    schema does not): refused, counted, no traceback, the controller steps on."""
+    """A cylinder of radius 1e300 on world/obstacles, as bytes a sender's own check let through:
+    the message's schema refuses it (``rejected.world/obstacles``) in one line naming the
+    field, no traceback, and the controller steps on."""
     from messages.obstacles import Cylinder, Obstacles, Solids
 
     operator.send_goal()
     obstacles = operator.system.router.declare_publisher(
         topics.WORLD_OBSTACLES.key(operator.namespace))
     header = Header(stamp_ns=operator.stamp(), frame="world", seq=0, source="test")
-    huge = Solids(cylinders=(Cylinder(x=3.0, y=0.0, radius=1e300),))
-    obstacles.put(codec.encode(Obstacles(header=header, solids=huge)))
+    pole = Solids(cylinders=(Cylinder(x=3.0, y=0.0, radius=0.1),))
+    tag, name, fields = msgpack.unpackb(codec.encode(Obstacles(header=header, solids=pole)))
+    fields["solids"]["cylinders"][0]["radius"] = 1e300
+    obstacles.put(msgpack.packb([tag, name, fields], use_bin_type=True))
     deadline = time.monotonic() + DEADLINE_S
-    while operator.counters()["refused_obstacles"] < 1:
+    while operator.counters()["rejected.world/obstacles"] < 1:
         assert time.monotonic() < deadline, "the obstacles were not refused"
     assert operator.step()[0].status == "optimal"
     log = operator.system.log("controller")
-    assert "world/obstacles refused: radius: expected a number > 0 and <= 100 m" in log
+    assert "expected a number > 0 and <= 100 m" in log, log
     assert "Traceback" not in log and operator.counters()["errors.world/obstacles"] == 0
 
 
