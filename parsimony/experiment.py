@@ -62,6 +62,7 @@ from record.judge import (
 from record.report import write_report
 from record.session_reader import info, make_whole
 from sim2d.scenarios import SimScenario, scenario
+from wbc.cascade_law import CascadeParams
 from wbc.lp_law import LPParams
 from wbc.planar import inverse
 from wbc.robot import MobileManipulator
@@ -94,30 +95,35 @@ class Options:
     time_limit_s: float = TIME_LIMIT_S
     hide_base_marker: tuple[float, float] | None = None
     gains: Mapping[str, Any] = dataclasses.field(default_factory=dict)
-    """LP gains (``LPParams``' names) that replace the experiment's: another law on the same
-    set-up, such as another obstacle constraint (``obstacle_mode``)."""
+    """Gains of the law (``GAINS``' names) that replace the experiment's: another law on the
+    same set-up, such as another obstacle constraint (``obstacle_mode``) or the cascade held
+    to the robot's bounds (``saturate``)."""
+
+
+GAINS = {"lp": LPParams, "qp": LPParams, "cascade": CascadeParams}
+"""The gains each controller takes (the QP reads the LP's), declared once with their bounds."""
 
 
 def law_overrides(options: Options) -> dict[str, Any]:
-    """The LP gains of the experiment that differ from the LP's defaults, then ``gains``, for
-    the LP and the QP (which reads the same gains; the cascade's defaults are the
-    dissertation's; an experiment under the supervisor takes its profile's). ``ProfileError``
-    naming a gain that is not the LP's, or a value its declaration refuses."""
+    """The controller's gains: for the LP and the QP the experiment's LP gains that differ from
+    the LP's defaults, then ``gains``; for the cascade ``gains`` over its declared defaults
+    (appendix B's); an experiment under the supervisor takes its profile's. ``ProfileError``
+    naming a gain the law does not have, or a value its declaration refuses."""
     given = dict(options.gains)
-    if options.controller not in ("lp", "qp"):
-        if given:
-            raise ProfileError(f"the {options.controller} law reads no LP gain "
-                               f"({', '.join(given)})")  # fmt: skip
-        return {}
-    names = [f.name for f in dataclasses.fields(LPParams)]
+    params = GAINS[options.controller]
+    law = "LP" if params is LPParams else options.controller
+    names = [f.name for f in dataclasses.fields(params)]
     for name in given:
         if name not in names:
-            raise ProfileError(f"no LP gain {name!r}; the LP's gains are {', '.join(names)}")
+            raise ProfileError(f"no {law} gain {name!r}; the {law}'s gains are "
+                               f"{', '.join(names)}")  # fmt: skip
+    experiment = params is LPParams and options.name in LP_PARAMS
     try:  # each value checked against its declaration, then the gains together
-        wanted = dataclasses.replace(LP_PARAMS.get(options.name, LPParams()), **given)
+        wanted = dataclasses.replace(LP_PARAMS[options.name] if experiment else params(),
+                                     **given)  # fmt: skip
     except ValueError as error:
         raise ProfileError(f"gain {error}") from None
-    if options.name not in LP_PARAMS:
+    if not experiment:
         return {name: getattr(wanted, name) for name in given}
     default = LPParams()
     return {name: getattr(wanted, name) for name in names

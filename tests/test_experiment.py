@@ -19,14 +19,16 @@ from mcap.reader import make_reader
 
 from deploy import query
 from messages.obstacles import Plane
-from parsimony.experiment import DEPLOY, PROFILES, connect
+from parsimony.experiment import DEPLOY, PROFILES, Options, connect, experiment_profile
 from parsimony.sessions import load_session
 from profiles.profile import load_profile
 from record.foxglove_views import MODEL_EVERY, View
 from record.session_reader import info
+from sim2d.scenarios import scenario
 from tests.processes import process_gone
 from tests.record.test_foxglove_views import decode, vector
 from wbc.planar import inverse
+from wbc.robot import MobileManipulator
 from wbc.supervisor_phase import Phase
 
 ONE_DEGREE = math.radians(1.0)
@@ -301,7 +303,11 @@ def test_a_killed_vision_tracker_is_restarted_and_the_run_converges(tmp_path: Pa
     (["obstacle", "--gain", "obstacle_radius=1"], "no LP gain 'obstacle_radius'"),
     (["obstacle", "--gain", "obstacle_gain=-1"], "LPParams.obstacle_gain: expected a float in"),
     (["obstacle", "--controller", "cascade", "--gain", "obstacle_gain=1"],
-     "the cascade law reads no LP gain (obstacle_gain)"),
+     "no cascade gain 'obstacle_gain'; the cascade's gains are eta, offset"),
+    (["pose", "--controller", "cascade", "--gain", "eta=-1"],
+     "CascadeParams.eta: expected a float in"),
+    (["pose", "--controller", "cascade", "--gain", "saturate=maybe"],
+     "CascadeParams.saturate: expected a bool"),
 ])  # fmt: skip
 def test_usage_errors_exit_2_and_say_why(bad: list[str], why: str, tmp_path: Path) -> None:
     extra = [] if bad == ["pose"] else ["--out", str(tmp_path)]
@@ -310,6 +316,17 @@ def test_usage_errors_exit_2_and_say_why(bad: list[str], why: str, tmp_path: Pat
     assert done.returncode == 2 and why in done.stderr, done.stderr
     assert done.stdout == "" and "Traceback" not in done.stderr
     assert not any(tmp_path.iterdir())  # refused before anything was written
+
+
+def test_the_cascade_takes_its_declared_gains(tmp_path: Path) -> None:
+    """--gain with --controller cascade: the cascade's controller is given CascadeParams' gains
+    (held to the robot's bounds with saturate), the LP's experiment gains none of them."""
+    options = Options("pose", "cascade", out=tmp_path, gains={"eta": 1.0, "saturate": True})
+    robot = MobileManipulator.from_yaml(load_profile(PROFILES["cascade"]).robot)
+    profile = experiment_profile(options, PROFILES["cascade"], scenario("pose", robot))
+    (controller,) = [c for c in profile["components"] if c["name"] == "controller"]
+    assert controller == {"name": "controller", "module": "cascade_controller",
+                          "params": {"eta": 1.0, "saturate": True}}
 
 
 def test_an_experiment_does_not_write_over_a_directory_that_holds_files(tmp_path: Path) -> None:

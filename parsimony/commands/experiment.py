@@ -86,8 +86,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("--hide-base-marker", type=seconds_window, metavar="FROM,TO",
                         help="hide the base marker from the camera then (sim s)")  # fmt: skip
     parser.add_argument("--gain", type=gain_setting, action="append", default=[],
-                        metavar="NAME=VALUE", help="an LP gain in place of the experiment's "
-                        "(repeatable), e.g. obstacle_mode=border")  # fmt: skip
+                        metavar="NAME=VALUE", help="a gain of the controller's law in place "
+                        "of the experiment's (repeatable; the LP's and the QP's: LPParams, the "
+                        "cascade's: CascadeParams), e.g. obstacle_mode=border, or saturate=true "
+                        "with --controller cascade")  # fmt: skip
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
     return parser
 
