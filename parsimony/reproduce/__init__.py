@@ -7,10 +7,14 @@ the dissertation ran it (``efficiency``). Every law is named by a label, and the
 what each label ran, its rows and terms read from the law itself (``laws``). Each row gives
 what the dissertation reports (``dissertation``), what this run measures (``measures``) and the
 direction the comparison should take by the dissertation's text; the command makes no
-judgement. ``write_figures`` draws the runs with the report's own figures.
+judgement. ``write_figures`` draws the runs with the report's own figures. ``loop`` runs the
+set-ups of 6.2 on the whole simulated loop and gives the same rows of each recording
+(``--loop``).
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 from parsimony.reproduce.dissertation import NOTES, TABLE_6_1
 from parsimony.reproduce.efficiency import TRIALS, section_6_3
@@ -23,26 +27,32 @@ from parsimony.reproduce.rows import (
     step_time_rows,
     task_rows,
 )
-from parsimony.reproduce.runs import Experiment, experiments
+from parsimony.reproduce.runs import NAMES, Experiment, experiments
 from parsimony.reproduce.table import Row, format_laws, format_rows
 from wbc.robot import MobileManipulator
 
-__all__ = ["NOTES", "TABLE_6_1", "TRIALS", "Row", "format_laws", "format_rows", "reproduce",
-           "write_figures"]  # fmt: skip
+__all__ = ["NAMES", "NOTES", "TABLE_6_1", "TRIALS", "Row", "format_laws", "format_rows",
+           "reproduce", "write_figures"]  # fmt: skip
 
 
-def reproduce(robot: MobileManipulator, trials: int = TRIALS
+def reproduce(robot: MobileManipulator, trials: int = TRIALS, names: tuple[str, ...] = NAMES
               ) -> tuple[list[Row], list[dict[str, str]], dict[str, Experiment]]:  # fmt: skip
-    """The rows, what each law ran, and the experiments they come from. The timed tests of
-    6.3 run first, before thousands of runs' outputs load the garbage collector."""
-    timing, ran = section_6_3(robot, trials)
-    found = experiments(robot)
-    pose, position = found["pose"], found["position"]
-    rows = [*task_rows(robot, pose), *joint_limit_rows(robot, found["joint_limit"]),
-            *task_rows(robot, position), *effort_rows(pose), *effort_rows(position),
-            *obstacle_rows(robot, found["obstacle"]), *step_time_rows(found), *timing,
-            *qp_rows(pose), *qp_rows(position), *input_change_rows(pose),
-            *input_change_rows(position)]  # fmt: skip
+    """The rows, what each law ran, and the experiments they come from: the set-ups
+    ``names`` and, with all of them, section 6.3. The timed tests of 6.3 run first, before
+    thousands of runs' outputs load the garbage collector."""
+    timing, ran = section_6_3(robot, trials) if set(names) == set(NAMES) else ([], [])
+    found = experiments(robot, names)
+
+    def each(make: Callable[[Experiment], list[Row]], *wanted: str) -> list[Row]:
+        return [row for name in wanted if name in found for row in make(found[name])]
+
+    rows = [*each(lambda e: task_rows(robot, e), "pose"),
+            *each(lambda e: joint_limit_rows(robot, e), "joint_limit"),
+            *each(lambda e: task_rows(robot, e), "position"),
+            *each(effort_rows, "pose", "position"),
+            *each(lambda e: obstacle_rows(robot, e), "obstacle"), *step_time_rows(found),
+            *timing, *each(qp_rows, "pose", "position"),
+            *each(input_change_rows, "pose", "position")]  # fmt: skip
     laws = [{"experiment": name, "label": label, "ran": text}
             for name, experiment in found.items()
             for label, text in experiment.laws.items()]  # fmt: skip

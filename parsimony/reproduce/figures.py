@@ -42,17 +42,21 @@ PAIRS = {
 def write_figures(robot: MobileManipulator, found: dict[str, Experiment], out: Path
                   ) -> list[Path]:  # fmt: skip
     """Every folder of ``PAIRS``, the pose task's 2-norm and residual figure, and NOTES.md:
-    what the dissertation's figures show, beside ours."""
+    what the dissertation's figures show, beside ours (of the experiments ``found``)."""
     written: list[Path] = []
     for folder, (name, labels) in PAIRS.items():
+        if name not in found:
+            continue
         experiment = found[name]
         sessions = [(label, session_of(experiment.runs[label], experiment, robot))
                     for label in labels]  # fmt: skip
         written += write_report(sessions, robot, out / folder)["figures"]
-    written.append(two_norm_figure(found["pose"], robot, out / "pose" / "two_norm.png"))
+    if "pose" in found:
+        written.append(two_norm_figure(found["pose"], robot, out / "pose" / "two_norm.png"))
     lines = ["# Chapter 6 figures: what the dissertation shows, and ours", "",
              "| ours | the dissertation's |", "| --- | --- |"]  # fmt: skip
-    lines += [f"| `{path}` | {note} |" for path, note in NOTES.items()]
+    lines += [f"| `{path}` | {note} |" for path, note in NOTES.items()
+              if path.split("/")[0] in found]  # fmt: skip
     (out / "NOTES.md").write_text("\n".join(lines) + "\n")
     return [*written, out / "NOTES.md"]
 

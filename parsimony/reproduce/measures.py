@@ -5,6 +5,7 @@ of the end effector and the base, the step time."""
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -53,11 +54,14 @@ def task_terms(robot: MobileManipulator, task: Task, q: np.ndarray) -> tuple[np.
     return task.error(pose, jacobian, q)
 
 
-def residuals(run: Run, robot: MobileManipulator, task: Task, eta: float) -> list[float]:
-    """||J u + eta e|| / ||eta e|| at each step: 0 where u realises J u = -eta e."""
+def residuals(run: Run, robot: MobileManipulator, task: Task | Sequence[Task], eta: float
+              ) -> list[float]:  # fmt: skip
+    """||J u + eta e|| / ||eta e|| at each step (of ``task``, or of the task of each step):
+    0 where u realises J u = -eta e."""
+    tasks = task if isinstance(task, Sequence) else [task] * len(run.outputs)
     out = []
-    for q, step in zip(run.configurations, run.outputs, strict=True):
-        error, jacobian = task_terms(robot, task, q)
+    for q, step, current in zip(run.configurations, run.outputs, tasks, strict=True):
+        error, jacobian = task_terms(robot, current, q)
         out.append(float(np.linalg.norm(jacobian @ step.u + eta * error)
                          / np.linalg.norm(eta * error)))  # fmt: skip
     return out

@@ -4,7 +4,8 @@ its label (``parsimony.reproduce.laws``) and with the words of what it ran."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -27,9 +28,15 @@ STEPS = 4000
 """80 s of 50 Hz steps: the longest run."""
 
 
+NAMES = ("pose", "position", "joint_limit", "obstacle")
+"""The set-ups: 6.2.1 (pose), 6.2.2 (position), the joint limit of figure 6.10, 6.2.3."""
+
+
 @dataclass(frozen=True)
 class Experiment:
-    """A set-up of chapter 6: its task, the runs of its laws and what each law ran."""
+    """A set-up of chapter 6: its task, the runs of its laws and what each law ran. A run on
+    the whole loop (``parsimony.reproduce.loop``) gives the task of each of its steps (the goal
+    the controller held) and its true configurations, where they are not the run's own."""
 
     name: str
     task: Task
@@ -37,6 +44,20 @@ class Experiment:
     runs: dict[str, Run]
     laws: dict[str, str]
     obstacles: tuple[Obstacle, ...] = ()
+    tasks: Mapping[str, list[Task]] = field(default_factory=dict)
+    """The task of each step of a run, by label; ``task`` at every step of the others."""
+    truth: Mapping[str, Run] = field(default_factory=dict)
+    """A run's true configurations (the simulator's world) beside its outputs, by label."""
+    until: str = "||e|| < 1e-3"
+    """Where a run stops."""
+
+    def step_tasks(self, label: str) -> Task | list[Task]:
+        """The task of each step of run ``label``, or the one task of them all."""
+        return self.tasks.get(label, self.task)
+
+    def true_run(self, label: str) -> Run:
+        """Run ``label`` with its true configurations."""
+        return self.truth.get(label, self.runs[label])
 
 
 def run_laws(name: str, task: Task, eta: float, laws: dict[str, Law],
@@ -48,42 +69,60 @@ def run_laws(name: str, task: Task, eta: float, laws: dict[str, Law],
                       obstacles)  # fmt: skip
 
 
-def experiments(robot: MobileManipulator) -> dict[str, Experiment]:
-    """6.2.1 (pose), 6.2.2 (position), the joint limit of figure 6.10 and 6.2.3 (obstacle),
-    each with its laws: the default LP, 5.29 as written and the cascade as the dissertation ran
-    it and held to the robot's bounds; for table 6.1, the cascade with the eta that converges
-    in the LP's time and the LP without its speed bounds beside the pseudoinverse under 5.11;
-    for future work 1 and 5 of 7.2, the LP with its input change term and the QP."""
-    free = robot.with_velocity_max(np.full(robot.dof, UNBOUNDED_SPEED))
+def task_of(robot: MobileManipulator, name: str) -> Task:
+    """The task of set-up ``name`` (one of ``NAMES``)."""
     reach = robot.fkm(REACH_GOAL)
-    tasks = {"pose": PoseTask(reach), "position": PositionTask(dq.translation(reach)[1:])}
-    found = {}
-    for name, task in tasks.items():
-        params = LP_PARAMS[name]
-        found[name] = run_laws(name, task, params.eta, {
-            L.LP: LPLaw(robot, params),
-            L.LP_5_29: LPLaw(robot, L.bare_5_29(params)),
-            L.CASCADE: CascadeLaw(robot, CascadeParams(eta=params.eta)),
-            L.SATURATED: CascadeLaw(robot, CascadeParams(eta=params.eta, saturate=True)),
-            L.LP_FREE: LPLaw(free, params),
-            L.PINV_5_11: PseudoinverseLaw(robot, PinvParams(eta=params.eta, nonholonomic=True)),
-            L.QP: QPLaw(robot, QPParams(eta=params.eta, beta=params.beta)),
-            L.LP_INPUT_CHANGE: LPLaw(robot, replace(params, **input_change_gains())),
-        })  # fmt: skip
-        eta = matched_eta(robot, task, len(found[name].runs[L.LP].outputs))
-        matched = CascadeLaw(robot, CascadeParams(eta=eta))
-        found[name].runs[L.CASCADE_LP_TIME] = integrate(matched, HOME, task, DT, STEPS)
-        found[name].laws[L.CASCADE_LP_TIME] = L.describe(matched)
+    return {"pose": PoseTask(reach), "position": PositionTask(dq.translation(reach)[1:]),
+            "joint_limit": PoseTask(robot.fkm(JOINT_LIMIT_GOAL)),
+            "obstacle": PoseTask(robot.fkm(OBSTACLE_GOAL))}[name]  # fmt: skip
+
+
+def laws_of(robot: MobileManipulator, name: str) -> dict[str, Law]:
+    """The laws of set-up ``name`` by label: the default LP, 5.29 as written and the cascade as
+    the dissertation ran it and held to the robot's bounds; on the pose and the position task,
+    for table 6.1, the LP without its speed bounds beside the pseudoinverse under 5.11, and for
+    future work 1 and 5 of 7.2, the LP with its input change term and the QP. On the obstacle
+    task, the default LP, the LP with 5.28 in place of the vector-field inequality and 5.29 as
+    written (no cascade: appendix B has no obstacle row)."""
     pose = LP_PARAMS["pose"]
-    found["joint_limit"] = run_laws("joint_limit", PoseTask(robot.fkm(JOINT_LIMIT_GOAL)), pose.eta,
-                                    {L.LP: LPLaw(robot, pose),
-                                     L.LP_5_29: LPLaw(robot, L.bare_5_29(pose)),
-                                     L.CASCADE: CascadeLaw(robot, CascadeParams(eta=pose.eta)),
-                                     L.SATURATED: CascadeLaw(robot, CascadeParams(
-                                         eta=pose.eta, saturate=True))})  # fmt: skip
-    found["obstacle"] = run_laws("obstacle", PoseTask(robot.fkm(OBSTACLE_GOAL)), pose.eta, {
-        L.LP: LPLaw(robot, LP_PARAMS["obstacle"]), L.LP_BORDER: LPLaw(robot, BORDER_PARAMS),
-        L.LP_5_29: LPLaw(robot, L.bare_5_29(pose))}, (OBSTACLE,))  # fmt: skip
+    if name == "obstacle":
+        return {L.LP: LPLaw(robot, LP_PARAMS["obstacle"]), L.LP_BORDER: LPLaw(robot, BORDER_PARAMS),
+                L.LP_5_29: LPLaw(robot, L.bare_5_29(pose))}  # fmt: skip
+    params = pose if name == "joint_limit" else LP_PARAMS[name]
+    laws: dict[str, Law] = {
+        L.LP: LPLaw(robot, params), L.LP_5_29: LPLaw(robot, L.bare_5_29(params)),
+        L.CASCADE: CascadeLaw(robot, CascadeParams(eta=params.eta)),
+        L.SATURATED: CascadeLaw(robot, CascadeParams(eta=params.eta, saturate=True)),
+    }  # fmt: skip
+    if name == "joint_limit":
+        return laws
+    free = robot.with_velocity_max(np.full(robot.dof, UNBOUNDED_SPEED))
+    return laws | {
+        L.LP_FREE: LPLaw(free, params),
+        L.PINV_5_11: PseudoinverseLaw(robot, PinvParams(eta=params.eta, nonholonomic=True)),
+        L.QP: QPLaw(robot, QPParams(eta=params.eta, beta=params.beta)),
+        L.LP_INPUT_CHANGE: LPLaw(robot, replace(params, **input_change_gains())),
+    }  # fmt: skip
+
+
+def experiments(robot: MobileManipulator, names: tuple[str, ...] = NAMES
+                ) -> dict[str, Experiment]:  # fmt: skip
+    """The set-ups ``names``, each with the runs of its laws (``laws_of``); on the pose and the
+    position task, for table 6.1, also the cascade with the eta that converges in the LP's
+    time."""
+    found = {}
+    for name in NAMES:
+        if name not in names:
+            continue
+        eta = LP_PARAMS[name].eta if name in ("pose", "position") else LP_PARAMS["pose"].eta
+        task = task_of(robot, name)
+        found[name] = run_laws(name, task, eta, laws_of(robot, name),
+                               (OBSTACLE,) if name == "obstacle" else ())  # fmt: skip
+        if name in ("pose", "position"):
+            matched = CascadeLaw(robot, CascadeParams(eta=matched_eta(
+                robot, task, len(found[name].runs[L.LP].outputs))))  # fmt: skip
+            found[name].runs[L.CASCADE_LP_TIME] = integrate(matched, HOME, task, DT, STEPS)
+            found[name].laws[L.CASCADE_LP_TIME] = L.describe(matched)
     return found
 
 
