@@ -11,6 +11,7 @@ import sys
 import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -19,16 +20,15 @@ from parsimony.goal_sets import goal_report
 from parsimony.kinematic_demo import TABLE_PARAMS, WITHOUT_ARM_ROWS
 from parsimony.output import table
 from wbc import dq
-from wbc.cascade_law import CascadeLaw, CascadeParams
+from wbc.cascade_law import CascadeLaw
 from wbc.constraints.arm_obstacles import ArmObstacles
 from wbc.kinematic_run import integrate
 from wbc.law_output import Law
-from wbc.lp_law import LPLaw, LPParams
-from wbc.pinv_law import PinvParams, PseudoinverseLaw
+from wbc.lp_law import LPLaw
+from wbc.pinv_law import PseudoinverseLaw
 from wbc.qp_law import QPLaw
 from wbc.robot import MobileManipulator
 from wbc.scenarios import (
-    CONVERGENCE_GOAL,
     DT,
     HOME,
     REACH_GOAL,
@@ -221,45 +221,29 @@ UNBOUNDED_SPEED = 1e3
 robot's own (0.8 rad/s) would slow the LP alone (132 iterations against the classic law's
 60), since neither the classic law nor the cascade has any."""
 
+CONVERGENCE_NAMES = {("test 1", "classic"): "holonomic/classic", ("test 1", "LP"): "holonomic/lp",
+                     ("test 2", "classic"): "nonholonomic/cascade",
+                     ("test 2", "LP"): "nonholonomic/lp"}  # fmt: skip
+"""The bench's name of each law of each test of section 6.3."""
 
-def convergence_test(robot: MobileManipulator, trials: int) -> dict[str, dict[str, float]]:
-    """Section 6.3: the same pose task repeated; iterations to ||e|| < 1e-3, time per iteration.
 
-    Test 1 (holonomic): the classic law and the LP with no constraint but 5.10 and no term
-    beside the task (5.29 as written, but for the tie-break); test 2 (nonholonomic): the
-    cascade and the LP with 5.12 and the joint limits (k = 1, b_l = 0.99) and its default
-    terms. eta = 5, beta = 40, no velocity bound (``UNBOUNDED_SPEED``).
-    """
-    task = PoseTask(robot.fkm(CONVERGENCE_GOAL))
-    free = robot.with_velocity_max(np.full(robot.dof, UNBOUNDED_SPEED))
-    tests = {
-        "holonomic/classic": lambda: PseudoinverseLaw(free, PinvParams(eta=5.0)),
-        "holonomic/lp": lambda: LPLaw(
-            free, LPParams(eta=5.0, beta=40.0, nonholonomic=False, safety_factor=1.0,
-                           joint_gain=1e3, obstacle_mode="off", waist_hold=0.0,
-                           base_target=0.0)),  # fmt: skip
-        "nonholonomic/cascade": lambda: CascadeLaw(free, CascadeParams(eta=5.0)),
-        "nonholonomic/lp": lambda: LPLaw(
-            free, LPParams(eta=5.0, beta=40.0, safety_factor=0.99, obstacle_mode="off")),
-    }  # fmt: skip
+def convergence_test(robot: MobileManipulator, trials: int) -> dict[str, dict[str, Any]]:
+    """Section 6.3 as the dissertation ran it: the laws, goals and timing of
+    ``parsimony.reproduce.efficiency`` (declared there), ``trials`` runs of each law."""
+    from parsimony.reproduce import efficiency  # not above: reproduce imports this module
+
     results = {}
-    for name, make_law in tests.items():
-        integrate(make_law(), HOME, task, DT, 2000)  # warm-up, untimed
-        iterations, durations = [], []
-        for _ in range(trials):
-            law = make_law()
-            start = time.perf_counter()
-            run = integrate(law, HOME, task, DT, 2000)
-            durations.append(time.perf_counter() - start)
-            iterations.append(len(run.outputs) if run.converged else -1)
-        per_iteration = np.array(durations) / np.abs(iterations)
-        results[name] = {
-            "iterations": int(np.median(iterations)),
-            "converged_trials": int(np.sum(np.array(iterations) > 0)),
-            "convergence_time_ms": float(np.mean(durations) * 1e3),
-            "convergence_time_std_ms": float(np.std(durations) * 1e3),
-            "time_per_iteration_us": float(np.median(per_iteration) * 1e6),
-        }
+    for test, makers in efficiency.laws(robot).items():
+        task = PoseTask(robot.fkm(efficiency.GOALS[test]))
+        for label, make_law in makers.items():
+            found = efficiency.timed(make_law, task, trials)
+            results[CONVERGENCE_NAMES[test, label]] = {
+                "iterations": found["iterations"],
+                "converged_trials": found["converged"],
+                "convergence_time_ms": found["ms"][0],
+                "convergence_time_std_ms": found["ms"][1],
+                "time_per_iteration_us": found["ms per iteration"] * 1e3,
+            }
     return results
 
 
