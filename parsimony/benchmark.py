@@ -323,8 +323,10 @@ def format_report(report: dict) -> str:
                              f"{row['plan_p99_ms']:.0f} ms p99 "
                              f"({row['plan_cpu_median_ms']:.0f} and "
                              f"{row['plan_cpu_p99_ms']:.0f} ms of its thread's CPU time)")
-            if "failures" in row:
+            if "contacts" in row:
                 parts.append(f"{law}: {row['contacts']} runs with a contact, least clearance "
-                             f"{row['least_clearance_m']:.3f} m; not reached, by reason:")
+                             f"{row['least_clearance_m']:.3f} m")
+            if law.startswith("lp") and row.get("failures"):
+                parts.append(f"{law}: not reached, by reason:")
                 parts += [f"  {n} x {reason}" for reason, n in row["failures"].items()]
     return "\n".join(parts)

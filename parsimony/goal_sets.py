@@ -1,8 +1,5 @@
-"""Random pose goals, and the share of them a law reaches inside the robot's limits.
-
-A goal is the end-effector pose of a goal configuration: the base placed some distance and
-bearing from the start, at some heading, with the arm in a box of joint angles; so every goal
-is reachable. Each family declares its ranges once.
+"""The share of random pose goals (``parsimony.goal_families``) a law reaches inside the
+robot's limits, and how parsimonious its u is on the way.
 """
 
 from __future__ import annotations
@@ -16,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from parsimony.goal_families import FAMILIES, OBSTACLE_FAMILIES, goals, obstacle_goals
 from parsimony.kinematic_demo import supervised_params
 from wbc import dq
 from wbc.cascade_law import CascadeLaw
@@ -25,114 +23,15 @@ from wbc.lp_law import LPLaw, LPParams
 from wbc.obstacles import Circle, least_clearance
 from wbc.qp_law import QPLaw
 from wbc.robot import BASE_DOF, MobileManipulator
-from wbc.scenarios import ARM_BOX, DT, HOME
+from wbc.scenarios import DT
 from wbc.staging_supervisor import StagingSupervisor, SupervisorParams
 from wbc.task import PoseTask, PositionTask, Task
 
 Array = np.ndarray
 
-START_SPREAD = 0.3
-"""The start arm is HOME's, each joint moved by up to this much (rad), clipped to ARM_BOX."""
 TIME_LIMIT_S = 60.0
 TOLERANCE = 1e-3
 LIMIT_TOLERANCE = 1e-6
-GOAL_SEED = 2
-"""The bench's goals. The secondary objective terms were tuned on seed 1, so it is not used."""
-
-
-@dataclass(frozen=True)
-class GoalFamily:
-    """Goal base at distance and bearing from the start base (facing x), at a heading; the
-    arm's start near HOME and its goal in ARM_BOX, or, with ``joint_box`` b, both anywhere in
-    b [q-, q+] (the LP's joint box for b = its safety factor)."""
-
-    name: str
-    distance: tuple[float, float]
-    bearing: tuple[float, float]
-    heading: tuple[float, float]
-    joint_box: float | None = None
-
-    def sample(self, rng: np.random.Generator, robot: MobileManipulator
-               ) -> tuple[Array, Array]:  # fmt: skip
-        """(start configuration, goal configuration)."""
-        if self.joint_box is None:
-            low, high = ARM_BOX
-            spread = rng.uniform(-START_SPREAD, START_SPREAD, 5)
-            arm_start = np.clip(HOME[3:] + spread, low, high)
-        else:
-            low = self.joint_box * robot.q_min[BASE_DOF:]
-            high = self.joint_box * robot.q_max[BASE_DOF:]
-            arm_start = rng.uniform(low, high)
-        distance, bearing = rng.uniform(*self.distance), rng.uniform(*self.bearing)
-        base = [distance * math.cos(bearing), distance * math.sin(bearing),
-                rng.uniform(*self.heading)]  # fmt: skip
-        goal = np.concatenate((base, rng.uniform(low, high)))
-        return np.concatenate((HOME[:3], arm_start)), goal
-
-
-AHEAD = math.radians(35.0)
-FAMILIES = {
-    "ahead": GoalFamily("ahead", (0.3, 1.2), (-AHEAD, AHEAD), (-AHEAD, AHEAD)),
-    "anywhere": GoalFamily("anywhere", (0.0, 1.2), (-math.pi, math.pi), (-math.pi, math.pi),
-                           LPParams().safety_factor),
-}
-"""'ahead': the dissertation's kind (goal base 0.3-1.2 m away, within 35 degrees of straight
-ahead, heading within 35 degrees); 'anywhere': within 1.2 m at any bearing and heading, the
-arm's start and goal anywhere in the LP's joint box."""
-
-
-@dataclass(frozen=True)
-class ObstacleFamily:
-    """Goals of ``goals``, each with one circle of ``radius`` near the straight way from the
-    start base to the goal's: its centre a share U(0.2, 0.8) along the way and U(-near, near)
-    beside it, pushed further aside (in steps of 1 cm) until the base's body, with the LP's
-    margin, clears it at the start and at the goal, and the goal's gripper stands outside it
-    by the margin. Every goal is reached by its own configuration, clear of the circle."""
-
-    name: str
-    goals: GoalFamily
-    radius: float = 0.1
-    near: float = 0.2
-    margin: float = LPParams().obstacle_margin
-    seed: int = 25
-    """The bench's goals: held out (the planner was tuned on seeds 1 and 4)."""
-
-    def sample(self, rng: np.random.Generator, robot: MobileManipulator
-               ) -> tuple[Array, Array, Circle]:  # fmt: skip
-        """(start configuration, goal configuration, the circle)."""
-        start, goal = self.goals.sample(rng, robot)
-        way = goal[:2] - start[:2]
-        length = float(np.hypot(*way))
-        along = way / length if length > 1e-9 else np.array([1.0, 0.0])
-        aside = np.array([-along[1], along[0]])
-        centre = start[:2] + rng.uniform(0.2, 0.8) * way
-        offset = rng.uniform(-self.near, self.near)
-        side = 1.0 if offset >= 0.0 else -1.0
-        gripper = dq.translation(robot.fkm(goal))[1:3]
-        body = self.radius + robot.base.body_radius + self.margin
-        while not (np.hypot(*(centre + offset * aside - start[:2])) >= body
-                   and np.hypot(*(centre + offset * aside - goal[:2])) >= body
-                   and np.hypot(*(centre + offset * aside - gripper))
-                   >= self.radius + self.margin):  # fmt: skip
-            offset += side * 0.01
-        x, y = centre + offset * aside
-        return start, goal, Circle(float(x), float(y), self.radius)
-
-
-OBSTACLE_FAMILIES = {
-    "anywhere, obstacle": ObstacleFamily("anywhere, obstacle", FAMILIES["anywhere"]),
-}
-"""Goals with an obstacle (issue 25): the 'anywhere' goals, each with a circle of 0.1 m near
-the straight way, which the supervised LP must drive round."""
-
-
-def obstacle_goals(family: ObstacleFamily, count: int, robot: MobileManipulator,
-                   seed: int | None = None) -> list[tuple[Array, Array, Circle]]:  # fmt: skip
-    """``count`` goals of ``family`` drawn from ``seed`` (the family's own by default)."""
-    rng = np.random.default_rng(family.seed if seed is None else seed)
-    return [family.sample(rng, robot) for _ in range(count)]
-
-
 MOVING_ERROR = 0.05
 """||e|| above which a step of a pose run counts as moving (figure 6.7's first part)."""
 SETTLING_S = 2.0
@@ -168,7 +67,8 @@ class Attempt:
     """The same with u = 0 before the first command: the jump from rest counts."""
     reason: str = ""
     """Why the goal was not reached: the supervisor's reason, or the time limit and the phase
-    it ran out in; empty when reached."""
+    it ran out in; alone, the time limit and the joints then at or past the edge of the law's
+    joint box (``at_joint_box_edge``); empty when reached."""
     clearance: float = math.inf
     """The least distance between the base's body and an obstacle over the run, m (below 0 is
     a contact); inf with no obstacle."""
@@ -211,7 +111,8 @@ def attempt(law: Law, robot: MobileManipulator, start: Array, goal: Array,
             robot.fkm(goal))
         run = integrate(law, start, task, DT, steps, TOLERANCE, obstacles)
         own = [True] * len(run.outputs)
-        reason = "time limit"
+        edge = at_joint_box_edge(law, robot, run.configurations[-1])
+        reason = f"time limit, {' and '.join(edge) or 'no joint'} at the joint box's edge"
     q = np.array([start, *run.configurations])  # a supervisor may stop before any step
     u = np.vstack((np.zeros(robot.dof), run.velocities().reshape(-1, robot.dof)))
     joint_overrun = np.maximum(q - robot.q_max, robot.q_min - q).max()
@@ -227,6 +128,20 @@ def attempt(law: Law, robot: MobileManipulator, start: Array, goal: Array,
                    least_clearance(q[:, :2], obstacles, robot.base.body_radius))  # fmt: skip
 
 
+EDGE = 0.01
+"""How near the edge of its law's joint box (rad) a joint counts as at it."""
+
+
+def at_joint_box_edge(law: Law, robot: MobileManipulator, q: Array) -> list[str]:
+    """The arm joints of ``q`` (q1..q5) within EDGE of the joint box of ``law``: b_l [q-, q+]
+    for the LP and the QP (their safety factor b_l), the joint limits for a law without one."""
+    factor = law.params.safety_factor if isinstance(law, LPLaw | QPLaw) else 1.0
+    arm = q[BASE_DOF:]
+    near = np.minimum(arm - factor * robot.q_min[BASE_DOF:],
+                      factor * robot.q_max[BASE_DOF:] - arm) < EDGE  # fmt: skip
+    return [f"q{index + 1}" for index in np.flatnonzero(near)]
+
+
 def _logged(supervisor: StagingSupervisor, tasks: list[object]) -> StagingSupervisor:
     """``supervisor`` noting the task of every step in ``tasks``."""
     step = supervisor.step
@@ -238,12 +153,6 @@ def _logged(supervisor: StagingSupervisor, tasks: list[object]) -> StagingSuperv
 
     supervisor.step = noted  # type: ignore[method-assign]
     return supervisor
-
-
-def goals(family: GoalFamily, count: int, robot: MobileManipulator, seed: int = GOAL_SEED
-          ) -> list[tuple[Array, Array]]:  # fmt: skip
-    rng = np.random.default_rng(seed)
-    return [family.sample(rng, robot) for _ in range(count)]
 
 
 def shares(attempts: Iterable[Attempt]) -> dict[str, float]:
@@ -310,18 +219,26 @@ def histogram(masks: list[int], dof: int) -> list[int]:
     return np.bincount([m.bit_count() for m in masks], minlength=dof + 1).tolist()
 
 
+def exact_5_29() -> LPParams:
+    """5.29 as written, with the default law's eta, beta, k and b_l: no term beside the task,
+    5.28 on the axle centre with 5.10 (``parsimony.reproduce.laws.bare_5_29``, declared once
+    there; imported here, not above, as ``parsimony.reproduce`` imports this module)."""
+    from parsimony.reproduce.laws import bare_5_29
+
+    return bare_5_29(LPParams())
+
+
 SUPERVISED = "lp + staging supervisor"
 LAWS: dict[str, Callable[[MobileManipulator], Law]] = {
     "lp": lambda robot: LPLaw(robot),
-    "lp 5.29 exactly": lambda robot: LPLaw(robot, EXACT_5_29),
+    "lp 5.29 exactly": lambda robot: LPLaw(robot, exact_5_29()),
     SUPERVISED: lambda robot: LPLaw(robot, supervised_params()),
     "qp": lambda robot: QPLaw(robot),
     "cascade": lambda robot: CascadeLaw(robot),
 }
-"""The laws compared: the default LP, LP 5.29 with no term added to the task, the LP under the
+"""The laws compared: the default LP, LP 5.29 as written (``exact_5_29``), the LP under the
 staging supervisor (wbc.staging_supervisor) with its gains, the QP of the same rows and terms
 (wbc.qp_law), the cascade."""
-EXACT_5_29 = LPParams(velocity_cost=0.0, waist_hold=0.0, waist_centring=0.0, base_target=0.0)
 POSITION_LAWS = ("lp", "lp 5.29 exactly", "qp", "cascade")
 """The laws run on the position task of each family's goals (6.2.2)."""
 
@@ -333,16 +250,21 @@ def _attempt_one(job: tuple[str, Path, Array, Array, bool, tuple[Circle, ...]]) 
                    obstacles)  # fmt: skip
 
 
-def failures(attempts: Iterable[Attempt]) -> dict:
-    """The goals not reached, by reason (most first), and the contacts: runs whose base's
-    body came within 0 of an obstacle, and the least clearance of all runs, m."""
-    attempts = list(attempts)
+def not_reached(attempts: Iterable[Attempt]) -> dict[str, dict[str, int]]:
+    """The goals not reached, by reason (most first)."""
     reasons: dict[str, int] = {}
     for a in attempts:
         if not a.converged:
             reasons[a.reason] = reasons.get(a.reason, 0) + 1
+    return {"failures": dict(sorted(reasons.items(), key=lambda item: -item[1]))}
+
+
+def failures(attempts: Iterable[Attempt]) -> dict:
+    """The goals not reached, by reason (``not_reached``), and the contacts: runs whose base's
+    body came within 0 of an obstacle, and the least clearance of all runs, m."""
+    attempts = list(attempts)
     return {
-        "failures": dict(sorted(reasons.items(), key=lambda item: -item[1])),
+        **not_reached(attempts),
         "contacts": sum(a.clearance < 0.0 for a in attempts),
         "least_clearance_m": min((a.clearance for a in attempts), default=math.inf),
     }
@@ -364,9 +286,10 @@ def _obstacle_rows(pool: Pool, robot_file: Path, count: int) -> dict:
 
 
 def goal_report(robot_file: Path, count: int, processes: int = 2) -> dict:
-    """For every family and law: the shares reached and the parsimony of u, for the pose task
-    and, with the laws of POSITION_LAWS, for the position task of the same goals; and the LP
-    under the supervisor on the goals of OBSTACLE_FAMILIES (``_obstacle_rows``)."""
+    """For every family and law: the shares reached, the parsimony of u and the goals not
+    reached by reason, for the pose task and, with the laws of POSITION_LAWS, for the position
+    task of the same goals; and the LP under the supervisor on the goals of OBSTACLE_FAMILIES
+    (``_obstacle_rows``)."""
     robot = MobileManipulator.from_yaml(robot_file)
     report: dict = {}
     with multiprocessing.get_context("spawn").Pool(processes) as pool:
@@ -378,7 +301,8 @@ def goal_report(robot_file: Path, count: int, processes: int = 2) -> dict:
                     jobs = [(law_name, robot_file, start, goal, task == "position", ())
                             for start, goal in pairs]  # fmt: skip
                     attempts = pool.map(_attempt_one, jobs, chunksize=1)
-                    rows[law_name] = {**shares(attempts), **parsimony(attempts, robot.dof)}
+                    rows[law_name] = {**shares(attempts), **parsimony(attempts, robot.dof),
+                                      **not_reached(attempts)}  # fmt: skip
                     if law_name == SUPERVISED:
                         rows[law_name].update(planning(attempts))
                 report[f"{family.name} {task}"] = {"goals": count, "laws": rows}
