@@ -218,8 +218,9 @@ def dqrobotics_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[s
 
 UNBOUNDED_SPEED = 1e3
 """The velocity bound of section 6.3's tests, rad/s or m/s: none is stated there, and the
-robot's own (0.8 rad/s) would slow the LP alone (132 iterations against the classic law's
-60), since neither the classic law nor the cascade has any."""
+robot's own would hold the LP alone, since neither the classic law nor the cascade has any
+(test 2's LP on the robot's bounds ends 2000 iterations at ||e|| 0.094; unbounded it converges
+in 76)."""
 
 CONVERGENCE_NAMES = {("test 1", "classic"): "holonomic/classic", ("test 1", "LP"): "holonomic/lp",
                      ("test 2", "classic"): "nonholonomic/cascade",
