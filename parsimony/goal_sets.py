@@ -72,6 +72,8 @@ class Attempt:
     clearance: float = math.inf
     """The least distance between the base's body and an obstacle over the run, m (below 0 is
     a contact); inf with no obstacle."""
+    last: Array | None = None
+    """The configuration the run ended in."""
 
     @property
     def seconds(self) -> float:
@@ -125,7 +127,8 @@ def attempt(law: Law, robot: MobileManipulator, start: Array, goal: Array,
                    tuple(out.error_norm for out in outputs), planning, planning_cpu,
                    all(out.ok for out in run.outputs), control_effort(run),
                    control_effort(run, from_rest=True), "" if run.converged else reason,
-                   least_clearance(q[:, :2], obstacles, robot.base.body_radius))  # fmt: skip
+                   least_clearance(q[:, :2], obstacles, robot.base.body_radius),
+                   q[-1])  # fmt: skip
 
 
 EDGE = 0.01
