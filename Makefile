@@ -41,6 +41,7 @@ foxglove-client: $(CLIENT_STAMP)
 
 test: $(STAMP) $(CLIENT_STAMP)
 	$(VENV)/bin/ruff check .
+	$(VENV)/bin/ruff format --check .
 	$(VENV)/bin/python -m pytest -q --durations=20
 
 bench: $(STAMP)
@@ -48,6 +49,7 @@ bench: $(STAMP)
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .
+	$(VENV)/bin/ruff format --check .
 
 # Resolve pyproject.toml (runtime and test dependencies, and setuptools to build the project)
 # into exact versions with hashes, for every platform, on Python 3.11.

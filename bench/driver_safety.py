@@ -82,8 +82,9 @@ class Wheels:
     def stopped_after(self, since_ns: int) -> int | None:
         """When the wheels were first told to stop after ``since_ns``."""
         with self.lock:
-            return next((t for t, left, right in self.told
-                         if t > since_ns and left == right == 0.0), None)  # fmt: skip
+            return next(
+                (t for t, left, right in self.told if t > since_ns and left == right == 0.0), None
+            )
 
 
 class Joints(IntegratingJoints):
@@ -119,9 +120,17 @@ class Controller:
             header = Header(stamp_ns=time.time_ns(), frame="", seq=0, source="bench")
             speed, joints = self.speed, self.joints
             if speed is not None:
-                self.base.put(codec.encode(BaseCommand(header=header, forward_velocity=speed,
-                                                       angular_velocity=0.0, left_wheel=speed,
-                                                       right_wheel=speed)))  # fmt: skip
+                self.base.put(
+                    codec.encode(
+                        BaseCommand(
+                            header=header,
+                            forward_velocity=speed,
+                            angular_velocity=0.0,
+                            left_wheel=speed,
+                            right_wheel=speed,
+                        )
+                    )
+                )
                 self.last_base_ns = time.monotonic_ns()
             if joints is not None:
                 self.arm.put(codec.encode(ArmCommand(header=header, joint_velocities=joints)))
@@ -161,8 +170,9 @@ class Rig:
         self.wheels, self.joints = Wheels(), Joints()
         self.stack = contextlib.ExitStack()
         self.create = self.stack.enter_context(Create2Emulator(self.wheels, directory / "create2"))
-        self.servos = self.stack.enter_context(AXChainEmulator(self.joints,
-                                                               link=directory / "servos"))
+        self.servos = self.stack.enter_context(
+            AXChainEmulator(self.joints, link=directory / "servos")
+        )
         self.stepping = True
         threading.Thread(target=self._step_arm, daemon=True).start()
         self.stack.callback(setattr, self, "stepping", False)
@@ -171,8 +181,10 @@ class Rig:
         launcher = self.stack.enter_context(launched(path))
         self.session = self.stack.enter_context(connect(self.profile, launcher))
         self.odometry: list[int] = []
-        self.session.declare_subscriber(topics.BASE_ODOMETRY.key(self.profile.namespace),
-                                        lambda _: self.odometry.append(time.monotonic_ns()))
+        self.session.declare_subscriber(
+            topics.BASE_ODOMETRY.key(self.profile.namespace),
+            lambda _: self.odometry.append(time.monotonic_ns()),
+        )
         self.controller = Controller(self.session, self.profile.namespace)
         self.stack.callback(setattr, self.controller, "running", False)
         wait(lambda: {"base_driver", "arm_driver"} <= set(self.alive()), "both drivers alive")
@@ -195,6 +207,7 @@ class Rig:
     def pid(self, name: str) -> int | None:
         answer = query.statuses(self.session, self.profile.namespace).get(name)
         return None if answer is None else answer.pid
+
 
 def stop_delays(rig: Rig, runs: int) -> list[float]:
     delays = []
@@ -252,8 +265,10 @@ def odometry_gaps(rig: Rig, runs: int, garbage: Callable[[], bytes]) -> list[flo
         time.sleep(0.3)
         injected = time.monotonic_ns()
         rig.create.send(garbage())
-        after = wait(lambda at=injected: next((t for t in rig.odometry if t > at), None),
-                     "odometry after the injection")  # fmt: skip
+        after = wait(
+            lambda at=injected: next((t for t in rig.odometry if t > at), None),
+            "odometry after the injection",
+        )
         before = max(t for t in rig.odometry if t <= injected)
         gaps.append((after - before) / 1e6)
     rig.controller.speed = None
@@ -261,23 +276,27 @@ def odometry_gaps(rig: Rig, runs: int, garbage: Callable[[], bytes]) -> list[flo
 
 
 def measure(runs: int) -> dict:
-    with tempfile.TemporaryDirectory(prefix="parsimony-safety-") as directory, \
-            Rig(Path(directory)) as rig:  # fmt: skip
+    with (
+        tempfile.TemporaryDirectory(prefix="parsimony-safety-") as directory,
+        Rig(Path(directory)) as rig,
+    ):
         delays = stop_delays(rig, runs)
         stray = odometry_gaps(rig, runs, lambda: bytes([create_oi.STREAM_HEADER, 255]))
         noise = odometry_gaps(rig, runs, lambda: os.urandom(32))
         normal = odometry_gaps(rig, runs, lambda: b"")
         kills = base_kills(rig, max(3, runs // 2))
         still, back = arm_kills(rig, max(3, runs // 2))
-    return {"bench": "driver_safety",
-            "stop_delay_ms": spread(delays),
-            "base_kill_to_stop_ms": spread(kills),
-            "arm_kill_to_still_ms": spread(still),
-            "arm_kill_to_back_ms": spread(back),
-            "stray_header_gap_ms": spread(stray),
-            "garbage_gap_ms": spread(noise),
-            "undisturbed_gap_ms": spread(normal),
-            "stream_period_ms": create_oi.STREAM_PERIOD_S * 1e3}  # fmt: skip
+    return {
+        "bench": "driver_safety",
+        "stop_delay_ms": spread(delays),
+        "base_kill_to_stop_ms": spread(kills),
+        "arm_kill_to_still_ms": spread(still),
+        "arm_kill_to_back_ms": spread(back),
+        "stray_header_gap_ms": spread(stray),
+        "garbage_gap_ms": spread(noise),
+        "undisturbed_gap_ms": spread(normal),
+        "stream_period_ms": create_oi.STREAM_PERIOD_S * 1e3,
+    }
 
 
 def lines(report: dict) -> list[str]:

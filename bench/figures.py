@@ -16,13 +16,21 @@ def spread(values: Sequence[float], digits: int = 1) -> dict[str, float | int | 
     if not values:
         return {"median": None, "p99": None, "max": None, "n": 0}
     data = np.asarray(values, dtype=float)
-    return {"median": round(float(np.median(data)), digits),
-            "p99": round(float(np.percentile(data, 99)), digits),
-            "max": round(float(data.max()), digits), "n": int(data.size)}  # fmt: skip
+    return {
+        "median": round(float(np.median(data)), digits),
+        "p99": round(float(np.percentile(data, 99)), digits),
+        "max": round(float(data.max()), digits),
+        "n": int(data.size),
+    }
 
 
-def run_bench(doc: str, measure: Callable[[int], dict], lines: Callable[[dict], Iterable[str]],
-              runs: int, argv: list[str] | None) -> int:  # fmt: skip
+def run_bench(
+    doc: str,
+    measure: Callable[[int], dict],
+    lines: Callable[[dict], Iterable[str]],
+    runs: int,
+    argv: list[str] | None,
+) -> int:
     """The command line of a benchmark of ``--runs`` repetitions: its report as lines of
     figures, or as JSON with ``--json``."""
     parser = argparse.ArgumentParser(description=doc.split("\n\n")[0])

@@ -48,8 +48,9 @@ def _attempt_one(job: tuple[str, dict[str, Any], Path, np.ndarray, np.ndarray]) 
     return attempt(LPLaw(robot, LPParams(**gains)), robot, start, goal)
 
 
-def misses(pairs: list[tuple[np.ndarray, np.ndarray]], attempts: list[Attempt],
-           robot: MobileManipulator) -> dict[str, int]:  # fmt: skip
+def misses(
+    pairs: list[tuple[np.ndarray, np.ndarray]], attempts: list[Attempt], robot: MobileManipulator
+) -> dict[str, int]:
     """The goals not reached inside every limit, by kind (a goal may be of several)."""
     kinds: Counter[str] = Counter()
     for (_, goal), a in zip(pairs, attempts, strict=True):
@@ -65,8 +66,15 @@ def misses(pairs: list[tuple[np.ndarray, np.ndarray]], attempts: list[Attempt],
     return {kind: n for kind, n in kinds.items() if n}
 
 
-def measure(families: list[str], seeds: list[int], count: int, variants: dict[str, dict],
-            supervised: bool, workers: int, robot_file: Path = ROBOT_FILE) -> dict:  # fmt: skip
+def measure(
+    families: list[str],
+    seeds: list[int],
+    count: int,
+    variants: dict[str, dict],
+    supervised: bool,
+    workers: int,
+    robot_file: Path = ROBOT_FILE,
+) -> dict:
     """Every law's attempts at every set: the rows per set, and the misses per family."""
     robot = MobileManipulator.from_yaml(robot_file)
     laws = list(variants.items())
@@ -82,15 +90,29 @@ def measure(families: list[str], seeds: list[int], count: int, variants: dict[st
                     jobs = [(name, gains, robot_file, start, goal) for start, goal in pairs]
                     attempts = pool.map(_attempt_one, jobs, chunksize=1)
                     found[name] += list(zip(pairs, attempts, strict=True))
-                    rows.append({"family": family, "seed": seed, "law": name,
-                                 "reached inside every limit":
-                                     shares(attempts)["within_joint_and_speed_limits"],
-                                 "nonzero moving":
-                                     parsimony(attempts, robot.dof)["median_nonzero_moving"]})
+                    rows.append(
+                        {
+                            "family": family,
+                            "seed": seed,
+                            "law": name,
+                            "reached inside every limit": shares(attempts)[
+                                "within_joint_and_speed_limits"
+                            ],
+                            "nonzero moving": parsimony(attempts, robot.dof)[
+                                "median_nonzero_moving"
+                            ],
+                        }
+                    )
             for name, runs in found.items():
                 pairs, attempts = [run[0] for run in runs], [run[1] for run in runs]
-                missed.append({"family": family, "law": name, "goals": len(runs),
-                               **misses(pairs, attempts, robot)})  # fmt: skip
+                missed.append(
+                    {
+                        "family": family,
+                        "law": name,
+                        "goals": len(runs),
+                        **misses(pairs, attempts, robot),
+                    }
+                )
     return {"rows": rows, "misses": missed}
 
 
@@ -111,12 +133,19 @@ def variant(text: str) -> dict[str, Any]:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--families", default=";".join(AHEAD),
-                        help="';'-separated families of parsimony.goal_families")  # fmt: skip
+    parser.add_argument(
+        "--families",
+        default=";".join(AHEAD),
+        help="';'-separated families of parsimony.goal_families",
+    )
     parser.add_argument("--seeds", default="2,3,4", help="comma-separated seeds (default 2,3,4)")
     parser.add_argument("--goals", type=int, default=100, help="goals per set (default 100)")
-    parser.add_argument("--variant", action="append", default=[],
-                        help="an LP with these gains changed, 'gain=value,...' (repeatable)")
+    parser.add_argument(
+        "--variant",
+        action="append",
+        default=[],
+        help="an LP with these gains changed, 'gain=value,...' (repeatable)",
+    )
     parser.add_argument("--supervised", action="store_true", help="run the supervised LP too")
     parser.add_argument("--workers", type=int, default=2, help="processes (default 2)")
     parser.add_argument("--json", action="store_true", help="print JSON instead of tables")
@@ -130,8 +159,11 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     unknown = [family for family in families if family not in FAMILIES]
     if unknown or args.goals < 1 or args.workers < 1:
-        print(f"bench.goal_reach: unknown families {unknown} (known: {'; '.join(FAMILIES)}), "
-              "or --goals or --workers below 1", file=sys.stderr)  # fmt: skip
+        print(
+            f"bench.goal_reach: unknown families {unknown} (known: {'; '.join(FAMILIES)}), "
+            "or --goals or --workers below 1",
+            file=sys.stderr,
+        )
         return 2
     report = measure(families, seeds, args.goals, variants, args.supervised, args.workers)
     if args.json:

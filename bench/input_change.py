@@ -48,8 +48,9 @@ def _attempt_one(job: tuple[dict[str, Any], Path, np.ndarray, np.ndarray, bool])
     return attempt(LPLaw(robot, LPParams(**gains)), robot, start, goal, position=position)
 
 
-def measure(names: list[str], count: int, workers: int, robot_file: Path = ROBOT_FILE
-            ) -> dict[str, dict[str, list[Attempt]]]:  # fmt: skip
+def measure(
+    names: list[str], count: int, workers: int, robot_file: Path = ROBOT_FILE
+) -> dict[str, dict[str, list[Attempt]]]:
     """Every variant's attempts at the 'ahead' goals, per task."""
     robot = MobileManipulator.from_yaml(robot_file)
     pairs = goals(FAMILIES["ahead"], count, robot)
@@ -58,18 +59,24 @@ def measure(names: list[str], count: int, workers: int, robot_file: Path = ROBOT
         for task in TASKS:
             for name in names:
                 print(f"bench: {name}, {task} task, {count} goals", file=sys.stderr, flush=True)
-                jobs = [(VARIANTS[name], robot_file, start, goal, task == "position")
-                        for start, goal in pairs]  # fmt: skip
+                jobs = [
+                    (VARIANTS[name], robot_file, start, goal, task == "position")
+                    for start, goal in pairs
+                ]
                 found[task][name] = pool.map(_attempt_one, jobs, chunksize=1)
     return found
 
 
 REFERENCE = "lp"
 """The variant every other is compared with, goal by goal."""
-FIELDS = {"metric 1": ("velocity_l1", False), "metric 2": ("velocity_l2", False),
-          "metric 3": ("acceleration_l1", False), "metric 4": ("acceleration_l2", False),
-          "metric 3 from rest": ("acceleration_l1", True),
-          "metric 4 from rest": ("acceleration_l2", True)}  # fmt: skip
+FIELDS = {
+    "metric 1": ("velocity_l1", False),
+    "metric 2": ("velocity_l2", False),
+    "metric 3": ("acceleration_l1", False),
+    "metric 4": ("acceleration_l2", False),
+    "metric 3 from rest": ("acceleration_l1", True),
+    "metric 4 from rest": ("acceleration_l2", True),
+}
 """The figures of each run compared: a ``ControlEffort`` field, from rest or not."""
 
 
@@ -82,13 +89,19 @@ def summary(found: dict[str, dict[str, list[Attempt]]], dof: int) -> list[dict[s
         reference = variants.get(REFERENCE)
         for name, attempts in variants.items():
             counts = parsimony(attempts, dof)
-            pairs = [(a, b) for a, b in zip(attempts, reference or attempts, strict=True)
-                     if a.within_all_limits and b.within_all_limits]  # fmt: skip
-            row = {"task": task, "law": name,
-                   "reached inside every limit": shares(attempts)["within_joint_and_speed_limits"],
-                   "nonzero moving": counts["median_nonzero_moving"],
-                   "nonzero last 2 s": counts["median_nonzero_settling"],
-                   "goals compared": len(pairs)}  # fmt: skip
+            pairs = [
+                (a, b)
+                for a, b in zip(attempts, reference or attempts, strict=True)
+                if a.within_all_limits and b.within_all_limits
+            ]
+            row = {
+                "task": task,
+                "law": name,
+                "reached inside every limit": shares(attempts)["within_joint_and_speed_limits"],
+                "nonzero moving": counts["median_nonzero_moving"],
+                "nonzero last 2 s": counts["median_nonzero_settling"],
+                "goals compared": len(pairs),
+            }
             for label, (field, from_rest) in FIELDS.items():
                 mine = [_metric(a, field, from_rest) for a, _ in pairs]
                 theirs = [_metric(b, field, from_rest) for _, b in pairs]
@@ -110,26 +123,34 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--goals", type=int, default=100, help="'ahead' goals (default 100)")
     parser.add_argument("--workers", type=int, default=2, help="processes (default 2)")
-    parser.add_argument("--variants", default=",".join(VARIANTS),
-                        help=f"comma-separated laws among {', '.join(VARIANTS)}")  # fmt: skip
+    parser.add_argument(
+        "--variants",
+        default=",".join(VARIANTS),
+        help=f"comma-separated laws among {', '.join(VARIANTS)}",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     args = parser.parse_args(argv)
     names = args.variants.split(",")
     unknown = [name for name in names if name not in VARIANTS]
     if unknown or args.goals < 1 or args.workers < 1:
-        print(f"bench.input_change: unknown variants {unknown}, or --goals or --workers below 1",
-              file=sys.stderr)  # fmt: skip
+        print(
+            f"bench.input_change: unknown variants {unknown}, or --goals or --workers below 1",
+            file=sys.stderr,
+        )
         return 2
     found = measure(names, args.goals, args.workers)
     rows = summary(found, MobileManipulator.from_yaml(ROBOT_FILE).dof)
     if args.json:
         emit(json_text({"bench": "input_change", "goals": args.goals, "rows": rows}))
     else:
-        shown = ("task", "law", "reached inside every limit", "nonzero moving",
-                 "nonzero last 2 s")  # fmt: skip
+        shown = ("task", "law", "reached inside every limit", "nonzero moving", "nonzero last 2 s")
         emit(table([{k: row[k] for k in shown} for row in rows], floatfmt=".3g"))
-        emit(table([{k: v for k, v in row.items() if k not in shown[2:]} for row in rows],
-                   floatfmt=".3g"))  # fmt: skip
+        emit(
+            table(
+                [{k: v for k, v in row.items() if k not in shown[2:]} for row in rows],
+                floatfmt=".3g",
+            )
+        )
     return 0
 
 

@@ -61,24 +61,35 @@ STALL_S = 20.0
 SAMPLE_S = 0.5
 
 
-def lockstep_profile(directory: Path, base: Path = DEPLOY / "sim_supervised.yaml",
-                     name: str = "liveview") -> Path:
+def lockstep_profile(
+    directory: Path, base: Path = DEPLOY / "sim_supervised.yaml", name: str = "liveview"
+) -> Path:
     """``base`` on a namespace and port of its own, in lockstep (paused until everything is
     up), with a recorder writing ``directory``/session.mcap: the system a view watches."""
     path = directory / f"{name}.yaml"
-    path.write_text(yaml.safe_dump({
-        "extends": str(base),
-        "namespace": f"{name}{os.getpid()}",
-        "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
-        "startup_timeout_s": 60.0,
-        "components": [
-            {"name": "simulator",
-             "params": {"lockstep": True, "real_time_factor": 0.0, "paused": True}},
-            {"name": "recorder", "module": "recorder", "role": "recorder",
-             "restart": {"policy": "never"},
-             "params": {"path": str(directory / "session.mcap")}},
-        ],
-    }))  # fmt: skip
+    path.write_text(
+        yaml.safe_dump(
+            {
+                "extends": str(base),
+                "namespace": f"{name}{os.getpid()}",
+                "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
+                "startup_timeout_s": 60.0,
+                "components": [
+                    {
+                        "name": "simulator",
+                        "params": {"lockstep": True, "real_time_factor": 0.0, "paused": True},
+                    },
+                    {
+                        "name": "recorder",
+                        "module": "recorder",
+                        "role": "recorder",
+                        "restart": {"policy": "never"},
+                        "params": {"path": str(directory / "session.mcap")},
+                    },
+                ],
+            }
+        )
+    )
     return path
 
 
@@ -114,8 +125,10 @@ def rss_mb(pid: int) -> float:
     raise RuntimeError(f"no VmRSS for {pid}")
 
 
-LAYOUT_CLIENT = {"schemaPrefix": "foxglove.",
-                 "topics": [topics.CONTROL_DIAGNOSTICS.name, topics.SUPERVISOR_STATUS.name]}
+LAYOUT_CLIENT = {
+    "schemaPrefix": "foxglove.",
+    "topics": [topics.CONTROL_DIAGNOSTICS.name, topics.SUPERVISOR_STATUS.name],
+}
 """What Foxglove reads with the layout of `parsimony layout`: every view (the 3-D panel reads
 every transform, the scenes, the image and its annotations) and the diagnostics and the
 supervisor's status (plots, messages); topic names are made keys in ``viewing``."""
@@ -123,8 +136,9 @@ EVERY_CHANNEL: dict = {}
 
 
 @contextlib.contextmanager
-def viewing(profile_path: Path, namespace: str, reads: dict
-            ) -> Iterator[tuple[subprocess.Popen, FoxgloveClient, dict]]:  # fmt: skip
+def viewing(
+    profile_path: Path, namespace: str, reads: dict
+) -> Iterator[tuple[subprocess.Popen, FoxgloveClient, dict]]:
     """A `parsimony view` and one counting client that reads the channels ``reads`` says
     (``LAYOUT_CLIENT``, ``EVERY_CHANNEL``); at the end the view's own summary fills the
     dict."""
@@ -145,8 +159,9 @@ def loop_cpu_s(session: zenoh.Session, namespace: str) -> float:
     return sum(s.counters["cpu_ms"] for s in query.statuses(session, namespace).values()) / 1e3
 
 
-def window(counter: Counter, session: zenoh.Session, namespace: str, pid: int | None = None
-           ) -> dict:  # fmt: skip
+def window(
+    counter: Counter, session: zenoh.Session, namespace: str, pid: int | None = None
+) -> dict:
     """Over ``WINDOW_S``: the loop's real-time factor and CPU seconds per simulated second (its
     components'), and the view's CPU share of a core and CPU seconds per simulated second if
     ``pid``."""
@@ -157,8 +172,10 @@ def window(counter: Counter, session: zenoh.Session, namespace: str, pid: int | 
     (clock1, _), wall1 = counter.read(), time.monotonic()
     loop1, cpu1 = loop_cpu_s(session, namespace), cpu_seconds(pid) if pid else 0.0
     sim_s = (clock1 - clock0) / 1e9
-    found = {"rtf": round(sim_s / (wall1 - wall0), 3),
-             "loop_cpu_per_sim_s": round((loop1 - loop0) / sim_s, 3)}  # fmt: skip
+    found = {
+        "rtf": round(sim_s / (wall1 - wall0), 3),
+        "loop_cpu_per_sim_s": round((loop1 - loop0) / sim_s, 3),
+    }
     if pid:
         found["view_cpu_share"] = round((cpu1 - cpu0) / (wall1 - wall0), 3)
         found["view_cpu_per_sim_s"] = round((cpu1 - cpu0) / sim_s, 3)
@@ -185,10 +202,14 @@ def stalled_client(profile_path: Path, counter: Counter, namespace: str) -> dict
         time.sleep(WARM_S)
         received = client.counts().get(state_key, (0, 0, 0))[0] - received_before
     published = published_after - published_before
-    return {"rss_mb_before": round(before, 1), "rss_mb_max": round(max(samples), 1),
-            "rss_mb_end": round(samples[-1], 1), "states_published": published,
-            "states_received": received,
-            "states_dropped": max(0, published - received)}  # fmt: skip
+    return {
+        "rss_mb_before": round(before, 1),
+        "rss_mb_max": round(max(samples), 1),
+        "rss_mb_end": round(samples[-1], 1),
+        "states_published": published,
+        "states_received": received,
+        "states_dropped": max(0, published - received),
+    }
 
 
 ADDED_SUFFIXES = (f"/{ANNOTATIONS_SUFFIX}", f"/{SCENE_SUFFIX}", "/model")
@@ -198,8 +219,11 @@ def without_the_additions(message):
     """A message as it was before the view drew the robot: no corners, no candidate arm, no
     way."""
     if isinstance(message, MarkerDetections):
-        return message.model_copy(update={"markers": tuple(
-            m.model_copy(update={"corners": None}) for m in message.markers)})  # fmt: skip
+        return message.model_copy(
+            update={
+                "markers": tuple(m.model_copy(update={"corners": None}) for m in message.markers)
+            }
+        )
     if isinstance(message, SupervisorStatus):
         return message.model_copy(update={"candidate_arm": None, "way": ()})
     return message
@@ -218,18 +242,24 @@ def recording_cost(path: Path, robot: MobileManipulator, directory: Path) -> dic
             start = recorded.log_time_ns if start is None else min(start, recorded.log_time_ns)
             end = max(end, recorded.log_time_ns)
             new.write(recorded.key, recorded.message, recorded.log_time_ns, views=True)
-            for entry in entries(recorded.key, without_the_additions(recorded.message), True,
-                                 plain):  # fmt: skip
+            for entry in entries(
+                recorded.key, without_the_additions(recorded.message), True, plain
+            ):
                 if not entry.channel.endswith(ADDED_SUFFIXES):
                     old.write_raw(entry, recorded.log_time_ns)
     seconds = (end - (start or 0)) / 1e9
     channels = info(now)["channels"]
-    added = {c["key"].split("/", 1)[1]: round(c["bytes"] / seconds)
-             for c in channels if c["key"].endswith(ADDED_SUFFIXES)}  # fmt: skip
-    return {"sim_s": round(seconds, 1),
-            "bytes_per_sim_s": round(now.stat().st_size / seconds),
-            "bytes_per_sim_s_without_additions": round(before.stat().st_size / seconds),
-            "added_channels_uncompressed_bytes_per_sim_s": added}  # fmt: skip
+    added = {
+        c["key"].split("/", 1)[1]: round(c["bytes"] / seconds)
+        for c in channels
+        if c["key"].endswith(ADDED_SUFFIXES)
+    }
+    return {
+        "sim_s": round(seconds, 1),
+        "bytes_per_sim_s": round(now.stat().st_size / seconds),
+        "bytes_per_sim_s_without_additions": round(before.stat().st_size / seconds),
+        "added_channels_uncompressed_bytes_per_sim_s": added,
+    }
 
 
 def measure(runs: int) -> dict:
@@ -240,8 +270,11 @@ def measure(runs: int) -> dict:
         path = lockstep_profile(directory)
         profile = load_profile(path)
         rounds = []
-        with (directory / "launch.log").open("w") as log, launched(path, log) as launcher,\
-                connect(profile, launcher) as session:  # fmt: skip
+        with (
+            (directory / "launch.log").open("w") as log,
+            launched(path, log) as launcher,
+            connect(profile, launcher) as session,
+        ):
             wait_alive(session, profile, launcher)
             wait_reached(session, profile, launcher)
             counter = Counter(session, profile.namespace)
@@ -254,22 +287,29 @@ def measure(runs: int) -> dict:
                         found[name] = window(counter, session, profile.namespace, view.pid)
                     found[f"{name}_view"] = summary
                 rounds.append(found)
-                print(f"[bench] round {index + 1}: rtf {alone['rtf']} without the view, "
-                      f"{found['layout']['rtf']} with a client of the layout, "
-                      f"{found['every']['rtf']} with one of every channel", file=sys.stderr,
-                      flush=True)  # fmt: skip
+                print(
+                    f"[bench] round {index + 1}: rtf {alone['rtf']} without the view, "
+                    f"{found['layout']['rtf']} with a client of the layout, "
+                    f"{found['every']['rtf']} with one of every channel",
+                    file=sys.stderr,
+                    flush=True,
+                )
             stall = stalled_client(path, counter, profile.namespace)
         robot = MobileManipulator.from_yaml(profile.robot)
         recording = recording_cost(directory / "session.mcap", robot, directory)
+
     def median(name: str, field: str) -> float:
         return statistics.median(r[name][field] for r in rounds)
 
     def handler(name: str, field: str) -> float:
-        return statistics.median(r[f"{name}_view"].get("handler_us", {}).get(field, 0.0)
-                                 for r in rounds)  # fmt: skip
+        return statistics.median(
+            r[f"{name}_view"].get("handler_us", {}).get(field, 0.0) for r in rounds
+        )
 
-    summary = {"rtf_without": median("without", "rtf"),
-               "loop_cpu_per_sim_s_without": median("without", "loop_cpu_per_sim_s")}
+    summary = {
+        "rtf_without": median("without", "rtf"),
+        "loop_cpu_per_sim_s_without": median("without", "loop_cpu_per_sim_s"),
+    }
     for name in ("layout", "every"):
         summary[name] = {
             "rtf": median(name, "rtf"),
@@ -277,41 +317,76 @@ def measure(runs: int) -> dict:
             "loop_cpu_per_sim_s": median(name, "loop_cpu_per_sim_s"),
             "view_cpu_share": median(name, "view_cpu_share"),
             "view_cpu_per_sim_s": median(name, "view_cpu_per_sim_s"),
-            "handler_us_median": handler(name, "median"), "handler_us_p99": handler(name, "p99"),
-        }  # fmt: skip
+            "handler_us_median": handler(name, "median"),
+            "handler_us_p99": handler(name, "p99"),
+        }
     return {"rounds": rounds, **summary, "stalled_client": stall, "recording": recording}
 
 
 def lines(report: dict) -> list[str]:
     rows = []
     for index, found in enumerate(report["rounds"], start=1):
-        rows.append([index, "none", found["without"]["rtf"],
-                     found["without"]["loop_cpu_per_sim_s"], None, None, None, None])
+        rows.append(
+            [
+                index,
+                "none",
+                found["without"]["rtf"],
+                found["without"]["loop_cpu_per_sim_s"],
+                None,
+                None,
+                None,
+                None,
+            ]
+        )
         for name in ("layout", "every"):
             handler, window_ = found[f"{name}_view"].get("handler_us", {}), found[name]
-            rows.append([index, name, window_["rtf"], window_["loop_cpu_per_sim_s"],
-                         window_["view_cpu_share"], window_["view_cpu_per_sim_s"],
-                         handler.get("median"), handler.get("p99")])  # fmt: skip
+            rows.append(
+                [
+                    index,
+                    name,
+                    window_["rtf"],
+                    window_["loop_cpu_per_sim_s"],
+                    window_["view_cpu_share"],
+                    window_["view_cpu_per_sim_s"],
+                    handler.get("median"),
+                    handler.get("p99"),
+                ]
+            )
     stall, recording = report["stalled_client"], report["recording"]
     return [
-        table(rows, ["round", "client reads", "loop rtf", "loop cpu s / sim s",
-                     "view cpu (cores)", "view cpu s / sim s", "handler us median",
-                     "handler us p99"]),
-        *(f"medians, client of {name}: rtf {report[name]['rtf']} against "
-          f"{report['rtf_without']} without a view (ratio {report[name]['rtf_ratio']}); view "
-          f"{report[name]['view_cpu_per_sim_s']} cpu s per sim s against the loop's "
-          f"{report['loop_cpu_per_sim_s_without']}, {report[name]['view_cpu_share']} cores; "
-          f"handler {report[name]['handler_us_median']} us median, "
-          f"{report[name]['handler_us_p99']} us p99" for name in ("layout", "every")),
+        table(
+            rows,
+            [
+                "round",
+                "client reads",
+                "loop rtf",
+                "loop cpu s / sim s",
+                "view cpu (cores)",
+                "view cpu s / sim s",
+                "handler us median",
+                "handler us p99",
+            ],
+        ),
+        *(
+            f"medians, client of {name}: rtf {report[name]['rtf']} against "
+            f"{report['rtf_without']} without a view (ratio {report[name]['rtf_ratio']}); view "
+            f"{report[name]['view_cpu_per_sim_s']} cpu s per sim s against the loop's "
+            f"{report['loop_cpu_per_sim_s_without']}, {report[name]['view_cpu_share']} cores; "
+            f"handler {report[name]['handler_us_median']} us median, "
+            f"{report[name]['handler_us_p99']} us p99"
+            for name in ("layout", "every")
+        ),
         f"stalled client {STALL_S:.0f} s: view rss {stall['rss_mb_before']} MB before, max "
         f"{stall['rss_mb_max']} MB, {stall['rss_mb_end']} MB at the end; robot states' "
         f"frames published {stall['states_published']}, received {stall['states_received']}, "
         f"dropped {stall['states_dropped']}",
         f"recording over {recording['sim_s']} sim s: {recording['bytes_per_sim_s']} B per sim s, "
         f"{recording['bytes_per_sim_s_without_additions']} without what the view adds",
-        "added channels, uncompressed B per sim s: " + ", ".join(
-            f"{k} {v}" for k, v in sorted(recording["added_channels_uncompressed_bytes_per_sim_s"]
-                                          .items())),  # fmt: skip
+        "added channels, uncompressed B per sim s: "
+        + ", ".join(
+            f"{k} {v}"
+            for k, v in sorted(recording["added_channels_uncompressed_bytes_per_sim_s"].items())
+        ),
     ]
 
 

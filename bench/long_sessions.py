@@ -74,8 +74,9 @@ def peak_memory_mb(arguments: Sequence[str], directory: Path) -> float:
     return round(int(peak.read_text()) / 1024, 1)
 
 
-def memory_use(recorded: Path, spans_s: Sequence[float], profile: Path,
-               directory: Path) -> list[dict]:  # fmt: skip
+def memory_use(
+    recorded: Path, spans_s: Sequence[float], profile: Path, directory: Path
+) -> list[dict]:
     """Peak memory of the commands that read a whole file, on the recording repeated to span
     each of ``spans_s``; then each command's ratio of the longest span's to the shortest's."""
     rows = []
@@ -88,15 +89,27 @@ def memory_use(recorded: Path, spans_s: Sequence[float], profile: Path,
             "info": ["info", str(session)],
             "report": ["report", str(session), "--out", str(out)],
             "rerun": ["rerun", str(session), "--controller", "lp", "-o", str(out / "rerun.mcap")],
-            "replay": ["replay", str(session), "--profile", str(profile),
-                       "--rate", f"{MEMORY_REPLAY_RATE:g}"],
-        }  # fmt: skip
+            "replay": [
+                "replay",
+                str(session),
+                "--profile",
+                str(profile),
+                "--rate",
+                f"{MEMORY_REPLAY_RATE:g}",
+            ],
+        }
         row = {"session_s": span, "file_MB": round(session.stat().st_size / 1e6, 1)}
-        row |= {f"{name}_MB": peak_memory_mb(arguments, directory)
-                for name, arguments in commands.items()}  # fmt: skip
+        row |= {
+            f"{name}_MB": peak_memory_mb(arguments, directory)
+            for name, arguments in commands.items()
+        }
         rows.append(row)
         session.unlink()
     first, last = rows[0], rows[-1]
-    rows.append({"session_s": "ratio", **{k: round(last[k] / first[k], 2)
-                                          for k in first if k.endswith("_MB")}})  # fmt: skip
+    rows.append(
+        {
+            "session_s": "ratio",
+            **{k: round(last[k] / first[k], 2) for k in first if k.endswith("_MB")},
+        }
+    )
     return rows

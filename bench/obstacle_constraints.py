@@ -49,15 +49,21 @@ from wbc.scenarios import DT
 from wbc.task import PoseTask
 
 VARIANTS: Mapping[str, Mapping[str, Any]] = {
-    "5.28, 5.10 (the dissertation's)": {"obstacle_mode": "border", "obstacle_circulation": 0.0,
-                                        "error_bound": "derivative"},
+    "5.28, 5.10 (the dissertation's)": {
+        "obstacle_mode": "border",
+        "obstacle_circulation": 0.0,
+        "error_bound": "derivative",
+    },
     "5.28 + circulation, 5.7": {"obstacle_mode": "border"},
     "VFI + circulation, 5.7": {"obstacle_mode": "vector_field"},
     "VFI, 5.7": {"obstacle_mode": "vector_field", "obstacle_circulation": 0.0},
-    "VFI, 5.10": {"obstacle_mode": "vector_field", "obstacle_circulation": 0.0,
-                  "error_bound": "derivative"},
+    "VFI, 5.10": {
+        "obstacle_mode": "vector_field",
+        "obstacle_circulation": 0.0,
+        "error_bound": "derivative",
+    },
     "5.19, 5.7": {"obstacle_mode": "conservative"},
-}  # fmt: skip
+}
 """Each law compared: the obstacle experiment's gains with these in their place. 5.28 with the
 rate bound 5.10 and no circulation term is the dissertation's; 5.7 bounds ||u||_1 by the error
 instead (the experiment's), the circulation term (wbc.objectives.obstacle_circulation) takes a
@@ -91,14 +97,34 @@ def kinematic_run(variant: str, seed: int) -> Outcome:
     setup = scenario("obstacle", robot, seed)
     goal = setup.goal(profile.scene.goal.height_m, profile.scene.goal.offset)
     law = LPLaw(robot, replace(LP_PARAMS["obstacle"], **VARIANTS[variant]))
-    run = integrate(law, np.array(setup.start), PoseTask(goal), DT, round(TIME_LIMIT_S / DT),
-                    CONVERGED_ERROR, setup.obstacles)  # fmt: skip
+    run = integrate(
+        law,
+        np.array(setup.start),
+        PoseTask(goal),
+        DT,
+        round(TIME_LIMIT_S / DT),
+        CONVERGED_ERROR,
+        setup.obstacles,
+    )
     base = np.array(run.configurations)[:, :2]
-    clearance = min(float(np.min(np.hypot(base[:, 0] - c.x, base[:, 1] - c.y)))
-                    - c.radius - robot.base.body_radius for c in setup.obstacles)  # fmt: skip
+    clearance = min(
+        float(np.min(np.hypot(base[:, 0] - c.x, base[:, 1] - c.y)))
+        - c.radius
+        - robot.base.body_radius
+        for c in setup.obstacles
+    )
     moving = tuple(out.nonzero for out in run.outputs if out.error_norm > MOVING_ERROR)
-    return Outcome(variant, "kinematic", seed, run.converged, clearance < 0.0, clearance,
-                   run.final_error, len(run.outputs) * DT, moving)  # fmt: skip
+    return Outcome(
+        variant,
+        "kinematic",
+        seed,
+        run.converged,
+        clearance < 0.0,
+        clearance,
+        run.final_error,
+        len(run.outputs) * DT,
+        moving,
+    )
 
 
 def sim_run(variant: str, seed: int, directory: Path) -> Outcome | None:
@@ -114,25 +140,39 @@ def sim_run(variant: str, seed: int, directory: Path) -> Outcome | None:
     diagnostics = [d for d in messages(run, CONTROL_DIAGNOSTICS) if d.status == "optimal"]
     since = converged_at(messages(run, CONTROL_DIAGNOSTICS), messages(run, SUPERVISOR_STATUS))
     seconds = TIME_LIMIT_S if since is None else since - origin_s(run)
-    moving = tuple(d.nonzero for d in diagnostics
-                   if d.error_norm is not None and d.error_norm > MOVING_ERROR)  # fmt: skip
-    return Outcome(variant, "sim", seed, report["converged"], report["contacts"] > 0,
-                   report["min_obstacle_clearance_m"], report["final_error"], seconds,
-                   moving)  # fmt: skip
+    moving = tuple(
+        d.nonzero for d in diagnostics if d.error_norm is not None and d.error_norm > MOVING_ERROR
+    )
+    return Outcome(
+        variant,
+        "sim",
+        seed,
+        report["converged"],
+        report["contacts"] > 0,
+        report["min_obstacle_clearance_m"],
+        report["final_error"],
+        seconds,
+        moving,
+    )
 
 
 def said(future: Future) -> Outcome | None:
     """A run's outcome, logged to stderr as it lands."""
     found = future.result()
     if found is not None:
-        print(f"[bench] {found.loop} {found.variant} seed {found.seed}: converged="
-              f"{found.converged} {found.seconds:.1f} s error {found.final_error:.3g} "
-              f"clearance {found.clearance_m:.3f}", file=sys.stderr, flush=True)  # fmt: skip
+        print(
+            f"[bench] {found.loop} {found.variant} seed {found.seed}: converged="
+            f"{found.converged} {found.seconds:.1f} s error {found.final_error:.3g} "
+            f"clearance {found.clearance_m:.3f}",
+            file=sys.stderr,
+            flush=True,
+        )
     return found
 
 
-def summary(loop: str, variant: str, found: Sequence[Outcome | None],
-            held_out: Sequence[int] = ()) -> dict[str, Any]:  # fmt: skip
+def summary(
+    loop: str, variant: str, found: Sequence[Outcome | None], held_out: Sequence[int] = ()
+) -> dict[str, Any]:
     """A variant's runs on one loop: the seeds of 0..N-1 summarised, ``held_out`` apart."""
     runs = [o for o in found if o is not None and o.seed not in held_out]
     times = [o.seconds for o in runs if o.converged]
@@ -152,8 +192,13 @@ def summary(loop: str, variant: str, found: Sequence[Outcome | None],
     }
     for seed in held_out:
         run = next((o for o in found if o is not None and o.seed == seed), None)
-        row[f"seed_{seed}"] = ("-" if run is None else f"{run.seconds:.1f} s" if run.converged
-                               else f"no ({run.final_error:.2f})")  # fmt: skip
+        row[f"seed_{seed}"] = (
+            "-"
+            if run is None
+            else f"{run.seconds:.1f} s"
+            if run.converged
+            else f"no ({run.final_error:.2f})"
+        )
     return row
 
 
@@ -165,28 +210,49 @@ def brief(seeds: list[str], shown: int = 5) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--seeds", type=int, default=40,
-                        help="seeds 0..N-1 of the simulated loop, besides the held-out one")
-    parser.add_argument("--kinematic-seeds", type=int, default=200,
-                        help="seeds 0..M-1 of the kinematic loop")
-    parser.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1),
-                        help="runs at once (default: two, or one on one core)")
+    parser.add_argument(
+        "--seeds",
+        type=int,
+        default=40,
+        help="seeds 0..N-1 of the simulated loop, besides the held-out one",
+    )
+    parser.add_argument(
+        "--kinematic-seeds", type=int, default=200, help="seeds 0..M-1 of the kinematic loop"
+    )
+    parser.add_argument(
+        "--workers",
+        type=int,
+        default=min(2, os.cpu_count() or 1),
+        help="runs at once (default: two, or one on one core)",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of tables")
     args = parser.parse_args(argv)
     sim_seeds = [*range(args.seeds), *HELD_OUT] if args.seeds > 0 else []
     started = time.monotonic()
     with tempfile.TemporaryDirectory() as directory, ProcessPoolExecutor(args.workers) as pool:
-        simulated = {v: [pool.submit(sim_run, v, s, Path(directory)) for s in sim_seeds]
-                     for v in VARIANTS}  # fmt: skip
-        kinematic = {v: [pool.submit(kinematic_run, v, s) for s in range(args.kinematic_seeds)]
-                     for v in VARIANTS}  # fmt: skip
-        rows = [summary("sim", v, [said(f) for f in found], HELD_OUT)
-                for v, found in simulated.items() if found]  # fmt: skip
-        rows += [summary("kinematic", v, [said(f) for f in found])
-                 for v, found in kinematic.items() if found]  # fmt: skip
-    study = {"sim_seeds": len(sim_seeds), "kinematic_seeds": args.kinematic_seeds,
-             "workers": args.workers,
-             "minutes": round((time.monotonic() - started) / 60.0, 1)}  # fmt: skip
+        simulated = {
+            v: [pool.submit(sim_run, v, s, Path(directory)) for s in sim_seeds] for v in VARIANTS
+        }
+        kinematic = {
+            v: [pool.submit(kinematic_run, v, s) for s in range(args.kinematic_seeds)]
+            for v in VARIANTS
+        }
+        rows = [
+            summary("sim", v, [said(f) for f in found], HELD_OUT)
+            for v, found in simulated.items()
+            if found
+        ]
+        rows += [
+            summary("kinematic", v, [said(f) for f in found])
+            for v, found in kinematic.items()
+            if found
+        ]
+    study = {
+        "sim_seeds": len(sim_seeds),
+        "kinematic_seeds": args.kinematic_seeds,
+        "workers": args.workers,
+        "minutes": round((time.monotonic() - started) / 60.0, 1),
+    }
     if args.json:
         emit(json_text({"bench": "obstacle_constraints", "study": study, "variants": rows}))
     else:

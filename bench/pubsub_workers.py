@@ -54,9 +54,13 @@ def message(kind: str, index: int, count: int, image: bytes) -> tuple[topics.Top
     if kind == "image":
         intrinsics = CameraIntrinsics(fx=500.0, fy=500.0, cx=320.0, cy=240.0)
         frame = CameraFrame(
-            header=header, encoding="mono8", width=WIDTH, height=HEIGHT, data=image,
+            header=header,
+            encoding="mono8",
+            width=WIDTH,
+            height=HEIGHT,
+            data=image,
             intrinsics=intrinsics,
-        )  # fmt: skip
+        )
         return topics.CAMERA_IMAGE, frame
     if kind == "obstacles":
         circles = tuple(Circle(x=0.5 + 0.01 * i, y=0.2, radius=0.1) for i in range(FLOOD_CIRCLES))

@@ -92,10 +92,16 @@ class Settings:
     memory_spans_s: tuple[float, ...]
 
 
-FULL = Settings(flood_s=10.0, experiment_s=TIME_LIMIT_S, report_s=60.0, report_runs=3,
-                memory_spans_s=(30.0, 120.0))  # fmt: skip
-QUICK = Settings(flood_s=1.5, experiment_s=3.0, report_s=None, report_runs=1,
-                 memory_spans_s=(5.0, 20.0))  # fmt: skip
+FULL = Settings(
+    flood_s=10.0,
+    experiment_s=TIME_LIMIT_S,
+    report_s=60.0,
+    report_runs=3,
+    memory_spans_s=(30.0, 120.0),
+)
+QUICK = Settings(
+    flood_s=1.5, experiment_s=3.0, report_s=None, report_runs=1, memory_spans_s=(5.0, 20.0)
+)
 
 
 def progress(text: str) -> None:
@@ -108,18 +114,27 @@ class Camera:
     def __init__(self, profile: Profile) -> None:
         scene = profile.scene
         self.settings = scene.camera
-        reference = PlacedMarker(scene.reference.id, scene.reference.size_m,
-                                 planar_pose(*scene.reference_pose))  # fmt: skip
+        reference = PlacedMarker(
+            scene.reference.id, scene.reference.size_m, planar_pose(*scene.reference_pose)
+        )
         camera, rng = ceiling_camera(scene.camera), np.random.default_rng(0)
-        self.images = [render(camera, [reference], scene.dictionary_id, ImageNoise(), rng)
-                       .tobytes() for _ in range(FRAMES)]  # fmt: skip
+        self.images = [
+            render(camera, [reference], scene.dictionary_id, ImageNoise(), rng).tobytes()
+            for _ in range(FRAMES)
+        ]
 
     def frame(self, header: Header) -> CameraFrame:
         c = self.settings
         intrinsics = CameraIntrinsics(fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy)
         image = self.images[header.seq % FRAMES]
-        return CameraFrame(header=header, encoding="mono8", width=c.width, height=c.height,
-                           data=image, intrinsics=intrinsics)  # fmt: skip
+        return CameraFrame(
+            header=header,
+            encoding="mono8",
+            width=c.width,
+            height=c.height,
+            data=image,
+            intrinsics=intrinsics,
+        )
 
 
 def small_message(topic: topics.Topic, seq: int) -> BaseModel:
@@ -128,11 +143,24 @@ def small_message(topic: topics.Topic, seq: int) -> BaseModel:
         return message("state", seq, seq + 1, b"")[1]
     header = Header(stamp_ns=time.time_ns(), frame="bench", seq=seq, source="bench")
     if topic is topics.ARM_JOINT_STATES:
-        return JointStates(header=header, names=JOINT_NAMES, positions=(0.1, 0.2, 0.3, 0.4, 0.5),
-                           velocities=(0.0, 0.01, 0.02, 0.03, 0.04))  # fmt: skip
-    return BaseOdometry(header=header, left_encoder=seq, right_encoder=seq, left_distance=0.1,
-                        right_distance=0.1, x=0.5, y=0.2, phi=0.1, forward_velocity=0.1,
-                        angular_velocity=0.0)  # fmt: skip
+        return JointStates(
+            header=header,
+            names=JOINT_NAMES,
+            positions=(0.1, 0.2, 0.3, 0.4, 0.5),
+            velocities=(0.0, 0.01, 0.02, 0.03, 0.04),
+        )
+    return BaseOdometry(
+        header=header,
+        left_encoder=seq,
+        right_encoder=seq,
+        left_distance=0.1,
+        right_distance=0.1,
+        x=0.5,
+        y=0.2,
+        phi=0.1,
+        forward_velocity=0.1,
+        angular_velocity=0.0,
+    )
 
 
 @dataclass
@@ -151,8 +179,10 @@ def flood(session: zenoh.Session, seconds: float, camera: Camera | None) -> Sent
     whenever one is due at the camera's rate (none without ``camera``)."""
     chosen = [*SMALL, topics.CAMERA_IMAGE] if camera is not None else list(SMALL)
     block = zenoh.CongestionControl.BLOCK
-    publishers = {t.name: session.declare_publisher(t.key(NAMESPACE), congestion_control=block)
-                  for t in chosen}  # fmt: skip
+    publishers = {
+        t.name: session.declare_publisher(t.key(NAMESPACE), congestion_control=block)
+        for t in chosen
+    }
     deadline = time.monotonic() + WAIT_S
     while not all(p.matching_status.matching for p in publishers.values()):
         if time.monotonic() > deadline:
@@ -224,9 +254,15 @@ def wait_recorded(router: zenoh.Session, sent: Sent) -> tuple[float, dict[str, i
         time.sleep(0.05)  # polling the recorder's counters, not waiting for an event
 
 
-def record_throughput(name: str, camera: Camera | None, settings: Settings, profile: Path,
-                      zenoh_settings: ZenohSettings, router: zenoh.Session, directory: Path
-                      ) -> tuple[dict, dict[str, int]]:  # fmt: skip
+def record_throughput(
+    name: str,
+    camera: Camera | None,
+    settings: Settings,
+    profile: Path,
+    zenoh_settings: ZenohSettings,
+    router: zenoh.Session,
+    directory: Path,
+) -> tuple[dict, dict[str, int]]:
     """One flood into a real recorder: the row of the table and the recorder's counters."""
     path = directory / f"{name.split()[0]}.mcap"
     progress(f"record: {name} for {settings.flood_s:g} s")
@@ -238,20 +274,26 @@ def record_throughput(name: str, camera: Camera | None, settings: Settings, prof
     recorded = sum(c["messages"] for c in shown["channels"] if c["encoding"] == MESSAGE_ENCODING)
     total = sum(sent.counts.values())
     row = {
-        "load": name, "sent": total, "sent_hz": round(total / sent.seconds),
-        "recorded": recorded, "lost": total - recorded,
+        "load": name,
+        "sent": total,
+        "sent_hz": round(total / sent.seconds),
+        "recorded": recorded,
+        "lost": total - recorded,
         "overflowed": sum(v for k, v in counters.items() if k.startswith("overflowed.")),
         "recorded_hz": round(recorded / done_s),
         "file_MBps": round(shown["bytes"] / done_s / 1e6, 1),
         "payload_MBps": round(sent.payload_bytes / done_s / 1e6, 1),
-        "file_MB": round(shown["bytes"] / 1e6, 1), "drain_s": round(done_s - sent.seconds, 2),
-        "exit": process.returncode, "complete": shown["complete"],
-    }  # fmt: skip
+        "file_MB": round(shown["bytes"] / 1e6, 1),
+        "drain_s": round(done_s - sent.seconds, 2),
+        "exit": process.returncode,
+        "complete": shown["complete"],
+    }
     return row, {k: v for k, v in sorted(counters.items()) if v}
 
 
-def gap_errors_ms(recorded: Sequence[tuple[str, int]], arrivals: Mapping[str, Sequence[int]],
-                  rate: float) -> list[float]:  # fmt: skip
+def gap_errors_ms(
+    recorded: Sequence[tuple[str, int]], arrivals: Mapping[str, Sequence[int]], rate: float
+) -> list[float]:
     """|arrival gap - recorded gap / rate| in ms between each two consecutive recorded messages
     that both arrived. ``recorded``: (key, log time ns) in the order sent; ``arrivals``: per
     key, the arrival times (ns) in the order received. The i-th arrival on a key is the i-th
@@ -262,17 +304,31 @@ def gap_errors_ms(recorded: Sequence[tuple[str, int]], arrivals: Mapping[str, Se
         index, got = seen[key], arrivals.get(key, ())
         seen[key] += 1
         matched.append((log_ns, got[index]) if index < len(got) else None)
-    return [abs((after[1] - before[1]) - (after[0] - before[0]) / rate) / 1e6
-            for before, after in zip(matched, matched[1:], strict=False)
-            if before is not None and after is not None]  # fmt: skip
+    return [
+        abs((after[1] - before[1]) - (after[0] - before[0]) / rate) / 1e6
+        for before, after in zip(matched, matched[1:], strict=False)
+        if before is not None and after is not None
+    ]
 
 
 def replay_timing(session_file: Path, rate: float, profile: Path, router: zenoh.Session) -> dict:
     """``parsimony replay`` of ``session_file`` at ``rate`` into this process: its gap errors."""
-    recorded = [(r.topic_name, r.log_time_ns) for r in read_session(session_file)
-                if r.topic_name is not None]  # fmt: skip
-    command = [sys.executable, "-m", "parsimony.cli", "replay", str(session_file),
-               "--profile", str(profile), "--rate", str(rate)]  # fmt: skip
+    recorded = [
+        (r.topic_name, r.log_time_ns)
+        for r in read_session(session_file)
+        if r.topic_name is not None
+    ]
+    command = [
+        sys.executable,
+        "-m",
+        "parsimony.cli",
+        "replay",
+        str(session_file),
+        "--profile",
+        str(profile),
+        "--rate",
+        str(rate),
+    ]
     progress(f"replay: {len(recorded)} messages at rate {rate:g}")
     arrivals: dict[str, list[int]] = {}  # per topic name, stamped on the receiving Zenoh thread
 
@@ -301,10 +357,14 @@ def replay_timing(session_file: Path, rate: float, profile: Path, router: zenoh.
     every = gap_errors_ms(recorded, arrivals, rate)
     frames = gap_errors_ms([r for r in recorded if r[0] == camera], arrivals, rate)
     return {
-        "rate": rate, "recorded": len(recorded), "received": received(),
-        "all_median_ms": percentile_ms(every, 50), "all_p99_ms": percentile_ms(every, 99),
-        "camera_median_ms": percentile_ms(frames, 50), "camera_p99_ms": percentile_ms(frames, 99),
-    }  # fmt: skip
+        "rate": rate,
+        "recorded": len(recorded),
+        "received": received(),
+        "all_median_ms": percentile_ms(every, 50),
+        "all_p99_ms": percentile_ms(every, 99),
+        "camera_median_ms": percentile_ms(frames, 50),
+        "camera_p99_ms": percentile_ms(frames, 99),
+    }
 
 
 def percentile_ms(values_ms: list[float], q: float) -> float | None:
@@ -323,16 +383,23 @@ def report_time(session_file: Path, experiment: Path, runs: int, directory: Path
         started = time.perf_counter()
         session = load_session(session_file)
         loaded = time.perf_counter()
-        write_report([("lp", session)], robot, directory / f"report{run}",
-                     profile.scene.reference_pose)  # fmt: skip
+        write_report(
+            [("lp", session)], robot, directory / f"report{run}", profile.scene.reference_pose
+        )
         loads.append(round(loaded - started, 2))
         draws.append(round(time.perf_counter() - loaded, 2))
         del session
         progress(f"report run {run + 1}: load {loads[-1]} s, figures {draws[-1]} s")
     totals = [round(a + b, 2) for a, b in zip(loads, draws, strict=True)]
-    return {"session_s": shown["duration_s"], "messages": shown["messages"],
-            "file_MB": round(shown["bytes"] / 1e6, 1), "median_s": statistics.median(totals),
-            "runs_s": totals, "load_s": loads, "figures_s": draws}  # fmt: skip
+    return {
+        "session_s": shown["duration_s"],
+        "messages": shown["messages"],
+        "file_MB": round(shown["bytes"] / 1e6, 1),
+        "median_s": statistics.median(totals),
+        "runs_s": totals,
+        "load_s": loads,
+        "figures_s": draws,
+    }
 
 
 def bench_profile(directory: Path, zenoh_settings: ZenohSettings) -> Path:
@@ -340,8 +407,11 @@ def bench_profile(directory: Path, zenoh_settings: ZenohSettings) -> Path:
     router (its one component is never run)."""
     profile = directory / "bench.yaml"
     component = {"name": "publisher", "module": "scripted_publisher", "role": "tool"}
-    data = {"namespace": NAMESPACE, "components": [component],
-            "zenoh": {"router": zenoh_settings.router, "mode": zenoh_settings.mode}}  # fmt: skip
+    data = {
+        "namespace": NAMESPACE,
+        "components": [component],
+        "zenoh": {"router": zenoh_settings.router, "mode": zenoh_settings.mode},
+    }
     profile.write_text(yaml.safe_dump(data))
     return profile
 
@@ -352,17 +422,23 @@ def run(settings: Settings, directory: Path) -> dict:
     camera = Camera(load_profile(PROFILES["lp"]))
     report: dict = {"record": [], "recorder_counters": {}, "replay": []}
     with zenoh.open(zenoh_settings.router_config()) as router:
-        loads = (("small messages", None),
-                 (f"images {camera.settings.rate_hz:g} Hz + small messages", camera))  # fmt: skip
+        loads = (
+            ("small messages", None),
+            (f"images {camera.settings.rate_hz:g} Hz + small messages", camera),
+        )
         for name, images in loads:
-            row, counters = record_throughput(name, images, settings, profile, zenoh_settings,
-                                              router, directory)  # fmt: skip
+            row, counters = record_throughput(
+                name, images, settings, profile, zenoh_settings, router, directory
+            )
             report["record"].append(row)
             report["recorder_counters"][name] = counters
         experiment = directory / "experiment"
         progress("experiment pose --controller lp (lockstep), recorded")
-        run_experiment(Options(name="pose", controller="lp", out=experiment,
-                               time_limit_s=settings.experiment_s))  # fmt: skip
+        run_experiment(
+            Options(
+                name="pose", controller="lp", out=experiment, time_limit_s=settings.experiment_s
+            )
+        )
         recorded = experiment / SESSION_FILE
         for rate in REPLAY_RATES:
             report["replay"].append(replay_timing(recorded, rate, profile, router))
@@ -384,8 +460,13 @@ def main(argv: list[str] | None = None) -> int:
     started = time.monotonic()
     with tempfile.TemporaryDirectory() as directory:
         report = run(QUICK if args.quick else FULL, Path(directory))
-    report = {"bench": "recording", "quick": args.quick, "cpus": os.cpu_count(),
-              "duration_s": round(time.monotonic() - started, 1), **report}  # fmt: skip
+    report = {
+        "bench": "recording",
+        "quick": args.quick,
+        "cpus": os.cpu_count(),
+        "duration_s": round(time.monotonic() - started, 1),
+        **report,
+    }
     if args.json:
         emit(json_text(report))
         return 0

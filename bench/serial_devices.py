@@ -49,8 +49,10 @@ class Wheels:
 
 
 def figures(values_us: list[float]) -> dict[str, float]:
-    return {"median_us": round(float(np.median(values_us)), 1),
-            "p99_us": round(float(np.percentile(values_us, 99)), 1)}  # fmt: skip
+    return {
+        "median_us": round(float(np.median(values_us)), 1),
+        "p99_us": round(float(np.percentile(values_us, 99)), 1),
+    }
 
 
 def servo_bus() -> dict:
@@ -74,8 +76,11 @@ def servo_bus() -> dict:
             writes.append((time.perf_counter() - start) * 1e6)
         port.closePort()
     cycle_us = 5 * float(np.median(reads)) + float(np.median(writes))
-    return {"read_one_servo": figures(reads), "sync_write_five": figures(writes),
-            "joint_state_rate_hz": round(1e6 / cycle_us, 1)}  # fmt: skip
+    return {
+        "read_one_servo": figures(reads),
+        "sync_write_five": figures(writes),
+        "joint_state_rate_hz": round(1e6 / cycle_us, 1),
+    }
 
 
 def create_link() -> dict:
@@ -100,8 +105,7 @@ def create_link() -> dict:
         client.close()
     # Frames arrive in bursts when the reader is late: the mean period over 100 frames.
     period_ms = (stamps[-1] - stamps[0]) * 1e3 / (len(stamps) - 1)
-    return {"drive_direct_to_wheels": figures(latencies),
-            "stream_period_ms": round(period_ms, 2)}  # fmt: skip
+    return {"drive_direct_to_wheels": figures(latencies), "stream_period_ms": round(period_ms, 2)}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -50,12 +50,17 @@ def percentile(values: list[float], q: float) -> float:
 def run_one(name: str, controller: str, seed: int, directory: Path) -> dict | None:
     """One lockstep run (in a worker process: its pid names the system's namespace); None
     when it could not run (said, with why)."""
-    options = Options(name=name, controller=controller, seed=seed,
-                      out=directory / f"{name}-{controller}-{seed}")  # fmt: skip
+    options = Options(
+        name=name, controller=controller, seed=seed, out=directory / f"{name}-{controller}-{seed}"
+    )
     report = experiment_or_none(options, f"{name} {controller} seed {seed}")
     if report is not None:
-        print(f"[bench] {name} {controller} seed {seed}: converged={report['converged']} "
-              f"rtf={report['real_time_factor']}", file=sys.stderr, flush=True)  # fmt: skip
+        print(
+            f"[bench] {name} {controller} seed {seed}: converged={report['converged']} "
+            f"rtf={report['real_time_factor']}",
+            file=sys.stderr,
+            flush=True,
+        )
     return report
 
 
@@ -70,8 +75,9 @@ def experiment_or_none(options: Options, label: str) -> dict | None:
 
 
 def median_of(reports: list[dict], component: str, counter: str) -> int:
-    return round(statistics.median(
-        r["durations_us"].get(component, {}).get(counter, 0) for r in reports))  # fmt: skip
+    return round(
+        statistics.median(r["durations_us"].get(component, {}).get(counter, 0) for r in reports)
+    )
 
 
 def summary(name: str, controller: str, found: list[dict | None]) -> dict:
@@ -93,14 +99,16 @@ def summary(name: str, controller: str, found: list[dict | None]) -> dict:
         "real_time_factor": round(statistics.median(r["real_time_factor"] for r in reports), 2),
         "rtf_min": round(min(r["real_time_factor"] for r in reports), 2),
         "tracker_frame_us": median_of(reports, "vision_tracker", "handler.camera/image_us_median"),
-        "estimator_odometry_us": median_of(reports, "state_estimator",
-                                           "handler.base/odometry_us_median"),  # fmt: skip
+        "estimator_odometry_us": median_of(
+            reports, "state_estimator", "handler.base/odometry_us_median"
+        ),
         "controller_state_us": median_of(reports, "controller", "handler.robot/state_us_median"),
         "frame_answer_us": median_of(reports, "simulator", "frame_us_median"),
         "loop_us": median_of(reports, "simulator", "loop_us_median"),
         "recorder_cpu_pct_rt": round(100 * statistics.median(recorder), 1),
-        "bytes_per_sim_s": round(statistics.median(r["recording"]["bytes_per_sim_s"]
-                                                   for r in reports)),  # fmt: skip
+        "bytes_per_sim_s": round(
+            statistics.median(r["recording"]["bytes_per_sim_s"] for r in reports)
+        ),
         "recordings_whole": sum(r["recording"]["whole"] for r in reports),
     }
 
@@ -114,12 +122,15 @@ def vision_speed() -> dict:
     setup = scenario("obstacle", robot)
     camera = ceiling_camera(c)
     below = [
-        PlacedMarker(scene.reference.id, scene.reference.size_m,
-                     planar_pose(*scene.reference_pose)),
+        PlacedMarker(
+            scene.reference.id, scene.reference.size_m, planar_pose(*scene.reference_pose)
+        ),
         PlacedMarker(scene.goal.id, scene.goal.size_m, planar_pose(*setup.bin)),
-    ]  # fmt: skip
-    above = [PlacedMarker(i, scene.obstacles.size_m, planar_pose(o.x, o.y, 0.0, 0.3))
-             for i, o in zip(scene.obstacles.ids, setup.obstacles, strict=False)]  # fmt: skip
+    ]
+    above = [
+        PlacedMarker(i, scene.obstacles.size_m, planar_pose(o.x, o.y, 0.0, 0.3))
+        for i, o in zip(scene.obstacles.ids, setup.obstacles, strict=False)
+    ]
     rng = np.random.default_rng(0)
     renderer = Renderer(camera, scene.dictionary_id, ImageNoise(), rng, below, above)
     detector = MarkerDetector(scene.dictionary_id)
@@ -127,8 +138,9 @@ def vision_speed() -> dict:
     stages = ("render_us", "encode_us", "decode_us", "detect_us", "fit_us")
     times: dict[str, list[float]] = {name: [] for name in stages}
     for index in range(FRAMES):
-        base = PlacedMarker(scene.base.id, scene.base.size_m,
-                            planar_pose(0.002 * index, 0.0, 0.2, 0.092))  # fmt: skip
+        base = PlacedMarker(
+            scene.base.id, scene.base.size_m, planar_pose(0.002 * index, 0.0, 0.2, 0.092)
+        )
         marks = [time.perf_counter()]
         image = renderer.frame([base])
         marks.append(time.perf_counter())
@@ -146,39 +158,60 @@ def vision_speed() -> dict:
         marks.append(time.perf_counter())
         for name, start, end in zip(stages, marks[:-1], marks[1:], strict=True):
             times[name].append((end - start) * 1e6)
-    return {name: {"median": percentile(v, 50), "p99": percentile(v, 99)}
-            for name, v in times.items()}  # fmt: skip
+    return {
+        name: {"median": percentile(v, 50), "p99": percentile(v, 99)} for name, v in times.items()
+    }
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seeds", type=int, default=20, help="seeds per experiment and law")
-    parser.add_argument("--workers", type=int, default=max(1, (os.cpu_count() or 2) // 2),
-                        help="experiments run at once (default: one per two cores)")  # fmt: skip
+    parser.add_argument(
+        "--workers",
+        type=int,
+        default=max(1, (os.cpu_count() or 2) // 2),
+        help="experiments run at once (default: one per two cores)",
+    )
     parser.add_argument("--only", help="comma-separated experiments to run (default: all)")
     parser.add_argument("--laws", default="lp,cascade", help="comma-separated laws to run")
     parser.add_argument("--json", action="store_true", help="print JSON instead of tables")
     args = parser.parse_args(argv)
-    runs = [(n, law) for n, law in RUNS
-            if (not args.only or n in args.only.split(",")) and law in args.laws.split(",")]
+    runs = [
+        (n, law)
+        for n, law in RUNS
+        if (not args.only or n in args.only.split(",")) and law in args.laws.split(",")
+    ]
     started = time.monotonic()
     with tempfile.TemporaryDirectory() as directory, ProcessPoolExecutor(args.workers) as pool:
-        jobs = {(n, law): [pool.submit(run_one, n, law, seed, Path(directory))
-                           for seed in range(args.seeds)] for n, law in runs}  # fmt: skip
-        rows = [summary(n, law, [job.result() for job in found])
-                for (n, law), found in jobs.items()]  # fmt: skip
+        jobs = {
+            (n, law): [
+                pool.submit(run_one, n, law, seed, Path(directory)) for seed in range(args.seeds)
+            ]
+            for n, law in runs
+        }
+        rows = [
+            summary(n, law, [job.result() for job in found]) for (n, law), found in jobs.items()
+        ]
     minutes = (time.monotonic() - started) / 60.0
-    study = {"experiments": len(runs) * args.seeds, "workers": args.workers,
-             "experiments_per_minute": round(len(runs) * args.seeds / minutes, 1)}  # fmt: skip
+    study = {
+        "experiments": len(runs) * args.seeds,
+        "workers": args.workers,
+        "experiments_per_minute": round(len(runs) * args.seeds / minutes, 1),
+    }
     speed = vision_speed()
     if args.json:
-        emit(json_text({"bench": "sim_experiments", "study": study, "experiments": rows,
-                         "vision": speed}))  # fmt: skip
+        emit(
+            json_text(
+                {"bench": "sim_experiments", "study": study, "experiments": rows, "vision": speed}
+            )
+        )
     else:
         emit(table(rows))
         emit(" ".join(f"{k}={v}" for k, v in study.items()))
-        emit("per camera frame: " + "  ".join(
-            f"{k} median {v['median']} p99 {v['p99']}" for k, v in speed.items()))  # fmt: skip
+        emit(
+            "per camera frame: "
+            + "  ".join(f"{k} median {v['median']} p99 {v['p99']}" for k, v in speed.items())
+        )
     return 0
 
 

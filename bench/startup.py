@@ -37,8 +37,9 @@ def bench_profile(directory: Path) -> Path:
     data["zenoh"]["router"] = [f"tcp/127.0.0.1:{free_port()}"]
     for spec in data["components"]:
         if spec["name"] == "simulator":
-            spec["params"].update(create_link=str(directory / "create2"),
-                                  servo_link=str(directory / "servos"))  # fmt: skip
+            spec["params"].update(
+                create_link=str(directory / "create2"), servo_link=str(directory / "servos")
+            )
     data["components"].append({"name": "supervisor", "module": "supervisor", "role": "controller"})
     path = directory / "startup.yaml"
     path.write_text(yaml.safe_dump(data))
@@ -73,8 +74,9 @@ class Tokens:
 
 def alive_ms(path: Path, module: str, name: str, tokens: Tokens) -> float:
     started = time.monotonic_ns()
-    child = subprocess.Popen(process.command(module, path, name), stdout=subprocess.DEVNULL,
-                             stderr=subprocess.DEVNULL)  # fmt: skip
+    child = subprocess.Popen(
+        process.command(module, path, name), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
     try:
         return (tokens.wait(name, started) - started) / 1e6
     finally:
@@ -100,16 +102,25 @@ def measure(runs: int) -> dict:
                     continue
                 alive = [alive_ms(path, spec.module_path, spec.name, tokens) for _ in range(runs)]
                 imports = [import_ms(spec.module_path) for _ in range(runs)]
-                results[spec.name] = {"module": spec.module_path, "alive_ms": spread(alive),
-                                      "import_ms": spread(imports)}  # fmt: skip
+                results[spec.name] = {
+                    "module": spec.module_path,
+                    "alive_ms": spread(alive),
+                    "import_ms": spread(imports),
+                }
     return {"bench": "startup", "components": results}
 
 
 def lines(report: dict) -> list[str]:
-    rows = [{"component": name, "alive_ms_median": f["alive_ms"]["median"],
-             "alive_ms_max": f["alive_ms"]["max"], "import_ms_median": f["import_ms"]["median"],
-             "import_ms_max": f["import_ms"]["max"]}
-            for name, f in report["components"].items()]  # fmt: skip
+    rows = [
+        {
+            "component": name,
+            "alive_ms_median": f["alive_ms"]["median"],
+            "alive_ms_max": f["alive_ms"]["max"],
+            "import_ms_median": f["import_ms"]["median"],
+            "import_ms_max": f["import_ms"]["max"],
+        }
+        for name, f in report["components"].items()
+    ]
     return [table(rows)]
 
 

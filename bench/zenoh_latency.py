@@ -293,11 +293,12 @@ def main(argv: list[str] | None = None) -> int:
         emit(json_text(report))
     else:
         emit(table([asdict(r) for r in results]))
-        emit("lp_controller counters: "
-             + " ".join(f"{k}={v}" for k, v in sorted(counters.items())))  # fmt: skip
+        emit("lp_controller counters: " + " ".join(f"{k}={v}" for k, v in sorted(counters.items())))
         for name, figures in flood.items():
-            emit(f"world/obstacles flood into the {name}: "
-                 + " ".join(f"{k}={v}" for k, v in figures.items()))  # fmt: skip
+            emit(
+                f"world/obstacles flood into the {name}: "
+                + " ".join(f"{k}={v}" for k, v in figures.items())
+            )
     return 0
 
 

@@ -73,16 +73,40 @@ class ArmDriver(Component):
         Param("baud", int, 1_000_000, low=9600, high=3_000_000, doc="bus speed, bit/s"),
         Param("ids", str, "1, 2, 3, 4, 5", doc="servo ids of q1..q5", can_take=ids_of),
         Param("rate_hz", float, 50.0, low=1.0, high=200.0, doc="joint state rate"),
-        Param("command_timeout_s", float, 0.2, low=0.01, high=10.0,
-              doc="hold the arm after this long without a command, s"),
-        Param("lookahead_s", float, 0.25, low=0.01, high=5.0,
-              doc="a goal is this many seconds of motion ahead"),
+        Param(
+            "command_timeout_s",
+            float,
+            0.2,
+            low=0.01,
+            high=10.0,
+            doc="hold the arm after this long without a command, s",
+        ),
+        Param(
+            "lookahead_s",
+            float,
+            0.25,
+            low=0.01,
+            high=5.0,
+            doc="a goal is this many seconds of motion ahead",
+        ),
         Param("min_step", int, 8, low=1, high=100, doc="least goal step ahead, units"),
-        Param("limit_margin", float, 0.02, low=0.0, high=0.5,
-              doc="a reading this far outside a joint limit is refused, rad"),
-        Param("answer_timeout_s", float, 0.0, low=0.0, high=5.0,
-              doc="how long a servo's answer is awaited, s; 0: the SDK's (34 ms at 1 Mbit/s)"),
-    )  # fmt: skip
+        Param(
+            "limit_margin",
+            float,
+            0.02,
+            low=0.0,
+            high=0.5,
+            doc="a reading this far outside a joint limit is refused, rad",
+        ),
+        Param(
+            "answer_timeout_s",
+            float,
+            0.0,
+            low=0.0,
+            high=5.0,
+            doc="how long a servo's answer is awaited, s; 0: the SDK's (34 ms at 1 Mbit/s)",
+        ),
+    )
 
     def __init__(self, node: Node) -> None:
         super().__init__(node)
@@ -92,15 +116,24 @@ class ArmDriver(Component):
         self.low, self.high = robot.q_min[BASE_DOF:], robot.q_max[BASE_DOF:]
         self.speed_max = robot.velocity_max[BASE_DOF:]
         self.goal_low = [max(0, math.ceil(dxl.position_of_angle(q))) for q in self.low]
-        self.goal_high = [min(dxl.POSITION_MAX, math.floor(dxl.position_of_angle(q)))
-                          for q in self.high]  # fmt: skip
+        self.goal_high = [
+            min(dxl.POSITION_MAX, math.floor(dxl.position_of_angle(q))) for q in self.high
+        ]
         """The Goal Positions inside the joint limits (every goal written lies in them)."""
         self.ids = ids_of(node.params["ids"])
         self.port = PortHandler(str(node.params["port"]))
         self.packet = PacketHandler(1.0)
         self.connected = False
-        for name in ("sync_writes", "holds", "reads", "out_of_limits", "non_finite_commands",
-                     "speed_limited", "refused_commands", "port_errors"):  # fmt: skip
+        for name in (
+            "sync_writes",
+            "holds",
+            "reads",
+            "out_of_limits",
+            "non_finite_commands",
+            "speed_limited",
+            "refused_commands",
+            "port_errors",
+        ):
             node.counters[name] = 0
         for fault in dxl.StatusFault:
             node.counters[f"servo_faults.{fault}"] = 0
@@ -218,8 +251,10 @@ class ArmDriver(Component):
         margin = self.node.params["limit_margin"]
         if not low - margin <= position <= high + margin:
             self.node.count("out_of_limits")
-            return (f"servo {servo} reads {position:.3f} rad, outside its limits "
-                    f"[{low:.3f}, {high:.3f}]")  # fmt: skip
+            return (
+                f"servo {servo} reads {position:.3f} rad, outside its limits "
+                f"[{low:.3f}, {high:.3f}]"
+            )
         self.present[index] = position
         return position, dxl.rad_s_of_speed_units(data[2] | data[3] << 8)
 
@@ -244,8 +279,10 @@ class ArmDriver(Component):
         velocities = command.joint_velocities
         if len(velocities) != ARM_JOINTS or not all(math.isfinite(v) for v in velocities):
             self.node.count("non_finite_commands")
-            self.node.warn("non_finite_commands", f"expected {ARM_JOINTS} finite joint "
-                           f"velocities, got {velocities}; holding")  # fmt: skip
+            self.node.warn(
+                "non_finite_commands",
+                f"expected {ARM_JOINTS} finite joint velocities, got {velocities}; holding",
+            )
             self.hold()
             return
         if self.fault or not self.connected or any(p is None for p in self.present):
@@ -272,8 +309,10 @@ class ArmDriver(Component):
         self.held[index] = None
         present = self.present[index]
         assert present is not None
-        step = max(abs(velocity) * self.node.params["lookahead_s"],
-                   self.node.params["min_step"] / dxl.POSITION_UNITS_PER_RAD)  # fmt: skip
+        step = max(
+            abs(velocity) * self.node.params["lookahead_s"],
+            self.node.params["min_step"] / dxl.POSITION_UNITS_PER_RAD,
+        )
         return self._inside_limits(index, present + math.copysign(step, velocity)), speed
 
     def _read_stopping(self, joints: Sequence[int], failed: Collection[int] = ()) -> None:
@@ -325,8 +364,10 @@ class ArmDriver(Component):
             return
         group = GroupSyncWrite(self.port, self.packet, dxl.Address.GOAL_POSITION, 4)
         for index, (servo, goal, speed) in enumerate(zip(self.ids, goals, speeds, strict=True)):
-            if not (self.goal_low[index] <= goal <= self.goal_high[index]
-                    and 1 <= speed <= dxl.SPEED_MAX):  # fmt: skip
+            if not (
+                self.goal_low[index] <= goal <= self.goal_high[index]
+                and 1 <= speed <= dxl.SPEED_MAX
+            ):
                 raise ValueError(f"servo {servo}: goal {goal} or speed {speed} out of range")
             group.addParam(servo, [goal & 0xFF, goal >> 8, speed & 0xFF, speed >> 8])
         try:

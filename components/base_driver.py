@@ -59,10 +59,16 @@ class BaseDriver(Component):
     params = (
         Param("port", str, "/dev/ttyUSB0", doc="serial port of the Create"),
         Param("mode", str, "safe", choices=("safe", "full"), doc="OI mode after Start"),
-        Param("command_timeout_s", float, 0.2, low=0.01, high=10.0,
-              doc="stop the wheels after this long without a command, s"),
+        Param(
+            "command_timeout_s",
+            float,
+            0.2,
+            low=0.01,
+            high=10.0,
+            doc="stop the wheels after this long without a command, s",
+        ),
         Param("reconnect_s", float, 0.5, low=0.05, high=60.0, doc="retry period of a lost port"),
-    )  # fmt: skip
+    )
 
     def __init__(self, node: Node) -> None:
         super().__init__(node)
@@ -71,9 +77,17 @@ class BaseDriver(Component):
         self.base = MobileManipulator.from_yaml(node.profile.robot).base
         self.metres_per_count = create_oi.mm_per_count(2.0 * self.base.wheel_radius) / 1000.0
         self.output = node.publisher(topics.BASE_ODOMETRY)
-        for name in ("frames", "bad_checksums", "bad_frames", "resync_bytes", "port_errors",
-                     "reconnects", "stops", "implausible_counts",
-                     "non_finite_commands"):  # fmt: skip
+        for name in (
+            "frames",
+            "bad_checksums",
+            "bad_frames",
+            "resync_bytes",
+            "port_errors",
+            "reconnects",
+            "stops",
+            "implausible_counts",
+            "non_finite_commands",
+        ):
             node.counters[name] = 0
         self.serial: serial.Serial | None = None
         self.parser = create_oi.StreamParser(ENCODERS)
@@ -102,8 +116,11 @@ class BaseDriver(Component):
         try:
             port = serial.Serial(self.node.params["port"], create_oi.BAUD, timeout=0.05)
             mode = create_oi.FULL if self.node.params["mode"] == "full" else create_oi.SAFE
-            port.write(bytes([create_oi.START, mode]) + create_oi.drive_direct(0, 0)
-                       + create_oi.stream_request(ENCODERS))  # fmt: skip
+            port.write(
+                bytes([create_oi.START, mode])
+                + create_oi.drive_direct(0, 0)
+                + create_oi.stream_request(ENCODERS)
+            )
         except (serial.SerialException, OSError) as error:
             self.node.warn("port_errors", f"cannot open {self.node.params['port']}: {error}")
             return
@@ -216,15 +233,22 @@ class BaseDriver(Component):
         previous, self.counts = self.counts, counts
         if previous is None:
             return
-        deltas = [abs(create_oi.encoder_delta(new, old))
-                  for new, old in zip(counts, previous, strict=True)]  # fmt: skip
+        deltas = [
+            abs(create_oi.encoder_delta(new, old))
+            for new, old in zip(counts, previous, strict=True)
+        ]
         if max(deltas) > self.plausible_counts(periods):
             self.node.count("implausible_counts")
-            self.node.warn("implausible_counts", f"encoder counts jumped by {max(deltas)} in "
-                           f"{periods} stream period(s); frame skipped")  # fmt: skip
+            self.node.warn(
+                "implausible_counts",
+                f"encoder counts jumped by {max(deltas)} in "
+                f"{periods} stream period(s); frame skipped",
+            )
             return
-        signed = [math.copysign(d * self.metres_per_count, v) if v != 0.0 else 0.0
-                  for d, v in zip(deltas, self.commanded, strict=True)]  # fmt: skip
+        signed = [
+            math.copysign(d * self.metres_per_count, v) if v != 0.0 else 0.0
+            for d, v in zip(deltas, self.commanded, strict=True)
+        ]
         self.distances = [a + b for a, b in zip(self.distances, signed, strict=True)]
         self.pose = dead_reckoning(*self.pose, signed[0], signed[1], self.base.wheel_base)
         covered_s = periods * create_oi.STREAM_PERIOD_S
@@ -248,8 +272,9 @@ class BaseDriver(Component):
     def plausible_counts(self, periods: int) -> int:
         """The largest count change a wheel can make in ``periods`` stream periods."""
         metres = self.base.wheel_speed_max * periods * create_oi.STREAM_PERIOD_S
-        return math.ceil(PLAUSIBLE_SPEED_FACTOR * metres / self.metres_per_count
-                         + PLAUSIBLE_SLACK_COUNTS)  # fmt: skip
+        return math.ceil(
+            PLAUSIBLE_SPEED_FACTOR * metres / self.metres_per_count + PLAUSIBLE_SLACK_COUNTS
+        )
 
     def shutdown(self) -> None:
         """Stop the wheels, stop the stream, close the port."""

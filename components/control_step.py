@@ -67,8 +67,7 @@ class Step:
     output: LawOutput | None = None
 
     @classmethod
-    def zero(cls, stamp_ns: int, status: str, reason: str,
-             output: LawOutput | None = None) -> Step:  # fmt: skip
+    def zero(cls, stamp_ns: int, status: str, reason: str, output: LawOutput | None = None) -> Step:
         return cls(stamp_ns, ZERO_WHEELS, (0.0,) * ARM_JOINTS, status, reason, output)
 
 
@@ -76,8 +75,13 @@ class ControlStep:
     """A law stepped on states: the task of the last goal (a different task resets the law),
     the last obstacles, the last state's stamp (for dt) and the gains in force."""
 
-    def __init__(self, name: str, law_type: Callable[[MobileManipulator, Any], Law],
-                 robot: MobileManipulator, gains: Any) -> None:  # fmt: skip
+    def __init__(
+        self,
+        name: str,
+        law_type: Callable[[MobileManipulator, Any], Law],
+        robot: MobileManipulator,
+        gains: Any,
+    ) -> None:
         self.name, self.law_type, self.robot = name, law_type, robot
         self.gains = gains
         self.law = law_type(robot, gains)
@@ -143,37 +147,49 @@ class ControlStep:
         self.last_stamp_ns = stamp
         age_s = (now_ns - stamp) / 1e9
         if age_s > stale_timeout_s:
-            return Step.zero(stamp, "stale", f"robot/state is {age_s:.2f} s old "
-                                             f"(timeout {stale_timeout_s} s)")  # fmt: skip
+            return Step.zero(
+                stamp, "stale", f"robot/state is {age_s:.2f} s old (timeout {stale_timeout_s} s)"
+            )
         if not state.valid:
-            return Step.zero(stamp, "invalid state",
-                             "robot/state is not valid (the estimator has no fix)")  # fmt: skip
+            return Step.zero(
+                stamp, "invalid state", "robot/state is not valid (the estimator has no fix)"
+            )
         if self.task is None and self.refusal:
             return Step.zero(stamp, "goal refused", self.refusal)
         if self.task is None:
             return Step.zero(stamp, "no goal", "no control/goal received yet")
         try:
-            output = self.law.step(np.array(state.configuration()), self.task,
-                                   min(max(dt, DT_MIN_S), DT_MAX_S), self.obstacles)  # fmt: skip
+            output = self.law.step(
+                np.array(state.configuration()),
+                self.task,
+                min(max(dt, DT_MIN_S), DT_MAX_S),
+                self.obstacles,
+            )
         except Exception as error:  # noqa: BLE001 - any failure of the law holds the robot
             return Step.zero(stamp, "error", f"the {self.name} law raised: {error}")
         if not output.ok:
-            return Step.zero(stamp, output.status, f"the {self.name} law returned "
-                                                   f"{output.status}", output)  # fmt: skip
+            return Step.zero(
+                stamp, output.status, f"the {self.name} law returned {output.status}", output
+            )
         u = output.u
         if u.shape != (3 + ARM_JOINTS,):
-            return Step.zero(stamp, "error", f"u has shape {u.shape}; the arm command takes "
-                                             f"{ARM_JOINTS} joints")  # fmt: skip
+            return Step.zero(
+                stamp, "error", f"u has shape {u.shape}; the arm command takes {ARM_JOINTS} joints"
+            )
         if not np.all(np.isfinite(u)):  # before any conversion, which would raise
-            return Step.zero(stamp, "non-finite", f"the {self.name} law reported optimal with "
-                                                  f"a non-finite u {u} (a law error)")  # fmt: skip
+            return Step.zero(
+                stamp,
+                "non-finite",
+                f"the {self.name} law reported optimal with a non-finite u {u} (a law error)",
+            )
         speeds, wheels = unicycle(u[0], u[1], u[2], state.base_pose[2]), (math.nan,) * 4
         if all(math.isfinite(v) for v in speeds):  # v may overflow where u does not
             base = wheel_speeds(*speeds, self.robot.base)
             wheels = (base.forward, base.angular, base.left_wheel, base.right_wheel)
         if not all(math.isfinite(w) for w in wheels):
-            return Step.zero(stamp, "non-finite", f"the {self.name} law's u {u} gives "
-                                                  "non-finite base speeds")  # fmt: skip
+            return Step.zero(
+                stamp, "non-finite", f"the {self.name} law's u {u} gives non-finite base speeds"
+            )
         return Step(stamp, wheels, tuple(u[3:].tolist()), "optimal", "", output)
 
 

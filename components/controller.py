@@ -52,7 +52,6 @@ STALE_CHECK_PERIOD_S = 0.1
 """How often the controller checks that states still arrive."""
 
 
-
 def robot_loads(path: object) -> None:
     """``ParamError`` unless ``path`` is empty (the profile's robot) or a robot that loads."""
     if path:
@@ -84,11 +83,21 @@ def goal_of(task: Task, header: Header) -> Goal:
     if isinstance(task, PositionTask):
         return Goal(header=header, task="position", position=tuple(task.position.tolist()))
     if isinstance(task, PointTask):
-        return Goal(header=header, task="point", point=tuple(task.point.tolist()),
-                    arm=tuple(task.arm.tolist()), lookahead=task.lookahead)  # fmt: skip
+        return Goal(
+            header=header,
+            task="point",
+            point=tuple(task.point.tolist()),
+            arm=tuple(task.arm.tolist()),
+            lookahead=task.lookahead,
+        )
     if isinstance(task, HeadingTask):
-        return Goal(header=header, task="heading", heading=task.heading,
-                    arm=tuple(task.arm.tolist()), point=tuple(task.position.tolist()))  # fmt: skip
+        return Goal(
+            header=header,
+            task="heading",
+            heading=task.heading,
+            arm=tuple(task.arm.tolist()),
+            point=tuple(task.position.tolist()),
+        )
     raise TypeError(f"no goal asks for a {type(task).__name__}")
 
 
@@ -109,8 +118,7 @@ class Controller(Component):
         self.diagnostics = node.publisher(topics.CONTROL_DIAGNOSTICS)
         self.robot_path = self._robot_path()
         gains = gains_of(self.gains_type, node.params, None)
-        self.stepper = ControlStep(self.law_name, self.law_type, load_robot(self.robot_path),
-                                   gains)  # fmt: skip
+        self.stepper = ControlStep(self.law_name, self.law_type, load_robot(self.robot_path), gains)
         self._seen = (node.params.version, None)  # the parameters and goal the gains are of
         node.counters["non_finite_commands"] = 0
         node.counters["law_errors"] = 0
@@ -135,8 +143,9 @@ class Controller(Component):
             self.stepper.take_goal(goal)
         except ValueError:
             self.node.count("refused_goals")
-            self.node.warn("refused_goals", f"{self.stepper.refusal}; zero sent until the "
-                                            "next goal")  # fmt: skip
+            self.node.warn(
+                "refused_goals", f"{self.stepper.refusal}; zero sent until the next goal"
+            )
 
     def on_obstacles(self, message: Obstacles) -> None:
         """Take the obstacles every following step avoids; a message with a solid the law
@@ -146,8 +155,9 @@ class Controller(Component):
             obstacles = obstacles_of(message)
         except ValueError as error:
             self.node.count("refused_obstacles")
-            self.node.warn("refused_obstacles", f"world/obstacles refused: {error}; the last "
-                                                "obstacles kept")  # fmt: skip
+            self.node.warn(
+                "refused_obstacles", f"world/obstacles refused: {error}; the last obstacles kept"
+            )
             return
         self.stepper.take_obstacles(obstacles)
 
@@ -159,8 +169,9 @@ class Controller(Component):
             self.stepper.last_stamp_ns = state.header.stamp_ns
             self.publish(self.stepper.zero(state.header.stamp_ns, "error", str(error)))
             return
-        step = self.stepper.step(state, self.node.clock.now_ns(),
-                                 self.node.params["stale_timeout_s"])  # fmt: skip
+        step = self.stepper.step(
+            state, self.node.clock.now_ns(), self.node.params["stale_timeout_s"]
+        )
         counter = {"error": "law_errors", "non-finite": "non_finite_commands"}.get(step.status)
         if counter is not None:
             self.node.count(counter)
@@ -181,8 +192,11 @@ class Controller(Component):
 
     def clock_stalled(self, stalled_s: float) -> None:
         """The simulated clock stopped: command zero and say why."""
-        self.publish(self.stepper.zero(self.node.clock.now_ns(), "stale",
-                               f"sim/clock has not moved for {stalled_s:.2f} s"))  # fmt: skip
+        self.publish(
+            self.stepper.zero(
+                self.node.clock.now_ns(), "stale", f"sim/clock has not moved for {stalled_s:.2f} s"
+            )
+        )
 
     def update_law(self) -> None:
         """After a parameter or the goal changed: reload the robot if its parameter changed,
@@ -202,14 +216,29 @@ class Controller(Component):
         """The commands and the diagnostics of ``step``."""
         forward, angular, left, right = step.wheels
         base, arm = self.base_command, self.arm_command
-        base.put(BaseCommand(header=self.node.header("base", step.stamp_ns, base.next_seq),
-                             forward_velocity=forward, angular_velocity=angular,
-                             left_wheel=left, right_wheel=right))  # fmt: skip
-        arm.put(ArmCommand(header=self.node.header("arm", step.stamp_ns, arm.next_seq),
-                           joint_velocities=step.joints))  # fmt: skip
-        self.diagnostics.put(diagnostics_of(
-            step, self.law_name, self.stepper.gains,
-            self.node.header("world", step.stamp_ns, self.diagnostics.next_seq)))  # fmt: skip
+        base.put(
+            BaseCommand(
+                header=self.node.header("base", step.stamp_ns, base.next_seq),
+                forward_velocity=forward,
+                angular_velocity=angular,
+                left_wheel=left,
+                right_wheel=right,
+            )
+        )
+        arm.put(
+            ArmCommand(
+                header=self.node.header("arm", step.stamp_ns, arm.next_seq),
+                joint_velocities=step.joints,
+            )
+        )
+        self.diagnostics.put(
+            diagnostics_of(
+                step,
+                self.law_name,
+                self.stepper.gains,
+                self.node.header("world", step.stamp_ns, self.diagnostics.next_seq),
+            )
+        )
 
     def _robot_path(self) -> Path:
         """The ``robot`` parameter, or the profile's robot when it is empty."""

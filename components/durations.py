@@ -29,5 +29,6 @@ class Durations:
         if self._notes < EVERY or self._notes % EVERY == 0:
             ordered = sorted(self._recent)
             self._counters[self._median] = round(ordered[len(ordered) // 2])
-            self._counters[self._p99] = round(ordered[min(len(ordered) - 1,
-                                                          int(len(ordered) * 0.99))])  # fmt: skip
+            self._counters[self._p99] = round(
+                ordered[min(len(ordered) - 1, int(len(ordered) * 0.99))]
+            )

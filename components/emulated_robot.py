@@ -69,8 +69,10 @@ class EmulatedRobot(Simulator):
         if node.params["lockstep"]:
             raise ParamError("lockstep: a serial line carries no stamps; run in real time")
         if node.params["real_time_factor"] != 1.0 or not node.params["host_epoch"]:
-            raise ParamError("real_time_factor: the drivers keep the host's time; the emulated "
-                             "robot runs at 1.0 with host_epoch true")  # fmt: skip
+            raise ParamError(
+                "real_time_factor: the drivers keep the host's time; the emulated "
+                "robot runs at 1.0 with host_epoch true"
+            )
         super().__init__(node)
         self.devices = WorldDevices(self.world)
         links = [Path(str(node.params[name])) for name in ("create_link", "servo_link")]

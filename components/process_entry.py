@@ -73,8 +73,14 @@ def _configure(component_class: type[Component], args: argparse.Namespace) -> No
         return None
     try:
         kept = os.environ.get(PARAMS_FILE_ENV)
-        return Node(profile, args.name, component_class.params, component_class.reads,
-                    component_class.writes, Path(kept) if kept else None)  # fmt: skip
+        return Node(
+            profile,
+            args.name,
+            component_class.params,
+            component_class.reads,
+            component_class.writes,
+            Path(kept) if kept else None,
+        )
     except ParamError as error:
         log.error("%s: components[%d].params.%s", args.profile, names.index(args.name), error)
         return None

@@ -180,8 +180,10 @@ class Subscription(Generic[M]):
     def _warn_oversized(self, size: int) -> None:
         with self._lock:
             self._oversized_warning_waiting = False
-        self._reject("size", f"dropped a {size}-byte message on {self._key}: over "
-                     f"{self.topic.max_bytes} bytes")  # fmt: skip
+        self._reject(
+            "size",
+            f"dropped a {size}-byte message on {self._key}: over {self.topic.max_bytes} bytes",
+        )
 
     def _reject(self, check: str, reason: str) -> None:
         """Handler thread: log a refusal, rate-limited per topic and check (so that each
@@ -192,8 +194,9 @@ class Subscription(Generic[M]):
                 self._on_reject(reason)
             except Exception:
                 self._node.counters[f"errors.{self.topic.name}"] += 1
-                self._node.warn(f"errors.{self.topic.name}", f"refusal handler of {self._key} "
-                                "failed", True)  # fmt: skip
+                self._node.warn(
+                    f"errors.{self.topic.name}", f"refusal handler of {self._key} failed", True
+                )
 
     def drain(self) -> None:
         """Handler thread: deliver every sample still waiting (a recorder closing its file)."""

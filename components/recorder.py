@@ -101,8 +101,11 @@ class Recorder(Component):
             return
         counter = f"outside.{name}"
         if counter not in self.node.counters:
-            log.warning("%s: recorded, but %s; info, replay and report leave it out",
-                        self.node.name, outside_line({name: (1, stamp_ns)}, session))
+            log.warning(
+                "%s: recorded, but %s; info, replay and report leave it out",
+                self.node.name,
+                outside_line({name: (1, stamp_ns)}, session),
+            )
         self.node.count(counter)
 
     def _writing(self, operation, *args, **kwargs) -> bool:
@@ -114,17 +117,22 @@ class Recorder(Component):
             return True
         except OSError as error:
             self.failed = True
-            self.node.fail(f"cannot write {self.path}: {error}; stopping with "
-                           f"{self.node.counters['written']} messages written, the file recovers "
-                           f"to its last complete chunk (parsimony record --recover "
-                           f"{self.path} OUT)")  # fmt: skip
+            self.node.fail(
+                f"cannot write {self.path}: {error}; stopping with "
+                f"{self.node.counters['written']} messages written, the file recovers "
+                f"to its last complete chunk (parsimony record --recover "
+                f"{self.path} OUT)"
+            )
             return False
 
     def _flush(self) -> None:
         """The chunk to the file, and what was lost since the last flush, if anything (the
         file's ``DROPPED`` metadata)."""
-        dropped = {k: v for k, v in self.node.counters.items()
-                   if k.startswith(("overflowed.", "overwritten.")) and v}  # fmt: skip
+        dropped = {
+            k: v
+            for k, v in self.node.counters.items()
+            if k.startswith(("overflowed.", "overwritten.")) and v
+        }
         if dropped != self.dropped:
             self.writer.metadata(DROPPED, dropped)
             self.dropped = dropped

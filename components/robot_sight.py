@@ -27,8 +27,7 @@ def sight_region(scene: Scene | None) -> Region:
 
     base = scene.base
     margin = math.hypot(*base.offset) + base.size_m / math.sqrt(2.0)
-    return camera_region(ceiling_camera(scene.camera), scene.reference_pose, base.height_m,
-                         margin)  # fmt: skip
+    return camera_region(ceiling_camera(scene.camera), scene.reference_pose, base.height_m, margin)
 
 
 class RobotSight:
@@ -68,8 +67,11 @@ class RobotSight:
             return f"no robot state on robot/state for {(now_ns - self.last_ns) / 1e9:.1f} s"
         if self.name != "invalid":
             return ""
-        fix = (f"no camera fix of the base for {self.no_fix_s:.1f} s" if self.no_fix_s
-               else "no camera fix of the base yet")  # fmt: skip
+        fix = (
+            f"no camera fix of the base for {self.no_fix_s:.1f} s"
+            if self.no_fix_s
+            else "no camera fix of the base yet"
+        )
         return f"no valid robot state for {self._for_s(now_ns):.1f} s ({fix})"
 
     def fields(self, now_ns: int) -> dict[str, Any]:
@@ -78,11 +80,16 @@ class RobotSight:
         since = self.last_ns if state == "none" else self.since_ns
         warning = ""
         if state == "degraded":
-            warning = (f"the camera has not fixed the base for {self.no_fix_s:.1f} s: its pose "
-                       "is odometry alone")  # fmt: skip
-        return {"state": state, "state_since_s": None if since is None else since / 1e9,
-                "no_fix_s": self.no_fix_s if state in ("degraded", "invalid") else None,
-                "warning": warning}  # fmt: skip
+            warning = (
+                f"the camera has not fixed the base for {self.no_fix_s:.1f} s: its pose "
+                "is odometry alone"
+            )
+        return {
+            "state": state,
+            "state_since_s": None if since is None else since / 1e9,
+            "no_fix_s": self.no_fix_s if state in ("degraded", "invalid") else None,
+            "warning": warning,
+        }
 
     def _for_s(self, now_ns: int) -> float:
         return max(0.0, (now_ns - (self.since_ns or now_ns)) / 1e9)

@@ -147,8 +147,10 @@ class Node:
         """
         actual = self.spec.topic(topic)
         if actual.ground_truth and self.spec.role in ("estimator", "controller"):
-            raise ValueError(f"{self.name} is an {self.spec.role}: it may not read the ground "
-                             f"truth on {actual.name}")  # fmt: skip
+            raise ValueError(
+                f"{self.name} is an {self.spec.role}: it may not read the ground "
+                f"truth on {actual.name}"
+            )
         if self.reads is not None and topic.name in self.reads:
             queue = self.reads[topic.name].queue  # sim/clock too, when declared (a recorder)
         elif self.reads is not None and topic is not topics.SIM_CLOCK:

@@ -31,9 +31,14 @@ BASE_GREY, OBSTACLE_GREY = 70, 200
 class SimCamera:
     """The camera of the simulator of ``node`` (its profile's scene, its parameters)."""
 
-    def __init__(self, node: Node, robot: MobileManipulator, obstacles: Sequence[Circle],
-                 rng: np.random.Generator,
-                 publish: Callable[[CameraFrame], None]) -> None:  # fmt: skip
+    def __init__(
+        self,
+        node: Node,
+        robot: MobileManipulator,
+        obstacles: Sequence[Circle],
+        rng: np.random.Generator,
+        publish: Callable[[CameraFrame], None],
+    ) -> None:
         self.node, self.robot, self.publish = node, robot, publish
         self.scene = node.profile.scene
         self.renderer = self._renderer(obstacles, rng)
@@ -45,17 +50,20 @@ class SimCamera:
         scene, p = self.scene, self.node.params
         reference = planar_pose(*scene.reference_pose, scene.reference.height_m)
         gx, gy, gyaw = p["goal_marker"]
-        below = [PlacedMarker(scene.reference.id, scene.reference.size_m, reference),
-                 PlacedMarker(scene.goal.id, scene.goal.size_m,
-                              planar_pose(gx, gy, gyaw, scene.goal.height_m))]  # fmt: skip
-        above: list = [(o.x, o.y, scene.obstacles.height_m, o.radius, OBSTACLE_GREY)
-                       for o in obstacles]  # fmt: skip
+        below = [
+            PlacedMarker(scene.reference.id, scene.reference.size_m, reference),
+            PlacedMarker(
+                scene.goal.id, scene.goal.size_m, planar_pose(gx, gy, gyaw, scene.goal.height_m)
+            ),
+        ]
+        above: list = [
+            (o.x, o.y, scene.obstacles.height_m, o.radius, OBSTACLE_GREY) for o in obstacles
+        ]
         for marker_id, circle in zip(scene.obstacles.ids, obstacles, strict=False):
             pose = planar_pose(circle.x, circle.y, 0.0, scene.obstacles.height_m)
             above.append(PlacedMarker(marker_id, scene.obstacles.size_m, pose))
         noise = ImageNoise(p["image_noise"], p["image_blur_px"])
-        return Renderer(ceiling_camera(scene.camera), scene.dictionary_id, noise, rng,
-                        below, above)  # fmt: skip
+        return Renderer(ceiling_camera(scene.camera), scene.dictionary_id, noise, rng, below, above)
 
     def take(self, header: Header, q: np.ndarray, now_s: float, wait: bool) -> None:
         """Start drawing the frame of ``header`` with the robot at ``q``; with ``wait`` after
@@ -70,8 +78,7 @@ class SimCamera:
     def moving(self, q: np.ndarray, now_s: float) -> list:
         """What moves in the camera's view: the base's top disc, and its marker unless hidden."""
         scene = self.scene
-        elements: list = [(q[0], q[1], scene.base.height_m, self.robot.base.body_radius,
-                           BASE_GREY)]  # fmt: skip
+        elements: list = [(q[0], q[1], scene.base.height_m, self.robot.base.body_radius, BASE_GREY)]
         hidden = any(start <= now_s < end for start, end in self.node.params["hide_base_marker"])
         if not hidden:
             x, y, phi = compose(tuple(q[:3]), (*scene.base.offset, 0.0))
@@ -87,9 +94,16 @@ class SimCamera:
             jpeg_file = p["image_format"] == "jpeg"
             data = jpeg(image, p["jpeg_quality"]) if jpeg_file else image.tobytes()
             intrinsics = CameraIntrinsics(fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy)
-            self.publish(CameraFrame(header=header, encoding=p["image_format"], width=c.width,
-                                     height=c.height, data=data,
-                                     intrinsics=intrinsics))  # fmt: skip
+            self.publish(
+                CameraFrame(
+                    header=header,
+                    encoding=p["image_format"],
+                    width=c.width,
+                    height=c.height,
+                    data=data,
+                    intrinsics=intrinsics,
+                )
+            )
         except Exception:
             self.node.count("errors.camera")
             self.node.warn("errors.camera", "drawing a camera frame failed", True)

@@ -109,35 +109,79 @@ class Simulator(Component):
     )
     params = (
         Param("step_s", float, 0.01, low=1e-4, high=0.1, doc="simulated time per step, s"),
-        Param("real_time_factor", float, 1.0, low=0.0, high=1000.0,
-              doc="simulated s per wall s; 0: as fast as possible"),
+        Param(
+            "real_time_factor",
+            float,
+            1.0,
+            low=0.0,
+            high=1000.0,
+            doc="simulated s per wall s; 0: as fast as possible",
+        ),
         Param("lockstep", bool, False, doc="advance only when the loop answered each step"),
-        Param("ack_timeout_s", float, 2.0, low=0.01, high=60.0,
-              doc="host s a lockstep step waits for an answer"),
+        Param(
+            "ack_timeout_s",
+            float,
+            2.0,
+            low=0.01,
+            high=60.0,
+            doc="host s a lockstep step waits for an answer",
+        ),
         Param("paused", bool, False, doc="hold the simulation (set false to start)"),
-        Param("command_timeout_s", float, 0.5, low=0.01, high=10.0,
-              doc="stop the robot after this long without a command, s (simulated)"),
+        Param(
+            "command_timeout_s",
+            float,
+            0.5,
+            low=0.01,
+            high=10.0,
+            doc="stop the robot after this long without a command, s (simulated)",
+        ),
         Param("seed", int, 0, low=0, high=SEED_MAX, doc="noise seed"),
-        Param("start", tuple, (0.0, 0.0, 0.0, 0.0, -0.2, 0.2, 0.0, 0.5), length=8,
-              doc="q0 = [x, y, phi, q1..q5]"),
+        Param(
+            "start",
+            tuple,
+            (0.0, 0.0, 0.0, 0.0, -0.2, 0.2, 0.0, 0.5),
+            length=8,
+            doc="q0 = [x, y, phi, q1..q5]",
+        ),
         Param("obstacles", list, (), length=3, doc="obstacle circles [[x, y, radius], ...], m"),
-        Param("goal_marker", tuple, (0.6, 0.0, 0.0), length=3,
-              doc="the bin marker F2: [x, y, yaw]"),
-        Param("hide_base_marker", list, (), length=2,
-              doc="sim seconds [[from, to], ...] the base marker is hidden"),
-        Param("host_epoch", bool, False,
-              doc="stamp with the host's clock, to match drivers on host time (real time)"),
+        Param(
+            "goal_marker", tuple, (0.6, 0.0, 0.0), length=3, doc="the bin marker F2: [x, y, yaw]"
+        ),
+        Param(
+            "hide_base_marker",
+            list,
+            (),
+            length=2,
+            doc="sim seconds [[from, to], ...] the base marker is hidden",
+        ),
+        Param(
+            "host_epoch",
+            bool,
+            False,
+            doc="stamp with the host's clock, to match drivers on host time (real time)",
+        ),
         Param("camera", bool, True, doc="render camera frames"),
         Param("image_noise", float, 2.0, low=0.0, high=50.0, doc="pixel noise std, grey levels"),
         Param("image_blur_px", float, 0.6, low=0.0, high=5.0, doc="Gaussian blur sigma, px"),
-        Param("image_format", str, "jpeg", choices=("jpeg", "mono8"),
-              doc="camera frames as JPEG files or raw grey pixels"),
+        Param(
+            "image_format",
+            str,
+            "jpeg",
+            choices=("jpeg", "mono8"),
+            doc="camera frames as JPEG files or raw grey pixels",
+        ),
         Param("jpeg_quality", int, 90, low=1, high=100, doc="JPEG quality of the frames"),
-        Param("encoder_noise_counts", float, 0.0, low=0.0, high=100.0,
-              doc="encoder noise std per step, counts"),
+        Param(
+            "encoder_noise_counts",
+            float,
+            0.0,
+            low=0.0,
+            high=100.0,
+            doc="encoder noise std per step, counts",
+        ),
         Param("wheel_slip", float, 0.0, low=0.0, high=0.5, doc="wheel slip std, fraction"),
         Param("wheel_acceleration_max", float, 1.0, low=0.01, high=100.0, doc="m/s^2"),
-    )  # fmt: skip
+    )
 
     def __init__(self, node: Node) -> None:
         super().__init__(node)
@@ -149,11 +193,13 @@ class Simulator(Component):
         self.robot = MobileManipulator.from_yaml(node.profile.robot)
         self.scene: Scene = node.profile.scene
         self.obstacles = [Circle(*c) for c in p["obstacles"]]
-        self.truth_obstacles = tuple(TruthCircle(x=c.x, y=c.y, radius=c.radius)
-                                     for c in self.obstacles)  # fmt: skip
+        self.truth_obstacles = tuple(
+            TruthCircle(x=c.x, y=c.y, radius=c.radius) for c in self.obstacles
+        )
         # The scene declares its solids in F0; this world has F0 at the reference pose.
-        solids = tuple(solid.moved(*self.scene.reference_pose)
-                       for solid in self.scene.arm_obstacles.solids())  # fmt: skip
+        solids = tuple(
+            solid.moved(*self.scene.reference_pose) for solid in self.scene.arm_obstacles.solids()
+        )
         self.truth_solids = Solids.of(solids)
         self.goal_of: tuple[tuple, tuple[float, ...]] = ((), ())
         settings = WorldSettings(
@@ -162,17 +208,26 @@ class Simulator(Component):
             wheel_slip=p["wheel_slip"],
         )
         start = np.array(p["start"])
-        for index, line in enumerate(inside_at_start(self.robot, start, solids,
-                                                     self.scene.solid_labels())):  # fmt: skip
+        for index, line in enumerate(
+            inside_at_start(self.robot, start, solids, self.scene.solid_labels())
+        ):
             node.warn(f"starts_inside.{index}", line)
-        self.world = World(self.robot, start, self.obstacles, settings, seed=p["seed"],
-                           solids=solids)  # fmt: skip
+        self.world = World(
+            self.robot, start, self.obstacles, settings, seed=p["seed"], solids=solids
+        )
         self.step_ns = round(p["step_s"] * 1e9)
         self.now_ns = time.time_ns() if p["host_epoch"] else 0
-        self.camera = SimCamera(node, self.robot, self.obstacles,
-                                np.random.default_rng(p["seed"] + 1),
-                                lambda frame: self.publishers["camera/image"].put(frame),
-                                ) if p["camera"] else None  # fmt: skip
+        self.camera = (
+            SimCamera(
+                node,
+                self.robot,
+                self.obstacles,
+                np.random.default_rng(p["seed"] + 1),
+                lambda frame: self.publishers["camera/image"].put(frame),
+            )
+            if p["camera"]
+            else None
+        )
         self.frame_period_ns = round(1e9 / self.scene.camera.rate_hz)
         self.next_frame_ns = self.now_ns
         self.metres_per_count = wheel_distance_per_count(self.robot.base, settings.counts_per_turn)
@@ -185,8 +240,9 @@ class Simulator(Component):
         self.frame_done = True
         self.sensors_ns: int | None = None
         self.answered = AnswerStamps()
-        self.answer_times = {k: Durations(node.counters, k)
-                             for k in ("frame", "frame_wait", "loop")}  # fmt: skip
+        self.answer_times = {
+            k: Durations(node.counters, k) for k in ("frame", "frame_wait", "loop")
+        }
         node.counters["lockstep_timeouts"] = 0
         node.counters["frames_skipped"] = 0
         node.counters["contacts"] = 0
@@ -261,8 +317,12 @@ class Simulator(Component):
             self.frame_done = True
             self.next_frame_ns += self.frame_period_ns
             lockstep = self.node.params["lockstep"]
-            self.camera.take(self._header("camera", "camera/image"), self.world.q,
-                             self.now_ns / 1e9, wait=lockstep)  # fmt: skip
+            self.camera.take(
+                self._header("camera", "camera/image"),
+                self.world.q,
+                self.now_ns / 1e9,
+                wait=lockstep,
+            )
             if lockstep:
                 self.unanswered = Frame(self.now_ns, time.monotonic())
                 if self.latency_ns == 0:
@@ -324,8 +384,10 @@ class Simulator(Component):
         if awaited is not None and time.monotonic() > awaited.deadline:
             missing = self.answered.missing(awaited.stamp_ns, awaited.topics)
             self.node.count("lockstep_timeouts")
-            self.node.warn("lockstep_timeouts", f"no answer on {', '.join(missing)} for "
-                           f"t={awaited.stamp_ns / 1e9:.3f} s; going on")  # fmt: skip
+            self.node.warn(
+                "lockstep_timeouts",
+                f"no answer on {', '.join(missing)} for t={awaited.stamp_ns / 1e9:.3f} s; going on",
+            )
             self._proceed()
         self._kick()  # also starts a run once ``paused`` is set false
 
@@ -364,11 +426,13 @@ class Simulator(Component):
 
     def _publish_odometry(self) -> None:
         counts = self.world.encoder_counts
-        d_left, d_right = ((c - c0) * self.metres_per_count
-                           for c, c0 in zip(counts, self.last_counts, strict=True))  # fmt: skip
+        d_left, d_right = (
+            (c - c0) * self.metres_per_count for c, c0 in zip(counts, self.last_counts, strict=True)
+        )
         self.last_counts = counts
-        self.odometry_pose = dead_reckoning(*self.odometry_pose, d_left, d_right,
-                                            self.robot.base.wheel_base)  # fmt: skip
+        self.odometry_pose = dead_reckoning(
+            *self.odometry_pose, d_left, d_right, self.robot.base.wheel_base
+        )
         left, right = self.world.wheel_speeds
         x, y, phi = self.odometry_pose
         self.publishers["base/odometry"].put(

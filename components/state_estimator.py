@@ -79,20 +79,43 @@ class StateEstimator(Component):
         Input(topics.BASE_ODOMETRY, queue=200),
         Input(topics.ARM_JOINT_STATES),
     )
-    writes = (topics.ROBOT_STATE, topics.CONTROL_GOAL, topics.WORLD_OBSTACLES,
-              topics.WORLD_MARKERS)
+    writes = (topics.ROBOT_STATE, topics.CONTROL_GOAL, topics.WORLD_OBSTACLES, topics.WORLD_MARKERS)
     params = (
         Param("task", str, "pose", choices=("pose", "position"), doc="the goal's task"),
         Param("reference_samples", int, 100, low=1, high=100000, doc="eq. 6.1 samples of F0"),
-        Param("static_samples", int, 30, low=1, high=100000,
-              doc="eq. 6.1 samples of the goal and obstacle markers"),
-        Param("base_samples", int, 20, low=1, high=1000,
-              doc="a camera fix corrects the base by 1/base_samples"),
-        Param("marker_timeout_s", float, 0.5, low=0.01, high=60.0,
-              doc="the state is degraded when F1 has not been seen for this long, s"),
-        Param("odometry_timeout_s", float, 0.5, low=0.01, high=60.0,
-              doc="the state is invalid when odometry stopped this long too, s"),
-    )  # fmt: skip
+        Param(
+            "static_samples",
+            int,
+            30,
+            low=1,
+            high=100000,
+            doc="eq. 6.1 samples of the goal and obstacle markers",
+        ),
+        Param(
+            "base_samples",
+            int,
+            20,
+            low=1,
+            high=1000,
+            doc="a camera fix corrects the base by 1/base_samples",
+        ),
+        Param(
+            "marker_timeout_s",
+            float,
+            0.5,
+            low=0.01,
+            high=60.0,
+            doc="the state is degraded when F1 has not been seen for this long, s",
+        ),
+        Param(
+            "odometry_timeout_s",
+            float,
+            0.5,
+            low=0.01,
+            high=60.0,
+            doc="the state is invalid when odometry stopped this long too, s",
+        ),
+    )
 
     def __init__(self, node: Node) -> None:
         super().__init__(node)
@@ -116,8 +139,13 @@ class StateEstimator(Component):
         self.goal = node.publisher(topics.CONTROL_GOAL)
         self.obstacles = node.publisher(topics.WORLD_OBSTACLES)
         self.placed = node.publisher(topics.WORLD_MARKERS)
-        for name in ("base_fixes", "fixes_without_odometry", "duplicates", "degraded_states",
-                     "joints_behind"):
+        for name in (
+            "base_fixes",
+            "fixes_without_odometry",
+            "duplicates",
+            "degraded_states",
+            "joints_behind",
+        ):
             node.counters[name] = 0
         node.subscribe(topics.VISION_MARKERS, self.on_markers)
         node.subscribe(topics.BASE_ODOMETRY, self.on_odometry)
@@ -152,14 +180,28 @@ class StateEstimator(Component):
                 if marker_id in in_world:
                     self._static(marker_id).update(in_world[marker_id])
         base = in_world.get(scene.base.id)
-        self.frames.append(Frame(stamp, None if base is None else self._base_of(base),
-                                 self._goal_pose(), self._obstacle_centres()))  # fmt: skip
-        self.placed.put(MarkerDetections(
-            header=self.node.header(WORLD_FRAME, stamp, self.placed.next_seq),
-            markers=tuple(MarkerDetection(id=m.id, pose=tuple(in_world[m.id].tolist()),
-                                          reprojection_error=m.reprojection_error)
-                          for m in message.markers if m.id in in_world),
-        ))  # fmt: skip
+        self.frames.append(
+            Frame(
+                stamp,
+                None if base is None else self._base_of(base),
+                self._goal_pose(),
+                self._obstacle_centres(),
+            )
+        )
+        self.placed.put(
+            MarkerDetections(
+                header=self.node.header(WORLD_FRAME, stamp, self.placed.next_seq),
+                markers=tuple(
+                    MarkerDetection(
+                        id=m.id,
+                        pose=tuple(in_world[m.id].tolist()),
+                        reprojection_error=m.reprojection_error,
+                    )
+                    for m in message.markers
+                    if m.id in in_world
+                ),
+            )
+        )
 
     def _static(self, marker_id: int) -> PoseFilter:
         if marker_id not in self.statics:
@@ -207,17 +249,20 @@ class StateEstimator(Component):
         if self.node.params["task"] == "pose":
             goal = Goal(header=header, task="pose", pose=tuple(frame.goal.tolist()))
         else:
-            goal = Goal(header=header, task="position",
-                        position=tuple(dq.translation(frame.goal)[1:].tolist()))  # fmt: skip
+            goal = Goal(
+                header=header,
+                task="position",
+                position=tuple(dq.translation(frame.goal)[1:].tolist()),
+            )
         self.goal.put(goal)
 
     def _publish_obstacles(self, frame: Frame, stamp_ns: int) -> None:
         radius, height = self.scene.obstacles.radius_m, self.scene.obstacles.height_m or None
-        circles = tuple(Circle(x=x, y=y, radius=radius, height=height)
-                        for x, y in frame.obstacles)  # fmt: skip
+        circles = tuple(Circle(x=x, y=y, radius=radius, height=height) for x, y in frame.obstacles)
         header = self.node.header(WORLD_FRAME, stamp_ns, self.obstacles.next_seq)
-        self.obstacles.put(Obstacles(header=header, circles=circles,
-                                     solids=self.scene.arm_obstacles))  # fmt: skip
+        self.obstacles.put(
+            Obstacles(header=header, circles=circles, solids=self.scene.arm_obstacles)
+        )
 
     # -- odometry and joints ---------------------------------------------------------------
 
@@ -268,8 +313,9 @@ class StateEstimator(Component):
         """Timer: with odometry silent and the marker lost as well, say the state is invalid."""
         now = self.node.clock.now_ns()
         p = self.node.params
-        odometry_silent = self.odometry_ns is None or now - self.odometry_ns > p[
-            "odometry_timeout_s"] * 1e9  # fmt: skip
+        odometry_silent = (
+            self.odometry_ns is None or now - self.odometry_ns > p["odometry_timeout_s"] * 1e9
+        )
         marker_lost = self.fix_ns is None or now - self.fix_ns > p["marker_timeout_s"] * 1e9
         if odometry_silent and marker_lost:
             self.base.reset()  # a fix is needed again

@@ -73,22 +73,56 @@ class Supervisor(Component):
     reads = (Input(topics.GOAL_REQUEST), Input(topics.ROBOT_STATE), Input(topics.WORLD_OBSTACLES))
     writes = (topics.CONTROL_GOAL, topics.SUPERVISOR_STATUS)
     params = (
-        Param("stall_window_s", float, DEFAULTS.stall_window_s, low=0.1, high=60.0,
-              doc="a phase stalls when its error falls by less than stall_reduction over this"),
-        Param("stall_reduction", float, DEFAULTS.stall_reduction, low=0.0, high=0.9,
-              doc="share of the error a phase must shed per stall window"),
-        Param("max_replans", int, DEFAULTS.max_replans, low=0, high=20,
-              doc="re-plans after stalls before the goal is reported unreachable"),
-        Param("pose_tolerance", float, 5e-3, low=1e-5, high=0.5,
-              doc="||e|| of the goal's task under which it counts as reached (||vec8(x - x_d)||"
-                  " for a pose: looser than the kinematic bench's, a measured pose jitters)"),
-        Param("planning_budget_s", float, StagingParams.budget_s, low=0.05, high=30.0,
-              doc="CPU seconds a plan may take, its way round the obstacles included"),
-        Param("keep_in_view", bool, True,
-              doc="plans keep the base where the scene's camera sees its marker, and goals "
-                  "out of its sight are refused (the scene's camera position and reference_pose "
-                  "must place the camera)"),
-    )  # fmt: skip
+        Param(
+            "stall_window_s",
+            float,
+            DEFAULTS.stall_window_s,
+            low=0.1,
+            high=60.0,
+            doc="a phase stalls when its error falls by less than stall_reduction over this",
+        ),
+        Param(
+            "stall_reduction",
+            float,
+            DEFAULTS.stall_reduction,
+            low=0.0,
+            high=0.9,
+            doc="share of the error a phase must shed per stall window",
+        ),
+        Param(
+            "max_replans",
+            int,
+            DEFAULTS.max_replans,
+            low=0,
+            high=20,
+            doc="re-plans after stalls before the goal is reported unreachable",
+        ),
+        Param(
+            "pose_tolerance",
+            float,
+            5e-3,
+            low=1e-5,
+            high=0.5,
+            doc="||e|| of the goal's task under which it counts as reached (||vec8(x - x_d)||"
+            " for a pose: looser than the kinematic bench's, a measured pose jitters)",
+        ),
+        Param(
+            "planning_budget_s",
+            float,
+            StagingParams.budget_s,
+            low=0.05,
+            high=30.0,
+            doc="CPU seconds a plan may take, its way round the obstacles included",
+        ),
+        Param(
+            "keep_in_view",
+            bool,
+            True,
+            doc="plans keep the base where the scene's camera sees its marker, and goals "
+            "out of its sight are refused (the scene's camera position and reference_pose "
+            "must place the camera)",
+        ),
+    )
 
     def __init__(self, node: Node) -> None:
         super().__init__(node)
@@ -186,19 +220,23 @@ class Supervisor(Component):
         """A goal of another kind than a pose: passed on, and reached once its error is within
         ``pose_tolerance``."""
         self.goal_out.put(request.model_copy(update={"header": self.node.header(stamp_ns=stamp)}))
-        if not self.reached and self.error_norm is not None and (
-                self.error_norm < self.node.params["pose_tolerance"]):  # fmt: skip
+        if (
+            not self.reached
+            and self.error_norm is not None
+            and (self.error_norm < self.node.params["pose_tolerance"])
+        ):
             self.reached = True
-            log.info("reached at %.2f s: %s goal, error %.3g", self._t, request.task,
-                     self.error_norm)  # fmt: skip
+            log.info(
+                "reached at %.2f s: %s goal, error %.3g", self._t, request.task, self.error_norm
+            )
 
     def _staged(self, request: Goal, q: np.ndarray) -> Task:
         """The task of the pose goal's phase at q (a hold while it plans or once it is
         unreachable), its plan handed to the planner thread when one is due."""
         if self.supervisor is None:
-            self.supervisor = StagingSupervisor(self.robot, np.array(request.pose),
-                                                self.obstacles, self._params(),
-                                                self._staging())  # fmt: skip
+            self.supervisor = StagingSupervisor(
+                self.robot, np.array(request.pose), self.obstacles, self._params(), self._staging()
+            )
         supervisor = self.supervisor
         task = supervisor.update(q, self._t)
         if supervisor.pending is not None and supervisor.pending is not self._planning:
@@ -222,12 +260,16 @@ class Supervisor(Component):
         x, y = request.position[:2] if request.task == "position" else request.point
         distance, limit = math.hypot(x - q[0], y - q[1]), StagingParams.max_distance
         if not distance <= limit:
-            return (f"the {request.task} goal is {distance:.3g} m from the base, farther than "
-                    f"the {limit:g} m a goal may lie")  # fmt: skip
+            return (
+                f"the {request.task} goal is {distance:.3g} m from the base, farther than "
+                f"the {limit:g} m a goal may lie"
+            )
         region = self._region()
         if region and not within(region, (x, y)):
-            return (f"the {request.task} goal's ({x:.2f}, {y:.2f}) m lies where the camera "
-                    "cannot see the base (keep_in_view)")  # fmt: skip
+            return (
+                f"the {request.task} goal's ({x:.2f}, {y:.2f}) m lies where the camera "
+                "cannot see the base (keep_in_view)"
+            )
         return ""
 
     def _give_up(self, reason: str) -> None:
@@ -263,14 +305,15 @@ class Supervisor(Component):
 
     def _params(self) -> SupervisorParams:
         p = self.node.params
-        return SupervisorParams(stall_window_s=p["stall_window_s"],
-                                stall_reduction=p["stall_reduction"],
-                                max_replans=p["max_replans"],
-                                pose_tolerance=p["pose_tolerance"])  # fmt: skip
+        return SupervisorParams(
+            stall_window_s=p["stall_window_s"],
+            stall_reduction=p["stall_reduction"],
+            max_replans=p["max_replans"],
+            pose_tolerance=p["pose_tolerance"],
+        )
 
     def _staging(self) -> StagingParams:
-        return StagingParams(budget_s=self.node.params["planning_budget_s"],
-                             region=self._region())  # fmt: skip
+        return StagingParams(budget_s=self.node.params["planning_budget_s"], region=self._region())
 
     def _region(self) -> tuple[tuple[float, float, float], ...]:
         return self.sight.region if self.node.params["keep_in_view"] else ()
@@ -284,7 +327,7 @@ class Supervisor(Component):
         return goal_of(task, header)
 
     def _report_events(self, supervisor: StagingSupervisor) -> None:
-        for event in supervisor.events[self._events_reported:]:
+        for event in supervisor.events[self._events_reported :]:
             counter = COUNTED.get(event.kind)
             if counter:
                 self.node.count(counter)
@@ -313,9 +356,15 @@ class Supervisor(Component):
             phase, reason = "planning", ""
         else:
             phase, reason = supervisor.phase.value, supervisor.reason
-        fields = dict(header=self.node.header(stamp_ns=stamp_ns), phase=phase, reason=reason,
-                      error_norm=self.error_norm, refusals=self.node.counters["refusals"],
-                      last_refusal=self.last_refusal, **self.sight.fields(stamp_ns))  # fmt: skip
+        fields = dict(
+            header=self.node.header(stamp_ns=stamp_ns),
+            phase=phase,
+            reason=reason,
+            error_norm=self.error_norm,
+            refusals=self.node.counters["refusals"],
+            last_refusal=self.last_refusal,
+            **self.sight.fields(stamp_ns),
+        )
         if supervisor is None:
             return SupervisorStatus(candidate=0, plans=0, replans=0, stalls=0, **fields)
         candidate = supervisor.candidate
@@ -329,8 +378,9 @@ class Supervisor(Component):
             stalls=sum(e.kind == "stall" for e in supervisor.events),
             last_event=supervisor.events[-1].detail if supervisor.events else "",
             planning_ms=supervisor.planning_s[-1] * 1e3 if supervisor.planning_s else None,
-            planning_cpu_ms=(supervisor.planning_cpu_s[-1] * 1e3
-                             if supervisor.planning_cpu_s else None),  # fmt: skip
+            planning_cpu_ms=(
+                supervisor.planning_cpu_s[-1] * 1e3 if supervisor.planning_cpu_s else None
+            ),
             **fields,
         )
 

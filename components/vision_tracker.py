@@ -60,14 +60,32 @@ class VisionTracker(Component):
     params = (
         Param("device", str, "", doc="cv2.VideoCapture source; empty: the camera/image topic"),
         Param("calibration", str, "", doc="intrinsics YAML of the capture device"),
-        Param("reference_samples", int, 100, low=1, high=100000,
-              doc="eq. 6.1 samples of the floor reference F0"),
+        Param(
+            "reference_samples",
+            int,
+            100,
+            low=1,
+            high=100000,
+            doc="eq. 6.1 samples of the floor reference F0",
+        ),
         Param("plane_fit", bool, True, doc="fit markers on their known plane (else IPPE only)"),
-        Param("threshold_window_px", int, THRESHOLD_WINDOW_PX, low=3, high=255,
-              doc="the adaptive threshold's window, px (about a marker's side or less)"),
-        Param("threads", int, 1, low=0, high=256,
-              doc="OpenCV's worker threads (0: one per core); 1 spends the least CPU per frame"),
-    )  # fmt: skip
+        Param(
+            "threshold_window_px",
+            int,
+            THRESHOLD_WINDOW_PX,
+            low=3,
+            high=255,
+            doc="the adaptive threshold's window, px (about a marker's side or less)",
+        ),
+        Param(
+            "threads",
+            int,
+            1,
+            low=0,
+            high=256,
+            doc="OpenCV's worker threads (0: one per core); 1 spends the least CPU per frame",
+        ),
+    )
 
     def __init__(self, node: Node) -> None:
         super().__init__(node)
@@ -119,8 +137,9 @@ class VisionTracker(Component):
             if self.node.params["plane_fit"]:
                 # The floor plane from the filtered fits; F0's position and yaw on it.
                 normal, offset = plane_of(reference_pose, 0.0)
-                pose, error = plane_pose(reference, self.scene.reference.size_m, intrinsics,
-                                         normal, offset)  # fmt: skip
+                pose, error = plane_pose(
+                    reference, self.scene.reference.size_m, intrinsics, normal, offset
+                )
             found.append((reference, pose, error))
         elif self.reference.pose is not None:
             reference_pose = self.reference.pose
@@ -144,8 +163,12 @@ class VisionTracker(Component):
             MarkerDetections(
                 header=self.node.header("camera", stamp_ns, self.output.next_seq),
                 markers=tuple(
-                    MarkerDetection(id=d.id, pose=tuple(p.tolist()), reprojection_error=float(e),
-                                    corners=tuple(map(tuple, d.corners.tolist())))
+                    MarkerDetection(
+                        id=d.id,
+                        pose=tuple(p.tolist()),
+                        reprojection_error=float(e),
+                        corners=tuple(map(tuple, d.corners.tolist())),
+                    )
                     for d, p, e in sorted(found, key=lambda item: item[0].id)
                 ),
             )
@@ -193,8 +216,9 @@ def load_calibration(path: Path) -> Intrinsics:
     try:
         data = yaml.safe_load(path.read_text())
         distortion = tuple(float(v) for v in data.get("distortion", ()))
-        return Intrinsics(float(data["fx"]), float(data["fy"]), float(data["cx"]),
-                          float(data["cy"]), distortion)  # fmt: skip
+        return Intrinsics(
+            float(data["fx"]), float(data["fy"]), float(data["cx"]), float(data["cy"]), distortion
+        )
     except (OSError, yaml.YAMLError, KeyError, TypeError, ValueError, AttributeError) as error:
         raise ParamError(f"calibration: cannot read intrinsics from {path}: {error}") from error
 

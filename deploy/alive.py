@@ -46,8 +46,9 @@ class _Say:
         self._say(f"{text} ({now - self._started:.0f} s of at most {self._timeout_s:g})")
 
 
-def wait_alive(target: Target, names: Sequence[str], timeout_s: float,
-               say: Callable[[str], None]) -> None:  # fmt: skip
+def wait_alive(
+    target: Target, names: Sequence[str], timeout_s: float, say: Callable[[str], None]
+) -> None:
     """Return once every component of ``names`` is alive in ``target``'s namespace; raise
     ``NotAlive`` naming those that are not after ``timeout_s``. What it waits for goes to
     ``say``: the router while it cannot be reached, then the components still missing."""
@@ -60,21 +61,26 @@ def wait_alive(target: Target, names: Sequence[str], timeout_s: float,
             break
         except NoRouter:
             if time.monotonic() >= deadline:
-                raise NotAlive(f"no router at {where} after {timeout_s:g} s (is the profile "
-                               f"launched?); not alive: {', '.join(names)}") from None  # fmt: skip
+                raise NotAlive(
+                    f"no router at {where} after {timeout_s:g} s (is the profile "
+                    f"launched?); not alive: {', '.join(names)}"
+                ) from None
             tell(f"waiting for the router at {where} to listen")
             time.sleep(ROUTER_RETRY_S)
     with session:
         missing = _wait_tokens(session, target.namespace, names, deadline, tell)
     if missing:
-        raise NotAlive(f"not alive after {timeout_s:g} s: {', '.join(missing)} "
-                       f"({len(names) - len(missing)} of {len(names)} alive)")  # fmt: skip
+        raise NotAlive(
+            f"not alive after {timeout_s:g} s: {', '.join(missing)} "
+            f"({len(names) - len(missing)} of {len(names)} alive)"
+        )
     if tell.said:
         say(f"all {len(names)} components alive")
 
 
-def _wait_tokens(session: zenoh.Session, namespace: str, names: Sequence[str], deadline: float,
-                 tell: _Say) -> list[str]:  # fmt: skip
+def _wait_tokens(
+    session: zenoh.Session, namespace: str, names: Sequence[str], deadline: float, tell: _Say
+) -> list[str]:
     """The components of ``names`` still without a liveliness token at ``deadline``, or []
     as soon as all have one."""
     alive: set[str] = set()
@@ -97,8 +103,10 @@ def _wait_tokens(session: zenoh.Session, namespace: str, names: Sequence[str], d
                 left = deadline - time.monotonic()
                 if left <= 0:
                     return missing
-                tell(f"waiting for {', '.join(missing)} to come alive, "
-                     f"{len(names) - len(missing)} of {len(names)} so far")  # fmt: skip
+                tell(
+                    f"waiting for {', '.join(missing)} to come alive, "
+                    f"{len(names) - len(missing)} of {len(names)} so far"
+                )
                 changed.wait(min(SAY_EVERY_S, left))
             return []
     finally:

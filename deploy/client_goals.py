@@ -79,8 +79,7 @@ def marker_pose(schema_name: str, data: bytes) -> np.ndarray:
     """The pose (a unit dual quaternion) a client's message of ``SCHEMAS`` gives, or
     ``GoalRefused``. Sizes and magnitudes are checked before anything is computed."""
     if schema_name not in SCHEMAS:
-        raise GoalRefused(f"schema {echo(schema_name)}: goal/request takes "
-                          f"{' or '.join(SCHEMAS)}")  # fmt: skip
+        raise GoalRefused(f"schema {echo(schema_name)}: goal/request takes {' or '.join(SCHEMAS)}")
     if len(data) > GOAL_BYTES:
         raise GoalRefused(f"a message of {len(data)} bytes: a goal is at most {GOAL_BYTES}")
     try:
@@ -103,12 +102,14 @@ def marker_pose(schema_name: str, data: bytes) -> np.ndarray:
     position = [_number(where, axis, f"{prefix}position.", FARTHEST_M, far) for axis in "xyz"]
     unit = f"a unit quaternion's components lie in [-1, 1] (tolerance {UNIT_TOLERANCE:g})"
     turn = _object(fields, "orientation", prefix)
-    w, x, y, z = (_number(turn, axis, f"{prefix}orientation.", 1.0 + UNIT_TOLERANCE, unit)
-                  for axis in "wxyz")  # fmt: skip
+    w, x, y, z = (
+        _number(turn, axis, f"{prefix}orientation.", 1.0 + UNIT_TOLERANCE, unit) for axis in "wxyz"
+    )
     norm = math.sqrt(w * w + x * x + y * y + z * z)
     if abs(norm - 1.0) > UNIT_TOLERANCE:
-        raise GoalRefused(f"orientation has norm {norm:.9g}, expected 1 (tolerance "
-                          f"{UNIT_TOLERANCE:g})")  # fmt: skip
+        raise GoalRefused(
+            f"orientation has norm {norm:.9g}, expected 1 (tolerance {UNIT_TOLERANCE:g})"
+        )
     return dq.pose(np.array([w, x, y, z]), np.array(position))
 
 

@@ -82,10 +82,18 @@ def _answering(about: str, nothing: Any = None) -> Callable:
             except Exception as error:
                 with self._lock:
                     self.errors += 1
-                log.error("view: %s failed: %s: %s", method.__name__, type(error).__name__,
-                          cut(str(error), STATUS_CHARS))  # fmt: skip
-                self._status(client, about, f"{about}: not done, the view failed: "
-                             f"{type(error).__name__}: {error}", StatusLevel.Error)  # fmt: skip
+                log.error(
+                    "view: %s failed: %s: %s",
+                    method.__name__,
+                    type(error).__name__,
+                    cut(str(error), STATUS_CHARS),
+                )
+                self._status(
+                    client,
+                    about,
+                    f"{about}: not done, the view failed: {type(error).__name__}: {error}",
+                    StatusLevel.Error,
+                )
                 return nothing
 
         return answered
@@ -104,7 +112,8 @@ class ControlStation(ServerListener):
         access = profile.zenoh.access
         self.may_publish = access is None or access.may_write(topics.GOAL_REQUEST.name, self.user)
         self.may_set_any = access is None or any(
-            access.may_set(spec.name, self.user) for spec in profile.components)
+            access.may_set(spec.name, self.user) for spec in profile.components
+        )
         scene = profile.scene
         self._offset = offset_pose(*scene.goal.offset) if scene is not None else dq.ONE.copy()
         self._server: WebSocketServer | None = None
@@ -190,8 +199,10 @@ class ControlStation(ServerListener):
             if self.session is not failed:
                 return
             self.session_errors += 1
-            log.error("view: the control station's Zenoh session failed (%s); opening a new "
-                      "one", zenoh_error_text(error))  # fmt: skip
+            log.error(
+                "view: the control station's Zenoh session failed (%s); opening a new one",
+                zenoh_error_text(error),
+            )
             self._undeclare()
             try:
                 self.session = zenoh.open(self._profile.zenoh.client_config(self.user))
@@ -229,14 +240,22 @@ class ControlStation(ServerListener):
     def on_client_advertise(self, client: Client, channel: ClientChannel) -> None:
         key = (client.id, channel.id)
         if channel.topic not in (topics.GOAL_REQUEST.name, topics.GOAL_REQUEST.key(self.namespace)):
-            self._status(client, "publish", f"{echo(channel.topic)}: only "
-                         f"{topics.GOAL_REQUEST.name} may be published",
-                         StatusLevel.Error)  # fmt: skip
+            self._status(
+                client,
+                "publish",
+                f"{echo(channel.topic)}: only {topics.GOAL_REQUEST.name} may be published",
+                StatusLevel.Error,
+            )
             return
         if channel.encoding != ENCODING or channel.schema_name not in SCHEMAS:
-            self._status(client, "goal", f"goal/request in {echo(channel.encoding)} "
-                         f"{echo(channel.schema_name)} refused: it takes {ENCODING} "
-                         f"{' or '.join(SCHEMAS)}", StatusLevel.Error)  # fmt: skip
+            self._status(
+                client,
+                "goal",
+                f"goal/request in {echo(channel.encoding)} "
+                f"{echo(channel.schema_name)} refused: it takes {ENCODING} "
+                f"{' or '.join(SCHEMAS)}",
+                StatusLevel.Error,
+            )
             return
         with self._lock:
             self._goal_channels[key] = channel
@@ -262,17 +281,21 @@ class ControlStation(ServerListener):
             told = 0 if within else bucket.tell(now_s)
             self.goals_dropped += 0 if within else 1
         if told:
-            self._status(client, "goal", f"goal/request dropped: more than {GOAL_RATE} from "
-                         f"this client ({told} dropped); the next is taken in "
-                         f"{bucket.wait_s():.1f} s", StatusLevel.Warning)  # fmt: skip
+            self._status(
+                client,
+                "goal",
+                f"goal/request dropped: more than {GOAL_RATE} from "
+                f"this client ({told} dropped); the next is taken in "
+                f"{bucket.wait_s():.1f} s",
+                StatusLevel.Warning,
+            )
         if not within:
             return
         try:
             stamp_ns = clock.now_ns()
             if stamp_ns is None:
                 raise GoalRefused("the simulator's clock has not reached the view yet")
-            header = Header(stamp_ns=stamp_ns, frame="world", seq=self.goals_sent,
-                            source=SOURCE)  # fmt: skip
+            header = Header(stamp_ns=stamp_ns, frame="world", seq=self.goals_sent, source=SOURCE)
             goal = client_goal(channel.schema_name, data, self._offset, header, q, obstacles)
         except GoalRefused as error:
             with self._lock:
@@ -287,8 +310,12 @@ class ControlStation(ServerListener):
         with self._lock:
             self.goals_sent += 1
         x, y, z = dq.translation(np.array(goal.pose))[1:]
-        self._status(client, "goal", f"goal/request sent: the gripper to ({x:.3f}, {y:.3f}, "
-                     f"{z:.3f}) in world", StatusLevel.Info)  # fmt: skip
+        self._status(
+            client,
+            "goal",
+            f"goal/request sent: the gripper to ({x:.3f}, {y:.3f}, {z:.3f}) in world",
+            StatusLevel.Info,
+        )
 
     def _put(self, payload: bytes) -> None:
         assert self._goal_out is not None
@@ -302,8 +329,9 @@ class ControlStation(ServerListener):
         return "" if access is None else access.why_not_set(component, self.user)
 
     @_answering("parameters", [])
-    def on_get_parameters(self, client: Client, param_names: list[str],
-                          request_id: str | None = None) -> list[Parameter]:  # fmt: skip
+    def on_get_parameters(
+        self, client: Client, param_names: list[str], request_id: str | None = None
+    ) -> list[Parameter]:
         wanted = set(param_names)
         try:
             found = self._on_session(lambda s: running_parameters(s, self.namespace))
@@ -313,25 +341,35 @@ class ControlStation(ServerListener):
         return [p for p in found if not wanted or p.name in wanted]
 
     @_answering("parameters", [])
-    def on_set_parameters(self, client: Client, parameters: list[Parameter],
-                          request_id: str | None = None) -> list[Parameter]:  # fmt: skip
+    def on_set_parameters(
+        self, client: Client, parameters: list[Parameter], request_id: str | None = None
+    ) -> list[Parameter]:
         if not self.may_set_any:
-            self._status(client, "parameters", f"parameters are read-only in this view: "
-                         f"{self.user} may set no component's (zenoh.access.parameters)",
-                         StatusLevel.Error)  # fmt: skip
+            self._status(
+                client,
+                "parameters",
+                f"parameters are read-only in this view: "
+                f"{self.user} may set no component's (zenoh.access.parameters)",
+                StatusLevel.Error,
+            )
             return self.on_get_parameters(client, [p.name for p in parameters], request_id)
         try:
             values, refusals = self._on_session(
-                lambda s: set_parameters(s, self.namespace, parameters, self._may_set))
+                lambda s: set_parameters(s, self.namespace, parameters, self._may_set)
+            )
         except SessionFailed as error:
             self._status(client, "parameters", str(error), StatusLevel.Error)
             return []
         for refusal in refusals:
             self._status(client, "parameters", refusal, StatusLevel.Error)
         if values and not refusals:
-            self._status(client, "parameters", "set: " + ", ".join(
-                f"{p.name} = {cut(repr(p.get_value()), ECHO_CHARS)}" for p in values),
-                StatusLevel.Info)  # fmt: skip
+            self._status(
+                client,
+                "parameters",
+                "set: "
+                + ", ".join(f"{p.name} = {cut(repr(p.get_value()), ECHO_CHARS)}" for p in values),
+                StatusLevel.Info,
+            )
         return values
 
     def _status(self, client: Client, about: str, text: str, level: StatusLevel) -> None:

@@ -42,8 +42,7 @@ def foxglove_parameter(component: str, name: str, value: ParamValue) -> Paramete
         items = list(value)
         if all(isinstance(v, float) for v in items):
             return Parameter(full, value=items, type=ParameterType.Float64Array)
-        return Parameter(full, value=[list(v) if isinstance(v, tuple | list) else v
-                                      for v in items])  # fmt: skip
+        return Parameter(full, value=[list(v) if isinstance(v, tuple | list) else v for v in items])
     return Parameter(full, value=value)
 
 
@@ -51,8 +50,10 @@ def split_name(full: str) -> tuple[str, str]:
     """``(component, name)`` of a Foxglove parameter's name, or ``QueryError``."""
     component, separator, name = full.partition(SEPARATOR)
     if not separator or not component or not name:
-        raise QueryError(f"{echo(full)}: a parameter is named component{SEPARATOR}name "
-                         f"(controller{SEPARATOR}eta)")  # fmt: skip
+        raise QueryError(
+            f"{echo(full)}: a parameter is named component{SEPARATOR}name "
+            f"(controller{SEPARATOR}eta)"
+        )
     return component, name
 
 
@@ -82,8 +83,9 @@ class SetRefused(QueryError):
     """A parameter set that is not sent to the component; the text says why."""
 
 
-def checked(parameter: Parameter, running: Iterable[str], may_set: Callable[[str], str] = _free
-            ) -> tuple[str, str, str]:  # fmt: skip
+def checked(
+    parameter: Parameter, running: Iterable[str], may_set: Callable[[str], str] = _free
+) -> tuple[str, str, str]:
     """``(component, name, value as text)`` of a set of one of the ``running`` parameters
     (their Foxglove names), or ``SetRefused``: a name too long or no running parameter's, a
     component ``may_set`` refuses (it says why, or empty), a value of no parameter's type or
@@ -92,8 +94,10 @@ def checked(parameter: Parameter, running: Iterable[str], may_set: Callable[[str
     if len(full) > NAME_CHARS:
         raise SetRefused(f"a name of {len(full)} characters: at most {NAME_CHARS}")
     if full not in running:
-        raise SetRefused(f"no running component has this parameter (they are named "
-                         f"component{SEPARATOR}name, as controller{SEPARATOR}eta)")  # fmt: skip
+        raise SetRefused(
+            f"no running component has this parameter (they are named "
+            f"component{SEPARATOR}name, as controller{SEPARATOR}eta)"
+        )
     component, name = split_name(full)
     why = may_set(component)
     if why:
@@ -113,9 +117,12 @@ def checked(parameter: Parameter, running: Iterable[str], may_set: Callable[[str
 
 
 def set_parameters(
-    session: zenoh.Session, namespace: str, wanted: Sequence[Parameter],
-    may_set: Callable[[str], str] = _free, timeout_s: float = DEFAULT_TIMEOUT_S,
-) -> tuple[list[Parameter], list[str]]:  # fmt: skip
+    session: zenoh.Session,
+    namespace: str,
+    wanted: Sequence[Parameter],
+    may_set: Callable[[str], str] = _free,
+    timeout_s: float = DEFAULT_TIMEOUT_S,
+) -> tuple[list[Parameter], list[str]]:
     """Set each parameter ``checked`` lets through on its component; the values they have
     afterwards (the new one, or the one kept after a refusal), and why each refused set was
     refused. Zenoh's own errors are raised."""
@@ -126,11 +133,16 @@ def set_parameters(
     for parameter in wanted:
         try:
             component, name, text = checked(parameter, running, may_set)
-            values.append(foxglove_parameter(
-                component, name, set_param(session, namespace, component, name, text, timeout_s)))
+            values.append(
+                foxglove_parameter(
+                    component, name, set_param(session, namespace, component, name, text, timeout_s)
+                )
+            )
         except QueryError as error:
-            refusals.append(f"{cut(parameter.name, ECHO_CHARS)} = {echo(parameter.get_value())} "
-                            f"refused: {error}")  # fmt: skip
+            refusals.append(
+                f"{cut(parameter.name, ECHO_CHARS)} = {echo(parameter.get_value())} "
+                f"refused: {error}"
+            )
             if parameter.name in running:
                 values.append(running[parameter.name])
     return values, refusals

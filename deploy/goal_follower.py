@@ -45,21 +45,22 @@ class GoalFollower:
     """The statuses of the supervisor ``component`` of ``namespace``, on ``session``: declare
     it before the goal is sent, ``sent`` once it is, then ``follow``."""
 
-    def __init__(self, session: zenoh.Session, namespace: str, component: str,
-                 timeout_s: float) -> None:  # fmt: skip
+    def __init__(
+        self, session: zenoh.Session, namespace: str, component: str, timeout_s: float
+    ) -> None:
         self.session, self.namespace, self.component = session, namespace, component
         self.timeout_s = timeout_s
         self._key = topics.SUPERVISOR_STATUS.key(namespace)
         self._statuses: queue.Queue[SupervisorStatus] = queue.Queue()
         self._subscriber: zenoh.Subscriber | None = session.declare_subscriber(
-            self._key, self._on_status)  # fmt: skip
+            self._key, self._on_status
+        )
         self._before = self._requests()
         self._refused = False
 
     def _on_status(self, sample: zenoh.Sample) -> None:
         try:
-            self._statuses.put(codec.decode(sample.payload.to_bytes(), SupervisorStatus,
-                                            self._key))  # fmt: skip
+            self._statuses.put(codec.decode(sample.payload.to_bytes(), SupervisorStatus, self._key))
         except codec.DecodeError:
             pass  # the supervisor's own counters say it published; a bad one is no answer
 
@@ -80,8 +81,7 @@ class GoalFollower:
                 self._refused = now_refused > refused
                 break
             if time.monotonic() > deadline:
-                raise QueryError(f"{self.component} did not take the goal in "
-                                 f"{self.timeout_s:g} s")  # fmt: skip
+                raise QueryError(f"{self.component} did not take the goal in {self.timeout_s:g} s")
             time.sleep(POLL_S)  # asking again: the supervisor answers on its handler thread
         while not self._statuses.empty():
             self._statuses.get_nowait()
@@ -94,8 +94,10 @@ class GoalFollower:
             try:
                 status = self._statuses.get(timeout=self.timeout_s)
             except queue.Empty:
-                raise QueryError(f"no {self._key} in {self.timeout_s:g} s (is the simulator "
-                                 "paused, or the state invalid?)") from None  # fmt: skip
+                raise QueryError(
+                    f"no {self._key} in {self.timeout_s:g} s (is the simulator "
+                    "paused, or the state invalid?)"
+                ) from None
             if self._refused:
                 return Outcome("refused", status.last_refusal, status)
             progress(status)

@@ -51,19 +51,28 @@ class Dataflow:
 
     def readers(self, topic: str, waiting: bool = False) -> list[str]:
         """The components that read ``topic`` (``waiting``: but a recorder)."""
-        return [c.name for c in self.components if topic in {i.topic.name for i in c.reads}
-                and not (waiting and c.role == "recorder")]  # fmt: skip
+        return [
+            c.name
+            for c in self.components
+            if topic in {i.topic.name for i in c.reads} and not (waiting and c.role == "recorder")
+        ]
 
     def read_never_written(self) -> list[str]:
         """Topics some component waits for that no component of the profile publishes (a
         recorder, which takes whatever comes, waits for none)."""
-        return [name for name in self.topics()
-                if not self.writers(name) and self.readers(name, waiting=True)]  # fmt: skip
+        return [
+            name
+            for name in self.topics()
+            if not self.writers(name) and self.readers(name, waiting=True)
+        ]
 
     def warnings(self) -> list[str]:
         """One line per topic read and never written."""
-        return [f"warning: {self.key(name)} is read by {', '.join(self.readers(name))} and "
-                "written by no component of the profile" for name in self.read_never_written()]
+        return [
+            f"warning: {self.key(name)} is read by {', '.join(self.readers(name))} and "
+            "written by no component of the profile"
+            for name in self.read_never_written()
+        ]
 
     def key(self, topic: str) -> str:
         return topics.TOPICS[topic].key(self.namespace)
@@ -102,25 +111,38 @@ class Dataflow:
         return {
             "namespace": self.namespace,
             "components": [
-                {"name": c.name, "module": c.module, "role": c.role,
-                 "reads": [{"topic": i.topic.name, "queue": i.queue} for i in c.reads],
-                 "writes": [t.name for t in c.writes]}
+                {
+                    "name": c.name,
+                    "module": c.module,
+                    "role": c.role,
+                    "reads": [{"topic": i.topic.name, "queue": i.queue} for i in c.reads],
+                    "writes": [t.name for t in c.writes],
+                }
                 for c in self.components
             ],
-            "topics": {name: {"key": self.key(name), "writers": self.writers(name),
-                              "readers": self.readers(name)} for name in self.topics()},
+            "topics": {
+                name: {
+                    "key": self.key(name),
+                    "writers": self.writers(name),
+                    "readers": self.readers(name),
+                }
+                for name in self.topics()
+            },
             "read_never_written": self.read_never_written(),
-        }  # fmt: skip
+        }
 
 
 def component_class(spec: ComponentSpec) -> type[Component]:
     """The ``Component`` subclass that ``spec``'s module defines and runs."""
     module = importlib.import_module(spec.module_path)
     found = [
-        value for value in vars(module).values()
-        if inspect.isclass(value) and issubclass(value, Component) and not inspect.isabstract(value)
+        value
+        for value in vars(module).values()
+        if inspect.isclass(value)
+        and issubclass(value, Component)
+        and not inspect.isabstract(value)
         and value.__module__ == module.__name__
-    ]  # fmt: skip
+    ]
     if len(found) != 1:
         names = [cls.__name__ for cls in found]
         raise LookupError(f"{spec.module_path}: expected one Component subclass, found {names}")
@@ -137,8 +159,9 @@ def dataflow(profile: Profile, path: Path | str = "profile") -> Dataflow:
             Parameters(cls.params, spec.params)
         except ParamError as error:
             index = profile.components.index(spec)
-            raise ProfileError(f"{path}: invalid profile\n  components[{index}] ({spec.name})"
-                               f".params.{error}") from None  # fmt: skip
+            raise ProfileError(
+                f"{path}: invalid profile\n  components[{index}] ({spec.name}).params.{error}"
+            ) from None
         reads = tuple(Input(spec.topic(i.topic), i.queue) for i in cls.reads)
         if profile.clock_of(spec, topics.SIM_CLOCK in cls.writes) == "sim":
             reads += (Input(topics.SIM_CLOCK),)

@@ -162,15 +162,20 @@ class Launcher:
             try:
                 self._start_ready()
                 if self.recorders and len(self.recorders) < len(self.children):
-                    self.output.say(f"the others start once {' and '.join(self.recorders)} "
-                                    "alive, to be recorded from their first message")  # fmt: skip
+                    self.output.say(
+                        f"the others start once {' and '.join(self.recorders)} "
+                        "alive, to be recorded from their first message"
+                    )
                 for child in self.children:
                     if child.waiting and child.spec.after:
-                        self.output.say(f"{child.spec.name} starts once "
-                                        f"{' and '.join(child.spec.after)} alive")  # fmt: skip
+                        self.output.say(
+                            f"{child.spec.name} starts once {' and '.join(child.spec.after)} alive"
+                        )
                 self._starting_until = time.monotonic() + self.profile.startup_timeout_s
-                self.output.say(f"waiting for {len(self.children)} component(s) to come alive "
-                                f"(at most {self.profile.startup_timeout_s:g} s)")  # fmt: skip
+                self.output.say(
+                    f"waiting for {len(self.children)} component(s) to come alive "
+                    f"(at most {self.profile.startup_timeout_s:g} s)"
+                )
                 threading.Thread(target=self._watch, args=(router,), daemon=True).start()
                 self._supervise(None if duration_s is None else time.monotonic() + duration_s)
             finally:
@@ -260,33 +265,46 @@ class Launcher:
         for child in self.children:
             silent_s = now - child.answered_at
             if child.process is not None and child.alive and silent_s > self.profile.watchdog_s:
-                self.output.say(f"{child.spec.name} hung: no status answer for {silent_s:.1f} s; "
-                                "killing it")  # fmt: skip
+                self.output.say(
+                    f"{child.spec.name} hung: no status answer for {silent_s:.1f} s; killing it"
+                )
                 child.process.kill()
                 child.answered_at = now
 
     def _check_startup(self, now: float) -> None:
         """Until every component has been alive once: fail the launch when one stops for good
         before (a configuration error, say), or is not alive when the start-up timeout runs out."""
-        refused = [c.spec.name for c in self.children
-                   if c.done and c.failed and c.spec.name not in self._seen_alive]  # fmt: skip
-        waiting = [c.spec.name for c in self.children
-                   if not c.done and c.spec.name not in self._seen_alive]  # fmt: skip
+        refused = [
+            c.spec.name
+            for c in self.children
+            if c.done and c.failed and c.spec.name not in self._seen_alive
+        ]
+        waiting = [
+            c.spec.name for c in self.children if not c.done and c.spec.name not in self._seen_alive
+        ]
         if refused:
             self._fail_startup(f"{', '.join(refused)} failed during start-up", refused)
         elif not waiting:
             self._starting_until = None
-            until = "Ctrl-C" if self._duration_s is None else \
-                f"the end of the {self._duration_s:g} s duration"  # fmt: skip
+            until = (
+                "Ctrl-C"
+                if self._duration_s is None
+                else f"the end of the {self._duration_s:g} s duration"
+            )
             self.output.say(f"all {len(self.children)} components alive; running until {until}")
         elif now >= self._starting_until:
             timeout = self.profile.startup_timeout_s
-            unstarted = [f"{c.spec.name} waited for {', '.join(self._awaited(c.spec))}"
-                         for c in self.children if c.waiting]  # fmt: skip
+            unstarted = [
+                f"{c.spec.name} waited for {', '.join(self._awaited(c.spec))}"
+                for c in self.children
+                if c.waiting
+            ]
             more = f"; never started: {'; '.join(unstarted)}" if unstarted else ""
-            self._fail_startup(f"{', '.join(waiting)} not alive after {timeout:.1f} s "
-                               f"(check its zenoh endpoints and its log){more}",
-                               waiting)  # fmt: skip
+            self._fail_startup(
+                f"{', '.join(waiting)} not alive after {timeout:.1f} s "
+                f"(check its zenoh endpoints and its log){more}",
+                waiting,
+            )
 
     def _fail_startup(self, why: str, names: list[str]) -> None:
         self._starting_until = None
@@ -312,10 +330,14 @@ class Launcher:
         spec = child.spec
         child.waiting = False
         command = process.command(spec.module_path, self.profile_path, spec.name)
-        env = dict(os.environ, PYTHONUNBUFFERED="1", **{
-            PARENT_PID_ENV: str(os.getpid()),
-            PARAMS_FILE_ENV: str(self._kept_params / f"{spec.name}.json"),
-        })  # fmt: skip
+        env = dict(
+            os.environ,
+            PYTHONUNBUFFERED="1",
+            **{
+                PARENT_PID_ENV: str(os.getpid()),
+                PARAMS_FILE_ENV: str(self._kept_params / f"{spec.name}.json"),
+            },
+        )
         child.process = subprocess.Popen(
             command,
             stdin=subprocess.DEVNULL,
@@ -384,8 +406,9 @@ class Launcher:
         def order(child: Child) -> tuple[int, int]:
             return ROLES.index(child.spec.role), self.profile.start_depth(child.spec)
 
-        running = sorted((c for c in self.children if c.process is not None), key=order,
-                         reverse=True)  # fmt: skip
+        running = sorted(
+            (c for c in self.children if c.process is not None), key=order, reverse=True
+        )
         for _, wave in groupby(running, key=order):
             group = list(wave)
             for child in group:
@@ -401,16 +424,18 @@ class Launcher:
         if code is None:
             process.kill()
             process.wait()
-            self.output.say(f"{child.spec.name} did not stop in {child.spec.stop_timeout_s:g} s; "
-                            "killed")  # fmt: skip
+            self.output.say(
+                f"{child.spec.name} did not stop in {child.spec.stop_timeout_s:g} s; killed"
+            )
             child.failed = True
         else:
             child.failed = child.failed or code not in CLEAN_STOP_CODES
             self.output.say(f"{child.spec.name} stopped ({code})")
         child.process = None
 
-    def _wait_stopped(self, child: Child, process: subprocess.Popen[str], deadline: float
-                      ) -> int | None:  # fmt: skip
+    def _wait_stopped(
+        self, child: Child, process: subprocess.Popen[str], deadline: float
+    ) -> int | None:
         """Its exit code, or None once ``deadline`` passed; a recorder's deadline moves on
         while it spends CPU time. A wait longer than ``QUIET_WAIT_S`` is said."""
         spent, said = cpu_seconds(process.pid), False
@@ -424,8 +449,10 @@ class Launcher:
                 said = True
                 if time.monotonic() < deadline:
                     progress = " without progress" if child.spec.role == "recorder" else ""
-                    self.output.say(f"waiting for {child.spec.name} to stop (killed after "
-                                    f"{child.spec.stop_timeout_s:g} s{progress})")  # fmt: skip
+                    self.output.say(
+                        f"waiting for {child.spec.name} to stop (killed after "
+                        f"{child.spec.stop_timeout_s:g} s{progress})"
+                    )
                     continue
             now_spent = cpu_seconds(process.pid)
             if child.spec.role != "recorder" or now_spent <= spent:

@@ -96,9 +96,11 @@ def overwritten_by(writers: list[str], key: str) -> str:
     """What a message a tool publishes on ``key`` meets when ``writers`` (running components,
     ``live_writers``) write it too, in words: their next message replaces it."""
     one = len(writers) == 1
-    return (f"{', '.join(writers)} {'writes' if one else 'write'} {key} in this profile and "
-            f"{'is' if one else 'are'} running: {'its' if one else 'their'} next message "
-            "replaces what is published here")  # fmt: skip
+    return (
+        f"{', '.join(writers)} {'writes' if one else 'write'} {key} in this profile and "
+        f"{'is' if one else 'are'} running: {'its' if one else 'their'} next message "
+        "replaces what is published here"
+    )
 
 
 def statuses(
@@ -154,8 +156,10 @@ def all_params(
             name = str(reply.ok.key_expr).removeprefix(prefix)
             values[name] = decode_value(reply.ok.payload.to_bytes())
     if not values:
-        raise QueryError(f"no reply from {component!r} in namespace {namespace!r} within "
-                         f"{timeout_s} s (is it running?)")  # fmt: skip
+        raise QueryError(
+            f"no reply from {component!r} in namespace {namespace!r} within "
+            f"{timeout_s} s (is it running?)"
+        )
     return dict(sorted(values.items()))
 
 
@@ -167,8 +171,10 @@ def status_of(
     for reply in session.get(key, timeout=timeout_s):
         if reply.ok is not None:
             return codec.decode(reply.ok.payload.to_bytes(), topics.STATUS_TYPE, key)
-    raise QueryError(f"no status from {component!r} in namespace {namespace!r} within "
-                     f"{timeout_s} s (is it running?)")  # fmt: skip
+    raise QueryError(
+        f"no status from {component!r} in namespace {namespace!r} within "
+        f"{timeout_s} s (is it running?)"
+    )
 
 
 def _param_query(

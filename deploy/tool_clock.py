@@ -33,8 +33,9 @@ class ToolClock:
         self._key = topics.SIM_CLOCK.key(profile.namespace)
         self._stamp_ns: int | None = None
         self._arrived = threading.Event()
-        self._subscriber = (session.declare_subscriber(self._key, self._on_clock)
-                            if self.simulated else None)  # fmt: skip
+        self._subscriber = (
+            session.declare_subscriber(self._key, self._on_clock) if self.simulated else None
+        )
 
     def _on_clock(self, sample: zenoh.Sample) -> None:
         try:
@@ -53,8 +54,10 @@ class ToolClock:
         """``now_ns``, waiting up to ``timeout_s`` for the simulator's first clock
         (``NoClock`` if it does not come)."""
         if self.simulated and not self._arrived.wait(timeout_s):
-            raise NoClock(f"no simulator clock on {self._key} in {timeout_s:g} s: a sim-clock "
-                          "profile's messages are stamped on it (is the simulator running?)")
+            raise NoClock(
+                f"no simulator clock on {self._key} in {timeout_s:g} s: a sim-clock "
+                "profile's messages are stamped on it (is the simulator running?)"
+            )
         stamp_ns = self.now_ns()
         assert stamp_ns is not None
         return stamp_ns

@@ -49,6 +49,5 @@ class Goal(Message):
             if given != (name in needed):
                 article = "an" if name[0] in "aeiou" else "a"
                 what = "takes no" if given else f"needs {article}"
-                raise ValueError(f"a {self.task} task {what} {name} "
-                                 f"(it needs {', '.join(needed)})")  # fmt: skip
+                raise ValueError(f"a {self.task} task {what} {name} (it needs {', '.join(needed)})")
         return self

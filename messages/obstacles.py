@@ -48,8 +48,9 @@ class Plane(Message):
 
     @classmethod
     def of(cls, solid: obstacles3d.Plane) -> Plane:
-        return cls(name=solid.name, normal=solid.normal, offset=solid.offset,
-                   footprint=solid.footprint)  # fmt: skip
+        return cls(
+            name=solid.name, normal=solid.normal, offset=solid.offset, footprint=solid.footprint
+        )
 
 
 class Cylinder(Message):
@@ -72,8 +73,7 @@ class Cylinder(Message):
 
     @classmethod
     def of(cls, solid: obstacles3d.Cylinder) -> Cylinder:
-        return cls(name=solid.name, x=solid.x, y=solid.y, radius=solid.radius,
-                   height=solid.height)  # fmt: skip
+        return cls(name=solid.name, x=solid.x, y=solid.y, radius=solid.radius, height=solid.height)
 
 
 class Solids(Message):
@@ -89,9 +89,10 @@ class Solids(Message):
 
     @classmethod
     def of(cls, solids: tuple[obstacles3d.Solid, ...]) -> Solids:
-        return cls(planes=tuple(Plane.of(s) for s in solids if isinstance(s, obstacles3d.Plane)),
-                   cylinders=tuple(Cylinder.of(s) for s in solids
-                                   if isinstance(s, obstacles3d.Cylinder)))  # fmt: skip
+        return cls(
+            planes=tuple(Plane.of(s) for s in solids if isinstance(s, obstacles3d.Plane)),
+            cylinders=tuple(Cylinder.of(s) for s in solids if isinstance(s, obstacles3d.Cylinder)),
+        )
 
 
 class Obstacles(Message):

@@ -40,6 +40,7 @@ def parent_gone() -> bool:
     parent = os.environ.get(PARENT_PID_ENV)
     return parent is not None and os.getppid() != int(parent)
 
+
 PARAMS_FILE_ENV = "PARSIMONY_PARAMS_FILE"
 """Set by the launcher: a JSON file where a component keeps the parameters set while it runs,
 and from which it takes them back when it is started again (a restart keeps them)."""

@@ -254,11 +254,16 @@ def topics_matching(patterns: Sequence[str]) -> list[Topic]:
     """The topics whose names match one of the ``fnmatch`` patterns; ``ValueError`` when there
     is no pattern, or one matches no topic (a typo beside good patterns too)."""
     if not patterns:
-        raise ValueError(f"keys: give at least one topic name pattern (the topics: "
-                         f"{', '.join(TOPICS)})")  # fmt: skip
+        raise ValueError(
+            f"keys: give at least one topic name pattern (the topics: {', '.join(TOPICS)})"
+        )
     for pattern in patterns:
         if not fnmatch.filter(TOPICS, pattern):
-            raise ValueError(f"keys: {pattern!r} matches no topic (the topics: "
-                             f"{', '.join(TOPICS)})")  # fmt: skip
-    return [topic for topic in TOPICS.values()
-            if any(fnmatch.fnmatch(topic.name, pattern) for pattern in patterns)]  # fmt: skip
+            raise ValueError(
+                f"keys: {pattern!r} matches no topic (the topics: {', '.join(TOPICS)})"
+            )
+    return [
+        topic
+        for topic in TOPICS.values()
+        if any(fnmatch.fnmatch(topic.name, pattern) for pattern in patterns)
+    ]

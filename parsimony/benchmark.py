@@ -85,8 +85,12 @@ def step_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str, fl
     """
     task = PoseTask(robot.fkm(GOAL))
     trajectory = integrate(LPLaw(robot), HOME, task, DT, 3000).configurations
-    laws = {"lp": LPLaw(robot), "qp": QPLaw(robot), "classic": PseudoinverseLaw(robot),
-            "cascade": CascadeLaw(robot)}  # fmt: skip
+    laws = {
+        "lp": LPLaw(robot),
+        "qp": QPLaw(robot),
+        "classic": PseudoinverseLaw(robot),
+        "cascade": CascadeLaw(robot),
+    }
     samples: dict[str, list[float]] = {name: [] for name in laws}
     for block in blocks(trajectory, repeats, laws.values()):
         for name, law in laws.items():
@@ -108,10 +112,13 @@ def arm_row_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str,
     less: the time the process was not running is not counted."""
     task = PoseTask(robot.fkm(TABLE_GOAL))
     obstacles = (TABLE,)
-    trajectory = integrate(LPLaw(robot, TABLE_PARAMS), TABLE_START, task, DT, 3000,
-                           obstacles=obstacles).configurations  # fmt: skip
-    laws = {"lp_with_arm_rows": LPLaw(robot, TABLE_PARAMS),
-            "lp_without_arm_rows": LPLaw(robot, WITHOUT_ARM_ROWS)}  # fmt: skip
+    trajectory = integrate(
+        LPLaw(robot, TABLE_PARAMS), TABLE_START, task, DT, 3000, obstacles=obstacles
+    ).configurations
+    laws = {
+        "lp_with_arm_rows": LPLaw(robot, TABLE_PARAMS),
+        "lp_without_arm_rows": LPLaw(robot, WITHOUT_ARM_ROWS),
+    }
     names = (*laws, "arm_rows")
     wall: dict[str, list[float]] = {name: [] for name in names}
     cpu: dict[str, list[float]] = {name: [] for name in names}
@@ -129,12 +136,26 @@ def arm_row_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str,
             for q in block:
                 timed(name, lambda law=law, q=q: law.step(q, task, DT, obstacles))
         for q in block:
-            context = StepContext(robot, q, np.zeros(8), np.zeros(8), np.zeros(2), (), None, DT,
-                                  obstacles, chain=robot.forward(q))  # fmt: skip
+            context = StepContext(
+                robot,
+                q,
+                np.zeros(8),
+                np.zeros(8),
+                np.zeros(2),
+                (),
+                None,
+                DT,
+                obstacles,
+                chain=robot.forward(q),
+            )
             timed("arm_rows", lambda context=context: rows.rows(context))
-    return {name: {**percentiles(wall[name]),
-                   **{f"cpu_{key}": value for key, value in percentiles(cpu[name]).items()}}
-            for name in names}  # fmt: skip
+    return {
+        name: {
+            **percentiles(wall[name]),
+            **{f"cpu_{key}": value for key, value in percentiles(cpu[name]).items()},
+        }
+        for name in names
+    }
 
 
 def lp_breakdown(robot: MobileManipulator, repeats: int) -> dict[str, float]:
@@ -222,9 +243,12 @@ robot's own would hold the LP alone, since neither the classic law nor the casca
 (test 2's LP on the robot's bounds ends 2000 iterations at ||e|| 0.094; unbounded it converges
 in 76)."""
 
-CONVERGENCE_NAMES = {("test 1", "classic"): "holonomic/classic", ("test 1", "LP"): "holonomic/lp",
-                     ("test 2", "classic"): "nonholonomic/cascade",
-                     ("test 2", "LP"): "nonholonomic/lp"}  # fmt: skip
+CONVERGENCE_NAMES = {
+    ("test 1", "classic"): "holonomic/classic",
+    ("test 1", "LP"): "holonomic/lp",
+    ("test 2", "classic"): "nonholonomic/cascade",
+    ("test 2", "LP"): "nonholonomic/lp",
+}
 """The bench's name of each law of each test of section 6.3."""
 
 
@@ -256,15 +280,21 @@ def run_bench(repeats: int, trials: int, goals: int, robot_file: Path = ROBOT_FI
     breakdown = lp_breakdown(robot, repeats)
     reference = dqrobotics_times(robot, repeats)
     arm = arm_row_times(robot, repeats)
-    report: dict = {"step": steps, "lp_breakdown_us": breakdown, "dqrobotics": reference,
-                    "arm_rows": arm}  # fmt: skip
+    report: dict = {
+        "step": steps,
+        "lp_breakdown_us": breakdown,
+        "dqrobotics": reference,
+        "arm_rows": arm,
+    }
     report["ratios"] = {
         "lp_over_classic": steps["lp"]["median_us"] / steps["classic"]["median_us"],
         "qp_over_classic": steps["qp"]["median_us"] / steps["classic"]["median_us"],
-        "lp_with_arm_rows_over_without": (arm["lp_with_arm_rows"]["median_us"]
-                                          / arm["lp_without_arm_rows"]["median_us"]),
-        "lp_with_arm_rows_over_without_cpu": (arm["lp_with_arm_rows"]["cpu_median_us"]
-                                              / arm["lp_without_arm_rows"]["cpu_median_us"]),
+        "lp_with_arm_rows_over_without": (
+            arm["lp_with_arm_rows"]["median_us"] / arm["lp_without_arm_rows"]["median_us"]
+        ),
+        "lp_with_arm_rows_over_without_cpu": (
+            arm["lp_with_arm_rows"]["cpu_median_us"] / arm["lp_without_arm_rows"]["cpu_median_us"]
+        ),
     }
     if reference:
         report["ratios"]["kinematics_over_dqrobotics"] = (
@@ -288,45 +318,89 @@ def progress(what: str) -> None:
 
 def format_report(report: dict) -> str:
     """The figures as tables, one per section."""
-    steps = [{"control step (model + Jacobian + rows + solve)": name, **figures}
-             for name, figures in report["step"].items()]
-    steps += [{"control step (model + Jacobian + rows + solve)": f"DQ Robotics {name}",
-               **figures} for name, figures in report["dqrobotics"].items()]  # fmt: skip
-    arm = [{"reach over the table (wbc.constraints.arm_obstacles)": name, **figures}
-           for name, figures in report["arm_rows"].items()]  # fmt: skip
-    parts = [table(steps, floatfmt=".1f"), "", table(arm, floatfmt=".1f"), "",
-             "LP step, median us by part",
-             table([report["lp_breakdown_us"]], floatfmt=".1f"), "",
-             table([{"ratios (medians, same run)": n, "ratio": v}
-                    for n, v in report["ratios"].items()], floatfmt=".2f"), "",
-             table([{"section 6.3 convergence": n, **row}
-                    for n, row in report["convergence"].items()], floatfmt=".2f")]  # fmt: skip
+    steps = [
+        {"control step (model + Jacobian + rows + solve)": name, **figures}
+        for name, figures in report["step"].items()
+    ]
+    steps += [
+        {"control step (model + Jacobian + rows + solve)": f"DQ Robotics {name}", **figures}
+        for name, figures in report["dqrobotics"].items()
+    ]
+    arm = [
+        {"reach over the table (wbc.constraints.arm_obstacles)": name, **figures}
+        for name, figures in report["arm_rows"].items()
+    ]
+    parts = [
+        table(steps, floatfmt=".1f"),
+        "",
+        table(arm, floatfmt=".1f"),
+        "",
+        "LP step, median us by part",
+        table([report["lp_breakdown_us"]], floatfmt=".1f"),
+        "",
+        table(
+            [{"ratios (medians, same run)": n, "ratio": v} for n, v in report["ratios"].items()],
+            floatfmt=".2f",
+        ),
+        "",
+        table(
+            [{"section 6.3 convergence": n, **row} for n, row in report["convergence"].items()],
+            floatfmt=".2f",
+        ),
+    ]
     for family, result in report.get("goals", {}).items():
-        reached = [{f"{family} goals ({result['goals']})": law,
-                    **{k: row[k] for k in ("reached", "within_joint_limits",
-                                           "within_joint_and_speed_limits",
-                                           "median_time_to_converge_s")}}
-                   for law, row in result["laws"].items()]  # fmt: skip
-        nonzero = [{"nonzero entries of u": law,
-                    **{k: row[k] for k in ("median_nonzero_moving", "median_nonzero_settling",
-                                           "median_nonzero_settling_forward_as_one")},
-                    "steps by count 0..8 (exact | practical, Upsilon 0.01)":
-                        f"{row['nonzero_histogram']} | {row['practical_histogram']}"}
-                   for law, row in result["laws"].items()]  # fmt: skip
+        reached = [
+            {
+                f"{family} goals ({result['goals']})": law,
+                **{
+                    k: row[k]
+                    for k in (
+                        "reached",
+                        "within_joint_limits",
+                        "within_joint_and_speed_limits",
+                        "median_time_to_converge_s",
+                    )
+                },
+            }
+            for law, row in result["laws"].items()
+        ]
+        nonzero = [
+            {
+                "nonzero entries of u": law,
+                **{
+                    k: row[k]
+                    for k in (
+                        "median_nonzero_moving",
+                        "median_nonzero_settling",
+                        "median_nonzero_settling_forward_as_one",
+                    )
+                },
+                "steps by count 0..8 (exact | practical, Upsilon 0.01)": (
+                    f"{row['nonzero_histogram']} | {row['practical_histogram']}"
+                ),
+            }
+            for law, row in result["laws"].items()
+        ]
         parts += ["", table(reached, floatfmt=".2f"), "", table(nonzero, floatfmt=".1f")]
         for law, row in result["laws"].items():
             if law.startswith("lp"):
-                parts.append(f"{law}: every command an optimal LP solution in "
-                             f"{row['every_step_optimal']:.2f} of the runs")
+                parts.append(
+                    f"{law}: every command an optimal LP solution in "
+                    f"{row['every_step_optimal']:.2f} of the runs"
+                )
             if "plans_per_run" in row:
-                parts.append(f"{law}: {row['plans_per_run']:.2f} plans per run, a plan takes "
-                             f"{row['plan_median_ms']:.0f} ms median, "
-                             f"{row['plan_p99_ms']:.0f} ms p99 "
-                             f"({row['plan_cpu_median_ms']:.0f} and "
-                             f"{row['plan_cpu_p99_ms']:.0f} ms of its thread's CPU time)")
+                parts.append(
+                    f"{law}: {row['plans_per_run']:.2f} plans per run, a plan takes "
+                    f"{row['plan_median_ms']:.0f} ms median, "
+                    f"{row['plan_p99_ms']:.0f} ms p99 "
+                    f"({row['plan_cpu_median_ms']:.0f} and "
+                    f"{row['plan_cpu_p99_ms']:.0f} ms of its thread's CPU time)"
+                )
             if "contacts" in row:
-                parts.append(f"{law}: {row['contacts']} runs with a contact, least clearance "
-                             f"{row['least_clearance_m']:.3f} m")
+                parts.append(
+                    f"{law}: {row['contacts']} runs with a contact, least clearance "
+                    f"{row['least_clearance_m']:.3f} m"
+                )
             if law.startswith("lp") and row.get("failures"):
                 parts.append(f"{law}: not reached, by reason:")
                 parts += [f"  {n} x {reason}" for reason, n in row["failures"].items()]

@@ -14,10 +14,26 @@ from parsimony.output import result_only_stdout
 from parsimony.target_options import exit_code
 
 COMMANDS = (
-    "demo", "experiment", "bench", "launch", "status", "param", "node", "topic", "goal", "graph",
+    "demo",
+    "experiment",
+    "bench",
+    "launch",
+    "status",
+    "param",
+    "node",
+    "topic",
+    "goal",
+    "graph",
     "schema",
-    "record", "info", "replay", "rerun", "report", "view", "layout", "reproduce",
-)  # fmt: skip
+    "record",
+    "info",
+    "replay",
+    "rerun",
+    "report",
+    "view",
+    "layout",
+    "reproduce",
+)
 
 
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:

@@ -67,13 +67,18 @@ from wbc.lp_law import LPParams
 from wbc.planar import inverse
 from wbc.robot import MobileManipulator
 
-PROFILES = {"lp": DEPLOY / "sim.yaml", "cascade": DEPLOY / "sim_cascade.yaml",
-            "qp": DEPLOY / "sim_qp.yaml"}
+PROFILES = {
+    "lp": DEPLOY / "sim.yaml",
+    "cascade": DEPLOY / "sim_cascade.yaml",
+    "qp": DEPLOY / "sim_qp.yaml",
+}
 """The profile each controller runs in unless ``--profile`` names another."""
 SUPERVISED = {name: DEPLOY / "sim_supervised.yaml" for name in ("anywhere", "blocked")}
 """Experiments whose LP runs under the staging supervisor (components/supervisor.py)."""
-MODULES = {c.law_name: c.__module__.rsplit(".", 1)[-1]
-           for c in (LPController, CascadeController, QPController)}
+MODULES = {
+    c.law_name: c.__module__.rsplit(".", 1)[-1]
+    for c in (LPController, CascadeController, QPController)
+}
 """The controller module of each law, as the controllers name themselves."""
 
 TIME_LIMIT_S = 60.0
@@ -115,23 +120,25 @@ def law_overrides(options: Options) -> dict[str, Any]:
     names = [f.name for f in dataclasses.fields(params)]
     for name in given:
         if name not in names:
-            raise ProfileError(f"no {law} gain {name!r}; the {law}'s gains are "
-                               f"{', '.join(names)}")  # fmt: skip
+            raise ProfileError(f"no {law} gain {name!r}; the {law}'s gains are {', '.join(names)}")
     experiment = params is LPParams and options.name in LP_PARAMS
     try:  # each value checked against its declaration, then the gains together
-        wanted = dataclasses.replace(LP_PARAMS[options.name] if experiment else params(),
-                                     **given)  # fmt: skip
+        wanted = dataclasses.replace(LP_PARAMS[options.name] if experiment else params(), **given)
     except ValueError as error:
         raise ProfileError(f"gain {error}") from None
     if not experiment:
         return {name: getattr(wanted, name) for name in given}
     default = LPParams()
-    return {name: getattr(wanted, name) for name in names
-            if getattr(wanted, name) != getattr(default, name) or name in given}
+    return {
+        name: getattr(wanted, name)
+        for name in names
+        if getattr(wanted, name) != getattr(default, name) or name in given
+    }
 
 
-def scene_overrides(setup: SimScenario, reference_pose: tuple[float, float, float]
-                    ) -> dict[str, Any]:  # fmt: skip
+def scene_overrides(
+    setup: SimScenario, reference_pose: tuple[float, float, float]
+) -> dict[str, Any]:
     """What the set-up changes in the profile's scene: its solids, moved from the simulator's
     world into F0 (which the simulator places at ``reference_pose``), and its goal marker's
     height and offset."""
@@ -151,8 +158,10 @@ def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict
     """A profile extending ``base`` with the set-up, the law, lockstep or real time, its own
     namespace and router port (so it never meets another running system)."""
     simulator: dict[str, Any] = {**setup.sim_params(), "paused": True, "seed": options.seed or 0}
-    simulator |= {"lockstep": not options.realtime,
-                  "real_time_factor": 1.0 if options.realtime else 0.0}  # fmt: skip
+    simulator |= {
+        "lockstep": not options.realtime,
+        "real_time_factor": 1.0 if options.realtime else 0.0,
+    }
     if options.hide_base_marker is not None:
         simulator["hide_base_marker"] = [list(options.hide_base_marker)]
     controller = {"module": MODULES[options.controller], "params": law_overrides(options)}
@@ -163,17 +172,25 @@ def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict
         {"name": "controller", **controller},
     ]
     base_profile = load_profile(base)
-    scene = scene_overrides(setup, base_profile.scene.reference_pose) \
-        if base_profile.scene is not None else {}  # fmt: skip
+    scene = (
+        scene_overrides(setup, base_profile.scene.reference_pose)
+        if base_profile.scene is not None
+        else {}
+    )
     if base_profile.component("simulator").module == "emulated_robot":
         if not options.realtime:
-            raise ProfileError(f"{base}: a serial line carries no stamps, so the emulated "
-                               "devices run in real time only: add --realtime")  # fmt: skip
+            raise ProfileError(
+                f"{base}: a serial line carries no stamps, so the emulated "
+                "devices run in real time only: add --realtime"
+            )
         # The emulated devices' ports live in the run's directory: runs never share one.
         devices = options.out.resolve() / "devices"
         links = {"base_driver": devices / "create2", "arm_driver": devices / "servos"}
-        simulator |= {"create_link": str(links["base_driver"]),
-                      "servo_link": str(links["arm_driver"]), "host_epoch": True}  # fmt: skip
+        simulator |= {
+            "create_link": str(links["base_driver"]),
+            "servo_link": str(links["arm_driver"]),
+            "host_epoch": True,
+        }
         components += [{"name": n, "params": {"port": str(p)}} for n, p in links.items()]
     return {
         "extends": str(base.resolve()),
@@ -228,15 +245,19 @@ def progress_line(session: dict[str, list], origin: float, wall_s: float) -> str
     d = diagnostics[-1]
     t = d.header.stamp_ns / 1e9 - min(origin, d.header.stamp_ns / 1e9)
     error = "-" if d.error_norm is None else f"{d.error_norm:.4f}"
-    return (f"[experiment] sim {t:6.2f} s  wall {wall_s:5.1f} s  error {error}  "
-            f"nonzero {d.nonzero}  {d.status}")  # fmt: skip
+    return (
+        f"[experiment] sim {t:6.2f} s  wall {wall_s:5.1f} s  error {error}  "
+        f"nonzero {d.nonzero}  {d.status}"
+    )
 
 
 def run_experiment(options: Options) -> dict[str, Any]:
     """Run one experiment; return its report (also written to ``out/report.json``)."""
     if options.name in SUPERVISED and options.controller != "lp":
-        raise ProfileError(f"the {options.name} experiment runs the LP under the staging "
-                           "supervisor; the cascade cannot follow its drive tasks")  # fmt: skip
+        raise ProfileError(
+            f"the {options.name} experiment runs the LP under the staging "
+            "supervisor; the cascade cannot follow its drive tasks"
+        )
     say(f"setting up the {options.name} experiment")
     base = options.profile or SUPERVISED.get(options.name) or PROFILES[options.controller]
     base_profile = load_profile(base)
@@ -251,9 +272,11 @@ def run_experiment(options: Options) -> dict[str, Any]:
     started = time.monotonic()
     names = [spec.name for spec in profile.start_order()]
     say(f"starting {len(names)} processes (their log: {options.out / 'launch.log'})")
-    with (options.out / "launch.log").open("w") as log,\
-            launched(profile_path, log, None) as launcher,\
-            connect(profile, launcher) as session:  # fmt: skip
+    with (
+        (options.out / "launch.log").open("w") as log,
+        launched(profile_path, log, None) as launcher,
+        connect(profile, launcher) as session,
+    ):
         follower = Follower(session, profile.namespace)
         say(f"waiting for {', '.join(names)} to come alive")
         wait_alive(session, profile, launcher)
@@ -261,15 +284,19 @@ def run_experiment(options: Options) -> dict[str, Any]:
         wait_reached(session, profile, launcher)
         before = component_counters(session, profile.namespace)
         query.set_param(session, profile.namespace, "simulator", "paused", "false")
-        say(f"running until the error stays under {CONVERGED_ERROR} for {HOLD_S:g} s, at most "
-            f"{options.time_limit_s:g} s of simulated time")  # fmt: skip
+        say(
+            f"running until the error stays under {CONVERGED_ERROR} for {HOLD_S:g} s, at most "
+            f"{options.time_limit_s:g} s of simulated time"
+        )
         started = time.monotonic()
         (followed, truth_ns), wall_s = follow(follower, options, started)
         counters = component_counters(session, profile.namespace)
         say("stopping the processes (the recorder writes all it holds)")
     say("judging the recording")
-    counters = {name: {**found, "run_cpu_ms": found["cpu_ms"] - before.get(name, found)["cpu_ms"]}
-                for name, found in counters.items()}  # fmt: skip
+    counters = {
+        name: {**found, "run_cpu_ms": found["cpu_ms"] - before.get(name, found)["cpu_ms"]}
+        for name, found in counters.items()
+    }
     ran_s = (truth_ns[-1] - truth_ns[0]) / 1e9 if truth_ns else 0.0  # simulated s, as followed
     origin = truth_ns[0] / 1e9 if truth_ns else math.inf
     end_ns, _ = end_of_run(followed, options.time_limit_s, origin)
@@ -279,38 +306,42 @@ def run_experiment(options: Options) -> dict[str, Any]:
         saved = make_whole(path)
         say(f"the recording had no footer: {saved} messages kept")
     recorded = load_session(path, JUDGED)
-    start_ns = min((s.header.stamp_ns for s in recorded.get(ROBOT_STATE.name, [])),
-                   default=end_ns)  # fmt: skip
+    start_ns = min((s.header.stamp_ns for s in recorded.get(ROBOT_STATE.name, [])), default=end_ns)
     report = {
-        "experiment": options.name, "controller": options.controller, "seed": options.seed,
+        "experiment": options.name,
+        "controller": options.controller,
+        "seed": options.seed,
         "mode": "realtime" if options.realtime else "lockstep",
         **judge(recorded, robot, options.time_limit_s),
         "wall_time_s": round(wall_s, 3),
         "real_time_factor": round(ran_s / wall_s, 2) if wall_s > 0 else None,
         "lockstep_timeouts": counters.get("simulator", {}).get("lockstep_timeouts", 0),
         "durations_us": durations(counters),
-        "cpu_s": {name: round(found["run_cpu_ms"] / 1e3, 3)
-                  for name, found in sorted(counters.items())},  # fmt: skip
+        "cpu_s": {
+            name: round(found["run_cpu_ms"] / 1e3, 3) for name, found in sorted(counters.items())
+        },
         "gains": dict(options.gains),
         "scenario": dataclasses.asdict(setup) | {"obstacles": setup.sim_params()["obstacles"]},
         "recording": recording_check(facts, (start_ns, end_ns)),
-    }  # fmt: skip
+    }
     run, _ = the_run(recorded, options.time_limit_s)
     (options.out / "commands.csv").write_text(commands_csv(run))
     label = options.controller
     say("drawing the figures")
     if report["recording"]["missing"]:
         label += " (RECORDING CUT SHORT: " + "; ".join(report["recording"]["missing"]) + ")"
-    figures = write_report([(label, run)], robot, options.out,
-                           profile.scene.reference_pose)["figures"]  # fmt: skip
+    figures = write_report([(label, run)], robot, options.out, profile.scene.reference_pose)[
+        "figures"
+    ]
     report["figures"] = [str(path) for path in figures]
     (options.out / "report.json").write_text(json_text(report, indent=2))
     return report
 
 
 @contextlib.contextmanager
-def launched(profile_path: Path, log: IO[str] | int = subprocess.DEVNULL,
-             stop_timeout_s: float | None = 30.0) -> Iterator[subprocess.Popen]:  # fmt: skip
+def launched(
+    profile_path: Path, log: IO[str] | int = subprocess.DEVNULL, stop_timeout_s: float | None = 30.0
+) -> Iterator[subprocess.Popen]:
     """``parsimony launch PROFILE`` as a child process, its output to ``log``; at the end of
     the block it is stopped by SIGINT (its components in order), killed after
     ``stop_timeout_s`` (None: the launcher's own limits, a recorder's progress, decide)."""
@@ -355,8 +386,11 @@ def wait_reached(session: zenoh.Session, profile: Profile, launcher: subprocess.
 
     def missing() -> list[str]:
         found = query.statuses(session, profile.namespace, 0.5)
-        return [name for name, status in found.items()
-                if status.counters.get("received.sim/clock", 1) == 0]  # fmt: skip
+        return [
+            name
+            for name, status in found.items()
+            if status.counters.get("received.sim/clock", 1) == 0
+        ]
 
     wait_launch(launcher, missing, "never received the simulator's clock")
 
@@ -373,8 +407,9 @@ def wait_launch(launcher: subprocess.Popen, missing: Callable[[], list[str]], wh
         time.sleep(0.1)  # polling the router (liveliness tokens, the components' counters)
 
 
-def follow(follower: Follower, options: Options, started: float
-           ) -> tuple[tuple[dict[str, list], list[int]], float]:  # fmt: skip
+def follow(
+    follower: Follower, options: Options, started: float
+) -> tuple[tuple[dict[str, list], list[int]], float]:
     """Print progress until the run converges or its time is up; return what was followed
     (``Follower.snapshot``), and the host seconds since ``started`` when it was."""
     last_print = 0.0

@@ -55,8 +55,7 @@ class GoalFamily:
             return self.arm * robot.q_min[BASE_DOF:], self.arm * robot.q_max[BASE_DOF:]
         return self.arm
 
-    def sample(self, rng: np.random.Generator, robot: MobileManipulator
-               ) -> tuple[Array, Array]:  # fmt: skip
+    def sample(self, rng: np.random.Generator, robot: MobileManipulator) -> tuple[Array, Array]:
         """(start configuration, goal configuration)."""
         low, high = self.box(robot)
         if self.start_spread is None:
@@ -65,8 +64,11 @@ class GoalFamily:
             spread = rng.uniform(-self.start_spread, self.start_spread, 5)
             arm_start = np.clip(HOME[3:] + spread, low, high)
         distance, bearing = rng.uniform(*self.distance), rng.uniform(*self.bearing)
-        base = [distance * math.cos(bearing), distance * math.sin(bearing),
-                rng.uniform(*self.heading)]  # fmt: skip
+        base = [
+            distance * math.cos(bearing),
+            distance * math.sin(bearing),
+            rng.uniform(*self.heading),
+        ]
         goal = np.concatenate((base, rng.uniform(low, high)))
         return np.concatenate((HOME[:3], arm_start)), goal
 
@@ -74,12 +76,20 @@ class GoalFamily:
 AHEAD = math.radians(35.0)
 FAMILIES = {
     "ahead": GoalFamily("ahead", (0.3, 1.2), (-AHEAD, AHEAD), (-AHEAD, AHEAD)),
-    "anywhere": GoalFamily("anywhere", (0.0, 1.2), (-math.pi, math.pi), (-math.pi, math.pi),
-                           LPParams().safety_factor, None),
-    "ahead, any arm start": GoalFamily("ahead, any arm start", (0.3, 1.2), (-AHEAD, AHEAD),
-                                       (-AHEAD, AHEAD), start_spread=None),
-    "ahead, wide arm": GoalFamily("ahead, wide arm", (0.3, 1.2), (-AHEAD, AHEAD),
-                                  (-AHEAD, AHEAD), WIDE_ARM_BOX, None),
+    "anywhere": GoalFamily(
+        "anywhere",
+        (0.0, 1.2),
+        (-math.pi, math.pi),
+        (-math.pi, math.pi),
+        LPParams().safety_factor,
+        None,
+    ),
+    "ahead, any arm start": GoalFamily(
+        "ahead, any arm start", (0.3, 1.2), (-AHEAD, AHEAD), (-AHEAD, AHEAD), start_spread=None
+    ),
+    "ahead, wide arm": GoalFamily(
+        "ahead, wide arm", (0.3, 1.2), (-AHEAD, AHEAD), (-AHEAD, AHEAD), WIDE_ARM_BOX, None
+    ),
 }
 """'ahead': the dissertation's kind (goal base 0.3-1.2 m away, within 35 degrees of straight
 ahead, heading within 35 degrees, the arm starting near HOME); 'anywhere': within 1.2 m at any
@@ -104,8 +114,9 @@ class ObstacleFamily:
     seed: int = 25
     """The bench's goals: held out (the planner was tuned on seeds 1 and 4)."""
 
-    def sample(self, rng: np.random.Generator, robot: MobileManipulator
-               ) -> tuple[Array, Array, Circle]:  # fmt: skip
+    def sample(
+        self, rng: np.random.Generator, robot: MobileManipulator
+    ) -> tuple[Array, Array, Circle]:
         """(start configuration, goal configuration, the circle)."""
         start, goal = self.goals.sample(rng, robot)
         way = goal[:2] - start[:2]
@@ -117,10 +128,11 @@ class ObstacleFamily:
         side = 1.0 if offset >= 0.0 else -1.0
         gripper = dq.translation(robot.fkm(goal))[1:3]
         body = self.radius + robot.base.body_radius + self.margin
-        while not (np.hypot(*(centre + offset * aside - start[:2])) >= body
-                   and np.hypot(*(centre + offset * aside - goal[:2])) >= body
-                   and np.hypot(*(centre + offset * aside - gripper))
-                   >= self.radius + self.margin):  # fmt: skip
+        while not (
+            np.hypot(*(centre + offset * aside - start[:2])) >= body
+            and np.hypot(*(centre + offset * aside - goal[:2])) >= body
+            and np.hypot(*(centre + offset * aside - gripper)) >= self.radius + self.margin
+        ):
             offset += side * 0.01
         x, y = centre + offset * aside
         return start, goal, Circle(float(x), float(y), self.radius)
@@ -133,15 +145,17 @@ OBSTACLE_FAMILIES = {
 the straight way, which the supervised LP must drive round."""
 
 
-def obstacle_goals(family: ObstacleFamily, count: int, robot: MobileManipulator,
-                   seed: int | None = None) -> list[tuple[Array, Array, Circle]]:  # fmt: skip
+def obstacle_goals(
+    family: ObstacleFamily, count: int, robot: MobileManipulator, seed: int | None = None
+) -> list[tuple[Array, Array, Circle]]:
     """``count`` goals of ``family`` drawn from ``seed`` (the family's own by default)."""
     rng = np.random.default_rng(family.seed if seed is None else seed)
     return [family.sample(rng, robot) for _ in range(count)]
 
 
-def goals(family: GoalFamily, count: int, robot: MobileManipulator, seed: int = GOAL_SEED
-          ) -> list[tuple[Array, Array]]:  # fmt: skip
+def goals(
+    family: GoalFamily, count: int, robot: MobileManipulator, seed: int = GOAL_SEED
+) -> list[tuple[Array, Array]]:
     """``count`` goals of ``family`` drawn from ``seed`` (the bench's by default)."""
     rng = np.random.default_rng(seed)
     return [family.sample(rng, robot) for _ in range(count)]

@@ -89,9 +89,15 @@ class Attempt:
         return self.within_joint_limits and self.speed_overrun <= LIMIT_TOLERANCE
 
 
-def attempt(law: Law, robot: MobileManipulator, start: Array, goal: Array,
-            supervised: bool = False, position: bool = False,
-            obstacles: Sequence[Circle] = ()) -> Attempt:  # fmt: skip
+def attempt(
+    law: Law,
+    robot: MobileManipulator,
+    start: Array,
+    goal: Array,
+    supervised: bool = False,
+    position: bool = False,
+    obstacles: Sequence[Circle] = (),
+) -> Attempt:
     """Run ``law`` from ``start`` to the pose of ``goal`` (or its position) for at most
     TIME_LIMIT_S, alone or with the staging supervisor handing it its tasks, with the
     obstacle constraint on ``obstacles``."""
@@ -102,15 +108,17 @@ def attempt(law: Law, robot: MobileManipulator, start: Array, goal: Array,
         params = SupervisorParams(pose_tolerance=TOLERANCE)
         supervisor = StagingSupervisor(robot, robot.fkm(goal), obstacles, params=params)
         tasks: list[object] = []
-        run = integrate_supervised(law, _logged(supervisor, tasks), start, DT, steps,
-                                   obstacles)  # fmt: skip
+        run = integrate_supervised(law, _logged(supervisor, tasks), start, DT, steps, obstacles)
         own = [isinstance(task, PoseTask) for task in tasks[: len(run.outputs)]]
         planning = tuple(supervisor.planning_s)
         planning_cpu = tuple(supervisor.planning_cpu_s)
         reason = supervisor.reason or f"time limit in {supervisor.phase}"
     else:
-        task = PositionTask(dq.translation(robot.fkm(goal))[1:]) if position else PoseTask(
-            robot.fkm(goal))
+        task = (
+            PositionTask(dq.translation(robot.fkm(goal))[1:])
+            if position
+            else PoseTask(robot.fkm(goal))
+        )
         run = integrate(law, start, task, DT, steps, TOLERANCE, obstacles)
         own = [True] * len(run.outputs)
         edge = at_joint_box_edge(law, robot, run.configurations[-1])
@@ -120,15 +128,23 @@ def attempt(law: Law, robot: MobileManipulator, start: Array, goal: Array,
     joint_overrun = np.maximum(q - robot.q_max, robot.q_min - q).max()
     speed_overrun = (np.abs(u) - robot.velocity_max).max()
     outputs = [out for out, mine in zip(run.outputs, own, strict=True) if mine]
-    return Attempt(run.converged, len(run.outputs), float(max(joint_overrun, 0.0)),
-                   float(max(speed_overrun, 0.0)),
-                   tuple(entry_mask(out.u) for out in outputs),
-                   tuple(entry_mask(out.u, True) for out in outputs),
-                   tuple(out.error_norm for out in outputs), planning, planning_cpu,
-                   all(out.ok for out in run.outputs), control_effort(run),
-                   control_effort(run, from_rest=True), "" if run.converged else reason,
-                   least_clearance(q[:, :2], obstacles, robot.base.body_radius),
-                   q[-1])  # fmt: skip
+    return Attempt(
+        run.converged,
+        len(run.outputs),
+        float(max(joint_overrun, 0.0)),
+        float(max(speed_overrun, 0.0)),
+        tuple(entry_mask(out.u) for out in outputs),
+        tuple(entry_mask(out.u, True) for out in outputs),
+        tuple(out.error_norm for out in outputs),
+        planning,
+        planning_cpu,
+        all(out.ok for out in run.outputs),
+        control_effort(run),
+        control_effort(run, from_rest=True),
+        "" if run.converged else reason,
+        least_clearance(q[:, :2], obstacles, robot.base.body_radius),
+        q[-1],
+    )
 
 
 EDGE = 0.01
@@ -140,8 +156,10 @@ def at_joint_box_edge(law: Law, robot: MobileManipulator, q: Array) -> list[str]
     for the LP and the QP (their safety factor b_l), the joint limits for a law without one."""
     factor = law.params.safety_factor if isinstance(law, LPLaw | QPLaw) else 1.0
     arm = q[BASE_DOF:]
-    near = np.minimum(arm - factor * robot.q_min[BASE_DOF:],
-                      factor * robot.q_max[BASE_DOF:] - arm) < EDGE  # fmt: skip
+    near = (
+        np.minimum(arm - factor * robot.q_min[BASE_DOF:], factor * robot.q_max[BASE_DOF:] - arm)
+        < EDGE
+    )
     return [f"q{index + 1}" for index in np.flatnonzero(near)]
 
 
@@ -200,8 +218,9 @@ def parsimony(attempts: Iterable[Attempt], dof: int) -> dict:
     attempts = list(attempts)
     exact = [m for a in attempts for m in a.nonzero]
     settling = round(SETTLING_S / DT)
-    moving = [m for a in attempts for m, e in zip(a.nonzero, a.errors, strict=True)
-              if e > MOVING_ERROR]  # fmt: skip
+    moving = [
+        m for a in attempts for m, e in zip(a.nonzero, a.errors, strict=True) if e > MOVING_ERROR
+    ]
     last = [m for a in attempts if a.converged for m in a.nonzero[-settling:]]
 
     def median(masks: list[int], forward_as_one: bool = False) -> float:
@@ -249,8 +268,9 @@ POSITION_LAWS = ("lp", "lp 5.29 exactly", "qp", "cascade")
 def _attempt_one(job: tuple[str, Path, Array, Array, bool, tuple[Circle, ...]]) -> Attempt:
     law_name, robot_file, start, goal, position, obstacles = job
     robot = MobileManipulator.from_yaml(robot_file)
-    return attempt(LAWS[law_name](robot), robot, start, goal, law_name == SUPERVISED, position,
-                   obstacles)  # fmt: skip
+    return attempt(
+        LAWS[law_name](robot), robot, start, goal, law_name == SUPERVISED, position, obstacles
+    )
 
 
 def not_reached(attempts: Iterable[Attempt]) -> dict[str, dict[str, int]]:
@@ -279,11 +299,17 @@ def _obstacle_rows(pool: Pool, robot_file: Path, count: int) -> dict:
     robot = MobileManipulator.from_yaml(robot_file)
     report: dict = {}
     for family in OBSTACLE_FAMILIES.values():
-        jobs = [(SUPERVISED, robot_file, start, goal, False, (circle,))
-                for start, goal, circle in obstacle_goals(family, count, robot)]  # fmt: skip
+        jobs = [
+            (SUPERVISED, robot_file, start, goal, False, (circle,))
+            for start, goal, circle in obstacle_goals(family, count, robot)
+        ]
         attempts = pool.map(_attempt_one, jobs, chunksize=1)
-        row = {**shares(attempts), **parsimony(attempts, robot.dof), **failures(attempts),
-               **planning(attempts)}
+        row = {
+            **shares(attempts),
+            **parsimony(attempts, robot.dof),
+            **failures(attempts),
+            **planning(attempts),
+        }
         report[f"{family.name} pose"] = {"goals": count, "laws": {SUPERVISED: row}}
     return report
 
@@ -301,11 +327,16 @@ def goal_report(robot_file: Path, count: int, processes: int = 2) -> dict:
             for task, law_names in (("pose", tuple(LAWS)), ("position", POSITION_LAWS)):
                 rows = {}
                 for law_name in law_names:
-                    jobs = [(law_name, robot_file, start, goal, task == "position", ())
-                            for start, goal in pairs]  # fmt: skip
+                    jobs = [
+                        (law_name, robot_file, start, goal, task == "position", ())
+                        for start, goal in pairs
+                    ]
                     attempts = pool.map(_attempt_one, jobs, chunksize=1)
-                    rows[law_name] = {**shares(attempts), **parsimony(attempts, robot.dof),
-                                      **not_reached(attempts)}  # fmt: skip
+                    rows[law_name] = {
+                        **shares(attempts),
+                        **parsimony(attempts, robot.dof),
+                        **not_reached(attempts),
+                    }
                     if law_name == SUPERVISED:
                         rows[law_name].update(planning(attempts))
                 report[f"{family.name} {task}"] = {"goals": count, "laws": rows}

@@ -41,8 +41,9 @@ from wbc.scenarios import (
 from wbc.task import PoseTask, PositionTask, Task
 
 STEPS = 4000
-OBSTACLE_PARAMS = LPParams(base_target=0.0, waist_hold=0.0, waist_centring=0.02,
-                           error_bound="error")
+OBSTACLE_PARAMS = LPParams(
+    base_target=0.0, waist_hold=0.0, waist_centring=0.02, error_bound="error"
+)
 """The obstacle experiment's law (6.2.3): the default obstacle constraint, the vector-field
 inequality of wbc.constraints.obstacle_vector_field, in place of 5.28 (python -m
 bench.obstacle_constraints compares them), the circulation term that takes the base round an
@@ -69,8 +70,13 @@ def supervised_params() -> LPParams:
     """The LP law's gains under the staging supervisor (wbc.staging_supervisor), as
     ``SUPERVISED_PROFILE`` gives its controller (declared there once, the reasons beside)."""
     controller = load_profile(SUPERVISED_PROFILE).component("controller")
-    return LPParams(**{f.name: controller.params[f.name] for f in dataclasses.fields(LPParams)
-                       if f.name in controller.params})  # fmt: skip
+    return LPParams(
+        **{
+            f.name: controller.params[f.name]
+            for f in dataclasses.fields(LPParams)
+            if f.name in controller.params
+        }
+    )
 
 
 POSE_PARAMS = LPParams(eta=0.6, beta=15.0)
@@ -147,8 +153,10 @@ def experiments(robot: MobileManipulator) -> list[Experiment]:
         Experiment(
             "table",
             PoseTask(robot.fkm(TABLE_GOAL)),
-            {"LP": LPLaw(robot, TABLE_PARAMS),
-             "LP without arm rows": LPLaw(robot, WITHOUT_ARM_ROWS)},  # fmt: skip
+            {
+                "LP": LPLaw(robot, TABLE_PARAMS),
+                "LP without arm rows": LPLaw(robot, WITHOUT_ARM_ROWS),
+            },
             (TABLE,),
             TABLE_START,
         ),
@@ -178,8 +186,9 @@ def summary_row(experiment: Experiment, law_name: str, run: Run, robot: MobileMa
     }
     circles, solids = split(experiment.obstacles)
     if circles:
-        row["min_obstacle_clearance"] = least_clearance(configurations[:, :2], circles,
-                                                        robot.base.body_radius)  # fmt: skip
+        row["min_obstacle_clearance"] = least_clearance(
+            configurations[:, :2], circles, robot.base.body_radius
+        )
     if solids:
         count = PenetrationCount()
         least = np.inf
@@ -196,19 +205,31 @@ def run_demo(robot_file: Path = ROBOT_FILE) -> list[dict]:
     rows = []
     for experiment in experiments(robot):
         for law_name, law in experiment.laws.items():
-            run = integrate(law, experiment.start, experiment.task, DT, STEPS,
-                            obstacles=experiment.obstacles)  # fmt: skip
+            run = integrate(
+                law, experiment.start, experiment.task, DT, STEPS, obstacles=experiment.obstacles
+            )
             rows.append(summary_row(experiment, law_name, run, robot))
     return rows
 
 
-COLUMNS = ("experiment", "law", "converged", "steps", "final_error", "median_nonzero",
-           "median_practical_nonzero", "worst_joint_overrun", "effort_velocity_l1",
-           "effort_velocity_l2", "median_step_us", "min_obstacle_clearance", "min_arm_clearance",
-           "arm_penetrations")  # fmt: skip
+COLUMNS = (
+    "experiment",
+    "law",
+    "converged",
+    "steps",
+    "final_error",
+    "median_nonzero",
+    "median_practical_nonzero",
+    "worst_joint_overrun",
+    "effort_velocity_l1",
+    "effort_velocity_l2",
+    "median_step_us",
+    "min_obstacle_clearance",
+    "min_arm_clearance",
+    "arm_penetrations",
+)
 """The demo's table: these figures of each run (clearances where there are obstacles)."""
 
 
 def format_table(rows: list[dict]) -> str:
-    return table([{key: row.get(key) for key in COLUMNS} for row in rows],
-                 floatfmt=".3g")
+    return table([{key: row.get(key) for key in COLUMNS} for row in rows], floatfmt=".3g")

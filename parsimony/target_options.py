@@ -21,9 +21,13 @@ def target_options() -> argparse.ArgumentParser:
         default=os.environ.get(PROFILE_ENV),
         help=f"the deploy profile of the running system (default: ${PROFILE_ENV})",
     )
-    common.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT_S, metavar="S",
-                        help="seconds to wait for the running system's answers "
-                        f"(default {DEFAULT_TIMEOUT_S:g})")
+    common.add_argument(
+        "--timeout",
+        type=float,
+        default=DEFAULT_TIMEOUT_S,
+        metavar="S",
+        help=f"seconds to wait for the running system's answers (default {DEFAULT_TIMEOUT_S:g})",
+    )
     common.add_argument("--json", action="store_true", help="print JSON")
     return common
 

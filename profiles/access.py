@@ -75,12 +75,14 @@ class AccessSettings(BaseModel):
         try:
             users = read_credentials(self.credentials)
         except OSError as error:
-            raise ValueError(f"credentials: cannot read {self.credentials}: "
-                             f"{error.strerror}") from error  # fmt: skip
+            raise ValueError(
+                f"credentials: cannot read {self.credentials}: {error.strerror}"
+            ) from error
         for topic, writers in self.writers.items():
             if topic not in topics.TOPICS:
-                raise ValueError(f"writers.{topic}: not a topic of the table "
-                                 f"({', '.join(topics.TOPICS)})")  # fmt: skip
+                raise ValueError(
+                    f"writers.{topic}: not a topic of the table ({', '.join(topics.TOPICS)})"
+                )
             unknown = sorted(set(writers) - set(users))
             if unknown:
                 raise ValueError(f"writers.{topic}: {unknown} not in {self.credentials}")
@@ -102,16 +104,27 @@ class AccessSettings(BaseModel):
             others = sorted(users - set(writers))
             if not others:
                 continue
-            rules.append({"id": f"no-put-{index}", "permission": "deny", "flows": ["ingress"],
-                          "messages": ["put", "delete"],
-                          "key_exprs": [topics.TOPICS[topic].key(namespace)]})  # fmt: skip
+            rules.append(
+                {
+                    "id": f"no-put-{index}",
+                    "permission": "deny",
+                    "flows": ["ingress"],
+                    "messages": ["put", "delete"],
+                    "key_exprs": [topics.TOPICS[topic].key(namespace)],
+                }
+            )
             subjects.append({"id": f"not-writers-{index}", "usernames": others})
             policies.append({"rules": [f"no-put-{index}"], "subjects": [f"not-writers-{index}"]})
         return {
             "transport/auth/usrpwd": {"dictionary_file": str(self.credentials)},
-            "access_control": {"enabled": True, "default_permission": "allow", "rules": rules,
-                               "subjects": subjects, "policies": policies},
-        }  # fmt: skip
+            "access_control": {
+                "enabled": True,
+                "default_permission": "allow",
+                "rules": rules,
+                "subjects": subjects,
+                "policies": policies,
+            },
+        }
 
     def may_write(self, topic: str, user: str | None) -> bool:
         """Whether ``user`` (a tool's: ``$PARSIMONY_USER``) may put on ``topic``: the topic

@@ -28,8 +28,10 @@ def endpoint_problem(endpoint: str, needs_port: bool = False) -> str | None:
     if protocol in LOCAL_PROTOCOLS:
         return None
     if protocol not in IP_PROTOCOLS:
-        return f"unknown protocol {protocol!r} (expected one of {', '.join(IP_PROTOCOLS)} or " \
-               f"{', '.join(LOCAL_PROTOCOLS)})"
+        return (
+            f"unknown protocol {protocol!r} (expected one of {', '.join(IP_PROTOCOLS)} or "
+            f"{', '.join(LOCAL_PROTOCOLS)})"
+        )
     host, colon, port = address.rpartition(":")
     if not colon or not port.isdigit() or not 0 <= int(port) <= 65535:
         return "expected host:port with a port from 0 to 65535"

@@ -100,8 +100,9 @@ class ZenohSettings(StrictModel):
     @model_validator(mode="after")
     def _local_unless_allowed(self) -> ZenohSettings:
         if self.access is not None and self.mode != "client":
-            raise ValueError("access: the router's rules only see what passes through it; "
-                             "set mode: client")  # fmt: skip
+            raise ValueError(
+                "access: the router's rules only see what passes through it; set mode: client"
+            )
         if self.allow_remote:
             return self
         if self.multicast_scouting:
@@ -190,16 +191,20 @@ def _param_value(value: object) -> ParamValue:
     """A parameter's value as a profile gives it: a number, a flag, a word, or a list (of
     numbers, or of lists of numbers); what the component declares is checked later
     (``deploy.graph.dataflow``)."""
+
     def numbers(row: object) -> bool:
         return isinstance(row, list | tuple) and all(
-            isinstance(v, int | float) and not isinstance(v, bool) for v in row)  # fmt: skip
+            isinstance(v, int | float) and not isinstance(v, bool) for v in row
+        )
 
     if isinstance(value, bool | int | float | str) or numbers(value):
         return value
     if isinstance(value, list | tuple) and all(numbers(row) for row in value):
         return value
-    raise PydanticCustomError("param_value", "expected a number, a flag, a word or a list of "
-                              "numbers (or of lists of numbers)")  # fmt: skip
+    raise PydanticCustomError(
+        "param_value",
+        "expected a number, a flag, a word or a list of numbers (or of lists of numbers)",
+    )
 
 
 class ComponentSpec(StrictModel):
@@ -231,11 +236,14 @@ class ComponentSpec(StrictModel):
         for old, new in self.remap.items():
             for name in (old, new):
                 if name not in topics.TOPICS:
-                    raise ValueError(f"remap: {name!r} is not a topic (have "
-                                     f"{', '.join(topics.TOPICS)})")  # fmt: skip
+                    raise ValueError(
+                        f"remap: {name!r} is not a topic (have {', '.join(topics.TOPICS)})"
+                    )
             if topics.TOPICS[old].type is not topics.TOPICS[new].type:
-                raise ValueError(f"remap: {old} carries {topics.TOPICS[old].type.__name__} and "
-                                 f"{new} {topics.TOPICS[new].type.__name__}")  # fmt: skip
+                raise ValueError(
+                    f"remap: {old} carries {topics.TOPICS[old].type.__name__} and "
+                    f"{new} {topics.TOPICS[new].type.__name__}"
+                )
         return self
 
     def topic(self, topic: topics.Topic) -> topics.Topic:
@@ -275,14 +283,18 @@ class Profile(StrictModel):
             users = access.users()
             for index, spec in enumerate(self.components):
                 if spec.name not in users:
-                    raise ValueError(f"components[{index}].name: {spec.name!r} has no line in "
-                                     f"{access.credentials}; each component authenticates "
-                                     "as its name")  # fmt: skip
+                    raise ValueError(
+                        f"components[{index}].name: {spec.name!r} has no line in "
+                        f"{access.credentials}; each component authenticates "
+                        "as its name"
+                    )
             names = [spec.name for spec in self.components]
             for name in access.parameters:
                 if name != EVERY_COMPONENT and name not in names:
-                    raise ValueError(f"zenoh.access.parameters.{name}: names no component of "
-                                     f"the profile (have {', '.join(names)})")  # fmt: skip
+                    raise ValueError(
+                        f"zenoh.access.parameters.{name}: names no component of "
+                        f"the profile (have {', '.join(names)})"
+                    )
         return self
 
     @model_validator(mode="after")
@@ -323,8 +335,13 @@ class Profile(StrictModel):
         if spec.name in chain:
             circle = " -> ".join((*chain, spec.name))
             raise ValueError(f"components: they wait for each other in a circle ({circle})")
-        return max((1 + self.start_depth(self.component(name), (*chain, spec.name))
-                    for name in spec.after), default=0)  # fmt: skip
+        return max(
+            (
+                1 + self.start_depth(self.component(name), (*chain, spec.name))
+                for name in spec.after
+            ),
+            default=0,
+        )
 
     def component(self, name: str) -> ComponentSpec:
         """The component called ``name``; ``KeyError`` if the profile has none."""

@@ -15,7 +15,6 @@ class ProfileError(Exception):
     """A profile that cannot be used; the message says where and what was expected."""
 
 
-
 MAX_YAML_VALUES = 100_000
 """A profile expands to at most this many YAML values, aliases counted where they point."""
 
@@ -27,8 +26,10 @@ class _ProfileLoader(yaml.SafeLoader):
     def get_single_node(self):  # noqa: ANN201 - PyYAML's own signature
         node = super().get_single_node()
         if node is not None and _expanded(node, {}) > MAX_YAML_VALUES:
-            raise ProfileError(f"{self.name}: expands to more than {MAX_YAML_VALUES} values "
-                               "(aliases inside aliases?)")  # fmt: skip
+            raise ProfileError(
+                f"{self.name}: expands to more than {MAX_YAML_VALUES} values "
+                "(aliases inside aliases?)"
+            )
         return node
 
 
@@ -125,5 +126,3 @@ def read_profile_data(path: Path, chain: tuple[Path, ...] = ()) -> dict:
         raise ProfileError(f"{path}: extends: no profile at {base_path}")
     base = read_profile_data(base_path, (*chain, path.resolve()))
     return merge(base, data)  # type: ignore[return-value]
-
-

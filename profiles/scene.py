@@ -108,8 +108,10 @@ class Scene(_Strict):
         import cv2  # only profiles with a scene pay for it
 
         if not self.dictionary.startswith("DICT_") or not hasattr(cv2.aruco, self.dictionary):
-            raise ValueError(f"dictionary: not an OpenCV ArUco dictionary: {self.dictionary!r} "
-                             "(e.g. 'DICT_4X4_50')")  # fmt: skip
+            raise ValueError(
+                f"dictionary: not an OpenCV ArUco dictionary: {self.dictionary!r} "
+                "(e.g. 'DICT_4X4_50')"
+            )
         return self
 
     @model_validator(mode="after")
@@ -119,15 +121,21 @@ class Scene(_Strict):
         import cv2
 
         size = cv2.aruco.getPredefinedDictionary(self.dictionary_id).bytesList.shape[0]
-        fields = [("reference.id", self.reference.id), ("base.id", self.base.id),
-                  ("goal.id", self.goal.id)]  # fmt: skip
-        fields += [(f"obstacles.ids[{i}]", marker_id) for i, marker_id in
-                   enumerate(self.obstacles.ids)]  # fmt: skip
+        fields = [
+            ("reference.id", self.reference.id),
+            ("base.id", self.base.id),
+            ("goal.id", self.goal.id),
+        ]
+        fields += [
+            (f"obstacles.ids[{i}]", marker_id) for i, marker_id in enumerate(self.obstacles.ids)
+        ]
         seen: dict[int, str] = {}
         for field, marker_id in fields:
             if not 0 <= marker_id < size:
-                raise ValueError(f"{field}: marker id {marker_id} is not in {self.dictionary} "
-                                 f"(ids 0 to {size - 1})")  # fmt: skip
+                raise ValueError(
+                    f"{field}: marker id {marker_id} is not in {self.dictionary} "
+                    f"(ids 0 to {size - 1})"
+                )
             if marker_id in seen:
                 raise ValueError(f"{field}: marker id {marker_id} is already {seen[marker_id]}")
             seen[marker_id] = field
@@ -147,9 +155,13 @@ class Scene(_Strict):
     def solid_labels(self) -> tuple[str, ...]:
         """Each solid of ``arm_obstacles.solids()`` (planes first) by its name and field."""
         planes = self.arm_obstacles.planes
-        return (*(f"{p.name!r} (scene.arm_obstacles.planes[{i}])" for i, p in enumerate(planes)),
-                *(f"{c.name!r} (scene.arm_obstacles.cylinders[{i}])"
-                  for i, c in enumerate(self.arm_obstacles.cylinders)))  # fmt: skip
+        return (
+            *(f"{p.name!r} (scene.arm_obstacles.planes[{i}])" for i, p in enumerate(planes)),
+            *(
+                f"{c.name!r} (scene.arm_obstacles.cylinders[{i}])"
+                for i, c in enumerate(self.arm_obstacles.cylinders)
+            ),
+        )
 
     @property
     def dictionary_id(self) -> int:

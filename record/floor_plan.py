@@ -33,8 +33,7 @@ def _solids(obstacles: Sequence[Obstacles]) -> tuple[list[Plane], list[Cylinder]
     return list(planes), list(cylinders)
 
 
-def _solids_on_the_floor(ax: Axes, planes: Sequence[Plane], cylinders: Sequence[Cylinder]
-                         ) -> None:  # fmt: skip
+def _solids_on_the_floor(ax: Axes, planes: Sequence[Plane], cylinders: Sequence[Cylinder]) -> None:
     """The solids seen from above: a table's (or an underside's) footprint, each pole's disc,
     each wall's line where it meets the floor (a horizontal plane without a footprint, which
     covers the whole floor, is not drawn); each labelled with its height."""
@@ -43,14 +42,34 @@ def _solids_on_the_floor(ax: Axes, planes: Sequence[Plane], cylinders: Sequence[
         nx, ny, _ = plane.normal
         if plane.footprint:
             kind = "top" if solid.side > 0 else "underside"
-            ax.add_patch(Polygon(solid.footprint, closed=True, color=OBSTACLE_RGB, alpha=0.35,
-                                 hatch="//", label=f"{plane.name} ({kind} at "
-                                 f"{plane.offset * solid.side:.2f} m)"))  # fmt: skip
+            ax.add_patch(
+                Polygon(
+                    solid.footprint,
+                    closed=True,
+                    color=OBSTACLE_RGB,
+                    alpha=0.35,
+                    hatch="//",
+                    label=f"{plane.name} ({kind} at {plane.offset * solid.side:.2f} m)",
+                )
+            )
         elif nx * nx + ny * ny > UNIT_TOLERANCE:
             along = plane.offset / (nx * nx + ny * ny)  # the floor's point nearest F0
-            ax.axline((along * nx, along * ny), (along * nx - ny, along * ny + nx),
-                      color=OBSTACLE_RGB, linewidth=2.0, label=f"{plane.name} (at the floor)")
+            ax.axline(
+                (along * nx, along * ny),
+                (along * nx - ny, along * ny + nx),
+                color=OBSTACLE_RGB,
+                linewidth=2.0,
+                label=f"{plane.name} (at the floor)",
+            )
     for cylinder in cylinders:
         top = "no top" if cylinder.height is None else f"{cylinder.height:.2f} m high"
-        ax.add_patch(Circle((cylinder.x, cylinder.y), cylinder.radius, color=OBSTACLE_RGB,
-                            alpha=0.6, hatch="xx", label=f"{cylinder.name} ({top})"))  # fmt: skip
+        ax.add_patch(
+            Circle(
+                (cylinder.x, cylinder.y),
+                cylinder.radius,
+                color=OBSTACLE_RGB,
+                alpha=0.6,
+                hatch="xx",
+                label=f"{cylinder.name} ({top})",
+            )
+        )

@@ -28,10 +28,12 @@ def planar_transform(
     """The transform of a planar pose (x, y, phi): translation (x, y, 0), phi about z."""
     x, y, phi = base_pose
     return fox.FrameTransform(
-        timestamp=timestamp(stamp_ns), parent_frame_id=parent, child_frame_id=child,
+        timestamp=timestamp(stamp_ns),
+        parent_frame_id=parent,
+        child_frame_id=child,
         translation=fox.Vector3(x=float(x), y=float(y), z=0.0),
         rotation=fox.Quaternion(x=0.0, y=0.0, z=math.sin(phi / 2), w=math.cos(phi / 2)),
-    )  # fmt: skip
+    )
 
 
 def pose_transform(
@@ -41,7 +43,9 @@ def pose_transform(
     x = np.asarray(pose, dtype=float)
     t, r = dq.translation(x), dq.rotation(x)
     return fox.FrameTransform(
-        timestamp=timestamp(stamp_ns), parent_frame_id=parent, child_frame_id=child,
+        timestamp=timestamp(stamp_ns),
+        parent_frame_id=parent,
+        child_frame_id=child,
         translation=fox.Vector3(x=float(t[1]), y=float(t[2]), z=float(t[3])),
         rotation=fox.Quaternion(w=float(r[0]), x=float(r[1]), y=float(r[2]), z=float(r[3])),
-    )  # fmt: skip
+    )

@@ -50,57 +50,92 @@ def path(namespace: str, topic: topics.Topic, field: str) -> str:
 def three_d(namespace: str) -> fl.ThreeDeePanel:
     """The robot, estimate and truth (its parts inside a solid red), the obstacles (circles and
     solids) and the plan, in F0; the publish-pose tool sends to goal/request."""
-    scenes = [(topics.ROBOT_STATE, MODEL_SUFFIX), (topics.SIM_TRUTH, MODEL_SUFFIX),
-              (topics.SIM_TRUTH, PENETRATIONS_SUFFIX), (topics.SUPERVISOR_STATUS, SCENE_SUFFIX),
-              (topics.WORLD_OBSTACLES, CHANNEL_SUFFIX), (topics.WORLD_OBSTACLES, SOLIDS_SUFFIX)]
-    shown = {channel(namespace, topic, suffix): fl.BaseRendererSceneUpdateTopicSettings(
-        visible=True) for topic, suffix in scenes}  # fmt: skip
-    return fl.ThreeDeePanel(title="Robot", config=fl.ThreeDeeConfig(
-        follow_tf=FIXED_FRAME, fixed_frame=FIXED_FRAME, follow_mode="follow-none",
-        topics=shown,
-        camera_state=fl.ThreeDeeCameraState(distance=4.0, perspective=True, phi=50.0,
-                                            target=(0.5, 0.0, 0.0), theta_offset=45.0),
-        publish=fl.ThreeDeePublishSettings(type="pose",
-                                           pose_topic=channel(namespace, topics.GOAL_REQUEST)),
-    ))  # fmt: skip
+    scenes = [
+        (topics.ROBOT_STATE, MODEL_SUFFIX),
+        (topics.SIM_TRUTH, MODEL_SUFFIX),
+        (topics.SIM_TRUTH, PENETRATIONS_SUFFIX),
+        (topics.SUPERVISOR_STATUS, SCENE_SUFFIX),
+        (topics.WORLD_OBSTACLES, CHANNEL_SUFFIX),
+        (topics.WORLD_OBSTACLES, SOLIDS_SUFFIX),
+    ]
+    shown = {
+        channel(namespace, topic, suffix): fl.BaseRendererSceneUpdateTopicSettings(visible=True)
+        for topic, suffix in scenes
+    }
+    return fl.ThreeDeePanel(
+        title="Robot",
+        config=fl.ThreeDeeConfig(
+            follow_tf=FIXED_FRAME,
+            fixed_frame=FIXED_FRAME,
+            follow_mode="follow-none",
+            topics=shown,
+            camera_state=fl.ThreeDeeCameraState(
+                distance=4.0, perspective=True, phi=50.0, target=(0.5, 0.0, 0.0), theta_offset=45.0
+            ),
+            publish=fl.ThreeDeePublishSettings(
+                type="pose", pose_topic=channel(namespace, topics.GOAL_REQUEST)
+            ),
+        ),
+    )
 
 
 def camera(namespace: str) -> fl.ImagePanel:
     """The image with each detected marker's outline and id."""
     annotations = channel(namespace, topics.VISION_MARKERS, ANNOTATIONS_SUFFIX)
-    return fl.ImagePanel(title="Camera", config=fl.ImageConfig(image_mode=fl.ImageModeConfig(
-        image_topic=channel(namespace, topics.CAMERA_IMAGE, CHANNEL_SUFFIX),
-        annotations={annotations: fl.ImageAnnotationSettings(visible=True)},
-    )))  # fmt: skip
+    return fl.ImagePanel(
+        title="Camera",
+        config=fl.ImageConfig(
+            image_mode=fl.ImageModeConfig(
+                image_topic=channel(namespace, topics.CAMERA_IMAGE, CHANNEL_SUFFIX),
+                annotations={annotations: fl.ImageAnnotationSettings(visible=True)},
+            )
+        ),
+    )
 
 
 def plot(namespace: str, title: str, fields: dict[str, str]) -> fl.PlotPanel:
     """The controller's diagnostics ``fields`` (label -> field) over time."""
-    series = [fl.PlotSeries(value=path(namespace, topics.CONTROL_DIAGNOSTICS, field), label=label)
-              for label, field in fields.items()]  # fmt: skip
+    series = [
+        fl.PlotSeries(value=path(namespace, topics.CONTROL_DIAGNOSTICS, field), label=label)
+        for label, field in fields.items()
+    ]
     return fl.PlotPanel(title=title, config=fl.PlotConfig(paths=series, show_legend=True))
 
 
 def messages_of(namespace: str, topic: topics.Topic, title: str) -> fl.RawMessagesPanel:
-    return fl.RawMessagesPanel(title=title, config=fl.RawMessagesConfig(
-        topic_path=f'"{channel(namespace, topic)}"'))  # fmt: skip
+    return fl.RawMessagesPanel(
+        title=title, config=fl.RawMessagesConfig(topic_path=f'"{channel(namespace, topic)}"')
+    )
 
 
 def split(direction: str, *items: tuple[float, fl.Content]) -> fl.SplitContainer:
-    return fl.SplitContainer(direction=direction, items=[
-        fl.SplitItem(proportion=share, content=content) for share, content in items])  # fmt: skip
+    return fl.SplitContainer(
+        direction=direction,
+        items=[fl.SplitItem(proportion=share, content=content) for share, content in items],
+    )
 
 
 def layout(namespace: str) -> fl.Layout:
     """The layout of the module docstring, on the channels of ``namespace``."""
-    plots = split("row",
-                  (1, plot(namespace, "Task error", {"||e||": "error_norm"})),
-                  (1, plot(namespace, "Nonzero entries of u", {
-                      "exact": "nonzero", "practical": "practical_nonzero"})))  # fmt: skip
-    top = split("row", (3, three_d(namespace)),
-                (2, split("column", (3, camera(namespace)), (2, plots))))  # fmt: skip
-    bottom = split("row",
-                   (2, messages_of(namespace, topics.CONTROL_DIAGNOSTICS, "Controller")),
-                   (2, messages_of(namespace, topics.SUPERVISOR_STATUS, "Supervisor")),
-                   (2, fl.ParametersPanel(title="Parameters")))  # fmt: skip
+    plots = split(
+        "row",
+        (1, plot(namespace, "Task error", {"||e||": "error_norm"})),
+        (
+            1,
+            plot(
+                namespace,
+                "Nonzero entries of u",
+                {"exact": "nonzero", "practical": "practical_nonzero"},
+            ),
+        ),
+    )
+    top = split(
+        "row", (3, three_d(namespace)), (2, split("column", (3, camera(namespace)), (2, plots)))
+    )
+    bottom = split(
+        "row",
+        (2, messages_of(namespace, topics.CONTROL_DIAGNOSTICS, "Controller")),
+        (2, messages_of(namespace, topics.SUPERVISOR_STATUS, "Supervisor")),
+        (2, fl.ParametersPanel(title="Parameters")),
+    )
     return fl.Layout(content=split("column", (3, top), (2, bottom)))

@@ -105,28 +105,48 @@ class View:
     def channel(self, key: str) -> tuple[str, str, str, bytes, str, bytes]:
         """The channel, schema, message encoding and data of the view of the message on
         ``key`` (``record.session_file.Entry``)."""
-        return (view_channel(key, self.channel_suffix), self.schema_name, self.schema_encoding,
-                self.schema_data, self.message_encoding, self.data)  # fmt: skip
+        return (
+            view_channel(key, self.channel_suffix),
+            self.schema_name,
+            self.schema_encoding,
+            self.schema_data,
+            self.message_encoding,
+            self.data,
+        )
 
 
 def view(message: Any, carries: str = "", suffix: str = CHANNEL_SUFFIX) -> View:
     """A foxglove-sdk message as a ``View`` on ``<key>/<suffix>``: its protobuf schema and
     bytes."""
     schema = type(message).get_schema()
-    return View(suffix, schema.name, schema.encoding, bytes(schema.data), "protobuf",
-                bytes(message.encode()), carries)  # fmt: skip
+    return View(
+        suffix,
+        schema.name,
+        schema.encoding,
+        bytes(schema.data),
+        "protobuf",
+        bytes(message.encode()),
+        carries,
+    )
 
 
 def image_view(frame: CameraFrame) -> fox.CompressedImage | fox.RawImage:
     """A JPEG frame as it is, raw pixels as they are; the view carries them (``carries``)."""
     stamp = timestamp(frame.header.stamp_ns)
     if frame.encoding in COMPRESSED:
-        return fox.CompressedImage(timestamp=stamp, frame_id="camera", data=frame.data,
-                                   format=frame.encoding)  # fmt: skip
+        return fox.CompressedImage(
+            timestamp=stamp, frame_id="camera", data=frame.data, format=frame.encoding
+        )
     step = frame.width * CHANNELS[frame.encoding]
-    return fox.RawImage(timestamp=stamp, frame_id="camera", width=frame.width,
-                        height=frame.height, encoding=frame.encoding, step=step,
-                        data=frame.data)  # fmt: skip
+    return fox.RawImage(
+        timestamp=stamp,
+        frame_id="camera",
+        width=frame.width,
+        height=frame.height,
+        encoding=frame.encoding,
+        step=step,
+        data=frame.data,
+    )
 
 
 CARRIERS = (fox.CompressedImage, fox.RawImage)
@@ -155,8 +175,10 @@ def marker_frames(prefix: str) -> Callable[[MarkerDetections], fox.FrameTransfor
 
     def make(detections: MarkerDetections) -> fox.FrameTransforms | None:
         stamp, parent = detections.header.stamp_ns, detections.header.frame
-        transforms = [pose_transform(parent, f"{prefix}marker_{m.id}", m.pose, stamp)
-                      for m in detections.markers]  # fmt: skip
+        transforms = [
+            pose_transform(parent, f"{prefix}marker_{m.id}", m.pose, stamp)
+            for m in detections.markers
+        ]
         return fox.FrameTransforms(transforms=transforms) if transforms else None
 
     return make
@@ -204,8 +226,7 @@ def truth_frames(drawing: RobotDrawing | None, truth: SimTruth) -> fox.FrameTran
     return fox.FrameTransforms(transforms=transforms)
 
 
-def robot_model(drawing: RobotDrawing) -> Callable[[RobotState | SimTruth],
-                                                   fox.SceneUpdate | None]:  # fmt: skip
+def robot_model(drawing: RobotDrawing) -> Callable[[RobotState | SimTruth], fox.SceneUpdate | None]:
     """The robot's model, with one state in ``MODEL_EVERY``."""
 
     def make(state: RobotState | SimTruth) -> fox.SceneUpdate | None:
@@ -228,8 +249,9 @@ class ViewMaker:
     carries: str = ""
 
 
-def maker(suffix: str, schema: type | None, make: Callable[[Any], Any], carries: str = ""
-          ) -> ViewMaker:  # fmt: skip
+def maker(
+    suffix: str, schema: type | None, make: Callable[[Any], Any], carries: str = ""
+) -> ViewMaker:
     """A ``ViewMaker`` of a view that depends on the message alone."""
     return ViewMaker(suffix, schema, lambda _key, message: make(message), carries)
 
@@ -260,29 +282,42 @@ class Viewer:
             topics.CAMERA_IMAGE.name: (maker(CHANNEL_SUFFIX, None, image_view, "data"),),
             topics.ROBOT_STATE.name: (
                 maker(CHANNEL_SUFFIX, frames, functools.partial(state_frames, estimate)),
-                *([maker(MODEL_SUFFIX, scene, robot_model(estimate))] if estimate else [])),
+                *([maker(MODEL_SUFFIX, scene, robot_model(estimate))] if estimate else []),
+            ),
             topics.SIM_TRUTH.name: (
                 maker(CHANNEL_SUFFIX, frames, functools.partial(truth_frames, truth)),
-                *([maker(MODEL_SUFFIX, scene, robot_model(truth)),
-                   ViewMaker(PENETRATIONS_SUFFIX, scene,
-                             functools.partial(self._penetrations, robot))] if truth else [])),
+                *(
+                    [
+                        maker(MODEL_SUFFIX, scene, robot_model(truth)),
+                        ViewMaker(
+                            PENETRATIONS_SUFFIX, scene, functools.partial(self._penetrations, robot)
+                        ),
+                    ]
+                    if truth
+                    else []
+                ),
+            ),
             topics.VISION_MARKERS.name: (
                 maker(CHANNEL_SUFFIX, frames, marker_frames("")),
-                maker(ANNOTATIONS_SUFFIX, fox.ImageAnnotations, marker_annotations)),
-            topics.WORLD_MARKERS.name: (maker(CHANNEL_SUFFIX, frames,
-                                              marker_frames("estimate/")),),
+                maker(ANNOTATIONS_SUFFIX, fox.ImageAnnotations, marker_annotations),
+            ),
+            topics.WORLD_MARKERS.name: (maker(CHANNEL_SUFFIX, frames, marker_frames("estimate/")),),
             topics.CONTROL_GOAL.name: (goal,),
             topics.GOAL_REQUEST.name: (goal,),
             topics.WORLD_GOAL.name: (maker(CHANNEL_SUFFIX, frames, goal_frame("estimate/goal")),),
-            topics.WORLD_OBSTACLES.name: (maker(CHANNEL_SUFFIX, scene, circle_scene),
-                                          ViewMaker(SOLIDS_SUFFIX, scene, self._solid_scene)),
+            topics.WORLD_OBSTACLES.name: (
+                maker(CHANNEL_SUFFIX, scene, circle_scene),
+                ViewMaker(SOLIDS_SUFFIX, scene, self._solid_scene),
+            ),
             topics.SUPERVISOR_STATUS.name: (
                 maker(CHANNEL_SUFFIX, frames, self._plan_frames),
-                ViewMaker(SCENE_SUFFIX, scene, self._plan_scene)),
-        }  # fmt: skip
+                ViewMaker(SCENE_SUFFIX, scene, self._plan_scene),
+            ),
+        }
 
-    def __call__(self, topic_name: str, key: str, message: Any,
-                 wanted: Callable[[str], bool] = everything) -> list[View]:  # fmt: skip
+    def __call__(
+        self, topic_name: str, key: str, message: Any, wanted: Callable[[str], bool] = everything
+    ) -> list[View]:
         """The well-known views of one message of ``topic_name`` whose suffix is ``wanted``;
         each goes on ``view.channel(key)``, beside the channel ``key`` the message is on."""
         found = []
@@ -296,8 +331,9 @@ class Viewer:
     def carrier(self, topic_name: str) -> tuple[str, str] | None:
         """The field of the message a view of ``topic_name`` carries, and that view's suffix
         (an image's pixels in its view), or None."""
-        return next(((m.carries, m.suffix) for m in self._makers.get(topic_name, ())
-                     if m.carries), None)  # fmt: skip
+        return next(
+            ((m.carries, m.suffix) for m in self._makers.get(topic_name, ()) if m.carries), None
+        )
 
     def channels(self, topic_name: str) -> list[tuple[str, type]]:
         """The suffix and Foxglove type of every view of ``topic_name`` whose type does not
@@ -321,8 +357,9 @@ class Viewer:
         due = _due(self._solids, key, solids, obstacles.header.seq)
         return solid_scene(obstacles) if due else None
 
-    def _penetrations(self, robot: MobileManipulator, key: str, truth: SimTruth
-                      ) -> fox.SceneUpdate | None:  # fmt: skip
+    def _penetrations(
+        self, robot: MobileManipulator, key: str, truth: SimTruth
+    ) -> fox.SceneUpdate | None:
         """The parts inside a solid, with every truth while there are some; an empty scene
         with the first truth and when they are gone."""
         parts = penetrating(robot, truth)

@@ -52,9 +52,20 @@ CONVERGED_ERROR = 0.01
 """The controller's error norm ||e|| under which the goal counts as reached."""
 HOLD_S = 2.0
 """Simulated seconds the error must stay under ``CONVERGED_ERROR``; also the steady state."""
-JUDGED = frozenset(t.name for t in (ROBOT_STATE, CONTROL_GOAL, GOAL_REQUEST, BASE_COMMAND,
-                                    ARM_COMMAND, CONTROL_DIAGNOSTICS, WORLD_OBSTACLES, SIM_TRUTH,
-                                    SUPERVISOR_STATUS))  # fmt: skip
+JUDGED = frozenset(
+    t.name
+    for t in (
+        ROBOT_STATE,
+        CONTROL_GOAL,
+        GOAL_REQUEST,
+        BASE_COMMAND,
+        ARM_COMMAND,
+        CONTROL_DIAGNOSTICS,
+        WORLD_OBSTACLES,
+        SIM_TRUTH,
+        SUPERVISOR_STATUS,
+    )
+)
 """The topics a run is judged (and its figures drawn) from: no images."""
 RERUN_SOURCE = "rerun_"
 """The source of the commands ``parsimony rerun`` computes, before the law's name: offline, on
@@ -68,8 +79,9 @@ METRICS: Mapping[str, str] = {
 """Table 6.1's metrics: the ``ControlEffort`` field each reports."""
 
 
-def judge(session: Session, robot: MobileManipulator, time_limit_s: float | None = None
-          ) -> dict[str, Any]:  # fmt: skip
+def judge(
+    session: Session, robot: MobileManipulator, time_limit_s: float | None = None
+) -> dict[str, Any]:
     """Every figure of the run ``session`` holds, up to its end (``the_run``);
     ``outside_session`` says in one line what was left out as stamped far outside the session
     (``record.session_span``), None when nothing was; ``open_loop`` whether its commands were
@@ -97,8 +109,10 @@ def judge(session: Session, robot: MobileManipulator, time_limit_s: float | None
         "estimator_error": estimator_error(truth, states, end_s - HOLD_S),
         "nonzero_entries": dict(sorted(Counter(d.nonzero for d in steps).items())),
         "effort": effort(run),
-        "step_time_us": {"median": round(float(np.median(solve)), 1),
-                         "p99": round(float(np.percentile(solve, 99)), 1)},  # fmt: skip
+        "step_time_us": {
+            "median": round(float(np.median(solve)), 1),
+            "p99": round(float(np.percentile(solve, 99)), 1),
+        },
         "controller_statuses": dict(sorted(Counter(d.status for d in diagnostics).items())),
         "degraded_states": sum(s.degraded for s in states),
         "invalid_states": sum(not s.valid for s in states),
@@ -179,9 +193,14 @@ def end_of_run(session: Session, time_limit_s: float | None, origin: float) -> t
     same steps, however long each went on before it was stopped."""
     limited = time_limit_s is not None and math.isfinite(origin)
     limit_ns = round((origin + time_limit_s) * 1e9) if limited else None
-    within = session if limit_ns is None else until(
-        {t.name: session.get(t.name) or [] for t in (CONTROL_DIAGNOSTICS, SUPERVISOR_STATUS)},
-        limit_ns)  # fmt: skip
+    within = (
+        session
+        if limit_ns is None
+        else until(
+            {t.name: session.get(t.name) or [] for t in (CONTROL_DIAGNOSTICS, SUPERVISOR_STATUS)},
+            limit_ns,
+        )
+    )
     diagnostics = messages(within, CONTROL_DIAGNOSTICS)
     since = converged_at(diagnostics, messages(within, SUPERVISOR_STATUS))
     if since is not None and diagnostics[-1].header.stamp_ns / 1e9 - since >= HOLD_S:
@@ -222,9 +241,15 @@ def supervisor_summary(statuses: Sequence) -> dict[str, Any] | None:
     for status in statuses:
         if not began or began[-1][0] != status.phase:
             began.append((status.phase, status.header.stamp_ns / 1e9))
-    return {"phase": last.phase, "plans": last.plans, "replans": last.replans,
-            "stalls": last.stalls, "reason": last.reason, "candidate_base": last.candidate_base,
-            "phases": [{"phase": p, "from_s": t} for p, t in began]}  # fmt: skip
+    return {
+        "phase": last.phase,
+        "plans": last.plans,
+        "replans": last.replans,
+        "stalls": last.stalls,
+        "reason": last.reason,
+        "candidate_base": last.candidate_base,
+        "phases": [{"phase": p, "from_s": t} for p, t in began],
+    }
 
 
 def joints_at_stops(truth: Sequence, robot: MobileManipulator) -> int:
@@ -251,8 +276,9 @@ def arm_clearances(truth: Sequence, robot: MobileManipulator) -> Array | None:
     if not truth or not truth[-1].solids.solids() or not robot.collision.names:
         return None
     solids = truth[-1].solids.solids()
-    return np.array([part_clearances(robot, np.array(t.configuration()), solids)
-                     .min(axis=1) for t in truth])  # fmt: skip
+    return np.array(
+        [part_clearances(robot, np.array(t.configuration()), solids).min(axis=1) for t in truth]
+    )
 
 
 def arm_clearance(truth: Sequence, robot: MobileManipulator) -> dict[str, float] | None:
@@ -263,8 +289,10 @@ def arm_clearance(truth: Sequence, robot: MobileManipulator) -> dict[str, float]
     if found is None:
         return None
     least = found.min(axis=0)
-    return {name: round(float(value), 4)
-            for name, value in zip(robot.collision.names, least, strict=True)}  # fmt: skip
+    return {
+        name: round(float(value), 4)
+        for name, value in zip(robot.collision.names, least, strict=True)
+    }
 
 
 def nearest(sorted_stamps: Array, stamps: Array) -> Array:
@@ -301,8 +329,11 @@ def estimator_error(truth: Sequence, states: Sequence, since_s: float) -> dict:
         angle.append(abs(wrap(state.base_pose[2] - phi)))
     if not position:
         return {"position_m": None, "angle_rad": None, "samples": 0}
-    return {"position_m": round(max(position), 5), "angle_rad": round(max(angle), 5),
-            "samples": len(position)}  # fmt: skip
+    return {
+        "position_m": round(max(position), 5),
+        "angle_rad": round(max(angle), 5),
+        "samples": len(position),
+    }
 
 
 def commands(session: Session) -> tuple[Array, Array]:
@@ -398,5 +429,10 @@ def recording_check(facts: dict[str, Any], run_ns: tuple[int, int]) -> dict:
     if last_ns < end_ns:
         missing.append(f"its states end {(end_ns - last_ns) / 1e9:.2f} s before the run's")
     span_s = max((end_ns - start_ns) / 1e9, 1e-9)
-    return {"whole": not missing, "missing": missing, "messages": facts["messages"],
-            "bytes": facts["bytes"], "bytes_per_sim_s": round(facts["bytes"] / span_s)}  # fmt: skip
+    return {
+        "whole": not missing,
+        "missing": missing,
+        "messages": facts["messages"],
+        "bytes": facts["bytes"],
+        "bytes_per_sim_s": round(facts["bytes"] / span_s),
+    }

@@ -79,9 +79,15 @@ class LiveView:
         self._context = foxglove.Context()
         try:
             self.server = foxglove.start_server(
-                name=f"parsimony {namespace}", host=HOST, port=port, context=self._context,
-                server_listener=listener, capabilities=list(capabilities),
-                supported_encodings=list(encodings), message_backlog_size=BACKLOG)  # fmt: skip
+                name=f"parsimony {namespace}",
+                host=HOST,
+                port=port,
+                context=self._context,
+                server_listener=listener,
+                capabilities=list(capabilities),
+                supported_encodings=list(encodings),
+                message_backlog_size=BACKLOG,
+            )
         except RuntimeError as error:
             raise OSError(f"port: cannot listen on {HOST}:{port}: {error}") from error
         self._viewer = viewer if viewer is not None else Viewer()
@@ -126,8 +132,11 @@ class LiveView:
             times = np.array(self._timings, dtype=float) / 1e3
         if not len(times):
             return {"samples": 0, "median": 0.0, "p99": 0.0}
-        return {"samples": len(times), "median": round(float(np.median(times)), 1),
-                "p99": round(float(np.percentile(times, 99)), 1)}  # fmt: skip
+        return {
+            "samples": len(times),
+            "median": round(float(np.median(times)), 1),
+            "p99": round(float(np.percentile(times, 99)), 1),
+        }
 
     def _on_sample(self, topic: topics.Topic, sample: zenoh.Sample) -> None:
         started = time.perf_counter_ns()
@@ -152,8 +161,11 @@ class LiveView:
         except Exception as error:  # a view that fails must not take the others with it
             with self._lock:
                 self.failed += 1
-                self._warn(key, f"view: no views of a {type(message).__name__} on {key}: "
-                                f"{type(error).__name__}: {error}")  # fmt: skip
+                self._warn(
+                    key,
+                    f"view: no views of a {type(message).__name__} on {key}: "
+                    f"{type(error).__name__}: {error}",
+                )
             found = entries(key, message, views=False)
         for entry in found:
             self._log(key, entry, stamp)
@@ -174,9 +186,15 @@ class LiveView:
         for suffix, kind in self._viewer.channels(topic.name):
             if view_channel(key, suffix) not in self._by_name:
                 schema = kind.get_schema()
-                self._open(key, view_channel(key, suffix), foxglove.Schema(
-                    name=schema.name, encoding=schema.encoding, data=bytes(schema.data)),
-                    "protobuf", {})  # fmt: skip
+                self._open(
+                    key,
+                    view_channel(key, suffix),
+                    foxglove.Schema(
+                        name=schema.name, encoding=schema.encoding, data=bytes(schema.data)
+                    ),
+                    "protobuf",
+                    {},
+                )
         with self._lock:
             self._of_key.setdefault(key, [])
 
@@ -186,21 +204,29 @@ class LiveView:
         with self._lock:
             channel = self._channels.get((entry.channel, entry.schema_name))
         if channel is None:
-            schema = foxglove.Schema(name=entry.schema_name, encoding=entry.schema_encoding,
-                                     data=entry.schema_data)  # fmt: skip
-            channel = self._open(key, entry.channel, schema, entry.message_encoding,
-                                 dict(entry.metadata))  # fmt: skip
+            schema = foxglove.Schema(
+                name=entry.schema_name, encoding=entry.schema_encoding, data=entry.schema_data
+            )
+            channel = self._open(
+                key, entry.channel, schema, entry.message_encoding, dict(entry.metadata)
+            )
         channel.log(entry.data, log_time=log_time_ns)
 
-    def _open(self, key: str, name: str, schema: foxglove.Schema, encoding: str,
-              metadata: dict[str, str]) -> foxglove.Channel:  # fmt: skip
+    def _open(
+        self, key: str, name: str, schema: foxglove.Schema, encoding: str, metadata: dict[str, str]
+    ) -> foxglove.Channel:
         """A channel, advertised to the clients, and remembered under its message's key."""
         with self._lock:
             found = self._channels.get((name, schema.name))
             if found is not None:
                 return found
-            channel = foxglove.Channel(name, schema=schema, message_encoding=encoding,
-                                       context=self._context, metadata=metadata)  # fmt: skip
+            channel = foxglove.Channel(
+                name,
+                schema=schema,
+                message_encoding=encoding,
+                context=self._context,
+                metadata=metadata,
+            )
             self._channels[(name, schema.name)] = channel
             self._by_name.setdefault(name, channel)
             self._of_key.setdefault(key, []).append(channel)

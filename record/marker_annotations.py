@@ -30,14 +30,33 @@ def marker_annotations(detections: MarkerDetections) -> fox.ImageAnnotations:
         if marker.corners is None:
             continue
         points = [fox.Point2(x=u, y=v) for u, v in marker.corners]
-        outlines.append(fox.PointsAnnotation(
-            timestamp=stamp, type=fox.PointsAnnotationType.LineLoop, points=points,
-            outline_color=OUTLINE_COLOR, thickness=OUTLINE_PX))  # fmt: skip
-        corners.append(fox.CircleAnnotation(
-            timestamp=stamp, position=points[0], diameter=FIRST_CORNER_PX, thickness=OUTLINE_PX,
-            outline_color=OUTLINE_COLOR, fill_color=OUTLINE_COLOR))  # fmt: skip
-        labels.append(fox.TextAnnotation(
-            timestamp=stamp, position=points[0], text=f"id {marker.id}", font_size=FONT_PX,
-            text_color=TEXT_COLOR, background_color=TEXT_BACKGROUND))  # fmt: skip
-    return fox.ImageAnnotations(timestamp=stamp, circles=corners, points=outlines,
-                                texts=labels)
+        outlines.append(
+            fox.PointsAnnotation(
+                timestamp=stamp,
+                type=fox.PointsAnnotationType.LineLoop,
+                points=points,
+                outline_color=OUTLINE_COLOR,
+                thickness=OUTLINE_PX,
+            )
+        )
+        corners.append(
+            fox.CircleAnnotation(
+                timestamp=stamp,
+                position=points[0],
+                diameter=FIRST_CORNER_PX,
+                thickness=OUTLINE_PX,
+                outline_color=OUTLINE_COLOR,
+                fill_color=OUTLINE_COLOR,
+            )
+        )
+        labels.append(
+            fox.TextAnnotation(
+                timestamp=stamp,
+                position=points[0],
+                text=f"id {marker.id}",
+                font_size=FONT_PX,
+                text_color=TEXT_COLOR,
+                background_color=TEXT_BACKGROUND,
+            )
+        )
+    return fox.ImageAnnotations(timestamp=stamp, circles=corners, points=outlines, texts=labels)

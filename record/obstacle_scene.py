@@ -60,26 +60,41 @@ LABEL_LIFT_M = 0.05
 
 
 def _label(name: str, position: np.ndarray) -> fox.TextPrimitive:
-    return fox.TextPrimitive(pose=at(*map(float, position)), billboard=True,
-                             font_size=LABEL_SIZE_PX, scale_invariant=True, color=EDGE_COLOR,
-                             text=name)  # fmt: skip
+    return fox.TextPrimitive(
+        pose=at(*map(float, position)),
+        billboard=True,
+        font_size=LABEL_SIZE_PX,
+        scale_invariant=True,
+        color=EDGE_COLOR,
+        text=name,
+    )
 
 
-def _upright(x: float, y: float, radius: float, height: float, color: fox.Color
-             ) -> fox.CylinderPrimitive:  # fmt: skip
+def _upright(
+    x: float, y: float, radius: float, height: float, color: fox.Color
+) -> fox.CylinderPrimitive:
     """A vertical cylinder from the floor to ``height``."""
-    return fox.CylinderPrimitive(pose=at(x, y, height / 2), bottom_scale=1.0, top_scale=1.0,
-                                 size=fox.Vector3(x=2 * radius, y=2 * radius, z=height),
-                                 color=color)  # fmt: skip
+    return fox.CylinderPrimitive(
+        pose=at(x, y, height / 2),
+        bottom_scale=1.0,
+        top_scale=1.0,
+        size=fox.Vector3(x=2 * radius, y=2 * radius, z=height),
+        color=color,
+    )
 
 
 def circle_scene(obstacles: Obstacles) -> fox.SceneUpdate:
     """Every circle as a cylinder standing on the floor, after deleting the last ones."""
     stamp = timestamp(obstacles.header.stamp_ns)
-    entities = [fox.SceneEntity(
-        timestamp=stamp, frame_id=obstacles.header.frame, id=f"obstacle_{index}",
-        cylinders=[_upright(c.x, c.y, c.radius, c.height or CIRCLE_HEIGHT_M, OBSTACLE_COLOR)],
-    ) for index, c in enumerate(obstacles.circles)]  # fmt: skip
+    entities = [
+        fox.SceneEntity(
+            timestamp=stamp,
+            frame_id=obstacles.header.frame,
+            id=f"obstacle_{index}",
+            cylinders=[_upright(c.x, c.y, c.radius, c.height or CIRCLE_HEIGHT_M, OBSTACLE_COLOR)],
+        )
+        for index, c in enumerate(obstacles.circles)
+    ]
     return replacing(stamp, entities)
 
 
@@ -88,14 +103,26 @@ def solid_scene(obstacles: Obstacles) -> fox.SceneUpdate:
     last ones."""
     stamp = timestamp(obstacles.header.stamp_ns)
     frame = obstacles.header.frame
-    entities = [fox.SceneEntity(timestamp=stamp, frame_id=frame, id=f"plane_{index}",
-                                metadata=[fox.KeyValuePair(key="name", value=plane.name)],
-                                **plane_primitives(plane))
-                for index, plane in enumerate(obstacles.solids.planes)]  # fmt: skip
-    entities += [fox.SceneEntity(timestamp=stamp, frame_id=frame, id=f"cylinder_{index}",
-                                 metadata=[fox.KeyValuePair(key="name", value=cylinder.name)],
-                                 **cylinder_primitives(cylinder))
-                 for index, cylinder in enumerate(obstacles.solids.cylinders)]  # fmt: skip
+    entities = [
+        fox.SceneEntity(
+            timestamp=stamp,
+            frame_id=frame,
+            id=f"plane_{index}",
+            metadata=[fox.KeyValuePair(key="name", value=plane.name)],
+            **plane_primitives(plane),
+        )
+        for index, plane in enumerate(obstacles.solids.planes)
+    ]
+    entities += [
+        fox.SceneEntity(
+            timestamp=stamp,
+            frame_id=frame,
+            id=f"cylinder_{index}",
+            metadata=[fox.KeyValuePair(key="name", value=cylinder.name)],
+            **cylinder_primitives(cylinder),
+        )
+        for index, cylinder in enumerate(obstacles.solids.cylinders)
+    ]
     return replacing(stamp, entities)
 
 
@@ -104,9 +131,10 @@ def cylinder_primitives(cylinder: Cylinder) -> dict[str, list]:
     it."""
     height = cylinder.height if cylinder.height is not None else UNBOUNDED_HEIGHT_M
     label = np.array([cylinder.x, cylinder.y, height + LABEL_LIFT_M])
-    return {"cylinders": [_upright(cylinder.x, cylinder.y, cylinder.radius, height,
-                                   OBSTACLE_COLOR)],
-            "texts": [_label(cylinder.name, label)]}  # fmt: skip
+    return {
+        "cylinders": [_upright(cylinder.x, cylinder.y, cylinder.radius, height, OBSTACLE_COLOR)],
+        "texts": [_label(cylinder.name, label)],
+    }
 
 
 def plane_primitives(plane: Plane) -> dict[str, list]:
@@ -134,23 +162,34 @@ def _prism(plane: Plane) -> dict[str, list]:
     ring = [fox.Point3(x=float(x), y=float(y), z=height) for x, y in footprint]
     far_ring = [fox.Point3(x=float(x), y=float(y), z=far) for x, y in footprint]
     fan = [i for j in range(1, count - 1) for i in (0, j, j + 1)]
-    face = fox.TriangleListPrimitive(pose=at(0.0, 0.0, 0.0), points=ring, color=FACE_COLOR,
-                                     indices=fan)  # fmt: skip
+    face = fox.TriangleListPrimitive(
+        pose=at(0.0, 0.0, 0.0), points=ring, color=FACE_COLOR, indices=fan
+    )
     following = [(i, (i + 1) % count) for i in range(count)]
     rim = [index for i, j in following for index in (i, j)]
     primitives: dict[str, list] = {"triangles": [face]}
     if far != height:
-        sides = [index for i, j in following for index in (i, j, count + j, i, count + j,
-                                                           count + i)]  # fmt: skip
-        primitives["triangles"].append(fox.TriangleListPrimitive(
-            pose=at(0.0, 0.0, 0.0), points=ring + far_ring, color=BODY_COLOR,
-            indices=sides))  # fmt: skip
+        sides = [
+            index for i, j in following for index in (i, j, count + j, i, count + j, count + i)
+        ]
+        primitives["triangles"].append(
+            fox.TriangleListPrimitive(
+                pose=at(0.0, 0.0, 0.0), points=ring + far_ring, color=BODY_COLOR, indices=sides
+            )
+        )
         rim += [index for i in range(count) for index in (i, count + i)]
         rim += [count + index for i, j in following for index in (i, j)]
-    primitives["lines"] = [fox.LinePrimitive(
-        type=fox.LinePrimitiveLineType.LineList, pose=at(0.0, 0.0, 0.0),
-        thickness=EDGE_THICKNESS_PX, scale_invariant=True, color=EDGE_COLOR,
-        points=ring + far_ring, indices=rim)]  # fmt: skip
+    primitives["lines"] = [
+        fox.LinePrimitive(
+            type=fox.LinePrimitiveLineType.LineList,
+            pose=at(0.0, 0.0, 0.0),
+            thickness=EDGE_THICKNESS_PX,
+            scale_invariant=True,
+            color=EDGE_COLOR,
+            points=ring + far_ring,
+            indices=rim,
+        )
+    ]
     centre = np.array([*footprint.mean(axis=0), height + side * LABEL_LIFT_M])
     primitives["texts"] = [_label(plane.name, centre)]
     return primitives
@@ -167,15 +206,18 @@ def wall_box(plane: Plane) -> tuple[np.ndarray, fox.Quaternion]:
     if w < 1e-9:
         return centre, fox.Quaternion(x=0.0, y=0.0, z=1.0, w=0.0)
     norm = math.sqrt(w * w + float(axis @ axis))
-    return centre, fox.Quaternion(x=float(axis[0]) / norm, y=float(axis[1]) / norm,
-                                  z=float(axis[2]) / norm, w=w / norm)  # fmt: skip
+    return centre, fox.Quaternion(
+        x=float(axis[0]) / norm, y=float(axis[1]) / norm, z=float(axis[2]) / norm, w=w / norm
+    )
 
 
 def _wall(plane: Plane) -> dict[str, list]:
     """A thin box with its front face on the plane, its name in front of its centre."""
     centre, orientation = wall_box(plane)
-    box = fox.CubePrimitive(pose=at(*map(float, centre), orientation), color=FACE_COLOR,
-                            size=fox.Vector3(x=WALL_THICKNESS_M, y=WALL_SIDE_M,
-                                             z=WALL_SIDE_M))  # fmt: skip
+    box = fox.CubePrimitive(
+        pose=at(*map(float, centre), orientation),
+        color=FACE_COLOR,
+        size=fox.Vector3(x=WALL_THICKNESS_M, y=WALL_SIDE_M, z=WALL_SIDE_M),
+    )
     label = centre + np.array(plane.normal) * (WALL_THICKNESS_M / 2 + LABEL_LIFT_M)
     return {"cubes": [box], "texts": [_label(plane.name, label)]}

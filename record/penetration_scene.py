@@ -34,31 +34,49 @@ def penetrating(robot: MobileManipulator, truth: SimTruth) -> tuple[str, ...]:
     if not solids:
         return ()
     inside = part_clearances(robot, np.array(truth.configuration()), solids).min(axis=1) < 0.0
-    return tuple(name for name, found in zip(robot.collision.names, inside, strict=True)
-                 if found)  # fmt: skip
+    return tuple(name for name, found in zip(robot.collision.names, inside, strict=True) if found)
 
 
-def penetration_scene(robot: MobileManipulator, frame: str, truth: SimTruth,
-                      parts: tuple[str, ...]) -> fox.SceneUpdate:  # fmt: skip
+def penetration_scene(
+    robot: MobileManipulator, frame: str, truth: SimTruth, parts: tuple[str, ...]
+) -> fox.SceneUpdate:
     """The ``parts`` (names) at the truth's configuration, in ``frame`` (the simulator's
     world), after deleting the last ones."""
     stamp = timestamp(truth.header.stamp_ns)
     model = robot.collision
     positions = point_positions(robot.frames(np.array(truth.configuration())), model)
-    spheres = [_sphere(positions[i], p.radius) for i, p in enumerate(model.points)
-               if p.name in parts]  # fmt: skip
+    spheres = [
+        _sphere(positions[i], p.radius) for i, p in enumerate(model.points) if p.name in parts
+    ]
     lines = []
     for segment in model.segments:
         if segment.name in parts:
             ends = positions[[segment.start, segment.end]]
             spheres += [_sphere(end, segment.radius) for end in ends]
-            lines.append(fox.LinePrimitive(
-                type=fox.LinePrimitiveLineType.LineStrip, pose=at(0.0, 0.0, 0.0),
-                thickness=2 * segment.radius, scale_invariant=False, color=PENETRATION_COLOR,
-                points=[point(end) for end in ends]))  # fmt: skip
-    entities = [fox.SceneEntity(timestamp=stamp, frame_id=frame, id="penetrating",
-                                metadata=[fox.KeyValuePair(key="parts", value=", ".join(parts))],
-                                spheres=spheres, lines=lines)] if parts else []  # fmt: skip
+            lines.append(
+                fox.LinePrimitive(
+                    type=fox.LinePrimitiveLineType.LineStrip,
+                    pose=at(0.0, 0.0, 0.0),
+                    thickness=2 * segment.radius,
+                    scale_invariant=False,
+                    color=PENETRATION_COLOR,
+                    points=[point(end) for end in ends],
+                )
+            )
+    entities = (
+        [
+            fox.SceneEntity(
+                timestamp=stamp,
+                frame_id=frame,
+                id="penetrating",
+                metadata=[fox.KeyValuePair(key="parts", value=", ".join(parts))],
+                spheres=spheres,
+                lines=lines,
+            )
+        ]
+        if parts
+        else []
+    )
     return replacing(stamp, entities)
 
 

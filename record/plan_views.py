@@ -31,8 +31,9 @@ def candidate_of(status: SupervisorStatus) -> np.ndarray | None:
     return np.array([*status.candidate_base, *status.candidate_arm])
 
 
-def plan_transforms(drawing: RobotDrawing | None, status: SupervisorStatus
-                    ) -> list[fox.FrameTransform]:  # fmt: skip
+def plan_transforms(
+    drawing: RobotDrawing | None, status: SupervisorStatus
+) -> list[fox.FrameTransform]:
     """The candidate's frames, if there is a candidate and a robot to draw."""
     q = candidate_of(status)
     if drawing is None or q is None:
@@ -47,14 +48,26 @@ def plan_scene(drawing: RobotDrawing | None, status: SupervisorStatus) -> fox.Sc
     if status.way:
         points = [fox.Point3(x=x, y=y, z=WAY_HEIGHT_M) for x, y in status.way]
         size = fox.Vector3(x=WAY_POINT_M, y=WAY_POINT_M, z=WAY_POINT_M)
-        entities.append(fox.SceneEntity(
-            timestamp=stamp, frame_id="world", id="plan/way",
-            lines=[fox.LinePrimitive(type=fox.LinePrimitiveLineType.LineStrip,
-                                     pose=at(0.0, 0.0, 0.0), thickness=WAY_THICKNESS_M,
-                                     color=WAY_COLOR, points=points)],
-            spheres=[fox.SpherePrimitive(pose=at(x, y, WAY_HEIGHT_M), size=size, color=WAY_COLOR)
-                     for x, y in status.way],
-        ))  # fmt: skip
+        entities.append(
+            fox.SceneEntity(
+                timestamp=stamp,
+                frame_id="world",
+                id="plan/way",
+                lines=[
+                    fox.LinePrimitive(
+                        type=fox.LinePrimitiveLineType.LineStrip,
+                        pose=at(0.0, 0.0, 0.0),
+                        thickness=WAY_THICKNESS_M,
+                        color=WAY_COLOR,
+                        points=points,
+                    )
+                ],
+                spheres=[
+                    fox.SpherePrimitive(pose=at(x, y, WAY_HEIGHT_M), size=size, color=WAY_COLOR)
+                    for x, y in status.way
+                ],
+            )
+        )
     if drawing is not None and candidate_of(status) is not None:
         entities += drawing.model(status.header.stamp_ns)
     return replacing(stamp, entities)

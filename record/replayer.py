@@ -49,6 +49,7 @@ ANSWER_TIMEOUT_S = 1.0
 """Host seconds ``--lockstep`` waits for an answer before it goes on (said and counted)."""
 KEYS_HELP = "space: pause/play, s or right arrow: step, +/-: rate, q: quit"
 
+
 def sending_rank(topic_name: str) -> int:
     """Where a message goes among those of its recorded time: ``SENSORS`` first, in order."""
     return SENSORS.index(topic_name) if topic_name in SENSORS else len(SENSORS)
@@ -74,20 +75,30 @@ class Recording:
     def of(cls, path: Path, wanted: Callable[[str], bool]) -> Recording:
         """The topics of ``path`` that ``wanted`` lets through, and their span."""
         found = info(path)
-        channels = [c for c in found["channels"]
-                    if c["topic"] is not None and c["messages"] and wanted(c["topic"])]  # fmt: skip
-        namespaces = frozenset(c["key"].removesuffix(topics.TOPICS[c["topic"]].suffix)[:-1]
-                               for c in channels)  # fmt: skip
-        return cls(path, frozenset(c["topic"] for c in channels),
-                   min((c["start_ns"] for c in channels), default=0),
-                   max((c["end_ns"] for c in channels), default=0), found["warning"],
-                   namespaces)  # fmt: skip
+        channels = [
+            c
+            for c in found["channels"]
+            if c["topic"] is not None and c["messages"] and wanted(c["topic"])
+        ]
+        namespaces = frozenset(
+            c["key"].removesuffix(topics.TOPICS[c["topic"]].suffix)[:-1] for c in channels
+        )
+        return cls(
+            path,
+            frozenset(c["topic"] for c in channels),
+            min((c["start_ns"] for c in channels), default=0),
+            max((c["end_ns"] for c in channels), default=0),
+            found["warning"],
+            namespaces,
+        )
 
     def namespace(self) -> str:
         """The one namespace it was recorded in; ``ValueError`` when it holds several."""
         if len(self.namespaces) != 1:
-            raise ValueError(f"{self.path}: recorded in the namespaces "
-                             f"{', '.join(sorted(self.namespaces))}: give --namespace")
+            raise ValueError(
+                f"{self.path}: recorded in the namespaces "
+                f"{', '.join(sorted(self.namespaces))}: give --namespace"
+            )
         return topics.check_namespace(next(iter(self.namespaces)))
 
     def window(self, start_offset_s: float, duration_s: float | None) -> tuple[int, int]:
@@ -162,9 +173,11 @@ class Progress:
         if not changed and now - self.shown_s < 1.0:
             return
         self.shown_s = now
-        line = (f"[replay] {(recorded_ns - self.first_ns) / 1e9:7.2f} / "
-                f"{self.duration_ns / 1e9:.2f} s  rate {pace.rate:g}"
-                f"{'  paused' if pace.paused else ''}  {sent} messages")  # fmt: skip
+        line = (
+            f"[replay] {(recorded_ns - self.first_ns) / 1e9:7.2f} / "
+            f"{self.duration_ns / 1e9:.2f} s  rate {pace.rate:g}"
+            f"{'  paused' if pace.paused else ''}  {sent} messages"
+        )
         end = "\x1b[K" if self.in_place else "\n"
         print(("\r" if self.in_place else "") + line, end=end, file=sys.stderr, flush=True)
         self.line_open = self.in_place
@@ -209,8 +222,9 @@ class Answers:
         ``ANSWER_TIMEOUT_S``; False (and counted in ``timeouts``) when one did not come."""
         names = [t.name for t in ANSWERS[record.topic_name]]
         with self._changed:
-            if self._changed.wait_for(lambda: self._stamps.answered(record.log_time_ns, names),
-                                      ANSWER_TIMEOUT_S):  # fmt: skip
+            if self._changed.wait_for(
+                lambda: self._stamps.answered(record.log_time_ns, names), ANSWER_TIMEOUT_S
+            ):
                 return True
         self.timeouts += 1
         return False
@@ -233,21 +247,27 @@ class Playing:
 class Player:
     """One replay: the passes over the records, the keys, the progress line."""
 
-    def __init__(self, playing: Playing, session: zenoh.Session, namespace: str,
-                 recording: Recording, keys: KeyReader | None) -> None:  # fmt: skip
+    def __init__(
+        self,
+        playing: Playing,
+        session: zenoh.Session,
+        namespace: str,
+        recording: Recording,
+        keys: KeyReader | None,
+    ) -> None:
         self.playing, self.keys, self.recording = playing, keys, recording
         self.first_ns, self.last_ns = recording.window(playing.start_offset_s, playing.duration_s)
         self.progress = Progress(self.first_ns, self.last_ns - self.first_ns)
-        self.pace = Pace(playing.rate, self.first_ns, time.monotonic(),
-                         paused=playing.start_paused)  # fmt: skip
+        self.pace = Pace(playing.rate, self.first_ns, time.monotonic(), paused=playing.start_paused)
         self.answers = Answers(session, namespace) if playing.lockstep else None
         names = recording.names | ({"sim/clock"} if playing.clock else set())
         block = zenoh.CongestionControl.BLOCK  # a replay waits rather than drop a sample
         self.publishers = {
-            name: session.declare_publisher(topics.TOPICS[name].key(namespace),
-                                            congestion_control=block)
+            name: session.declare_publisher(
+                topics.TOPICS[name].key(namespace), congestion_control=block
+            )
             for name in names
-        }  # fmt: skip
+        }
 
     def run(self) -> int:
         if self.keys is not None:
@@ -259,8 +279,9 @@ class Player:
         while True:
             sent, quit_asked = self.replay_once()
             if self.answers is not None and self.answers.timeouts:
-                self.progress.say(f"{self.answers.timeouts} messages not answered "
-                                  f"within {ANSWER_TIMEOUT_S:g} s")  # fmt: skip
+                self.progress.say(
+                    f"{self.answers.timeouts} messages not answered within {ANSWER_TIMEOUT_S:g} s"
+                )
             self.progress.say(f"{sent} messages sent" + (" (quit)" if quit_asked else ""))
             if quit_asked or not self.playing.loop:
                 return 0
@@ -325,8 +346,10 @@ class Player:
             started = time.monotonic()
             if not self.answers.wait(record):
                 stamp_s = record.log_time_ns / 1e9
-                self.progress.say(f"no answer to {record.topic_name} of {stamp_s:.3f} s "
-                                  f"in {ANSWER_TIMEOUT_S:g} s; going on")  # fmt: skip
+                self.progress.say(
+                    f"no answer to {record.topic_name} of {stamp_s:.3f} s "
+                    f"in {ANSWER_TIMEOUT_S:g} s; going on"
+                )
             self.pace.anchor_s += time.monotonic() - started
 
     def publish(self, name: str, message) -> None:

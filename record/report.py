@@ -116,8 +116,9 @@ def write_report(
     efforts = {rec.label: effort_of_inputs(rec.stamps_ns, rec.u) for rec in recordings}
     if short := [label for label, found in efforts.items() if found is None]:
         raise ValueError(f"{', '.join(short)}: the control effort needs two commands or more")
-    notes = [OPEN_LOOP_NOTE.format(label=label) for label, session in sessions
-             if open_loop(session)]  # fmt: skip
+    notes = [
+        OPEN_LOOP_NOTE.format(label=label) for label, session in sessions if open_loop(session)
+    ]
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     figures, gaps = [], {}
@@ -135,9 +136,11 @@ def write_report(
     return {"figures": figures, "effort": efforts, "gaps": gaps, "notes": notes}
 
 
-OPEN_LOOP_NOTE = ("{label}: its commands were computed by `parsimony rerun` on the recording's "
-                  "states, not in a closed loop (the states did not follow them): its effort "
-                  "is not that of a run of its law")
+OPEN_LOOP_NOTE = (
+    "{label}: its commands were computed by `parsimony rerun` on the recording's "
+    "states, not in a closed loop (the states did not follow them): its effort "
+    "is not that of a run of its law"
+)
 """What a report says of a session whose commands a rerun computed."""
 
 
@@ -183,8 +186,10 @@ def _recording(
     stamps, u = commands(session)
     states = required(session, ROBOT_STATE)
     if len(states[0].arm_joints) != robot.arm_dof:
-        raise ValueError(f"the robot description has {robot.arm_dof} arm joints, the "
-                         f"recording's states {len(states[0].arm_joints)}")  # fmt: skip
+        raise ValueError(
+            f"the robot description has {robot.arm_dof} arm joints, the "
+            f"recording's states {len(states[0].arm_joints)}"
+        )
     recorded = messages(session, SIM_TRUTH)
     truth = recorded if truth_frame is not None else []
     clearance = arm_clearances(recorded, robot)  # the same in any frame: no truth_frame needed
@@ -338,15 +343,17 @@ def _end_effector_path_figure(recordings: Sequence[_Recording], _: MobileManipul
     figure, axes = _panels(recordings, 1, 5.0)
     for ax, rec in zip(axes[0], recordings, strict=True):
         if estimated := _estimated(rec.states):
-            _path(ax, [dq.translation(np.array(s.end_effector))[1:3] for s in estimated],
-                  "estimate")  # fmt: skip
+            _path(
+                ax, [dq.translation(np.array(s.end_effector))[1:3] for s in estimated], "estimate"
+            )
         else:
             _nothing(ax, NO_FIX)
         if rec.truth:
             truth = [dq.translation(np.array(s.end_effector))[1:3] for s in rec.truth]
             _path(ax, truth, "truth", linestyle="--")
-        goals = np.array([_goal_position(g)[:2] for g in rec.goals
-                          if g.task in END_EFFECTOR_TASKS]).reshape(-1, 2)  # fmt: skip
+        goals = np.array(
+            [_goal_position(g)[:2] for g in rec.goals if g.task in END_EFFECTOR_TASKS]
+        ).reshape(-1, 2)
         ax.plot(goals[:, 0], goals[:, 1], "*", color="green", markersize=12, label="goal")
         _legend(ax)
     return figure
@@ -358,8 +365,9 @@ def _base_path_figure(recordings: Sequence[_Recording], robot: MobileManipulator
         if estimated := _estimated(rec.states):
             _path(ax, [s.base_pose[:2] for s in estimated], "estimate")
             x, y = estimated[-1].base_pose[:2]
-            ax.add_patch(Circle((x, y), robot.base.body_radius, fill=False, color="gray",
-                                label="base body"))  # fmt: skip
+            ax.add_patch(
+                Circle((x, y), robot.base.body_radius, fill=False, color="gray", label="base body")
+            )
         else:
             _nothing(ax, NO_FIX)
         if rec.truth:
@@ -370,8 +378,9 @@ def _base_path_figure(recordings: Sequence[_Recording], robot: MobileManipulator
     return figure
 
 
-def _arm_clearance_figure(recordings: Sequence[_Recording], robot: MobileManipulator
-                          ) -> Figure | None:  # fmt: skip
+def _arm_clearance_figure(
+    recordings: Sequence[_Recording], robot: MobileManipulator
+) -> Figure | None:
     """Each collision part's clearance from the nearest solid over time, 0 (contact) dashed
     black; None when no session's truth has solids."""
     if all(rec.arm_clearance is None for rec in recordings):

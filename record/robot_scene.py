@@ -71,8 +71,9 @@ class RobotDrawing:
         """The base on the floor, then every link in the one before it, at configuration q."""
         found = [planar_transform(self.parent, self.frame("base"), tuple(q[:BASE_DOF]), stamp_ns)]
         links = self.links()
-        for parent, child, pose in zip([self.frame("base"), *links[:-1]], links,
-                                       self.robot.link_transforms(q), strict=True):  # fmt: skip
+        for parent, child, pose in zip(
+            [self.frame("base"), *links[:-1]], links, self.robot.link_transforms(q), strict=True
+        ):
             found.append(pose_transform(parent, child, pose, stamp_ns))
         return found
 
@@ -82,44 +83,74 @@ class RobotDrawing:
         entities = [self._entity("base", stamp, **self._base())]
         for i in range(1, self.robot.arm_dof + 1):
             outline = self.robot.link_outline(i)
-            joint = fox.SpherePrimitive(pose=at(*map(float, outline[0])), color=self.color,
-                                        size=fox.Vector3(x=JOINT_DIAMETER_M, y=JOINT_DIAMETER_M,
-                                                         z=JOINT_DIAMETER_M))  # fmt: skip
-            line = fox.LinePrimitive(type=fox.LinePrimitiveLineType.LineStrip, pose=at(0, 0, 0),
-                                     thickness=LINK_THICKNESS_M, color=self.color,
-                                     points=[point(p) for p in outline])  # fmt: skip
+            joint = fox.SpherePrimitive(
+                pose=at(*map(float, outline[0])),
+                color=self.color,
+                size=fox.Vector3(x=JOINT_DIAMETER_M, y=JOINT_DIAMETER_M, z=JOINT_DIAMETER_M),
+            )
+            line = fox.LinePrimitive(
+                type=fox.LinePrimitiveLineType.LineStrip,
+                pose=at(0, 0, 0),
+                thickness=LINK_THICKNESS_M,
+                color=self.color,
+                points=[point(p) for p in outline],
+            )
             entities.append(self._entity(f"link_{i}", stamp, spheres=[joint], lines=[line]))
-        entities.append(self._entity(f"link_{self.robot.arm_dof}", stamp, "gripper",
-                                     cubes=self._fingers()))  # fmt: skip
+        entities.append(
+            self._entity(f"link_{self.robot.arm_dof}", stamp, "gripper", cubes=self._fingers())
+        )
         return entities
 
-    def _entity(self, frame: str, stamp: fox.Timestamp, part: str = "", **primitives: list
-                ) -> fox.SceneEntity:  # fmt: skip
-        return fox.SceneEntity(timestamp=stamp, frame_id=self.frame(frame), frame_locked=True,
-                               id=self.frame(part or frame), **primitives)  # fmt: skip
+    def _entity(
+        self, frame: str, stamp: fox.Timestamp, part: str = "", **primitives: list
+    ) -> fox.SceneEntity:
+        return fox.SceneEntity(
+            timestamp=stamp,
+            frame_id=self.frame(frame),
+            frame_locked=True,
+            id=self.frame(part or frame),
+            **primitives,
+        )
 
     def _base(self) -> dict[str, list]:
         """The Create: a disc of the base's radius up to the arm's mount, two wheels on the
         axle, an arrow to its front."""
         base = self.robot.base
         height, radius, wheel = base.height, base.body_radius, base.wheel_radius
-        disc = fox.CylinderPrimitive(pose=at(0.0, 0.0, height / 2), color=self.color,
-                                     size=fox.Vector3(x=2 * radius, y=2 * radius, z=height),
-                                     bottom_scale=1.0, top_scale=1.0)  # fmt: skip
-        wheels = [fox.CylinderPrimitive(pose=at(0.0, side * base.wheel_base / 2, wheel, AXLE),
-                                        size=fox.Vector3(x=2 * wheel, y=2 * wheel,
-                                                         z=WHEEL_WIDTH_M),
-                                        bottom_scale=1.0, top_scale=1.0, color=WHEEL_COLOR)
-                  for side in (-1.0, 1.0)]  # fmt: skip
-        front = fox.ArrowPrimitive(pose=at(0.0, 0.0, height + 0.01), shaft_length=0.7 * radius,
-                                   shaft_diameter=0.02, head_length=0.25 * radius,
-                                   head_diameter=0.05, color=self.color)  # fmt: skip
+        disc = fox.CylinderPrimitive(
+            pose=at(0.0, 0.0, height / 2),
+            color=self.color,
+            size=fox.Vector3(x=2 * radius, y=2 * radius, z=height),
+            bottom_scale=1.0,
+            top_scale=1.0,
+        )
+        wheels = [
+            fox.CylinderPrimitive(
+                pose=at(0.0, side * base.wheel_base / 2, wheel, AXLE),
+                size=fox.Vector3(x=2 * wheel, y=2 * wheel, z=WHEEL_WIDTH_M),
+                bottom_scale=1.0,
+                top_scale=1.0,
+                color=WHEEL_COLOR,
+            )
+            for side in (-1.0, 1.0)
+        ]
+        front = fox.ArrowPrimitive(
+            pose=at(0.0, 0.0, height + 0.01),
+            shaft_length=0.7 * radius,
+            shaft_diameter=0.02,
+            head_length=0.25 * radius,
+            head_diameter=0.05,
+            color=self.color,
+        )
         return {"cylinders": [disc, *wheels], "arrows": [front]}
 
     def _fingers(self) -> list[fox.CubePrimitive]:
         """Two fingers either side of the end effector, along the last link (its x axis)."""
         length, width, height = FINGER_SIZE_M
         size = fox.Vector3(x=length, y=width, z=height)
-        return [fox.CubePrimitive(pose=at(-length / 2, side * FINGER_GAP_M / 2, 0.0), size=size,
-                                  color=self.color)
-                for side in (-1.0, 1.0)]  # fmt: skip
+        return [
+            fox.CubePrimitive(
+                pose=at(-length / 2, side * FINGER_GAP_M / 2, 0.0), size=size, color=self.color
+            )
+            for side in (-1.0, 1.0)
+        ]

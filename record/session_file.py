@@ -83,8 +83,11 @@ def to_json(message: BaseModel, left_out: str = "") -> bytes:
     """
     names = [name for name in bytes_fields(type(message)) if name != left_out]
     dumped = message.model_dump(exclude={*bytes_fields(type(message)), left_out})
-    fields = {name: BYTES_MARKER if name in names else dumped[name]
-              for name in type(message).model_fields if name != left_out}  # fmt: skip
+    fields = {
+        name: BYTES_MARKER if name in names else dumped[name]
+        for name in type(message).model_fields
+        if name != left_out
+    }
     text = json.dumps(fields, allow_nan=False, separators=(",", ":")).encode()
     for name in names:
         value = b'"' + base64.b64encode(getattr(message, name)) + b'"'
@@ -124,8 +127,11 @@ def entries(
     metadata. Only the channels ``wanted`` (by name) are made: a live view leaves out those no
     client reads."""
     topic = topic_of(key, type(message).__name__) if views else None
-    found = viewer(topic.name, key, message, lambda suffix: wanted(view_channel(key, suffix))
-                   ) if topic is not None else []  # fmt: skip
+    found = (
+        viewer(topic.name, key, message, lambda suffix: wanted(view_channel(key, suffix)))
+        if topic is not None
+        else []
+    )
     carrier = viewer.carrier(topic.name) if topic is not None else None
     made: list[Entry] = []
     if wanted(key):
@@ -133,9 +139,17 @@ def entries(
         if carrier is not None:
             left_out, suffix = carrier
             metadata = ((CARRIED_FIELD, left_out), (CARRIER, view_channel(key, suffix)))
-        made.append(Entry(key, type(message).__name__, SCHEMA_ENCODING,
-                          schema_of(type(message), left_out), MESSAGE_ENCODING,
-                          to_json(message, left_out), metadata))  # fmt: skip
+        made.append(
+            Entry(
+                key,
+                type(message).__name__,
+                SCHEMA_ENCODING,
+                schema_of(type(message), left_out),
+                MESSAGE_ENCODING,
+                to_json(message, left_out),
+                metadata,
+            )
+        )
     return [*made, *(Entry(*v.channel(key)) for v in found)]
 
 
@@ -172,8 +186,9 @@ class SessionWriter:
     description, and the file draws the robot).
     """
 
-    def __init__(self, path: Path, chunk_size: int = 1024 * 1024, viewer: Viewer | None = None
-                 ) -> None:  # fmt: skip
+    def __init__(
+        self, path: Path, chunk_size: int = 1024 * 1024, viewer: Viewer | None = None
+    ) -> None:
         self._viewer = viewer if viewer is not None else Viewer()
         self._file = Path(path).open("wb")
         self._writer = Writer(self._file, chunk_size=chunk_size, compression=CompressionType.ZSTD)
@@ -206,8 +221,9 @@ class SessionWriter:
         if channel is None:
             if schema not in self._schemas:
                 self._schemas[schema] = self._writer.register_schema(*schema)
-            channel = self._writer.register_channel(entry.channel, entry.message_encoding,
-                                                    self._schemas[schema], dict(entry.metadata))
+            channel = self._writer.register_channel(
+                entry.channel, entry.message_encoding, self._schemas[schema], dict(entry.metadata)
+            )
             self._channels[(entry.channel, schema)] = channel
             self._sequences[channel] = 0
         sequence = self._sequences[channel]

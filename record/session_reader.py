@@ -130,8 +130,10 @@ class _Scan:
         try:
             return breakup_chunk(chunk, validate_crc=True)
         except Exception as error:  # noqa: BLE001 - zstandard's, mcap's CRC, struct's: all mean one thing
-            what = (f"the chunk of {chunk.message_start_time / 1e9:.3f} to "
-                    f"{chunk.message_end_time / 1e9:.3f} s ({error or type(error).__name__})")
+            what = (
+                f"the chunk of {chunk.message_start_time / 1e9:.3f} to "
+                f"{chunk.message_end_time / 1e9:.3f} s ({error or type(error).__name__})"
+            )
             self.damaged.append(what)
             log.warning("%s: skipped %s", self.path, what)
             return []
@@ -141,8 +143,9 @@ class _Scan:
             schemas[record.id] = record
         elif isinstance(record, Channel):
             if record.schema_id != 0 and record.schema_id not in schemas:
-                raise McapError(f"{self.path}: channel {record.topic!r} has no schema record "
-                                f"{record.schema_id}")  # fmt: skip
+                raise McapError(
+                    f"{self.path}: channel {record.topic!r} has no schema record {record.schema_id}"
+                )
             channels[record.id] = record
         elif isinstance(record, Message):
             channel = channels.get(record.channel_id)
@@ -206,8 +209,9 @@ def read_groups(path: Path, only: Collection[str] | None = None) -> Iterator[lis
             log.warning("%s: skipped %d messages of %s in all", path, count, key)
 
 
-def _decoded(path: Path, group: list, only: Collection[str] | None, complete: bool,
-             skipped: dict[str, int]) -> list[Recorded]:  # fmt: skip
+def _decoded(
+    path: Path, group: list, only: Collection[str] | None, complete: bool, skipped: dict[str, int]
+) -> list[Recorded]:
     """The messages of one log time as ``Recorded``, each carried field taken from its
     carrier among them; those that do not decode left out, said once per channel and counted
     in ``skipped``."""
@@ -222,8 +226,10 @@ def _decoded(path: Path, group: list, only: Collection[str] | None, complete: bo
             carried_fields = _carried_fields(channel, carriers)
             if carried_fields is None:
                 if complete:
-                    raise McapError(f"{path}: {channel.topic} at {message.log_time} ns has no "
-                                    f"{channel.metadata[CARRIER]} message")  # fmt: skip
+                    raise McapError(
+                        f"{path}: {channel.topic} at {message.log_time} ns has no "
+                        f"{channel.metadata[CARRIER]} message"
+                    )
                 continue
             try:
                 decoded = from_json(message.data, topic.type, carried_fields)
@@ -232,16 +238,23 @@ def _decoded(path: Path, group: list, only: Collection[str] | None, complete: bo
                 if skipped[channel.topic] == 1:
                     _skipped(path, channel.topic, message.log_time, topic.type, error)
                 continue
-        out.append(Recorded(channel.topic, topic.name if topic else None, message.log_time,
-                            decoded))  # fmt: skip
+        out.append(
+            Recorded(channel.topic, topic.name if topic else None, message.log_time, decoded)
+        )
     return out
 
 
 def _skipped(path: Path, key: str, log_time_ns: int, expected: type, error: Exception) -> None:
     """Say that a message was left out because it does not decode, where and why."""
     reason = str(error).splitlines()[0] if str(error) else type(error).__name__
-    log.warning("%s: skipped the message of %s at %.3f s: not a %s (%s)", path, key,
-                log_time_ns / 1e9, expected.__name__, reason)  # fmt: skip
+    log.warning(
+        "%s: skipped the message of %s at %.3f s: not a %s (%s)",
+        path,
+        key,
+        log_time_ns / 1e9,
+        expected.__name__,
+        reason,
+    )
 
 
 def _carried_fields(channel: Channel, carriers: dict[str, tuple]) -> dict[str, bytes] | None:
@@ -284,8 +297,9 @@ def info(path: Path) -> dict[str, Any]:
                 "encoding": channel.message_encoding,
             }
         span.add(message.log_time)
-        counted = bins.setdefault((channel.id, message.log_time // FAR_NS),
-                                  [0, 0, message.log_time, message.log_time])  # fmt: skip
+        counted = bins.setdefault(
+            (channel.id, message.log_time // FAR_NS), [0, 0, message.log_time, message.log_time]
+        )
         counted[0] += 1
         counted[1] += len(message.data)
         counted[2] = min(counted[2], message.log_time)
@@ -306,8 +320,13 @@ def info(path: Path) -> dict[str, Any]:
     for channel_id, entry in channels.items():
         count, size, first, last = totals.get(channel_id, [0, 0, 0, 0])
         span_s = (last - first) / 1e9
-        entry.update(messages=count, bytes=size, start_ns=first, end_ns=last,
-                     rate_hz=round((count - 1) / span_s, 2) if span_s > 0 else 0.0)
+        entry.update(
+            messages=count,
+            bytes=size,
+            start_ns=first,
+            end_ns=last,
+            rate_hz=round((count - 1) / span_s, 2) if span_s > 0 else 0.0,
+        )
     return {
         "path": str(path),
         "complete": scan.complete,
@@ -321,7 +340,8 @@ def info(path: Path) -> dict[str, Any]:
         "channels": sorted(channels.values(), key=lambda c: c["key"]),
         "outside": {key: {"messages": n, "first_ns": first} for key, (n, first) in outside.items()},
         "warning": outside_line({k: tuple(v) for k, v in outside.items()}, session)
-        if outside else None,
+        if outside
+        else None,
     }
 
 
@@ -346,11 +366,18 @@ def recover(source: Path, target: Path) -> int:
                 )
             if channel.id not in channel_ids:
                 channel_ids[channel.id] = writer.register_channel(
-                    channel.topic, channel.message_encoding, schema_ids[channel.schema_id],
+                    channel.topic,
+                    channel.message_encoding,
+                    schema_ids[channel.schema_id],
                     channel.metadata,
-                )  # fmt: skip
-            writer.add_message(channel_ids[channel.id], message.log_time, message.data,
-                               message.publish_time, message.sequence)  # fmt: skip
+                )
+            writer.add_message(
+                channel_ids[channel.id],
+                message.log_time,
+                message.data,
+                message.publish_time,
+                message.sequence,
+            )
             saved += 1
         for name, values in scan.metadata.items():
             writer.add_metadata(name, values)

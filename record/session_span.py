@@ -60,11 +60,15 @@ def inside(stamp_ns: int, session: tuple[int, int]) -> bool:
 
 def outside_line(outside: Mapping[str, tuple[int, int]], session: tuple[int, int]) -> str:
     """One line of what is far outside ``session``: by topic, (messages, first stamp)."""
-    parts = [f"{count} message{'s' * (count != 1)} of {topic} (at {first / 1e9:.3f} s"
-             f"{' first' if count > 1 else ''})"
-             for topic, (count, first) in sorted(outside.items())]  # fmt: skip
-    return (f"stamped far outside the session ({session[0] / 1e9:.3f} to "
-            f"{session[1] / 1e9:.3f} s): {', '.join(parts)}")  # fmt: skip
+    parts = [
+        f"{count} message{'s' * (count != 1)} of {topic} (at {first / 1e9:.3f} s"
+        f"{' first' if count > 1 else ''})"
+        for topic, (count, first) in sorted(outside.items())
+    ]
+    return (
+        f"stamped far outside the session ({session[0] / 1e9:.3f} to "
+        f"{session[1] / 1e9:.3f} s): {', '.join(parts)}"
+    )
 
 
 @dataclass(frozen=True)

@@ -83,8 +83,15 @@ def ceiling_camera(settings) -> PinholeCamera:
     """The camera of a profile's scene (``profiles.scene.Camera``): its intrinsics, above
     ``position`` (x, y, height) looking straight down."""
     c = settings
-    return PinholeCamera(ceiling_pose(*c.position), width=c.width, height=c.height,
-                         fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy)  # fmt: skip
+    return PinholeCamera(
+        ceiling_pose(*c.position),
+        width=c.width,
+        height=c.height,
+        fx=c.fx,
+        fy=c.fy,
+        cx=c.cx,
+        cy=c.cy,
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -253,10 +260,16 @@ class Renderer:
     Rendering the default scene took 9.8 ms a frame from scratch, 0.7 ms this way.
     """
 
-    def __init__(self, camera: PinholeCamera, dictionary: int, noise: ImageNoise,
-                 rng: np.random.Generator, below: Sequence[Element] = (),
-                 above: Sequence[Element] = (),
-                 table_frames: int = NOISE_TABLE_FRAMES) -> None:  # fmt: skip
+    def __init__(
+        self,
+        camera: PinholeCamera,
+        dictionary: int,
+        noise: ImageNoise,
+        rng: np.random.Generator,
+        below: Sequence[Element] = (),
+        above: Sequence[Element] = (),
+        table_frames: int = NOISE_TABLE_FRAMES,
+    ) -> None:
         self.camera, self.noise, self.rng = camera, noise, rng
         self.dictionary = cv2.aruco.getPredefinedDictionary(dictionary)
         self.floor = np.full((camera.height, camera.width), FLOOR_GREY, np.float32)
@@ -264,8 +277,12 @@ class Renderer:
             composite.draw(self.floor)
         self.above = self._composites(above)
         pixels = camera.height * camera.width
-        self.table = (rng.standard_normal(table_frames * pixels, dtype=np.float32)
-                      * np.float32(noise.noise_std) if noise.noise_std > 0.0 else None)  # fmt: skip
+        self.table = (
+            rng.standard_normal(table_frames * pixels, dtype=np.float32)
+            * np.float32(noise.noise_std)
+            if noise.noise_std > 0.0
+            else None
+        )
         self._canvas, self._blurred = np.empty_like(self.floor), np.empty_like(self.floor)
 
     def _composites(self, elements: Sequence[Element]) -> list[Composite]:

@@ -30,8 +30,9 @@ def seen_floor(camera: PinholeCamera, height: float) -> np.ndarray:
     for u, v in ((-0.5, -0.5), (right, -0.5), (right, bottom), (-0.5, bottom)):
         ray = rotation @ np.array([(u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, 1.0])
         if not ray[2] < 0.0 < origin[2] - height:
-            raise ValueError(f"the camera does not look down on the plane z = {height:g} m "
-                             "with its whole image")  # fmt: skip
+            raise ValueError(
+                f"the camera does not look down on the plane z = {height:g} m with its whole image"
+            )
         corners.append((origin + (height - origin[2]) / ray[2] * ray)[:2])
     return np.array(corners)
 
@@ -48,8 +49,9 @@ def region_of(corners: np.ndarray, margin: float) -> Region:
     return tuple(planes)
 
 
-def camera_region(camera: PinholeCamera, reference: tuple[float, float, float], height: float,
-                  margin: float) -> Region:  # fmt: skip
+def camera_region(
+    camera: PinholeCamera, reference: tuple[float, float, float], height: float, margin: float
+) -> Region:
     """Where a point at ``height`` stays ``margin`` inside what ``camera`` sees, in the frame
     of the floor's reference marker, which lies at ``reference`` (x, y, yaw) in the camera's
     world."""

@@ -93,8 +93,7 @@ class SimScenario:
         return goal_above(self.bin, height_m, offset)
 
 
-def goal_above(bin_pose: Sequence[float], height_m: float, offset: Sequence[float]
-               ) -> np.ndarray:  # fmt: skip
+def goal_above(bin_pose: Sequence[float], height_m: float, offset: Sequence[float]) -> np.ndarray:
     """x_d = x_2 x_d^2 (eq. 6.3): the bin marker's pose (x, y, yaw) at ``height_m`` times the
     scene's offset (x, y, z, yaw, pitch, roll), a unit dual quaternion."""
     marker = planar_pose(*bin_pose, height_m)
@@ -130,12 +129,21 @@ def _table(robot: MobileManipulator, seed: int | None) -> SimScenario:
     x, y, yaw = planar_of(goal)
     offset = offset_of(dq.mul(dq.conj(planar_pose(x, y, yaw, height)), goal))
     start, bin_pose = _drawn(TABLE_START.copy(), np.array([x, y, yaw]), seed, TABLE_BIN_RANGE)
-    return SimScenario("table", "pose", tuple(start.tolist()), tuple(bin_pose.tolist()), (),
-                       (TABLE,), height, tuple(round(v, 9) for v in offset))  # fmt: skip
+    return SimScenario(
+        "table",
+        "pose",
+        tuple(start.tolist()),
+        tuple(bin_pose.tolist()),
+        (),
+        (TABLE,),
+        height,
+        tuple(round(v, 9) for v in offset),
+    )
 
 
-def _drawn(start: np.ndarray, bin_pose: np.ndarray, seed: int | None, bin_range: np.ndarray
-           ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+def _drawn(
+    start: np.ndarray, bin_pose: np.ndarray, seed: int | None, bin_range: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """The start and the bin, each moved by a draw of ``seed`` within ``START_RANGE`` and
     ``bin_range`` (as they are without a seed)."""
     if seed is None:

@@ -9,8 +9,9 @@ from pathlib import Path
 
 def parsimony(*arguments: str) -> subprocess.CompletedProcess:
     """``parsimony ARGUMENTS`` as a new user runs it, its output captured as text."""
-    return subprocess.run([sys.executable, "-m", "parsimony.cli", *arguments],
-                          capture_output=True, text=True)  # fmt: skip
+    return subprocess.run(
+        [sys.executable, "-m", "parsimony.cli", *arguments], capture_output=True, text=True
+    )
 
 
 def process_gone(pid: int) -> bool:

@@ -16,7 +16,10 @@ def test_the_bench_runs_section_6_3_as_reproduce_runs_it():
     bench = convergence_test(ROBOT, 1)
     rows = {row.key: row.ours for row in section_6_3(ROBOT, 1)[0]}
     assert [bench["holonomic/classic"]["iterations"], bench["holonomic/lp"]["iterations"]] == (
-        rows["6.3.test 1.iterations"])
-    assert [bench["nonholonomic/cascade"]["iterations"],
-            bench["nonholonomic/lp"]["iterations"]] == rows["6.3.test 2.iterations"]  # fmt: skip
+        rows["6.3.test 1.iterations"]
+    )
+    assert [
+        bench["nonholonomic/cascade"]["iterations"],
+        bench["nonholonomic/lp"]["iterations"],
+    ] == rows["6.3.test 2.iterations"]
     assert all(law["converged_trials"] == 1 for law in bench.values())

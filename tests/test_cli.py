@@ -60,8 +60,11 @@ def test_bench_prints_step_times_and_the_convergence_test_as_json():
         laws = report["goals"][f"{family} pose"]["laws"]
         assert laws.keys() == set(LAWS)
         for row in laws.values():
-            assert row["reached"] >= row["within_joint_limits"] >= (
-                row["within_joint_and_speed_limits"])
+            assert (
+                row["reached"]
+                >= row["within_joint_limits"]
+                >= (row["within_joint_and_speed_limits"])
+            )
             assert sum(row["nonzero_histogram"]) == sum(row["practical_histogram"]) > 0
         supervised = laws["lp + staging supervisor"]
         assert supervised["plans_per_run"] >= 1.0
@@ -96,8 +99,9 @@ def test_a_library_writing_to_file_descriptor_1_reaches_stderr():
         "    print('a log line')\n"
         "    emit('{\"result\": 1}')\n"
     )
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                            timeout=60)  # fmt: skip
+    result = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=60
+    )
     assert result.returncode == 0, result.stderr
     assert json.loads(result.stdout) == {"result": 1}
     assert "banner from C" in result.stderr and "a log line" in result.stderr
@@ -145,10 +149,12 @@ def test_zenoh_errors_reach_the_user_as_one_readable_line():
         (("0.5", "nan", "0.4"), "argument Y: expected a finite number, got 'nan'"),
         (("0.5", "0", "0.4", "--position", "--yaw", "30"), "--position takes no --yaw or --rpy"),
         (("0.5", "0", "0.4", "--yaw", "10", "--rpy", "0", "0", "10"), "not allowed with"),
-        (("0.5", "0", "0.4", "--wait", "--profile", "deploy/sim.yaml"),
-         "--wait follows supervisor/status, and no component of deploy/sim.yaml writes it"),
+        (
+            ("0.5", "0", "0.4", "--wait", "--profile", "deploy/sim.yaml"),
+            "--wait follows supervisor/status, and no component of deploy/sim.yaml writes it",
+        ),
     ],
-)  # fmt: skip
+)
 def test_goal_refuses_input_it_cannot_use_with_exit_2(argv: tuple[str, ...], error: str) -> None:
     """Before anything is sent, and with no running system to ask."""
     result = run_cli("goal", *argv)

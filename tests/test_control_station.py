@@ -64,12 +64,16 @@ def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Station]:
     directory = tmp_path_factory.mktemp("station")
     path = lockstep_profile(directory, DEPLOY / "sim_station.yaml", "station")
     profile = load_profile(path)
-    with (directory / "launch.log").open("w") as log, launched(path, log) as launcher,\
-            connect(profile, launcher) as session:  # fmt: skip
+    with (
+        (directory / "launch.log").open("w") as log,
+        launched(path, log) as launcher,
+        connect(profile, launcher) as session,
+    ):
         goals: list[Goal] = []
-        watcher = session.declare_subscriber(topics.GOAL_REQUEST.key(profile.namespace),
-                                             lambda sample: goals.append(codec.decode(
-                                                 sample.payload.to_bytes(), Goal)))  # fmt: skip
+        watcher = session.declare_subscriber(
+            topics.GOAL_REQUEST.key(profile.namespace),
+            lambda sample: goals.append(codec.decode(sample.payload.to_bytes(), Goal)),
+        )
         wait_alive(session, profile, launcher)  # answered after the router has the watcher
         wait_reached(session, profile, launcher)
         with running_view(path, "--json", timeout_s=READY_S) as view:
@@ -90,8 +94,9 @@ def client(station: Station) -> Iterator[FoxgloveClient]:
         yield connected
 
 
-def same_time(client: FoxgloveClient, first: str, second: str, found=lambda a, b: True
-              ) -> tuple[dict, dict]:  # fmt: skip
+def same_time(
+    client: FoxgloveClient, first: str, second: str, found=lambda a, b: True
+) -> tuple[dict, dict]:
     """Messages of ``first`` and ``second`` logged at one time, decoded, that ``found``
     accepts: the message and its view."""
     pair: list[tuple[dict, dict]] = []
@@ -125,8 +130,9 @@ def test_the_robot_links_arrive_and_match_the_kinematics(
     composed = chain(by_child, ["estimate/base", *links], "world")
     q = np.array([*state["base_pose"], *state["arm_joints"]])
     for found, expected in zip(composed[1:], robot.frames(q), strict=True):
-        assert np.allclose(found * np.sign(found[0] or 1), expected * np.sign(expected[0] or 1),
-                           atol=1e-9), (found, expected)  # fmt: skip
+        assert np.allclose(
+            found * np.sign(found[0] or 1), expected * np.sign(expected[0] or 1), atol=1e-9
+        ), (found, expected)
     # The last link is the end effector the estimator gives.
     hand = pose_of(by_child["estimate/end_effector"])
     assert np.allclose(dq.translation(hand), dq.translation(composed[-1]), atol=1e-9)
@@ -151,7 +157,8 @@ def test_each_detected_marker_is_annotated_on_the_image(
         image of their stamp comes to the client too."""
         stamp = int(markers["header"]["stamp_ns"])
         return len(markers["markers"]) >= 2 and any(
-            t <= stamp for t, _ in client.messages(image_key))  # fmt: skip
+            t <= stamp for t, _ in client.messages(image_key)
+        )
 
     markers, annotations = same_time(client, markers_key, annotations_key, after_an_image)
     seen = markers["markers"]
@@ -168,38 +175,52 @@ def test_each_detected_marker_is_annotated_on_the_image(
 
 
 def test_a_parameter_set_from_the_client_changes_the_controllers_diagnostics(
-    station: Station, client: FoxgloveClient,
+    station: Station,
+    client: FoxgloveClient,
 ) -> None:
     client.send("getParameters", names=[], id="all")
-    listed = client.wait_for(lambda e: e["event"] == "parameterValues" and e.get("id") == "all",
-                             "every parameter")  # fmt: skip
+    listed = client.wait_for(
+        lambda e: e["event"] == "parameterValues" and e.get("id") == "all", "every parameter"
+    )
     names = {p["name"] for p in listed["parameters"]}
     running = {spec.name for spec in station.profile.components if spec.enabled}
     assert {name.split(".")[0] for name in names} == running
     assert "controller.eta" in names and "supervisor.max_replans" in names
     diagnostics = station.key("control/diagnostics")
     client.send("subscribe", topics=[diagnostics])
-    client.send("setParameters", parameters=[{"name": "controller.eta", "value": 0.85,
-                                              "type": "float64"}], id="eta")  # fmt: skip
-    answer = client.wait_for(lambda e: e["event"] == "parameterValues" and e.get("id") == "eta",
-                             "the new value")  # fmt: skip
+    client.send(
+        "setParameters",
+        parameters=[{"name": "controller.eta", "value": 0.85, "type": "float64"}],
+        id="eta",
+    )
+    answer = client.wait_for(
+        lambda e: e["event"] == "parameterValues" and e.get("id") == "eta", "the new value"
+    )
     assert answer["parameters"] == [{"name": "controller.eta", "type": "float64", "value": 0.85}]
-    client.message(diagnostics, lambda t, d: json.loads(d)["parameters"]["eta"] == 0.85,
-                   "diagnostics with the new eta")  # fmt: skip
+    client.message(
+        diagnostics,
+        lambda t, d: json.loads(d)["parameters"]["eta"] == 0.85,
+        "diagnostics with the new eta",
+    )
 
 
 def test_a_refused_set_says_why_and_keeps_the_value(
     station: Station, client: FoxgloveClient
 ) -> None:
     before = query.get_param(station.session, station.profile.namespace, "controller", "beta")
-    client.send("setParameters", parameters=[{"name": "controller.beta", "value": -3.0,
-                                              "type": "float64"}], id="beta")  # fmt: skip
-    status = client.wait_for(lambda e: e["event"] == "status" and "controller.beta" in
-                             e["message"], "the refusal")  # fmt: skip
+    client.send(
+        "setParameters",
+        parameters=[{"name": "controller.beta", "value": -3.0, "type": "float64"}],
+        id="beta",
+    )
+    status = client.wait_for(
+        lambda e: e["event"] == "status" and "controller.beta" in e["message"], "the refusal"
+    )
     assert status["level"] == 2  # error
     assert "refused" in status["message"] and "expected a float in [" in status["message"]
-    kept = client.wait_for(lambda e: e["event"] == "parameterValues" and e.get("id") == "beta",
-                           "the value kept")  # fmt: skip
+    kept = client.wait_for(
+        lambda e: e["event"] == "parameterValues" and e.get("id") == "beta", "the value kept"
+    )
     assert kept["parameters"][0]["value"] == before
 
 
@@ -210,16 +231,22 @@ def client_goal_message(profile: Profile, robot: MobileManipulator) -> tuple[dic
     assert scene is not None
     x, y, yaw = in_frame(*scenario("pose", robot).bin, scene.reference_pose)
     x, y = x + GOAL_SHIFT_M[0], y + GOAL_SHIFT_M[1]
-    message = {"timestamp": {"sec": 0, "nsec": 0}, "frame_id": "world", "pose": {
-        "position": {"x": x, "y": y, "z": 0.0},
-        "orientation": {"x": 0.0, "y": 0.0, "z": math.sin(yaw / 2), "w": math.cos(yaw / 2)}}}
+    message = {
+        "timestamp": {"sec": 0, "nsec": 0},
+        "frame_id": "world",
+        "pose": {
+            "position": {"x": x, "y": y, "z": 0.0},
+            "orientation": {"x": 0.0, "y": 0.0, "z": math.sin(yaw / 2), "w": math.cos(yaw / 2)},
+        },
+    }
     goal_f0 = dq.mul(planar_pose(x, y, yaw), offset_pose(*scene.goal.offset))
     f0 = planar_pose(*scene.reference_pose, scene.reference.height_m)
     return message, dq.mul(f0, goal_f0)
 
 
 def test_a_goal_from_the_client_reaches_the_supervisor_and_the_robot_goes_there(
-    station: Station, client: FoxgloveClient,
+    station: Station,
+    client: FoxgloveClient,
 ) -> None:
     info = client.server_info()
     assert "clientPublish" in info["capabilities"] and info["supportedEncodings"] == ["json"]
@@ -229,27 +256,38 @@ def test_a_goal_from_the_client_reaches_the_supervisor_and_the_robot_goes_there(
     truth = station.key("sim/truth")
     client.send("subscribe", topics=[status_key, truth])
     # A goal in another frame is refused, and says why; only goal/request may be published.
-    client.send("advertise", topic=station.key("base/command"), encoding="json",
-                schemaName="BaseCommand")  # fmt: skip
+    client.send(
+        "advertise", topic=station.key("base/command"), encoding="json", schemaName="BaseCommand"
+    )
     client.send("advertise", topic=request, encoding="json", schemaName="foxglove.PoseInFrame")
-    channel = client.wait_for(lambda e: e["event"] == "advertised" and e["topic"] == request,
-                              "the client's channel")["channel"]  # fmt: skip
+    channel = client.wait_for(
+        lambda e: e["event"] == "advertised" and e["topic"] == request, "the client's channel"
+    )["channel"]
     client.send("publish", channel=channel, text=json.dumps({**message, "frame_id": "camera"}))
-    refused = client.wait_for(lambda e: e["event"] == "status" and "refused" in e["message"],
-                              "the refusal of a goal in the camera frame")  # fmt: skip
+    refused = client.wait_for(
+        lambda e: e["event"] == "status" and "refused" in e["message"],
+        "the refusal of a goal in the camera frame",
+    )
     assert "frame_id 'camera'" in refused["message"] and refused["level"] == 2
-    assert any("only goal/request may be published" in e.get("message", "")
-               for e in client.events if e["event"] == "status")  # fmt: skip
+    assert any(
+        "only goal/request may be published" in e.get("message", "")
+        for e in client.events
+        if e["event"] == "status"
+    )
     already = len(station.goals)
     start = len(client.events)
     client.send("publish", channel=channel, text=json.dumps(message))
     client.wait_for(lambda e: e["event"] == "status" and "sent" in e["message"], "the goal sent")
     # The supervisor has it: the goal is x_d = x_2 x_d^2 (eq. 6.3) at the published pose.
-    client.wait_for(json_message(status_key, lambda status: status["plans"] >= 1),
-                    "the supervisor's plan of the client's goal", start)  # fmt: skip
+    client.wait_for(
+        json_message(status_key, lambda status: status["plans"] >= 1),
+        "the supervisor's plan of the client's goal",
+        start,
+    )
     (goal,) = station.goals[already:]
-    f0 = planar_pose(*station.profile.scene.reference_pose,
-                     station.profile.scene.reference.height_m)  # fmt: skip
+    f0 = planar_pose(
+        *station.profile.scene.reference_pose, station.profile.scene.reference.height_m
+    )
     assert goal.header.source == "view" and goal.task == "pose"
     assert np.allclose(np.array(goal.pose), dq.mul(dq.conj(f0), goal_in_sim), atol=1e-9)
     target = dq.translation(goal_in_sim)[1:]
@@ -258,8 +296,9 @@ def test_a_goal_from_the_client_reaches_the_supervisor_and_the_robot_goes_there(
         hand = dq.translation(np.array(json.loads(payload)["end_effector"]))[1:]
         return float(np.linalg.norm(hand - target)) < REACHED_M
 
-    reached, _ = client.message(truth, near, f"the true gripper within {REACHED_M} m of the "
-                                "client's goal")  # fmt: skip
+    reached, _ = client.message(
+        truth, near, f"the true gripper within {REACHED_M} m of the client's goal"
+    )
     client.send("unsubscribe", topics=[truth, status_key])
     # Stamped on the simulator's clock, as the truth is (not on the wall clock).
     first = min(t for t, _ in client.messages(truth))
@@ -267,16 +306,26 @@ def test_a_goal_from_the_client_reaches_the_supervisor_and_the_robot_goes_there(
 
 
 HOSTILE_GOALS = [
-    ('{"frame_id": "world", "pose": {"position": {"x": 1' + "0" * 400 + '}, '
-     '"orientation": {"w": 1}}}', "pose.position.x = an integer of 401 digits is out of range"),
-    ('{"frame_id": "world", "pose": ' + "[" * 5000 + "]" * 5000 + "}",
-     "not a goal: its JSON is nested too deeply"),
-    ('{"frame_id": "world", "pose": {"position": {"x": 1e154, "y": 1e154}, "orientation": '
-     '{"w": 1}}}', "pose.position.x = 1e+154 is out of range: a goal lies within 1000 m of F0"),
+    (
+        '{"frame_id": "world", "pose": {"position": {"x": 1' + "0" * 400 + "}, "
+        '"orientation": {"w": 1}}}',
+        "pose.position.x = an integer of 401 digits is out of range",
+    ),
+    (
+        '{"frame_id": "world", "pose": ' + "[" * 5000 + "]" * 5000 + "}",
+        "not a goal: its JSON is nested too deeply",
+    ),
+    (
+        '{"frame_id": "world", "pose": {"position": {"x": 1e154, "y": 1e154}, "orientation": '
+        '{"w": 1}}}',
+        "pose.position.x = 1e+154 is out of range: a goal lies within 1000 m of F0",
+    ),
     ('{"frame_id": "world", "pose": {"orientation": {"w": 1}}}', "pose.position is missing"),
-    (json.dumps({"frame_id": "f" * 1_000_000}),
-     "a message of 1000016 bytes: a goal is at most 16384"),
-]  # fmt: skip
+    (
+        json.dumps({"frame_id": "f" * 1_000_000}),
+        "a message of 1000016 bytes: a goal is at most 16384",
+    ),
+]
 """Goals the campaign sent, and what the station answers each: the first two got no answer
 (the view raised), the third was '1.86e137 m below the floor', the last a 1 MB status."""
 
@@ -292,8 +341,11 @@ def test_each_hostile_goal_gets_a_short_refusal_and_none_reaches_the_supervisor(
     for text, reason in HOSTILE_GOALS:
         start = len(client.events)
         client.send("publish", channel=channel, text=text)
-        status = client.wait_for(lambda e: e["event"] == "status" and "goal/request" in
-                                 e["message"], f"the answer to {reason!r}", start)  # fmt: skip
+        status = client.wait_for(
+            lambda e: e["event"] == "status" and "goal/request" in e["message"],
+            f"the answer to {reason!r}",
+            start,
+        )
         assert reason in status["message"] and status["level"] == 2, status
         assert len(status["message"]) <= STATUS_CHARS
     assert len(station.goals) == already
@@ -301,17 +353,22 @@ def test_each_hostile_goal_gets_a_short_refusal_and_none_reaches_the_supervisor(
 
 def json_message(topic: str, found: Callable[[dict], bool]) -> Callable[[dict], bool]:
     """Whether a client event is a message of ``topic`` whose JSON ``found`` accepts."""
-    return lambda event: (event["event"] == "message" and event["topic"] == topic
-                          and found(json.loads(base64.b64decode(event["data"]))))
+    return lambda event: (
+        event["event"] == "message"
+        and event["topic"] == topic
+        and found(json.loads(base64.b64decode(event["data"])))
+    )
 
 
 def test_the_recording_carries_the_robot_and_the_annotations(station: Station) -> None:
     """The recorder of the running system writes the same views (read as `parsimony info`
     reads a file still being written: every complete chunk)."""
     keys = {channel["key"]: channel for channel in info(station.recording)["channels"]}
-    for suffix, schema in (("robot/state/model", "foxglove.SceneUpdate"),
-                           ("robot/state/foxglove", "foxglove.FrameTransforms"),
-                           ("sim/truth/model", "foxglove.SceneUpdate"),
-                           ("vision/markers/annotations", "foxglove.ImageAnnotations"),
-                           ("supervisor/status/scene", "foxglove.SceneUpdate")):  # fmt: skip
+    for suffix, schema in (
+        ("robot/state/model", "foxglove.SceneUpdate"),
+        ("robot/state/foxglove", "foxglove.FrameTransforms"),
+        ("sim/truth/model", "foxglove.SceneUpdate"),
+        ("vision/markers/annotations", "foxglove.ImageAnnotations"),
+        ("supervisor/status/scene", "foxglove.SceneUpdate"),
+    ):
         assert keys[station.key(suffix)]["schema"] == schema, sorted(keys)

@@ -31,10 +31,13 @@ def components(path: Path) -> dict[str, dict]:
 def test_emulated_differs_from_hardware_by_device_paths_and_camera_source_only() -> None:
     hardware, emulated = components(DEPLOY / "hardware.yaml"), components(DEPLOY / "emulated.yaml")
     changed = {
-        name: {key for key in set(spec) | set(hardware[name])
-               if spec.get(key) != hardware[name].get(key)}
+        name: {
+            key
+            for key in set(spec) | set(hardware[name])
+            if spec.get(key) != hardware[name].get(key)
+        }
         for name, spec in emulated.items()
-    }  # fmt: skip
+    }
     assert changed.pop("simulator") == {"enabled", "module", "params"}  # the emulated robot
     for driver in ("base_driver", "arm_driver"):
         params = (emulated[driver]["params"], hardware[driver]["params"])
@@ -44,7 +47,9 @@ def test_emulated_differs_from_hardware_by_device_paths_and_camera_source_only()
     camera = (emulated["vision_tracker"]["params"], hardware["vision_tracker"]["params"])
     assert {k for k in camera[0] if camera[0][k] != camera[1].get(k)} <= {"device", "calibration"}
     assert {name for name, keys in changed.items() if keys} == {
-        "base_driver", "arm_driver", "vision_tracker"
+        "base_driver",
+        "arm_driver",
+        "vision_tracker",
     }
     sim = components(DEPLOY / "sim.yaml")
     assert set(hardware) - set(sim) == {"base_driver", "arm_driver"}
@@ -58,9 +63,21 @@ def test_emulated_differs_from_hardware_by_device_paths_and_camera_source_only()
 def test_the_pose_experiment_converges_through_the_emulated_devices(
     tmp_path: Path, seed: str
 ) -> None:
-    command = [sys.executable, "-m", "parsimony.cli", "experiment", "pose", "--profile",
-               str(DEPLOY / "emulated.yaml"), "--realtime", "--seed", seed, "--json",
-               "--out", str(tmp_path)]  # fmt: skip
+    command = [
+        sys.executable,
+        "-m",
+        "parsimony.cli",
+        "experiment",
+        "pose",
+        "--profile",
+        str(DEPLOY / "emulated.yaml"),
+        "--realtime",
+        "--seed",
+        seed,
+        "--json",
+        "--out",
+        str(tmp_path),
+    ]
     done = subprocess.run(command, capture_output=True, text=True, timeout=300)
     report = json.loads(done.stdout)
     assert done.returncode == 0 and report["converged"], report
@@ -77,13 +94,18 @@ def emulated_profile(tmp_path: Path, namespace: str, *components: dict) -> Path:
         "namespace": namespace,
         "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
         "components": [
-            {"name": "simulator", "params": {"create_link": str(tmp_path / "create2"),
-                                             "servo_link": str(tmp_path / "servos")}},
+            {
+                "name": "simulator",
+                "params": {
+                    "create_link": str(tmp_path / "create2"),
+                    "servo_link": str(tmp_path / "servos"),
+                },
+            },
             {"name": "base_driver", "params": {"port": str(tmp_path / "create2")}},
             {"name": "arm_driver", "params": {"port": str(tmp_path / "servos")}},
             *components,
         ],
-    }  # fmt: skip
+    }
     path = tmp_path / "profile.yaml"
     path.write_text(yaml.safe_dump(data))
     return path
@@ -110,8 +132,9 @@ def test_the_emulated_profile_starts_and_stops_without_a_word_of_failure(tmp_pat
 
 def test_a_killed_controller_leaves_the_robot_stopped_by_its_drivers(tmp_path: Path) -> None:
     """The Create keeps its last Drive command for ever; the base driver's timeout stops it."""
-    path = emulated_profile(tmp_path, "killtest", {"name": "controller",
-                                                   "restart": {"policy": "never"}})
+    path = emulated_profile(
+        tmp_path, "killtest", {"name": "controller", "restart": {"policy": "never"}}
+    )
     profile = load_profile(path)
     truth: list = []
     with launched(path) as launcher:

@@ -38,8 +38,9 @@ def experiment(out: Path, *arguments: str, stderr: list[str] | None = None) -> t
     """Run `parsimony experiment ... --json`; its exit status and the report on its stdout
     (its stderr's lines added to ``stderr``)."""
     command = [sys.executable, "-m", "parsimony.cli", "experiment", *arguments, "--json"]
-    done = subprocess.run([*command, "--out", str(out)], capture_output=True, text=True,
-                          timeout=300)  # fmt: skip
+    done = subprocess.run(
+        [*command, "--out", str(out)], capture_output=True, text=True, timeout=300
+    )
     assert done.stdout.strip(), done.stderr[-2000:]
     if stderr is not None:
         stderr += done.stderr.splitlines()
@@ -65,14 +66,22 @@ def test_pose_experiment_with_the_lp_reaches_the_goal_seen_by_the_camera(tmp_pat
     assert code == 0
     assert_sound(report)
     # Each wait says what it waits for (before, 15-20 s of starting and stopping said nothing).
-    steps = ["setting up the pose experiment", "starting 5 processes (their log: ",
-             "waiting for recorder, simulator, vision_tracker, state_estimator, controller to "
-             "come alive", "waiting for every component to receive the paused simulator's clock",
-             "running until the error stays under 0.01 for 2 s, at most 60 s of simulated time",
-             "stopping the processes", "judging the recording", "drawing the figures",
-             "report: "]  # fmt: skip
-    found = [next((i for i, line in enumerate(said) if line.startswith(f"[experiment] {step}")),
-                  None) for step in steps]  # fmt: skip
+    steps = [
+        "setting up the pose experiment",
+        "starting 5 processes (their log: ",
+        "waiting for recorder, simulator, vision_tracker, state_estimator, controller to "
+        "come alive",
+        "waiting for every component to receive the paused simulator's clock",
+        "running until the error stays under 0.01 for 2 s, at most 60 s of simulated time",
+        "stopping the processes",
+        "judging the recording",
+        "drawing the figures",
+        "report: ",
+    ]
+    found = [
+        next((i for i, line in enumerate(said) if line.startswith(f"[experiment] {step}")), None)
+        for step in steps
+    ]
     assert None not in found and found == sorted(found), said
     assert report["mode"] == "lockstep" and report["lockstep_timeouts"] == 0
     # Section 5.7: 6 task DOF + the nonholonomic equality, plus one per active constraint.
@@ -86,9 +95,21 @@ def test_pose_experiment_with_the_lp_reaches_the_goal_seen_by_the_camera(tmp_pat
     assert report["iterations"] == sum(report["controller_statuses"].values())
     # The folder never disagrees with itself: `report` judges the file as `experiment` did.
     out = tmp_path / "again"
-    done = subprocess.run([sys.executable, "-m", "parsimony.cli", "report",
-                           str(tmp_path / "session.mcap"), "--out", str(out), "--json"],
-                          capture_output=True, text=True, timeout=300)  # fmt: skip
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "parsimony.cli",
+            "report",
+            str(tmp_path / "session.mcap"),
+            "--out",
+            str(out),
+            "--json",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert done.returncode == 0, done.stderr
     judged = json.loads(done.stdout)["judged"]["lp"]
     assert judged == {key: report[key] for key in judged}
@@ -146,8 +167,7 @@ def test_an_experiment_runs_the_obstacle_constraint_it_is_given(tmp_path: Path) 
     assert obstacle_rows(tmp_path) == ({"border"}, {"obstacle_border"})
 
 
-def test_table_experiment_reaches_over_the_edge_without_touching_the_table(tmp_path: Path
-                                                                           ) -> None:  # fmt: skip
+def test_table_experiment_reaches_over_the_edge_without_touching_the_table(tmp_path: Path) -> None:
     """The scene declares the table (in F0, the simulator places it in its world), the
     estimator publishes it, the LP's rows keep every collision part clear, and the simulator
     counts the penetrations from the true kinematics; blind to it, the LP reaches the same goal
@@ -164,37 +184,57 @@ def test_table_experiment_reaches_over_the_edge_without_touching_the_table(tmp_p
     # What a user opening the runs sees: the table in Foxglove's 3-D panel, where the scene
     # puts it, sent at a low rate; the blind run's parts inside it in red; the clearance figure.
     # The scenario's table is in the simulator's world; the 3-D panel stands in F0 ("world").
-    in_f0 = Plane.model_validate(report["scenario"]["solids"][0]).solid().moved(
-        *inverse(load_profile(PROFILES["lp"]).scene.reference_pose))
+    in_f0 = (
+        Plane.model_validate(report["scenario"]["solids"][0])
+        .solid()
+        .moved(*inverse(load_profile(PROFILES["lp"]).scene.reference_pose))
+    )
     guarded = tmp_path / "guarded" / "session.mcap"
     solids = scenes(guarded, "/world/obstacles/solids")
-    obstacles = next(c["messages"] for c in info(guarded)["channels"]
-                     if c["key"].endswith("/world/obstacles"))  # fmt: skip
+    obstacles = next(
+        c["messages"] for c in info(guarded)["channels"] if c["key"].endswith("/world/obstacles")
+    )
     assert 0 < len(solids) <= obstacles // MODEL_EVERY + 1, (len(solids), obstacles)
     for update in solids:
         (entity,) = update["entities"]
         top = np.array([vector(p, "xyz") for p in entity["triangles"][0]["points"]])
         assert entity["frame_id"] == "world"  # F0, where the scene declares it
-        np.testing.assert_allclose(sorted(map(tuple, top[:, :2])), sorted(in_f0.footprint),
-                                   atol=1e-9)  # fmt: skip
+        np.testing.assert_allclose(
+            sorted(map(tuple, top[:, :2])), sorted(in_f0.footprint), atol=1e-9
+        )
         assert top[:, 2] == pytest.approx(in_f0.offset)
     assert not any(u.get("entities") for u in scenes(guarded, "/sim/truth/penetrations"))
-    inside = [u for u in scenes(tmp_path / "blind" / "session.mcap", "/sim/truth/penetrations")
-              if u.get("entities")]  # fmt: skip
+    inside = [
+        u
+        for u in scenes(tmp_path / "blind" / "session.mcap", "/sim/truth/penetrations")
+        if u.get("entities")
+    ]
     assert inside and all(u["entities"][0]["frame_id"] == "truth/world" for u in inside)
     for run in (report, blind):
-        assert any(Path(f).name == "arm_clearance.png" and Path(f).stat().st_size > 10_000
-                   for f in run["figures"])  # fmt: skip
+        assert any(
+            Path(f).name == "arm_clearance.png" and Path(f).stat().st_size > 10_000
+            for f in run["figures"]
+        )
 
 
 def scenes(path: Path, suffix: str) -> list[dict]:
     """Every message of a recording's channel ending in ``suffix``, decoded with nothing but
     the schema written beside it."""
     with path.open("rb") as file:
-        return [decode(View(suffix, schema.name, schema.encoding, schema.data,
-                            channel.message_encoding, message.data))
-                for schema, channel, message in make_reader(file).iter_messages()
-                if channel.topic.endswith(suffix)]  # fmt: skip
+        return [
+            decode(
+                View(
+                    suffix,
+                    schema.name,
+                    schema.encoding,
+                    schema.data,
+                    channel.message_encoding,
+                    message.data,
+                )
+            )
+            for schema, channel, message in make_reader(file).iter_messages()
+            if channel.topic.endswith(suffix)
+        ]
 
 
 def test_position_experiment_with_the_cascade_converges(tmp_path: Path) -> None:
@@ -212,13 +252,16 @@ def test_hidden_base_marker_degrades_the_state_and_the_run_still_converges(
     assert report["degraded_states"] > 50  # about 2.5 s of 50 Hz states after the timeout
 
 
-def kill_during_run(tmp_path: Path, component: str, name: str = "pose"
-                    ) -> tuple[int, dict, str]:  # fmt: skip
+def kill_during_run(tmp_path: Path, component: str, name: str = "pose") -> tuple[int, dict, str]:
     """Start experiment ``name``, SIGKILL ``component`` once the controller has run 200 steps,
     and return the exit status, the report and the launch log."""
     command = [sys.executable, "-m", "parsimony.cli", "experiment", name, "--json"]
-    process = subprocess.Popen([*command, "--out", str(tmp_path)], stdout=subprocess.PIPE,
-                               stderr=subprocess.DEVNULL, text=True)  # fmt: skip
+    process = subprocess.Popen(
+        [*command, "--out", str(tmp_path)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    )
     try:
         found = statuses_while_moving(tmp_path, process, {component})
         os.kill(found[component].pid, signal.SIGKILL)
@@ -251,8 +294,9 @@ def test_a_killed_experiment_leaves_no_process_behind(tmp_path: Path) -> None:
     """`parsimony experiment` killed with -9 mid-run: its launcher sees it gone, stops every
     component in order (the recorder writes its footer) and exits; nothing runs on."""
     command = [sys.executable, "-m", "parsimony.cli", "experiment", "pose", "--json"]
-    process = subprocess.Popen([*command, "--out", str(tmp_path)], stdout=subprocess.DEVNULL,
-                               stderr=subprocess.DEVNULL)  # fmt: skip
+    process = subprocess.Popen(
+        [*command, "--out", str(tmp_path)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
     try:
         found = statuses_while_moving(tmp_path, process, {"recorder", "simulator"})
         children = Path(f"/proc/{process.pid}/task/{process.pid}/children").read_text()
@@ -287,28 +331,39 @@ def test_a_killed_vision_tracker_is_restarted_and_the_run_converges(tmp_path: Pa
     assert report["lockstep_timeouts"] >= 1  # the frame the dead tracker never answered
 
 
-@pytest.mark.parametrize("bad, why", [
-    (["pose", "--seed", "x"], "--seed: expected an integer"),
-    (["pose", "--seed", "-1"], "--seed: expected 0 to 2147483648, got -1"),
-    (["pose", "--seed", str(2**31 + 1)], "--seed: expected 0 to 2147483648"),
-    (["pose", "--time-limit", "nan"], "--time-limit: expected a finite number of seconds > 0"),
-    (["pose", "--time-limit", "0"], "--time-limit: expected a finite number of seconds > 0"),
-    (["pose", "--time-limit", "-3"], "--time-limit: expected a finite number of seconds > 0"),
-    (["pose", "--profile", str(DEPLOY / "emulated.yaml")], "add --realtime"),
-    (["jump"], "invalid choice: 'jump'"),
-    (["pose"], "the following arguments are required: --out"),
-    (["obstacle", "--gain", "obstacle_mode"], "--gain: expected NAME=VALUE"),
-    (["obstacle", "--gain", "obstacle_mode=around"],
-     "LPParams.obstacle_mode: expected a str in {'border', 'vector_field', 'conservative'"),
-    (["obstacle", "--gain", "obstacle_radius=1"], "no LP gain 'obstacle_radius'"),
-    (["obstacle", "--gain", "obstacle_gain=-1"], "LPParams.obstacle_gain: expected a float in"),
-    (["obstacle", "--controller", "cascade", "--gain", "obstacle_gain=1"],
-     "no cascade gain 'obstacle_gain'; the cascade's gains are eta, offset"),
-    (["pose", "--controller", "cascade", "--gain", "eta=-1"],
-     "CascadeParams.eta: expected a float in"),
-    (["pose", "--controller", "cascade", "--gain", "saturate=maybe"],
-     "CascadeParams.saturate: expected a bool"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    "bad, why",
+    [
+        (["pose", "--seed", "x"], "--seed: expected an integer"),
+        (["pose", "--seed", "-1"], "--seed: expected 0 to 2147483648, got -1"),
+        (["pose", "--seed", str(2**31 + 1)], "--seed: expected 0 to 2147483648"),
+        (["pose", "--time-limit", "nan"], "--time-limit: expected a finite number of seconds > 0"),
+        (["pose", "--time-limit", "0"], "--time-limit: expected a finite number of seconds > 0"),
+        (["pose", "--time-limit", "-3"], "--time-limit: expected a finite number of seconds > 0"),
+        (["pose", "--profile", str(DEPLOY / "emulated.yaml")], "add --realtime"),
+        (["jump"], "invalid choice: 'jump'"),
+        (["pose"], "the following arguments are required: --out"),
+        (["obstacle", "--gain", "obstacle_mode"], "--gain: expected NAME=VALUE"),
+        (
+            ["obstacle", "--gain", "obstacle_mode=around"],
+            "LPParams.obstacle_mode: expected a str in {'border', 'vector_field', 'conservative'",
+        ),
+        (["obstacle", "--gain", "obstacle_radius=1"], "no LP gain 'obstacle_radius'"),
+        (["obstacle", "--gain", "obstacle_gain=-1"], "LPParams.obstacle_gain: expected a float in"),
+        (
+            ["obstacle", "--controller", "cascade", "--gain", "obstacle_gain=1"],
+            "no cascade gain 'obstacle_gain'; the cascade's gains are eta, offset",
+        ),
+        (
+            ["pose", "--controller", "cascade", "--gain", "eta=-1"],
+            "CascadeParams.eta: expected a float in",
+        ),
+        (
+            ["pose", "--controller", "cascade", "--gain", "saturate=maybe"],
+            "CascadeParams.saturate: expected a bool",
+        ),
+    ],
+)
 def test_usage_errors_exit_2_and_say_why(bad: list[str], why: str, tmp_path: Path) -> None:
     extra = [] if bad == ["pose"] else ["--out", str(tmp_path)]
     command = [sys.executable, "-m", "parsimony.cli", "experiment", *bad, *extra]
@@ -325,8 +380,11 @@ def test_the_cascade_takes_its_declared_gains(tmp_path: Path) -> None:
     robot = MobileManipulator.from_yaml(load_profile(PROFILES["cascade"]).robot)
     profile = experiment_profile(options, PROFILES["cascade"], scenario("pose", robot))
     (controller,) = [c for c in profile["components"] if c["name"] == "controller"]
-    assert controller == {"name": "controller", "module": "cascade_controller",
-                          "params": {"eta": 1.0, "saturate": True}}
+    assert controller == {
+        "name": "controller",
+        "module": "cascade_controller",
+        "params": {"eta": 1.0, "saturate": True},
+    }
 
 
 def test_an_experiment_does_not_write_over_a_directory_that_holds_files(tmp_path: Path) -> None:
@@ -363,7 +421,7 @@ def test_a_goal_behind_the_robot_is_reached_though_the_supervisor_is_killed_mid_
     phases = [p["phase"] for p in report["supervisor"]["phases"] if p["phase"] != "idle"]
     # After the last drive the phases run in their declared order (one already met at the
     # step its predecessor ends is skipped), and the run ends reached.
-    after = phases[len(phases) - phases[::-1].index("drive"):]
+    after = phases[len(phases) - phases[::-1].index("drive") :]
     order = [Phase(p) for p in after]
     assert phases[:2] == ["planning", "drive"] and phases[-1] == "reached", phases
     assert order == sorted(order, key=list(Phase).index) and len(set(order)) == len(order), phases

@@ -73,25 +73,39 @@ def watch(session: zenoh.Session, namespace: str, watched: Watched) -> list:
         if message.valid:
             watched.state = message
 
-    return [on(topics.SIM_CLOCK, lambda m: setattr(watched, "clock_ns", m.stamp_ns)),
-            on(topics.ROBOT_STATE, state),
-            on(topics.GOAL_REQUEST, watched.requests.append)]  # fmt: skip
+    return [
+        on(topics.SIM_CLOCK, lambda m: setattr(watched, "clock_ns", m.stamp_ns)),
+        on(topics.ROBOT_STATE, state),
+        on(topics.GOAL_REQUEST, watched.requests.append),
+    ]
 
 
 @pytest.fixture(scope="module")
 def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Station]:
     directory = tmp_path_factory.mktemp("goal")
     path = directory / "station.yaml"
-    path.write_text(yaml.safe_dump({
-        "extends": str(DEPLOY / "sim_station.yaml"), "namespace": "goalcommand",
-        "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]}, "startup_timeout_s": 60.0,
-        "components": [{"name": "simulator", "params": {"lockstep": True,
-                                                        "real_time_factor": 0.0,
-                                                        "paused": True}}],
-    }))  # fmt: skip
+    path.write_text(
+        yaml.safe_dump(
+            {
+                "extends": str(DEPLOY / "sim_station.yaml"),
+                "namespace": "goalcommand",
+                "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
+                "startup_timeout_s": 60.0,
+                "components": [
+                    {
+                        "name": "simulator",
+                        "params": {"lockstep": True, "real_time_factor": 0.0, "paused": True},
+                    }
+                ],
+            }
+        )
+    )
     profile = load_profile(path)
-    with (directory / "launch.log").open("w") as log, launched(path, log) as launcher, \
-            connect(profile, launcher) as session:  # fmt: skip
+    with (
+        (directory / "launch.log").open("w") as log,
+        launched(path, log) as launcher,
+        connect(profile, launcher) as session,
+    ):
         watched = Watched()
         subscribers = watch(session, profile.namespace, watched)
         wait_alive(session, profile, launcher)
@@ -104,8 +118,12 @@ def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Station]:
 
 
 def parsimony(*arguments: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "parsimony.cli", *arguments],
-                          capture_output=True, text=True, timeout=COMMAND_S)  # fmt: skip
+    return subprocess.run(
+        [sys.executable, "-m", "parsimony.cli", *arguments],
+        capture_output=True,
+        text=True,
+        timeout=COMMAND_S,
+    )
 
 
 def test_topic_pub_stamps_a_header_it_makes_on_the_simulators_clock(station: Station) -> None:
@@ -126,9 +144,14 @@ def test_topic_pub_stamps_a_header_it_makes_on_the_simulators_clock(station: Sta
     assert before is not None
     subscriber = station.session.declare_subscriber(key, on_goal)
     try:
-        result = parsimony("topic", "pub", "world/goal",
-                           '{"task": "position", "position": [0.5, 0.0, 0.4]}',
-                           "--profile", str(station.path))  # fmt: skip
+        result = parsimony(
+            "topic",
+            "pub",
+            "world/goal",
+            '{"task": "position", "position": [0.5, 0.0, 0.4]}',
+            "--profile",
+            str(station.path),
+        )
         assert result.returncode == 0, result.stderr
         watched.wait(lambda: published, "published goal")
         with watched.changed:
@@ -153,15 +176,27 @@ def test_a_goal_is_sent_on_the_profiles_clock_and_reached(station: Station) -> N
     target = (round(x + 0.08, 4), round(y + 0.05, 4), round(z - 0.04, 4))
     with station.watched.changed:
         sent, before = len(station.watched.requests), station.watched.clock_ns
-    result = parsimony("goal", *(str(v) for v in target), "--yaw",
-                       f"{math.degrees(yaw) + 10.0:.2f}", "--wait", "--json", "--timeout", "60",
-                       "--profile", str(station.path))  # fmt: skip
+    result = parsimony(
+        "goal",
+        *(str(v) for v in target),
+        "--yaw",
+        f"{math.degrees(yaw) + 10.0:.2f}",
+        "--wait",
+        "--json",
+        "--timeout",
+        "60",
+        "--profile",
+        str(station.path),
+    )
     assert result.returncode == 0, result.stderr
     outcome = json.loads(result.stdout)
     assert outcome["result"] == "reached" and outcome["topic"] == "goal/request", outcome
     # The phases as they came, on stderr: planning first, reached last.
-    phases = [line.split()[3].rstrip(",") for line in result.stderr.splitlines()
-              if line.startswith("goal: ") and " s " in line]  # fmt: skip
+    phases = [
+        line.split()[3].rstrip(",")
+        for line in result.stderr.splitlines()
+        if line.startswith("goal: ") and " s " in line
+    ]
     assert phases[0] == "planning" and phases[-1] == "reached", result.stderr
     (request,) = station.watched.requests[sent:]
     assert request.header.source == "parsimony" and request.task == "pose"
@@ -177,8 +212,9 @@ def test_a_goal_is_sent_on_the_profiles_clock_and_reached(station: Station) -> N
 def test_a_goal_below_the_floor_is_refused_and_not_sent(station: Station) -> None:
     x, y, _, _, _, _ = gripper(station)
     sent = len(station.watched.requests)
-    result = parsimony("goal", f"{x:.3f}", f"{y:.3f}", "-0.1", "--wait",
-                       "--profile", str(station.path))  # fmt: skip
+    result = parsimony(
+        "goal", f"{x:.3f}", f"{y:.3f}", "-0.1", "--wait", "--profile", str(station.path)
+    )
     assert result.returncode == 1, result.stderr
     assert "goal refused: the goal is 0.100 m below the floor" in result.stderr
     assert len(station.watched.requests) == sent and "Traceback" not in result.stderr
@@ -188,8 +224,18 @@ def test_a_goal_no_configuration_reaches_is_unreachable_with_the_reason(
     station: Station,
 ) -> None:
     x, y, _, _, _, _ = gripper(station)
-    result = parsimony("goal", f"{x:.3f}", f"{y:.3f}", "1.5", "--wait", "--json",
-                       "--timeout", "60", "--profile", str(station.path))  # fmt: skip
+    result = parsimony(
+        "goal",
+        f"{x:.3f}",
+        f"{y:.3f}",
+        "1.5",
+        "--wait",
+        "--json",
+        "--timeout",
+        "60",
+        "--profile",
+        str(station.path),
+    )
     assert result.returncode == 1, result.stderr
     outcome = json.loads(result.stdout)
     assert outcome["result"] == "unreachable" and outcome["reason"], outcome

@@ -32,8 +32,10 @@ def test_the_staging_supervisor_reaches_goals_anywhere_inside_the_limits():
     """Goals at any bearing and heading within 1.2 m, on a set the planner was not tuned on;
     the default LP alone reaches about one in eight of such goals."""
     pairs = goals(FAMILIES["anywhere"], 8, ROBOT, HELD_OUT_SEED)
-    attempts = [attempt(LAWS[SUPERVISED](ROBOT), ROBOT, start, goal, supervised=True)
-                for start, goal in pairs]  # fmt: skip
+    attempts = [
+        attempt(LAWS[SUPERVISED](ROBOT), ROBOT, start, goal, supervised=True)
+        for start, goal in pairs
+    ]
     result = shares(attempts)
     assert result["within_joint_and_speed_limits"] >= 7 / 8, result
     assert all(max(a.joint_overrun, a.speed_overrun) <= LIMIT_TOLERANCE for a in attempts)
@@ -62,8 +64,10 @@ def test_goals_ahead_drawn_another_way_start_the_arm_anywhere_in_its_box():
         assert (starts.max(axis=0) > high - 0.1 * (high - low)).all()
 
 
-STALLS_AT_ELBOW = (np.array([0.0, 0.0, 0.0, 0.066, 0.059, 0.273, 0.255, 0.509]),
-                   np.array([0.725, 0.063, -0.604, 0.268, -0.646, 0.238, -0.456, 0.333]))
+STALLS_AT_ELBOW = (
+    np.array([0.0, 0.0, 0.0, 0.066, 0.059, 0.273, 0.255, 0.509]),
+    np.array([0.725, 0.063, -0.604, 0.268, -0.646, 0.238, -0.456, 0.333]),
+)
 """A goal 'ahead' (seed 2) that the default LP alone misses: its base stops 8 cm from the goal
 configuration's and 0.52 rad off its heading, the elbow at the edge of the LP's joint box,
 ||e|| 0.013."""

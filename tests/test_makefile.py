@@ -19,14 +19,26 @@ def test_each_long_step_of_make_demo_and_test_is_announced_first() -> None:
     and not a word."""
     # -W: as if the lock and the client's package.json had just changed, so both are rebuilt.
     done = subprocess.run(
-        ["make", "-n", "-W", "requirements.lock", "-W", "tests/foxglove_client/package.json",
-         "demo", "foxglove-client"],
-        cwd=ROOT, capture_output=True, text=True, timeout=60, check=True,
-    )  # fmt: skip
+        [
+            "make",
+            "-n",
+            "-W",
+            "requirements.lock",
+            "-W",
+            "tests/foxglove_client/package.json",
+            "demo",
+            "foxglove-client",
+        ],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=True,
+    )
     commands = [line for line in done.stdout.splitlines() if not line.startswith("\t")]
     long = [i for i, line in enumerate(commands) if any(step in line for step in LONG_STEPS)]
     assert len(long) == 4, commands  # two pip installs, the experiment, npm ci
     for index in long:
-        assert commands[index - 1].startswith('echo "[make] '), commands[index - 1: index + 1]
+        assert commands[index - 1].startswith('echo "[make] '), commands[index - 1 : index + 1]
     said = done.stdout
     assert "packages pinned in" in said and "about a minute" in said

@@ -28,8 +28,13 @@ def test_the_first_hour_of_the_readme_runs_as_written(tmp_path: Path) -> None:
     is written and the replay ends."""
     for name in ("deploy", ".venv"):
         (tmp_path / name).symlink_to(ROOT / name)
-    result = subprocess.run(["bash", "-e", "-c", first_hour_block()], cwd=tmp_path,
-                            capture_output=True, text=True, timeout=SAFETY_NET_S)  # fmt: skip
+    result = subprocess.run(
+        ["bash", "-e", "-c", first_hour_block()],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=SAFETY_NET_S,
+    )
     assert result.returncode == 0, result.stderr[-3000:]
     assert result.stdout.count("reached in") == 2, result.stdout
     assert "supervisor reached" in result.stderr

@@ -31,11 +31,22 @@ from tests.processes import parsimony, process_gone
 
 def system_profile(tmp_path: Path) -> Path:
     path = tmp_path / "system.yaml"
-    path.write_text(yaml.safe_dump({
-        "namespace": "rec", "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
-        "components": [{"name": "pub", "module": "scripted_publisher", "role": "tool",
-                        "params": {"rate_hz": 100.0}}],
-    }))  # fmt: skip
+    path.write_text(
+        yaml.safe_dump(
+            {
+                "namespace": "rec",
+                "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
+                "components": [
+                    {
+                        "name": "pub",
+                        "module": "scripted_publisher",
+                        "role": "tool",
+                        "params": {"rate_hz": 100.0},
+                    }
+                ],
+            }
+        )
+    )
     return path
 
 
@@ -49,9 +60,10 @@ def test_the_recorder_stops_with_the_record_command(tmp_path: Path, how: signal.
     temporary = tmp_path / "tmp"
     temporary.mkdir()
     with launched(profile) as launcher, connect(load_profile(profile), launcher) as session:
-        command = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "record",
-                                    str(profile), "-o", str(out)],
-                                   env={**os.environ, "TMPDIR": str(temporary)})  # fmt: skip
+        command = subprocess.Popen(
+            [sys.executable, "-m", "parsimony.cli", "record", str(profile), "-o", str(out)],
+            env={**os.environ, "TMPDIR": str(temporary)},
+        )
         while "recorder" not in live_components(session, "rec", 0.5):
             assert command.poll() is None
         while not out.exists() or info(out)["messages"] < 50:
@@ -74,16 +86,30 @@ def test_the_recorder_says_once_which_topic_was_stamped_far_outside_the_session(
     """On simulated time, a goal stamped on the wall clock (as `topic pub` stamped it) is
     recorded and said in one line naming its topic; `info` leaves it out of the span."""
     profile = tmp_path / "sim.yaml"
-    profile.write_text(yaml.safe_dump({
-        "namespace": "rec", "clock": "sim", "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
-        "components": [{"name": "pub", "module": "scripted_publisher", "role": "tool",
-                        "params": {"rate_hz": 50.0}}],
-    }))  # fmt: skip
+    profile.write_text(
+        yaml.safe_dump(
+            {
+                "namespace": "rec",
+                "clock": "sim",
+                "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
+                "components": [
+                    {
+                        "name": "pub",
+                        "module": "scripted_publisher",
+                        "role": "tool",
+                        "params": {"rate_hz": 50.0},
+                    }
+                ],
+            }
+        )
+    )
     out = tmp_path / "far.mcap"
     with launched(profile) as launcher, connect(load_profile(profile), launcher) as session:
-        command = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "record",
-                                    str(profile), "-o", str(out)], stderr=subprocess.PIPE,
-                                   text=True)  # fmt: skip
+        command = subprocess.Popen(
+            [sys.executable, "-m", "parsimony.cli", "record", str(profile), "-o", str(out)],
+            stderr=subprocess.PIPE,
+            text=True,
+        )
         while "recorder" not in live_components(session, "rec", 0.5):
             assert command.poll() is None
         clock = session.declare_publisher(topics.SIM_CLOCK.key("rec"))
@@ -91,9 +117,11 @@ def test_the_recorder_says_once_which_topic_was_stamped_far_outside_the_session(
         for tick in range(1, 101):  # a simulated second
             clock.put(codec.encode(Clock(stamp_ns=tick * 10_000_000)))
             if tick in (50, 60):
-                goal = Goal(header=Header(stamp_ns=time.time_ns(), frame="world", seq=tick,
-                                          source="topic"), task="position",
-                            position=(1.0, 0.0, 0.5))  # fmt: skip
+                goal = Goal(
+                    header=Header(stamp_ns=time.time_ns(), frame="world", seq=tick, source="topic"),
+                    task="position",
+                    position=(1.0, 0.0, 0.5),
+                )
                 goals.put(codec.encode(goal))
         deadline = time.monotonic() + 60.0  # a safety net: the recorder counts them in 0.1 s
         while statuses(session, "rec")["recorder"].counters.get("outside.goal/request") != 2:
@@ -120,17 +148,20 @@ def test_no_command_writes_over_its_input_or_an_existing_file(tmp_path: Path) ->
     profile = system_profile(tmp_path)
     recording = tmp_path / "k.mcap"
     with launched(profile) as launcher, connect(load_profile(profile), launcher):
-        command = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "record",
-                                    str(profile), "-o", str(recording)])  # fmt: skip
+        command = subprocess.Popen(
+            [sys.executable, "-m", "parsimony.cli", "record", str(profile), "-o", str(recording)]
+        )
         while not recording.exists() or info(recording)["messages"] < 50:
             assert command.poll() is None
             time.sleep(0.1)
         command.send_signal(signal.SIGINT)
         assert command.wait() == 0
     kept = recording.read_bytes()
-    for arguments in (["rerun", str(recording), "--controller", "lp", "-o", str(recording)],
-                      ["record", "--recover", str(recording), "-o", str(recording)],
-                      ["record", str(profile), "-o", str(recording)]):  # fmt: skip
+    for arguments in (
+        ["rerun", str(recording), "--controller", "lp", "-o", str(recording)],
+        ["record", "--recover", str(recording), "-o", str(recording)],
+        ["record", str(profile), "-o", str(recording)],
+    ):
         done = parsimony(*arguments)
         assert done.returncode == 2, (arguments, done.stderr)
         assert "Traceback" not in done.stderr and str(recording) in done.stderr, done.stderr
@@ -152,18 +183,31 @@ def test_a_robot_file_that_is_no_description_is_one_line_from_report_and_rerun(
     field: list indices must be integers or slices, not str')."""
     robot = tmp_path / "robot.yaml"
     robot.write_text("- arm\n- base\n")
-    done = parsimony("report", str(tmp_path / "k.mcap"), "--out", str(tmp_path / "report"),
-                     "--robot", str(robot))  # fmt: skip
+    done = parsimony(
+        "report", str(tmp_path / "k.mcap"), "--out", str(tmp_path / "report"), "--robot", str(robot)
+    )
     assert done.returncode == 2, done.stderr
-    assert done.stderr == (f"report: {robot}: a robot description is a mapping (arm:, base:, "
-                           "...), this file holds a list\n")  # fmt: skip
+    assert done.stderr == (
+        f"report: {robot}: a robot description is a mapping (arm:, base:, "
+        "...), this file holds a list\n"
+    )
     recording = tmp_path / "k.mcap"
     recording.write_bytes(b"")
-    done = parsimony("rerun", str(recording), "--controller", "lp", "-o",
-                     str(tmp_path / "rerun.mcap"), "--robot", str(robot))  # fmt: skip
+    done = parsimony(
+        "rerun",
+        str(recording),
+        "--controller",
+        "lp",
+        "-o",
+        str(tmp_path / "rerun.mcap"),
+        "--robot",
+        str(robot),
+    )
     assert done.returncode == 2, done.stderr
-    assert done.stderr == (f"rerun: {robot}: a robot description is a mapping (arm:, base:, "
-                           "...), this file holds a list\n")  # fmt: skip
+    assert done.stderr == (
+        f"rerun: {robot}: a robot description is a mapping (arm:, base:, "
+        "...), this file holds a list\n"
+    )
 
 
 def test_record_onto_a_full_disk_says_so_in_one_line_and_its_file_recovers(tmp_path: Path) -> None:
@@ -171,23 +215,25 @@ def test_record_onto_a_full_disk_says_so_in_one_line_and_its_file_recovers(tmp_p
     of its own (``unshare``): the recorder stops for good when the disk is full, the command
     exits non-zero with one line saying so, no traceback, and the file recovers."""
     unshare = shutil.which("unshare")
-    probe = unshare and subprocess.run([unshare, "-rm", "mount", "-t", "tmpfs", "tmpfs",
-                                        str(tmp_path)], capture_output=True)  # fmt: skip
+    probe = unshare and subprocess.run(
+        [unshare, "-rm", "mount", "-t", "tmpfs", "tmpfs", str(tmp_path)], capture_output=True
+    )
     if not probe or probe.returncode != 0:
         pytest.skip("no mount namespace here to mount a tmpfs in")
     profile = system_profile(tmp_path)
     disk = tmp_path / "disk"
     disk.mkdir()
     recovered = tmp_path / "recovered.mcap"
-    script = (f'mount -t tmpfs -o size=64k tmpfs {disk} && '
-              f'{sys.executable} -m parsimony.cli record {profile} -o {disk}/k.mcap; '
-              f'code=$?; {sys.executable} -m parsimony.cli record --recover {disk}/k.mcap '
-              f'-o {recovered} >&2; exit $code')  # fmt: skip
+    script = (
+        f"mount -t tmpfs -o size=64k tmpfs {disk} && "
+        f"{sys.executable} -m parsimony.cli record {profile} -o {disk}/k.mcap; "
+        f"code=$?; {sys.executable} -m parsimony.cli record --recover {disk}/k.mcap "
+        f"-o {recovered} >&2; exit $code"
+    )
     with launched(profile) as launcher, connect(load_profile(profile), launcher) as session:
         while "pub" not in live_components(session, "rec", 0.5):
             assert launcher.poll() is None
-        done = subprocess.run([unshare, "-rm", "sh", "-c", script], capture_output=True,
-                              text=True)  # fmt: skip
+        done = subprocess.run([unshare, "-rm", "sh", "-c", script], capture_output=True, text=True)
     assert done.returncode == EXIT_FOR_GOOD, done.stderr
     assert "Traceback" not in done.stderr, done.stderr
     full = [line for line in done.stderr.splitlines() if "No space left on device" in line]

@@ -28,8 +28,12 @@ from record.session_reader import info, read_session, recover
 
 
 def parsimony(*arguments: str, timeout: float = 300) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "parsimony.cli", *arguments],
-                          capture_output=True, text=True, timeout=timeout)  # fmt: skip
+    return subprocess.run(
+        [sys.executable, "-m", "parsimony.cli", *arguments],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
 
 
 SMOOTH_PROFILE = DEPLOY / "sim_smooth.yaml"
@@ -40,9 +44,11 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     """The pose experiment of one seed with each law, and with the LP's input change term on
     (deploy/sim_smooth.yaml), recorded."""
     found = {}
-    for name, arguments in (("lp", ("--controller", "lp")),
-                            ("cascade", ("--controller", "cascade")),
-                            ("lp smooth", ("--profile", str(SMOOTH_PROFILE)))):  # fmt: skip
+    for name, arguments in (
+        ("lp", ("--controller", "lp")),
+        ("cascade", ("--controller", "cascade")),
+        ("lp smooth", ("--profile", str(SMOOTH_PROFILE))),
+    ):
         out = tmp_path_factory.mktemp(name.replace(" ", "_"))
         done = parsimony("experiment", "pose", *arguments, "--seed", "6", "--out", str(out))
         assert done.returncode == 0, done.stderr[-2000:]
@@ -59,8 +65,13 @@ def test_a_recorded_experiment_reads_back_with_every_channel_schema(runs) -> Non
     assert counted == summary.statistics.message_count > 1000
     assert all(channel.schema_id in summary.schemas for channel in summary.channels.values())
     names = {schema.name for schema in summary.schemas.values()}
-    assert {"RobotState", "CameraFrame", "foxglove.CompressedImage", "foxglove.FrameTransforms",
-            "foxglove.SceneUpdate"} <= names
+    assert {
+        "RobotState",
+        "CameraFrame",
+        "foxglove.CompressedImage",
+        "foxglove.FrameTransforms",
+        "foxglove.SceneUpdate",
+    } <= names
     shown = json.loads(parsimony("info", str(path), "--json").stdout)
     assert shown["messages"] == counted
     by_key = {c["key"]: c for c in shown["channels"]}
@@ -95,8 +106,16 @@ def test_the_report_of_two_laws_shows_the_norms_they_minimise(runs, tmp_path: Pa
 def test_a_recorder_killed_with_sigkill_loses_at_most_half_a_second(tmp_path: Path) -> None:
     """The experiment records; its recorder is killed mid-run: the file still reads, less at
     most 0.5 s of messages, and the experiment says loudly that its recording is cut short."""
-    command = [sys.executable, "-m", "parsimony.cli", "experiment", "pose", "--realtime",
-               "--out", str(tmp_path)]  # fmt: skip
+    command = [
+        sys.executable,
+        "-m",
+        "parsimony.cli",
+        "experiment",
+        "pose",
+        "--realtime",
+        "--out",
+        str(tmp_path),
+    ]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     while not (tmp_path / "profile.yaml").exists():
         assert process.poll() is None, process.communicate()
@@ -136,15 +155,28 @@ def test_a_recorder_whose_file_fills_up_stops_for_good_and_its_file_recovers(
     restart it, and the file recovers to its last complete chunk."""
     path = tmp_path / "session.mcap"
     profile = tmp_path / "profile.yaml"
-    profile.write_text(yaml.safe_dump({
-        "namespace": "full", "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
-        "components": [
-            {"name": "recorder", "module": "recorder", "role": "recorder",
-             "params": {"path": str(path), "flush_s": 0.05}},
-            {"name": "pub", "module": "scripted_publisher", "role": "tool",
-             "params": {"rate_hz": 1000.0}},
-        ],
-    }))  # fmt: skip
+    profile.write_text(
+        yaml.safe_dump(
+            {
+                "namespace": "full",
+                "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
+                "components": [
+                    {
+                        "name": "recorder",
+                        "module": "recorder",
+                        "role": "recorder",
+                        "params": {"path": str(path), "flush_s": 0.05},
+                    },
+                    {
+                        "name": "pub",
+                        "module": "scripted_publisher",
+                        "role": "tool",
+                        "params": {"rate_hz": 1000.0},
+                    },
+                ],
+            }
+        )
+    )
     limit = 64 * 1024
 
     def small_files() -> None:
@@ -152,9 +184,12 @@ def test_a_recorder_whose_file_fills_up_stops_for_good_and_its_file_recovers(
 
     log = tmp_path / "launch.log"
     with log.open("w") as stream:
-        launcher = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "launch",
-                                     str(profile)], stdout=stream, stderr=subprocess.STDOUT,
-                                    preexec_fn=small_files)  # fmt: skip
+        launcher = subprocess.Popen(
+            [sys.executable, "-m", "parsimony.cli", "launch", str(profile)],
+            stdout=stream,
+            stderr=subprocess.STDOUT,
+            preexec_fn=small_files,
+        )
     try:
         while f"recorder exited with {EXIT_FOR_GOOD}" not in log.read_text():
             assert launcher.poll() is None, log.read_text()
@@ -183,19 +218,35 @@ def test_replay_republishes_the_sensors_with_headers_as_recorded(runs, tmp_path:
     port = free_port()
     component = {"name": "x", "module": "scripted_publisher", "role": "tool"}
     zenoh_settings = {"router": [f"tcp/127.0.0.1:{port}"]}
-    profile.write_text(yaml.safe_dump(
-        {"namespace": "replayed", "zenoh": zenoh_settings, "components": [component]}))
+    profile.write_text(
+        yaml.safe_dump(
+            {"namespace": "replayed", "zenoh": zenoh_settings, "components": [component]}
+        )
+    )
     loaded = load_profile(profile)
     received: list = []
     with zenoh.open(loaded.zenoh.router_config()) as router:
         key = topics.BASE_ODOMETRY.key("replayed")
-        router.declare_subscriber(key, lambda s: received.append(
-            codec.decode(s.payload.to_bytes(), topics.BASE_ODOMETRY.type)))  # fmt: skip
+        router.declare_subscriber(
+            key,
+            lambda s: received.append(
+                codec.decode(s.payload.to_bytes(), topics.BASE_ODOMETRY.type)
+            ),
+        )
         recorded_all = load_session(path)["base/odometry"]
         first = recorded_all[0].header.stamp_ns
         recorded = [m for m in recorded_all if m.header.stamp_ns <= first + 3_000_000_000]
-        done = parsimony("replay", str(path), "--profile", str(profile), "--sensors",
-                         "--rate", "4", "--duration", "3")  # fmt: skip
+        done = parsimony(
+            "replay",
+            str(path),
+            "--profile",
+            str(profile),
+            "--sensors",
+            "--rate",
+            "4",
+            "--duration",
+            "3",
+        )
         assert done.returncode == 0, done.stderr
         deadline = time.monotonic() + 5.0
         while len(received) < len(recorded) and time.monotonic() < deadline:
@@ -205,19 +256,19 @@ def test_replay_republishes_the_sensors_with_headers_as_recorded(runs, tmp_path:
 
 
 @pytest.mark.parametrize("run", ["lp", "lp smooth"])
-def test_rerun_of_the_recorded_law_reproduces_its_commands(runs, run: str, tmp_path: Path
-                                                           ) -> None:  # fmt: skip
+def test_rerun_of_the_recorded_law_reproduces_its_commands(runs, run: str, tmp_path: Path) -> None:
     """The LP run offline on a lockstep recording's states, goals and obstacles, with the
     gains its diagnostics carry, is the controller that ran: every command bit for bit; with
     the input change term on too, whose u_prev the law keeps from step to step."""
     out = tmp_path / "rerun.mcap"
-    done = parsimony("rerun", str(runs[run] / "session.mcap"), "--controller", "lp",
-                     "-o", str(out))  # fmt: skip
+    done = parsimony("rerun", str(runs[run] / "session.mcap"), "--controller", "lp", "-o", str(out))
     assert done.returncode == 0, done.stderr
     recorded = load_session(runs[run] / "session.mcap")
     rerun = load_session(out)
-    for topic, fields in (("arm/command", ("joint_velocities",)),
-                          ("base/command", ("forward_velocity", "angular_velocity"))):
+    for topic, fields in (
+        ("arm/command", ("joint_velocities",)),
+        ("base/command", ("forward_velocity", "angular_velocity")),
+    ):
         sent = {m.header.stamp_ns: [getattr(m, f) for f in fields] for m in recorded[topic]}
         again = {m.header.stamp_ns: [getattr(m, f) for f in fields] for m in rerun[topic]}
         assert len(sent) > 100 and {stamp: again[stamp] for stamp in sent} == sent, topic
@@ -233,7 +284,8 @@ def test_the_input_change_term_lowers_metric_4_of_the_simulated_run(runs) -> Non
     """The same seed of the pose experiment on the whole simulated loop, the LP with and
     without its input change term: both converge, and table 6.1's metric 4 of the commands
     (from the zero commands before the goal on) is lower with it."""
-    reports = {name: json.loads((runs[name] / "report.json").read_text())
-               for name in ("lp", "lp smooth")}  # fmt: skip
+    reports = {
+        name: json.loads((runs[name] / "report.json").read_text()) for name in ("lp", "lp smooth")
+    }
     assert all(report["converged"] for report in reports.values())
     assert reports["lp smooth"]["effort"]["metric4"] < reports["lp"]["effort"]["metric4"]

@@ -27,11 +27,21 @@ def recording(path: Path, namespace: str) -> Path:
         for index in range(50):
             stamp = index * 20_000_000
             header = Header(stamp_ns=stamp, frame="world", seq=index, source="recorded")
-            writer.write(topics.ARM_COMMAND.key(namespace),
-                         ArmCommand(header=header, joint_velocities=(0.1,) * 5))  # fmt: skip
-            writer.write(topics.ROBOT_STATE.key(namespace), RobotState(
-                header=header, base_pose=(0.0, 0.0, 0.0), arm_joints=(0.0,) * 5,
-                end_effector=(1.0, 0, 0, 0, 0, 0, 0, 0), valid=True, age_s=0.0))  # fmt: skip
+            writer.write(
+                topics.ARM_COMMAND.key(namespace),
+                ArmCommand(header=header, joint_velocities=(0.1,) * 5),
+            )
+            writer.write(
+                topics.ROBOT_STATE.key(namespace),
+                RobotState(
+                    header=header,
+                    base_pose=(0.0, 0.0, 0.0),
+                    arm_joints=(0.0,) * 5,
+                    end_effector=(1.0, 0, 0, 0, 0, 0, 0, 0),
+                    valid=True,
+                    age_s=0.0,
+                ),
+            )
             writer.write(topics.SIM_CLOCK.key(namespace), Clock(stamp_ns=stamp))
     return path
 
@@ -42,10 +52,15 @@ def replay(file: Path, profile: Path, *extra: str) -> subprocess.CompletedProces
 
 def test_a_replay_into_a_live_namespace_refuses_commands_and_live_topics(tmp_path: Path) -> None:
     profile = tmp_path / "live.yaml"
-    profile.write_text(yaml.safe_dump({
-        "namespace": "live", "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
-        "components": [{"name": "pub", "module": "scripted_publisher", "role": "tool"}],
-    }))  # fmt: skip
+    profile.write_text(
+        yaml.safe_dump(
+            {
+                "namespace": "live",
+                "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
+                "components": [{"name": "pub", "module": "scripted_publisher", "role": "tool"}],
+            }
+        )
+    )
     file = recording(tmp_path / "k.mcap", "live")
     with launched(profile) as launcher, connect(load_profile(profile), launcher) as session:
         while "pub" not in live_components(session, "live", 0.5):

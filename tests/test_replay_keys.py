@@ -36,12 +36,21 @@ QUIET_S = 0.3
 
 
 def odometry(index: int) -> BaseOdometry:
-    header = Header(stamp_ns=1_000_000_000 + index * STEP_NS, frame="odom", seq=index,
-                    source="base_driver")  # fmt: skip
-    return BaseOdometry(header=header, left_encoder=index, right_encoder=2 * index,
-                        left_distance=index * 1e-3, right_distance=index * 2e-3, x=index * 1e-3,
-                        y=0.0, phi=index * 1e-4, forward_velocity=0.1,
-                        angular_velocity=0.01)  # fmt: skip
+    header = Header(
+        stamp_ns=1_000_000_000 + index * STEP_NS, frame="odom", seq=index, source="base_driver"
+    )
+    return BaseOdometry(
+        header=header,
+        left_encoder=index,
+        right_encoder=2 * index,
+        left_distance=index * 1e-3,
+        right_distance=index * 2e-3,
+        x=index * 1e-3,
+        y=0.0,
+        phi=index * 1e-4,
+        forward_velocity=0.1,
+        angular_velocity=0.01,
+    )
 
 
 @pytest.fixture
@@ -95,20 +104,33 @@ def replay(tmp_path: Path, recording) -> Iterator[Replay]:
     profile = tmp_path / "replay.yaml"
     component = {"name": "x", "module": "scripted_publisher", "role": "tool"}
     router = {"router": [f"tcp/127.0.0.1:{free_port()}"]}
-    profile.write_text(yaml.safe_dump(
-        {"namespace": "replayed", "components": [component], "zenoh": router}))  # fmt: skip
+    profile.write_text(
+        yaml.safe_dump({"namespace": "replayed", "components": [component], "zenoh": router})
+    )
     received: queue.Queue = queue.Queue()
     with zenoh.open(load_profile(profile).zenoh.router_config()) as router:
-        router.declare_subscriber(topics.BASE_ODOMETRY.key("replayed"), lambda s: received.put(
-            codec.decode(s.payload.to_bytes(), BaseOdometry)))  # fmt: skip
+        router.declare_subscriber(
+            topics.BASE_ODOMETRY.key("replayed"),
+            lambda s: received.put(codec.decode(s.payload.to_bytes(), BaseOdometry)),
+        )
         terminal, replica = pty.openpty()
-        command = [sys.executable, "-m", "parsimony.cli", "replay", str(tmp_path / "session.mcap"),
-                   "--profile", str(profile), "--start-paused"]  # fmt: skip
-        process = subprocess.Popen(command, stdin=replica, stdout=subprocess.DEVNULL,
-                                   stderr=subprocess.PIPE, text=True)  # fmt: skip
+        command = [
+            sys.executable,
+            "-m",
+            "parsimony.cli",
+            "replay",
+            str(tmp_path / "session.mcap"),
+            "--profile",
+            str(profile),
+            "--start-paused",
+        ]
+        process = subprocess.Popen(
+            command, stdin=replica, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True
+        )
         lines: queue.Queue = queue.Queue()
-        threading.Thread(target=lambda: [lines.put(line) for line in process.stderr],
-                         daemon=True).start()  # fmt: skip
+        threading.Thread(
+            target=lambda: [lines.put(line) for line in process.stderr], daemon=True
+        ).start()
         try:
             yield Replay(process, terminal, replica, lines, received)
         finally:
@@ -119,8 +141,7 @@ def replay(tmp_path: Path, recording) -> Iterator[Replay]:
             os.close(replica)
 
 
-def test_paused_replay_steps_three_messages_then_plays_the_rest(replay: Replay,
-                                                                recording) -> None:  # fmt: skip
+def test_paused_replay_steps_three_messages_then_plays_the_rest(replay: Replay, recording) -> None:
     before = termios.tcgetattr(replay.replica)
     replay.wait_for_line("paused", f"0.00 / {(MESSAGES - 1) * STEP_NS / 1e9:.2f} s")
     # The replay reads single keys: the terminal is in cbreak mode (no line editing).

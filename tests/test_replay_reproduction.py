@@ -53,13 +53,19 @@ def complete_until(session: dict[str, list]) -> int:
 def estimators_profile(path: Path, namespace: str) -> Path:
     """A profile of only the simulation's vision tracker and state estimator, on ``namespace``
     and a fresh router."""
-    path.write_text(yaml.safe_dump({
-        "extends": str(DEPLOY / "sim.yaml"),
-        "namespace": namespace,
-        "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
-        "components": [{"name": "simulator", "enabled": False},
-                       {"name": "controller", "enabled": False}],
-    }))  # fmt: skip
+    path.write_text(
+        yaml.safe_dump(
+            {
+                "extends": str(DEPLOY / "sim.yaml"),
+                "namespace": namespace,
+                "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
+                "components": [
+                    {"name": "simulator", "enabled": False},
+                    {"name": "controller", "enabled": False},
+                ],
+            }
+        )
+    )
     enabled = {c.name for c in load_profile(path).components if c.enabled}
     assert enabled == {"vision_tracker", "state_estimator"}
     return path
@@ -80,16 +86,29 @@ def replay_into(profile_path: Path, recording: Path, stamps: set[int]) -> dict[i
 
     command = [sys.executable, "-m", "parsimony.cli"]
     with (profile_path.parent / "launch.log").open("w") as log:
-        launcher = subprocess.Popen([*command, "launch", str(profile_path)], stdout=log,
-                                    stderr=subprocess.STDOUT)  # fmt: skip
+        launcher = subprocess.Popen(
+            [*command, "launch", str(profile_path)], stdout=log, stderr=subprocess.STDOUT
+        )
     try:
         with connect(profile, launcher) as session:
             session.declare_subscriber(topics.ROBOT_STATE.key(profile.namespace), take)
             wait_alive(session, profile, launcher)
-            done = subprocess.run([*command, "replay", str(recording), "--profile",
-                                   str(profile_path), "--sensors", "--clock", "--lockstep",
-                                   "--rate", str(RATE)],
-                                  capture_output=True, text=True)  # fmt: skip
+            done = subprocess.run(
+                [
+                    *command,
+                    "replay",
+                    str(recording),
+                    "--profile",
+                    str(profile_path),
+                    "--sensors",
+                    "--clock",
+                    "--lockstep",
+                    "--rate",
+                    str(RATE),
+                ],
+                capture_output=True,
+                text=True,
+            )
             assert done.returncode == 0, done.stderr
             assert "no answer" not in done.stderr, done.stderr
             with arrived:  # the replay had every answer; this subscription may trail it
@@ -102,8 +121,9 @@ def replay_into(profile_path: Path, recording: Path, stamps: set[int]) -> dict[i
 
 def differences(recorded: RobotState, replayed: RobotState) -> tuple[float, float, float]:
     """Base position (m), heading (rad) and end-effector position (m) apart."""
-    base = math.hypot(recorded.base_pose[0] - replayed.base_pose[0],
-                      recorded.base_pose[1] - replayed.base_pose[1])  # fmt: skip
+    base = math.hypot(
+        recorded.base_pose[0] - replayed.base_pose[0], recorded.base_pose[1] - replayed.base_pose[1]
+    )
     heading = abs(wrap(recorded.base_pose[2] - replayed.base_pose[2]))
     tips = [dq.translation(np.array(s.end_effector)) for s in (recorded, replayed)]
     return base, heading, float(np.linalg.norm(tips[0] - tips[1]))
@@ -124,9 +144,11 @@ def test_replayed_sensors_reproduce_the_recorded_states_exactly(tmp_path: Path) 
 
     apart = [differences(s, replayed[s.header.stamp_ns]) for s in recorded]
     worst = [max(d[i] for d in apart) for i in range(3)]
-    figures = (f"{len(recorded)} states; largest differences: base {worst[0] * 1e3:.4f} mm, "
-               f"heading {math.degrees(worst[1]):.5f} deg, "
-               f"end effector {worst[2] * 1e3:.4f} mm")  # fmt: skip
+    figures = (
+        f"{len(recorded)} states; largest differences: base {worst[0] * 1e3:.4f} mm, "
+        f"heading {math.degrees(worst[1]):.5f} deg, "
+        f"end effector {worst[2] * 1e3:.4f} mm"
+    )
     assert worst[0] <= POSITION_M and worst[1] <= HEADING_RAD and worst[2] <= POSITION_M, figures
     assert [s.valid for s in recorded] == [replayed[s.header.stamp_ns].valid for s in recorded]
     # A lockstep recording replayed in lockstep: the same inputs in the same order, exactly.

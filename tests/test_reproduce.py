@@ -35,9 +35,22 @@ SECTIONS = ("6.2.1", "6.2.2", "6.2.3", "table 6.1", "6.3", "7.2 (1)", "7.2 (5)")
 
 
 def run_reproduce(out: Path) -> dict:
-    done = subprocess.run([sys.executable, "-m", "parsimony.cli", "reproduce", "--json",
-                           "--trials", str(TRIALS), "--out", str(out)],
-                          capture_output=True, text=True, timeout=900)  # fmt: skip
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "parsimony.cli",
+            "reproduce",
+            "--json",
+            "--trials",
+            str(TRIALS),
+            "--out",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout)  # the JSON alone on stdout
 
@@ -59,20 +72,19 @@ def same(ours: Any, golden: Any, tolerance: dict[str, float], where: str) -> Non
         for index, (a, b) in enumerate(zip(ours, golden, strict=True)):
             same(a, b, tolerance, f"{where}[{index}]")
     elif isinstance(golden, float) and not isinstance(golden, bool):
-        assert isinstance(ours, int | float) and (math.isnan(golden) and math.isnan(ours)
-                                                  or ours == pytest.approx(golden, **tolerance)), (
-            where, ours, golden)  # fmt: skip
+        assert isinstance(ours, int | float) and (
+            math.isnan(golden) and math.isnan(ours) or ours == pytest.approx(golden, **tolerance)
+        ), (where, ours, golden)
     else:
         assert ours == golden, (where, ours, golden)
 
 
-def test_every_result_that_does_not_depend_on_the_clock_equals_the_golden_one(report: dict
-                                                                               ) -> None:
+def test_every_result_that_does_not_depend_on_the_clock_equals_the_golden_one(report: dict) -> None:
     golden = json.loads(GOLDEN.read_text())
     rows = {row["key"]: row for row in report["rows"]}
     assert len(rows) == len(report["rows"]), "row keys must be unique"
     untimed = {key for key, row in rows.items() if not row["timed"]}
-    assert untimed == golden["rows"].keys(), (untimed ^ golden["rows"].keys())
+    assert untimed == golden["rows"].keys(), untimed ^ golden["rows"].keys()
     for key, ours in golden["rows"].items():
         same(rows[key]["ours"], ours, golden["tolerance"], key)
 
@@ -92,8 +104,7 @@ def test_every_chapter_6_result_is_a_row_and_every_law_says_what_it_ran(report: 
                 assert (experiment, label) in ran, row["key"]
     assert "none (5.29 exactly)" in ran["pose", "LP 5.29"]
     assert "5.28 (lambda 2, on the axle centre" in ran["obstacle", "LP 5.29"]
-    assert "5.10" in ran["obstacle", "LP 5.29"] and "circulation" not in ran["obstacle",
-                                                                            "LP 5.29"]
+    assert "5.10" in ran["obstacle", "LP 5.29"] and "circulation" not in ran["obstacle", "LP 5.29"]
     assert "saturated" in ran["pose", "cascade, saturated"]
     assert ran["6.3 test 1", "LP"].startswith("min ||J u + eta e||_1, eta 5, subject to 5.10")
 
@@ -134,14 +145,32 @@ LOOP_LAWS = ("LP 5.29", "cascade, saturated")
 
 
 def test_the_loop_prints_the_rows_of_its_recordings_beside_the_kinematic_ones(
-        tmp_path: Path) -> None:
+    tmp_path: Path,
+) -> None:
     """`reproduce --loop`: each law runs the pose set-up on the whole loop with the gains of its
     kinematic run (the recording says which), and its rows, read back from the recording,
     follow the kinematic ones; the command says how long the loop took."""
     laws = [argument for label in LOOP_LAWS for argument in ("--law", label)]
-    done = subprocess.run([sys.executable, "-m", "parsimony.cli", "reproduce", "--json", "--loop",
-                           "--only", "pose", *laws, "--time-limit", "2", "--out", str(tmp_path)],
-                          capture_output=True, text=True, timeout=900)  # fmt: skip
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "parsimony.cli",
+            "reproduce",
+            "--json",
+            "--loop",
+            "--only",
+            "pose",
+            *laws,
+            "--time-limit",
+            "2",
+            "--out",
+            str(tmp_path),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
     assert done.returncode == 0, done.stderr[-3000:]
     found = json.loads(done.stdout)
     rows = found["rows"]
@@ -149,23 +178,26 @@ def test_the_loop_prints_the_rows_of_its_recordings_beside_the_kinematic_ones(
     assert {row["experiment"] for row in rows} <= {"pose", "pose on the loop"}
     for index, row in enumerate(rows):  # each after its kinematic row, or another of the loop
         if row["key"].startswith("loop.") and row["key"][5:] in keys:
-            before = keys[keys.index(row["key"][5:]):index]
+            before = keys[keys.index(row["key"][5:]) : index]
             assert all(key.startswith("loop.") for key in before[1:]), (row["key"], before)
     ran = {(law["experiment"], law["label"]): law["ran"] for law in found["laws"]}
     robot = MobileManipulator.from_yaml(ROBOT_FILE)
     for label in LOOP_LAWS:
         assert ran["pose on the loop", label].startswith("the whole loop in lockstep")
-        session = load_session(tmp_path / "loop" / "pose" / folder(label) / "session.mcap",
-                               JUDGED)  # fmt: skip
+        session = load_session(tmp_path / "loop" / "pose" / folder(label) / "session.mcap", JUDGED)
         run, _ = the_run(session, 2.0)
         stamps, u = commands(run)
-        diagnostics = [d for d in messages(run, CONTROL_DIAGNOSTICS)
-                       if d.header.stamp_ns in set(stamps.tolist())]  # fmt: skip
+        diagnostics = [
+            d
+            for d in messages(run, CONTROL_DIAGNOSTICS)
+            if d.header.stamp_ns in set(stamps.tolist())
+        ]
         first = next(i for i, d in enumerate(diagnostics) if d.status == "optimal")
         steps = diagnostics[first:]
         assert steps[-1].parameters == asdict(laws_of(robot, "pose")[label].params)
-        row = {key[5:]: r["ours"] for key, r in zip(keys, rows, strict=True)
-               if key.startswith("loop.")}  # fmt: skip
+        row = {
+            key[5:]: r["ours"] for key, r in zip(keys, rows, strict=True) if key.startswith("loop.")
+        }
         assert row["pose.converged"][label] == [False, len(steps)]
         index = list(stamps).index(steps[0].header.stamp_ns)
         assert row[f"pose.first_step.{label}"]["u"] == [round(float(v), 3) for v in u[index]]
@@ -178,9 +210,12 @@ def test_the_loop_prints_the_rows_of_its_recordings_beside_the_kinematic_ones(
 
 
 def test_the_laws_of_the_loop_need_the_loop(tmp_path: Path) -> None:
-    done = subprocess.run([sys.executable, "-m", "parsimony.cli", "reproduce", "--law", "LP",
-                           "--out", str(tmp_path)], capture_output=True, text=True,
-                          timeout=120)  # fmt: skip
+    done = subprocess.run(
+        [sys.executable, "-m", "parsimony.cli", "reproduce", "--law", "LP", "--out", str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert done.returncode == 2 and done.stdout == "", done.stderr
     assert "--law chooses the laws of the loop: add --loop" in done.stderr
     assert "Traceback" not in done.stderr and not any(tmp_path.iterdir())
@@ -189,10 +224,16 @@ def test_the_laws_of_the_loop_need_the_loop(tmp_path: Path) -> None:
 def write_golden(out: Path) -> None:
     """Run the command and keep every untimed row's result as the golden one."""
     found = run_reproduce(out)
-    GOLDEN.write_text(json.dumps({
-        "tolerance": {"rel": 1e-3, "abs": 1e-6},
-        "rows": {row["key"]: row["ours"] for row in found["rows"] if not row["timed"]},
-    }, indent=1) + "\n")  # fmt: skip
+    GOLDEN.write_text(
+        json.dumps(
+            {
+                "tolerance": {"rel": 1e-3, "abs": 1e-6},
+                "rows": {row["key"]: row["ours"] for row in found["rows"] if not row["timed"]},
+            },
+            indent=1,
+        )
+        + "\n"
+    )
 
 
 if __name__ == "__main__" and sys.argv[1:] == ["--write"]:

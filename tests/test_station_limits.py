@@ -31,8 +31,12 @@ from record.live_view import LiveView
 from tests.foxglove_client.client import DEADLINE_S, FoxgloveClient, missing
 
 NAMESPACE = "limits"
-GOAL = json.dumps({"frame_id": "world", "pose": {"position": {"x": 0.6, "y": 0.1, "z": 0.0},
-                                                 "orientation": {"w": 1.0}}})  # fmt: skip
+GOAL = json.dumps(
+    {
+        "frame_id": "world",
+        "pose": {"position": {"x": 0.6, "y": 0.1, "z": 0.0}, "orientation": {"w": 1.0}},
+    }
+)
 """A good goal (with no robot state known, only the message is checked)."""
 
 
@@ -54,26 +58,49 @@ def view(tmp_path: Path) -> Iterator[View]:
     node with parameters ``eta`` (a float in [0, 10]) and ``mode``."""
     assert not missing(), missing()
     path = tmp_path / "limits.yaml"
-    path.write_text(yaml.safe_dump({
-        "namespace": NAMESPACE,
-        "zenoh": {"mode": "client", "router": [f"tcp/127.0.0.1:{free_port()}"]},
-        "components": [{"name": "ctl", "module": "scripted_publisher", "role": "tool",
-                        "enabled": False}],
-    }))  # fmt: skip
+    path.write_text(
+        yaml.safe_dump(
+            {
+                "namespace": NAMESPACE,
+                "zenoh": {"mode": "client", "router": [f"tcp/127.0.0.1:{free_port()}"]},
+                "components": [
+                    {
+                        "name": "ctl",
+                        "module": "scripted_publisher",
+                        "role": "tool",
+                        "enabled": False,
+                    }
+                ],
+            }
+        )
+    )
     profile = load_profile(path)
-    params = (Param("eta", float, 0.5, low=0.0, high=10.0, doc="a gain"),
-              Param("mode", str, "on", choices=("on", "off"), doc="a choice"))  # fmt: skip
+    params = (
+        Param("eta", float, 0.5, low=0.0, high=10.0, doc="a gain"),
+        Param("mode", str, "on", choices=("on", "off"), doc="a choice"),
+    )
     goals: list[Goal] = []
-    with zenoh.open(profile.zenoh.router_config()) as router, Node(profile, "ctl", params) as node,\
-            zenoh.open(profile.zenoh.client_config()) as viewing:  # fmt: skip
+    with (
+        zenoh.open(profile.zenoh.router_config()) as router,
+        Node(profile, "ctl", params) as node,
+        zenoh.open(profile.zenoh.client_config()) as viewing,
+    ):
         node.start()
-        watcher = router.declare_subscriber(topics.GOAL_REQUEST.key(NAMESPACE), lambda sample:
-                                            goals.append(codec.decode(sample.payload.to_bytes(),
-                                                                      Goal)))  # fmt: skip
+        watcher = router.declare_subscriber(
+            topics.GOAL_REQUEST.key(NAMESPACE),
+            lambda sample: goals.append(codec.decode(sample.payload.to_bytes(), Goal)),
+        )
         own = zenoh.open(profile.zenoh.client_config())
         station = ControlStation(own, profile)
-        with LiveView(viewing, NAMESPACE, [], 0, listener=station,
-                      capabilities=station.capabilities, encodings=station.encodings) as live:
+        with LiveView(
+            viewing,
+            NAMESPACE,
+            [],
+            0,
+            listener=station,
+            capabilities=station.capabilities,
+            encodings=station.encodings,
+        ) as live:
             station.attach(live.server)
             yield View(profile, station, live.address, node, router, goals, live)
         station.close()
@@ -90,32 +117,45 @@ def answer(client: FoxgloveClient, parameters: list[dict], id_: str) -> tuple[li
     """The values a set answers, and the statuses said with them."""
     start = len(client.events)
     client.send("setParameters", parameters=parameters, id=id_)
-    values = client.wait_for(lambda e: e["event"] == "parameterValues" and e.get("id") == id_,
-                             f"the answer to {id_}", start)  # fmt: skip
+    values = client.wait_for(
+        lambda e: e["event"] == "parameterValues" and e.get("id") == id_,
+        f"the answer to {id_}",
+        start,
+    )
     return values["parameters"], statuses(client, start)
 
 
 HOSTILE = [
-    ({"name": "ctl." + "x" * 65536, "value": 1.0, "type": "float64"},
-     "= 1.0 refused: a name of 65540 characters: at most 128"),
+    (
+        {"name": "ctl." + "x" * 65536, "value": 1.0, "type": "float64"},
+        "= 1.0 refused: a name of 65540 characters: at most 128",
+    ),
     ({"name": "*.eta", "value": 1.0}, "*.eta = 1 refused: no running component has this"),
     ({"name": "**.eta", "value": 1.0}, "**.eta = 1 refused: no running component has this"),
     ({"name": "ctl/x.eta", "value": 1.0}, "ctl/x.eta = 1 refused: no running component"),
-    ({"name": "ctl.eta", "value": base64.b64encode(b"\0\1\2").decode(), "type": "byte_array"},
-     "ctl.eta = 3 bytes refused: a byte array is no parameter's value"),
-    ({"name": "ctl.mode", "value": "o" * 100_000},
-     "ctl.mode = 'oooooooooooooooooooooooooooooooooooooooo... (100000 characters)' refused: "
-     "a value of 100000 characters: at most 4096"),
-    ({"name": "ctl.eta", "value": -3.0, "type": "float64"},
-     "ctl.eta = -3.0 refused: eta: expected a float in"),
-]  # fmt: skip
+    (
+        {"name": "ctl.eta", "value": base64.b64encode(b"\0\1\2").decode(), "type": "byte_array"},
+        "ctl.eta = 3 bytes refused: a byte array is no parameter's value",
+    ),
+    (
+        {"name": "ctl.mode", "value": "o" * 100_000},
+        "ctl.mode = 'oooooooooooooooooooooooooooooooooooooooo... (100000 characters)' refused: "
+        "a value of 100000 characters: at most 4096",
+    ),
+    (
+        {"name": "ctl.eta", "value": -3.0, "type": "float64"},
+        "ctl.eta = -3.0 refused: eta: expected a float in",
+    ),
+]
 """Parameter sets that cannot be, and what the station says of each (the first three panicked
 Zenoh or raised in the view before, and no answer came)."""
 
 
 def test_each_malformed_set_is_refused_saying_why_and_the_station_goes_on(view: View) -> None:
-    kept = {"ctl.eta": [{"name": "ctl.eta", "type": "float64", "value": 0.5}],
-            "ctl.mode": [{"name": "ctl.mode", "value": "on"}]}  # fmt: skip
+    kept = {
+        "ctl.eta": [{"name": "ctl.eta", "type": "float64", "value": 0.5}],
+        "ctl.mode": [{"name": "ctl.mode", "value": "on"}],
+    }
     with FoxgloveClient(view.address) as client:
         client.server_info()
         for index, (parameter, said) in enumerate(HOSTILE):
@@ -123,8 +163,9 @@ def test_each_malformed_set_is_refused_saying_why_and_the_station_goes_on(view: 
             assert len(said_then) == 1 and said in said_then[0], said_then
             assert len(said_then[0]) <= STATUS_CHARS
             assert values == kept.get(parameter["name"], [])  # a known one's value is kept
-        values, said_then = answer(client, [{"name": "ctl.eta", "value": 0.7,
-                                             "type": "float64"}], "good")  # fmt: skip
+        values, said_then = answer(
+            client, [{"name": "ctl.eta", "value": 0.7, "type": "float64"}], "good"
+        )
         assert values == [{"name": "ctl.eta", "type": "float64", "value": 0.7}], said_then
     assert view.node.params["eta"] == 0.7
 
@@ -135,15 +176,19 @@ def test_after_its_session_fails_the_station_says_so_and_goes_on_on_a_new_one(
     """After a panic in Zenoh, the session answers nothing again."""
     failed = view.station.session
     poison(failed)
-    with caplog.at_level(logging.WARNING, "parsimony.view"), \
-            FoxgloveClient(view.address) as client:  # fmt: skip
+    with caplog.at_level(logging.WARNING, "parsimony.view"), FoxgloveClient(view.address) as client:
         client.server_info()
         client.send("getParameters", names=[], id="all")
-        listed = client.wait_for(lambda e: e["event"] == "parameterValues" and e.get("id")
-                                 == "all", "every parameter")  # fmt: skip
+        listed = client.wait_for(
+            lambda e: e["event"] == "parameterValues" and e.get("id") == "all", "every parameter"
+        )
         assert {p["name"] for p in listed["parameters"]} == {"ctl.eta", "ctl.mode"}
-        client.send("advertise", topic=topics.GOAL_REQUEST.key(NAMESPACE), encoding="json",
-                    schemaName="foxglove.PoseInFrame")  # fmt: skip
+        client.send(
+            "advertise",
+            topic=topics.GOAL_REQUEST.key(NAMESPACE),
+            encoding="json",
+            schemaName="foxglove.PoseInFrame",
+        )
         channel = client.wait_for(lambda e: e["event"] == "advertised", "the channel")["channel"]
         client.send("publish", channel=channel, text=GOAL)
         client.wait_for(lambda e: e["event"] == "status" and "sent" in e["message"], "the goal")
@@ -168,16 +213,19 @@ def test_when_no_new_session_can_be_opened_each_goal_and_set_says_so(
     """And `parsimony view` says so when it stops, and exits 1."""
     with FoxgloveClient(view.address) as client:
         client.server_info()
-        client.send("advertise", topic=topics.GOAL_REQUEST.name, encoding="json",
-                    schemaName="foxglove.PoseInFrame")  # fmt: skip
+        client.send(
+            "advertise",
+            topic=topics.GOAL_REQUEST.name,
+            encoding="json",
+            schemaName="foxglove.PoseInFrame",
+        )
         channel = client.wait_for(lambda e: e["event"] == "advertised", "the channel")["channel"]
         view.station.session.close()
         view.router.close()  # and no router to open a new session with
         client.send("publish", channel=channel, text=GOAL)
         said = client.wait_for(lambda e: e["event"] == "status", "the goal's answer")["message"]
         assert "goal/request not sent: the view's Zenoh session failed: Unable to connect" in said
-        _, said_then = answer(client, [{"name": "ctl.eta", "value": 0.7, "type": "float64"}],
-                              "set")  # fmt: skip
+        _, said_then = answer(client, [{"name": "ctl.eta", "value": 0.7, "type": "float64"}], "set")
         assert len(said_then) == 1 and "the view's Zenoh session failed" in said_then[0]
     assert view.station.failed.startswith("the view's Zenoh session failed: Unable to connect")
     assert view.station.session_errors == 2 and not view.goals
@@ -198,14 +246,20 @@ def test_a_client_sending_goals_faster_than_their_rate_is_told_its_goals_are_dro
     sent = 30
     with FoxgloveClient(view.address) as client:
         client.server_info()
-        client.send("advertise", topic=topics.GOAL_REQUEST.name, encoding="json",
-                    schemaName="foxglove.PoseInFrame")  # fmt: skip
+        client.send(
+            "advertise",
+            topic=topics.GOAL_REQUEST.name,
+            encoding="json",
+            schemaName="foxglove.PoseInFrame",
+        )
         channel = client.wait_for(lambda e: e["event"] == "advertised", "the channel")["channel"]
         began = time.monotonic()
         for _ in range(sent):
             client.send("publish", channel=channel, text=GOAL)
-        client.wait_for(lambda e: e["event"] == "status" and "dropped" in e["message"],
-                        "a goal dropped for its rate")  # fmt: skip
+        client.wait_for(
+            lambda e: e["event"] == "status" and "dropped" in e["message"],
+            "a goal dropped for its rate",
+        )
         station = view.station
         deadline = time.monotonic() + DEADLINE_S
         while station.goals_sent + station.goals_dropped < sent:
@@ -215,5 +269,7 @@ def test_a_client_sending_goals_faster_than_their_rate_is_told_its_goals_are_dro
     # Whatever the machine's speed: no more than the rate lets through in the time it took.
     assert station.goals_sent <= GOAL_RATE.burst + GOAL_RATE.per_s * elapsed_s
     dropped = [m for m in statuses(client) if "dropped" in m]
-    assert "goal/request dropped: more than 1 goal/s (5 at once) from this client (1 dropped);"\
-        " the next is taken in " in dropped[0]  # fmt: skip
+    assert (
+        "goal/request dropped: more than 1 goal/s (5 at once) from this client (1 dropped);"
+        " the next is taken in " in dropped[0]
+    )

@@ -36,19 +36,33 @@ def guarded(tmp_path: Path) -> Iterator[Path]:
     users = ("operator", "viewer", "guest", "ctl", "cam")
     (tmp_path / "credentials.txt").write_text("".join(f"{u}:{u}-secret\n" for u in users))
     path = tmp_path / "guarded.yaml"
-    path.write_text(yaml.safe_dump({
-        "namespace": NAMESPACE,
-        "zenoh": {"mode": "client", "router": [f"tcp/127.0.0.1:{free_port()}"],
-                  "access": {"credentials": "credentials.txt",
-                             "writers": {"goal/request": ["operator"]},
-                             "parameters": {"*": ["operator"], "cam": ["operator", "guest"]}}},
-        "components": [{"name": name, "module": "scripted_publisher", "role": "tool",
-                        "enabled": False} for name in ("ctl", "cam")],
-    }))  # fmt: skip
+    path.write_text(
+        yaml.safe_dump(
+            {
+                "namespace": NAMESPACE,
+                "zenoh": {
+                    "mode": "client",
+                    "router": [f"tcp/127.0.0.1:{free_port()}"],
+                    "access": {
+                        "credentials": "credentials.txt",
+                        "writers": {"goal/request": ["operator"]},
+                        "parameters": {"*": ["operator"], "cam": ["operator", "guest"]},
+                    },
+                },
+                "components": [
+                    {"name": name, "module": "scripted_publisher", "role": "tool", "enabled": False}
+                    for name in ("ctl", "cam")
+                ],
+            }
+        )
+    )
     profile = load_profile(path)
     gain = Param("gain", float, 0.5, low=0.0, high=10.0, doc="a gain")
-    with zenoh.open(profile.zenoh.router_config(NAMESPACE)), Node(profile, "ctl", [gain]) as ctl,\
-            Node(profile, "cam", [gain]) as cam:  # fmt: skip
+    with (
+        zenoh.open(profile.zenoh.router_config(NAMESPACE)),
+        Node(profile, "ctl", [gain]) as ctl,
+        Node(profile, "cam", [gain]) as cam,
+    ):
         ctl.start()
         cam.start()
         yield path
@@ -56,8 +70,7 @@ def guarded(tmp_path: Path) -> Iterator[Path]:
 
 def view_as(user: str, profile: Path) -> contextlib.AbstractContextManager[RunningView]:
     """``parsimony view`` run by ``user``."""
-    return running_view(profile, env={**os.environ, "PARSIMONY_USER": user},
-                        timeout_s=DEADLINE_S)  # fmt: skip
+    return running_view(profile, env={**os.environ, "PARSIMONY_USER": user}, timeout_s=DEADLINE_S)
 
 
 def test_a_view_whose_user_may_not_write_goals_offers_no_publishing(guarded: Path) -> None:
@@ -70,8 +83,12 @@ def test_a_view_whose_user_may_not_write_goals_offers_no_publishing(guarded: Pat
             info = client.server_info()
             assert "clientPublish" not in info["capabilities"]
             assert "parameters" in info["capabilities"]
-            client.send("advertise", topic=f"{NAMESPACE}/goal/request", encoding="json",
-                        schemaName="foxglove.PoseInFrame")  # fmt: skip
+            client.send(
+                "advertise",
+                topic=f"{NAMESPACE}/goal/request",
+                encoding="json",
+                schemaName="foxglove.PoseInFrame",
+            )
             refused = client.wait_for(lambda e: e["event"] == "status", "the server's answer")
             assert "does not support clientPublish" in refused["message"]
     assert view.process.returncode == 0, view.err
@@ -86,10 +103,14 @@ def test_a_view_whose_user_may_not_write_goals_offers_no_publishing(guarded: Pat
 def set_gain(client: FoxgloveClient, component: str, gain: float) -> tuple[float, list[str]]:
     """The gain a set of ``component.gain`` answers, and the statuses said with it."""
     start = len(client.events)
-    client.send("setParameters", parameters=[{"name": f"{component}.gain", "value": gain,
-                                              "type": "float64"}], id=component)  # fmt: skip
-    answer = client.wait_for(lambda e: e["event"] == "parameterValues"
-                             and e.get("id") == component, "the answer", start)  # fmt: skip
+    client.send(
+        "setParameters",
+        parameters=[{"name": f"{component}.gain", "value": gain, "type": "float64"}],
+        id=component,
+    )
+    answer = client.wait_for(
+        lambda e: e["event"] == "parameterValues" and e.get("id") == component, "the answer", start
+    )
     said = [e["message"] for e in client.events[start:] if e["event"] == "status"]
     (value,) = answer["parameters"]
     return value["value"], said

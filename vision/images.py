@@ -20,8 +20,9 @@ def grey(data: bytes, encoding: str, width: int, height: int) -> np.ndarray:
         if image is None:
             raise ValueError("the JPEG data does not decode")
         if image.shape != (height, width):
-            raise ValueError(f"the JPEG is {image.shape[1]}x{image.shape[0]}, the frame says "
-                             f"{width}x{height}")  # fmt: skip
+            raise ValueError(
+                f"the JPEG is {image.shape[1]}x{image.shape[0]}, the frame says {width}x{height}"
+            )
         return image
     channels = CHANNELS.get(encoding)
     if channels is None:

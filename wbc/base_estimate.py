@@ -27,8 +27,11 @@ Pose = tuple[float, float, float]
 def blend(estimate: Pose, measured: Pose, gain: float) -> Pose:
     """x + g (z - x), the heading's difference wrapped to [-pi, pi)."""
     x, y, phi = estimate
-    return (x + gain * (measured[0] - x), y + gain * (measured[1] - y),
-            phi + gain * wrap(measured[2] - phi))  # fmt: skip
+    return (
+        x + gain * (measured[0] - x),
+        y + gain * (measured[1] - y),
+        phi + gain * wrap(measured[2] - phi),
+    )
 
 
 class BaseEstimate:

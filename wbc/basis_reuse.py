@@ -76,16 +76,20 @@ class KeptBasis:
             return None
         values = getrs(factor, pivot_rows, rhs)[0]
         basic_values, activities = values[:count], values[count:]
-        if (basic_values.min(initial=0.0) < -PRIMAL_TOLERANCE
-                or (activities < lower[rows] - PRIMAL_TOLERANCE).any()
-                or (activities > upper[rows] + PRIMAL_TOLERANCE).any()):  # fmt: skip
+        if (
+            basic_values.min(initial=0.0) < -PRIMAL_TOLERANCE
+            or (activities < lower[rows] - PRIMAL_TOLERANCE).any()
+            or (activities > upper[rows] + PRIMAL_TOLERANCE).any()
+        ):
             return None
         self._basic_cost[:count] = cost[basic]
         duals = getrs(factor, pivot_rows, self._basic_cost, trans=1)[0]
         reduced = cost - matrix.T @ duals
-        if (reduced[self.nonbasic_columns].min(initial=0.0) < -DUAL_TOLERANCE
-                or ((self.dual_sign * duals < -DUAL_TOLERANCE) & (lower != upper)).any()
-                or (np.abs(duals[self.free]) > DUAL_TOLERANCE).any()):  # fmt: skip
+        if (
+            reduced[self.nonbasic_columns].min(initial=0.0) < -DUAL_TOLERANCE
+            or ((self.dual_sign * duals < -DUAL_TOLERANCE) & (lower != upper)).any()
+            or (np.abs(duals[self.free]) > DUAL_TOLERANCE).any()
+        ):
             return None
         solution = np.zeros(matrix.shape[1])
         solution[basic] = np.maximum(basic_values, 0.0)

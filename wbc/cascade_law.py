@@ -111,8 +111,9 @@ class CascadeLaw:
     def stopped(self) -> None:
         """Nothing to forget: its reference base advances only when it steps."""
 
-    def step(self, q: Array, task: Task, dt: float, obstacles: Sequence[Obstacle] = ()
-             ) -> LawOutput:  # fmt: skip
+    def step(
+        self, q: Array, task: Task, dt: float, obstacles: Sequence[Obstacle] = ()
+    ) -> LawOutput:
         """One step; the reference base advances by the outer loop's u_b over ``dt``."""
         start = time.perf_counter()
         q = require_finite("configuration q", q)

@@ -95,14 +95,17 @@ def _point(entry: Mapping[str, Any], field: str, frames: int) -> CollisionPoint:
     offset = entry.get("offset", [0.0, 0.0, 0.0])
     if not isinstance(offset, list) or len(offset) != 3:
         raise ValueError(f"{field}.offset: expected 3 numbers, got {offset!r}")
-    return CollisionPoint(str(entry.get("name", "")) or field,
-                          _frame(entry.get("frame"), f"{field}.frame", frames),
-                          tuple(_number(v, f"{field}.offset") for v in offset),  # type: ignore[arg-type]
-                          _number(entry.get("radius"), f"{field}.radius", 0.0))  # fmt: skip
+    return CollisionPoint(
+        str(entry.get("name", "")) or field,
+        _frame(entry.get("frame"), f"{field}.frame", frames),
+        tuple(_number(v, f"{field}.offset") for v in offset),  # type: ignore[arg-type]
+        _number(entry.get("radius"), f"{field}.radius", 0.0),
+    )
 
 
-def _segment(entry: Mapping[str, Any], field: str, frames: int, names: Sequence[str]
-             ) -> CollisionSegment:  # fmt: skip
+def _segment(
+    entry: Mapping[str, Any], field: str, frames: int, names: Sequence[str]
+) -> CollisionSegment:
     unknown = set(entry) - {"name", "frame", "axis", "start", "end", "radius"}
     if unknown:
         raise ValueError(f"{field}: unknown fields {sorted(unknown)}")
@@ -111,15 +114,21 @@ def _segment(entry: Mapping[str, Any], field: str, frames: int, names: Sequence[
     ends = []
     for key in ("start", "end"):
         if entry.get(key) not in names:
-            raise ValueError(f"{field}.{key}: expected the name of a point ({', '.join(names)}), "
-                             f"got {entry.get(key)!r}")  # fmt: skip
+            raise ValueError(
+                f"{field}.{key}: expected the name of a point ({', '.join(names)}), "
+                f"got {entry.get(key)!r}"
+            )
         ends.append(names.index(entry[key]))
     if ends[0] == ends[1]:
         raise ValueError(f"{field}: start and end must be two different points")
-    return CollisionSegment(str(entry.get("name", "")) or field,
-                            _frame(entry.get("frame"), f"{field}.frame", frames),
-                            entry["axis"], ends[0], ends[1],
-                            _number(entry.get("radius"), f"{field}.radius", 0.0))  # fmt: skip
+    return CollisionSegment(
+        str(entry.get("name", "")) or field,
+        _frame(entry.get("frame"), f"{field}.frame", frames),
+        entry["axis"],
+        ends[0],
+        ends[1],
+        _number(entry.get("radius"), f"{field}.radius", 0.0),
+    )
 
 
 def collision_model(data: object, frames: int) -> CollisionModel:
@@ -129,13 +138,16 @@ def collision_model(data: object, frames: int) -> CollisionModel:
         return CollisionModel()
     if not isinstance(data, dict) or set(data) - {"points", "segments"}:
         raise ValueError("collision: expected a mapping of `points` and `segments`")
-    points = tuple(_point(e, f"collision.points[{i}]", frames)
-                   for i, e in enumerate(_entries(data, "points")))  # fmt: skip
+    points = tuple(
+        _point(e, f"collision.points[{i}]", frames) for i, e in enumerate(_entries(data, "points"))
+    )
     names = [p.name for p in points]
     if len(set(names)) != len(names):
         raise ValueError(f"collision.points: names must differ, got {names}")
-    segments = tuple(_segment(e, f"collision.segments[{i}]", frames, names)
-                     for i, e in enumerate(_entries(data, "segments")))  # fmt: skip
+    segments = tuple(
+        _segment(e, f"collision.segments[{i}]", frames, names)
+        for i, e in enumerate(_entries(data, "segments"))
+    )
     return CollisionModel(points, segments)
 
 
@@ -151,8 +163,9 @@ def check_segments(robot: Kinematic, model: CollisionModel) -> None:
     """``ValueError`` unless each segment's ends lie on its frame's axis line, at the zero
     configuration and at three fixed others across the joint box."""
     rng = np.random.default_rng(0)
-    box = [np.zeros(robot.dof)] + [rng.uniform(np.maximum(robot.q_min, -2.0),
-                                               np.minimum(robot.q_max, 2.0)) for _ in range(3)]
+    box = [np.zeros(robot.dof)] + [
+        rng.uniform(np.maximum(robot.q_min, -2.0), np.minimum(robot.q_max, 2.0)) for _ in range(3)
+    ]
     for q in box:
         frames = robot.frames(q)
         points = point_positions(frames, model)
@@ -162,9 +175,11 @@ def check_segments(robot: Kinematic, model: CollisionModel) -> None:
             for end in (segment.start, segment.end):
                 off = float(np.linalg.norm(np.cross(points[end] - origin, direction)))
                 if off > ON_LINE_TOLERANCE:
-                    raise ValueError(f"collision.segments[{index}] ({segment.name}): point "
-                                     f"{model.points[end].name} is {off:.3g} m off the "
-                                     f"{segment.axis} axis of frame {segment.frame}")  # fmt: skip
+                    raise ValueError(
+                        f"collision.segments[{index}] ({segment.name}): point "
+                        f"{model.points[end].name} is {off:.3g} m off the "
+                        f"{segment.axis} axis of frame {segment.frame}"
+                    )
 
 
 def axis_direction(pose: Array, axis: str) -> Array:
@@ -180,5 +195,6 @@ def offset_pose(point: CollisionPoint) -> Array:
 
 def point_positions(frames: Sequence[Array], model: CollisionModel) -> Array:
     """(k, 3) world positions of the model's points, for the frames' poses."""
-    return np.array([dq.translation(dq.mul(frames[p.frame], offset_pose(p)))[1:]
-                     for p in model.points]).reshape(-1, 3)  # fmt: skip
+    return np.array(
+        [dq.translation(dq.mul(frames[p.frame], offset_pose(p)))[1:] for p in model.points]
+    ).reshape(-1, 3)

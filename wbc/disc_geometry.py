@@ -24,8 +24,9 @@ def segment_clear(a: Array, b: Array, obstacles: Sequence[Circle], clearance: fl
     return clear(np.asarray(a, dtype=float)[:2], np.asarray(b, dtype=float)[:2], centres, radii)
 
 
-def bitangents(first: tuple[Array, float], second: tuple[Array, float]
-               ) -> list[tuple[float, float]]:  # fmt: skip
+def bitangents(
+    first: tuple[Array, float], second: tuple[Array, float]
+) -> list[tuple[float, float]]:
     """The angles on each disc of their common tangents: outer (same angle on both), inner
     (opposite angles), those that exist."""
     (c1, r1), (c2, r2) = first, second
@@ -46,14 +47,18 @@ def clear(a: Array, b: Array, centres: Array, radii: Array) -> bool:
     """No disc's interior (centres (n, 2), radii (n,)) meets the segment a-b."""
     direction = b - a
     squared = float(direction @ direction)
-    t = np.zeros(len(radii)) if squared == 0.0 else np.clip((centres - a) @ direction / squared,
-                                                            0.0, 1.0)  # fmt: skip
+    t = (
+        np.zeros(len(radii))
+        if squared == 0.0
+        else np.clip((centres - a) @ direction / squared, 0.0, 1.0)
+    )
     nearest = a + t[:, None] * direction - centres
     return bool(np.all(np.hypot(nearest[:, 0], nearest[:, 1]) >= radii - TOUCH))
 
 
-def covered(centre: Array, radius: float, other: Array, other_radius: float
-            ) -> tuple[float, float] | None:  # fmt: skip
+def covered(
+    centre: Array, radius: float, other: Array, other_radius: float
+) -> tuple[float, float] | None:
     """The angles (from, width) of the circle (centre, radius) inside the other disc, or
     None where they do not meet."""
     offset = other - centre

@@ -70,12 +70,16 @@ def point_to_line(point: Sequence[float], line: Sequence[float]) -> tuple[float,
     rx = py * lz - pz * ly - line[5]
     ry = pz * lx - px * lz - line[6]
     rz = px * ly - py * lx - line[7]
-    return rx * rx + ry * ry + rz * rz, (2.0 * (ly * rz - lz * ry), 2.0 * (lz * rx - lx * rz),
-                                         2.0 * (lx * ry - ly * rx))  # fmt: skip
+    return rx * rx + ry * ry + rz * rz, (
+        2.0 * (ly * rz - lz * ry),
+        2.0 * (lz * rx - lx * rz),
+        2.0 * (lx * ry - ly * rx),
+    )
 
 
-def line_to_line(robot_line: Sequence[float], workspace_line: Sequence[float]
-                 ) -> tuple[float, Vector]:  # fmt: skip
+def line_to_line(
+    robot_line: Sequence[float], workspace_line: Sequence[float]
+) -> tuple[float, Vector]:
     """(D, w): D = a^2 / s of two lines (vec8) that are not parallel, and the 8 weights w with
     D' = w^T vec8(l_') (module docstring): w = [0, (2 a / s) m_z + (2 a^2 / s^2) (l x l_z) x
     l_z, 0, (2 a / s) l_z]. ``ParallelLinesError`` for parallel lines, where D is not
@@ -86,14 +90,22 @@ def line_to_line(robot_line: Sequence[float], workspace_line: Sequence[float]
     cx, cy, cz = ly * zz - lz * zy, lz * zx - lx * zz, lx * zy - ly * zx  # l x l_z
     s = cx * cx + cy * cy + cz * cz
     if s <= PARALLEL:
-        raise ParallelLinesError("the line-to-line distance Jacobian needs lines that are not "
-                                 f"parallel (sin^2 of their angle is {s:.3g})")  # fmt: skip
+        raise ParallelLinesError(
+            "the line-to-line distance Jacobian needs lines that are not "
+            f"parallel (sin^2 of their angle is {s:.3g})"
+        )
     # s' = 2 <l x l_z, l' x l_z> = -2 <(l x l_z) x l_z, l'>, and D' = (2 a a' s - a^2 s') / s^2.
     first, second = 2.0 * a / s, 2.0 * a * a / (s * s)
-    return a * a / s, (0.0, first * nx + second * (cy * zz - cz * zy),
-                       first * ny + second * (cz * zx - cx * zz),
-                       first * nz + second * (cx * zy - cy * zx),
-                       0.0, first * zx, first * zy, first * zz)  # fmt: skip
+    return a * a / s, (
+        0.0,
+        first * nx + second * (cy * zz - cz * zy),
+        first * ny + second * (cz * zx - cx * zz),
+        first * nz + second * (cx * zy - cy * zx),
+        0.0,
+        first * zx,
+        first * zy,
+        first * zz,
+    )
 
 
 def _jacobian(weights: Vector, jacobian: Array) -> Array:
@@ -108,8 +120,9 @@ def point_to_point_squared_distance(point: Array, other: Array) -> float:
     return point_to_point(point[1:4], other[1:4])[0]
 
 
-def point_to_point_distance_jacobian(translation_jacobian: Array, point: Array, other: Array
-                                     ) -> Array:  # fmt: skip
+def point_to_point_distance_jacobian(
+    translation_jacobian: Array, point: Array, other: Array
+) -> Array:
     """2 vec4(p - c)^T J_t: the row of D' for the squared distance of the robot's point (vec4)
     from the workspace point ``other`` (vec4)."""
     return _jacobian(point_to_point(point[1:4], other[1:4])[1], translation_jacobian)
@@ -131,8 +144,9 @@ def point_to_line_squared_distance(point: Array, line: Array) -> float:
     return point_to_line(point[1:4], line)[0]
 
 
-def point_to_line_distance_jacobian(translation_jacobian: Array, point: Array, line: Array
-                                    ) -> Array:  # fmt: skip
+def point_to_line_distance_jacobian(
+    translation_jacobian: Array, point: Array, line: Array
+) -> Array:
     """2 vec4(p x l - m)^T C4(l)^T J_t = 2 vec4(l x (p x l - m))^T J_t: the row of D' for the
     squared distance of ``point`` (vec4) from ``line``."""
     return _jacobian(point_to_line(point[1:4], line)[1], translation_jacobian)
@@ -149,8 +163,9 @@ def line_to_line_squared_distance(robot_line: Array, workspace_line: Array) -> f
         return float(residual @ residual)
 
 
-def line_to_line_distance_jacobian(line_jacobian: Array, robot_line: Array,
-                                   workspace_line: Array) -> Array:  # fmt: skip
+def line_to_line_distance_jacobian(
+    line_jacobian: Array, robot_line: Array, workspace_line: Array
+) -> Array:
     """The row of D' for the squared distance a^2 / s (module docstring); ``ParallelLinesError``
     for parallel lines, where the distance is not differentiable."""
     return _jacobian(line_to_line(robot_line, workspace_line)[1], line_jacobian)

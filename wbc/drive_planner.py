@@ -73,8 +73,10 @@ class Arc:
         step = self.sweep / pieces
         lifted = self.radius / math.cos(0.5 * step)
         angles = self.start + step * (np.arange(pieces) + 0.5)
-        return [np.array([self.centre[0] + lifted * math.cos(a),
-                          self.centre[1] + lifted * math.sin(a)]) for a in angles]  # fmt: skip
+        return [
+            np.array([self.centre[0] + lifted * math.cos(a), self.centre[1] + lifted * math.sin(a)])
+            for a in angles
+        ]
 
 
 @dataclass(frozen=True)
@@ -107,16 +109,21 @@ class Way:
 
     def last_bearing(self) -> float:
         """The direction of the way's last leg, into the target, rad."""
-        return _bearing(self.waypoints[-2] if len(self.waypoints) > 1 else self.start,
-                        self.target)  # fmt: skip
+        return _bearing(self.waypoints[-2] if len(self.waypoints) > 1 else self.start, self.target)
 
 
 def _bearing(a: Array, b: Array) -> float:
     return math.atan2(float(b[1] - a[1]), float(b[0] - a[0]))
 
 
-def plan_way(start: Array, target: Array, obstacles: Sequence[Circle], clearance: float,
-             slack: float = 0.0, max_turn: float = math.pi / 4) -> Way:  # fmt: skip
+def plan_way(
+    start: Array,
+    target: Array,
+    obstacles: Sequence[Circle],
+    clearance: float,
+    slack: float = 0.0,
+    max_turn: float = math.pi / 4,
+) -> Way:
     """The shortest way from ``start`` (x, y) to ``target`` (x, y) for a point that keeps
     ``clearance`` (and ``slack`` where it can) from every obstacle: the module's docstring."""
     return WayPlanner(start, obstacles, clearance, slack, max_turn).to(target)
@@ -141,9 +148,16 @@ class WayPlanner:
     ``deadline`` (a ``time.thread_time()``, s) building the graph or a way raises
     ``OutOfBudget``."""
 
-    def __init__(self, start: Array, obstacles: Sequence[Circle], clearance: float,
-                 slack: float = 0.0, max_turn: float = math.pi / 4,
-                 target: Array | None = None, deadline: float = math.inf) -> None:  # fmt: skip
+    def __init__(
+        self,
+        start: Array,
+        obstacles: Sequence[Circle],
+        clearance: float,
+        slack: float = 0.0,
+        max_turn: float = math.pi / 4,
+        target: Array | None = None,
+        deadline: float = math.inf,
+    ) -> None:
         self.deadline = deadline
         self.origin = require_finite("start", start)[:2]
         self.obstacles = tuple(obstacles)
@@ -158,16 +172,28 @@ class WayPlanner:
         slack of the disc it stands in."""
         near = [self.start] if target is None else [self.start, target]
         self.centres = np.array([(c.x, c.y) for c in self.obstacles], dtype=float).reshape(-1, 2)
-        self.radii = np.array([max(c.radius, min([c.radius + clearance + slack] + [
-            float(np.hypot(*(p - centre))) - ROOM for p in near]))
-            for c, centre in zip(self.obstacles, self.centres, strict=True)])  # fmt: skip
+        self.radii = np.array(
+            [
+                max(
+                    c.radius,
+                    min(
+                        [c.radius + clearance + slack]
+                        + [float(np.hypot(*(p - centre))) - ROOM for p in near]
+                    ),
+                )
+                for c, centre in zip(self.obstacles, self.centres, strict=True)
+            ]
+        )
         self.shrunk_for_target = target is not None
         self._covers: list[list[tuple[float, float]]] = []
         """For each disc, the arcs of its circle that the other discs cover (``covered``)."""
         for disc in range(len(self.obstacles)):
             self._check_budget()
-            arcs = (covered(*self._disc(disc), *self._disc(other))
-                    for other in range(len(self.obstacles)) if other != disc)  # fmt: skip
+            arcs = (
+                covered(*self._disc(disc), *self._disc(other))
+                for other in range(len(self.obstacles))
+                if other != disc
+            )
             self._covers.append([arc for arc in arcs if arc is not None])
         self.nodes = [_Node(self.start, -1, 0.0)]
         self.edges: Edges = {0: []}
@@ -191,12 +217,22 @@ class WayPlanner:
         gaps = np.hypot(*(target - self.centres).T) if len(self.radii) else np.zeros(0)
         for index, c in enumerate(self.obstacles, start=1):
             if gaps[index - 1] < c.radius + self.clearance - TOUCH:
-                return self._none(target, f"the target ({target[0]:.2f}, {target[1]:.2f}) lies "
-                                  f"within {self.clearance:g} m of obstacle {index} at "
-                                  f"({c.x:.2f}, {c.y:.2f})")  # fmt: skip
+                return self._none(
+                    target,
+                    f"the target ({target[0]:.2f}, {target[1]:.2f}) lies "
+                    f"within {self.clearance:g} m of obstacle {index} at "
+                    f"({c.x:.2f}, {c.y:.2f})",
+                )
         if np.any(gaps < self.radii) and not self.shrunk_for_target:
-            return WayPlanner(self.origin, self.obstacles, self.clearance, self.slack,
-                              self.max_turn, target, self.deadline).to(target)  # fmt: skip
+            return WayPlanner(
+                self.origin,
+                self.obstacles,
+                self.clearance,
+                self.slack,
+                self.max_turn,
+                target,
+                self.deadline,
+            ).to(target)
         best: tuple[float, list[tuple[int, float | None]]] = (math.inf, [])
         if clear(self.start, target, self.centres, self.radii):
             best = (float(np.hypot(*(target - self.start))), [(0, None)])
@@ -204,17 +240,24 @@ class WayPlanner:
             self._check_budget()
             for angle in self._tangent_angles(target, disc):
                 point = self._point(disc, angle)
-                if self._inside_another(point, disc) or not clear(point, target, self.centres,
-                                                                   self.radii):  # fmt: skip
+                if self._inside_another(point, disc) or not clear(
+                    point, target, self.centres, self.radii
+                ):
                     continue
                 for node, sweep in self._arcs_into(disc, angle):
-                    length = (self.distance[node] + self.radii[disc] * abs(sweep)
-                              + float(np.hypot(*(target - point))))  # fmt: skip
+                    length = (
+                        self.distance[node]
+                        + self.radii[disc] * abs(sweep)
+                        + float(np.hypot(*(target - point)))
+                    )
                     if length < best[0]:
                         best = (length, self._path(node) + [(-1, sweep)])
         if not math.isfinite(best[0]):
-            return self._none(target, f"no way round the obstacles from ({self.start[0]:.2f}, "
-                              f"{self.start[1]:.2f}) to ({target[0]:.2f}, {target[1]:.2f})")
+            return self._none(
+                target,
+                f"no way round the obstacles from ({self.start[0]:.2f}, "
+                f"{self.start[1]:.2f}) to ({target[0]:.2f}, {target[1]:.2f})",
+            )
         return self._way(target, *best)
 
     def _check_budget(self) -> None:
@@ -231,8 +274,10 @@ class WayPlanner:
         constraint 5.28 may leave no solution for a leg that passes the obstacle, while one
         that moves straight away from it does not engage the constraint at all."""
         full = [c.radius + self.clearance + self.slack for c in self.obstacles]
-        inside = [(float(np.hypot(self.origin[0] - c.x, self.origin[1] - c.y)), index)
-                  for index, c in enumerate(self.obstacles)]  # fmt: skip
+        inside = [
+            (float(np.hypot(self.origin[0] - c.x, self.origin[1] - c.y)), index)
+            for index, c in enumerate(self.obstacles)
+        ]
         inside = [(d, i) for d, i in inside if d < full[i]]
         if not inside:
             return self.origin
@@ -242,8 +287,9 @@ class WayPlanner:
         others = [o for i, o in enumerate(self.obstacles) if i != index]
         if segment_clear(self.origin, out, others, self.clearance) and all(
             np.hypot(out[0] - o.x, out[1] - o.y) >= full[i]
-            for i, o in enumerate(self.obstacles) if i != index
-        ):  # fmt: skip
+            for i, o in enumerate(self.obstacles)
+            if i != index
+        ):
             return out
         return self.origin
 
@@ -364,8 +410,9 @@ class WayPlanner:
             if sweep is None or abs(sweep) < TOUCH:
                 continue
             disc = self.nodes[a].disc
-            arc = Arc(tuple(self.centres[disc]), float(self.radii[disc]), self.nodes[a].angle,
-                      sweep)  # fmt: skip
+            arc = Arc(
+                tuple(self.centres[disc]), float(self.radii[disc]), self.nodes[a].angle, sweep
+            )
             arcs.append(arc)
             waypoints += arc.corners(self.max_turn)
         waypoints.append(target)

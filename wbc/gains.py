@@ -71,13 +71,17 @@ class GainSpec:
             value = float(value)
         number = isinstance(value, int | float) and not isinstance(value, bool)
         wrong = type(value) is not self.type or (number and not math.isfinite(value))
-        outside = number and not wrong and (
-            (self.low is not None and value < self.low)
-            or (self.high is not None and value > self.high))  # fmt: skip
+        outside = (
+            number
+            and not wrong
+            and (
+                (self.low is not None and value < self.low)
+                or (self.high is not None and value > self.high)
+            )
+        )
         if wrong or outside or (self.choices is not None and value not in self.choices):
             raise ValueError(f"{self.name}: expected {self.expected()}, got {shown(value)}")
         return value
-
 
     def _vectors(self, value: object) -> tuple:
         """A vector (or list of vectors) as tuples of floats."""
@@ -85,8 +89,9 @@ class GainSpec:
             rows = [value] if self.type is tuple else list(value)
             held = tuple(self._vector(row) for row in rows)
         except (TypeError, ValueError):
-            raise ValueError(f"{self.name}: expected {self.expected()}, got {shown(value)}"
-                             ) from None  # fmt: skip
+            raise ValueError(
+                f"{self.name}: expected {self.expected()}, got {shown(value)}"
+            ) from None
         return held[0] if self.type is tuple else held
 
     def _vector(self, row: object) -> tuple[float, ...]:
@@ -106,8 +111,13 @@ def gain(default: Any, *, doc: str, low: float | None = None, high: float | None
     return dataclasses.field(default=default, metadata={GAIN: (low, high, doc)})
 
 
-def composed(name: str, doc: str, parts: Sequence[type], module: str,
-             defaults: Mapping[str, Any] | None = None) -> type:  # fmt: skip
+def composed(
+    name: str,
+    doc: str,
+    parts: Sequence[type],
+    module: str,
+    defaults: Mapping[str, Any] | None = None,
+) -> type:
     """A frozen dataclass ``name`` of every field of the gains dataclasses ``parts`` (each
     once, in order), validated on construction (``check_gains``, then each part's
     ``check_together``): a law's parameters, as each of its terms declares its own. A law that
@@ -121,8 +131,13 @@ def composed(name: str, doc: str, parts: Sequence[type], module: str,
                 raise TypeError(f"{name}: two parts declare the gain {field.name!r}")
             seen.add(field.name)
             default = defaults.pop(field.name, field.default)
-            fields.append((field.name, hints[field.name],
-                           dataclasses.field(default=default, metadata=field.metadata)))
+            fields.append(
+                (
+                    field.name,
+                    hints[field.name],
+                    dataclasses.field(default=default, metadata=field.metadata),
+                )
+            )
     if defaults:
         raise TypeError(f"{name}: no part declares {', '.join(defaults)}")
     checks = [part.check_together for part in parts if hasattr(part, "check_together")]
@@ -132,8 +147,9 @@ def composed(name: str, doc: str, parts: Sequence[type], module: str,
         for check in checks:
             check(self)
 
-    made = dataclasses.make_dataclass(name, fields, frozen=True,
-                                      namespace={"__post_init__": __post_init__})  # fmt: skip
+    made = dataclasses.make_dataclass(
+        name, fields, frozen=True, namespace={"__post_init__": __post_init__}
+    )
     made.__doc__, made.__module__ = doc, module  # where pickle finds it
     return made
 
@@ -147,8 +163,9 @@ def gain_specs(params_type: type) -> tuple[GainSpec, ...]:
         low, high, doc = field.metadata[GAIN]
         hint = hints[field.name]
         choices = typing.get_args(hint) if typing.get_origin(hint) is Literal else None
-        specs.append(GainSpec(field.name, type(field.default), field.default, low, high,
-                              choices, doc))  # fmt: skip
+        specs.append(
+            GainSpec(field.name, type(field.default), field.default, low, high, choices, doc)
+        )
     return tuple(specs)
 
 

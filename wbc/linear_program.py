@@ -79,8 +79,9 @@ class _Layout:
     all, dense; ``varying`` is a view of its last rows, as passed to HiGHS.
     """
 
-    def __init__(self, n: int, residual_rows: tuple[int, ...], linear_rows: int,
-                 norm_rows: int) -> None:  # fmt: skip
+    def __init__(
+        self, n: int, residual_rows: tuple[int, ...], linear_rows: int, norm_rows: int
+    ) -> None:
         self.key = (n, residual_rows, linear_rows, norm_rows)
         self.n, self.norm_rows = n, norm_rows
         residual_total = self.residual_rows = sum(residual_rows)
@@ -186,8 +187,9 @@ class WarmStartedLP:
         active = _active(u, float(u_positive.sum() + u_negative.sum()), linear, norms, bounds)
         return LPSolution(u, status, objective, active, u_positive, u_negative)
 
-    def _layout_for(self, n: int, residual_rows: tuple[int, ...], linear_rows: int,
-                    norm_rows: int) -> _Layout:  # fmt: skip
+    def _layout_for(
+        self, n: int, residual_rows: tuple[int, ...], linear_rows: int, norm_rows: int
+    ) -> _Layout:
         key = (n, residual_rows, linear_rows, norm_rows)
         if self._layout is None or self._layout.key != key:
             self._build(_Layout(*key))
@@ -199,17 +201,37 @@ class WarmStartedLP:
         highs = self._highs
         highs.clearModel()
         empty_int, empty = np.zeros(0, dtype=np.int32), np.zeros(0)
-        highs.addCols(layout.columns, layout.cost, layout.col_lower, layout.col_upper, 0,
-                      empty_int, empty_int, empty)  # fmt: skip
+        highs.addCols(
+            layout.columns,
+            layout.cost,
+            layout.col_lower,
+            layout.col_upper,
+            0,
+            empty_int,
+            empty_int,
+            empty,
+        )
         static = layout.matrix[: layout.static_rows]
         starts = np.arange(0, static.size, layout.columns, dtype=np.int32)
         indices = np.tile(layout.column_index, layout.static_rows)
-        highs.addRows(layout.static_rows, layout.lower[: layout.static_rows],
-                      layout.upper[: layout.static_rows], static.size, starts, indices,
-                      static.ravel())  # fmt: skip
-        highs.addRows(layout.varying_rows, layout.lower[layout.static_rows :],
-                      layout.upper[layout.static_rows :], 0,
-                      np.zeros(layout.varying_rows, dtype=np.int32), empty_int, empty)  # fmt: skip
+        highs.addRows(
+            layout.static_rows,
+            layout.lower[: layout.static_rows],
+            layout.upper[: layout.static_rows],
+            static.size,
+            starts,
+            indices,
+            static.ravel(),
+        )
+        highs.addRows(
+            layout.varying_rows,
+            layout.lower[layout.static_rows :],
+            layout.upper[layout.static_rows :],
+            0,
+            np.zeros(layout.varying_rows, dtype=np.int32),
+            empty_int,
+            empty,
+        )
         self._layout = layout
         self._basis = None
 
@@ -229,12 +251,19 @@ class WarmStartedLP:
         highs = self._highs
         static = layout.static_rows
         highs.changeColsCost(layout.columns, layout.column_index, layout.cost)
-        highs.changeRowsBounds(static, layout.static_index, layout.lower[:static],
-                               layout.upper[:static])  # fmt: skip
+        highs.changeRowsBounds(
+            static, layout.static_index, layout.lower[:static], layout.upper[:static]
+        )
         highs.deleteRows(layout.varying_rows, layout.varying_index)
-        highs.addRows(layout.varying_rows, layout.lower[static:], layout.upper[static:],
-                      layout.varying.size, layout.starts, layout.indices,
-                      layout.varying.ravel())  # fmt: skip
+        highs.addRows(
+            layout.varying_rows,
+            layout.lower[static:],
+            layout.upper[static:],
+            layout.varying.size,
+            layout.starts,
+            layout.indices,
+            layout.varying.ravel(),
+        )
         if self._basis is not None:
             highs.setBasis(self._basis.highs_basis)
         highs.run()
@@ -290,5 +319,8 @@ def _tight(rows: LinearRows, u: Array) -> bool:
     if np.array_equal(rows.lower, rows.upper):
         return True
     value = rows.matrix @ u
-    return bool(np.any(np.minimum(np.abs(value - rows.lower), np.abs(rows.upper - value))
-                       <= ACTIVE_TOLERANCE))  # fmt: skip
+    return bool(
+        np.any(
+            np.minimum(np.abs(value - rows.lower), np.abs(rows.upper - value)) <= ACTIVE_TOLERANCE
+        )
+    )

@@ -36,21 +36,31 @@ from wbc.validation import NonFiniteInputError, require_finite
 Array = np.ndarray
 
 
-CONSTRAINTS: tuple[type[Constraint], ...] = (Nonholonomic, JointLimits, ErrorBound,
-                                             BorderObstacle, VectorFieldObstacle,
-                                             ConservativeObstacle, ArmObstacles)  # fmt: skip
+CONSTRAINTS: tuple[type[Constraint], ...] = (
+    Nonholonomic,
+    JointLimits,
+    ErrorBound,
+    BorderObstacle,
+    VectorFieldObstacle,
+    ConservativeObstacle,
+    ArmObstacles,
+)
 """The constraints of 5.29, in the order of their rows; each builds itself from the gains it
 declares (``of``), or stays out."""
-OBJECTIVES: tuple[type[ObjectiveTerm], ...] = (LeastVelocity, WaistHold, WaistCentring,
-                                               ObstacleCirculation, BaseTarget,
-                                               InputChange)  # fmt: skip
+OBJECTIVES: tuple[type[ObjectiveTerm], ...] = (
+    LeastVelocity,
+    WaistHold,
+    WaistCentring,
+    ObstacleCirculation,
+    BaseTarget,
+    InputChange,
+)
 """The terms added to the task residual of 5.29, likewise."""
 
 
 @dataclass(frozen=True)
 class TaskGains:
-    eta: float = gain(0.6, low=1e-3, high=100.0,
-                      doc="task gain: the LP seeks J u = -eta e, 1/s")
+    eta: float = gain(0.6, low=1e-3, high=100.0, doc="task gain: the LP seeks J u = -eta e, 1/s")
 
 
 LPParams = composed(
@@ -72,11 +82,18 @@ def default_objectives(params: LPParams) -> list[ObjectiveTerm]:
     return [t for t in (term.of(params) for term in OBJECTIVES) if t is not None]
 
 
-def program(robot: MobileManipulator, q: Array, task: Task, dt: float,
-            obstacles: Sequence[Obstacle], eta: float, last: tuple[Task, Array] | None,
-            constraints: Sequence[Constraint], objectives: Sequence[ObjectiveTerm],
-            previous_u: Array | None = None,
-            ) -> tuple[list, list, Array, tuple[Task, Array]]:  # fmt: skip
+def program(
+    robot: MobileManipulator,
+    q: Array,
+    task: Task,
+    dt: float,
+    obstacles: Sequence[Obstacle],
+    eta: float,
+    last: tuple[Task, Array] | None,
+    constraints: Sequence[Constraint],
+    objectives: Sequence[ObjectiveTerm],
+    previous_u: Array | None = None,
+) -> tuple[list, list, Array, tuple[Task, Array]]:
     """One step's program of 5.29: the inputs checked (``NonFiniteInputError``, dt > 0), e
     and e' measured (e' = (e - e_last) / dt against the ``last`` error of the same task, else
     the commanded -eta e), the costs (the task's first, ||J u + eta e||) and the rows; with e
@@ -100,8 +117,19 @@ def program(robot: MobileManipulator, q: Array, task: Task, dt: float,
     else:
         error_rate = -eta * error
     goal_pose = task.pose if isinstance(task, PoseTask) else None
-    context = StepContext(robot, q, error, error_rate, task.goal_position[:2], circles,
-                          goal_pose, dt, solids, previous_u=previous_u, chain=chain)  # fmt: skip
+    context = StepContext(
+        robot,
+        q,
+        error,
+        error_rate,
+        task.goal_position[:2],
+        circles,
+        goal_pose,
+        dt,
+        solids,
+        previous_u=previous_u,
+        chain=chain,
+    )
     rows = [constraint.rows(context) for constraint in constraints]  # first: a term may read
     costs = [ResidualCost("task", task_jacobian, eta * error)]  # what a row engaged
     costs += [term.cost(context) for term in objectives]
@@ -165,8 +193,17 @@ class LPLaw:
         if self.objectives is None:
             self.objectives = default_objectives(self.params)
         costs, rows, error, self._last = program(
-            self.robot, q, task, dt, obstacles, self.params.eta, self._last,
-            self.constraints, self.objectives, self._previous_u)  # fmt: skip
+            self.robot,
+            q,
+            task,
+            dt,
+            obstacles,
+            self.params.eta,
+            self._last,
+            self.constraints,
+            self.objectives,
+            self._previous_u,
+        )
         solution = self._lp.solve(costs, rows)
         output = summarise(
             solution.u, solution.status, solution.objective, solution.active, error, start

@@ -35,8 +35,9 @@ def split(obstacles: Iterable[Obstacle]) -> tuple[tuple[Circle, ...], tuple[Soli
         elif isinstance(obstacle, Plane | Cylinder):
             solids.append(obstacle)
         else:
-            raise TypeError(f"an obstacle is a Circle, Plane or Cylinder, got "
-                            f"{type(obstacle).__name__}")  # fmt: skip
+            raise TypeError(
+                f"an obstacle is a Circle, Plane or Cylinder, got {type(obstacle).__name__}"
+            )
     return tuple(circles), tuple(solids)
 
 
@@ -45,6 +46,7 @@ def least_clearance(bases: np.ndarray, circles: Sequence[Circle], body_radius: f
     - body radius, m: the least gap between the base's body and an obstacle (below 0, a
     contact); inf without circles."""
     bases = np.asarray(bases, dtype=float).reshape(-1, 2)
-    gaps = [np.hypot(bases[:, 0] - c.x, bases[:, 1] - c.y) - c.radius - body_radius
-            for c in circles]  # fmt: skip
+    gaps = [
+        np.hypot(bases[:, 0] - c.x, bases[:, 1] - c.y) - c.radius - body_radius for c in circles
+    ]
     return float(np.min(gaps)) if gaps else float("inf")

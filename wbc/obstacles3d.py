@@ -50,8 +50,9 @@ def _within(field: str, *values: float) -> None:
     """``ValueError`` naming ``field`` unless every value is finite and within the scene's
     extent (``EXTENT_M``)."""
     if not all(math.isfinite(v) and abs(v) <= EXTENT_M for v in values):
-        raise ValueError(f"{field}: expected finite numbers within +-{EXTENT_M:g} m, got "
-                         f"{list(values)}")  # fmt: skip
+        raise ValueError(
+            f"{field}: expected finite numbers within +-{EXTENT_M:g} m, got {list(values)}"
+        )
 
 
 def _size(field: str, value: float) -> None:
@@ -85,12 +86,15 @@ class Plane:
         _within("offset", self.offset)
         norm = math.sqrt(sum(v * v for v in self.normal))
         if abs(norm - 1.0) > UNIT_TOLERANCE:
-            raise ValueError(f"normal: expected a unit vector, got {list(self.normal)} "
-                             f"(norm {norm:.6g})")  # fmt: skip
+            raise ValueError(
+                f"normal: expected a unit vector, got {list(self.normal)} (norm {norm:.6g})"
+            )
         if self.footprint:
             if abs(abs(self.normal[2]) - 1.0) > UNIT_TOLERANCE:
-                raise ValueError("footprint: only a horizontal plane (normal [0, 0, 1] or "
-                                 f"[0, 0, -1]) has a footprint, got normal {list(self.normal)}")
+                raise ValueError(
+                    "footprint: only a horizontal plane (normal [0, 0, 1] or "
+                    f"[0, 0, -1]) has a footprint, got normal {list(self.normal)}"
+                )
             object.__setattr__(self, "footprint", _convex_ccw(self.footprint))
 
     @property
@@ -121,8 +125,9 @@ class Plane:
             edges.append(Edge(rim, start, start + float(np.hypot(*(b - a)))))
         for a in vertices:
             corner = line([0.0, 0.0, 1.0], [*a, 0.0])
-            edges.append(Edge(corner, -math.inf, height) if side > 0
-                         else Edge(corner, height, math.inf))  # fmt: skip
+            edges.append(
+                Edge(corner, -math.inf, height) if side > 0 else Edge(corner, height, math.inf)
+            )
         return tuple(edges)
 
     def corners(self) -> Array:
@@ -249,8 +254,7 @@ class Cylinder:
             return np.full(len(points), SIDE), zero
         beside = np.hypot(points[:, 0] - self.x, points[:, 1] - self.y) - self.radius
         above = points[:, 2] - self.height
-        kind = np.where((beside > 0.0) & (above > 0.0), RIM,
-                        np.where(above > beside, FACE, SIDE))  # fmt: skip
+        kind = np.where((beside > 0.0) & (above > 0.0), RIM, np.where(above > beside, FACE, SIDE))
         return kind, zero
 
     def moved(self, x: float, y: float, yaw: float) -> Cylinder:
@@ -281,8 +285,10 @@ def _convex_ccw(footprint: tuple[tuple[float, float], ...]) -> tuple[tuple[float
         raise ValueError(f"footprint: expected at least 3 (x, y) vertices, got {footprint!r}")
     _within("footprint", *vertices.ravel())
     edges = np.roll(vertices, -1, axis=0) - vertices
-    turns = edges[:, 0] * np.roll(edges, -1, axis=0)[:, 1] - edges[:, 1] * np.roll(edges, -1,
-                                                                                   axis=0)[:, 0]
+    turns = (
+        edges[:, 0] * np.roll(edges, -1, axis=0)[:, 1]
+        - edges[:, 1] * np.roll(edges, -1, axis=0)[:, 0]
+    )
     if np.any(np.hypot(edges[:, 0], edges[:, 1]) < 1e-9):
         raise ValueError("footprint: two consecutive vertices coincide")
     if not (np.all(turns > 1e-12) or np.all(turns < -1e-12)):
@@ -312,6 +318,6 @@ def _polygon_distance(vertices: Array, points: Array) -> Array:
     length2 = (edge**2).sum(axis=2)
     along = np.clip((offset * edge).sum(axis=2) / length2, 0.0, 1.0)
     nearest = np.sqrt(((offset - along[:, :, None] * edge) ** 2).sum(axis=2)).min(axis=1)
-    outward = (offset[:, :, 0] * edge[:, :, 1] - offset[:, :, 1] * edge[:, :, 0])
+    outward = offset[:, :, 0] * edge[:, :, 1] - offset[:, :, 1] * edge[:, :, 0]
     depth = outward / np.sqrt(length2)
     return np.where(np.any(depth > 0.0, axis=1), nearest, depth.max(axis=1))

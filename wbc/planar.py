@@ -72,9 +72,10 @@ def inverse(pose: tuple[float, float, float]) -> tuple[float, float, float]:
 
 def offset_pose(x: float, y: float, z: float, yaw: float, pitch: float, roll: float) -> np.ndarray:
     """The pose of a translation (x, y, z) and the rotation Rz(yaw) Ry(pitch) Rx(roll)."""
-    r = dq.qmul(dq.qmul(dq.rotation_quaternion(yaw, dq.K_[1:]),
-                        dq.rotation_quaternion(pitch, dq.J_[1:])),
-                dq.rotation_quaternion(roll, dq.I_[1:]))  # fmt: skip
+    r = dq.qmul(
+        dq.qmul(dq.rotation_quaternion(yaw, dq.K_[1:]), dq.rotation_quaternion(pitch, dq.J_[1:])),
+        dq.rotation_quaternion(roll, dq.I_[1:]),
+    )
     return dq.pose(r, np.array([x, y, z]))
 
 

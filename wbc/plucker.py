@@ -39,15 +39,18 @@ def crossmatrix4(a: Array) -> Array:
     """C4(a) with vec4(cross(a, b)) = C4(a) vec4(b) for pure quaternions (DQ Robotics'
     ``crossmatrix4``): the skew matrix of Im(a) in the lower 3 x 3 block."""
     _, x, y, z = a
-    return np.array([[0.0, 0.0, 0.0, 0.0], [0.0, 0.0, -z, y], [0.0, z, 0.0, -x],
-                     [0.0, -y, x, 0.0]])  # fmt: skip
+    return np.array([[0.0, 0.0, 0.0, 0.0], [0.0, 0.0, -z, y], [0.0, z, 0.0, -x], [0.0, -y, x, 0.0]])
 
 
 def is_line(x: Array, tol: float = 1e-9) -> bool:
     """True for a Plücker line: pure primary and dual parts, |l| = 1 and <l, m> = 0."""
     x = np.asarray(x, dtype=float)
-    return bool(abs(x[0]) < tol and abs(x[4]) < tol and abs(np.linalg.norm(x[1:4]) - 1.0) < tol
-                and abs(float(x[1:4] @ x[5:8])) < tol)  # fmt: skip
+    return bool(
+        abs(x[0]) < tol
+        and abs(x[4]) < tol
+        and abs(np.linalg.norm(x[1:4]) - 1.0) < tol
+        and abs(float(x[1:4] @ x[5:8])) < tol
+    )
 
 
 def closest_parameters(first: Array, second: Array) -> tuple[Array, Array, Array]:

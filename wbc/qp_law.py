@@ -45,8 +45,9 @@ INF = 1e30
 
 @dataclass(frozen=True)
 class DampingGains:
-    damping: float = gain(1e-3, low=1e-9, high=10.0,
-                          doc="lambda of lambda ||u||^2: keeps the QP strictly convex")
+    damping: float = gain(
+        1e-3, low=1e-9, high=10.0, doc="lambda of lambda ||u||^2: keeps the QP strictly convex"
+    )
 
 
 QP_DEFAULTS = {"velocity_cost": 0.0, "waist_hold": 0.0, "input_change": 0.0}
@@ -99,15 +100,25 @@ class QPLaw:
         """The robot was told to stand still: u_prev = 0."""
         self._previous_u = np.zeros(self.robot.dof)
 
-    def step(self, q: Array, task: Task, dt: float, obstacles: Sequence[Obstacle] = ()
-             ) -> LawOutput:  # fmt: skip
+    def step(
+        self, q: Array, task: Task, dt: float, obstacles: Sequence[Obstacle] = ()
+    ) -> LawOutput:
         start = time.perf_counter()
         if self._constraints is None:
             self._constraints = default_constraints(self.params)
             self._objectives = default_objectives(self.params)
         costs, rows, error, self._last = program(
-            self.robot, q, task, dt, obstacles, self.params.eta, self._last,
-            self._constraints, self._objectives, self._previous_u)  # fmt: skip
+            self.robot,
+            q,
+            task,
+            dt,
+            obstacles,
+            self.params.eta,
+            self._last,
+            self._constraints,
+            self._objectives,
+            self._previous_u,
+        )
         u, status, objective = self._qp.solve(self.robot.dof, costs, rows, self.params.damping)
         output = summarise(u, status, objective, (), error, start)
         self._previous_u = output.u
@@ -125,8 +136,9 @@ class WarmStartedQP:
     def reset(self) -> None:
         self._active = None
 
-    def solve(self, n: int, costs: list, rows: list, damping: float
-              ) -> tuple[Array, str, float | None]:  # fmt: skip
+    def solve(
+        self, n: int, costs: list, rows: list, damping: float
+    ) -> tuple[Array, str, float | None]:
         """u, the status and the objective: u = 0 with the status ``non-finite`` where the
         program's numbers overflow (a configuration of 1e300 m) or DAQP's solution is not
         finite; never ``optimal`` with a u that is not."""
@@ -154,8 +166,9 @@ class WarmStartedQP:
         # The first 2n bounds are g >= 0 (simple bounds), then the rows.
         low = np.concatenate((np.zeros(2 * n), *lower))
         high = np.concatenate((np.full(2 * n, INF), *upper))
-        equal = np.concatenate((np.zeros(2 * n, dtype=bool), *(lo == hi for lo, hi in
-                                                                zip(lower, upper, strict=True))))
+        equal = np.concatenate(
+            (np.zeros(2 * n, dtype=bool), *(lo == hi for lo, hi in zip(lower, upper, strict=True)))
+        )
         sense = np.where(equal, EQUALITY, 0).astype(np.intc)
         if self._active is not None and self._active.shape == sense.shape:
             sense |= np.where(equal, 0, self._active).astype(np.intc)
@@ -191,6 +204,12 @@ NON_FINITE = "non-finite"
 """The status of a step whose program or solution is not finite."""
 EQUALITY, ACTIVE = 5, 1
 """DAQP's senses: an equality row, and an inequality taken as active (a warm start)."""
-EXIT_FLAGS = {-1: "infeasible", -2: "cycling", -3: "unbounded", -4: "iteration limit",
-              -5: "nonconvex", -6: "initial active set infeasible"}
+EXIT_FLAGS = {
+    -1: "infeasible",
+    -2: "cycling",
+    -3: "unbounded",
+    -4: "iteration limit",
+    -5: "nonconvex",
+    -6: "initial active set infeasible",
+}
 """DAQP's exit flags below 1, as statuses."""

@@ -54,8 +54,9 @@ def _mapping(path: Path) -> dict:
         raise RobotDescriptionError(f"{where}: not YAML: {problem}") from None
     if not isinstance(data, dict):
         found = "nothing" if data is None else f"a {type(data).__name__}"
-        raise RobotDescriptionError(f"{path}: a robot description is a mapping (arm:, base:, "
-                                    f"...), this file holds {found}")  # fmt: skip
+        raise RobotDescriptionError(
+            f"{path}: a robot description is a mapping (arm:, base:, ...), this file holds {found}"
+        )
     return data
 
 
@@ -94,8 +95,7 @@ class Chain:
     not (as a frozen dataclass stacking the poses at once, ``kinematics`` took 31 us of CPU
     against 25 us before it; so, as before)."""
 
-    __slots__ = ("_frame_jacobians", "_poses", "_prefixes", "columns", "jacobian", "pose",
-                 "twists")  # fmt: skip
+    __slots__ = ("_frame_jacobians", "_poses", "_prefixes", "columns", "jacobian", "pose", "twists")
 
     def __init__(self, prefixes: Array, pose: Array, twists: Array, columns: Array) -> None:
         self._prefixes, self.pose, self.twists = prefixes, pose, twists
@@ -157,8 +157,10 @@ class MobileManipulator:
         # H+(r_z(q) L) = cos(q/2) H+(L) + sin(q/2) H+(k) H+(L), with r_z(q) = cos(q/2) + k sin(q/2).
         self._link_cos = links
         self._link_sin = np.matmul(2.0 * _HALF_K, links)
-        self._frame_columns = (np.arange(self.dof)[None, None, :]
-                               < BASE_DOF + np.arange(self.arm_dof + 1)[:, None, None])
+        self._frame_columns = (
+            np.arange(self.dof)[None, None, :]
+            < BASE_DOF + np.arange(self.arm_dof + 1)[:, None, None]
+        )
         """Which columns of u move frame i: the base's and those of joints 1..i."""
         check_segments(self, collision)
         self.collision = collision
@@ -167,11 +169,18 @@ class MobileManipulator:
     def with_velocity_max(self, velocity_max: Array) -> MobileManipulator:
         """The same robot with other bounds on u (section 6.3's tests impose none)."""
         bounds = np.asarray(velocity_max, dtype=float)
-        base = replace(self.base, velocity_max=_readonly(bounds[:BASE_DOF], (3,),
-                                                                     "base.velocity_max"))
-        return MobileManipulator(np.array(self.dh), base, self.q_min[BASE_DOF:].copy(),
-                                 self.q_max[BASE_DOF:].copy(), bounds[BASE_DOF:], self.name,
-                                 self.collision)  # fmt: skip
+        base = replace(
+            self.base, velocity_max=_readonly(bounds[:BASE_DOF], (3,), "base.velocity_max")
+        )
+        return MobileManipulator(
+            np.array(self.dh),
+            base,
+            self.q_min[BASE_DOF:].copy(),
+            self.q_max[BASE_DOF:].copy(),
+            bounds[BASE_DOF:],
+            self.name,
+            self.collision,
+        )
 
     @classmethod
     def from_yaml(cls, path: str | Path) -> MobileManipulator:
@@ -217,8 +226,16 @@ class MobileManipulator:
         c, s, z = math.cos(0.5 * phi), math.sin(0.5 * phi), self.base.height
         # D = (1/2) p r with p = x i + y j + z k and r = c + s k.
         return np.array(
-            [c, 0.0, 0.0, s, -0.5 * z * s, 0.5 * (x * c + y * s), 0.5 * (y * c - x * s),
-             0.5 * z * c]  # fmt: skip
+            [
+                c,
+                0.0,
+                0.0,
+                s,
+                -0.5 * z * s,
+                0.5 * (x * c + y * s),
+                0.5 * (y * c - x * s),
+                0.5 * z * c,
+            ]
         )
 
     def _arm_link_operators(self, q_arm: Array) -> Array:

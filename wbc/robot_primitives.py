@@ -40,8 +40,10 @@ def translations(poses: Array) -> Array:
 def translation_jacobians(poses: Array, jacobians: Array) -> Array:
     """J_t = 2 H-_4(P(x*)) J_D + 2 H+_4(D(x)) C4 J_P (4.18) of each pose of a stack: (k, 4, n)."""
     conjugates = poses[:, :4] * _CONJ4
-    return 2.0 * (dq.haminus4_stack(conjugates) @ jacobians[:, 4:]
-                  + dq.hamiplus4_stack(poses[:, 4:]) @ (jacobians[:, :4] * _CONJ4[:, None]))
+    return 2.0 * (
+        dq.haminus4_stack(conjugates) @ jacobians[:, 4:]
+        + dq.hamiplus4_stack(poses[:, 4:]) @ (jacobians[:, :4] * _CONJ4[:, None])
+    )
 
 
 _CROSS_INDEX = np.array([[0, 0, 0, 0], [0, 0, 3, 2], [0, 3, 0, 1], [0, 2, 1, 0]])
@@ -53,8 +55,9 @@ def _cross_matrices(vectors: Array) -> Array:
     return vectors[:, _CROSS_INDEX] * _CROSS_SIGN
 
 
-def line_jacobians(poses: Array, jacobians: Array, directions: Array, positions: Array,
-                   position_jacobians: Array) -> tuple[Array, Array]:  # fmt: skip
+def line_jacobians(
+    poses: Array, jacobians: Array, directions: Array, positions: Array, position_jacobians: Array
+) -> tuple[Array, Array]:
     """The lines l + eps p x l through each pose's origin along its local direction d (k, 4),
     and their Jacobians (k, 8, n), DQ Robotics' ``line_jacobian`` of each, given the poses'
     translations p (k, 4) and translation Jacobians J_t (k, 4, n) (4.18):
@@ -68,10 +71,12 @@ def line_jacobians(poses: Array, jacobians: Array, directions: Array, positions:
     direction_conj = (dq.hamiplus4_stack(directions) @ conjugates[:, :, None])[:, :, 0]  # d r*
     around_p = _cross_matrices(positions)
     lines = np.concatenate((along, (around_p @ along[:, :, None])[:, :, 0]), axis=1)
-    jacobian_l = (dq.haminus4_stack(direction_conj)
-                  + dq.hamiplus4_stack(along_r) * _CONJ4) @ jacobians[:, :4]  # fmt: skip
-    jacobian_m = (np.swapaxes(_cross_matrices(along), 1, 2) @ position_jacobians
-                  + around_p @ jacobian_l)  # fmt: skip
+    jacobian_l = (
+        dq.haminus4_stack(direction_conj) + dq.hamiplus4_stack(along_r) * _CONJ4
+    ) @ jacobians[:, :4]
+    jacobian_m = (
+        np.swapaxes(_cross_matrices(along), 1, 2) @ position_jacobians + around_p @ jacobian_l
+    )
     return lines, np.concatenate((jacobian_l, jacobian_m), axis=1)
 
 
@@ -79,9 +84,11 @@ def _translation(pose: Sequence[float]) -> Vector:
     """t = 2 D(x) P(x)* (4.12) of a pose (vec8), as (x, y, z): with P = (p0, p) and
     D = (d0, d), t = 2 (p0 d - d0 p - d x p)."""
     p0, p1, p2, p3, d0, d1, d2, d3 = pose
-    return (2.0 * (p0 * d1 - d0 * p1 - d2 * p3 + d3 * p2),
-            2.0 * (p0 * d2 - d0 * p2 - d3 * p1 + d1 * p3),
-            2.0 * (p0 * d3 - d0 * p3 - d1 * p2 + d2 * p1))  # fmt: skip
+    return (
+        2.0 * (p0 * d1 - d0 * p1 - d2 * p3 + d3 * p2),
+        2.0 * (p0 * d2 - d0 * p2 - d3 * p1 + d1 * p3),
+        2.0 * (p0 * d3 - d0 * p3 - d1 * p2 + d2 * p1),
+    )
 
 
 def _rotated(pose: Sequence[float], vector: Sequence[float]) -> Vector:
@@ -90,8 +97,11 @@ def _rotated(pose: Sequence[float], vector: Sequence[float]) -> Vector:
     w, ax, ay, az = pose[0], pose[1], pose[2], pose[3]
     vx, vy, vz = vector
     cx, cy, cz = ay * vz - az * vy, az * vx - ax * vz, ax * vy - ay * vx
-    return (vx + 2.0 * (w * cx + ay * cz - az * cy), vy + 2.0 * (w * cy + az * cx - ax * cz),
-            vz + 2.0 * (w * cz + ax * cy - ay * cx))  # fmt: skip
+    return (
+        vx + 2.0 * (w * cx + ay * cz - az * cy),
+        vy + 2.0 * (w * cy + az * cx - ax * cz),
+        vz + 2.0 * (w * cz + ax * cy - ay * cx),
+    )
 
 
 class PrimitiveKinematics:
@@ -123,18 +133,22 @@ class PrimitiveKinematics:
         """Each segment's ends as p_0 + s l along its line: s = <p, l> at its end points p."""
         for segment in model.segments:
             (px, py, pz), (sx, sy, sz), (ex, ey, ez) = (
-                origins[segment.frame], self.positions[segment.start],
-                self.positions[segment.end])  # fmt: skip
+                origins[segment.frame],
+                self.positions[segment.start],
+                self.positions[segment.end],
+            )
             lx, ly, lz = _rotated(poses[segment.frame], AXES[segment.axis][1:])
-            self.line_list.append((0.0, lx, ly, lz, 0.0, py * lz - pz * ly, pz * lx - px * lz,
-                                   px * ly - py * lx))  # fmt: skip
+            self.line_list.append(
+                (0.0, lx, ly, lz, 0.0, py * lz - pz * ly, pz * lx - px * lz, px * ly - py * lx)
+            )
             self.end_list.append((sx * lx + sy * ly + sz * lz, ex * lx + ey * ly + ez * lz))
 
     @functools.cached_property
     def points(self) -> Array:
         """(k, 4) pure quaternions."""
-        return np.hstack((np.zeros((len(self.positions), 1)),
-                          np.array(self.positions).reshape(-1, 3)))  # fmt: skip
+        return np.hstack(
+            (np.zeros((len(self.positions), 1)), np.array(self.positions).reshape(-1, 3))
+        )
 
     @functools.cached_property
     def lines(self) -> Array:
@@ -154,9 +168,9 @@ class PrimitiveKinematics:
         for i, point in enumerate(self.robot.collision.points):
             if any(point.offset):
                 offset = offset_pose(point)
-                stack[i] = translation_jacobian(dq.mul(poses[point.frame], offset),
-                                                dq.haminus8(offset)
-                                                @ jacobians[point.frame])  # fmt: skip
+                stack[i] = translation_jacobian(
+                    dq.mul(poses[point.frame], offset), dq.haminus8(offset) @ jacobians[point.frame]
+                )
         return stack
 
     @functools.cached_property
@@ -165,12 +179,18 @@ class PrimitiveKinematics:
         frames = self.segment_frames
         poses, jacobians = self.chain.poses[frames], self.chain.frame_jacobians[frames]
         directions = np.array([AXES[s.axis] for s in self.robot.collision.segments])
-        return line_jacobians(poses, jacobians, directions.reshape(-1, 4), translations(poses),
-                              translation_jacobians(poses, jacobians))[1]  # fmt: skip
+        return line_jacobians(
+            poses,
+            jacobians,
+            directions.reshape(-1, 4),
+            translations(poses),
+            translation_jacobians(poses, jacobians),
+        )[1]
 
 
-def primitive_kinematics(robot: MobileManipulator, q: Array, chain: Chain | None = None
-                         ) -> PrimitiveKinematics:  # fmt: skip
+def primitive_kinematics(
+    robot: MobileManipulator, q: Array, chain: Chain | None = None
+) -> PrimitiveKinematics:
     """The points, segments and their Jacobians of ``robot.collision`` at ``q``, from the
     forward pass ``chain`` at q when the step has one (``MobileManipulator.forward``)."""
     return PrimitiveKinematics(robot, robot.forward(q) if chain is None else chain)

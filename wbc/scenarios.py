@@ -30,8 +30,9 @@ OBSTACLE_GOAL = np.concatenate(([1.3, 0.3, 0.2], HOME[3:]))
 OBSTACLE = Circle(0.56, 0.16, 0.1)
 """Section 6.2.3: an obstacle on the path the default LP law's base takes to OBSTACLE_GOAL."""
 
-TABLE = Plane((0.0, 0.0, 1.0), 0.40, ((0.55, -0.4), (1.15, -0.4), (1.15, 0.4), (0.55, 0.4)),
-               "table")  # fmt: skip
+TABLE = Plane(
+    (0.0, 0.0, 1.0), 0.40, ((0.55, -0.4), (1.15, -0.4), (1.15, 0.4), (0.55, 0.4)), "table"
+)
 """Reaching over a table edge (future work 3 of 7.2): a 0.6 x 0.8 m table top 0.40 m high, its
 near edge 0.55 m ahead of HOME's base; the solid is the top and what lies under it."""
 TABLE_START = np.array([0.0, 0.0, 0.0, 0.0, 0.3, -0.3, 0.0, 0.0])
@@ -45,16 +46,27 @@ NEAR_START = np.array([0.07, 0.0, 0.13, 0.03, 0.09, 0.02, 0.03, 0.49])
 """A start near HOME, the state of deploy/controllers.yaml's scripted publisher."""
 
 STARTS_AND_GOALS = (
-    (np.array([-0.15, 0.0, 0.04, -0.28, -0.41, 0.3, -0.26, 0.28]),
-     np.array([0.87, 0.07, -0.08, 0.01, -0.07, -0.5, -0.36, 0.46])),
+    (
+        np.array([-0.15, 0.0, 0.04, -0.28, -0.41, 0.3, -0.26, 0.28]),
+        np.array([0.87, 0.07, -0.08, 0.01, -0.07, -0.5, -0.36, 0.46]),
+    ),
     (NEAR_START, REACH_GOAL),
     (np.array([0.1, -0.12, -0.18, 0.06, 0.04, -0.08, 0.18, 0.31]), CONVERGENCE_GOAL),
-)  # fmt: skip
+)
 """Closed-loop test cases: goals 0.4 to 0.9 m ahead, as in the pick and place of 6.2."""
 
 ARM_BOX = (np.array([-0.5, -0.8, -0.8, -0.5, -0.8]), np.array([0.5, 0.3, 0.3, 0.5, 0.8]))
 """A moderate box of arm angles (rad) inside the 0.9-scaled joint limits: random goals'."""
 
-for _configuration in (HOME, REACH_GOAL, CONVERGENCE_GOAL, JOINT_LIMIT_GOAL, OBSTACLE_GOAL,
-                       TABLE_START, TABLE_GOAL, NEAR_START, *ARM_BOX):  # fmt: skip
+for _configuration in (
+    HOME,
+    REACH_GOAL,
+    CONVERGENCE_GOAL,
+    JOINT_LIMIT_GOAL,
+    OBSTACLE_GOAL,
+    TABLE_START,
+    TABLE_GOAL,
+    NEAR_START,
+    *ARM_BOX,
+):
     _configuration.flags.writeable = False

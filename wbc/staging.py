@@ -67,8 +67,16 @@ class StagingParams:
     that gives any candidate is kept (the last, 0, finds a goal whose only configurations
     lie at the box's edge: 'anywhere' draws its goals from the whole box)."""
     starts: int = 24
-    turns: tuple[float, ...] = (0.0, math.pi, 0.5 * math.pi, -0.5 * math.pi, 0.25 * math.pi,
-                                -0.75 * math.pi, -0.25 * math.pi, 0.75 * math.pi)
+    turns: tuple[float, ...] = (
+        0.0,
+        math.pi,
+        0.5 * math.pi,
+        -0.5 * math.pi,
+        0.25 * math.pi,
+        -0.75 * math.pi,
+        -0.25 * math.pi,
+        0.75 * math.pi,
+    )
     """The start's heading from the gripper's heading psi, rad (each with U(-0.2, 0.2) added),
     taken in turn: the base all round the goal."""
     reaches: tuple[float, ...] = (0.35, 0.15, -0.15)
@@ -150,16 +158,20 @@ def staging_point(base: Array, final_leg: float) -> Array:
     return np.array([x - final_leg * math.cos(phi), y - final_leg * math.sin(phi)])
 
 
-def arm_box(robot: MobileManipulator, safety_factor: float, margin: float
-            ) -> tuple[Array, Array]:  # fmt: skip
+def arm_box(robot: MobileManipulator, safety_factor: float, margin: float) -> tuple[Array, Array]:
     """The arm joints' search bounds: b_l [q-, q+] shrunk by ``margin`` on each side."""
     low = safety_factor * robot.q_min[BASE_DOF:] + margin
     high = safety_factor * robot.q_max[BASE_DOF:] - margin
     return low, high
 
 
-def solve_ik(robot: MobileManipulator, goal_pose: Array, start: Array,
-             bounds: tuple[Array, Array], tolerance: float) -> Array | None:  # fmt: skip
+def solve_ik(
+    robot: MobileManipulator,
+    goal_pose: Array,
+    start: Array,
+    bounds: tuple[Array, Array],
+    tolerance: float,
+) -> Array | None:
     """A configuration q (q1 = 0) with fkm(q) = goal_pose from ``start``, or None."""
     q = np.array(start, dtype=float)
     q[BASE_DOF] = 0.0
@@ -173,8 +185,17 @@ def solve_ik(robot: MobileManipulator, goal_pose: Array, start: Array,
         q[FREE] = z
         return robot.pose_jacobian(q)[:, FREE]
 
-    result = least_squares(residual, q[FREE], jac=jacobian, bounds=bounds, method="trf",
-                           xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=200)  # fmt: skip
+    result = least_squares(
+        residual,
+        q[FREE],
+        jac=jacobian,
+        bounds=bounds,
+        method="trf",
+        xtol=1e-12,
+        ftol=1e-12,
+        gtol=1e-12,
+        max_nfev=200,
+    )
     if not math.sqrt(2.0 * result.cost) < tolerance:
         return None
     q[FREE] = result.x
@@ -183,8 +204,9 @@ def solve_ik(robot: MobileManipulator, goal_pose: Array, start: Array,
 
 
 def clear_of(obstacles: Sequence[Circle], point: Array, body_radius: float) -> bool:
-    return all(math.hypot(point[0] - c.x, point[1] - c.y) >= c.radius + body_radius
-               for c in obstacles)  # fmt: skip
+    return all(
+        math.hypot(point[0] - c.x, point[1] - c.y) >= c.radius + body_radius for c in obstacles
+    )
 
 
 @dataclass(frozen=True)
@@ -199,9 +221,13 @@ class Plan:
     """The planning thread's CPU time, s (``elapsed_s`` also counts what else ran)."""
 
 
-def plan(robot: MobileManipulator, q_now: Array, goal_pose: Array,
-         obstacles: Sequence[Circle] = (), params: StagingParams = StagingParams()
-         ) -> Plan:  # fmt: skip
+def plan(
+    robot: MobileManipulator,
+    q_now: Array,
+    goal_pose: Array,
+    obstacles: Sequence[Circle] = (),
+    params: StagingParams = StagingParams(),
+) -> Plan:
     """Every distinct configuration of the goal pose the search finds, each with its way,
     from the widest joint margin on until one is roomy (or the margins run out); with none,
     the reason: the goal refused at once (``refusal``), the CPU budget spent, every
@@ -210,25 +236,37 @@ def plan(robot: MobileManipulator, q_now: Array, goal_pose: Array,
     started, cpu_started = time.perf_counter(), time.thread_time()
 
     def done(found: Sequence[Candidate], reason: str = "") -> Plan:
-        return Plan(tuple(sorted(found, key=lambda c: c.score)), reason,
-                    time.perf_counter() - started, time.thread_time() - cpu_started)
+        return Plan(
+            tuple(sorted(found, key=lambda c: c.score)),
+            reason,
+            time.perf_counter() - started,
+            time.thread_time() - cpu_started,
+        )
 
     refused = refusal(q_now, goal_pose, obstacles, params)
     if refused:
         return done((), refused)
     budget_end = time.thread_time() + params.budget_s
-    spent = (f"no whole-body configuration found within the planning budget of "
-             f"{params.budget_s:g} s of CPU time")  # fmt: skip
+    spent = (
+        f"no whole-body configuration found within the planning budget of "
+        f"{params.budget_s:g} s of CPU time"
+    )
     left_out = _LeftOut()
     found: list[Candidate] = []
     try:
-        ways = WayPlanner(q_now[:2], obstacles, robot.base.body_radius + params.clearance,
-                          params.slack, deadline=budget_end)  # fmt: skip
+        ways = WayPlanner(
+            q_now[:2],
+            obstacles,
+            robot.base.body_radius + params.clearance,
+            params.slack,
+            deadline=budget_end,
+        )
     except OutOfBudget as error:
         return done((), f"{spent} ({error})")
     for margin in params.joint_margins:
-        more, finished = _search(robot, q_now, goal_pose, ways, params, margin, budget_end,
-                                 left_out)  # fmt: skip
+        more, finished = _search(
+            robot, q_now, goal_pose, ways, params, margin, budget_end, left_out
+        )
         found += [c for c in more if not any(same_configuration(c.q, o.q) for o in found)]
         if any(c.roomy for c in found):
             return done(found)
@@ -265,28 +303,41 @@ class _LeftOut:
             parts.append(f"{self.no_way} have no way to their staging point ({self.way_reason})")
         if self.outside:
             parts.append(f"{self.outside} take the base where the camera cannot see it")
-        return (f"every whole-body configuration found that reaches the goal "
-                f"({self.near + self.no_way + self.outside}) is left out: {'; '.join(parts)}")
+        return (
+            f"every whole-body configuration found that reaches the goal "
+            f"({self.near + self.no_way + self.outside}) is left out: {'; '.join(parts)}"
+        )
 
 
-def refusal(q_now: Array, goal_pose: Array, obstacles: Sequence[Circle],
-            params: StagingParams) -> str:  # fmt: skip
+def refusal(
+    q_now: Array, goal_pose: Array, obstacles: Sequence[Circle], params: StagingParams
+) -> str:
     """Why a goal is refused before any search, or empty: its gripper inside an obstacle's
     circle, or farther than ``max_distance`` from the base."""
     x, y = dq.translation(goal_pose)[1:3]
     for index, c in enumerate(obstacles, start=1):
         if math.hypot(x - c.x, y - c.y) < c.radius:
-            return (f"the goal ({x:.2f}, {y:.2f}) lies inside obstacle {index} at "
-                    f"({c.x:.2f}, {c.y:.2f}), radius {c.radius:g} m")  # fmt: skip
+            return (
+                f"the goal ({x:.2f}, {y:.2f}) lies inside obstacle {index} at "
+                f"({c.x:.2f}, {c.y:.2f}), radius {c.radius:g} m"
+            )
     distance = math.hypot(x - q_now[0], y - q_now[1])
     if distance > params.max_distance:
-        return (f"the goal is {distance:.1f} m from the base, farther than the "
-                f"{params.max_distance:g} m a plan may cover")  # fmt: skip
+        return (
+            f"the goal is {distance:.1f} m from the base, farther than the "
+            f"{params.max_distance:g} m a plan may cover"
+        )
     return ""
 
 
-def _start(rng: np.random.Generator, index: int, goal_xy: Array, psi: float,
-           params: StagingParams, arm: tuple[Array, Array]) -> Array:  # fmt: skip
+def _start(
+    rng: np.random.Generator,
+    index: int,
+    goal_xy: Array,
+    psi: float,
+    params: StagingParams,
+    arm: tuple[Array, Array],
+) -> Array:
     """The ``index``-th start: the base ``reach`` behind the goal along a heading ``turn``
     from the gripper's, the arm uniform in its box."""
     yaw = psi + params.turns[index % len(params.turns)] + rng.uniform(-0.2, 0.2)
@@ -295,9 +346,16 @@ def _start(rng: np.random.Generator, index: int, goal_xy: Array, psi: float,
     return np.concatenate((base, [yaw], rng.uniform(*arm)))
 
 
-def _search(robot: MobileManipulator, q_now: Array, goal_pose: Array, ways: WayPlanner,
-            params: StagingParams, margin: float, budget_end: float, left_out: _LeftOut
-            ) -> tuple[list[Candidate], bool]:  # fmt: skip
+def _search(
+    robot: MobileManipulator,
+    q_now: Array,
+    goal_pose: Array,
+    ways: WayPlanner,
+    params: StagingParams,
+    margin: float,
+    budget_end: float,
+    left_out: _LeftOut,
+) -> tuple[list[Candidate], bool]:
     """The candidates of one margin in the order found (``plan`` ranks them; those left out
     are counted in ``left_out``), each with its way from ``ways``, and whether every start was
     tried before the CPU budget ran out."""
@@ -344,8 +402,9 @@ def _search(robot: MobileManipulator, q_now: Array, goal_pose: Array, ways: WayP
     return found, True
 
 
-def _final_leg(q: Array, obstacles: Sequence[Circle], body: float,
-               legs: Sequence[float]) -> float | None:  # fmt: skip
+def _final_leg(
+    q: Array, obstacles: Sequence[Circle], body: float, legs: Sequence[float]
+) -> float | None:
     """The first of ``legs`` whose staging point and straight leg into q's base keep ``body``
     from every obstacle, None when the base itself does not or none does."""
     if not clear_of(obstacles, q, body):
@@ -370,8 +429,14 @@ def same_kind(a: Array, b: Array) -> bool:
 
 def same_configuration(a: Array, b: Array) -> bool:
     """Every entry within 0.02 (m or rad, headings wrapped)."""
-    return bool(np.max(np.abs(np.concatenate((a[:2] - b[:2], [wrap(a[2] - b[2])],
-                                              a[BASE_DOF:] - b[BASE_DOF:])))) < 0.02)  # fmt: skip
+    return bool(
+        np.max(
+            np.abs(
+                np.concatenate((a[:2] - b[:2], [wrap(a[2] - b[2])], a[BASE_DOF:] - b[BASE_DOF:]))
+            )
+        )
+        < 0.02
+    )
 
 
 def _near(q_now: Array, q: Array, final_leg: float) -> bool:
@@ -383,23 +448,33 @@ def _near(q_now: Array, q: Array, final_leg: float) -> bool:
     return bool(distance < final_leg and ahead and abs(wrap(q[2] - q_now[2])) < NEAR_HEADING)
 
 
-def _scored(robot: MobileManipulator, q_now: Array, q: Array, way: Way | None,
-            final_leg: float, obstacles: Sequence[Circle], params: StagingParams
-            ) -> Candidate:  # fmt: skip
+def _scored(
+    robot: MobileManipulator,
+    q_now: Array,
+    q: Array,
+    way: Way | None,
+    final_leg: float,
+    obstacles: Sequence[Circle],
+    params: StagingParams,
+) -> Candidate:
     """The candidate q reached by ``way`` and the final leg, or straight (``way`` None)."""
     if way is None:
         travel = float(math.hypot(*(q[:2] - q_now[:2])))
         turning = abs(wrap(q[2] - q_now[2]))
     else:
         travel = way.length + abs(final_leg)
-        turning = (abs(wrap(way.first_bearing() - q_now[2])) + way.turning
-                   + abs(wrap(q[2] - way.last_bearing())))  # fmt: skip
+        turning = (
+            abs(wrap(way.first_bearing() - q_now[2]))
+            + way.turning
+            + abs(wrap(q[2] - way.last_bearing()))
+        )
     sigma = smallest_singular_value(robot, q)
     penalty = params.conditioning_weight * max(0.0, 1.0 - sigma / params.sigma_floor)
     room = robot.base.body_radius + params.clearance + params.slack
     ahead = q[:2] + params.slack * np.array([math.cos(q[2]), math.sin(q[2])])
-    roomy = (clear_of(obstacles, ahead, room)
-             and clear_of(obstacles, staging_point(q[:BASE_DOF], final_leg), room))  # fmt: skip
+    roomy = clear_of(obstacles, ahead, room) and clear_of(
+        obstacles, staging_point(q[:BASE_DOF], final_leg), room
+    )
     score = travel + params.heading_weight * turning + penalty
     score += 0.0 if roomy else params.crowding_weight
     return Candidate(q, travel, turning, sigma, score, way, final_leg, roomy)

@@ -154,7 +154,7 @@ class StagingSupervisor:
             return ()
         base = np.array(candidate.base[:2])
         if self.phase is Phase.DRIVE and candidate.way is not None:
-            return (*candidate.way.waypoints[self.leg:], base)
+            return (*candidate.way.waypoints[self.leg :], base)
         return (base,)
 
     def update(self, q: Array, t: float) -> Task | None:
@@ -162,9 +162,14 @@ class StagingSupervisor:
         while planning (the caller holds the robot) or once the goal is unreachable."""
         if self.phase is Phase.PLANNING:
             if self.pending is None:
-                self.pending = PlanRequest(self.robot, np.array(q, dtype=float),
-                                           self._pose_task.pose, tuple(self.obstacles),
-                                           self.staging, t)  # fmt: skip
+                self.pending = PlanRequest(
+                    self.robot,
+                    np.array(q, dtype=float),
+                    self._pose_task.pose,
+                    tuple(self.obstacles),
+                    self.staging,
+                    t,
+                )
             return None
         for _ in range(len(Phase)):
             if self._task is None:
@@ -194,8 +199,9 @@ class StagingSupervisor:
             return
         self.planning_s.append(found.elapsed_s)
         self.planning_cpu_s.append(found.cpu_s)
-        fresh = [c for c in found.candidates
-                 if not any(same_configuration(c.q, o.q) for o in self.tried)]  # fmt: skip
+        fresh = [
+            c for c in found.candidates if not any(same_configuration(c.q, o.q) for o in self.tried)
+        ]
         # After a stall, another kind of configuration first: the neighbours of one that
         # stalled stall alike (same base within 0.1 m and 0.3 rad).
         fresh.sort(key=lambda c: any(same_kind(c.q, o.q) for o in self.tried))
@@ -205,9 +211,15 @@ class StagingSupervisor:
         self.candidate = fresh[0]
         self.tried.append(fresh[0])
         base = ", ".join(f"{v:.2f}" for v in fresh[0].base)
-        self.events.append(Event(t, "plan", f"candidate {len(self.tried)} of "
-                                 f"{len(found.candidates)}: base ({base}) score "
-                                 f"{fresh[0].score:.2f} sigma {fresh[0].sigma:.3f}"))  # fmt: skip
+        self.events.append(
+            Event(
+                t,
+                "plan",
+                f"candidate {len(self.tried)} of "
+                f"{len(found.candidates)}: base ({base}) score "
+                f"{fresh[0].score:.2f} sigma {fresh[0].sigma:.3f}",
+            )
+        )
         self._enter(Phase.APPROACH if fresh[0].way is None else Phase.DRIVE, request.q, t)
 
     def _replan(self, q: Array, t: float) -> None:
@@ -258,8 +270,13 @@ class StagingSupervisor:
         else:
             self._task = PointTask(point, candidate.arm, d)
         legs = len(candidate.way.waypoints)
-        self.events.append(Event(t, "phase", f"drive, leg {self.leg + 1} of {legs}"
-                                 + (", facing it" if self.facing else "")))  # fmt: skip
+        self.events.append(
+            Event(
+                t,
+                "phase",
+                f"drive, leg {self.leg + 1} of {legs}" + (", facing it" if self.facing else ""),
+            )
+        )
 
     def _enter(self, phase: Phase, q: Array, t: float) -> None:
         self.phase = phase
@@ -301,8 +318,10 @@ class StagingSupervisor:
         if self.phase is Phase.TURN:
             return bool(abs(error[0]) < p.turn_tolerance)
         if self.phase is Phase.APPROACH:
-            return bool(np.linalg.norm(error[:2]) < p.approach_tolerance
-                        and np.max(np.abs(error[2:])) < p.arm_tolerance)  # fmt: skip
+            return bool(
+                np.linalg.norm(error[:2]) < p.approach_tolerance
+                and np.max(np.abs(error[2:])) < p.arm_tolerance
+            )
         if self.phase is Phase.ALIGN:
             return bool(abs(error[0]) < p.align_tolerance)
         if self.phase is Phase.POSE:

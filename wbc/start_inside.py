@@ -16,14 +16,17 @@ from wbc.arm_clearance import part_clearances
 from wbc.obstacles3d import Solid
 from wbc.robot import MobileManipulator
 
-CONSEQUENCE = ("the arm obstacle rows let no part inside go deeper but cannot push one out: "
-               "each moves only outwards or along the solid, and the robot may stop short of "
-               "its goal")  # fmt: skip
+CONSEQUENCE = (
+    "the arm obstacle rows let no part inside go deeper but cannot push one out: "
+    "each moves only outwards or along the solid, and the robot may stop short of "
+    "its goal"
+)
 """What the robot will do, the same for every solid."""
 
 
-def inside_at_start(robot: MobileManipulator, q: np.ndarray, solids: Sequence[Solid],
-                    labels: Sequence[str]) -> tuple[str, ...]:  # fmt: skip
+def inside_at_start(
+    robot: MobileManipulator, q: np.ndarray, solids: Sequence[Solid], labels: Sequence[str]
+) -> tuple[str, ...]:
     """One line for each solid (named by its ``labels`` entry) that a collision part of the
     robot at ``q`` is inside: the deepest part, how deep, and what the robot will do."""
     if not solids or not robot.collision.names:
@@ -34,7 +37,9 @@ def inside_at_start(robot: MobileManipulator, q: np.ndarray, solids: Sequence[So
         deepest = int(np.argmin(column))
         if column[deepest] < 0.0:
             parts = [robot.collision.names[i] for i in np.flatnonzero(column < 0.0)]
-            lines.append(f"the robot starts inside {label}: its {', '.join(parts)} "
-                         f"(the {robot.collision.names[deepest]} {-column[deepest]:.3f} m "
-                         f"deep); {CONSEQUENCE}")  # fmt: skip
+            lines.append(
+                f"the robot starts inside {label}: its {', '.join(parts)} "
+                f"(the {robot.collision.names[deepest]} {-column[deepest]:.3f} m "
+                f"deep); {CONSEQUENCE}"
+            )
     return tuple(lines)

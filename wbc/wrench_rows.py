@@ -48,8 +48,16 @@ def line_wrench(line: Sequence[float], weights: Sequence[float]) -> Vector:
     lx, ly, lz, mx, my, mz = (line[i] for i in (1, 2, 3, 5, 6, 7))
     ax, ay, az, bx, by, bz = (weights[i] for i in (1, 2, 3, 5, 6, 7))
     fx, fy, fz = ly * bz - lz * by, lz * bx - lx * bz, lx * by - ly * bx
-    return (0.0, ly * az - lz * ay + my * bz - mz * by, lz * ax - lx * az + mz * bx - mx * bz,
-            lx * ay - ly * ax + mx * by - my * bx, 0.0, fx, fy, fz)  # fmt: skip
+    return (
+        0.0,
+        ly * az - lz * ay + my * bz - mz * by,
+        lz * ax - lx * az + mz * bx - mx * bz,
+        lx * ay - ly * ax + mx * by - my * bx,
+        0.0,
+        fx,
+        fy,
+        fz,
+    )
 
 
 def wrench_rows(chain: Chain, wrenches: Sequence[Vector], frames: Sequence[int]) -> Array:

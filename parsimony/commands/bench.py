@@ -14,8 +14,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser = subparsers.add_parser("bench", help="time the control laws, measure goal shares")
     parser.add_argument("--repeats", type=int, default=2000, help="timed steps per law")
     parser.add_argument("--trials", type=int, default=50, help="repeats of the 6.3 pose task")
-    parser.add_argument("--goals", type=int, default=100,
-                        help="random goals per family and law (0: none)")  # fmt: skip
+    parser.add_argument(
+        "--goals", type=int, default=100, help="random goals per family and law (0: none)"
+    )
     parser.add_argument("--robot", type=Path, default=ROBOT_FILE, help="robot description")
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     return parser

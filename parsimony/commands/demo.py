@@ -23,7 +23,8 @@ def run(args: argparse.Namespace) -> int:
     rows = run_demo(args.robot)
     emit(json_text(rows, indent=2) if args.json else format_table(rows))
     expected = all(
-        row["converged"] != (row["law"] in ("LP conservative",)) for row in rows
+        row["converged"] != (row["law"] in ("LP conservative",))
+        for row in rows
         if row["experiment"] != "joint limit"
     )
     return 0 if expected else 1

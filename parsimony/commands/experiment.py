@@ -79,17 +79,35 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("--force", action="store_true", help="replace what --out holds")
     parser.add_argument("--seed", type=seed, help="draw the start and the bin from the ranges")
     parser.add_argument("--profile", type=Path, help="simulation profile to extend")
-    parser.add_argument("--realtime", action="store_true",
-                        help="run at the wall clock's pace instead of in lockstep")  # fmt: skip
-    parser.add_argument("--time-limit", type=time_limit, default=TIME_LIMIT_S, metavar="S",
-                        help="simulated seconds before giving up")  # fmt: skip
-    parser.add_argument("--hide-base-marker", type=seconds_window, metavar="FROM,TO",
-                        help="hide the base marker from the camera then (sim s)")  # fmt: skip
-    parser.add_argument("--gain", type=gain_setting, action="append", default=[],
-                        metavar="NAME=VALUE", help="a gain of the controller's law in place "
-                        "of the experiment's (repeatable; the LP's and the QP's: LPParams, the "
-                        "cascade's: CascadeParams), e.g. obstacle_mode=border, or saturate=true "
-                        "with --controller cascade")  # fmt: skip
+    parser.add_argument(
+        "--realtime",
+        action="store_true",
+        help="run at the wall clock's pace instead of in lockstep",
+    )
+    parser.add_argument(
+        "--time-limit",
+        type=time_limit,
+        default=TIME_LIMIT_S,
+        metavar="S",
+        help="simulated seconds before giving up",
+    )
+    parser.add_argument(
+        "--hide-base-marker",
+        type=seconds_window,
+        metavar="FROM,TO",
+        help="hide the base marker from the camera then (sim s)",
+    )
+    parser.add_argument(
+        "--gain",
+        type=gain_setting,
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="a gain of the controller's law in place "
+        "of the experiment's (repeatable; the LP's and the QP's: LPParams, the "
+        "cascade's: CascadeParams), e.g. obstacle_mode=border, or saturate=true "
+        "with --controller cascade",
+    )
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
     return parser
 
@@ -97,14 +115,22 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
 def run(args: argparse.Namespace) -> int:
     holds = args.out.exists() and not (args.out.is_dir() and not any(args.out.iterdir()))
     if holds and not args.force:
-        print(f"experiment: {args.out} is not empty; give --force to write over what it holds",
-              file=sys.stderr)  # fmt: skip
+        print(
+            f"experiment: {args.out} is not empty; give --force to write over what it holds",
+            file=sys.stderr,
+        )
         return EXIT_USAGE
     options = Options(
-        name=args.name, controller=args.controller, out=args.out, seed=args.seed,
-        profile=args.profile, realtime=args.realtime, time_limit_s=args.time_limit,
-        hide_base_marker=args.hide_base_marker, gains=dict(args.gain),
-    )  # fmt: skip
+        name=args.name,
+        controller=args.controller,
+        out=args.out,
+        seed=args.seed,
+        profile=args.profile,
+        realtime=args.realtime,
+        time_limit_s=args.time_limit,
+        hide_base_marker=args.hide_base_marker,
+        gains=dict(args.gain),
+    )
     try:
         report = run_experiment(options)
     except (ProfileError, RobotDescriptionError, OSError, QueryError, RuntimeError) as error:
@@ -113,16 +139,29 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         emit(json_text(report, indent=2))
     else:
-        keys = ("converged", "final_error", "sim_time_s", "wall_time_s", "real_time_factor",
-                "contacts", "arm_penetrations")  # fmt: skip
+        keys = (
+            "converged",
+            "final_error",
+            "sim_time_s",
+            "wall_time_s",
+            "real_time_factor",
+            "contacts",
+            "arm_penetrations",
+        )
         summary = {k: report[k] for k in keys}
         summary["recording"] = "whole" if report["recording"]["whole"] else "CUT_SHORT"
         emit(" ".join(f"{k}={v}" for k, v in summary.items()))
     for missing in report["recording"]["missing"]:
-        print(f"[experiment] WARNING: the recording is cut short: {missing}; the figures show "
-              "only what it holds", file=sys.stderr)  # fmt: skip
+        print(
+            f"[experiment] WARNING: the recording is cut short: {missing}; the figures show "
+            "only what it holds",
+            file=sys.stderr,
+        )
     print(f"[experiment] report: {args.out / 'report.json'}", file=sys.stderr)
     print(f"[experiment] figures: {', '.join(report.get('figures', []))}", file=sys.stderr)
-    print(f"[experiment] recording: {args.out / 'session.mcap'} (parsimony info, replay, "
-          "report; Foxglove opens it)", file=sys.stderr)  # fmt: skip
+    print(
+        f"[experiment] recording: {args.out / 'session.mcap'} (parsimony info, replay, "
+        "report; Foxglove opens it)",
+        file=sys.stderr,
+    )
     return 0 if report["converged"] else EXIT_NOT_CONVERGED

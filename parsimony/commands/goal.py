@@ -61,56 +61,98 @@ def finite(text: str) -> float:
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Declare `goal` and its arguments."""
     parser = subparsers.add_parser(
-        "goal", parents=[target_options()], conflict_handler="resolve",
+        "goal",
+        parents=[target_options()],
+        conflict_handler="resolve",
         help="send the gripper to a pose (or a position) and follow it",
         description="Send the robot a goal for its gripper, stamped on the profile's clock, "
         "where the profile takes goals: goal/request when a staging supervisor reads it, else "
         "control/goal. Lengths in metres, angles in degrees. Exits 0 (sent, or with --wait "
         "reached), 1 (refused, unreachable, or no answer), 2 (input that cannot be used).",
-    )  # fmt: skip
+    )
     for axis in "xyz":
-        parser.add_argument(axis, type=finite, metavar=axis.upper(),
-                            help=f"the gripper's {axis} in the frame, m")  # fmt: skip
+        parser.add_argument(
+            axis, type=finite, metavar=axis.upper(), help=f"the gripper's {axis} in the frame, m"
+        )
     turn = parser.add_mutually_exclusive_group()
-    turn.add_argument("--yaw", type=finite, metavar="DEG", default=0.0,
-                      help="the gripper level, pointing this many degrees from the frame's x "
-                           "towards its y (default 0)")  # fmt: skip
-    turn.add_argument("--rpy", type=finite, nargs=3, metavar=("ROLL", "PITCH", "YAW"),
-                      help="the gripper's roll, pitch and yaw in degrees: the rotation "
-                           "Rz(yaw) Ry(pitch) Rx(roll) of the frame's axes")  # fmt: skip
-    parser.add_argument("--position", action="store_true",
-                        help="a position goal: the gripper to X Y Z, its orientation free")
-    parser.add_argument("--frame", choices=FRAMES, default="world",
-                        help="world: F0, where the state is given (default); base: the robot's "
-                             "base as it stands now, x ahead, y to its left, z up from the "
-                             "floor")  # fmt: skip
-    parser.add_argument("--wait", action="store_true",
-                        help="follow supervisor/status until the goal is reached or refused, "
-                             "its phases and the goal's error on stderr")  # fmt: skip
-    parser.add_argument("--timeout", type=float, default=TIMEOUT_S, metavar="S",
-                        help="seconds to wait for the clock, the robot's state, the "
-                             f"supervisor's answer and, with --wait, each status (default "
-                             f"{TIMEOUT_S:g})")  # fmt: skip
+    turn.add_argument(
+        "--yaw",
+        type=finite,
+        metavar="DEG",
+        default=0.0,
+        help="the gripper level, pointing this many degrees from the frame's x "
+        "towards its y (default 0)",
+    )
+    turn.add_argument(
+        "--rpy",
+        type=finite,
+        nargs=3,
+        metavar=("ROLL", "PITCH", "YAW"),
+        help="the gripper's roll, pitch and yaw in degrees: the rotation "
+        "Rz(yaw) Ry(pitch) Rx(roll) of the frame's axes",
+    )
+    parser.add_argument(
+        "--position",
+        action="store_true",
+        help="a position goal: the gripper to X Y Z, its orientation free",
+    )
+    parser.add_argument(
+        "--frame",
+        choices=FRAMES,
+        default="world",
+        help="world: F0, where the state is given (default); base: the robot's "
+        "base as it stands now, x ahead, y to its left, z up from the "
+        "floor",
+    )
+    parser.add_argument(
+        "--wait",
+        action="store_true",
+        help="follow supervisor/status until the goal is reached or refused, "
+        "its phases and the goal's error on stderr",
+    )
+    parser.add_argument(
+        "--timeout",
+        type=float,
+        default=TIMEOUT_S,
+        metavar="S",
+        help="seconds to wait for the clock, the robot's state, the "
+        f"supervisor's answer and, with --wait, each status (default "
+        f"{TIMEOUT_S:g})",
+    )
     return parser
 
 
 def run(args: argparse.Namespace) -> int:
     try:
         if args.position and args.rpy is not None or args.position and args.yaw != 0.0:
-            raise ValueError("--position takes no --yaw or --rpy: a position goal leaves the "
-                             "gripper's orientation free")  # fmt: skip
+            raise ValueError(
+                "--position takes no --yaw or --rpy: a position goal leaves the "
+                "gripper's orientation free"
+            )
         if not (math.isfinite(args.timeout) and args.timeout > 0.0):
-            raise ValueError(f"--timeout: expected a finite number of seconds > 0, got "
-                             f"{args.timeout}")  # fmt: skip
+            raise ValueError(
+                f"--timeout: expected a finite number of seconds > 0, got {args.timeout}"
+            )
         profile, target = profile_and_target(args)
         graph = dataflow(profile)
-        topic = topics.GOAL_REQUEST if graph.readers(topics.GOAL_REQUEST.name) else (
-            topics.CONTROL_GOAL)  # fmt: skip
-        supervisor = next((name for name in graph.readers(topics.GOAL_REQUEST.name)
-                           if name in graph.writers(topics.SUPERVISOR_STATUS.name)), None)
+        topic = (
+            topics.GOAL_REQUEST
+            if graph.readers(topics.GOAL_REQUEST.name)
+            else (topics.CONTROL_GOAL)
+        )
+        supervisor = next(
+            (
+                name
+                for name in graph.readers(topics.GOAL_REQUEST.name)
+                if name in graph.writers(topics.SUPERVISOR_STATUS.name)
+            ),
+            None,
+        )
         if args.wait and supervisor is None:
-            raise ValueError(f"--wait follows {topics.SUPERVISOR_STATUS.name}, and no component "
-                             f"of {args.profile} writes it")  # fmt: skip
+            raise ValueError(
+                f"--wait follows {topics.SUPERVISOR_STATUS.name}, and no component "
+                f"of {args.profile} writes it"
+            )
         with target.open() as session:
             return send(args, session, profile, topic, supervisor)
     except GoalRefused as error:  # a ValueError, but of the goal, not of the input
@@ -120,8 +162,13 @@ def run(args: argparse.Namespace) -> int:
         return fail(error)
 
 
-def send(args: argparse.Namespace, session: zenoh.Session, profile: Profile,
-         topic: topics.Topic, supervisor: str | None) -> int:  # fmt: skip
+def send(
+    args: argparse.Namespace,
+    session: zenoh.Session,
+    profile: Profile,
+    topic: topics.Topic,
+    supervisor: str | None,
+) -> int:
     """Check the goal against the robot and the obstacles, send it, follow it with --wait."""
     key = topic.key(profile.namespace)
     with ToolClock(session, profile) as clock, Robot(session, profile.namespace) as robot:
@@ -129,22 +176,33 @@ def send(args: argparse.Namespace, session: zenoh.Session, profile: Profile,
         q = robot.wait(args.timeout)
         if q is None:
             if args.frame == "base":
-                raise QueryError(f"no valid robot state in {args.timeout:g} s: --frame base "
-                                 "is the base as it stands")  # fmt: skip
-            print(f"goal: no valid robot state in {args.timeout:g} s: not checked against "
-                  "where the robot stands", file=sys.stderr)  # fmt: skip
+                raise QueryError(
+                    f"no valid robot state in {args.timeout:g} s: --frame base "
+                    "is the base as it stands"
+                )
+            print(
+                f"goal: no valid robot state in {args.timeout:g} s: not checked against "
+                "where the robot stands",
+                file=sys.stderr,
+            )
         goal = build(args, header, q, robot.obstacles())
     writers = live_writers(session, profile, topic.name, args.timeout)
     if writers:
         print(f"warning: {overwritten_by(writers, key)}", file=sys.stderr)
-    follower = GoalFollower(session, profile.namespace, supervisor, args.timeout) if (
-        args.wait and supervisor is not None) else None  # fmt: skip
+    follower = (
+        GoalFollower(session, profile.namespace, supervisor, args.timeout)
+        if (args.wait and supervisor is not None)
+        else None
+    )
     try:
         put(session, key, goal, args.timeout)
         sent = f"sent on {key}: {described(goal)}"
         if follower is None:
-            emit(json_text({"topic": topic.name, "key": key, "goal": goal.model_dump()})
-                 if args.json else sent)  # fmt: skip
+            emit(
+                json_text({"topic": topic.name, "key": key, "goal": goal.model_dump()})
+                if args.json
+                else sent
+            )
             return 0
         print(f"goal: {sent}", file=sys.stderr)
         follower.sent()
@@ -155,8 +213,9 @@ def send(args: argparse.Namespace, session: zenoh.Session, profile: Profile,
     return reported(args, topic, key, goal, outcome, header.stamp_ns)
 
 
-def build(args: argparse.Namespace, header: Header, q: np.ndarray | None,
-          obstacles: tuple[Circle, ...]) -> Goal:  # fmt: skip
+def build(
+    args: argparse.Namespace, header: Header, q: np.ndarray | None, obstacles: tuple[Circle, ...]
+) -> Goal:
     """The goal the arguments give, checked as a client's goal of the live view is."""
     roll, pitch, yaw = args.rpy if args.rpy is not None else (0.0, 0.0, args.yaw)
     pose = offset_pose(args.x, args.y, args.z, *(math.radians(a) for a in (yaw, pitch, roll)))
@@ -165,8 +224,9 @@ def build(args: argparse.Namespace, header: Header, q: np.ndarray | None,
         pose = dq.mul(planar_pose(*q[:3]), pose)
     w, x, y, z = dq.rotation(pose)
     px, py, pz = dq.translation(pose)[1:]
-    data = json.dumps({"position": {"x": px, "y": py, "z": pz},
-                       "orientation": {"w": w, "x": x, "y": y, "z": z}}).encode()  # fmt: skip
+    data = json.dumps(
+        {"position": {"x": px, "y": py, "z": pz}, "orientation": {"w": w, "x": x, "y": y, "z": z}}
+    ).encode()
     goal = client_goal("foxglove.Pose", data, dq.ONE, header, q, obstacles)
     if args.position:
         return Goal(header=goal.header, task="position", position=(px, py, pz))
@@ -179,7 +239,8 @@ def put(session: zenoh.Session, key: str, goal: Goal, timeout_s: float) -> None:
     try:
         matched = threading.Event()
         listener = publisher.declare_matching_listener(
-            lambda status: matched.set() if status.matching else None)  # fmt: skip
+            lambda status: matched.set() if status.matching else None
+        )
         if not publisher.matching_status.matching and not matched.wait(timeout_s):
             raise QueryError(f"nothing subscribes to {key} (is the system running?)")
         listener.undeclare()
@@ -221,16 +282,31 @@ class Progress:
         print(", ".join(words), file=sys.stderr, flush=True)
 
 
-def reported(args: argparse.Namespace, topic: topics.Topic, key: str, goal: Goal,
-             outcome: Outcome, sent_ns: int) -> int:  # fmt: skip
+def reported(
+    args: argparse.Namespace,
+    topic: topics.Topic,
+    key: str,
+    goal: Goal,
+    outcome: Outcome,
+    sent_ns: int,
+) -> int:
     """Print how the goal ended: a line (or JSON with --json); 0 if it was reached."""
     status = outcome.status
     took_s = (status.header.stamp_ns - sent_ns) / 1e9 if status is not None else None
     if args.json:
-        emit(json_text({"topic": topic.name, "key": key, "goal": goal.model_dump(),
-                        "result": outcome.result, "reason": outcome.reason,
-                        "phase": status.phase if status is not None else None,
-                        "took_s": took_s}))  # fmt: skip
+        emit(
+            json_text(
+                {
+                    "topic": topic.name,
+                    "key": key,
+                    "goal": goal.model_dump(),
+                    "result": outcome.result,
+                    "reason": outcome.reason,
+                    "phase": status.phase if status is not None else None,
+                    "took_s": took_s,
+                }
+            )
+        )
     elif outcome.reached:
         emit(f"reached in {took_s:.2f} s: {described(goal)}")
     if not outcome.reached:
@@ -261,8 +337,9 @@ class Robot:
 
     def _on_obstacles(self, sample: zenoh.Sample) -> None:
         try:
-            self._obstacles = circles_of(codec.decode(sample.payload.to_bytes(),
-                                                      topics.WORLD_OBSTACLES.type))  # fmt: skip
+            self._obstacles = circles_of(
+                codec.decode(sample.payload.to_bytes(), topics.WORLD_OBSTACLES.type)
+            )
         except codec.DecodeError:
             return
 

@@ -24,16 +24,20 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("profile", type=Path, help="deploy profile (YAML)")
     parser.add_argument("--json", action="store_true", help="print JSON instead of text")
     parser.add_argument("--dot", type=Path, metavar="FILE", help="also write Graphviz DOT here")
-    parser.add_argument("--png", type=Path, metavar="FILE",
-                        help="also draw it as PNG (needs Graphviz's dot)")  # fmt: skip
+    parser.add_argument(
+        "--png", type=Path, metavar="FILE", help="also draw it as PNG (needs Graphviz's dot)"
+    )
     return parser
 
 
 def run(args: argparse.Namespace) -> int:
     dot = shutil.which("dot") if args.png else None
     if args.png and dot is None:
-        print("graph: --png needs Graphviz's dot (install it: apt-get install graphviz, "
-              "brew install graphviz); --dot FILE writes the graph without it", file=sys.stderr)
+        print(
+            "graph: --png needs Graphviz's dot (install it: apt-get install graphviz, "
+            "brew install graphviz); --dot FILE writes the graph without it",
+            file=sys.stderr,
+        )
         return 2
     try:
         graph = dataflow(load_profile(args.profile), args.profile)
@@ -46,6 +50,7 @@ def run(args: argparse.Namespace) -> int:
     if args.dot:
         args.dot.write_text(graph.to_dot() + "\n")
     if dot is not None:
-        subprocess.run([dot, "-Tpng", "-o", str(args.png)], input=graph.to_dot(), text=True,
-                       check=True)  # fmt: skip
+        subprocess.run(
+            [dot, "-Tpng", "-o", str(args.png)], input=graph.to_dot(), text=True, check=True
+        )
     return 0

@@ -13,9 +13,10 @@ from record.session_reader import info
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
-        "info", help="channels, counts, rates, duration and schemas of a recording",
+        "info",
+        help="channels, counts, rates, duration and schemas of a recording",
         description="Reads every complete chunk, so a file whose recorder was killed works too.",
-    )  # fmt: skip
+    )
     parser.add_argument("file", type=Path, help="MCAP session")
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     return parser
@@ -32,10 +33,20 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         emit(json_text(found, indent=2))
         return 0
-    rows = [{"channel": c["key"], "schema": c["schema"], "schema_bytes": c["schema_bytes"],
-             "messages": c["messages"], "rate_hz": c["rate_hz"]} for c in found["channels"]]
-    emit(f"{found['path']}: {found['messages']} messages, {found['bytes']} bytes, "
-         f"{found['duration_s']} s from {found['start_ns']} to {found['end_ns']} ns")  # fmt: skip
+    rows = [
+        {
+            "channel": c["key"],
+            "schema": c["schema"],
+            "schema_bytes": c["schema_bytes"],
+            "messages": c["messages"],
+            "rate_hz": c["rate_hz"],
+        }
+        for c in found["channels"]
+    ]
+    emit(
+        f"{found['path']}: {found['messages']} messages, {found['bytes']} bytes, "
+        f"{found['duration_s']} s from {found['start_ns']} to {found['end_ns']} ns"
+    )
     if not found["complete"]:
         emit("no footer: cut short (parsimony record --recover FILE -o OUT makes it whole)")
     for damaged in found["damaged"]:

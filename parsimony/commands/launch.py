@@ -31,8 +31,9 @@ def positive(what: str) -> Callable[[str], float]:
         except ValueError:
             raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}") from None
         if not math.isfinite(value) or value <= 0.0:
-            raise argparse.ArgumentTypeError(f"expected a finite number of {what} > 0, "
-                                             f"got {text!r}")  # fmt: skip
+            raise argparse.ArgumentTypeError(
+                f"expected a finite number of {what} > 0, got {text!r}"
+            )
         return value
 
     parse.__name__ = what  # argparse names the type in its own messages
@@ -58,8 +59,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument(
         "--duration", type=positive_seconds, metavar="S", help="stop everything after S seconds"
     )
-    parser.add_argument("--record", type=Path, metavar="FILE",
-                        help="record every topic to this MCAP file (see parsimony info FILE)")
+    parser.add_argument(
+        "--record",
+        type=Path,
+        metavar="FILE",
+        help="record every topic to this MCAP file (see parsimony info FILE)",
+    )
     parser.add_argument("--force", action="store_true", help="with --record, replace FILE")
     return parser
 
@@ -89,8 +94,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         code = launcher.run(args.duration)
     except zenoh.ZError as error:
-        print(f"{args.profile}: cannot open the router: {zenoh_error_text(error)}",
-              file=sys.stderr)  # fmt: skip
+        print(f"{args.profile}: cannot open the router: {zenoh_error_text(error)}", file=sys.stderr)
         return 1
     if args.record and args.record.exists():
         launcher.output.say(f"recorded to {args.record}; see parsimony info {args.record}")
@@ -102,9 +106,13 @@ def check_records_nothing(profile: Profile, path: Path) -> None:
     ``--record`` gives its own: one recording, to the file the user named."""
     for spec in profile.start_order():
         if spec.role == "recorder":
-            raise ProfileError(f"{path}: already records (its component {spec.name!r} writes "
-                               f"{spec.params.get('path', 'session.mcap')}); launch it without "
-                               "--record")  # fmt: skip
+            raise ProfileError(
+                f"{path}: already records (its component {spec.name!r} writes "
+                f"{spec.params.get('path', 'session.mcap')}); launch it without "
+                "--record"
+            )
         if spec.name == RECORDER:
-            raise ProfileError(f"{path}: its component {RECORDER!r} is a {spec.role}, and "
-                               "--record adds a recorder of that name; rename it")  # fmt: skip
+            raise ProfileError(
+                f"{path}: its component {RECORDER!r} is a {spec.role}, and "
+                "--record adds a recorder of that name; rename it"
+            )

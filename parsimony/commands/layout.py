@@ -16,8 +16,9 @@ from record.foxglove_layout import layout
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    parser = subparsers.add_parser("layout", help="the Foxglove layout of a profile's view",
-                                   description=__doc__)  # fmt: skip
+    parser = subparsers.add_parser(
+        "layout", help="the Foxglove layout of a profile's view", description=__doc__
+    )
     parser.add_argument("profile", type=Path, help="deploy profile of the system")
     parser.add_argument("-o", "--output", type=Path, help="write it to this file")
     parser.add_argument("--force", action="store_true", help="write over an existing file")
@@ -39,8 +40,10 @@ def run(args: argparse.Namespace) -> int:
             emit(layout(namespace).to_json())
         else:
             write_layout(namespace, args.output, args.force)
-            print(f"layout: {args.output}: import it in Foxglove (Layouts, Import from file)",
-                  file=sys.stderr)  # fmt: skip
+            print(
+                f"layout: {args.output}: import it in Foxglove (Layouts, Import from file)",
+                file=sys.stderr,
+            )
     except (ProfileError, OSError) as error:
         print(f"layout: {error}", file=sys.stderr)
         return 2

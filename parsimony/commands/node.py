@@ -17,8 +17,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser = subparsers.add_parser("node", help="describe a running component")
     actions = parser.add_subparsers(dest="action", required=True)
     info = actions.add_parser(
-        "info", parents=[target_options()],
-        help="its module, role, state, topics, counters, parameters")  # fmt: skip
+        "info",
+        parents=[target_options()],
+        help="its module, role, state, topics, counters, parameters",
+    )
     info.add_argument("component")
     return parser
 
@@ -33,18 +35,25 @@ def run(args: argparse.Namespace) -> int:
     except (ProfileError, QueryError, KeyError, LookupError) as error:
         return fail(error)
     info = {
-        "name": spec.name, "module": spec.module_path, "role": spec.role, "state": status.state,
-        "pid": status.pid, "reads": [i.describe() for i in cls.reads],
-        "writes": [t.name for t in cls.writes], "counters": status.counters,
+        "name": spec.name,
+        "module": spec.module_path,
+        "role": spec.role,
+        "state": status.state,
+        "pid": status.pid,
+        "reads": [i.describe() for i in cls.reads],
+        "writes": [t.name for t in cls.writes],
+        "counters": status.counters,
         "parameters": status.parameters,
-    }  # fmt: skip
+    }
     if args.json:
         emit(json_text(info, indent=2))
         return 0
-    lines = [f"{info['name']} ({info['module']}, {info['role']}): {info['state']}, "
-             f"pid {info['pid']}",
-             f"  reads  {', '.join(info['reads']) or '-'}",
-             f"  writes {', '.join(info['writes']) or '-'}", "  counters"]  # fmt: skip
+    lines = [
+        f"{info['name']} ({info['module']}, {info['role']}): {info['state']}, pid {info['pid']}",
+        f"  reads  {', '.join(info['reads']) or '-'}",
+        f"  writes {', '.join(info['writes']) or '-'}",
+        "  counters",
+    ]
     lines += [f"    {name} = {value}" for name, value in sorted(status.counters.items())]
     lines.append("  parameters")
     lines += [f"    {name} = {json.dumps(value)}" for name, value in status.parameters.items()]

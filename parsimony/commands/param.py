@@ -38,7 +38,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     listing = actions.add_parser("list", parents=[common], help="every parameter and its value")
     listing.add_argument("component")
     describe = actions.add_parser(
-        "describe", parents=[common], help="type, default, bounds, choices and doc of each")
+        "describe", parents=[common], help="type, default, bounds, choices and doc of each"
+    )
     describe.add_argument("component")
     describe.add_argument("name", nargs="?")
     dump = actions.add_parser("dump", parents=[common], help="the values as YAML, to load back")
@@ -54,10 +55,18 @@ def describe(args: argparse.Namespace) -> list[dict]:
     profile, _ = profile_and_target(args)
     params = component_class(profile.component(args.component)).params
     rows = [
-        {"name": p.name, "type": p.type.__name__, "default": p.default, "low": p.low,
-         "high": p.high, "choices": list(p.choices) if p.choices else None, "doc": p.doc}
-        for p in params if args.name in (None, p.name)
-    ]  # fmt: skip
+        {
+            "name": p.name,
+            "type": p.type.__name__,
+            "default": p.default,
+            "low": p.low,
+            "high": p.high,
+            "choices": list(p.choices) if p.choices else None,
+            "doc": p.doc,
+        }
+        for p in params
+        if args.name in (None, p.name)
+    ]
     if not rows:
         raise QueryError(f"{args.component} declares no parameter {args.name!r}")
     return rows
@@ -68,17 +77,29 @@ def run(args: argparse.Namespace) -> int:
     try:
         if args.action == "describe":
             rows = describe(args)
-            emit(json_text(rows, indent=2) if args.json else "\n".join(
-                f"{r['name']}: {r['type']} = {r['default']!r}"
-                + (f" in [{r['low']}, {r['high']}]" if r["low"] is not None
-                   or r["high"] is not None else "")
-                + (f" one of {r['choices']}" if r["choices"] else "") + f"  {r['doc']}"
-                for r in rows))  # fmt: skip
+            emit(
+                json_text(rows, indent=2)
+                if args.json
+                else "\n".join(
+                    f"{r['name']}: {r['type']} = {r['default']!r}"
+                    + (
+                        f" in [{r['low']}, {r['high']}]"
+                        if r["low"] is not None or r["high"] is not None
+                        else ""
+                    )
+                    + (f" one of {r['choices']}" if r["choices"] else "")
+                    + f"  {r['doc']}"
+                    for r in rows
+                )
+            )
             return 0
         profile, target = profile_and_target(args)
         access = profile.zenoh.access
-        why = access.why_not_set(args.component, None) if access is not None and \
-            args.action in ("set", "load") else ""  # fmt: skip
+        why = (
+            access.why_not_set(args.component, None)
+            if access is not None and args.action in ("set", "load")
+            else ""
+        )
         if why:
             raise QueryError(f"param {args.action} refused: {why}; ${USER_ENV} names the user")
         with target.open() as session:
@@ -86,8 +107,11 @@ def run(args: argparse.Namespace) -> int:
             if args.action == "get":
                 values = {args.name: get_param(session, ns, component, args.name, args.timeout)}
             elif args.action == "set":
-                values = {args.name: set_param(session, ns, component, args.name, args.value,
-                                               args.timeout)}  # fmt: skip
+                values = {
+                    args.name: set_param(
+                        session, ns, component, args.name, args.value, args.timeout
+                    )
+                }
             elif args.action == "load":
                 wanted = yaml.safe_load(args.file.read_text())
                 if not isinstance(wanted, dict):

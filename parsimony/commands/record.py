@@ -26,8 +26,9 @@ from record.session_reader import recover
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    parser = subparsers.add_parser("record", help="record a running system to MCAP",
-                                   description=__doc__)  # fmt: skip
+    parser = subparsers.add_parser(
+        "record", help="record a running system to MCAP", description=__doc__
+    )
     parser.add_argument("profile", type=Path, nargs="?", help="deploy profile of the system")
     parser.add_argument("-o", "--output", type=Path, required=True, help="the MCAP file")
     parser.add_argument("--keys", nargs="*", default=["*"], help="topic name patterns")
@@ -78,9 +79,15 @@ def recorder_component(output: Path, keys: Sequence[str] = ("*",)) -> dict[str, 
     """A profile's recorder writing every topic matching one of ``keys`` to ``output``: role
     ``recorder`` (it starts first and stops last, writing all that still waits), never
     restarted (a new one would begin the file again; a killed one's file recovers)."""
-    return {"name": RECORDER, "module": "recorder", "role": "recorder", "enabled": True,
-            "stop_timeout_s": RECORDER_STOP_S, "restart": {"policy": "never"},
-            "params": {"path": str(Path(output).resolve()), "keys": ",".join(keys)}}
+    return {
+        "name": RECORDER,
+        "module": "recorder",
+        "role": "recorder",
+        "enabled": True,
+        "stop_timeout_s": RECORDER_STOP_S,
+        "restart": {"policy": "never"},
+        "params": {"path": str(Path(output).resolve()), "keys": ",".join(keys)},
+    }
 
 
 def with_recorder(profile: Path, output: Path, keys: Sequence[str] = ("*",)) -> str:
@@ -104,8 +111,15 @@ def record(profile: str) -> int:
     this process dies (it watches its parent, ``PARENT_PID_ENV``). The profile is a
     ``memory_file`` the child inherits."""
     descriptor, path = memory_file("record.yaml", profile)
-    command = [sys.executable, "-m", "components.recorder", "--profile", str(path),
-               "--name", RECORDER]  # fmt: skip
+    command = [
+        sys.executable,
+        "-m",
+        "components.recorder",
+        "--profile",
+        str(path),
+        "--name",
+        RECORDER,
+    ]
     env = {**os.environ, PARENT_PID_ENV: str(os.getpid())}
     process = subprocess.Popen(command, env=env, start_new_session=True, pass_fds=(descriptor,))
     os.close(descriptor)

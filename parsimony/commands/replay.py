@@ -55,35 +55,63 @@ COMMANDS = (topics.BASE_COMMAND.name, topics.ARM_COMMAND.name)
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
-        "replay", parents=[target_options()], help="publish a recorded session again",
+        "replay",
+        parents=[target_options()],
+        help="publish a recorded session again",
         description=__doc__.split("\n\n")[1],
-    )  # fmt: skip
+    )
     parser.add_argument("file", type=Path, help="MCAP session")
-    parser.add_argument("--rate", type=positive("times the recorded speed"), default=1.0,
-                        help="speed factor")  # fmt: skip
+    parser.add_argument(
+        "--rate", type=positive("times the recorded speed"), default=1.0, help="speed factor"
+    )
     parser.add_argument("--loop", action="store_true", help="start again at the end")
-    parser.add_argument("--start-offset", type=float, default=0.0, metavar="S",
-                        help="start S s after the recording's first message")  # fmt: skip
-    parser.add_argument("--duration", type=positive_seconds, metavar="S",
-                        help="send S s of the recording (default: to its end)")  # fmt: skip
+    parser.add_argument(
+        "--start-offset",
+        type=float,
+        default=0.0,
+        metavar="S",
+        help="start S s after the recording's first message",
+    )
+    parser.add_argument(
+        "--duration",
+        type=positive_seconds,
+        metavar="S",
+        help="send S s of the recording (default: to its end)",
+    )
     parser.add_argument("--keys", nargs="*", default=["*"], help="topic name patterns to send")
     parser.add_argument("--exclude", nargs="*", default=[], help="topic name patterns to skip")
-    parser.add_argument("--namespace", type=namespace_argument,
-                        help="publish under this namespace instead of the recorded one "
-                        "(or --profile's)")  # fmt: skip
+    parser.add_argument(
+        "--namespace",
+        type=namespace_argument,
+        help="publish under this namespace instead of the recorded one (or --profile's)",
+    )
     parser.add_argument("--sensors", action="store_true", help="only " + ", ".join(SENSORS))
     parser.add_argument("--clock", action="store_true", help="publish sim/clock as recorded")
-    parser.add_argument("--lockstep", action="store_true",
-                        help="wait for the live tracker's and estimator's answers")  # fmt: skip
-    parser.add_argument("--start-paused", action="store_true",
-                        help="start paused (in a terminal), else wait for Enter")  # fmt: skip
-    parser.add_argument("--into-live", action="store_true",
-                        help="send commands, and topics live components publish")  # fmt: skip
-    parser.add_argument("--view", action="store_true",
-                        help="serve a Foxglove live view of the replay, as parsimony view "
-                        "(needs --profile: the robot it draws)")  # fmt: skip
-    parser.add_argument("--port", type=port_number, default=DEFAULT_PORT,
-                        help=f"--view's port on 127.0.0.1 (default {DEFAULT_PORT}, 0: any free)")
+    parser.add_argument(
+        "--lockstep",
+        action="store_true",
+        help="wait for the live tracker's and estimator's answers",
+    )
+    parser.add_argument(
+        "--start-paused",
+        action="store_true",
+        help="start paused (in a terminal), else wait for Enter",
+    )
+    parser.add_argument(
+        "--into-live", action="store_true", help="send commands, and topics live components publish"
+    )
+    parser.add_argument(
+        "--view",
+        action="store_true",
+        help="serve a Foxglove live view of the replay, as parsimony view "
+        "(needs --profile: the robot it draws)",
+    )
+    parser.add_argument(
+        "--port",
+        type=port_number,
+        default=DEFAULT_PORT,
+        help=f"--view's port on 127.0.0.1 (default {DEFAULT_PORT}, 0: any free)",
+    )
     return parser
 
 
@@ -101,8 +129,10 @@ def run(args: argparse.Namespace) -> int:
         profile = load_profile(args.profile) if args.profile is not None else None
         namespace = args.namespace or (profile.namespace if profile else recorded.namespace())
         if args.view and profile is None:
-            raise ValueError("--view: give the --profile the view draws the robot and takes "
-                             "goals as (or use parsimony view PROFILE)")  # fmt: skip
+            raise ValueError(
+                "--view: give the --profile the view draws the robot and takes "
+                "goals as (or use parsimony view PROFILE)"
+            )
         watched = watched_profile(profile, namespace) if profile else None
         robot = MobileManipulator.from_yaml(profile.robot) if args.view and profile.robot else None
         target = Target(namespace, profile.zenoh) if profile else Target.from_namespace(namespace)
@@ -112,20 +142,36 @@ def run(args: argparse.Namespace) -> int:
         return fail(error)
     if recorded.outside is not None:
         print(f"[replay] not sent, {recorded.outside}", file=sys.stderr)
-    conflicts = [] if args.into_live or own_router else live_conflicts(
-        session, profile, namespace, recorded.names)  # fmt: skip
+    conflicts = (
+        []
+        if args.into_live or own_router
+        else live_conflicts(session, profile, namespace, recorded.names)
+    )
     if conflicts:
         session.close()
-        print(f"replay: refused: {'; '.join(conflicts)}. Replay into a namespace of its own "
-              "(--namespace), leave those topics out (--exclude, --sensors), or say "
-              "--into-live", file=sys.stderr)  # fmt: skip
+        print(
+            f"replay: refused: {'; '.join(conflicts)}. Replay into a namespace of its own "
+            "(--namespace), leave those topics out (--exclude, --sensors), or say "
+            "--into-live",
+            file=sys.stderr,
+        )
         return 2
     try:
-        view = serving(session, watched, topics.topics_matching(["*"]), args.port,
-                       robot) if watched and args.view else contextlib.nullcontext()  # fmt: skip
+        view = (
+            serving(session, watched, topics.topics_matching(["*"]), args.port, robot)
+            if watched and args.view
+            else contextlib.nullcontext()
+        )
         with session, view, terminal_keys() as keys:
-            playing = Playing(args.rate, args.start_offset, args.duration, args.loop,
-                              args.clock, args.lockstep, args.start_paused)  # fmt: skip
+            playing = Playing(
+                args.rate,
+                args.start_offset,
+                args.duration,
+                args.loop,
+                args.clock,
+                args.lockstep,
+                args.start_paused,
+            )
             return Player(playing, session, namespace, recorded, keys).run()
     except OSError as error:  # the view's port
         print(f"replay: {error}", file=sys.stderr)
@@ -145,12 +191,16 @@ def recording(args: argparse.Namespace) -> Recording:
         raise ValueError(f"{args.file}: nothing to replay (--keys, --exclude, --sensors)")
     first, last = recorded.window(args.start_offset, args.duration)
     if first > last:
-        raise ValueError(f"{args.file}: nothing in the window of --start-offset and "
-                         f"--duration (the recording spans "
-                         f"{(recorded.end_ns - recorded.start_ns) / 1e9:.2f} s)")  # fmt: skip
+        raise ValueError(
+            f"{args.file}: nothing in the window of --start-offset and "
+            f"--duration (the recording spans "
+            f"{(recorded.end_ns - recorded.start_ns) / 1e9:.2f} s)"
+        )
     if args.lockstep and ANSWERING.keys() & recorded.names:
-        raise ValueError(f"--lockstep: the replay would answer itself; leave out "
-                         f"{', '.join(ANSWERING)} (or use --sensors)")  # fmt: skip
+        raise ValueError(
+            f"--lockstep: the replay would answer itself; leave out "
+            f"{', '.join(ANSWERING)} (or use --sensors)"
+        )
     return recorded
 
 
@@ -167,17 +217,23 @@ def opened(target: Target) -> tuple[zenoh.Session, bool]:
         try:
             session = zenoh.open(settings.router_config(target.namespace))
         except zenoh.ZError as failed:
-            raise NoRouter(f"{error}; nor could the replay's own router listen there: "
-                           f"{zenoh_error_text(failed)}") from failed  # fmt: skip
+            raise NoRouter(
+                f"{error}; nor could the replay's own router listen there: "
+                f"{zenoh_error_text(failed)}"
+            ) from failed
     where = ", ".join(target.zenoh.router)
-    print(f"[replay] no router at {where} (no system running): the replay serves its own "
-          f"there, into {target.namespace}; `parsimony view` of a profile on it watches it",
-          file=sys.stderr, flush=True)  # fmt: skip
+    print(
+        f"[replay] no router at {where} (no system running): the replay serves its own "
+        f"there, into {target.namespace}; `parsimony view` of a profile on it watches it",
+        file=sys.stderr,
+        flush=True,
+    )
     return session, True
 
 
-def live_conflicts(session: zenoh.Session, profile: Profile | None, namespace: str,
-                   sending: set[str]) -> list[str]:  # fmt: skip
+def live_conflicts(
+    session: zenoh.Session, profile: Profile | None, namespace: str, sending: set[str]
+) -> list[str]:
     """What the replay may not send into ``namespace``: commands while anything there is alive,
     and each topic a live component publishes (a live component the profile, if any, does not
     describe might publish any). Empty when nothing there is alive."""
@@ -186,8 +242,7 @@ def live_conflicts(session: zenoh.Session, profile: Profile | None, namespace: s
         return []
     found = []
     if moving := sorted(sending & set(COMMANDS)):
-        found.append(f"{', '.join(moving)} into {namespace}, where {', '.join(alive)} "
-                     "are alive")  # fmt: skip
+        found.append(f"{', '.join(moving)} into {namespace}, where {', '.join(alive)} are alive")
     for name in alive:
         specs = profile.components if profile and namespace == profile.namespace else []
         spec = next((s for s in specs if s.name == name), None)
@@ -198,5 +253,3 @@ def live_conflicts(session: zenoh.Session, profile: Profile | None, namespace: s
         if clash := sorted((sending & writes) - set(COMMANDS)):
             found.append(f"{', '.join(clash)}, which the live {name} publishes")
     return found
-
-

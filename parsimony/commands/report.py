@@ -22,21 +22,27 @@ from wbc.robot import MobileManipulator
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
-        "report", help="figures like 6.6 to 6.14 and table 6.1 of one or two recordings",
+        "report",
+        help="figures like 6.6 to 6.14 and table 6.1 of one or two recordings",
         description="Write PNG figures (control inputs, nonzero entries, the error's eight "
         "coefficients, joints against their limits, end-effector and base paths with the "
         "obstacles, the arm's clearance from the solids in 3-D) and the four "
         "effort metrics of table 6.1 (JSON and Markdown) into DIR; two files side by side.",
-    )  # fmt: skip
+    )
     parser.add_argument("files", type=Path, nargs="+", metavar="FILE", help="MCAP sessions")
     parser.add_argument("--labels", help="comma-separated labels (default: the law's name)")
     parser.add_argument("--out", type=Path, required=True, help="directory of the figures")
     parser.add_argument("--robot", type=Path, default=ROBOT_FILE, help="robot description")
-    parser.add_argument("--profile", type=Path,
-                        help="the recorded profile: truth drawn in F0's frame")  # fmt: skip
-    parser.add_argument("--time-limit", type=positive_seconds, metavar="S",
-                        help="a run that did not converge ends S s after its start, as "
-                        "`experiment --time-limit` ended it (default: at its last step)")
+    parser.add_argument(
+        "--profile", type=Path, help="the recorded profile: truth drawn in F0's frame"
+    )
+    parser.add_argument(
+        "--time-limit",
+        type=positive_seconds,
+        metavar="S",
+        help="a run that did not converge ends S s after its start, as "
+        "`experiment --time-limit` ended it (default: at its last step)",
+    )
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
     return parser
 
@@ -61,8 +67,10 @@ def run(args: argparse.Namespace) -> int:
             sessions.append((labels[index] if labels else label_of(session, path), session))
         args.out.mkdir(parents=True, exist_ok=True)
         result = write_report(sessions, robot, args.out, frame)
-        judged = {label: judge(whole, robot, args.time_limit)
-                  for (label, _), whole in zip(sessions, loaded, strict=True)}  # fmt: skip
+        judged = {
+            label: judge(whole, robot, args.time_limit)
+            for (label, _), whole in zip(sessions, loaded, strict=True)
+        }
     except (OSError, ValueError, ProfileError) as error:
         print(f"report: {error}", file=sys.stderr)
         return 2
@@ -82,8 +90,10 @@ def labels_given(labels: str | None, files: int) -> list[str]:
         return []
     given = [label.strip() for label in labels.split(",")]
     if len(given) != files or not all(given):
-        raise ValueError(f"--labels: expected {files} non-empty comma-separated label"
-                         f"{'s' * (files > 1)}, got {labels!r}")  # fmt: skip
+        raise ValueError(
+            f"--labels: expected {files} non-empty comma-separated label"
+            f"{'s' * (files > 1)}, got {labels!r}"
+        )
     return given
 
 

@@ -21,31 +21,57 @@ from wbc.robot import MobileManipulator
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
-        "reproduce", help="run chapter 6's set-ups kinematically (with --loop, on the whole "
-                          "simulated loop too) and print each result beside the "
-                          "dissertation's")  # fmt: skip
-    parser.add_argument("--out", type=Path, default=Path("runs/reproduce"),
-                        help="where the figures go, and the loop's runs in OUT/loop "
-                             "(default runs/reproduce)")  # fmt: skip
-    parser.add_argument("--trials", type=int, default=TRIALS,
-                        help=f"trials of each law in each test of 6.3 (default {TRIALS}; the "
-                             "dissertation ran 10,000)")  # fmt: skip
+        "reproduce",
+        help="run chapter 6's set-ups kinematically (with --loop, on the whole "
+        "simulated loop too) and print each result beside the "
+        "dissertation's",
+    )
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=Path("runs/reproduce"),
+        help="where the figures go, and the loop's runs in OUT/loop (default runs/reproduce)",
+    )
+    parser.add_argument(
+        "--trials",
+        type=int,
+        default=TRIALS,
+        help=f"trials of each law in each test of 6.3 (default {TRIALS}; the "
+        "dissertation ran 10,000)",
+    )
     parser.add_argument("--robot", type=Path, default=ROBOT_FILE, help="robot description")
-    parser.add_argument("--only", choices=NAMES, action="append", metavar="SET-UP",
-                        help=f"only this set-up ({', '.join(NAMES)}; repeatable): its rows, "
-                             "figures and loop runs; section 6.3's timed tests run with all "
-                             "of them")  # fmt: skip
-    parser.add_argument("--loop", action="store_true",
-                        help="also run the set-ups of 6.2 (pose, position, obstacle) on the "
-                             "whole simulated loop in lockstep, vision in the loop, and print "
-                             "the same rows of each recording beside the kinematic "
-                             "ones")  # fmt: skip
-    parser.add_argument("--law", choices=LABELS, action="append", metavar="LABEL",
-                        help="with --loop, run only this law on the loop (repeatable): "
-                             + "; ".join(LABELS))  # fmt: skip
-    parser.add_argument("--time-limit", type=time_limit, default=TIME_LIMIT_S, metavar="S",
-                        help="with --loop, simulated seconds before a run that has not "
-                             f"converged stops (default {TIME_LIMIT_S:g})")  # fmt: skip
+    parser.add_argument(
+        "--only",
+        choices=NAMES,
+        action="append",
+        metavar="SET-UP",
+        help=f"only this set-up ({', '.join(NAMES)}; repeatable): its rows, "
+        "figures and loop runs; section 6.3's timed tests run with all "
+        "of them",
+    )
+    parser.add_argument(
+        "--loop",
+        action="store_true",
+        help="also run the set-ups of 6.2 (pose, position, obstacle) on the "
+        "whole simulated loop in lockstep, vision in the loop, and print "
+        "the same rows of each recording beside the kinematic "
+        "ones",
+    )
+    parser.add_argument(
+        "--law",
+        choices=LABELS,
+        action="append",
+        metavar="LABEL",
+        help="with --loop, run only this law on the loop (repeatable): " + "; ".join(LABELS),
+    )
+    parser.add_argument(
+        "--time-limit",
+        type=time_limit,
+        default=TIME_LIMIT_S,
+        metavar="S",
+        help="with --loop, simulated seconds before a run that has not "
+        f"converged stops (default {TIME_LIMIT_S:g})",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of tables")
     return parser
 
@@ -59,8 +85,10 @@ def usage_error(args: argparse.Namespace) -> str | None:
     if args.loop:
         profile_robot = load_profile(PROFILES["lp"]).robot
         if args.robot.resolve() != profile_robot.resolve():
-            return (f"--loop runs the robot of {PROFILES['lp'].name} ({profile_robot}), not "
-                    f"{args.robot}")  # fmt: skip
+            return (
+                f"--loop runs the robot of {PROFILES['lp'].name} ({profile_robot}), not "
+                f"{args.robot}"
+            )
         if not set(args.only or NAMES) & set(LOOP_LAWS):
             return f"--loop runs {', '.join(LOOP_LAWS)} of 6.2; --only chose none of them"
     return None
@@ -79,17 +107,29 @@ def run(args: argparse.Namespace) -> int:
     ran = None
     if args.loop:
         try:
-            loop_rows, loop_laws, ran = loop(robot, names, tuple(args.law or LABELS),
-                                             args.out / "loop", args.time_limit)  # fmt: skip
+            loop_rows, loop_laws, ran = loop(
+                robot, names, tuple(args.law or LABELS), args.out / "loop", args.time_limit
+            )
         except (ProfileError, OSError, QueryError, RuntimeError, ValueError) as error:
             print(f"parsimony reproduce: the loop: {error}", file=sys.stderr)
             return 1
         rows, laws = beside(rows, loop_rows), laws + loop_laws
     if args.json:
-        emit(json_text({"laws": laws, "rows": [asdict(row) for row in rows],
-                         "figures": [str(path) for path in figures]}
-                        | ({"loop": ran} if ran else {})))  # fmt: skip
+        emit(
+            json_text(
+                {
+                    "laws": laws,
+                    "rows": [asdict(row) for row in rows],
+                    "figures": [str(path) for path in figures],
+                }
+                | ({"loop": ran} if ran else {})
+            )
+        )
     else:
-        emit(format_laws(laws) + "\n\n" + format_rows(rows)
-             + (f"\n\n{summary_line(ran)}" if ran else ""))  # fmt: skip
+        emit(
+            format_laws(laws)
+            + "\n\n"
+            + format_rows(rows)
+            + (f"\n\n{summary_line(ran)}" if ran else "")
+        )
     return 0

@@ -34,7 +34,8 @@ from record.session_reader import read_groups
 from wbc.robot import MobileManipulator, RobotDescriptionError
 
 LAWS: dict[str, type[Controller]] = {
-    c.law_name: c for c in (LPController, CascadeController, QPController)}
+    c.law_name: c for c in (LPController, CascadeController, QPController)
+}
 """The controllers whose law can be run again, by law name."""
 OUTPUTS = ("base/command", "arm/command", "control/diagnostics")
 """The topics the law writes; the recorded ones move to ``<key>/recorded``."""
@@ -44,8 +45,11 @@ a state holds for before it, and the diagnostics answering it carry the gains it
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    parser = subparsers.add_parser("rerun", help="run a law offline on a recording's inputs",
-                                   description=__doc__.split("\n\n")[1])  # fmt: skip
+    parser = subparsers.add_parser(
+        "rerun",
+        help="run a law offline on a recording's inputs",
+        description=__doc__.split("\n\n")[1],
+    )
     parser.add_argument("file", type=Path, help="MCAP session")
     parser.add_argument("--controller", choices=tuple(LAWS), required=True)
     parser.add_argument("-o", "--output", type=Path, required=True, help="the MCAP to write")
@@ -83,8 +87,7 @@ class Offline:
 
     def __init__(self, controller: type[Controller], robot: MobileManipulator) -> None:
         self.name, self.gains_type = controller.law_name, controller.gains_type
-        self.stepper = ControlStep(self.name, controller.law_type, robot,
-                                   self.gains_type())  # fmt: skip
+        self.stepper = ControlStep(self.name, controller.law_type, robot, self.gains_type())
         self.steps = 0
         self.recorded_gains = False  # whether the recording said the gains of this law
 
@@ -119,8 +122,15 @@ def write_step(out: SessionWriter, namespace: str, law: str, step: Step, gains) 
     """The commands and diagnostics of one step, stamped with its state's stamp."""
     header = Header(stamp_ns=step.stamp_ns, frame="world", seq=0, source=f"{RERUN_SOURCE}{law}")
     forward, angular, left, right = step.wheels
-    out.write(f"{namespace}/base/command", BaseCommand(
-        header=header, forward_velocity=forward, angular_velocity=angular, left_wheel=left,
-        right_wheel=right))  # fmt: skip
+    out.write(
+        f"{namespace}/base/command",
+        BaseCommand(
+            header=header,
+            forward_velocity=forward,
+            angular_velocity=angular,
+            left_wheel=left,
+            right_wheel=right,
+        ),
+    )
     out.write(f"{namespace}/arm/command", ArmCommand(header=header, joint_velocities=step.joints))
     out.write(f"{namespace}/control/diagnostics", diagnostics_of(step, law, gains, header))

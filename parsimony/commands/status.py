@@ -24,11 +24,32 @@ from parsimony.target_options import fail
 from profiles.profile import ProfileError, load_profile
 
 COLUMNS = ("NAME", "MODULE", "STATE", "PID", "IN", "OUT", "CPU S", "FAULTS (non-zero)")
-LEGEND = ("IN, OUT: messages received and published; FAULTS: counts of what was refused, "
-          "failed, stalled, held or lost; --counters lists every counter")  # fmt: skip
-FAULT_WORDS = ("rejected", "error", "overflowed", "fail", "bad_", "refus", "stall", "timeout",
-               "lost", "non_finite", "implausible", "unreachable", "contacts", "penetrations",
-               "undecodable", "out_of_limits", "fault", "degraded", "holds", "reconnects")
+LEGEND = (
+    "IN, OUT: messages received and published; FAULTS: counts of what was refused, "
+    "failed, stalled, held or lost; --counters lists every counter"
+)
+FAULT_WORDS = (
+    "rejected",
+    "error",
+    "overflowed",
+    "fail",
+    "bad_",
+    "refus",
+    "stall",
+    "timeout",
+    "lost",
+    "non_finite",
+    "implausible",
+    "unreachable",
+    "contacts",
+    "penetrations",
+    "undecodable",
+    "out_of_limits",
+    "fault",
+    "degraded",
+    "holds",
+    "reconnects",
+)
 """A counter whose name holds one of these counts faults; the summary shows it when not 0."""
 WAIT_TIMEOUT_S = 60.0
 """How long ``--wait`` waits for every component by default."""
@@ -54,16 +75,26 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         default=DEFAULT_ROUTER,
         help=f"router endpoint for a namespace target (default {DEFAULT_ROUTER})",
     )
-    parser.add_argument("--json", action="store_true",
-                        help="print JSON instead of a table (every counter)")  # fmt: skip
-    parser.add_argument("-v", "--counters", action="store_true",
-                        help="list every counter of each component under the table")  # fmt: skip
-    parser.add_argument("--wait", action="store_true",
-                        help="wait until every component of the profile is alive")  # fmt: skip
-    parser.add_argument("--timeout", type=positive_seconds, metavar="S",
-                        help="seconds to wait for the components' answers (default "
-                        f"{DEFAULT_TIMEOUT_S:g}); with --wait, for all of them to be alive "
-                        f"(default {WAIT_TIMEOUT_S:g})")  # fmt: skip
+    parser.add_argument(
+        "--json", action="store_true", help="print JSON instead of a table (every counter)"
+    )
+    parser.add_argument(
+        "-v",
+        "--counters",
+        action="store_true",
+        help="list every counter of each component under the table",
+    )
+    parser.add_argument(
+        "--wait", action="store_true", help="wait until every component of the profile is alive"
+    )
+    parser.add_argument(
+        "--timeout",
+        type=positive_seconds,
+        metavar="S",
+        help="seconds to wait for the components' answers (default "
+        f"{DEFAULT_TIMEOUT_S:g}); with --wait, for all of them to be alive "
+        f"(default {WAIT_TIMEOUT_S:g})",
+    )
     return parser
 
 
@@ -95,8 +126,9 @@ def wait(args: argparse.Namespace, target: Target) -> None:
         raise ProfileError("--wait waits for the components of a profile: name one")
     names = [spec.name for spec in load_profile(profile).start_order()]
     timeout_s = WAIT_TIMEOUT_S if args.timeout is None else args.timeout
-    wait_alive(target, names, timeout_s, lambda text: print(f"status: {text}", file=sys.stderr,
-                                                             flush=True))  # fmt: skip
+    wait_alive(
+        target, names, timeout_s, lambda text: print(f"status: {text}", file=sys.stderr, flush=True)
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -135,13 +167,26 @@ def format_table(rows: list[tuple[str, ComponentStatus | None]]) -> str:
             cells.append((name, "?", "?", "?", "?", "?", "?", ""))
             continue
         counters = status.counters
-        faults = " ".join(f"{k}={v}" for k, v in sorted(counters.items())
-                          if v and any(word in k for word in FAULT_WORDS))  # fmt: skip
+        faults = " ".join(
+            f"{k}={v}"
+            for k, v in sorted(counters.items())
+            if v and any(word in k for word in FAULT_WORDS)
+        )
         received = sum(v for k, v in counters.items() if k.startswith("received."))
         published = sum(v for k, v in counters.items() if k.startswith("published."))
         cpu_s = f"{counters.get('cpu_ms', 0) / 1e3:.1f}"
-        cells.append((name, status.module, status.state, str(status.pid), str(received),
-                      str(published), cpu_s, faults))  # fmt: skip
+        cells.append(
+            (
+                name,
+                status.module,
+                status.state,
+                str(status.pid),
+                str(received),
+                str(published),
+                cpu_s,
+                faults,
+            )
+        )
     return table(cells, COLUMNS, disable_numparse=True, colalign=("left",) * 4 + ("right",) * 3)
 
 

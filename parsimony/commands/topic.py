@@ -36,20 +36,35 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     actions.add_parser("list", parents=[common], help="every topic: key, type, who uses it")
     info = actions.add_parser("info", parents=[common], help="a topic's key, schema and users")
     # Its own copy of the common options: "resolve" takes --timeout out of the copy's action.
-    echo = actions.add_parser("echo", parents=[target_options()], conflict_handler="resolve",
-                              help="print each message, decoded")  # fmt: skip
+    echo = actions.add_parser(
+        "echo",
+        parents=[target_options()],
+        conflict_handler="resolve",
+        help="print each message, decoded",
+    )
     echo.add_argument("--count", type=int, help="stop after this many messages")
-    echo.add_argument("--timeout", type=float, metavar="S",
-                      help="stop with exit 1 and 'no message in S s on TOPIC' when S seconds "
-                           "pass with no message (default: wait until --count or Ctrl-C)")
+    echo.add_argument(
+        "--timeout",
+        type=float,
+        metavar="S",
+        help="stop with exit 1 and 'no message in S s on TOPIC' when S seconds "
+        "pass with no message (default: wait until --count or Ctrl-C)",
+    )
     hz = actions.add_parser("hz", parents=[common], help="measure a topic's rate")
     hz.add_argument("--window", type=float, default=2.0, metavar="S", help="seconds to listen")
     pub = actions.add_parser("pub", parents=[common], help="publish a message given as JSON")
     for action in (info, echo, hz, pub):
-        action.add_argument("topic", choices=list(topics.TOPICS), metavar="TOPIC",
-                            help="a topic of the table: " + ", ".join(topics.TOPICS))  # fmt: skip
-    pub.add_argument("message", help="the message's fields as JSON; a missing header is made, "
-                     "stamped on the profile's clock (the simulator's on a sim-clock profile)")
+        action.add_argument(
+            "topic",
+            choices=list(topics.TOPICS),
+            metavar="TOPIC",
+            help="a topic of the table: " + ", ".join(topics.TOPICS),
+        )
+    pub.add_argument(
+        "message",
+        help="the message's fields as JSON; a missing header is made, "
+        "stamped on the profile's clock (the simulator's on a sim-clock profile)",
+    )
     pub.add_argument("--count", type=int, default=1, help="how many times (default 1)")
     pub.add_argument("--rate", type=float, default=10.0, metavar="HZ")
     return parser
@@ -70,8 +85,9 @@ def printable(message: BaseModel) -> dict[str, Any]:
     return shown(message.model_dump())
 
 
-def listen(session: zenoh.Session, key: str, topic: topics.Topic, until: threading.Event,
-           on_message: Any) -> zenoh.Subscriber:  # fmt: skip
+def listen(
+    session: zenoh.Session, key: str, topic: topics.Topic, until: threading.Event, on_message: Any
+) -> zenoh.Subscriber:
     """Subscribe and hand each decoded message (or DecodeError) to ``on_message``."""
 
     def on_sample(sample: zenoh.Sample) -> None:
@@ -91,24 +107,36 @@ def run(args: argparse.Namespace) -> int:
         if args.action in ("list", "info"):
             graph = dataflow(profile)
             names = list(topics.TOPICS) if args.action == "list" else [args.topic]
-            rows = [{"topic": name, "key": topics.TOPICS[name].key(profile.namespace),
-                     "type": topics.TOPICS[name].type.__name__,
-                     "max_bytes": topics.TOPICS[name].max_bytes,
-                     "writers": graph.writers(name), "readers": graph.readers(name)}
-                    for name in names]  # fmt: skip
+            rows = [
+                {
+                    "topic": name,
+                    "key": topics.TOPICS[name].key(profile.namespace),
+                    "type": topics.TOPICS[name].type.__name__,
+                    "max_bytes": topics.TOPICS[name].max_bytes,
+                    "writers": graph.writers(name),
+                    "readers": graph.readers(name),
+                }
+                for name in names
+            ]
             if args.action == "info":
                 rows[0]["schema"] = topics.TOPICS[args.topic].type.model_json_schema()
                 emit(json_text(rows[0], indent=2))
             elif args.json:
                 emit(json_text(rows, indent=2))
             else:
-                emit("\n".join(f"{r['key']:<34} {r['type']:<22} "
-                               f"{', '.join(r['writers']) or '-'} -> "
-                               f"{', '.join(r['readers']) or '-'}" for r in rows))  # fmt: skip
+                emit(
+                    "\n".join(
+                        f"{r['key']:<34} {r['type']:<22} "
+                        f"{', '.join(r['writers']) or '-'} -> "
+                        f"{', '.join(r['readers']) or '-'}"
+                        for r in rows
+                    )
+                )
             return 0
         if args.timeout is not None and not (math.isfinite(args.timeout) and args.timeout > 0):
-            raise ValueError(f"--timeout: expected a finite number of seconds > 0, got "
-                             f"{args.timeout}")  # fmt: skip
+            raise ValueError(
+                f"--timeout: expected a finite number of seconds > 0, got {args.timeout}"
+            )
         with target.open() as session:
             return {"echo": echo, "hz": hz, "pub": pub}[args.action](args, session, profile)
     except (ProfileError, QueryError, LookupError, ValueError) as error:
@@ -165,22 +193,29 @@ def hz(args: argparse.Namespace, session: zenoh.Session, profile: Profile) -> in
     topic = topics.TOPICS[args.topic]
     arrivals: list[float] = []
     done = threading.Event()
-    with listen(session, topic.key(profile.namespace), topic, done,
-                lambda message, at: arrivals.append(at)):  # fmt: skip
+    with listen(
+        session, topic.key(profile.namespace), topic, done, lambda message, at: arrivals.append(at)
+    ):
         time.sleep(args.window)
         done.set()
     periods = np.diff(arrivals)
-    report = {"topic": args.topic, "messages": len(arrivals), "window_s": args.window,
-              "rate_hz": len(arrivals) / args.window,
-              "period_median_s": float(np.median(periods)) if len(periods) else math.nan,
-              "period_min_s": float(periods.min()) if len(periods) else math.nan,
-              "period_max_s": float(periods.max()) if len(periods) else math.nan}  # fmt: skip
+    report = {
+        "topic": args.topic,
+        "messages": len(arrivals),
+        "window_s": args.window,
+        "rate_hz": len(arrivals) / args.window,
+        "period_median_s": float(np.median(periods)) if len(periods) else math.nan,
+        "period_min_s": float(periods.min()) if len(periods) else math.nan,
+        "period_max_s": float(periods.max()) if len(periods) else math.nan,
+    }
     if args.json:
         emit(json_text(report))
     else:
-        emit(f"{args.topic}: {report['rate_hz']:.1f} Hz over {args.window} s "
-             f"({len(arrivals)} messages), period median {report['period_median_s']:.4f} s, "
-             f"min {report['period_min_s']:.4f}, max {report['period_max_s']:.4f}")  # fmt: skip
+        emit(
+            f"{args.topic}: {report['rate_hz']:.1f} Hz over {args.window} s "
+            f"({len(arrivals)} messages), period median {report['period_median_s']:.4f} s, "
+            f"min {report['period_min_s']:.4f}, max {report['period_max_s']:.4f}"
+        )
     return 0 if arrivals else 1
 
 
@@ -209,14 +244,21 @@ def pub(args: argparse.Namespace, session: zenoh.Session, profile: Profile) -> i
             try:
                 message = topic.type.model_validate(values)
             except ValidationError as error:
-                raise ValueError(f"{args.topic}: {error.errors()[0]['loc']}: "
-                                 f"{error.errors()[0]['msg']}") from None  # fmt: skip
+                raise ValueError(
+                    f"{args.topic}: {error.errors()[0]['loc']}: {error.errors()[0]['msg']}"
+                ) from None
             publisher.put(codec.encode(message))
             if seq + 1 < args.count:
                 time.sleep(1.0 / args.rate)
-    emit(json_text({"topic": args.topic, "published": args.count,
-                     "subscribers": publisher.matching_status.matching,
-                     "live_writers": writers}))  # fmt: skip
+    emit(
+        json_text(
+            {
+                "topic": args.topic,
+                "published": args.count,
+                "subscribers": publisher.matching_status.matching,
+                "live_writers": writers,
+            }
+        )
+    )
     publisher.undeclare()
     return 0
-

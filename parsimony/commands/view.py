@@ -56,20 +56,35 @@ def namespace_argument(text: str) -> str:
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    parser = subparsers.add_parser("view", help="a Foxglove live view and control station",
-                                   description=__doc__)  # fmt: skip
+    parser = subparsers.add_parser(
+        "view", help="a Foxglove live view and control station", description=__doc__
+    )
     parser.add_argument("profile", type=Path, help="deploy profile of the system")
-    parser.add_argument("--port", type=port_number, default=DEFAULT_PORT,
-                        help=f"on 127.0.0.1 (default {DEFAULT_PORT}, 0: any free one)")  # fmt: skip
+    parser.add_argument(
+        "--port",
+        type=port_number,
+        default=DEFAULT_PORT,
+        help=f"on 127.0.0.1 (default {DEFAULT_PORT}, 0: any free one)",
+    )
     parser.add_argument("--keys", nargs="*", default=["*"], help="topic name patterns")
-    parser.add_argument("--namespace", type=namespace_argument,
-                        help="watch this namespace instead of the profile's (a replay's)")
+    parser.add_argument(
+        "--namespace",
+        type=namespace_argument,
+        help="watch this namespace instead of the profile's (a replay's)",
+    )
     parser.add_argument("--layout", type=Path, help="write the Foxglove layout to this file")
     parser.add_argument("--force", action="store_true", help="write over an existing layout")
-    parser.add_argument("--nice", type=int, default=NICE, choices=range(0, 20), metavar="N",
-                        help=f"run N steps below the loop's priority (default {NICE})")
-    parser.add_argument("--json", action="store_true",
-                        help="when it stops, print what it did as JSON")  # fmt: skip
+    parser.add_argument(
+        "--nice",
+        type=int,
+        default=NICE,
+        choices=range(0, 20),
+        metavar="N",
+        help=f"run N steps below the loop's priority (default {NICE})",
+    )
+    parser.add_argument(
+        "--json", action="store_true", help="when it stops, print what it did as JSON"
+    )
     return parser
 
 
@@ -96,8 +111,10 @@ def run(args: argparse.Namespace) -> int:
     os.nice(args.nice)
     previous = signal.signal(signal.SIGTERM, _interrupt)
     try:
-        with target.open() as session, serving(session, profile, chosen, args.port,
-                                               robot) as (view, station):  # fmt: skip
+        with (
+            target.open() as session,
+            serving(session, profile, chosen, args.port, robot) as (view, station),
+        ):
             return _serve(view, station, args.json)
     except (QueryError, OSError) as error:
         print(f"view: {error}", file=sys.stderr)
@@ -115,24 +132,42 @@ def watched_profile(profile: Profile, namespace: str | None) -> Profile:
 
 
 @contextlib.contextmanager
-def serving(session: zenoh.Session, profile: Profile, chosen: Sequence[Topic], port: int,
-            robot: MobileManipulator | None
-            ) -> Iterator[tuple[LiveView, ControlStation]]:  # fmt: skip
+def serving(
+    session: zenoh.Session,
+    profile: Profile,
+    chosen: Sequence[Topic],
+    port: int,
+    robot: MobileManipulator | None,
+) -> Iterator[tuple[LiveView, ControlStation]]:
     """The live view and control station of ``profile``'s namespace on ``session``, served on
     127.0.0.1:``port``, said on stderr once live (``parsimony view``'s, ``replay --view``'s)."""
     warnings = RateLimitedLog(logging.getLogger("parsimony.view"))
     station = ControlStation(session, profile)
     try:
-        with LiveView(session, profile.namespace, chosen, port, warnings.warning,
-                      Viewer(robot), station, station.capabilities,
-                      station.encodings) as view:  # fmt: skip
+        with LiveView(
+            session,
+            profile.namespace,
+            chosen,
+            port,
+            warnings.warning,
+            Viewer(robot),
+            station,
+            station.capabilities,
+            station.encodings,
+        ) as view:
             station.attach(view.server)
-            publishing = "goals from clients on goal/request" if station.may_publish else (
-                f"no publishing: {station.user} may not write goal/request")  # fmt: skip
+            publishing = (
+                "goals from clients on goal/request"
+                if station.may_publish
+                else (f"no publishing: {station.user} may not write goal/request")
+            )
             setting = "" if station.may_set_any else f", read-only: {station.user} may set none"
-            print(f"view: {profile.namespace} live at {view.address} ({publishing}; the "
-                  f"parameters of every running component{setting})", file=sys.stderr,
-                  flush=True)  # fmt: skip
+            print(
+                f"view: {profile.namespace} live at {view.address} ({publishing}; the "
+                f"parameters of every running component{setting})",
+                file=sys.stderr,
+                flush=True,
+            )
             yield view, station
     finally:
         station.close()
@@ -152,21 +187,36 @@ def stopped(view: LiveView, station: ControlStation, as_json: bool) -> int:
     """Say on stderr what the view and its station did (as JSON on stdout if ``as_json``);
     1 if the station's Zenoh session failed and no new one could be opened, else 0."""
     handler = view.handler_us()
-    done = {"goals_sent": station.goals_sent, "goals_refused": station.goals_refused,
-            "goals_dropped": station.goals_dropped, "session_errors": station.session_errors,
-            "errors": station.errors}  # fmt: skip
-    print(f"view: {view.shown} messages shown, {view.malformed} malformed, {view.unwatched} "
-          f"read by no client, {view.failed} without views; handler "
-          f"{handler['median']} us median, {handler['p99']} us p99 over {handler['samples']}; "
-          f"{station.goals_sent} goals sent, {station.goals_refused} refused, "
-          f"{station.goals_dropped} dropped over their rate; {station.session_errors} Zenoh "
-          f"session errors, {station.errors} errors answering clients",
-          file=sys.stderr)  # fmt: skip
+    done = {
+        "goals_sent": station.goals_sent,
+        "goals_refused": station.goals_refused,
+        "goals_dropped": station.goals_dropped,
+        "session_errors": station.session_errors,
+        "errors": station.errors,
+    }
+    print(
+        f"view: {view.shown} messages shown, {view.malformed} malformed, {view.unwatched} "
+        f"read by no client, {view.failed} without views; handler "
+        f"{handler['median']} us median, {handler['p99']} us p99 over {handler['samples']}; "
+        f"{station.goals_sent} goals sent, {station.goals_refused} refused, "
+        f"{station.goals_dropped} dropped over their rate; {station.session_errors} Zenoh "
+        f"session errors, {station.errors} errors answering clients",
+        file=sys.stderr,
+    )
     if station.failed:
         print(f"view: {station.failed}", file=sys.stderr)
     if as_json:
-        emit(json_text({"shown": view.shown, "unwatched": view.unwatched,
-                        "malformed": view.malformed, "failed": view.failed,
-                        "handler_us": handler, **done,
-                        "session_failed": station.failed or None}))  # fmt: skip
+        emit(
+            json_text(
+                {
+                    "shown": view.shown,
+                    "unwatched": view.unwatched,
+                    "malformed": view.malformed,
+                    "failed": view.failed,
+                    "handler_us": handler,
+                    **done,
+                    "session_failed": station.failed or None,
+                }
+            )
+        )
     return 1 if station.failed else 0

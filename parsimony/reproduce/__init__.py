@@ -31,12 +31,22 @@ from parsimony.reproduce.runs import NAMES, Experiment, experiments
 from parsimony.reproduce.table import Row, format_laws, format_rows
 from wbc.robot import MobileManipulator
 
-__all__ = ["NAMES", "NOTES", "TABLE_6_1", "TRIALS", "Row", "format_laws", "format_rows",
-           "reproduce", "write_figures"]  # fmt: skip
+__all__ = [
+    "NAMES",
+    "NOTES",
+    "TABLE_6_1",
+    "TRIALS",
+    "Row",
+    "format_laws",
+    "format_rows",
+    "reproduce",
+    "write_figures",
+]
 
 
-def reproduce(robot: MobileManipulator, trials: int = TRIALS, names: tuple[str, ...] = NAMES
-              ) -> tuple[list[Row], list[dict[str, str]], dict[str, Experiment]]:  # fmt: skip
+def reproduce(
+    robot: MobileManipulator, trials: int = TRIALS, names: tuple[str, ...] = NAMES
+) -> tuple[list[Row], list[dict[str, str]], dict[str, Experiment]]:
     """The rows, what each law ran, and the experiments they come from: the set-ups
     ``names`` and, with all of them, section 6.3. The timed tests of 6.3 run first, before
     thousands of runs' outputs load the garbage collector."""
@@ -46,14 +56,20 @@ def reproduce(robot: MobileManipulator, trials: int = TRIALS, names: tuple[str, 
     def each(make: Callable[[Experiment], list[Row]], *wanted: str) -> list[Row]:
         return [row for name in wanted if name in found for row in make(found[name])]
 
-    rows = [*each(lambda e: task_rows(robot, e), "pose"),
-            *each(lambda e: joint_limit_rows(robot, e), "joint_limit"),
-            *each(lambda e: task_rows(robot, e), "position"),
-            *each(effort_rows, "pose", "position"),
-            *each(lambda e: obstacle_rows(robot, e), "obstacle"), *step_time_rows(found),
-            *timing, *each(qp_rows, "pose", "position"),
-            *each(input_change_rows, "pose", "position")]  # fmt: skip
-    laws = [{"experiment": name, "label": label, "ran": text}
-            for name, experiment in found.items()
-            for label, text in experiment.laws.items()]  # fmt: skip
+    rows = [
+        *each(lambda e: task_rows(robot, e), "pose"),
+        *each(lambda e: joint_limit_rows(robot, e), "joint_limit"),
+        *each(lambda e: task_rows(robot, e), "position"),
+        *each(effort_rows, "pose", "position"),
+        *each(lambda e: obstacle_rows(robot, e), "obstacle"),
+        *step_time_rows(found),
+        *timing,
+        *each(qp_rows, "pose", "position"),
+        *each(input_change_rows, "pose", "position"),
+    ]
+    laws = [
+        {"experiment": name, "label": label, "ran": text}
+        for name, experiment in found.items()
+        for label, text in experiment.laws.items()
+    ]
     return rows, laws + ran, found

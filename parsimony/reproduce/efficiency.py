@@ -39,15 +39,17 @@ def laws(robot: MobileManipulator) -> dict[str, dict[str, Callable[[], Law]]]:
     states none (``parsimony.benchmark.UNBOUNDED_SPEED``)."""
     free = robot.with_velocity_max(np.full(robot.dof, UNBOUNDED_SPEED))
     holonomic = LPParams(eta=ETA, beta=BETA, nonholonomic=False)
-    nonholonomic = L.bare_5_29(LPParams(eta=ETA, beta=BETA, joint_gain=1.0,
-                                        safety_factor=0.99))  # fmt: skip
+    nonholonomic = L.bare_5_29(LPParams(eta=ETA, beta=BETA, joint_gain=1.0, safety_factor=0.99))
     return {
-        "test 1": {"classic": lambda: PseudoinverseLaw(free, PinvParams(eta=ETA)),
-                   "LP": lambda: LPLaw(free, holonomic, constraints=[ErrorBound(BETA)],
-                                       objectives=[])},
-        "test 2": {"classic": lambda: CascadeLaw(free, CascadeParams(eta=ETA)),
-                   "LP": lambda: LPLaw(free, nonholonomic)},
-    }  # fmt: skip
+        "test 1": {
+            "classic": lambda: PseudoinverseLaw(free, PinvParams(eta=ETA)),
+            "LP": lambda: LPLaw(free, holonomic, constraints=[ErrorBound(BETA)], objectives=[]),
+        },
+        "test 2": {
+            "classic": lambda: CascadeLaw(free, CascadeParams(eta=ETA)),
+            "LP": lambda: LPLaw(free, nonholonomic),
+        },
+    }
 
 
 def timed(make_law: Callable[[], Law], task: PoseTask, trials: int) -> dict:
@@ -64,10 +66,12 @@ def timed(make_law: Callable[[], Law], task: PoseTask, trials: int) -> dict:
         iterations.append(len(run.outputs) if run.converged else -1)
     mean = float(np.mean(durations))
     low, high = min(iterations), max(iterations)
-    return {"iterations": low if low == high else [low, high],
-            "converged": int(np.sum(np.array(iterations) > 0)), "ms": [mean,
-                                                                      float(np.std(durations))],
-            "ms per iteration": mean / max(iterations)}  # fmt: skip
+    return {
+        "iterations": low if low == high else [low, high],
+        "converged": int(np.sum(np.array(iterations) > 0)),
+        "ms": [mean, float(np.std(durations))],
+        "ms per iteration": mean / max(iterations),
+    }
 
 
 def section_6_3(robot: MobileManipulator, trials: int) -> tuple[list[Row], list[dict]]:
@@ -79,21 +83,45 @@ def section_6_3(robot: MobileManipulator, trials: int) -> tuple[list[Row], list[
         theirs = SECTION_6_3[test]
         kind = "holonomic" if test == "test 1" else "nonholonomic"
         rows += [
-            Row(f"6.3.{test}.iterations", "6.3", f"{test} ({kind}): iterations to ||e|| < 1e-3 "
-                "(classic, LP), each over its trials", theirs["iterations"],
+            Row(
+                f"6.3.{test}.iterations",
+                "6.3",
+                f"{test} ({kind}): iterations to ||e|| < 1e-3 (classic, LP), each over its trials",
+                theirs["iterations"],
                 [found["classic"]["iterations"], found["LP"]["iterations"]],
-                "the same for both", f"6.3 {test}", ("classic", "LP")),
-            Row(f"6.3.{test}.time", "6.3", f"{test}: trials, trials converged (classic, LP); "
+                "the same for both",
+                f"6.3 {test}",
+                ("classic", "LP"),
+            ),
+            Row(
+                f"6.3.{test}.time",
+                "6.3",
+                f"{test}: trials, trials converged (classic, LP); "
                 "convergence time of a trial, mean and std, ms (classic, LP); ms per iteration",
-                {"trials": theirs["trials"], "classic": list(theirs["classic_ms"]),
-                 "LP": list(theirs["lp_ms"]),
-                 "per iteration": [round(theirs[k][0] / theirs["iterations"], 2)
-                                   for k in ("classic_ms", "lp_ms")]},
-                {"trials": trials, "converged": [found[k]["converged"] for k in found],
-                 "classic": found["classic"]["ms"], "LP": found["LP"]["ms"],
-                 "per iteration": [found[k]["ms per iteration"] for k in found]},
-                "classic faster", f"6.3 {test}", ("classic", "LP"), timed=True),
-        ]  # fmt: skip
-        ran += [{"experiment": f"6.3 {test}", "label": label, "ran": L.describe(make())}
-                for label, make in makers.items()]  # fmt: skip
+                {
+                    "trials": theirs["trials"],
+                    "classic": list(theirs["classic_ms"]),
+                    "LP": list(theirs["lp_ms"]),
+                    "per iteration": [
+                        round(theirs[k][0] / theirs["iterations"], 2)
+                        for k in ("classic_ms", "lp_ms")
+                    ],
+                },
+                {
+                    "trials": trials,
+                    "converged": [found[k]["converged"] for k in found],
+                    "classic": found["classic"]["ms"],
+                    "LP": found["LP"]["ms"],
+                    "per iteration": [found[k]["ms per iteration"] for k in found],
+                },
+                "classic faster",
+                f"6.3 {test}",
+                ("classic", "LP"),
+                timed=True,
+            ),
+        ]
+        ran += [
+            {"experiment": f"6.3 {test}", "label": label, "ran": L.describe(make())}
+            for label, make in makers.items()
+        ]
     return rows, ran

@@ -35,12 +35,11 @@ PAIRS = {
     "joint_limit": ("joint_limit", (L.LP, L.CASCADE)),
     "obstacle": ("obstacle", (L.LP, L.LP_BORDER)),
     "obstacle/5.29": ("obstacle", (L.LP_5_29,)),
-}  # fmt: skip
+}
 """Each folder of figures: the experiment and the one or two runs it draws."""
 
 
-def write_figures(robot: MobileManipulator, found: dict[str, Experiment], out: Path
-                  ) -> list[Path]:  # fmt: skip
+def write_figures(robot: MobileManipulator, found: dict[str, Experiment], out: Path) -> list[Path]:
     """Every folder of ``PAIRS``, the pose task's 2-norm and residual figure, and NOTES.md:
     what the dissertation's figures show, beside ours (of the experiments ``found``)."""
     written: list[Path] = []
@@ -48,15 +47,21 @@ def write_figures(robot: MobileManipulator, found: dict[str, Experiment], out: P
         if name not in found:
             continue
         experiment = found[name]
-        sessions = [(label, session_of(experiment.runs[label], experiment, robot))
-                    for label in labels]  # fmt: skip
+        sessions = [
+            (label, session_of(experiment.runs[label], experiment, robot)) for label in labels
+        ]
         written += write_report(sessions, robot, out / folder)["figures"]
     if "pose" in found:
         written.append(two_norm_figure(found["pose"], robot, out / "pose" / "two_norm.png"))
-    lines = ["# Chapter 6 figures: what the dissertation shows, and ours", "",
-             "| ours | the dissertation's |", "| --- | --- |"]  # fmt: skip
-    lines += [f"| `{path}` | {note} |" for path, note in NOTES.items()
-              if path.split("/")[0] in found]  # fmt: skip
+    lines = [
+        "# Chapter 6 figures: what the dissertation shows, and ours",
+        "",
+        "| ours | the dissertation's |",
+        "| --- | --- |",
+    ]
+    lines += [
+        f"| `{path}` | {note} |" for path, note in NOTES.items() if path.split("/")[0] in found
+    ]
     (out / "NOTES.md").write_text("\n".join(lines) + "\n")
     return [*written, out / "NOTES.md"]
 
@@ -64,33 +69,62 @@ def write_figures(robot: MobileManipulator, found: dict[str, Experiment], out: P
 def session_of(run: Run, experiment: Experiment, robot: MobileManipulator) -> dict[str, list]:
     """A kinematic run as the messages a recording of it would hold (stamps every DT), so the
     report draws it as it draws a recorded session."""
+
     def header(k: int, frame: str = "world") -> Header:
         return Header(stamp_ns=round(k * DT * 1e9), frame=frame, seq=k, source="reproduce")
 
     task = experiment.task
-    goal = (Goal(header=header(0), task="pose", pose=tuple(task.pose.tolist()))
-            if isinstance(task, PoseTask) else
-            Goal(header=header(0), task="position", position=tuple(task.position.tolist())))
-    session: dict[str, list] = {"control/goal": [goal], "robot/state": [], "base/command": [],
-                                "arm/command": [], "control/diagnostics": []}  # fmt: skip
+    goal = (
+        Goal(header=header(0), task="pose", pose=tuple(task.pose.tolist()))
+        if isinstance(task, PoseTask)
+        else Goal(header=header(0), task="position", position=tuple(task.position.tolist()))
+    )
+    session: dict[str, list] = {
+        "control/goal": [goal],
+        "robot/state": [],
+        "base/command": [],
+        "arm/command": [],
+        "control/diagnostics": [],
+    }
     if experiment.obstacles:
         circles = tuple(CircleMessage(x=c.x, y=c.y, radius=c.radius) for c in experiment.obstacles)
         session["world/obstacles"] = [Obstacles(header=header(0), circles=circles)]
     for k, (q, out) in enumerate(zip(run.configurations, run.outputs, strict=True)):
-        session["robot/state"].append(RobotState(
-            header=header(k), base_pose=tuple(q[:3].tolist()), arm_joints=tuple(q[3:].tolist()),
-            end_effector=tuple(robot.fkm(q).tolist()), valid=True, age_s=0.0))
+        session["robot/state"].append(
+            RobotState(
+                header=header(k),
+                base_pose=tuple(q[:3].tolist()),
+                arm_joints=tuple(q[3:].tolist()),
+                end_effector=tuple(robot.fkm(q).tolist()),
+                valid=True,
+                age_s=0.0,
+            )
+        )
         forward = float(out.u[0] * math.cos(q[2]) + out.u[1] * math.sin(q[2]))
-        session["base/command"].append(BaseCommand(
-            header=header(k, "base"), forward_velocity=forward, angular_velocity=float(out.u[2]),
-            left_wheel=0.0, right_wheel=0.0))
-        session["arm/command"].append(ArmCommand(header=header(k, "arm"),
-                                                 joint_velocities=tuple(out.u[3:].tolist())))
-        session["control/diagnostics"].append(ControllerDiagnostics(
-            header=header(k), law="reproduce", status=out.status, nonzero=out.nonzero,
-            practical_nonzero=out.practical_nonzero, solve_time_us=out.solve_time_s * 1e6,
-            error_norm=out.error_norm))
-    return session  # fmt: skip
+        session["base/command"].append(
+            BaseCommand(
+                header=header(k, "base"),
+                forward_velocity=forward,
+                angular_velocity=float(out.u[2]),
+                left_wheel=0.0,
+                right_wheel=0.0,
+            )
+        )
+        session["arm/command"].append(
+            ArmCommand(header=header(k, "arm"), joint_velocities=tuple(out.u[3:].tolist()))
+        )
+        session["control/diagnostics"].append(
+            ControllerDiagnostics(
+                header=header(k),
+                law="reproduce",
+                status=out.status,
+                nonzero=out.nonzero,
+                practical_nonzero=out.practical_nonzero,
+                solve_time_us=out.solve_time_s * 1e6,
+                error_norm=out.error_norm,
+            )
+        )
+    return session
 
 
 def two_norm_figure(pose: Experiment, robot: MobileManipulator, path: Path) -> Path:
@@ -104,8 +138,11 @@ def two_norm_figure(pose: Experiment, robot: MobileManipulator, path: Path) -> P
         t = np.arange(len(run.outputs)) * DT
         top.plot(t, [np.linalg.norm(out.u) for out in run.outputs], label=label)
         bottom.plot(t, residuals(run, robot, pose.task, pose.eta), label=label)
-    top.set(ylabel="||u||_2", xlim=(0.0, 6.0), title="pose task: the 2-norm of u (metric 2) "
-                                                     "and the residual of J u = -eta e")
+    top.set(
+        ylabel="||u||_2",
+        xlim=(0.0, 6.0),
+        title="pose task: the 2-norm of u (metric 2) and the residual of J u = -eta e",
+    )
     bottom.set(xlabel="t (s)", ylabel="||J u + eta e|| / ||eta e||", yscale="log")
     top.legend(fontsize="small")
     figure.savefig(path, dpi=100)

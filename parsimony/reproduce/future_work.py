@@ -19,16 +19,30 @@ def qp_rows(experiment: Experiment) -> list[Row]:
     runs = {label: experiment.runs[label] for label in (L.LP, L.QP)}
     metrics = {label: list(astuple(control_effort(run))) for label, run in runs.items()}
     return [
-        Row(f"{name}.qp.entries", "7.2 (5)", f"{name}: {L.LP} against {L.QP}, iterations; "
-            "nonzero entries [of u, x' y' as one] while moving", "not done",
-            {label: [len(run.outputs), entry_counts(run)["moving"]] for label, run in
-             runs.items()}, "LP sparser", name, (L.LP, L.QP)),
-        Row(f"{name}.qp.metrics", "7.2 (5)", f"{name}: {L.LP}, {L.QP}, {L.LP} / {L.QP}, "
-            "metrics 1-4", "not done",
-            {**metrics, "LP/QP": [a / b for a, b in zip(metrics[L.LP], metrics[L.QP],
-                                                         strict=True)]},
-            experiment=name, laws=(L.LP, L.QP)),
-    ]  # fmt: skip
+        Row(
+            f"{name}.qp.entries",
+            "7.2 (5)",
+            f"{name}: {L.LP} against {L.QP}, iterations; "
+            "nonzero entries [of u, x' y' as one] while moving",
+            "not done",
+            {label: [len(run.outputs), entry_counts(run)["moving"]] for label, run in runs.items()},
+            "LP sparser",
+            name,
+            (L.LP, L.QP),
+        ),
+        Row(
+            f"{name}.qp.metrics",
+            "7.2 (5)",
+            f"{name}: {L.LP}, {L.QP}, {L.LP} / {L.QP}, metrics 1-4",
+            "not done",
+            {
+                **metrics,
+                "LP/QP": [a / b for a, b in zip(metrics[L.LP], metrics[L.QP], strict=True)],
+            },
+            experiment=name,
+            laws=(L.LP, L.QP),
+        ),
+    ]
 
 
 def input_change_rows(experiment: Experiment) -> list[Row]:
@@ -39,17 +53,35 @@ def input_change_rows(experiment: Experiment) -> list[Row]:
     runs = {label: experiment.runs[label] for label in (L.LP_INPUT_CHANGE, L.LP)}
     found = {}
     for from_rest in (False, True):
-        with_term, without = (list(astuple(control_effort(run, from_rest)))[2 * from_rest:]
-                              for run in runs.values())  # fmt: skip
+        with_term, without = (
+            list(astuple(control_effort(run, from_rest)))[2 * from_rest :] for run in runs.values()
+        )
         found["from rest" if from_rest else "as run"] = {
-            "with": with_term, "LP": without,
-            "ratio": [a / b for a, b in zip(with_term, without, strict=True)]}
+            "with": with_term,
+            "LP": without,
+            "ratio": [a / b for a, b in zip(with_term, without, strict=True)],
+        }
     return [
-        Row(f"{name}.input_change.entries", "7.2 (1)", f"{name}: {L.LP_INPUT_CHANGE} against "
-            f"{L.LP}, iterations; nonzero entries [of u, x' y' as one]", "not done",
+        Row(
+            f"{name}.input_change.entries",
+            "7.2 (1)",
+            f"{name}: {L.LP_INPUT_CHANGE} against "
+            f"{L.LP}, iterations; nonzero entries [of u, x' y' as one]",
+            "not done",
             {label: [len(run.outputs), entry_counts(run)] for label, run in runs.items()},
-            "the same entries", name, (L.LP_INPUT_CHANGE, L.LP)),
-        Row(f"{name}.input_change.metrics", "7.2 (1)", f"{name}: {L.LP_INPUT_CHANGE} (with), "
-            f"{L.LP} and their ratio, metrics 1-4; 3 and 4 from rest", "not done",
-            found, "ratio of 3 and 4 < 1", name, (L.LP_INPUT_CHANGE, L.LP)),
-    ]  # fmt: skip
+            "the same entries",
+            name,
+            (L.LP_INPUT_CHANGE, L.LP),
+        ),
+        Row(
+            f"{name}.input_change.metrics",
+            "7.2 (1)",
+            f"{name}: {L.LP_INPUT_CHANGE} (with), "
+            f"{L.LP} and their ratio, metrics 1-4; 3 and 4 from rest",
+            "not done",
+            found,
+            "ratio of 3 and 4 < 1",
+            name,
+            (L.LP_INPUT_CHANGE, L.LP),
+        ),
+    ]

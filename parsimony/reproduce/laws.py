@@ -34,9 +34,18 @@ LP_INPUT_CHANGE = "LP + input change"
 LP_BORDER = "LP, 5.28 + circulation + 5.7"
 """The obstacle experiment's law with 5.28 in place of the vector-field inequality."""
 
-BARE = dict(velocity_cost=0.0, waist_hold=0.0, waist_centring=0.0, obstacle_circulation=0.0,
-            base_target=0.0, input_change=0.0, arm_obstacles=False, obstacle_mode="border",
-            obstacle_lookahead=0.0, error_bound="derivative")  # fmt: skip
+BARE = dict(
+    velocity_cost=0.0,
+    waist_hold=0.0,
+    waist_centring=0.0,
+    obstacle_circulation=0.0,
+    base_target=0.0,
+    input_change=0.0,
+    arm_obstacles=False,
+    obstacle_mode="border",
+    obstacle_lookahead=0.0,
+    error_bound="derivative",
+)
 """What turns an LPParams into 5.29 as the dissertation writes it: no term beside the task
 residual, 5.28 on the axle centre (d = 0), 5.10, no rows of this project's."""
 
@@ -55,26 +64,30 @@ def speed_bounds(robot: MobileManipulator) -> str:
         return "no speed bound"
     arm = np.unique(bounds[BASE_DOF:])
     arm_text = f"{arm[0]:g}" if len(arm) == 1 else "/".join(f"{b:g}" for b in bounds[BASE_DOF:])
-    return (f"|x'|, |y'| <= {bounds[0]:g} m/s, |phi'| <= {bounds[2]:g} rad/s, "
-            f"|q'| <= {arm_text} rad/s")  # fmt: skip
+    return (
+        f"|x'|, |y'| <= {bounds[0]:g} m/s, |phi'| <= {bounds[2]:g} rad/s, |q'| <= {arm_text} rad/s"
+    )
 
 
 def constraint_text(name: str, p: LPParams, robot: MobileManipulator) -> str:
     """One row group of the program in words, with the equation it writes."""
-    ahead = f"on the point {p.obstacle_lookahead:g} m ahead of the axle" \
-        if p.obstacle_lookahead else "on the axle centre"
+    ahead = (
+        f"on the point {p.obstacle_lookahead:g} m ahead of the axle"
+        if p.obstacle_lookahead
+        else "on the axle centre"
+    )
     reach = f"R = obstacle + body + {p.obstacle_margin:g} m"
     texts = {
         "nonholonomic": "5.12",
         "joint_limits": f"5.15 (k {p.joint_gain:g}, b_l {p.safety_factor:g}; "
-                        f"{speed_bounds(robot)})",
+        f"{speed_bounds(robot)})",
         "error_derivative_bound": f"5.10 (beta {p.beta:g})",
         "error_bound": f"5.7 (beta {p.beta:g}, on ||e||_1)",
         "obstacle_border": f"5.28 (lambda {p.obstacle_gain:g}, {ahead}, {reach})",
         "obstacle_vector_field": f"the vector-field inequality d' >= -{p.obstacle_gain:g} d in "
-                                 f"place of 5.28 ({ahead}, {reach})",
+        f"place of 5.28 ({ahead}, {reach})",
         "obstacle_conservative": f"5.19 ({reach})",
-    }  # fmt: skip
+    }
     return texts.get(name, name)
 
 
@@ -83,15 +96,23 @@ def describe(law: Law, obstacles: tuple[Obstacle, ...] = ()) -> str:
     there are obstacles, the 3-D rows only where there are solids: else they give none)."""
     if isinstance(law, CascadeLaw):
         p = law.params
-        bounds = (f"saturated: (v, phi') scaled into {speed_bounds(law.robot)} and wheels <= "
-                  f"{law.robot.base.wheel_speed_max:g} m/s, each joint clipped"
-                  if p.saturate else "no bound on u")  # fmt: skip
-        return (f"appendix B: u = -J^+ eta e (B.1), eta {p.eta:.3g}; the base by the "
-                f"linearising inner loop (d {p.offset:g} m, k1 {p.k1:g}, k2 {p.k2:g}); "
-                f"{bounds}")  # fmt: skip
+        bounds = (
+            f"saturated: (v, phi') scaled into {speed_bounds(law.robot)} and wheels <= "
+            f"{law.robot.base.wheel_speed_max:g} m/s, each joint clipped"
+            if p.saturate
+            else "no bound on u"
+        )
+        return (
+            f"appendix B: u = -J^+ eta e (B.1), eta {p.eta:.3g}; the base by the "
+            f"linearising inner loop (d {p.offset:g} m, k1 {p.k1:g}, k2 {p.k2:g}); "
+            f"{bounds}"
+        )
     if isinstance(law, PseudoinverseLaw):
-        under = "of J N (N spanning what 5.11 allows)" if law.params.nonholonomic else \
-            "holonomic base (5.3)"
+        under = (
+            "of J N (N spanning what 5.11 allows)"
+            if law.params.nonholonomic
+            else "holonomic base (5.3)"
+        )
         return f"u = -J^+ eta e, {under}, eta {law.params.eta:g}; no bound on u"
     if not isinstance(law, LPLaw | QPLaw):
         return type(law).__name__
@@ -101,11 +122,18 @@ def describe(law: Law, obstacles: tuple[Obstacle, ...] = ()) -> str:
     constraints = default_constraints(p) if constraints is None else constraints
     objectives = getattr(law, "objectives", None)
     objectives = default_objectives(p) if objectives is None else objectives
-    rows = [constraint_text(c.name, p, law.robot) for c in constraints
-            if (c.name != "arm_obstacles" or solids)
-            and (not c.name.startswith("obstacle") or circles)]  # fmt: skip
-    terms = [f"{t.name} {getattr(p, dataclasses.fields(type(t).gains[-1])[0].name):g}"
-             for t in objectives if circles or t.name != "obstacle_circulation"]  # fmt: skip
+    rows = [
+        constraint_text(c.name, p, law.robot)
+        for c in constraints
+        if (c.name != "arm_obstacles" or solids) and (not c.name.startswith("obstacle") or circles)
+    ]
+    terms = [
+        f"{t.name} {getattr(p, dataclasses.fields(type(t).gains[-1])[0].name):g}"
+        for t in objectives
+        if circles or t.name != "obstacle_circulation"
+    ]
     norm = "||J u + eta e||_2^2 (QP)" if isinstance(law, QPLaw) else "||J u + eta e||_1"
-    return (f"min {norm}, eta {p.eta:g}, subject to {'; '.join(rows) or 'nothing'}; terms "
-            f"beside the task: {', '.join(terms) or 'none (5.29 exactly)'}")
+    return (
+        f"min {norm}, eta {p.eta:g}, subject to {'; '.join(rows) or 'nothing'}; terms "
+        f"beside the task: {', '.join(terms) or 'none (5.29 exactly)'}"
+    )

@@ -35,14 +35,15 @@ from wbc.scenarios import OBSTACLE
 
 PLACE = "on the loop"
 """How a row of the loop is labelled."""
-LOOP_LAWS = {"pose": R.MAIN, "position": R.MAIN,
-             "obstacle": (L.LP, L.LP_BORDER, L.LP_5_29)}  # fmt: skip
+LOOP_LAWS = {"pose": R.MAIN, "position": R.MAIN, "obstacle": (L.LP, L.LP_BORDER, L.LP_5_29)}
 """The set-ups of 6.2 and the laws each runs on the loop: those of its rows in 6.2 that a
 controller process runs (not the pseudoinverse nor a law without the robot's bounds)."""
 LABELS = tuple(dict.fromkeys(label for labels in LOOP_LAWS.values() for label in labels))
-FRAMES = ("u, headings and the residual in F0, the reference marker's frame, which the "
-          "controller steps in (yaw 0.3 rad in the simulator's world); paths and clearance "
-          "from the simulator's truth in its world, the kinematic runs' frame")  # fmt: skip
+FRAMES = (
+    "u, headings and the residual in F0, the reference marker's frame, which the "
+    "controller steps in (yaw 0.3 rad in the simulator's world); paths and clearance "
+    "from the simulator's truth in its world, the kinematic runs' frame"
+)
 
 
 def controller_of(law: Law, name: str) -> tuple[str, dict[str, Any]]:
@@ -56,8 +57,11 @@ def controller_of(law: Law, name: str) -> tuple[str, dict[str, Any]]:
 
 
 def changed(params: Any, base: Any) -> dict[str, Any]:
-    return {f.name: getattr(params, f.name) for f in dataclasses.fields(params)
-            if getattr(params, f.name) != getattr(base, f.name)}  # fmt: skip
+    return {
+        f.name: getattr(params, f.name)
+        for f in dataclasses.fields(params)
+        if getattr(params, f.name) != getattr(base, f.name)
+    }
 
 
 def folder(label: str) -> str:
@@ -65,54 +69,92 @@ def folder(label: str) -> str:
     return re.sub(r"[^A-Za-z0-9.]+", "_", label).strip("_")
 
 
-def run_loop(robot: MobileManipulator, names: tuple[str, ...], labels: tuple[str, ...],
-             out: Path, time_limit_s: float
-             ) -> tuple[dict[str, Experiment], list[dict]]:  # fmt: skip
+def run_loop(
+    robot: MobileManipulator,
+    names: tuple[str, ...],
+    labels: tuple[str, ...],
+    out: Path,
+    time_limit_s: float,
+) -> tuple[dict[str, Experiment], list[dict]]:
     """Each law of ``labels`` in each set-up of ``names`` on the loop, its run in
     ``out/NAME/LABEL`` (recording, report, figures): the experiments as the rows take them,
     and what each run was (its controller, gains, verdict and wall time)."""
-    chosen = [(name, label) for name in NAMES if name in names and name in LOOP_LAWS
-              for label in LOOP_LAWS[name] if label in labels]  # fmt: skip
+    chosen = [
+        (name, label)
+        for name in NAMES
+        if name in names and name in LOOP_LAWS
+        for label in LOOP_LAWS[name]
+        if label in labels
+    ]
     runs: dict[str, dict[str, Any]] = {}
     done: list[dict] = []
     for count, (name, label) in enumerate(chosen, 1):
         law = laws_of(robot, name)[label]
         controller, gains = controller_of(law, name)
         where = out / name / folder(label)
-        print(f"[reproduce] the loop, {count}/{len(chosen)}: {name}, {label}", file=sys.stderr,
-              flush=True)  # fmt: skip
-        report = run_experiment(Options(name, controller, where, time_limit_s=time_limit_s,
-                                        gains=gains))  # fmt: skip
+        print(
+            f"[reproduce] the loop, {count}/{len(chosen)}: {name}, {label}",
+            file=sys.stderr,
+            flush=True,
+        )
+        report = run_experiment(
+            Options(name, controller, where, time_limit_s=time_limit_s, gains=gains)
+        )
         obstacles = (OBSTACLE,) if name == "obstacle" else ()
-        ran = (f"the whole loop in lockstep ({PROFILES[controller].name}: camera, vision "
-               "tracker, estimator, controller), its base command scaled into the wheel speed "
-               f"limit as every controller sends it; {L.describe(law, obstacles)}")  # fmt: skip
-        runs.setdefault(name, {})[label] = (recorded(where / SESSION_FILE, time_limit_s),
-                                            law.params.eta, ran)  # fmt: skip
-        done.append({"experiment": name, "label": label, "controller": controller,
-                     "gains": gains, "out": str(where), "report": report})  # fmt: skip
-    until = (f"||e|| < {CONVERGED_ERROR:g} held {HOLD_S:g} s (the loop's rule), else "
-             f"{time_limit_s:g} s")  # fmt: skip
+        ran = (
+            f"the whole loop in lockstep ({PROFILES[controller].name}: camera, vision "
+            "tracker, estimator, controller), its base command scaled into the wheel speed "
+            f"limit as every controller sends it; {L.describe(law, obstacles)}"
+        )
+        runs.setdefault(name, {})[label] = (
+            recorded(where / SESSION_FILE, time_limit_s),
+            law.params.eta,
+            ran,
+        )
+        done.append(
+            {
+                "experiment": name,
+                "label": label,
+                "controller": controller,
+                "gains": gains,
+                "out": str(where),
+                "report": report,
+            }
+        )
+    until = (
+        f"||e|| < {CONVERGED_ERROR:g} held {HOLD_S:g} s (the loop's rule), else {time_limit_s:g} s"
+    )
     found = {}
     for name, made in runs.items():
         first, eta, _ = next(iter(made.values()))
         found[name] = Experiment(
-            name, first.goal, eta, {label: r.run for label, (r, _, _) in made.items()},
+            name,
+            first.goal,
+            eta,
+            {label: r.run for label, (r, _, _) in made.items()},
             {label: ran for label, (_, _, ran) in made.items()},
             (OBSTACLE,) if name == "obstacle" else (),
             {label: r.tasks for label, (r, _, _) in made.items()},
-            {label: r.truth for label, (r, _, _) in made.items()}, until)  # fmt: skip
+            {label: r.truth for label, (r, _, _) in made.items()},
+            until,
+        )
     return found, done
 
 
-def loop_rows(robot: MobileManipulator, found: dict[str, Experiment], done: list[dict]
-              ) -> list[Row]:  # fmt: skip
+def loop_rows(
+    robot: MobileManipulator, found: dict[str, Experiment], done: list[dict]
+) -> list[Row]:
     """The rows of 6.2, table 6.1 and 6.3's step time of the runs ``found``, each labelled as
     on the loop, and the controller's whole step from its counters."""
-    rows = [row for name in ("pose", "position") if name in found
-            for row in R.task_rows(robot, found[name])]  # fmt: skip
-    rows += [row for name in ("pose", "position") if name in found
-             for row in R.effort_rows(found[name])]  # fmt: skip
+    rows = [
+        row
+        for name in ("pose", "position")
+        if name in found
+        for row in R.task_rows(robot, found[name])
+    ]
+    rows += [
+        row for name in ("pose", "position") if name in found for row in R.effort_rows(found[name])
+    ]
     if "obstacle" in found:
         rows += R.obstacle_rows(robot, found["obstacle"])
     rows += R.step_time_rows(found)
@@ -123,8 +165,11 @@ def loop_rows(robot: MobileManipulator, found: dict[str, Experiment], done: list
 def on_loop(row: Row) -> Row:
     """``row`` labelled as on the loop: its key, its result and its experiments."""
     return dataclasses.replace(
-        row, key=f"loop.{row.key}", result=f"{PLACE}: {row.result}",
-        experiment=", ".join(f"{name} {PLACE}" for name in row.experiment.split(", ")))
+        row,
+        key=f"loop.{row.key}",
+        result=f"{PLACE}: {row.result}",
+        experiment=", ".join(f"{name} {PLACE}" for name in row.experiment.split(", ")),
+    )
 
 
 HANDLER = "handler.robot/state_us"
@@ -140,13 +185,26 @@ def handler_rows(done: list[dict]) -> list[Row]:
         found = {}
         for run in runs:
             counters = run["report"]["durations_us"].get("controller", {})
-            found[run["experiment"]] = [counters.get(f"{HANDLER}_median", 0) / 1e3,
-                                        counters.get(f"{HANDLER}_p99", 0) / 1e3]  # fmt: skip
+            found[run["experiment"]] = [
+                counters.get(f"{HANDLER}_median", 0) / 1e3,
+                counters.get(f"{HANDLER}_p99", 0) / 1e3,
+            ]
         names = ", ".join(f"{run['experiment']} {PLACE}" for run in runs)
-        out.append(Row(f"loop.step_time.{label}.handler", "6.3", f"{PLACE}: {label}: the "
-                       "controller's whole step (its handling of a state: the law and the "
-                       "messages), median and p99 of each run, ms", f"under {R.PERIOD_MS:g} ms",
-                       found, f"p99 < {R.PERIOD_MS:g}", names, (label,), timed=True))
+        out.append(
+            Row(
+                f"loop.step_time.{label}.handler",
+                "6.3",
+                f"{PLACE}: {label}: the "
+                "controller's whole step (its handling of a state: the law and the "
+                "messages), median and p99 of each run, ms",
+                f"under {R.PERIOD_MS:g} ms",
+                found,
+                f"p99 < {R.PERIOD_MS:g}",
+                names,
+                (label,),
+                timed=True,
+            )
+        )
     return out
 
 
@@ -166,26 +224,47 @@ def beside(rows: list[Row], loop: list[Row]) -> list[Row]:
 
 def summary(done: list[dict], wall_s: float) -> dict:
     """What the loop ran and how long it took."""
-    return {"wall_s": round(wall_s, 1),
-            "sim_s": round(sum(run["report"]["sim_time_s"] for run in done), 2),
-            "runs": [{k: run[k] for k in ("experiment", "label", "controller", "gains", "out")}
-                     | {k: run["report"][k] for k in ("converged", "sim_time_s", "wall_time_s",
-                                                      "real_time_factor", "lockstep_timeouts")}
-                     for run in done]}  # fmt: skip
+    return {
+        "wall_s": round(wall_s, 1),
+        "sim_s": round(sum(run["report"]["sim_time_s"] for run in done), 2),
+        "runs": [
+            {k: run[k] for k in ("experiment", "label", "controller", "gains", "out")}
+            | {
+                k: run["report"][k]
+                for k in (
+                    "converged",
+                    "sim_time_s",
+                    "wall_time_s",
+                    "real_time_factor",
+                    "lockstep_timeouts",
+                )
+            }
+            for run in done
+        ],
+    }
 
 
 def summary_line(ran: dict) -> str:
     """The loop's run time (``summary``), as the command prints it."""
-    return (f"The whole loop (lockstep): {len(ran['runs'])} runs, {ran['sim_s']:g} s "
-            f"simulated in {ran['wall_s']:g} s of wall time; {FRAMES}.")
+    return (
+        f"The whole loop (lockstep): {len(ran['runs'])} runs, {ran['sim_s']:g} s "
+        f"simulated in {ran['wall_s']:g} s of wall time; {FRAMES}."
+    )
 
 
-def loop(robot: MobileManipulator, names: tuple[str, ...], labels: tuple[str, ...], out: Path,
-         time_limit_s: float) -> tuple[list[Row], list[dict[str, str]], dict]:  # fmt: skip
+def loop(
+    robot: MobileManipulator,
+    names: tuple[str, ...],
+    labels: tuple[str, ...],
+    out: Path,
+    time_limit_s: float,
+) -> tuple[list[Row], list[dict[str, str]], dict]:
     """The rows of the loop, what each law ran there, and the summary (``summary``)."""
     started = time.monotonic()
     found, done = run_loop(robot, names, labels, out, time_limit_s)
-    laws = [{"experiment": f"{name} {PLACE}", "label": label, "ran": text}
-            for name, experiment in found.items()
-            for label, text in experiment.laws.items()]  # fmt: skip
+    laws = [
+        {"experiment": f"{name} {PLACE}", "label": label, "ran": text}
+        for name, experiment in found.items()
+        for label, text in experiment.laws.items()
+    ]
     return loop_rows(robot, found, done), laws, summary(done, time.monotonic() - started)

@@ -33,8 +33,10 @@ def median(values: list[float]) -> float:
 def both_rules(masks: list[int]) -> list[float]:
     """The median count of ``masks`` (entry masks, ``wbc.law_output.entry_mask``) as
     [entries of u, entries with x' and y' as one]."""
-    return [median([m.bit_count() for m in masks]),
-            median([m.bit_count() - (m & 3 == 3) for m in masks])]  # fmt: skip
+    return [
+        median([m.bit_count() for m in masks]),
+        median([m.bit_count() - (m & 3 == 3) for m in masks]),
+    ]
 
 
 def entry_counts(run: Run, practical: bool = False) -> dict[str, list[float]]:
@@ -44,7 +46,7 @@ def entry_counts(run: Run, practical: bool = False) -> dict[str, list[float]]:
     that has turned off an axis of the world frame needs both."""
     masks = [entry_mask(out.u, practical) for out in run.outputs]
     moving = [m for m, o in zip(masks, run.outputs, strict=True) if o.error_norm > MOVING_ERROR]
-    last = masks[-round(SETTLING_S / run.dt):]
+    last = masks[-round(SETTLING_S / run.dt) :]
     return {"moving": both_rules(moving), f"last {SETTLING_S:g} s": both_rules(last)}
 
 
@@ -54,21 +56,24 @@ def task_terms(robot: MobileManipulator, task: Task, q: np.ndarray) -> tuple[np.
     return task.error(pose, jacobian, q)
 
 
-def residuals(run: Run, robot: MobileManipulator, task: Task | Sequence[Task], eta: float
-              ) -> list[float]:  # fmt: skip
+def residuals(
+    run: Run, robot: MobileManipulator, task: Task | Sequence[Task], eta: float
+) -> list[float]:
     """||J u + eta e|| / ||eta e|| at each step (of ``task``, or of the task of each step):
     0 where u realises J u = -eta e."""
     tasks = task if isinstance(task, Sequence) else [task] * len(run.outputs)
     out = []
     for q, step, current in zip(run.configurations, run.outputs, tasks, strict=True):
         error, jacobian = task_terms(robot, current, q)
-        out.append(float(np.linalg.norm(jacobian @ step.u + eta * error)
-                         / np.linalg.norm(eta * error)))  # fmt: skip
+        out.append(
+            float(np.linalg.norm(jacobian @ step.u + eta * error) / np.linalg.norm(eta * error))
+        )
     return out
 
 
-def least_residual(robot: MobileManipulator, task: Task, q: np.ndarray, nonholonomic: bool
-                   ) -> float:  # fmt: skip
+def least_residual(
+    robot: MobileManipulator, task: Task, q: np.ndarray, nonholonomic: bool
+) -> float:
     """The least ||J u + eta e|| / ||eta e|| any u reaches at ``q`` (under 5.11 with
     ``nonholonomic``): the part of e outside the range of J (or of J N)."""
     error, jacobian = task_terms(robot, task, q)
@@ -100,17 +105,24 @@ def speeds(run: Run, robot: MobileManipulator) -> dict:
         for name in out.active_constraints:
             if name.startswith("joint_limits["):
                 rows[int(name[13:-1])] += 1
-    return {"steps beyond a bound": int(beyond.sum()),
-            "on a speed bound": {ENTRIES[i]: int(n) for i, n in enumerate(on) if n},
-            "on a bound of 5.15": {ENTRIES[i]: n for i, n in enumerate(rows) if n},
-            "peak base m/s": float(np.hypot(u[:, 0], u[:, 1]).max()),
-            "peak |phi'|": float(np.abs(u[:, 2]).max()),
-            "peak wheel m/s": float(wheels.max()),
-            "phi range": [float(phi.min()), float(phi.max())]}  # fmt: skip
+    return {
+        "steps beyond a bound": int(beyond.sum()),
+        "on a speed bound": {ENTRIES[i]: int(n) for i, n in enumerate(on) if n},
+        "on a bound of 5.15": {ENTRIES[i]: n for i, n in enumerate(rows) if n},
+        "peak base m/s": float(np.hypot(u[:, 0], u[:, 1]).max()),
+        "peak |phi'|": float(np.abs(u[:, 2]).max()),
+        "peak wheel m/s": float(wheels.max()),
+        "phi range": [float(phi.min()), float(phi.max())],
+    }
 
 
-BINDING = {"nonholonomic": "5.12", "error_derivative_bound": "5.10", "error_bound": "5.7",
-           "obstacle_border": "5.28", "obstacle_vector_field": "the vector-field inequality"}
+BINDING = {
+    "nonholonomic": "5.12",
+    "error_derivative_bound": "5.10",
+    "error_bound": "5.7",
+    "obstacle_border": "5.28",
+    "obstacle_vector_field": "the vector-field inequality",
+}
 """The equation of each row group a law reports as active (``LawOutput.active_constraints``)."""
 
 
@@ -124,8 +136,11 @@ def binding(name: str) -> str:
 def first_step(run: Run) -> dict:
     """u of the first step, its 2-norm and the rows that bind there (a law that reports them)."""
     out = run.outputs[0]
-    return {"u": [round(float(v), 3) for v in out.u], "||u||_2": float(np.linalg.norm(out.u)),
-            "binding": [binding(name) for name in out.active_constraints]}  # fmt: skip
+    return {
+        "u": [round(float(v), 3) for v in out.u],
+        "||u||_2": float(np.linalg.norm(out.u)),
+        "binding": [binding(name) for name in out.active_constraints],
+    }
 
 
 def abruptness(run: Run) -> dict:
@@ -136,10 +151,12 @@ def abruptness(run: Run) -> dict:
     jumps = np.abs(np.diff(u, axis=0))
     step, entry = np.unravel_index(int(np.argmax(jumps)), jumps.shape) if len(jumps) else (0, 0)
     masks = [entry_mask(out.u) for out in run.outputs]
-    return {"total variation": float(jumps.sum()),
-            "largest jump": float(jumps.max()) if len(jumps) else 0.0,
-            "at": f"{ENTRIES[entry]}, t {(step + 1) * run.dt:.2f} s",
-            "switches": sum(a != b for a, b in zip(masks, masks[1:], strict=False))}  # fmt: skip
+    return {
+        "total variation": float(jumps.sum()),
+        "largest jump": float(jumps.max()) if len(jumps) else 0.0,
+        "at": f"{ENTRIES[entry]}, t {(step + 1) * run.dt:.2f} s",
+        "switches": sum(a != b for a, b in zip(masks, masks[1:], strict=False)),
+    }
 
 
 def end_effector_path(run: Run, robot: MobileManipulator, goal: np.ndarray) -> dict:
@@ -150,14 +167,18 @@ def end_effector_path(run: Run, robot: MobileManipulator, goal: np.ndarray) -> d
     line = goal - start
     along = np.clip((points - start) @ line / (line @ line), 0.0, 1.0)
     off = np.linalg.norm(points - start - along[:, None] * line, axis=1)
-    return {"length / straight line": float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum()
-                                            / np.linalg.norm(line)),
-            "largest distance from the line m": float(off.max()),
-            "final distance m": float(np.linalg.norm(points[-1] - goal))}  # fmt: skip
+    return {
+        "length / straight line": float(
+            np.linalg.norm(np.diff(points, axis=0), axis=1).sum() / np.linalg.norm(line)
+        ),
+        "largest distance from the line m": float(off.max()),
+        "final distance m": float(np.linalg.norm(points[-1] - goal)),
+    }
 
 
-def round_obstacle(run: Run, robot: MobileManipulator, obstacle: Circle, goal_xy: np.ndarray
-                   ) -> dict:  # fmt: skip
+def round_obstacle(
+    run: Run, robot: MobileManipulator, obstacle: Circle, goal_xy: np.ndarray
+) -> dict:
     """Figure 6.16: the base going round ``obstacle`` on its way from its start towards
     ``goal_xy``: the least clearance of its body, its largest distance to either side of the
     straight line start-goal (left positive), whether it passed the obstacle along that line,
@@ -169,34 +190,48 @@ def round_obstacle(run: Run, robot: MobileManipulator, obstacle: Circle, goal_xy
     unit = line / np.linalg.norm(line)
     side = (base - start) @ np.array([-unit[1], unit[0]])
     gap = np.hypot(base[:, 0] - obstacle.x, base[:, 1] - obstacle.y) - obstacle.radius
-    passed = bool(((base - start) @ unit).max() > (np.array([obstacle.x, obstacle.y]) - start)
-                  @ unit + obstacle.radius)  # fmt: skip
+    passed = bool(
+        ((base - start) @ unit).max()
+        > (np.array([obstacle.x, obstacle.y]) - start) @ unit + obstacle.radius
+    )
     still = sum(out.nonzero == 0 and out.error_norm > MOVING_ERROR for out in run.outputs)
-    bound = sum(any(name in ERROR_BOUNDS for name in out.active_constraints)
-                for out in run.outputs)  # fmt: skip
-    return {"least clearance m": float(gap.min() - robot.base.body_radius),
-            "lateral excursion m": [float(side.min()), float(side.max())],
-            "passed it": passed, "steps standing still": int(still),
-            "steps on the bound of 5.10 / 5.7": int(bound)}  # fmt: skip
+    bound = sum(any(name in ERROR_BOUNDS for name in out.active_constraints) for out in run.outputs)
+    return {
+        "least clearance m": float(gap.min() - robot.base.body_radius),
+        "lateral excursion m": [float(side.min()), float(side.max())],
+        "passed it": passed,
+        "steps standing still": int(still),
+        "steps on the bound of 5.10 / 5.7": int(bound),
+    }
 
 
 def obstacle_entries(run: Run) -> dict:
     """Figure 6.17 under one rule: median entries (x', y' as one in brackets) over the run and
     while an obstacle row is active, and the steps with all 8."""
     masks = [entry_mask(out.u) for out in run.outputs]
-    engaged = [m for m, out in zip(masks, run.outputs, strict=True)
-               if any(name.startswith("obstacle") for name in out.active_constraints)]
-    return {"run": both_rules(masks), "obstacle row active": both_rules(engaged),
-            "steps with the row active": len(engaged),
-            "steps with 8": sum(m.bit_count() == 8 for m in masks)}  # fmt: skip
+    engaged = [
+        m
+        for m, out in zip(masks, run.outputs, strict=True)
+        if any(name.startswith("obstacle") for name in out.active_constraints)
+    ]
+    return {
+        "run": both_rules(masks),
+        "obstacle row active": both_rules(engaged),
+        "steps with the row active": len(engaged),
+        "steps with 8": sum(m.bit_count() == 8 for m in masks),
+    }
 
 
 def step_times_ms(runs: list[Run]) -> dict:
     """The law's own step (model, Jacobian, rows, solve; not the loop's messages): p50, p99
     and the largest, ms, over every step of ``runs``."""
     times = np.array([out.solve_time_s for run in runs for out in run.outputs]) * 1e3
-    return {"steps": len(times), "p50": float(np.percentile(times, 50)),
-            "p99": float(np.percentile(times, 99)), "max": float(times.max())}  # fmt: skip
+    return {
+        "steps": len(times),
+        "p50": float(np.percentile(times, 50)),
+        "p99": float(np.percentile(times, 99)),
+        "max": float(times.max()),
+    }
 
 
 def worst_overrun(run: Run, robot: MobileManipulator) -> list:

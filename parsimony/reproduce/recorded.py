@@ -48,8 +48,11 @@ def recorded(path: Path, time_limit_s: float) -> Recorded:
     stamps, u = commands(run)
     inputs = dict(zip(stamps.tolist(), u, strict=True))
     states = {s.header.stamp_ns: s for s in required(run, ROBOT_STATE)}
-    steps = [d for d in required(run, CONTROL_DIAGNOSTICS)
-             if d.header.stamp_ns in states and d.header.stamp_ns in inputs]  # fmt: skip
+    steps = [
+        d
+        for d in required(run, CONTROL_DIAGNOSTICS)
+        if d.header.stamp_ns in states and d.header.stamp_ns in inputs
+    ]
     first = next((i for i, d in enumerate(steps) if d.status == "optimal"), None)
     if first is None:
         raise ValueError(f"{path}: the controller never stepped its law (no optimal step)")
@@ -64,19 +67,40 @@ def recorded(path: Path, time_limit_s: float) -> Recorded:
     outputs, error = [], math.nan
     for d in steps:
         error = d.error_norm if d.error_norm is not None else error  # a zero step: the last
-        outputs.append(LawOutput(inputs[d.header.stamp_ns], d.status, d.objective, d.nonzero,
-                                 d.practical_nonzero, d.active_constraints,
-                                 d.solve_time_us * 1e-6, error))  # fmt: skip
-    estimated = Run(dt=dt, outputs=outputs, reached=converged,
-                    configurations=[np.array(states[s].configuration()) for s in step_stamps])
-    true = Run(dt=dt, outputs=outputs, reached=converged,
-               configurations=[np.array(truth[i].configuration())
-                               for i in nearest(truth_stamps, step_stamps)])  # fmt: skip
+        outputs.append(
+            LawOutput(
+                inputs[d.header.stamp_ns],
+                d.status,
+                d.objective,
+                d.nonzero,
+                d.practical_nonzero,
+                d.active_constraints,
+                d.solve_time_us * 1e-6,
+                error,
+            )
+        )
+    estimated = Run(
+        dt=dt,
+        outputs=outputs,
+        reached=converged,
+        configurations=[np.array(states[s].configuration()) for s in step_stamps],
+    )
+    true = Run(
+        dt=dt,
+        outputs=outputs,
+        reached=converged,
+        configurations=[
+            np.array(truth[i].configuration()) for i in nearest(truth_stamps, step_stamps)
+        ],
+    )
     kind = task_of(goals[-1])
     placed = np.array(truth[-1].goal) if truth[-1].goal is not None else None
     if placed is None:
         raise ValueError(f"{path}: its ground truth does not say where the goal was placed")
-    goal = PositionTask(dq.translation(placed)[1:]) if isinstance(kind, PositionTask) else \
-        PoseTask(placed)  # fmt: skip
+    goal = (
+        PositionTask(dq.translation(placed)[1:])
+        if isinstance(kind, PositionTask)
+        else PoseTask(placed)
+    )
     made = {i: task_of(goals[i]) for i in set(held.tolist())}
     return Recorded(estimated, true, [made[i] for i in held.tolist()], goal)

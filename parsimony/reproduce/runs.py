@@ -60,21 +60,32 @@ class Experiment:
         return self.truth.get(label, self.runs[label])
 
 
-def run_laws(name: str, task: Task, eta: float, laws: dict[str, Law],
-             obstacles: tuple[Obstacle, ...] = ()) -> Experiment:  # fmt: skip
-    runs = {label: integrate(law, HOME, task, DT, STEPS, obstacles=obstacles)
-            for label, law in laws.items()}  # fmt: skip
-    return Experiment(name, task, eta, runs,
-                      {label: L.describe(law, obstacles) for label, law in laws.items()},
-                      obstacles)  # fmt: skip
+def run_laws(
+    name: str, task: Task, eta: float, laws: dict[str, Law], obstacles: tuple[Obstacle, ...] = ()
+) -> Experiment:
+    runs = {
+        label: integrate(law, HOME, task, DT, STEPS, obstacles=obstacles)
+        for label, law in laws.items()
+    }
+    return Experiment(
+        name,
+        task,
+        eta,
+        runs,
+        {label: L.describe(law, obstacles) for label, law in laws.items()},
+        obstacles,
+    )
 
 
 def task_of(robot: MobileManipulator, name: str) -> Task:
     """The task of set-up ``name`` (one of ``NAMES``)."""
     reach = robot.fkm(REACH_GOAL)
-    return {"pose": PoseTask(reach), "position": PositionTask(dq.translation(reach)[1:]),
-            "joint_limit": PoseTask(robot.fkm(JOINT_LIMIT_GOAL)),
-            "obstacle": PoseTask(robot.fkm(OBSTACLE_GOAL))}[name]  # fmt: skip
+    return {
+        "pose": PoseTask(reach),
+        "position": PositionTask(dq.translation(reach)[1:]),
+        "joint_limit": PoseTask(robot.fkm(JOINT_LIMIT_GOAL)),
+        "obstacle": PoseTask(robot.fkm(OBSTACLE_GOAL)),
+    }[name]
 
 
 def laws_of(robot: MobileManipulator, name: str) -> dict[str, Law]:
@@ -86,14 +97,18 @@ def laws_of(robot: MobileManipulator, name: str) -> dict[str, Law]:
     written (no cascade: appendix B has no obstacle row)."""
     pose = LP_PARAMS["pose"]
     if name == "obstacle":
-        return {L.LP: LPLaw(robot, LP_PARAMS["obstacle"]), L.LP_BORDER: LPLaw(robot, BORDER_PARAMS),
-                L.LP_5_29: LPLaw(robot, L.bare_5_29(pose))}  # fmt: skip
+        return {
+            L.LP: LPLaw(robot, LP_PARAMS["obstacle"]),
+            L.LP_BORDER: LPLaw(robot, BORDER_PARAMS),
+            L.LP_5_29: LPLaw(robot, L.bare_5_29(pose)),
+        }
     params = pose if name == "joint_limit" else LP_PARAMS[name]
     laws: dict[str, Law] = {
-        L.LP: LPLaw(robot, params), L.LP_5_29: LPLaw(robot, L.bare_5_29(params)),
+        L.LP: LPLaw(robot, params),
+        L.LP_5_29: LPLaw(robot, L.bare_5_29(params)),
         L.CASCADE: CascadeLaw(robot, CascadeParams(eta=params.eta)),
         L.SATURATED: CascadeLaw(robot, CascadeParams(eta=params.eta, saturate=True)),
-    }  # fmt: skip
+    }
     if name == "joint_limit":
         return laws
     free = robot.with_velocity_max(np.full(robot.dof, UNBOUNDED_SPEED))
@@ -102,11 +117,10 @@ def laws_of(robot: MobileManipulator, name: str) -> dict[str, Law]:
         L.PINV_5_11: PseudoinverseLaw(robot, PinvParams(eta=params.eta, nonholonomic=True)),
         L.QP: QPLaw(robot, QPParams(eta=params.eta, beta=params.beta)),
         L.LP_INPUT_CHANGE: LPLaw(robot, replace(params, **input_change_gains())),
-    }  # fmt: skip
+    }
 
 
-def experiments(robot: MobileManipulator, names: tuple[str, ...] = NAMES
-                ) -> dict[str, Experiment]:  # fmt: skip
+def experiments(robot: MobileManipulator, names: tuple[str, ...] = NAMES) -> dict[str, Experiment]:
     """The set-ups ``names``, each with the runs of its laws (``laws_of``); on the pose and the
     position task, for table 6.1, also the cascade with the eta that converges in the LP's
     time."""
@@ -116,11 +130,14 @@ def experiments(robot: MobileManipulator, names: tuple[str, ...] = NAMES
             continue
         eta = LP_PARAMS[name].eta if name in ("pose", "position") else LP_PARAMS["pose"].eta
         task = task_of(robot, name)
-        found[name] = run_laws(name, task, eta, laws_of(robot, name),
-                               (OBSTACLE,) if name == "obstacle" else ())  # fmt: skip
+        found[name] = run_laws(
+            name, task, eta, laws_of(robot, name), (OBSTACLE,) if name == "obstacle" else ()
+        )
         if name in ("pose", "position"):
-            matched = CascadeLaw(robot, CascadeParams(eta=matched_eta(
-                robot, task, len(found[name].runs[L.LP].outputs))))  # fmt: skip
+            matched = CascadeLaw(
+                robot,
+                CascadeParams(eta=matched_eta(robot, task, len(found[name].runs[L.LP].outputs))),
+            )
             found[name].runs[L.CASCADE_LP_TIME] = integrate(matched, HOME, task, DT, STEPS)
             found[name].laws[L.CASCADE_LP_TIME] = L.describe(matched)
     return found
@@ -132,7 +149,8 @@ def matched_eta(robot: MobileManipulator, task: Task, steps: int) -> float:
     low, high = 0.3, 3.0
     while high / low > 1.01:
         eta = math.sqrt(low * high)
-        taken = len(integrate(CascadeLaw(robot, CascadeParams(eta=eta)), HOME, task, DT,
-                              STEPS).outputs)  # fmt: skip
+        taken = len(
+            integrate(CascadeLaw(robot, CascadeParams(eta=eta)), HOME, task, DT, STEPS).outputs
+        )
         low, high = (eta, high) if taken > steps else (low, eta)
     return math.sqrt(low * high)

@@ -39,13 +39,17 @@ def shown(value: Any) -> str:
 
 
 def format_rows(rows: list[Row]) -> str:
-    return table([(r.section, r.result, shown(r.dissertation), shown(r.ours), r.direction)
-                  for r in rows],
-                 ("section", "result", "dissertation", "ours", "should be"),
-                 disable_numparse=True)  # fmt: skip
+    return table(
+        [(r.section, r.result, shown(r.dissertation), shown(r.ours), r.direction) for r in rows],
+        ("section", "result", "dissertation", "ours", "should be"),
+        disable_numparse=True,
+    )
 
 
 def format_laws(laws: list[dict[str, str]]) -> str:
     """Which law each label of each experiment ran: its rows and its terms."""
-    return table([(law["experiment"], law["label"], law["ran"]) for law in laws],
-                 ("experiment", "law", "what it ran"), disable_numparse=True)  # fmt: skip
+    return table(
+        [(law["experiment"], law["label"], law["ran"]) for law in laws],
+        ("experiment", "law", "what it ran"),
+        disable_numparse=True,
+    )

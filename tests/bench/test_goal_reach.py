@@ -10,15 +10,29 @@ WIDE = "ahead, wide arm"
 
 
 def run(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "bench.goal_reach", *args],
-                          capture_output=True, text=True, timeout=600)  # fmt: skip
+    return subprocess.run(
+        [sys.executable, "-m", "bench.goal_reach", *args],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
 
 
 def test_the_bench_says_how_often_each_law_reaches_each_set_and_why_it_misses() -> None:
     """Goals with the arm bent back over the base: the LP alone misses one of the four of
     seed 2, its base turned away, where the supervised LP reaches all."""
-    done = run("--families", WIDE, "--seeds", "2", "--goals", "4", "--variant",
-               "base_target_stop=0.25", "--supervised", "--json")  # fmt: skip
+    done = run(
+        "--families",
+        WIDE,
+        "--seeds",
+        "2",
+        "--goals",
+        "4",
+        "--variant",
+        "base_target_stop=0.25",
+        "--supervised",
+        "--json",
+    )
     assert done.returncode == 0, done.stderr[-2000:]
     report = json.loads(done.stdout)  # the JSON alone on stdout
     rows = {row["law"]: row for row in report["rows"]}

@@ -12,8 +12,18 @@ from bench.obstacle_constraints import VARIANTS
 def test_the_bench_prints_one_row_per_constraint_as_json_alone() -> None:
     """One kinematic seed, no simulated one: a row for each variant. 5.19 stops the base
     before the obstacle by design, so it is counted as not converged, naming the seed."""
-    command = [sys.executable, "-m", "bench.obstacle_constraints", "--seeds", "0",
-               "--kinematic-seeds", "1", "--workers", "1", "--json"]  # fmt: skip
+    command = [
+        sys.executable,
+        "-m",
+        "bench.obstacle_constraints",
+        "--seeds",
+        "0",
+        "--kinematic-seeds",
+        "1",
+        "--workers",
+        "1",
+        "--json",
+    ]
     done = subprocess.run(command, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr[-2000:]
     report = json.loads(done.stdout)

@@ -12,8 +12,7 @@ MS = 1_000_000
 
 def test_a_replay_on_time_has_no_gap_error_at_its_rate() -> None:
     recorded = [("camera/image", 0), ("robot/state", 10 * MS), ("camera/image", 33 * MS)]
-    arrivals = {"camera/image": [5_000 * MS, 5_016 * MS + MS // 2],
-                "robot/state": [5_005 * MS]}  # fmt: skip
+    arrivals = {"camera/image": [5_000 * MS, 5_016 * MS + MS // 2], "robot/state": [5_005 * MS]}
     assert gap_errors_ms(recorded, arrivals, rate=2.0) == [0.0, 0.0]
 
 

@@ -44,8 +44,9 @@ class Bench:
 
     def send(self, velocities: Sequence[float]) -> None:
         header = Header(stamp_ns=time.time_ns(), frame="arm", seq=0, source="test")
-        self.command.put(codec.encode(ArmCommand(header=header,
-                                                 joint_velocities=tuple(velocities))))  # fmt: skip
+        self.command.put(
+            codec.encode(ArmCommand(header=header, joint_velocities=tuple(velocities)))
+        )
 
     def run(self, seconds: float) -> None:
         """The world and the servos for ``seconds`` of their own time."""
@@ -81,8 +82,9 @@ def bench(deployed, tmp_path: Path) -> Iterator[Bench]:
     arm = IntegratingJoints([0.0, -0.2, 0.2, 0.0, 0.5])
     link = tmp_path / "servos"
     with AXChainEmulator(arm, link=link) as servos:
-        system = driver_system(deployed, tmp_path, "arm_driver", link,
-                               answer_timeout_s=ANSWER_TIMEOUT_S)  # fmt: skip
+        system = driver_system(
+            deployed, tmp_path, "arm_driver", link, answer_timeout_s=ANSWER_TIMEOUT_S
+        )
         bench = Bench(system, arm, servos)
         system.start("arm_driver")
         bench.joints.wait_for(lambda m: True, "a joint state")
@@ -134,8 +136,10 @@ def test_a_silent_servo_holds_the_whole_arm_until_it_answers_again(
     wait_until(lambda: bench.servos.counters["unanswered"] > asked, "the driver asking servo 3")
     bench.run(0.1)  # while the driver waits for its answer (ANSWER_TIMEOUT_S)
     wait_until(lambda: bench.state() == "holding: servo 3 silent", "the arm holding")
-    wait_until(lambda: [bench.speeds()[i] for i in (0, 1, 3, 4)] == [HOLD_SPEED] * 4,
-               "the hold written to every servo that answers")  # fmt: skip
+    wait_until(
+        lambda: [bench.speeds()[i] for i in (0, 1, 3, 4)] == [HOLD_SPEED] * 4,
+        "the hold written to every servo that answers",
+    )
     held = list(bench.arm.angles)
     for _ in range(50):  # a second of commands that must not move it
         bench.send(moving)
@@ -147,8 +151,9 @@ def test_a_silent_servo_holds_the_whole_arm_until_it_answers_again(
     silent_since = len(bench.joints.messages)
     bench.servos.recover(3)
     wait_until(lambda: bench.state() == "running", "every servo answering again")
-    bench.joints.wait_for(lambda m: bench.joints.messages.index(m) >= silent_since,
-                          "joint states again")  # fmt: skip
+    bench.joints.wait_for(
+        lambda m: bench.joints.messages.index(m) >= silent_since, "joint states again"
+    )
     q1 = bench.arm.angles[0]
 
     def moves_again() -> bool:
@@ -196,8 +201,10 @@ def test_speeds_over_the_limit_go_out_at_the_limit(bench: Bench, wait_until) -> 
     assert not any(v for k, v in counters.items() if k.startswith("errors."))
 
 
-@pytest.mark.parametrize("fault", [StatusFault.TRUNCATED, StatusFault.CHECKSUM,
-                                   StatusFault.WRONG_ID, StatusFault.WRONG_LENGTH])  # fmt: skip
+@pytest.mark.parametrize(
+    "fault",
+    [StatusFault.TRUNCATED, StatusFault.CHECKSUM, StatusFault.WRONG_ID, StatusFault.WRONG_LENGTH],
+)
 def test_a_spoiled_status_packet_is_reported_by_its_name(
     bench: Bench, wait_until, fault: StatusFault
 ) -> None:

@@ -24,8 +24,10 @@ from profiles.profile_files import read_profile_data
 from protocols import create_oi
 
 METRES_PER_COUNT = create_oi.mm_per_count(0.072) / 1000.0
-STARTED = bytes([create_oi.START, create_oi.SAFE]) + create_oi.drive_direct(0, 0) + bytes(
-    [create_oi.STREAM, 2, create_oi.LEFT_ENCODER, create_oi.RIGHT_ENCODER]
+STARTED = (
+    bytes([create_oi.START, create_oi.SAFE])
+    + create_oi.drive_direct(0, 0)
+    + bytes([create_oi.STREAM, 2, create_oi.LEFT_ENCODER, create_oi.RIGHT_ENCODER])
 )
 """What the driver writes first on opening the port: Start, Safe, the wheels stopped, the
 stream of the encoders."""
@@ -46,16 +48,25 @@ class Create:
     def drive(self, speed: float = 0.1) -> bool:
         """Send one command, as a controller does at 50 Hz; whether the driver passed it on."""
         header = Header(stamp_ns=time.time_ns(), frame="base", seq=0, source="test")
-        self.command.put(codec.encode(BaseCommand(header=header, forward_velocity=speed,
-                                                  angular_velocity=0.0, left_wheel=speed,
-                                                  right_wheel=speed)))  # fmt: skip
+        self.command.put(
+            codec.encode(
+                BaseCommand(
+                    header=header,
+                    forward_velocity=speed,
+                    angular_velocity=0.0,
+                    left_wheel=speed,
+                    right_wheel=speed,
+                )
+            )
+        )
         time.sleep(0.02)
         millimetres = round(speed * 1000)
         return self.heard(create_oi.drive_direct(millimetres, millimetres))
 
 
-def started_driver(deployed, tmp_path: Path, wait_until, **params: object
-                   ) -> tuple[System, Create, Inbox]:  # fmt: skip
+def started_driver(
+    deployed, tmp_path: Path, wait_until, **params: object
+) -> tuple[System, Create, Inbox]:
     """The driver on a fake Create, driving at 0.1 m/s, and its odometry: subscribed before the
     driver starts, so that its session knows the subscriber from its first frame on."""
     link = FakeLink(tmp_path / "create2")
@@ -90,9 +101,13 @@ def test_the_base_driver_survives_bad_bytes_and_a_port_that_vanishes(
     # From 65516 through the rollover: every count forward, the bad frames skipped.
     travelled = (moved.left_encoder - 65516) & 0xFFFF
     assert abs(moved.left_distance - travelled * METRES_PER_COUNT) < 1e-9
-    wait_until(lambda: (status(system, "base_driver") or None) is not None
-               and status(system, "base_driver").counters["bad_checksums"] >= 1,
-               "a counted bad checksum")  # fmt: skip
+    wait_until(
+        lambda: (
+            (status(system, "base_driver") or None) is not None
+            and status(system, "base_driver").counters["bad_checksums"] >= 1
+        ),
+        "a counted bad checksum",
+    )
     # No command for the timeout: the driver stops the wheels itself.
     wait_until(lambda: create.heard(create_oi.drive_direct(0, 0)), "the stop after the timeout")
     # The port vanishes and comes back: the driver opens it again and starts the OI again.
@@ -138,8 +153,9 @@ def test_a_frame_of_other_packets_is_counted_and_odometry_goes_on(
 ) -> None:
     system, create, odometry = started_driver(deployed, tmp_path, wait_until)
     bumps = create_oi.stream_frame({create_oi.BUMPS_AND_WHEEL_DROPS: b"\x00"})
-    cliff = create_oi.stream_frame({create_oi.CLIFF_FRONT_LEFT_SIGNAL: b"\x00\x10",
-                                    create_oi.LEFT_ENCODER: b"\x00\x02"})  # 6 bytes too
+    cliff = create_oi.stream_frame(
+        {create_oi.CLIFF_FRONT_LEFT_SIGNAL: b"\x00\x10", create_oi.LEFT_ENCODER: b"\x00\x02"}
+    )  # 6 bytes too
     create.link.write(frame(0, 0) + bumps + cliff + frame(4, 4))
     odometry.wait_for(lambda m: m.left_encoder == 4, "odometry after the foreign frames")
     counters = status(system, "base_driver").counters
@@ -151,8 +167,9 @@ def test_speeds_after_lost_frames_are_taken_over_the_time_that_passed(
 ) -> None:
     """At 0.2 m/s, 0.1 s of frames lost: the next frame's 45 counts are 0.1 s of motion (it
     used to be divided by one 15 ms period: 1.33 m/s). The command holds for the whole test."""
-    system, create, odometry = started_driver(deployed, tmp_path, wait_until,
-                                              command_timeout_s=10.0)  # fmt: skip
+    system, create, odometry = started_driver(
+        deployed, tmp_path, wait_until, command_timeout_s=10.0
+    )
     wait_until(lambda: create.drive(0.2), "Drive Direct 200 200 mm/s")
     create.link.write(frame(500, 500) + frame(509, 509))
     odometry.wait_for(lambda m: m.left_encoder == 509, "odometry before the loss")
@@ -185,8 +202,7 @@ def test_a_killed_driver_comes_back_at_once_and_stops_the_wheels_first(
         pid = query.statuses(session, profile.namespace)["base_driver"].pid
         os.kill(pid, signal.SIGKILL)
         create.received.clear()
-        wait_until(lambda: create.heard(STARTED), "the restarted driver's start",
-                   timeout_s=30.0)  # fmt: skip
+        wait_until(lambda: create.heard(STARTED), "the restarted driver's start", timeout_s=30.0)
         first_move = create.received.find(create_oi.drive_direct(100, 100))
         assert first_move == -1 or first_move > create.received.index(STARTED)
         wait_until(create.drive, "the restarted driver driving again")

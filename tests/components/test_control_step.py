@@ -31,9 +31,14 @@ STALE_S = 0.5
 def state(q: np.ndarray, stamp_ns: int, end_effector: np.ndarray | None = None) -> RobotState:
     """A valid state at ``q``, its end effector's pose ``fkm(q)`` unless given."""
     pose = ROBOT.fkm(q) if end_effector is None else end_effector
-    return RobotState(header=Header(stamp_ns=stamp_ns, frame="world", seq=0, source="test"),
-                      base_pose=tuple(q[:3]), arm_joints=tuple(q[3:]),
-                      end_effector=tuple(pose), valid=True, age_s=0.0)  # fmt: skip
+    return RobotState(
+        header=Header(stamp_ns=stamp_ns, frame="world", seq=0, source="test"),
+        base_pose=tuple(q[:3]),
+        arm_joints=tuple(q[3:]),
+        end_effector=tuple(pose),
+        valid=True,
+        age_s=0.0,
+    )
 
 
 @pytest.mark.parametrize("hold", ["a stale state", "a zero sent without a state"])

@@ -87,8 +87,12 @@ class Operator:
         self._stamps.add(stamp)
         return stamp
 
-    def send_state(self, valid: bool = True, age_s: float = 0.0,
-                   base_pose: tuple[float, float, float] = START[:3]) -> int:  # fmt: skip
+    def send_state(
+        self,
+        valid: bool = True,
+        age_s: float = 0.0,
+        base_pose: tuple[float, float, float] = START[:3],
+    ) -> int:
         """Publish a state at ``START`` (or its arm at ``base_pose``); return its stamp."""
         stamp = self.stamp(age_s)
         state = RobotState(
@@ -165,8 +169,12 @@ def operator(deployed: Callable[[str], System]) -> Operator:
 def test_the_cascade_profile_is_the_lp_profile_with_another_module() -> None:
     lp, cascade = load_profile(LP_PROFILE), load_profile(CASCADE_PROFILE)
     assert lp.component("controller").module == "lp_controller"
-    swapped = [spec.model_copy(update={"module": "cascade_controller"})
-               if spec.name == "controller" else spec for spec in lp.components]  # fmt: skip
+    swapped = [
+        spec.model_copy(update={"module": "cascade_controller"})
+        if spec.name == "controller"
+        else spec
+        for spec in lp.components
+    ]
     assert cascade == lp.model_copy(update={"components": swapped})
 
 
@@ -313,8 +321,9 @@ def test_a_goal_whose_gains_leave_the_parameter_bounds_is_refused(operator: Oper
     operator.send_goal(eta=1e300)
     diagnostics, base, arm = operator.step()
     assert diagnostics.status == "goal refused" and is_zero(base, arm), diagnostics
-    assert diagnostics.reason.startswith("control/goal refused: eta: expected a float in [0.001, "
-                                         "100.0], got 1e+300"), diagnostics.reason  # fmt: skip
+    assert diagnostics.reason.startswith(
+        "control/goal refused: eta: expected a float in [0.001, 100.0], got 1e+300"
+    ), diagnostics.reason
     assert operator.counters()["refused_goals"] == 1
     operator.send_goal(eta=1.5)
     assert operator.step()[0].parameters["eta"] == 1.5
@@ -330,7 +339,8 @@ def test_obstacles_with_a_solid_larger_than_a_scene_are_refused_in_one_line(
 
     operator.send_goal()
     obstacles = operator.system.router.declare_publisher(
-        topics.WORLD_OBSTACLES.key(operator.namespace))
+        topics.WORLD_OBSTACLES.key(operator.namespace)
+    )
     header = Header(stamp_ns=operator.stamp(), frame="world", seq=0, source="test")
     pole = Solids(cylinders=(Cylinder(x=3.0, y=0.0, radius=0.1),))
     tag, name, fields = msgpack.unpackb(codec.encode(Obstacles(header=header, solids=pole)))
@@ -381,8 +391,10 @@ def test_a_flood_of_states_far_away_and_of_goals_out_of_bounds_is_answered_witho
         name, value = gains[index % len(gains)]
         operator.put_goal(**{name: value})
     deadline = time.monotonic() + DEADLINE_S
-    while sum(operator.counters()[f"{kind}.control/goal"]
-              for kind in ("received", "overwritten")) < taken + FLOOD:  # fmt: skip
+    while (
+        sum(operator.counters()[f"{kind}.control/goal"] for kind in ("received", "overwritten"))
+        < taken + FLOOD
+    ):
         assert time.monotonic() < deadline, "the controller did not take every goal"
     diagnostics, base, arm = operator.step()  # the last goal sent: eta 1e-300
     assert diagnostics.status == "goal refused" and is_zero(base, arm), diagnostics
@@ -435,8 +447,9 @@ def test_the_law_gets_changed_gains_and_only_then(deployed: Callable[[str], Syst
 def test_on_simulated_time_a_stopped_clock_makes_the_controller_command_zero(
     deployed: Callable[[str | Path], System], wait_until: Callable[..., None]
 ) -> None:
-    text = LP_PROFILE.read_text().replace("namespace: parsimony",
-                                          "namespace: parsimony\nclock: sim\nclock_timeout_s: 0.3")
+    text = LP_PROFILE.read_text().replace(
+        "namespace: parsimony", "namespace: parsimony\nclock: sim\nclock_timeout_s: 0.3"
+    )
     system = deployed(text)
     diagnostics = system.inbox(topics.CONTROL_DIAGNOSTICS)
     system.start("controller")
@@ -458,7 +471,8 @@ def test_a_flood_of_huge_obstacle_messages_never_silences_the_controller(
     from messages.obstacles import Obstacles
 
     obstacles = operator.system.router.declare_publisher(
-        topics.WORLD_OBSTACLES.key(operator.namespace))
+        topics.WORLD_OBSTACLES.key(operator.namespace)
+    )
     header = Header(stamp_ns=operator.stamp(), frame="world", seq=0, source="test")
     circles = (CircleMessage(x=1.0, y=0.0, radius=0.1),) * 100_000
     many = codec.encode(Obstacles.model_construct(header=header, circles=circles))
@@ -469,8 +483,11 @@ def test_a_flood_of_huge_obstacle_messages_never_silences_the_controller(
         obstacles.put(huge if sent % 2 else many)
         sent += 1
     flood_end = time.time_ns()
-    stamps = sorted(m.header.stamp_ns for m in operator.diagnostics.messages
-                    if flood_start <= m.header.stamp_ns <= flood_end)  # fmt: skip
+    stamps = sorted(
+        m.header.stamp_ns
+        for m in operator.diagnostics.messages
+        if flood_start <= m.header.stamp_ns <= flood_end
+    )
     gaps = np.diff([flood_start, *stamps, flood_end]) / 1e9
     assert gaps.max() <= 0.5, f"silent for {gaps.max():.2f} s during the flood"
     assert all(m.status == "stale" for m in operator.diagnostics.messages)

@@ -101,13 +101,20 @@ def test_every_gain_of_a_law_is_a_parameter_with_the_bounds_its_dataclass_declar
     from wbc.gains import gain_specs
 
     module = importlib.import_module(f"components.{controller}")
-    component = next(v for v in vars(module).values()
-                     if isinstance(v, type) and v.__module__ == module.__name__)  # fmt: skip
+    component = next(
+        v for v in vars(module).values() if isinstance(v, type) and v.__module__ == module.__name__
+    )
     declared = {param.name: param for param in component.params}
     for spec in gain_specs(component.gains_type):
         param = declared[spec.name]
         assert (param.type, param.default, param.low, param.high, param.choices, param.doc) == (
-            spec.type, spec.default, spec.low, spec.high, spec.choices, spec.doc)
+            spec.type,
+            spec.default,
+            spec.low,
+            spec.high,
+            spec.choices,
+            spec.doc,
+        )
         if spec.high is not None:
             with pytest.raises(ParamError, match=spec.name):
                 param.check(spec.high * 2 + 1)

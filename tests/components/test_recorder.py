@@ -30,11 +30,17 @@ def test_the_recorder_waits_for_the_clocks_first_tick_and_says_a_stall_only_afte
     tmp_path: Path, wait_until: WaitUntil
 ) -> None:
     path = tmp_path / "rec.yaml"
-    path.write_text(yaml.safe_dump({
-        "namespace": NAMESPACE, "clock": "sim", "clock_timeout_s": 0.2,
-        "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
-        "components": [recorder_component(tmp_path / "k.mcap")],
-    }))  # fmt: skip
+    path.write_text(
+        yaml.safe_dump(
+            {
+                "namespace": NAMESPACE,
+                "clock": "sim",
+                "clock_timeout_s": 0.2,
+                "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
+                "components": [recorder_component(tmp_path / "k.mcap")],
+            }
+        )
+    )
     profile = load_profile(path)
     with zenoh.open(profile.zenoh.router_config()) as router:
         system = System(path, profile, router)
@@ -60,8 +66,10 @@ def test_the_recorder_waits_for_the_clocks_first_tick_and_says_a_stall_only_afte
                 return query.statuses(router, NAMESPACE)["recorder"].state == "running"
 
             wait_until(ticked_and_running, "the recorder to run on the clock")
-            wait_until(lambda: query.statuses(router, NAMESPACE)["recorder"].state
-                       == "clock stalled", "the stopped clock to be called stalled")  # fmt: skip
+            wait_until(
+                lambda: query.statuses(router, NAMESPACE)["recorder"].state == "clock stalled",
+                "the stopped clock to be called stalled",
+            )
             stalled = query.statuses(router, NAMESPACE)["recorder"]
             assert stalled.counters["clock_stalls"] == 1
         finally:

@@ -84,11 +84,15 @@ def test_a_busy_handler_gets_the_newest_or_every_sample_and_drops_are_counted(
             publisher.put(codec.encode(robot_state(base_x=float(index))))
         counters = listener.counters
         sent = 12
-        wait_until(lambda: counters[f"{dropped}.robot/state"] + len(handled) + (queue or 1)
-                   >= sent, "every sample kept or counted")  # fmt: skip
+        wait_until(
+            lambda: counters[f"{dropped}.robot/state"] + len(handled) + (queue or 1) >= sent,
+            "every sample kept or counted",
+        )
         release.set()
-        wait_until(lambda: counters[f"{dropped}.robot/state"] + len(handled) == sent,
-                   "the waiting samples handled")  # fmt: skip
+        wait_until(
+            lambda: counters[f"{dropped}.robot/state"] + len(handled) == sent,
+            "the waiting samples handled",
+        )
     kept = queue or 1
     assert handled == [0.0, *[float(i) for i in range(sent - kept, sent)]]
     assert counters[f"{dropped}.robot/state"] == sent - 1 - kept

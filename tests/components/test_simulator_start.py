@@ -36,8 +36,9 @@ def test_a_start_inside_a_solid_is_warned_of_in_one_line_naming_it(
     liveliness = system.liveliness()
     system.start("simulator")
     liveliness.wait_for("simulator", alive=True)  # warned while it starts, before it is alive
-    lines = [line for line in system.log("simulator").splitlines()
-             if "the robot starts inside" in line]  # fmt: skip
+    lines = [
+        line for line in system.log("simulator").splitlines() if "the robot starts inside" in line
+    ]
     if not planes:
         assert lines == []
         return

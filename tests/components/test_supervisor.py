@@ -73,15 +73,22 @@ class Operator:
     def send_state(self, q: np.ndarray, valid: bool = True, age_s: float = 0.0) -> None:
         header = Header(stamp_ns=time.time_ns(), frame="world", seq=0, source="test")
         x = tuple(self.robot.fkm(q))
-        state = RobotState(header=header, base_pose=tuple(q[:3]), arm_joints=tuple(q[3:]),
-                           end_effector=x, valid=valid, age_s=age_s)  # fmt: skip
+        state = RobotState(
+            header=header,
+            base_pose=tuple(q[:3]),
+            arm_joints=tuple(q[3:]),
+            end_effector=x,
+            valid=valid,
+            age_s=age_s,
+        )
         self.state.put(codec.encode(state))
 
     def send_goal(self, goal: Goal) -> None:
         self.request.put(codec.encode(goal))
 
-    def statuses_after(self, count: int, q: np.ndarray, what: str, **state: object
-                       ) -> SupervisorStatus:  # fmt: skip
+    def statuses_after(
+        self, count: int, q: np.ndarray, what: str, **state: object
+    ) -> SupervisorStatus:
         """A state at q, and the first status of the supervisor's ``count``-th on."""
         self.send_state(q, **state)
         return self.statuses.wait_for(lambda s: self.statuses.messages.index(s) >= count, what)
@@ -122,23 +129,27 @@ def test_a_goal_behind_the_robot_is_planned_off_the_handler_thread_then_driven_t
     np.testing.assert_allclose(first.arm, HOME[3:])
     np.testing.assert_allclose(first.point, HOME[:2] + [first.lookahead, 0.0])
 
-    status = operator.statuses.wait_for(lambda s: s.phase not in ("idle", "planning"),
-                                        "the plan's first phase, as soon as it is made")
+    status = operator.statuses.wait_for(
+        lambda s: s.phase not in ("idle", "planning"),
+        "the plan's first phase, as soon as it is made",
+    )
     operator.send_state(HOME)
     assert status.phase == "drive" and status.plans == 1 and status.candidate == 1
     assert status.candidate_base is not None and status.candidate_base[0] < -0.3
     assert status.planning_ms is not None and status.planning_ms > 0.0
-    drive = operator.goals.wait_for(lambda g: g.task == "heading" or (
-        g.point is not None and not np.allclose(g.point, first.point)), "the drive leg")
+    drive = operator.goals.wait_for(
+        lambda g: (
+            g.task == "heading" or (g.point is not None and not np.allclose(g.point, first.point))
+        ),
+        "the drive leg",
+    )
     assert drive.task == "heading"  # the base faces away from the way: it turns to face it
 
 
 def take_obstacles(operator: Operator, circles: tuple[Circle, ...]) -> None:
     """Publish ``circles`` until the supervisor has received them."""
     deadline = time.monotonic() + DEADLINE_S
-    while component_status(operator.system, "supervisor").counters[
-        "received.world/obstacles"
-    ] == 0:  # fmt: skip
+    while component_status(operator.system, "supervisor").counters["received.world/obstacles"] == 0:
         assert time.monotonic() < deadline, "the supervisor never took the obstacles"
         operator.obstacles.put(codec.encode(Obstacles(header=header(), circles=circles)))
 
@@ -215,23 +226,24 @@ def test_a_goal_inside_an_obstacle_is_refused_for_that_reason(
     x, y = dq.translation(goal)[1:3]
     obstacles = Obstacles(header=header(), circles=(Circle(x=x + 0.02, y=y, radius=0.1),))
     deadline = time.monotonic() + DEADLINE_S
-    while component_status(operator.system, "supervisor").counters[
-        "received.world/obstacles"
-    ] == 0:  # fmt: skip
+    while component_status(operator.system, "supervisor").counters["received.world/obstacles"] == 0:
         assert time.monotonic() < deadline, "the supervisor never took the obstacles"
         operator.obstacles.put(codec.encode(obstacles))
     status = unreachable(operator, goal)
     assert "lies inside obstacle 1" in status.reason, status.reason
 
 
-@pytest.mark.parametrize(("fields", "blamed"), [
-    ({"pose": (math.nan, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)}, "pose"),
-    ({"pose": (2.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)}, "pose"),
-    ({"pose": (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)}, "pose"),
-    ({"pose": (1.0, 0.0, 0.0, 0.0, 0.3, 0.0, 0.0, 0.0)}, "pose"),
-    ({"pose": (0.0,) * 8}, "pose"),
-    ({"pose": (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), "eta": -1.0}, "eta"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    ("fields", "blamed"),
+    [
+        ({"pose": (math.nan, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)}, "pose"),
+        ({"pose": (2.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)}, "pose"),
+        ({"pose": (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)}, "pose"),
+        ({"pose": (1.0, 0.0, 0.0, 0.0, 0.3, 0.0, 0.0, 0.0)}, "pose"),
+        ({"pose": (0.0,) * 8}, "pose"),
+        ({"pose": (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), "eta": -1.0}, "eta"),
+    ],
+)
 def test_a_refused_request_is_on_the_status_with_its_reason_and_the_goal_stays(
     deployed: Callable[[str], System], fields: dict, blamed: str
 ) -> None:
@@ -246,17 +258,21 @@ def test_a_refused_request_is_on_the_status_with_its_reason_and_the_goal_stays(
     assert refused.phase not in ("idle", "planning", "unreachable"), refused
     count = len(operator.statuses.messages)
     operator.send_state(REACH_GOAL)
-    after = operator.statuses.wait_for(lambda s: operator.statuses.messages.index(s) >= count,
-                                       "a status after the refusal")  # fmt: skip
+    after = operator.statuses.wait_for(
+        lambda s: operator.statuses.messages.index(s) >= count, "a status after the refusal"
+    )
     assert after.phase == refused.phase and after.refusals == 1
 
 
-@pytest.mark.parametrize("task", [
-    PoseTask(MODEL.fkm(REACH_GOAL)),
-    PositionTask(np.array([0.5, -0.2, 0.3])),
-    PointTask(np.array([0.4, -0.2]), np.array([0.0, -0.3, 0.2, 0.0, 0.4]), 0.03),
-    HeadingTask(-2.5, np.array([0.0, -0.3, 0.2, 0.0, 0.4]), np.array([0.3, 0.1])),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    "task",
+    [
+        PoseTask(MODEL.fkm(REACH_GOAL)),
+        PositionTask(np.array([0.5, -0.2, 0.3])),
+        PointTask(np.array([0.4, -0.2]), np.array([0.0, -0.3, 0.2, 0.0, 0.4]), 0.03),
+        HeadingTask(-2.5, np.array([0.0, -0.3, 0.2, 0.0, 0.4]), np.array([0.3, 0.1])),
+    ],
+)
 def test_the_goal_of_every_task_kind_asks_for_that_task(task) -> None:
     header = Header(stamp_ns=1, frame="world", seq=0, source="test")
     back = task_of(codec.decode(codec.encode(goal_of(task, header)), Goal))
@@ -271,8 +287,10 @@ def test_status_queries_are_answered_while_a_plan_runs_on_the_planner_thread(
     answered by the handler thread meanwhile, before the plan comes back, and the plan's
     verdict follows with its reason."""
     operator = supervised(deployed)
-    ring = tuple(Circle(x=2.0 + 0.9 * math.cos(a), y=0.9 * math.sin(a), radius=0.08)
-                 for a in np.linspace(0.0, 2.0 * math.pi, 30, endpoint=False))  # fmt: skip
+    ring = tuple(
+        Circle(x=2.0 + 0.9 * math.cos(a), y=0.9 * math.sin(a), radius=0.08)
+        for a in np.linspace(0.0, 2.0 * math.pi, 30, endpoint=False)
+    )
     take_obstacles(operator, ring)
     operator.ask(operator.robot.fkm(np.array([2.0, 0.0, 0.0, 0.0, -0.3, -0.4, 0.2, 0.3])))
     operator.send_state(HOME)
@@ -332,23 +350,28 @@ def test_an_invalid_state_aborts_the_goal_refuses_new_ones_and_the_status_says_w
     operator.ask(operator.robot.fkm(REACH_GOAL))
     operator.send_state(HOME)
     operator.statuses.wait_for(lambda s: s.phase not in ("idle", "planning"), "the plan")
-    aborted = operator.statuses_after(len(operator.statuses.messages), HOME, "the abort",
-                                      valid=False, age_s=12.0)  # fmt: skip
+    aborted = operator.statuses_after(
+        len(operator.statuses.messages), HOME, "the abort", valid=False, age_s=12.0
+    )
     assert aborted.phase == "aborted" and aborted.state == "invalid", aborted
     assert aborted.no_fix_s == 12.0 and aborted.state_since_s is not None
     assert "no valid robot state for 0.0 s (no camera fix of the base for 12.0 s)" in (
-        aborted.reason), aborted.reason  # fmt: skip
+        aborted.reason
+    ), aborted.reason
     goals = len(operator.goals.messages)
     for _ in range(3):
-        later = operator.statuses_after(len(operator.statuses.messages), HOME, "a later status",
-                                        valid=False, age_s=13.0)  # fmt: skip
+        later = operator.statuses_after(
+            len(operator.statuses.messages), HOME, "a later status", valid=False, age_s=13.0
+        )
         assert later.phase == "aborted" and later.no_fix_s == 13.0
     operator.ask(operator.robot.fkm(REACH_GOAL))
-    refused = operator.statuses_after(len(operator.statuses.messages), HOME, "the refusal",
-                                      valid=False, age_s=14.0)  # fmt: skip
+    refused = operator.statuses_after(
+        len(operator.statuses.messages), HOME, "the refusal", valid=False, age_s=14.0
+    )
     assert refused.phase == "refused" and refused.refusals == 1, refused
     assert refused.reason == refused.last_refusal and "no camera fix of the base for 14.0 s" in (
-        refused.reason)  # fmt: skip
+        refused.reason
+    )
     assert len(operator.goals.messages) == goals  # nothing for the controller meanwhile
     back = operator.statuses_after(len(operator.statuses.messages), REACH_GOAL, "valid again")
     assert back.phase == "refused" and back.state == "valid"
@@ -369,12 +392,15 @@ def test_a_plan_round_256_circles_keeps_to_its_cpu_budget_and_says_it_ran_out(
     operator = supervised(deployed, yaml.safe_dump(system))
     goal = operator.robot.fkm(REACH_GOAL)
     x, y = dq.translation(goal)[1:3]
-    take_obstacles(operator, tuple(Circle(x=cx, y=cy, radius=r)
-                                   for cx, cy, r in crowd(((HOME[0], HOME[1]), (x, y)))))
+    take_obstacles(
+        operator,
+        tuple(Circle(x=cx, y=cy, radius=r) for cx, cy, r in crowd(((HOME[0], HOME[1]), (x, y)))),
+    )
     operator.ask(goal)
     operator.send_state(HOME)
-    verdict = operator.statuses.wait_for(lambda s: s.phase == "unreachable", "the verdict",
-                                         timeout_s=60.0)  # fmt: skip
+    verdict = operator.statuses.wait_for(
+        lambda s: s.phase == "unreachable", "the verdict", timeout_s=60.0
+    )
     assert "planning budget of 0.5 s of CPU time" in verdict.reason, verdict.reason
     assert verdict.planning_cpu_ms is not None
     assert verdict.planning_cpu_ms <= 500.0 + 1e3 * CHECK_GAP_S, verdict.planning_cpu_ms
@@ -403,8 +429,9 @@ def test_goals_that_would_take_the_base_out_of_the_cameras_sight_are_turned_down
     assert "take the base where the camera cannot see it" in status.reason, status.reason
     operator.ask(operator.robot.fkm(REACH_GOAL))
     operator.send_state(HOME)
-    drive = operator.statuses.wait_for(lambda s: s.plans == 1 and s.phase != "unreachable",
-                                       "the plan in sight")  # fmt: skip
+    drive = operator.statuses.wait_for(
+        lambda s: s.plans == 1 and s.phase != "unreachable", "the plan in sight"
+    )
     assert drive.candidate_base is not None and within(region, *drive.way, drive.candidate_base)
 
 
@@ -418,8 +445,9 @@ def test_with_no_state_the_status_still_goes_out_says_so_and_a_goal_is_refused(
     refused = operator.statuses.wait_for(lambda s: s.phase == "refused", "the refusal")
     assert refused.state == "none" and "no robot state on robot/state for" in refused.reason
     count = len(operator.statuses.messages)
-    later = operator.statuses.wait_for(lambda s: operator.statuses.messages.index(s) > count,
-                                       "two statuses more, with no state")  # fmt: skip
+    later = operator.statuses.wait_for(
+        lambda s: operator.statuses.messages.index(s) > count, "two statuses more, with no state"
+    )
     assert later.phase == "refused" and later.state == "none"
 
 

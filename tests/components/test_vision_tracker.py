@@ -38,11 +38,14 @@ def scene_image(system: System, seed: int = 0) -> tuple[np.ndarray, PinholeCamer
     scene, c = system.profile.scene, system.profile.scene.camera
     camera = ceiling_camera(c)
     markers = [
-        PlacedMarker(scene.reference.id, scene.reference.size_m,
-                     planar_pose(*scene.reference_pose, scene.reference.height_m)),
+        PlacedMarker(
+            scene.reference.id,
+            scene.reference.size_m,
+            planar_pose(*scene.reference_pose, scene.reference.height_m),
+        ),
         PlacedMarker(scene.base.id, scene.base.size_m, planar_pose(0.3, -0.2, 0.5, 0.092)),
         PlacedMarker(scene.goal.id, scene.goal.size_m, planar_pose(1.2, 0.3, -0.4)),
-    ]  # fmt: skip
+    ]
     image = render(camera, markers, scene.dictionary_id, ImageNoise(), np.random.default_rng(seed))
     return image, camera, markers
 
@@ -77,9 +80,12 @@ def test_markers_of_a_camera_frame_are_found_where_they_are(
         stamp += 1
         frame = CameraFrame(
             header=Header(stamp_ns=stamp, frame="camera", seq=stamp, source="test"),
-            encoding=encoding, width=c.width, height=c.height, data=data,
+            encoding=encoding,
+            width=c.width,
+            height=c.height,
+            data=data,
             intrinsics=CameraIntrinsics(fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy),
-        )  # fmt: skip
+        )
         publisher.put(codec.encode(frame))
         time.sleep(0.05)  # one frame at a time, as a camera would
     found = inbox.wait_for(lambda m: len(m.markers) == 3, "with the three markers")
@@ -97,8 +103,9 @@ def test_markers_of_a_camera_frame_are_found_where_they_are(
     assert all(d.reprojection_error < 1.0 for d in found.markers)
 
 
-def test_a_jpeg_of_another_size_is_dropped_and_counted(deployed, tmp_path: Path,
-                                                       wait_until) -> None:
+def test_a_jpeg_of_another_size_is_dropped_and_counted(
+    deployed, tmp_path: Path, wait_until
+) -> None:
     system = tracker_system(deployed, tmp_path, {})
     image, _, _ = scene_image(system)
     inbox = system.inbox(topics.VISION_MARKERS)
@@ -107,11 +114,16 @@ def test_a_jpeg_of_another_size_is_dropped_and_counted(deployed, tmp_path: Path,
     publisher = system.router.declare_publisher(topics.CAMERA_IMAGE.key(system.profile.namespace))
 
     def frame(stamp: int, pixels: np.ndarray) -> bytes:
-        return codec.encode(CameraFrame(
-            header=Header(stamp_ns=stamp, frame="camera", seq=stamp, source="test"),
-            encoding="jpeg", width=c.width, height=c.height, data=jpeg(pixels, 90),
-            intrinsics=CameraIntrinsics(fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy),
-        ))  # fmt: skip
+        return codec.encode(
+            CameraFrame(
+                header=Header(stamp_ns=stamp, frame="camera", seq=stamp, source="test"),
+                encoding="jpeg",
+                width=c.width,
+                height=c.height,
+                data=jpeg(pixels, 90),
+                intrinsics=CameraIntrinsics(fx=c.fx, fy=c.fy, cx=c.cx, cy=c.cy),
+            )
+        )
 
     deadline = time.monotonic() + system.deadline_s
     stamp = 0
@@ -141,15 +153,17 @@ def test_markers_of_a_video_device_are_found(deployed, tmp_path: Path) -> None:
     system = tracker_system(deployed, tmp_path, {})
     video = tmp_path / "ceiling.avi"
     c = system.profile.scene.camera
-    writer = cv2.VideoWriter(str(video), cv2.VideoWriter_fourcc(*"MJPG"), 30.0,
-                             (c.width, c.height), isColor=False)  # fmt: skip
+    writer = cv2.VideoWriter(
+        str(video), cv2.VideoWriter_fourcc(*"MJPG"), 30.0, (c.width, c.height), isColor=False
+    )
     for seed in range(60):
         writer.write(scene_image(system, seed)[0])
     writer.release()
     calibration = tmp_path / "calibration.yaml"
     calibration.write_text(yaml.safe_dump({"fx": c.fx, "fy": c.fy, "cx": c.cx, "cy": c.cy}))
-    system = tracker_system(deployed, tmp_path, {"device": str(video),
-                                                 "calibration": str(calibration)})  # fmt: skip
+    system = tracker_system(
+        deployed, tmp_path, {"device": str(video), "calibration": str(calibration)}
+    )
     inbox = system.inbox(topics.VISION_MARKERS)
     system.start("vision_tracker")
     found = inbox.wait_for(lambda m: len(m.markers) == 3, "with the three markers", 20.0)
@@ -161,4 +175,3 @@ def test_a_device_that_does_not_open_is_a_configuration_error(deployed, tmp_path
     process = system.start("vision_tracker")
     assert process.wait(system.deadline_s) == 2
     assert "device: cannot open" in system.log("vision_tracker")
-

@@ -30,7 +30,6 @@ LAUNCH = (
 """`parsimony launch` through its own module, independent of the other subcommands."""
 
 
-
 def profile_file(directory: Path, components: list[dict[str, Any]], **top_level: Any) -> Path:
     """Write a profile of namespace ``test`` with its router on a free loopback port."""
     data = {

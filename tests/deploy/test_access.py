@@ -27,16 +27,22 @@ if TYPE_CHECKING:
 
 def access_profile(directory: Path) -> Path:
     (directory / "credentials.txt").write_text(
-        "# user:password\noperator:op-secret\nviewer:view-secret\nctl:ctl-secret\n")
+        "# user:password\noperator:op-secret\nviewer:view-secret\nctl:ctl-secret\n"
+    )
     profile = {
         "namespace": "test",
         "robot": str(ROBOT_FILE),
-        "zenoh": {"mode": "client", "router": [f"tcp/127.0.0.1:{free_port()}"],
-                  "access": {"credentials": "credentials.txt",
-                             "writers": {"control/goal": ["operator"]},
-                             "parameters": {"ctl": ["operator"]}}},
+        "zenoh": {
+            "mode": "client",
+            "router": [f"tcp/127.0.0.1:{free_port()}"],
+            "access": {
+                "credentials": "credentials.txt",
+                "writers": {"control/goal": ["operator"]},
+                "parameters": {"ctl": ["operator"]},
+            },
+        },
         "components": [{"name": "ctl", "module": "lp_controller", "role": "controller"}],
-    }  # fmt: skip
+    }
     path = directory / "profile.yaml"
     path.write_text(yaml.safe_dump(profile))
     return path
@@ -84,9 +90,13 @@ def test_only_the_writers_of_a_topic_may_put_and_strangers_cannot_connect(
 
 def param(user: str, profile: Path, *argv: str) -> subprocess.CompletedProcess[str]:
     """`parsimony param ARGV` run by ``user``."""
-    return subprocess.run([sys.executable, "-m", "parsimony.cli", "param", *argv, "--profile",
-                           str(profile)], capture_output=True, text=True, timeout=60,
-                          env={**os.environ, "PARSIMONY_USER": user})  # fmt: skip
+    return subprocess.run(
+        [sys.executable, "-m", "parsimony.cli", "param", *argv, "--profile", str(profile)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env={**os.environ, "PARSIMONY_USER": user},
+    )
 
 
 def test_only_the_users_a_rule_names_may_set_a_components_parameters(
@@ -99,8 +109,10 @@ def test_only_the_users_a_rule_names_may_set_a_components_parameters(
 
     refused = param("viewer", path, "set", "ctl", "stale_timeout_s", "0.25")
     assert refused.returncode == 1 and refused.stdout == "", refused
-    assert refused.stderr.startswith(f"param set refused: {why}") and \
-        len(refused.stderr.splitlines()) == 1, refused.stderr  # fmt: skip
+    assert (
+        refused.stderr.startswith(f"param set refused: {why}")
+        and len(refused.stderr.splitlines()) == 1
+    ), refused.stderr
     (tmp_path / "ctl.yaml").write_text("stale_timeout_s: 0.25\n")
     refused = param("viewer", path, "load", "ctl", str(tmp_path / "ctl.yaml"))
     assert refused.returncode == 1 and f"param load refused: {why}" in refused.stderr, refused
@@ -109,8 +121,10 @@ def test_only_the_users_a_rule_names_may_set_a_components_parameters(
 
     accepted = param("operator", path, "set", "ctl", "stale_timeout_s", "0.25")
     assert accepted.stdout.strip() == "ctl.stale_timeout_s = 0.25", accepted
-    assert param("viewer", path, "get", "ctl", "stale_timeout_s").stdout.strip() == \
-        "ctl.stale_timeout_s = 0.25"  # fmt: skip
+    assert (
+        param("viewer", path, "get", "ctl", "stale_timeout_s").stdout.strip()
+        == "ctl.stale_timeout_s = 0.25"
+    )
     assert launched.stop() == 0
 
 

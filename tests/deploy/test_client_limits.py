@@ -10,17 +10,20 @@ from deploy.client_limits import ECHO_CHARS, TOLD_EVERY_S, Bucket, Rate, echo
 RATE = Rate(per_s=2.0, burst=3)
 
 
-@pytest.mark.parametrize(("value", "shown"), [
-    ("x" * 1_000_000, f"'{'x' * ECHO_CHARS}... (1000000 characters)'"),
-    (10**400, "an integer of 401 digits"),
-    (-3, "-3"),
-    (1e300, "1e+300"),
-    (b"\0" * 7, "7 bytes"),
-    ([[1]] * 5, "a list of 5 entries"),
-    ({"a": {"b": 1}}, "an object of 1 entries"),
-    (True, "true"),
-    (None, "null"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    ("value", "shown"),
+    [
+        ("x" * 1_000_000, f"'{'x' * ECHO_CHARS}... (1000000 characters)'"),
+        (10**400, "an integer of 401 digits"),
+        (-3, "-3"),
+        (1e300, "1e+300"),
+        (b"\0" * 7, "7 bytes"),
+        ([[1]] * 5, "a list of 5 entries"),
+        ({"a": {"b": 1}}, "an object of 1 entries"),
+        (True, "true"),
+        (None, "null"),
+    ],
+)
 def test_an_answer_repeats_a_client_value_in_a_few_words(value: object, shown: str) -> None:
     assert echo(value) == shown
 

@@ -57,14 +57,27 @@ def test_a_sim_clock_profile_makes_every_component_read_sim_clock(tmp_path: Path
 def test_parsimony_graph_prints_json_alone_and_writes_dot(tmp_path: Path) -> None:
     dot = tmp_path / "graph.dot"
     result = subprocess.run(
-        [sys.executable, "-m", "parsimony.cli", "graph", str(DEPLOY / "controllers.yaml"),
-         "--json", "--dot", str(dot)],
-        capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
+        [
+            sys.executable,
+            "-m",
+            "parsimony.cli",
+            "graph",
+            str(DEPLOY / "controllers.yaml"),
+            "--json",
+            "--dot",
+            str(dot),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert result.returncode == 0, result.stderr
     report = json.loads(result.stdout)
     assert report["topics"]["robot/state"] == {
-        "key": "parsimony/robot/state", "writers": ["publisher"], "readers": ["controller"]}
+        "key": "parsimony/robot/state",
+        "writers": ["publisher"],
+        "readers": ["controller"],
+    }
     assert "parsimony/world/obstacles is read by controller" in result.stderr
     assert dot.read_text().startswith('digraph "parsimony" {')
 
@@ -72,15 +85,26 @@ def test_parsimony_graph_prints_json_alone_and_writes_dot(tmp_path: Path) -> Non
 def test_graph_png_without_graphviz_prints_only_how_to_install_it(tmp_path: Path) -> None:
     """Before, it printed the whole text graph, then the hint, and exited 1."""
     result = subprocess.run(
-        [sys.executable, "-m", "parsimony.cli", "graph", str(DEPLOY / "controllers.yaml"),
-         "--png", str(tmp_path / "graph.png")],
-        capture_output=True, text=True, timeout=120, env={"PATH": str(tmp_path)},
-    )  # fmt: skip
+        [
+            sys.executable,
+            "-m",
+            "parsimony.cli",
+            "graph",
+            str(DEPLOY / "controllers.yaml"),
+            "--png",
+            str(tmp_path / "graph.png"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={"PATH": str(tmp_path)},
+    )
     assert result.returncode == 2
     assert result.stdout == ""
     assert result.stderr.splitlines() == [
         "graph: --png needs Graphviz's dot (install it: apt-get install graphviz, brew install "
-        "graphviz); --dot FILE writes the graph without it"]
+        "graphviz); --dot FILE writes the graph without it"
+    ]
     assert not (tmp_path / "graph.png").exists()
 
 
@@ -111,14 +135,22 @@ def test_a_parameter_no_component_would_take_is_refused_before_anything_starts(
 ) -> None:
     """`graph` and `launch` name the file and the field, exit 2; nothing is launched."""
     path = tmp_path / "profile.yaml"
-    path.write_text(f"extends: {DEPLOY / 'sim.yaml'}\n"
-                    "components: [{name: simulator, params: {real_time_factor: -1}}]\n")
-    with pytest.raises(ProfileError, match=r"components\[0\] \(simulator\)\.params\."
-                                           r"real_time_factor: expected a float in \[0.0"):
+    path.write_text(
+        f"extends: {DEPLOY / 'sim.yaml'}\n"
+        "components: [{name: simulator, params: {real_time_factor: -1}}]\n"
+    )
+    with pytest.raises(
+        ProfileError,
+        match=r"components\[0\] \(simulator\)\.params\."
+        r"real_time_factor: expected a float in \[0.0",
+    ):
         dataflow(load_profile(path), path)
     for command in ("graph", "launch"):
-        done = subprocess.run([sys.executable, "-m", "parsimony.cli", command, str(path)],
-                              capture_output=True, text=True)  # fmt: skip
+        done = subprocess.run(
+            [sys.executable, "-m", "parsimony.cli", command, str(path)],
+            capture_output=True,
+            text=True,
+        )
         assert done.returncode == 2 and f"{path}: invalid profile" in done.stderr, done.stderr
         assert "[launch]" not in done.stderr  # refused before a component was started
 

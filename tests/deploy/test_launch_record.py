@@ -16,8 +16,7 @@ from tests.processes import parsimony
 if TYPE_CHECKING:
     from tests.deploy.conftest import LaunchFixture, ProfileWriter
 
-PUB = {"name": "pub", "module": "scripted_publisher", "role": "tool",
-       "params": {"rate_hz": 50.0}}  # fmt: skip
+PUB = {"name": "pub", "module": "scripted_publisher", "role": "tool", "params": {"rate_hz": 50.0}}
 CTL = {"name": "ctl", "module": "lp_controller", "role": "controller"}
 
 
@@ -67,8 +66,12 @@ def test_a_profile_that_already_records_is_refused(
     write_profile: ProfileWriter, tmp_path: Path
 ) -> None:
     """One recording, to the file the user named: not a second one beside the profile's."""
-    recorder = {"name": "rec", "module": "recorder", "role": "recorder",
-                "params": {"path": str(tmp_path / "its.mcap")}}  # fmt: skip
+    recorder = {
+        "name": "rec",
+        "module": "recorder",
+        "role": "recorder",
+        "params": {"path": str(tmp_path / "its.mcap")},
+    }
     profile = write_profile([PUB, recorder])
     done = parsimony("launch", str(profile), "--record", str(tmp_path / "mine.mcap"))
     assert done.returncode == 2

@@ -101,8 +101,9 @@ def test_a_component_starts_once_those_it_waits_for_are_alive_and_stops_before_t
 ) -> None:
     """An emulated device's driver waits for the emulator (before, a driver opened a device
     that did not exist yet and said so at every start)."""
-    profile = write_profile([publisher("drv", role="driver", after=["emu"]),
-                             publisher("emu", role="driver")])  # fmt: skip
+    profile = write_profile(
+        [publisher("drv", role="driver", after=["emu"]), publisher("emu", role="driver")]
+    )
     launched = launch(profile)
     waits, _, _ = launched.wait_for(r"\[launch\] drv starts once emu alive")
     alive, _, _ = launched.wait_for(r"\[launch\] emu alive")
@@ -143,8 +144,10 @@ def test_the_launcher_warns_of_a_topic_read_and_never_written(
     controller = {"name": "ctl", "module": "lp_controller", "role": "controller"}
     profile = write_profile([controller], robot=str(ROBOT_FILE))
     launched = launch(profile, "--duration", "1.0")
-    launched.wait_for(r"^\d\d:\d\d:\d\d\.\d{3} \[launch\] warning: test/robot/state is read "
-                      r"by ctl and written by no component")  # fmt: skip
+    launched.wait_for(
+        r"^\d\d:\d\d:\d\d\.\d{3} \[launch\] warning: test/robot/state is read "
+        r"by ctl and written by no component"
+    )
     assert launched.process.wait(10.0) == 0
     assert "test/base/command is read" not in launched.text()
 
@@ -170,8 +173,12 @@ def test_a_configuration_error_at_start_up_fails_the_whole_launch(
     """One component cannot start with what it was given (exit 2: a recorder whose file
     cannot be made, which no check of the profile can know): the others are stopped, the
     launch fails, instead of running on without it."""
-    bad = {"name": "bad", "module": "recorder", "role": "tool",
-           "params": {"path": "/dev/null/session.mcap"}}  # fmt: skip
+    bad = {
+        "name": "bad",
+        "module": "recorder",
+        "role": "tool",
+        "params": {"path": "/dev/null/session.mcap"},
+    }
     launched = launch(write_profile([publisher("good"), bad]))
     launched.wait_for(r"\[launch\] bad exited with 2; configuration error, not restarting")
     launched.wait_for(r"\[launch\] stopping \(start-up failed: bad failed during start-up\)")

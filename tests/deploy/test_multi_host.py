@@ -41,10 +41,25 @@ def hosts() -> Iterator[tuple[str, str]]:
     try:
         run("ip", "netns", "add", robot)
         run("ip", "netns", "add", station)
-        run("ip", "link", "add", "pz-robot", "netns", robot, "type", "veth", "peer", "name",
-            "pz-station", "netns", station)  # fmt: skip
-        for namespace, device, address in ((robot, "pz-robot", ROBOT_ADDRESS),
-                                           (station, "pz-station", STATION_ADDRESS)):  # fmt: skip
+        run(
+            "ip",
+            "link",
+            "add",
+            "pz-robot",
+            "netns",
+            robot,
+            "type",
+            "veth",
+            "peer",
+            "name",
+            "pz-station",
+            "netns",
+            station,
+        )
+        for namespace, device, address in (
+            (robot, "pz-robot", ROBOT_ADDRESS),
+            (station, "pz-station", STATION_ADDRESS),
+        ):
             run("ip", "-n", namespace, "addr", "add", f"{address}/24", "dev", device)
             run("ip", "-n", namespace, "link", "set", device, "up")
             run("ip", "-n", namespace, "link", "set", "lo", "up")
@@ -56,18 +71,56 @@ def hosts() -> Iterator[tuple[str, str]]:
 
 def make_certificates(directory: Path) -> None:
     """A CA, and a certificate for the robot's router at ROBOT_ADDRESS signed by it."""
-    run("openssl", "req", "-x509", "-newkey", "rsa:2048", "-nodes", "-days", "1",
-        "-keyout", str(directory / "ca-key.pem"), "-out", str(directory / "ca.pem"),
-        "-subj", "/CN=parsimony test CA")  # fmt: skip
-    run("openssl", "req", "-newkey", "rsa:2048", "-nodes", "-keyout",
-        str(directory / "robot-key.pem"), "-out", str(directory / "robot.csr"),
-        "-subj", f"/CN={ROBOT_ADDRESS}")  # fmt: skip
-    (directory / "ext.cnf").write_text(f"subjectAltName=IP:{ROBOT_ADDRESS}\n"
-                                       "extendedKeyUsage=serverAuth\n")  # fmt: skip
-    run("openssl", "x509", "-req", "-days", "1", "-in", str(directory / "robot.csr"),
-        "-CA", str(directory / "ca.pem"), "-CAkey", str(directory / "ca-key.pem"),
-        "-CAcreateserial", "-out", str(directory / "robot.pem"),
-        "-extfile", str(directory / "ext.cnf"))  # fmt: skip
+    run(
+        "openssl",
+        "req",
+        "-x509",
+        "-newkey",
+        "rsa:2048",
+        "-nodes",
+        "-days",
+        "1",
+        "-keyout",
+        str(directory / "ca-key.pem"),
+        "-out",
+        str(directory / "ca.pem"),
+        "-subj",
+        "/CN=parsimony test CA",
+    )
+    run(
+        "openssl",
+        "req",
+        "-newkey",
+        "rsa:2048",
+        "-nodes",
+        "-keyout",
+        str(directory / "robot-key.pem"),
+        "-out",
+        str(directory / "robot.csr"),
+        "-subj",
+        f"/CN={ROBOT_ADDRESS}",
+    )
+    (directory / "ext.cnf").write_text(
+        f"subjectAltName=IP:{ROBOT_ADDRESS}\nextendedKeyUsage=serverAuth\n"
+    )
+    run(
+        "openssl",
+        "x509",
+        "-req",
+        "-days",
+        "1",
+        "-in",
+        str(directory / "robot.csr"),
+        "-CA",
+        str(directory / "ca.pem"),
+        "-CAkey",
+        str(directory / "ca-key.pem"),
+        "-CAcreateserial",
+        "-out",
+        str(directory / "robot.pem"),
+        "-extfile",
+        str(directory / "ext.cnf"),
+    )
 
 
 def lab_profile(name: str, directory: Path) -> Path:
@@ -75,8 +128,9 @@ def lab_profile(name: str, directory: Path) -> Path:
     data = yaml.safe_load((DEPLOY / "lab" / f"{name}.yaml").read_text())
     if "robot" in data:
         data["robot"] = str(ROBOT_FILE)
-    data["zenoh"]["tls"] = {key: str(directory / Path(value).name)
-                            for key, value in data["zenoh"]["tls"].items()}  # fmt: skip
+    data["zenoh"]["tls"] = {
+        key: str(directory / Path(value).name) for key, value in data["zenoh"]["tls"].items()
+    }
     path = directory / f"{name}.yaml"
     path.write_text(yaml.safe_dump(data))
     return path
@@ -93,20 +147,35 @@ def test_a_station_reaches_the_robot_over_tls_between_two_hosts(
     make_certificates(tmp_path)
     robot, station = lab_profile("robot", tmp_path), lab_profile("station", tmp_path)
     launchers = [
-        subprocess.Popen(in_namespace(host, sys.executable, "-c", LAUNCH, str(profile),
-                                      "--duration", "30"),
-                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        subprocess.Popen(
+            in_namespace(host, sys.executable, "-c", LAUNCH, str(profile), "--duration", "30"),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
         for host, profile in ((robot_host, robot), (station_host, station))
-    ]  # fmt: skip
+    ]
     try:
         deadline = time.monotonic() + 20.0
         received = 0
         while received == 0:
             assert time.monotonic() < deadline, "no robot/state crossed from the station"
             status = subprocess.run(
-                in_namespace(robot_host, sys.executable, "-m", "parsimony.cli", "status",
-                             str(robot), "--json", "--timeout", "1"),
-                capture_output=True, text=True, timeout=30)  # fmt: skip
+                in_namespace(
+                    robot_host,
+                    sys.executable,
+                    "-m",
+                    "parsimony.cli",
+                    "status",
+                    str(robot),
+                    "--json",
+                    "--timeout",
+                    "1",
+                ),
+                capture_output=True,
+                text=True,
+                timeout=30,
+            )
             rows = json.loads(status.stdout) if status.returncode == 0 else []
             for row in rows:
                 if row["name"] == "controller" and row["status"]:

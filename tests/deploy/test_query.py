@@ -62,8 +62,10 @@ def test_status_json_is_the_whole_stdout_of_the_command(running_pub: Path) -> No
     wait_for_first_message(running_pub)
     result = subprocess.run(
         [sys.executable, "-m", "parsimony.cli", "status", str(running_pub), "--json"],
-        capture_output=True, text=True, timeout=60,
-    )  # fmt: skip
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert result.returncode == 0, result.stderr
     (row,) = json.loads(result.stdout)
     assert row["name"] == "pub"
@@ -117,8 +119,9 @@ def test_param_errors_are_reported(
 
 def cli(*argv: str) -> subprocess.CompletedProcess[str]:
     """`parsimony ARGV` as a user runs it: a process, stdout its result alone."""
-    return subprocess.run([sys.executable, "-m", "parsimony.cli", *argv], capture_output=True,
-                          text=True, timeout=60)  # fmt: skip
+    return subprocess.run(
+        [sys.executable, "-m", "parsimony.cli", *argv], capture_output=True, text=True, timeout=60
+    )
 
 
 def test_topic_echo_prints_each_decoded_message_as_a_json_line(running_pub: Path) -> None:
@@ -131,8 +134,9 @@ def test_topic_echo_prints_each_decoded_message_as_a_json_line(running_pub: Path
 
 
 def test_topic_hz_measures_the_rate_of_a_live_topic(running_pub: Path) -> None:
-    result = cli("topic", "hz", "robot/state", "--window", "1.0", "--json",
-                 "--profile", str(running_pub))  # fmt: skip
+    result = cli(
+        "topic", "hz", "robot/state", "--window", "1.0", "--json", "--profile", str(running_pub)
+    )
     assert result.returncode == 0, result.stderr
     report = json.loads(result.stdout)
     assert report["messages"] > 5 and report["rate_hz"] > 5.0
@@ -147,10 +151,17 @@ def test_topic_list_info_and_pub(running_pub: Path) -> None:
     assert info["type"] == "Goal" and "task" in info["schema"]["properties"]
     with query.Target.from_profile(running_pub).open() as session:
         received: list[bytes] = []
-        session.declare_subscriber("test/world/obstacles",
-                                   lambda sample: received.append(sample.payload.to_bytes()))
-        result = cli("topic", "pub", "world/obstacles", '{"circles": [{"x": 2, "y": 0, '
-                     '"radius": 0.1}]}', "--profile", str(running_pub))  # fmt: skip
+        session.declare_subscriber(
+            "test/world/obstacles", lambda sample: received.append(sample.payload.to_bytes())
+        )
+        result = cli(
+            "topic",
+            "pub",
+            "world/obstacles",
+            '{"circles": [{"x": 2, "y": 0, "radius": 0.1}]}',
+            "--profile",
+            str(running_pub),
+        )
         assert result.returncode == 0, result.stderr
         assert json.loads(result.stdout)["published"] == 1
         assert "warning" not in result.stderr  # no component of the profile writes it
@@ -164,8 +175,9 @@ def test_topic_list_info_and_pub(running_pub: Path) -> None:
 
 def test_topic_echo_gives_up_at_its_timeout_on_a_silent_topic(running_pub: Path) -> None:
     """Nothing writes world/obstacles here: echo says so and exits 1, instead of waiting on."""
-    result = cli("topic", "echo", "world/obstacles", "--timeout", "1",
-                 "--profile", str(running_pub))  # fmt: skip
+    result = cli(
+        "topic", "echo", "world/obstacles", "--timeout", "1", "--profile", str(running_pub)
+    )
     assert result.returncode == 1, result.stderr
     assert result.stdout == ""
     assert "no message in 1 s on test/world/obstacles" in result.stderr
@@ -175,8 +187,17 @@ def test_topic_echo_gives_up_at_its_timeout_on_a_silent_topic(running_pub: Path)
 
 def test_topic_echo_counts_its_timeout_from_the_last_message(running_pub: Path) -> None:
     """A live topic within the timeout is echoed to its count and exits 0."""
-    result = cli("topic", "echo", "robot/state", "--count", "2", "--timeout", "30",
-                 "--profile", str(running_pub))  # fmt: skip
+    result = cli(
+        "topic",
+        "echo",
+        "robot/state",
+        "--count",
+        "2",
+        "--timeout",
+        "30",
+        "--profile",
+        str(running_pub),
+    )
     assert result.returncode == 0, result.stderr
     assert len(result.stdout.splitlines()) == 2
 
@@ -184,8 +205,14 @@ def test_topic_echo_counts_its_timeout_from_the_last_message(running_pub: Path) 
 def test_topic_pub_warns_when_a_running_component_writes_the_topic(running_pub: Path) -> None:
     """pub writes control/goal in this profile: what the user publishes there is replaced by
     its next goal, and the user is told so."""
-    result = cli("topic", "pub", "control/goal", '{"task": "position", "position": [0.5, 0, 0.4]}',
-                 "--profile", str(running_pub))  # fmt: skip
+    result = cli(
+        "topic",
+        "pub",
+        "control/goal",
+        '{"task": "position", "position": [0.5, 0, 0.4]}',
+        "--profile",
+        str(running_pub),
+    )
     assert result.returncode == 0, result.stderr
     assert "warning: pub writes test/control/goal in this profile and is running" in result.stderr
     assert json.loads(result.stdout)["live_writers"] == ["pub"]
@@ -206,8 +233,9 @@ def test_goal_goes_to_control_goal_where_no_supervisor_takes_requests(running_pu
     with query.Target.from_profile(running_pub).open() as session:
         session.declare_subscriber("test/control/goal", on_goal)
         before = time.time_ns()
-        result = cli("goal", "0.5", "0", "0.4", "--yaw", "90", "--json",
-                     "--profile", str(running_pub))  # fmt: skip
+        result = cli(
+            "goal", "0.5", "0", "0.4", "--yaw", "90", "--json", "--profile", str(running_pub)
+        )
         assert result.returncode == 0, result.stderr
         assert arrived.wait(10.0), "the goal did not arrive"
     assert json.loads(result.stdout)["topic"] == "control/goal"
@@ -224,10 +252,20 @@ def test_param_list_describe_dump_and_load(running_pub: Path, tmp_path: Path) ->
     assert {"rate_hz", "goal_task", "goal_z", "q5"} <= values.keys()
     with query.Target.from_profile(running_pub).open() as session:
         assert values["rate_hz"] == query.get_param(session, "test", "pub", "rate_hz")
-    described = json.loads(cli("param", "describe", "pub", "rate_hz", "--json",
-                               "--profile", profile).stdout)  # fmt: skip
-    assert described == [{"name": "rate_hz", "type": "float", "default": 10.0, "low": 0.1,
-                          "high": 1000.0, "choices": None, "doc": "publishing rate"}]
+    described = json.loads(
+        cli("param", "describe", "pub", "rate_hz", "--json", "--profile", profile).stdout
+    )
+    assert described == [
+        {
+            "name": "rate_hz",
+            "type": "float",
+            "default": 10.0,
+            "low": 0.1,
+            "high": 1000.0,
+            "choices": None,
+            "doc": "publishing rate",
+        }
+    ]
     dump = cli("param", "dump", "pub", "--profile", profile)
     assert dump.returncode == 0 and yaml.safe_load(dump.stdout) == values
     saved = tmp_path / "pub.yaml"

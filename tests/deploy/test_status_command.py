@@ -34,8 +34,12 @@ def test_status_summarises_each_component_and_lists_every_counter_on_demand(
     write_profile: ProfileWriter, launch: LaunchFixture, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A controller fed by a scripted publisher, and one malformed state sent to it."""
-    pub = {"name": "pub", "module": "scripted_publisher", "role": "tool",
-           "params": {"rate_hz": 50.0}}  # fmt: skip
+    pub = {
+        "name": "pub",
+        "module": "scripted_publisher",
+        "role": "tool",
+        "params": {"rate_hz": 50.0},
+    }
     ctl = {"name": "ctl", "module": "lp_controller", "role": "controller"}
     profile = write_profile([pub, ctl], robot=str(ROBOT_FILE))
     launched = launch(profile)
@@ -54,8 +58,18 @@ def test_status_summarises_each_component_and_lists_every_counter_on_demand(
     assert command(str(profile)) == 0
     out, err = capsys.readouterr()
     header, *rows = out.splitlines()
-    assert header.split() == ["NAME", "MODULE", "STATE", "PID", "IN", "OUT", "CPU", "S",
-                              "FAULTS", "(non-zero)"]  # fmt: skip
+    assert header.split() == [
+        "NAME",
+        "MODULE",
+        "STATE",
+        "PID",
+        "IN",
+        "OUT",
+        "CPU",
+        "S",
+        "FAULTS",
+        "(non-zero)",
+    ]
     row = {line.split()[0]: line.split() for line in rows}
     assert row["ctl"][:3] == ["ctl", "lp_controller", "running"]
     assert int(row["ctl"][4]) > 0 and int(row["pub"][5]) > 0  # messages in, messages out
@@ -76,14 +90,38 @@ def test_status_summarises_each_component_and_lists_every_counter_on_demand(
 
 
 def test_a_components_faults_are_told_apart_from_its_other_counters() -> None:
-    counters = {"received.robot/state": 7, "received.control/goal": 3, "published.x": 5,
-                "overwritten.robot/state": 4, "clock_stalls": 1, "errors.timer.t": 0,
-                "port_errors": 2, "handler.robot/state_us_p99": 900, "cpu_ms": 2500}  # fmt: skip
-    found = ComponentStatus(header=Header(stamp_ns=0, frame="", seq=0, source="drv"), name="drv",
-                            module="base_driver", state="no port", pid=12, counters=counters)
+    counters = {
+        "received.robot/state": 7,
+        "received.control/goal": 3,
+        "published.x": 5,
+        "overwritten.robot/state": 4,
+        "clock_stalls": 1,
+        "errors.timer.t": 0,
+        "port_errors": 2,
+        "handler.robot/state_us_p99": 900,
+        "cpu_ms": 2500,
+    }
+    found = ComponentStatus(
+        header=Header(stamp_ns=0, frame="", seq=0, source="drv"),
+        name="drv",
+        module="base_driver",
+        state="no port",
+        pid=12,
+        counters=counters,
+    )
     (line,) = status.format_table([("drv", found)]).splitlines()[1:]
-    assert line.split() == ["drv", "base_driver", "no", "port", "12", "10", "5", "2.5",
-                            "clock_stalls=1", "port_errors=2"]  # fmt: skip
+    assert line.split() == [
+        "drv",
+        "base_driver",
+        "no",
+        "port",
+        "12",
+        "10",
+        "5",
+        "2.5",
+        "clock_stalls=1",
+        "port_errors=2",
+    ]
 
 
 def test_status_wait_started_before_the_launch_returns_once_every_component_is_alive(
@@ -94,9 +132,12 @@ def test_status_wait_started_before_the_launch_returns_once_every_component_is_a
     pub = {"name": "pub", "module": "scripted_publisher", "role": "tool"}
     ctl = {"name": "ctl", "module": "lp_controller", "role": "controller"}
     profile = write_profile([pub, ctl], robot=str(ROBOT_FILE))
-    waiting = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "status", str(profile),
-                                "--wait"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               text=True)  # fmt: skip
+    waiting = subprocess.Popen(
+        [sys.executable, "-m", "parsimony.cli", "status", str(profile), "--wait"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         assert waiting.stderr is not None
         first = waiting.stderr.readline()  # before the launch: nothing listens yet
@@ -118,8 +159,10 @@ def test_status_wait_names_the_components_that_never_come(
     """pub is alive; the profile also has a ghost, which nothing launched. And with no router
     at all, every component is named."""
     ghost = tmp_path / "ghost.yaml"
-    ghost.write_text(f"extends: {running_pub}\ncomponents:\n"
-                     "  - {name: ghost, module: scripted_publisher, role: tool}\n")  # fmt: skip
+    ghost.write_text(
+        f"extends: {running_pub}\ncomponents:\n"
+        "  - {name: ghost, module: scripted_publisher, role: tool}\n"
+    )
     assert command(str(ghost), "--wait", "--timeout", "0.5") == 1
     out, err = capsys.readouterr()
     assert out == ""
@@ -130,7 +173,8 @@ def test_status_wait_names_the_components_that_never_come(
     nowhere.write_text(f"extends: {ghost}\nzenoh: {{router: ['{router}']}}\n")
     assert command(str(nowhere), "--wait", "--timeout", "0.5") == 1
     assert capsys.readouterr().err.splitlines()[-1] == (
-        f"no router at {router} after 0.5 s (is the profile launched?); not alive: pub, ghost")
+        f"no router at {router} after 0.5 s (is the profile launched?); not alive: pub, ghost"
+    )
 
 
 def router_of(profile: Path) -> str:

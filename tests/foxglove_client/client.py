@@ -52,15 +52,20 @@ class RunningView:
 
 
 @contextlib.contextmanager
-def running_view(profile: Path, *flags: str, env: dict[str, str] | None = None,
-                 timeout_s: float = DEADLINE_S) -> Iterator[RunningView]:  # fmt: skip
+def running_view(
+    profile: Path, *flags: str, env: dict[str, str] | None = None, timeout_s: float = DEADLINE_S
+) -> Iterator[RunningView]:
     """``parsimony view PROFILE --port P FLAGS`` on a free port of 127.0.0.1, once it has said
     that it is live (or has ended: ``live_line`` is then its last line); stopped with SIGTERM
     at the end, its output and exit status kept (``out``, ``err``, ``process.returncode``)."""
     port = free_port()
-    process = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "view", str(profile),
-                                "--port", str(port), *flags], text=True, env=env,
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE)  # fmt: skip
+    process = subprocess.Popen(
+        [sys.executable, "-m", "parsimony.cli", "view", str(profile), "--port", str(port), *flags],
+        text=True,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
     assert process.stderr is not None
     line = said = process.stderr.readline()
     while said and " live at " not in line:
@@ -81,8 +86,9 @@ class FoxgloveClient:
 
     def __init__(self, address: str, count: bool = False) -> None:
         command = ["node", str(SCRIPT), address, *(["--count"] if count else [])]
-        self.process = subprocess.Popen(command, cwd=HERE, text=True, stdin=subprocess.PIPE,
-                                        stdout=subprocess.PIPE)  # fmt: skip
+        self.process = subprocess.Popen(
+            command, cwd=HERE, text=True, stdin=subprocess.PIPE, stdout=subprocess.PIPE
+        )
         self.events: list[dict[str, Any]] = []
         self._changed = threading.Condition()
         self._reader = threading.Thread(target=self._read, daemon=True)
@@ -109,8 +115,9 @@ class FoxgloveClient:
         self.process.stdin.write(json.dumps({"op": op, **fields}) + "\n")
         self.process.stdin.flush()
 
-    def wait_for(self, found: Callable[[dict[str, Any]], bool], what: str,
-                 start: int = 0) -> dict[str, Any]:  # fmt: skip
+    def wait_for(
+        self, found: Callable[[dict[str, Any]], bool], what: str, start: int = 0
+    ) -> dict[str, Any]:
         """The first event from index ``start`` on that ``found`` accepts; fails, saying
         ``what`` was awaited, if the client exits or ``DEADLINE_S`` passes first."""
 
@@ -133,21 +140,34 @@ class FoxgloveClient:
     def channels(self) -> dict[str, dict[str, Any]]:
         """Every channel advertised so far, by topic."""
         with self._changed:
-            return {c["topic"]: c for e in self.events if e["event"] == "advertise"
-                    for c in e["channels"]}  # fmt: skip
+            return {
+                c["topic"]: c
+                for e in self.events
+                if e["event"] == "advertise"
+                for c in e["channels"]
+            }
 
     def messages(self, topic: str) -> list[tuple[int, bytes]]:
         """(log time, payload) of every message heard on ``topic`` so far."""
         with self._changed:
-            return [(int(e["logTime"]), base64.b64decode(e["data"])) for e in self.events
-                    if e["event"] == "message" and e["topic"] == topic]  # fmt: skip
+            return [
+                (int(e["logTime"]), base64.b64decode(e["data"]))
+                for e in self.events
+                if e["event"] == "message" and e["topic"] == topic
+            ]
 
-    def message(self, topic: str, found: Callable[[int, bytes], bool] = lambda t, d: True,
-                what: str = "") -> tuple[int, bytes]:  # fmt: skip
+    def message(
+        self, topic: str, found: Callable[[int, bytes], bool] = lambda t, d: True, what: str = ""
+    ) -> tuple[int, bytes]:
         """The first message on ``topic`` that ``found(log_time, payload)`` accepts."""
-        event = self.wait_for(lambda e: e["event"] == "message" and e["topic"] == topic
-                              and found(int(e["logTime"]), base64.b64decode(e["data"])),
-                              what or f"a message on {topic}")  # fmt: skip
+        event = self.wait_for(
+            lambda e: (
+                e["event"] == "message"
+                and e["topic"] == topic
+                and found(int(e["logTime"]), base64.b64decode(e["data"]))
+            ),
+            what or f"a message on {topic}",
+        )
         return int(event["logTime"]), base64.b64decode(event["data"])
 
     def counts(self) -> dict[str, tuple[int, int, int]]:

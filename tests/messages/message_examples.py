@@ -43,12 +43,20 @@ QUARTER_TURN_SHIFTED: tuple[float, ...] = (
 """A unit dual quaternion: rotation pi/4 about z, then translation (1, 2, 0.5) m."""
 
 SOLIDS = Solids(
-    planes=(Plane(name="table", normal=(0.0, 0.0, 1.0), offset=0.4,
-                  footprint=((0.5, -0.4), (1.1, -0.4), (1.1, 0.4), (0.5, 0.4))),
-            Plane(normal=(-1.0, 0.0, 0.0), offset=-2.0)),
-    cylinders=(Cylinder(name="pole", x=0.2, y=-0.3, radius=0.05, height=0.6),
-               Cylinder(x=1.0, y=1.0, radius=0.1)),
-)  # fmt: skip
+    planes=(
+        Plane(
+            name="table",
+            normal=(0.0, 0.0, 1.0),
+            offset=0.4,
+            footprint=((0.5, -0.4), (1.1, -0.4), (1.1, 0.4), (0.5, 0.4)),
+        ),
+        Plane(normal=(-1.0, 0.0, 0.0), offset=-2.0),
+    ),
+    cylinders=(
+        Cylinder(name="pole", x=0.2, y=-0.3, radius=0.05, height=0.6),
+        Cylinder(x=1.0, y=1.0, radius=0.1),
+    ),
+)
 
 INTRINSICS = CameraIntrinsics(fx=525.0, fy=524.5, cx=319.5, cy=239.5, distortion=(0.1, -0.2, 0, 0))
 
@@ -74,11 +82,13 @@ POSE_GOAL = Goal(header=HEADER, task="pose", pose=QUARTER_TURN_SHIFTED, eta=5.0,
 
 POSITION_GOAL = Goal(header=HEADER, task="position", position=(0.5, -0.25, 0.4), eta=1.5, beta=3)
 
-POINT_GOAL = Goal(header=HEADER, task="point", point=(0.4, -0.2),
-                  arm=(0.0, -0.3, 0.2, 0.0, 0.4), lookahead=0.1)  # fmt: skip
+POINT_GOAL = Goal(
+    header=HEADER, task="point", point=(0.4, -0.2), arm=(0.0, -0.3, 0.2, 0.0, 0.4), lookahead=0.1
+)
 
-HEADING_GOAL = Goal(header=HEADER, task="heading", heading=-2.5, point=(0.3, 0.1),
-                    arm=(0.0, -0.3, 0.2, 0.0, 0.4))  # fmt: skip
+HEADING_GOAL = Goal(
+    header=HEADER, task="heading", heading=-2.5, point=(0.3, 0.1), arm=(0.0, -0.3, 0.2, 0.0, 0.4)
+)
 
 EXAMPLES: tuple[Message, ...] = (
     IMAGE,
@@ -144,7 +154,15 @@ EXAMPLES: tuple[Message, ...] = (
     POINT_GOAL,
     HEADING_GOAL,
     SupervisorStatus(
-        header=HEADER, phase="turn", candidate=2, candidate_base=(0.4, -0.1, 3.0), plans=2,
-        replans=1, stalls=1, error_norm=0.3, last_event="re-plan 1", planning_ms=61.5,
+        header=HEADER,
+        phase="turn",
+        candidate=2,
+        candidate_base=(0.4, -0.1, 3.0),
+        plans=2,
+        replans=1,
+        stalls=1,
+        error_norm=0.3,
+        last_event="re-plan 1",
+        planning_ms=61.5,
     ),
 )

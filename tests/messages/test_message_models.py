@@ -137,10 +137,20 @@ def test_unit_tolerance_is_one_in_a_million() -> None:
         ({"task": "orientation", "pose": IDENTITY_POSE}, "task"),
         ({"task": "point", "point": (0, 0), "lookahead": 0.1}, "a point task needs an arm"),
         ({"task": "heading", "heading": 1.0, "arm": (0, 0, 0, 0, 0)}, "needs a point"),
-        ({"task": "point", "point": (0, 0), "arm": (0, 0, 0, 0, 0), "lookahead": 0.1,
-          "heading": 0.0}, "a point task takes no heading"),
-        ({"task": "point", "point": (0, math.nan), "arm": (0, 0, 0, 0, 0), "lookahead": 0.1},
-         "point"),
+        (
+            {
+                "task": "point",
+                "point": (0, 0),
+                "arm": (0, 0, 0, 0, 0),
+                "lookahead": 0.1,
+                "heading": 0.0,
+            },
+            "a point task takes no heading",
+        ),
+        (
+            {"task": "point", "point": (0, math.nan), "arm": (0, 0, 0, 0, 0), "lookahead": 0.1},
+            "point",
+        ),
         ({"task": "pose", "pose": IDENTITY_POSE, "eta": 0.0}, "eta"),
         ({"task": "pose", "pose": IDENTITY_POSE, "beta": -1.0}, "beta"),
     ],
@@ -195,6 +205,8 @@ def test_a_plane_must_be_a_solid_wbc_accepts() -> None:
 
 
 def test_solids_come_back_as_the_wbc_obstacles_they_were_made_of() -> None:
-    solids = (obstacles3d.Plane((0.0, 0.0, 1.0), 0.4, ((0.5, -0.4), (1.1, -0.4), (1.1, 0.4))),
-              obstacles3d.Cylinder(0.2, -0.3, 0.05, None, "pole"))  # fmt: skip
+    solids = (
+        obstacles3d.Plane((0.0, 0.0, 1.0), 0.4, ((0.5, -0.4), (1.1, -0.4), (1.1, 0.4))),
+        obstacles3d.Cylinder(0.2, -0.3, 0.05, None, "pole"),
+    )
     assert Solids.of(solids).solids() == solids

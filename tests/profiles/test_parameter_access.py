@@ -22,8 +22,9 @@ def credentials(tmp_path: Path) -> Path:
 def test_a_component_named_its_users_else_every_components_else_anyone(
     credentials: Path,
 ) -> None:
-    access = AccessSettings(credentials=credentials,
-                            parameters={"*": ["operator"], "camera": ["operator", "guest"]})
+    access = AccessSettings(
+        credentials=credentials, parameters={"*": ["operator"], "camera": ["operator", "guest"]}
+    )
     assert access.may_set("controller", "operator") and not access.may_set("controller", "guest")
     assert access.may_set("camera", "guest") and not access.may_set("camera", "viewer")
     free = AccessSettings(credentials=credentials, parameters={"camera": ["operator"]})
@@ -39,16 +40,25 @@ def test_a_rule_must_name_a_component_of_the_profile(tmp_path: Path) -> None:
     (tmp_path / "credentials.txt").write_text("operator:a\nguest:b\nctl:c\ncam:d\n")
     data = {
         "namespace": "test",
-        "zenoh": {"mode": "client",
-                  "access": {"credentials": "credentials.txt",
-                             "parameters": {"*": ["operator"], "clt": ["guest"]}}},
-        "components": [{"name": name, "module": "scripted_publisher", "role": "tool"}
-                       for name in ("ctl", "cam")],
-    }  # fmt: skip
+        "zenoh": {
+            "mode": "client",
+            "access": {
+                "credentials": "credentials.txt",
+                "parameters": {"*": ["operator"], "clt": ["guest"]},
+            },
+        },
+        "components": [
+            {"name": name, "module": "scripted_publisher", "role": "tool"}
+            for name in ("ctl", "cam")
+        ],
+    }
     path = tmp_path / "profile.yaml"
     path.write_text(yaml.safe_dump(data))
-    with pytest.raises(ProfileError, match=r"zenoh.access.parameters.clt: names no component "
-                       r"of the profile \(have ctl, cam\)"):  # fmt: skip
+    with pytest.raises(
+        ProfileError,
+        match=r"zenoh.access.parameters.clt: names no component "
+        r"of the profile \(have ctl, cam\)",
+    ):
         load_profile(path)
     data["zenoh"]["access"]["parameters"] = {"*": ["operator"], "ctl": ["guest"]}
     path.write_text(yaml.safe_dump(data))

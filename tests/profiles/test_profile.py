@@ -81,17 +81,39 @@ def test_a_minimal_profile_gets_safe_defaults(tmp_path: Path) -> None:
         ({"clock": "sundial"}, "clock", "'wall' or 'sim'"),
         ({"robot": "missing.yaml"}, "robot", "no robot description"),
         ({"zenoh": {"mode": "router"}}, "zenoh.mode", "'client' or 'peer'"),
-        ({"components": [{**PUB, "after": ["nobody"]}]}, "components[0].after",
-         "'nobody' names no component (have pub)"),
+        (
+            {"components": [{**PUB, "after": ["nobody"]}]},
+            "components[0].after",
+            "'nobody' names no component (have pub)",
+        ),
         ({"components": [{**PUB, "after": ["pub"]}]}, "components[0].after", "'pub' is itself"),
-        ({"components": [PUB, {**PUB, "name": "b", "after": ["pub"], "enabled": False},
-                         {**PUB, "name": "c", "after": ["b"]}]},
-         "components[2].after", "'b' is not enabled"),
-        ({"components": [PUB, {**PUB, "name": "drv", "role": "driver", "after": ["pub"]}]},
-         "components[1].after", "'pub' is a tool, whose role starts after a driver's"),
-        ({"components": [{**PUB, "after": ["b"]}, {**PUB, "name": "b", "after": ["c"]},
-                         {**PUB, "name": "c", "after": ["pub"]}]},
-         "components", "wait for each other in a circle (pub -> b -> c -> pub)"),
+        (
+            {
+                "components": [
+                    PUB,
+                    {**PUB, "name": "b", "after": ["pub"], "enabled": False},
+                    {**PUB, "name": "c", "after": ["b"]},
+                ]
+            },
+            "components[2].after",
+            "'b' is not enabled",
+        ),
+        (
+            {"components": [PUB, {**PUB, "name": "drv", "role": "driver", "after": ["pub"]}]},
+            "components[1].after",
+            "'pub' is a tool, whose role starts after a driver's",
+        ),
+        (
+            {
+                "components": [
+                    {**PUB, "after": ["b"]},
+                    {**PUB, "name": "b", "after": ["c"]},
+                    {**PUB, "name": "c", "after": ["pub"]},
+                ]
+            },
+            "components",
+            "wait for each other in a circle (pub -> b -> c -> pub)",
+        ),
     ],
 )
 def test_invalid_profiles_name_the_field(
@@ -127,8 +149,13 @@ def test_an_alias_bomb_and_a_file_that_is_not_utf8_are_refused_at_once(tmp_path:
 
 
 def test_a_huge_wrong_value_is_not_echoed_whole(tmp_path: Path) -> None:
-    said = refusal(tmp_path, {"namespace": "t", "components": [
-        {**PUB, "params": {"rate_hz": {str(i): i for i in range(30_000)}}}]})  # fmt: skip
+    said = refusal(
+        tmp_path,
+        {
+            "namespace": "t",
+            "components": [{**PUB, "params": {"rate_hz": {str(i): i for i in range(30_000)}}}],
+        },
+    )
     assert "components[0].params" in said and len(said) < 1000, said[:2000]
 
 
@@ -188,15 +215,18 @@ def test_endpoints_not_provably_local_are_refused_with_the_reason(
     tmp_path: Path, endpoint: str, reason: str
 ) -> None:
     assert not is_local_endpoint(endpoint)
-    message = refusal(tmp_path, {"namespace": "sim", "zenoh": {"listen": [endpoint]},
-                                 "components": [PUB]})  # fmt: skip
+    message = refusal(
+        tmp_path, {"namespace": "sim", "zenoh": {"listen": [endpoint]}, "components": [PUB]}
+    )
     assert "zenoh.listen[0]" in message and reason in message
 
 
 def test_a_router_on_port_0_is_refused(tmp_path: Path) -> None:
     """Port 0 would bind some free port that no component knows to connect to."""
-    message = refusal(tmp_path, {"namespace": "sim", "zenoh": {"router": ["tcp/127.0.0.1:0"]},
-                                 "components": [PUB]})  # fmt: skip
+    message = refusal(
+        tmp_path,
+        {"namespace": "sim", "zenoh": {"router": ["tcp/127.0.0.1:0"]}, "components": [PUB]},
+    )
     assert "zenoh.router[0]" in message and "port 0" in message
 
 
@@ -278,10 +308,14 @@ def test_a_profile_extends_another_and_says_only_what_differs(tmp_path: Path) ->
         "zenoh": {"router": ["tcp/127.0.0.1:7600"]},
         "components": [
             {**PUB, "params": {"rate_hz": 50.0, "goal_task": "pose"}},
-            {"name": "ctl", "module": "lp_controller", "role": "controller",
-             "params": {"eta": 0.6}},
+            {
+                "name": "ctl",
+                "module": "lp_controller",
+                "role": "controller",
+                "params": {"eta": 0.6},
+            },
         ],
-    }  # fmt: skip
+    }
     (tmp_path / "base.yaml").write_text(yaml.safe_dump(base))
     child_dir = tmp_path / "variants"
     child_dir.mkdir()
@@ -317,24 +351,42 @@ def test_extends_that_is_missing_or_circular_is_refused(tmp_path: Path) -> None:
 
 def test_an_invalid_override_names_its_field(tmp_path: Path) -> None:
     (tmp_path / "base.yaml").write_text(yaml.safe_dump({"namespace": "sim", "components": [PUB]}))
-    message = refusal(tmp_path, {"extends": "base.yaml", "components": [{"name": "pub",
-                                 "restart": {"policy": "sometimes"}}]})  # fmt: skip
+    message = refusal(
+        tmp_path,
+        {
+            "extends": "base.yaml",
+            "components": [{"name": "pub", "restart": {"policy": "sometimes"}}],
+        },
+    )
     assert "components[0].restart.policy" in message
 
 
-@pytest.mark.parametrize(("remap", "complaint"), [
-    ({"control/goal": "robot/state"}, "control/goal carries Goal and robot/state RobotState"),
-    ({"control/goal": "goal/requests"}, "'goal/requests' is not a topic"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    ("remap", "complaint"),
+    [
+        ({"control/goal": "robot/state"}, "control/goal carries Goal and robot/state RobotState"),
+        ({"control/goal": "goal/requests"}, "'goal/requests' is not a topic"),
+    ],
+)
 def test_a_remap_must_name_topics_of_one_message_type(
     tmp_path: Path, remap: dict[str, str], complaint: str
 ) -> None:
     path = tmp_path / "remap.yaml"
-    path.write_text(yaml.safe_dump({
-        "namespace": "remap",
-        "components": [{"name": "estimator", "module": "state_estimator", "role": "estimator",
-                        "remap": remap}],
-    }))  # fmt: skip
+    path.write_text(
+        yaml.safe_dump(
+            {
+                "namespace": "remap",
+                "components": [
+                    {
+                        "name": "estimator",
+                        "module": "state_estimator",
+                        "role": "estimator",
+                        "remap": remap,
+                    }
+                ],
+            }
+        )
+    )
     with pytest.raises(ProfileError, match=r"components\[0\]\.remap: ") as error:
         load_profile(path)
     assert complaint in str(error.value)

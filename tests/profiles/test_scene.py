@@ -135,15 +135,29 @@ def test_a_repeated_id_outside_the_obstacles_names_the_marker_that_repeats(tmp_p
     assert "  scene.goal.id" in message, message
 
 
-TABLE = {"name": "table", "normal": [0, 0, 1], "offset": 0.4,
-         "footprint": [[0.5, -0.4], [1.1, -0.4], [1.1, 0.4], [0.5, 0.4]]}  # fmt: skip
+TABLE = {
+    "name": "table",
+    "normal": [0, 0, 1],
+    "offset": 0.4,
+    "footprint": [[0.5, -0.4], [1.1, -0.4], [1.1, 0.4], [0.5, 0.4]],
+}
 POLE = {"name": "pole", "x": 0.2, "y": -0.3, "radius": 0.05, "height": 0.6}
 
 
 def test_a_scene_declares_planes_and_cylinders_for_the_arm(tmp_path: Path) -> None:
     """Read into the obstacles of wbc.obstacles3d, in F0; none by default."""
-    scene = load_profile(write(tmp_path, {**SCENE, "arm_obstacles": {
-        "planes": [TABLE, {"normal": [-1, 0, 0], "offset": -2.0}], "cylinders": [POLE]}})).scene
+    scene = load_profile(
+        write(
+            tmp_path,
+            {
+                **SCENE,
+                "arm_obstacles": {
+                    "planes": [TABLE, {"normal": [-1, 0, 0], "offset": -2.0}],
+                    "cylinders": [POLE],
+                },
+            },
+        )
+    ).scene
     table, wall, pole = scene.arm_obstacles.solids()
     assert (table.name, table.offset, len(table.footprint)) == ("table", 0.4, 4)
     assert (wall.name, wall.normal, wall.footprint) == ("plane", (-1.0, 0.0, 0.0), ())
@@ -154,36 +168,76 @@ def test_a_scene_declares_planes_and_cylinders_for_the_arm(tmp_path: Path) -> No
 @pytest.mark.parametrize(
     ("planes", "cylinders", "field", "expected"),
     [
-        ([{**TABLE, "normal": [0, 0, 2]}], [], "scene.arm_obstacles.planes[0].normal",
-         "expected a unit vector"),
-        ([{**TABLE, "normal": [1, 0, 0]}], [], "scene.arm_obstacles.planes[0].footprint",
-         "only a horizontal plane"),
-        ([{**TABLE, "footprint": [[0, 0], [2, 0], [1, 0.2], [2, 2], [0, 2]]}], [],
-         "scene.arm_obstacles.planes[0].footprint", "expected a convex polygon"),
-        ([{**TABLE, "footprint": [[0, 0], [1, 0]]}], [], "scene.arm_obstacles.planes[0].footprint",
-         "at least 3"),
-        ([{**TABLE, "offset": "high"}], [], "scene.arm_obstacles.planes[0].offset",
-         "valid number"),
-        ([{**TABLE, "colour": "oak"}], [], "scene.arm_obstacles.planes[0].colour",
-         "Extra inputs"),
-        ([], [{**POLE, "radius": 0.0}], "scene.arm_obstacles.cylinders[0].radius",
-         "greater than 0"),
-        ([], [{**POLE, "height": -1.0}], "scene.arm_obstacles.cylinders[0].height",
-         "greater than 0"),
+        (
+            [{**TABLE, "normal": [0, 0, 2]}],
+            [],
+            "scene.arm_obstacles.planes[0].normal",
+            "expected a unit vector",
+        ),
+        (
+            [{**TABLE, "normal": [1, 0, 0]}],
+            [],
+            "scene.arm_obstacles.planes[0].footprint",
+            "only a horizontal plane",
+        ),
+        (
+            [{**TABLE, "footprint": [[0, 0], [2, 0], [1, 0.2], [2, 2], [0, 2]]}],
+            [],
+            "scene.arm_obstacles.planes[0].footprint",
+            "expected a convex polygon",
+        ),
+        (
+            [{**TABLE, "footprint": [[0, 0], [1, 0]]}],
+            [],
+            "scene.arm_obstacles.planes[0].footprint",
+            "at least 3",
+        ),
+        ([{**TABLE, "offset": "high"}], [], "scene.arm_obstacles.planes[0].offset", "valid number"),
+        ([{**TABLE, "colour": "oak"}], [], "scene.arm_obstacles.planes[0].colour", "Extra inputs"),
+        (
+            [],
+            [{**POLE, "radius": 0.0}],
+            "scene.arm_obstacles.cylinders[0].radius",
+            "greater than 0",
+        ),
+        (
+            [],
+            [{**POLE, "height": -1.0}],
+            "scene.arm_obstacles.cylinders[0].height",
+            "greater than 0",
+        ),
         ([], [{"x": 0.0, "radius": 0.1}], "scene.arm_obstacles.cylinders[0].y", "Field required"),
-        ([], [{**POLE, "radius": 1e300}], "scene.arm_obstacles.cylinders[0].radius",
-         "expected a number > 0 and <= 100 m, got 1e+300"),
-        ([], [POLE, {**POLE, "height": 1e300}], "scene.arm_obstacles.cylinders[1].height",
-         "<= 100 m"),
+        (
+            [],
+            [{**POLE, "radius": 1e300}],
+            "scene.arm_obstacles.cylinders[0].radius",
+            "expected a number > 0 and <= 100 m, got 1e+300",
+        ),
+        (
+            [],
+            [POLE, {**POLE, "height": 1e300}],
+            "scene.arm_obstacles.cylinders[1].height",
+            "<= 100 m",
+        ),
         ([], [{**POLE, "x": -1e300}], "scene.arm_obstacles.cylinders[0].x, y", "within +-100 m"),
-        ([{**TABLE, "offset": 1e300}], [], "scene.arm_obstacles.planes[0].offset",
-         "within +-100 m"),
-        ([{**TABLE, "footprint": [[0, 0], [1e300, 0], [0, 1]]}], [],
-         "scene.arm_obstacles.planes[0].footprint", "within +-100 m"),
+        (
+            [{**TABLE, "offset": 1e300}],
+            [],
+            "scene.arm_obstacles.planes[0].offset",
+            "within +-100 m",
+        ),
+        (
+            [{**TABLE, "footprint": [[0, 0], [1e300, 0], [0, 1]]}],
+            [],
+            "scene.arm_obstacles.planes[0].footprint",
+            "within +-100 m",
+        ),
     ],
-)  # fmt: skip
-def test_invalid_arm_obstacles_name_the_field(tmp_path: Path, planes: list, cylinders: list,
-                                              field: str, expected: str) -> None:  # fmt: skip
-    message = refusal(tmp_path, {**SCENE, "arm_obstacles": {"planes": planes,
-                                                            "cylinders": cylinders}})
+)
+def test_invalid_arm_obstacles_name_the_field(
+    tmp_path: Path, planes: list, cylinders: list, field: str, expected: str
+) -> None:
+    message = refusal(
+        tmp_path, {**SCENE, "arm_obstacles": {"planes": planes, "cylinders": cylinders}}
+    )
     assert f"  {field}" in message and expected in message, message

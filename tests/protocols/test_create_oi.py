@@ -92,8 +92,10 @@ def test_parser_counts_and_skips_a_bad_checksum() -> None:
 def test_parser_recovers_from_a_truncated_frame() -> None:
     parser = oi.StreamParser()
     assert packets(parser, ENCODER_FRAME[:5]) == []
-    assert packets(parser, SPEC_FRAME + ENCODER_FRAME) == [{29: 537, 13: 0},
-                                                    {43: 0x1234, 44: 0xFFFE}]
+    assert packets(parser, SPEC_FRAME + ENCODER_FRAME) == [
+        {29: 537, 13: 0},
+        {43: 0x1234, 44: 0xFFFE},
+    ]
     assert parser.bad_checksums == 1
 
 

@@ -139,16 +139,19 @@ def test_moving_speed() -> None:
 READ_ANSWER = dxl.status_packet(3, 0, bytes([0x00, 0x02, 0x10, 0x00]))
 
 
-@pytest.mark.parametrize(("answer", "fault"), [
-    (READ_ANSWER, None),
-    (b"", dxl.StatusFault.SILENT),
-    (READ_ANSWER[:5], dxl.StatusFault.TRUNCATED),
-    (READ_ANSWER[:-2], dxl.StatusFault.TRUNCATED),
-    (READ_ANSWER[:-1] + bytes([READ_ANSWER[-1] ^ 0x5A]), dxl.StatusFault.CHECKSUM),
-    (dxl.status_packet(4, 0, READ_ANSWER[5:-1]), dxl.StatusFault.WRONG_ID),
-    (dxl.status_packet(3, 0, READ_ANSWER[5:-2]), dxl.StatusFault.WRONG_LENGTH),
-    (dxl.status_packet(3, 0, READ_ANSWER[5:-1] + b"\x00"), dxl.StatusFault.WRONG_LENGTH),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    ("answer", "fault"),
+    [
+        (READ_ANSWER, None),
+        (b"", dxl.StatusFault.SILENT),
+        (READ_ANSWER[:5], dxl.StatusFault.TRUNCATED),
+        (READ_ANSWER[:-2], dxl.StatusFault.TRUNCATED),
+        (READ_ANSWER[:-1] + bytes([READ_ANSWER[-1] ^ 0x5A]), dxl.StatusFault.CHECKSUM),
+        (dxl.status_packet(4, 0, READ_ANSWER[5:-1]), dxl.StatusFault.WRONG_ID),
+        (dxl.status_packet(3, 0, READ_ANSWER[5:-2]), dxl.StatusFault.WRONG_LENGTH),
+        (dxl.status_packet(3, 0, READ_ANSWER[5:-1] + b"\x00"), dxl.StatusFault.WRONG_LENGTH),
+    ],
+)
 def test_each_fault_of_a_status_packet_is_named(answer: bytes, fault) -> None:
     assert dxl.status_fault(answer, 3, 4) == fault
 

@@ -22,10 +22,14 @@ MESSAGES = 3000
 
 
 def state(index: int) -> RobotState:
-    return RobotState(header=Header(stamp_ns=index * 20_000_000, frame="world", seq=index,
-                                    source="test"),
-                      base_pose=(index * 1e-3, 2.0, 0.3), arm_joints=(0.1, -0.2, 0.3, -0.4, 0.5),
-                      end_effector=(1.0, 0, 0, 0, 0, 0, 0, 0), valid=True, age_s=0.0)  # fmt: skip
+    return RobotState(
+        header=Header(stamp_ns=index * 20_000_000, frame="world", seq=index, source="test"),
+        base_pose=(index * 1e-3, 2.0, 0.3),
+        arm_joints=(0.1, -0.2, 0.3, -0.4, 0.5),
+        end_effector=(1.0, 0, 0, 0, 0, 0, 0, 0),
+        valid=True,
+        age_s=0.0,
+    )
 
 
 @pytest.fixture
@@ -49,8 +53,11 @@ def damaged(session: Path, tmp_path: Path) -> tuple[Path, int]:
     path = tmp_path / "flipped.mcap"
     path.write_bytes(bytes(data))
     with session.open("rb") as stream:
-        held = sum(1 for _, _, m in make_reader(stream).iter_messages()
-                   if chunk.message_start_time <= m.log_time <= chunk.message_end_time)  # fmt: skip
+        held = sum(
+            1
+            for _, _, m in make_reader(stream).iter_messages()
+            if chunk.message_start_time <= m.log_time <= chunk.message_end_time
+        )
     return path, held
 
 
@@ -64,9 +71,12 @@ def test_a_file_that_is_not_mcap_is_said_in_one_line_by_every_command(
     path = tmp_path / f"{kind}.mcap"
     path.write_bytes(FOREIGN[kind])
     out = str(tmp_path / "out.mcap")
-    every = (["info", str(path)], ["report", str(path), "--out", str(tmp_path / "r")],
-             ["rerun", str(path), "--controller", "lp", "-o", out],
-             ["record", "--recover", str(path), "-o", out])  # fmt: skip
+    every = (
+        ["info", str(path)],
+        ["report", str(path), "--out", str(tmp_path / "r")],
+        ["rerun", str(path), "--controller", "lp", "-o", out],
+        ["record", "--recover", str(path), "-o", out],
+    )
     for arguments in every if kind == "text" else every[:1]:  # all read through one scan
         done = parsimony(*arguments)
         assert done.returncode == 2, (arguments, done.stderr)
@@ -116,12 +126,14 @@ BAD_ARGUMENTS = {
     "--rate 0": (["--rate", "0"], "--rate: expected a finite number of times the recorded"),
     "--start-offset past the end": (["--start-offset", "1000"], "nothing in the window"),
     "--start-offset nan": (["--start-offset", "nan"], "--start-offset: expected seconds >= 0"),
-    "--keys matching nothing": (["--keys", "robot/state", "robot/stat"],
-                                "'robot/stat' matches no topic"),
+    "--keys matching nothing": (
+        ["--keys", "robot/state", "robot/stat"],
+        "'robot/stat' matches no topic",
+    ),
     "--keys none in the file": (["--keys", "camera/*"], "nothing to replay"),
     "--namespace *": (["--namespace", "*"], "must not contain the wildcard"),
     "--namespace ''": (["--namespace", ""], "namespace must not be empty"),
-}  # fmt: skip
+}
 
 
 @pytest.mark.parametrize("case", sorted(BAD_ARGUMENTS))
@@ -131,8 +143,10 @@ def test_bad_replay_arguments_are_said_before_any_router_is_reached(
     """Each is refused, said on the last line, exit 2; the profile's router is not there, so a
     check made after connecting would say that instead."""
     profile = tmp_path / "p.yaml"
-    profile.write_text(f"namespace: bad\nzenoh: {{router: ['tcp/127.0.0.1:{free_port()}']}}\n"
-                       "components: [{name: pub, module: scripted_publisher, role: tool}]\n")
+    profile.write_text(
+        f"namespace: bad\nzenoh: {{router: ['tcp/127.0.0.1:{free_port()}']}}\n"
+        "components: [{name: pub, module: scripted_publisher, role: tool}]\n"
+    )
     arguments, said = BAD_ARGUMENTS[case]
     done = parsimony("replay", str(session), "--profile", str(profile), *arguments)
     assert done.returncode == 2, done.stderr
@@ -143,8 +157,9 @@ def test_bad_replay_arguments_are_said_before_any_router_is_reached(
 @pytest.mark.parametrize("keys", [[], ["robot/state", "robots/*"]])
 def test_record_refuses_keys_that_match_no_topic(tmp_path: Path, keys: list[str]) -> None:
     profile = tmp_path / "p.yaml"
-    profile.write_text("namespace: bad\ncomponents: [{name: pub, module: scripted_publisher, "
-                       "role: tool}]\n")  # fmt: skip
+    profile.write_text(
+        "namespace: bad\ncomponents: [{name: pub, module: scripted_publisher, role: tool}]\n"
+    )
     done = parsimony("record", str(profile), "-o", str(tmp_path / "k.mcap"), "--keys", *keys)
     assert done.returncode == 2 and "keys: " in done.stderr, done.stderr
     assert not (tmp_path / "k.mcap").exists()
@@ -160,14 +175,22 @@ def foxglove_file(path: Path) -> Path:
     context = foxglove.Context()
     with foxglove.open_mcap(path, context=context):
         poses = PoseInFrameChannel("/goal", context=context)
-        state = foxglove.Channel("other/robot/state", schema={"type": "object"},
-                                 message_encoding="json", context=context)  # fmt: skip
+        state = foxglove.Channel(
+            "other/robot/state", schema={"type": "object"}, message_encoding="json", context=context
+        )
         for index in range(50):
             stamp = Timestamp(sec=index, nsec=0)
-            poses.log(PoseInFrame(timestamp=stamp, frame_id="world",
-                                  pose=Pose(position=Vector3(x=index, y=0, z=0),
-                                            orientation=Quaternion(x=0, y=0, z=0, w=1))),
-                      log_time=index * 10**9)  # fmt: skip
+            poses.log(
+                PoseInFrame(
+                    timestamp=stamp,
+                    frame_id="world",
+                    pose=Pose(
+                        position=Vector3(x=index, y=0, z=0),
+                        orientation=Quaternion(x=0, y=0, z=0, w=1),
+                    ),
+                ),
+                log_time=index * 10**9,
+            )
             state.log({"x": index}, log_time=index * 10**9)
     return path
 
@@ -179,13 +202,16 @@ def test_a_file_of_another_tool_is_read_for_what_it_holds(tmp_path: Path) -> Non
     shown = info(path)
     assert shown["complete"] and shown["messages"] == 100
     assert {c["key"]: c["topic"] for c in shown["channels"]} == {
-        "/goal": None, "other/robot/state": None}
+        "/goal": None,
+        "other/robot/state": None,
+    }
     assert {r.topic_name for r in read_session(path)} == {None}
     report = parsimony("report", str(path), "--out", str(tmp_path / "r"))
     assert report.returncode == 2 and "the session has no messages on topic" in report.stderr
     profile = tmp_path / "p.yaml"
-    profile.write_text("namespace: bad\ncomponents: [{name: pub, module: scripted_publisher, "
-                       "role: tool}]\n")  # fmt: skip
+    profile.write_text(
+        "namespace: bad\ncomponents: [{name: pub, module: scripted_publisher, role: tool}]\n"
+    )
     replay = parsimony("replay", str(path), "--profile", str(profile))
     assert replay.returncode == 2 and "nothing to replay" in replay.stderr, replay.stderr
     assert recover(path, tmp_path / "copy.mcap") == 100

@@ -34,8 +34,9 @@ NAMESPACE = "far"
 def write(path: Path, session: dict[str, list], poison: Goal | None = None) -> Path:
     """``session`` as a recorder writes it, in stamp order, ``poison`` on goal/request half
     way through (when it came)."""
-    recorded = sorted((m.header.stamp_ns, topic, m) for topic, found in session.items()
-                      for m in found)  # fmt: skip
+    recorded = sorted(
+        (m.header.stamp_ns, topic, m) for topic, found in session.items() for m in found
+    )
     with SessionWriter(path) as writer:
         for index, (_, topic, message) in enumerate(recorded):
             if poison is not None and index == len(recorded) // 2:
@@ -54,16 +55,27 @@ def files(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     goals a drive leg to a point, a turn, then the pose), and the same with the operator's
     goal on goal/request stamped on the wall clock, as `topic pub` stamped it."""
     task = PoseTask(ROBOT.fkm(scenarios.REACH_GOAL))
-    session = session_of(integrate(LPLaw(ROBOT, LPParams()), scenarios.HOME, task, DT, 1500),
-                         "lp", task)  # fmt: skip
+    session = session_of(
+        integrate(LPLaw(ROBOT, LPParams()), scenarios.HOME, task, DT, 1500), "lp", task
+    )
     arm, start_ns = tuple(scenarios.HOME[3:].tolist()), START_NS
     session[CONTROL_GOAL.name] = [
-        Goal(header=header(start_ns, "supervisor"), task="point", point=(0.5, 0.0),
-             arm=arm, lookahead=0.1),
-        Goal(header=header(start_ns + 10**9, "supervisor"), task="heading", heading=0.0,
-             arm=arm, point=(0.5, 0.0)),
+        Goal(
+            header=header(start_ns, "supervisor"),
+            task="point",
+            point=(0.5, 0.0),
+            arm=arm,
+            lookahead=0.1,
+        ),
+        Goal(
+            header=header(start_ns + 10**9, "supervisor"),
+            task="heading",
+            heading=0.0,
+            arm=arm,
+            point=(0.5, 0.0),
+        ),
         Goal(header=header(start_ns + 2 * 10**9, "supervisor"), task="pose", pose=tuple(task.pose)),
-    ]  # fmt: skip
+    ]
     folder = tmp_path_factory.mktemp("far")
     goal = Goal(header=header(time.time_ns(), "topic"), task="pose", pose=tuple(task.pose))
     return write(folder / "clean.mcap", session), write(folder / "poisoned.mcap", session, goal)
@@ -89,10 +101,15 @@ def test_info_gives_the_true_span_and_names_the_far_stamp_in_one_line(files) -> 
 
 def test_a_replay_of_it_ends_and_says_what_it_did_not_send(files, tmp_path: Path) -> None:
     profile = tmp_path / "far.yaml"
-    profile.write_text(yaml.safe_dump({
-        "namespace": NAMESPACE, "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
-        "components": [{"name": "pub", "module": "scripted_publisher", "role": "tool"}],
-    }))  # fmt: skip  # never launched: the replay has no router to reach, and serves its own
+    profile.write_text(
+        yaml.safe_dump(
+            {
+                "namespace": NAMESPACE,
+                "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
+                "components": [{"name": "pub", "module": "scripted_publisher", "role": "tool"}],
+            }
+        )
+    )  # never launched: the replay has no router to reach, and serves its own
     clean = json.loads(parsimony("info", str(files[0]), "--json").stdout)
     done = parsimony("replay", str(files[1]), "--profile", str(profile), "--rate", "20")
     assert done.returncode == 0, done.stderr
@@ -102,8 +119,7 @@ def test_a_replay_of_it_ends_and_says_what_it_did_not_send(files, tmp_path: Path
     assert len(lines) == 1 and "not sent" in lines[0] and "goal/request" in lines[0]
 
 
-def test_a_report_of_it_is_written_whole_and_says_what_it_left_out(files, tmp_path: Path
-                                                                     ) -> None:  # fmt: skip
+def test_a_report_of_it_is_written_whole_and_says_what_it_left_out(files, tmp_path: Path) -> None:
     out = tmp_path / "report"
     done = parsimony("report", str(files[1]), "--out", str(out), "--json")
     assert done.returncode == 0, done.stderr

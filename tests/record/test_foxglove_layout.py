@@ -37,25 +37,74 @@ def one_of_each() -> list[tuple[topics.Topic, object]]:
     corners = ((10.0, 10.0), (20.0, 10.0), (20.0, 20.0), (10.0, 20.0))
     image = jpeg(np.zeros((48, 64), np.uint8), 90)
     return [
-        (topics.CAMERA_IMAGE, CameraFrame.model_validate({
-            "header": camera, "encoding": "jpeg", "width": 64, "height": 48, "data": image,
-            "intrinsics": {"fx": 60.0, "fy": 60.0, "cx": 31.5, "cy": 23.5}})),
-        (topics.VISION_MARKERS, MarkerDetections(header=camera, markers=(MarkerDetection(
-            id=1, pose=pose_dq(0.0, (0.0, 0.0, 2.5)), reprojection_error=0.1,
-            corners=corners),))),
+        (
+            topics.CAMERA_IMAGE,
+            CameraFrame.model_validate(
+                {
+                    "header": camera,
+                    "encoding": "jpeg",
+                    "width": 64,
+                    "height": 48,
+                    "data": image,
+                    "intrinsics": {"fx": 60.0, "fy": 60.0, "cx": 31.5, "cy": 23.5},
+                }
+            ),
+        ),
+        (
+            topics.VISION_MARKERS,
+            MarkerDetections(
+                header=camera,
+                markers=(
+                    MarkerDetection(
+                        id=1,
+                        pose=pose_dq(0.0, (0.0, 0.0, 2.5)),
+                        reprojection_error=0.1,
+                        corners=corners,
+                    ),
+                ),
+            ),
+        ),
         (topics.ROBOT_STATE, robot_state(seq=0)),
-        (topics.SIM_TRUTH, SimTruth(header=HEADER, base_pose=(0.0, 0.0, 0.0),
-                                    arm_joints=(0.0,) * 5, end_effector=pose_dq(0.0, (0.5, 0, 0.4)),
-                                    contacts=0, in_contact=False)),
-        (topics.WORLD_OBSTACLES, Obstacles(header=HEADER, circles=(Circle(x=1.0, y=0.0,
-                                                                          radius=0.1),))),
-        (topics.SUPERVISOR_STATUS, SupervisorStatus(header=HEADER, phase="drive", candidate=1,
-                                                    plans=1, replans=0, stalls=0,
-                                                    way=((0.1, 0.2),))),
-        (topics.CONTROL_DIAGNOSTICS, ControllerDiagnostics(
-            header=HEADER, law="lp", status="optimal", nonzero=7, practical_nonzero=6,
-            solve_time_us=100.0, error_norm=math.pi)),
-    ]  # fmt: skip
+        (
+            topics.SIM_TRUTH,
+            SimTruth(
+                header=HEADER,
+                base_pose=(0.0, 0.0, 0.0),
+                arm_joints=(0.0,) * 5,
+                end_effector=pose_dq(0.0, (0.5, 0, 0.4)),
+                contacts=0,
+                in_contact=False,
+            ),
+        ),
+        (
+            topics.WORLD_OBSTACLES,
+            Obstacles(header=HEADER, circles=(Circle(x=1.0, y=0.0, radius=0.1),)),
+        ),
+        (
+            topics.SUPERVISOR_STATUS,
+            SupervisorStatus(
+                header=HEADER,
+                phase="drive",
+                candidate=1,
+                plans=1,
+                replans=0,
+                stalls=0,
+                way=((0.1, 0.2),),
+            ),
+        ),
+        (
+            topics.CONTROL_DIAGNOSTICS,
+            ControllerDiagnostics(
+                header=HEADER,
+                law="lp",
+                status="optimal",
+                nonzero=7,
+                practical_nonzero=6,
+                solve_time_us=100.0,
+                error_norm=math.pi,
+            ),
+        ),
+    ]
 
 
 def named_topics(node: object) -> set[str]:
@@ -88,11 +137,21 @@ def test_every_topic_the_layout_names_is_a_channel_of_the_namespace(tmp_path: Pa
     publish = f"{NAMESPACE}/goal/request"  # the client's, not the namespace's
     assert publish in named
     assert named - {publish} <= channels, sorted(named - channels)
-    assert {f"{NAMESPACE}/{suffix}" for suffix in (
-        "camera/image/foxglove", "vision/markers/annotations", "robot/state/model",
-        "sim/truth/model", "sim/truth/penetrations", "supervisor/status/scene",
-        "world/obstacles/foxglove", "world/obstacles/solids", "control/diagnostics",
-        "supervisor/status")} <= named  # fmt: skip
+    assert {
+        f"{NAMESPACE}/{suffix}"
+        for suffix in (
+            "camera/image/foxglove",
+            "vision/markers/annotations",
+            "robot/state/model",
+            "sim/truth/model",
+            "sim/truth/penetrations",
+            "supervisor/status/scene",
+            "world/obstacles/foxglove",
+            "world/obstacles/solids",
+            "control/diagnostics",
+            "supervisor/status",
+        )
+    } <= named
     panels = json.dumps(document)
     for panel in ("ThreeDee", "Image", "Plot", "RawMessages", "Parameters"):
         assert f'"panelType":"{panel}"' in panels.replace(" ", "")

@@ -84,8 +84,12 @@ def descriptors(file_descriptor_set: bytes) -> dict[str, dict[int, tuple[str, in
         for number, _, value in parts:
             if number == 2:  # FieldDescriptorProto: name 1, number 3, label 4, type 5, type 6
                 field = {n: v for n, _, v in wire_fields(value)}
-                fields[field[3]] = (field[1].decode(), field[4], field[5],
-                                    field.get(6, b"").decode())  # fmt: skip
+                fields[field[3]] = (
+                    field[1].decode(),
+                    field[4],
+                    field[5],
+                    field.get(6, b"").decode(),
+                )
             elif number == 3:  # a nested DescriptorProto
                 add(name, value)
         found[name] = fields
@@ -113,7 +117,8 @@ def decode(view: View) -> dict[str, Any]:
                 width = struct.calcsize(FIXED_WIDTH[kind])
                 out.setdefault(name, []).extend(
                     struct.unpack(FIXED_WIDTH[kind], raw[i : i + width])[0]
-                    for i in range(0, len(raw), width))  # fmt: skip
+                    for i in range(0, len(raw), width)
+                )
                 continue
             if kind == MESSAGE:
                 value = read(nested, raw)
@@ -166,10 +171,16 @@ def pose_dq(angle_z: float, translation: tuple[float, float, float]) -> tuple[fl
 def test_an_image_is_a_raw_image_with_the_same_bytes(encoding: str) -> None:
     width, height, channels = 32, 24, 1 if encoding == "mono8" else 3
     pixels = random.Random(encoding).randbytes(width * height * channels)
-    frame = CameraFrame.model_validate({
-        "header": HEADER, "encoding": encoding, "width": width, "height": height,
-        "data": pixels, "intrinsics": {"fx": 40.0, "fy": 40.0, "cx": 15.5, "cy": 11.5},
-    })  # fmt: skip
+    frame = CameraFrame.model_validate(
+        {
+            "header": HEADER,
+            "encoding": encoding,
+            "width": width,
+            "height": height,
+            "data": pixels,
+            "intrinsics": {"fx": 40.0, "fy": 40.0, "cx": 15.5, "cy": 11.5},
+        }
+    )
     (view,) = views_of(topics.CAMERA_IMAGE.name, "sim/camera/image", frame)
     assert view.schema_name == "foxglove.RawImage"
     assert view.schema_data == fox.RawImage.get_schema().data
@@ -186,10 +197,16 @@ def test_an_image_is_a_raw_image_with_the_same_bytes(encoding: str) -> None:
 def test_a_jpeg_frame_is_a_compressed_image_with_the_same_file() -> None:
     grey = np.random.default_rng(3).integers(0, 256, (24, 32), dtype=np.uint8)
     data = jpeg(grey, 90)
-    frame = CameraFrame.model_validate({
-        "header": HEADER, "encoding": "jpeg", "width": 32, "height": 24, "data": data,
-        "intrinsics": {"fx": 40.0, "fy": 40.0, "cx": 15.5, "cy": 11.5},
-    })  # fmt: skip
+    frame = CameraFrame.model_validate(
+        {
+            "header": HEADER,
+            "encoding": "jpeg",
+            "width": 32,
+            "height": 24,
+            "data": data,
+            "intrinsics": {"fx": 40.0, "fy": 40.0, "cx": 15.5, "cy": 11.5},
+        }
+    )
     (view,) = views_of(topics.CAMERA_IMAGE.name, "sim/camera/image", frame)
     assert (view.schema_name, view.carries) == ("foxglove.CompressedImage", "data")
     image = decode(view)
@@ -207,9 +224,14 @@ ARM = (0.1, -0.2, 0.3, -0.4, 0.5)
 
 def robot_state(seq: int = 3) -> RobotState:
     header = Header(stamp_ns=STAMP_NS, frame="world", seq=seq, source="test")
-    return RobotState(header=header, base_pose=(1.5, -2.0, 0.6), arm_joints=ARM,
-                      end_effector=pose_dq(math.pi / 2, (0.7, 0.2, 0.45)), valid=True,
-                      age_s=0.01)  # fmt: skip
+    return RobotState(
+        header=header,
+        base_pose=(1.5, -2.0, 0.6),
+        arm_joints=ARM,
+        end_effector=pose_dq(math.pi / 2, (0.7, 0.2, 0.45)),
+        valid=True,
+        age_s=0.01,
+    )
 
 
 def test_a_robot_state_gives_the_base_and_end_effector_frames() -> None:
@@ -219,18 +241,23 @@ def test_a_robot_state_gives_the_base_and_end_effector_frames() -> None:
     base, hand = frames["estimate/base"], frames["estimate/end_effector"]
     assert base["parent_frame_id"] == hand["parent_frame_id"] == "world"
     assert vector(base["translation"], "xyz") == [1.5, -2.0, 0.0]
-    assert vector(base["rotation"], "xyzw") == pytest.approx([0, 0, math.sin(0.3),
-                                                              math.cos(0.3)])  # fmt: skip
+    assert vector(base["rotation"], "xyzw") == pytest.approx([0, 0, math.sin(0.3), math.cos(0.3)])
     assert vector(hand["translation"], "xyz") == pytest.approx([0.7, 0.2, 0.45], abs=1e-12)
     half = math.sqrt(0.5)
     assert vector(hand["rotation"], "xyzw") == pytest.approx([0, 0, half, half], abs=1e-12)
 
 
 def test_the_truth_stands_in_the_simulators_world_under_the_estimates() -> None:
-    truth = SimTruth(header=HEADER, base_pose=(1.5, -2.0, 0.6), arm_joints=ARM,
-                     end_effector=pose_dq(0.0, (0.7, 0.2, 0.45)), contacts=0,
-                     in_contact=False, goal=pose_dq(0.3, (1.0, 0.5, 0.4)),
-                     reference_pose=(0.75, 0.85, 0.3))  # fmt: skip
+    truth = SimTruth(
+        header=HEADER,
+        base_pose=(1.5, -2.0, 0.6),
+        arm_joints=ARM,
+        end_effector=pose_dq(0.0, (0.7, 0.2, 0.45)),
+        contacts=0,
+        in_contact=False,
+        goal=pose_dq(0.3, (1.0, 0.5, 0.4)),
+        reference_pose=(0.75, 0.85, 0.3),
+    )
     (view,) = views_of(topics.SIM_TRUTH.name, "sim/sim/truth", truth)
     frames = transforms_of(view)
     assert set(frames) == {"truth/world", "truth/base", "truth/end_effector", "truth/goal"}
@@ -244,12 +271,16 @@ def test_the_truth_stands_in_the_simulators_world_under_the_estimates() -> None:
 
 
 def test_markers_are_frames_of_the_camera_and_placed_ones_of_the_world() -> None:
-    seen = (MarkerDetection(id=3, pose=pose_dq(0.0, (0.1, 0.2, 2.5)), reprojection_error=0.3),
-            MarkerDetection(id=7, pose=pose_dq(math.pi, (-0.4, 0.0, 2.4)),
-                            reprojection_error=0.5))  # fmt: skip
+    seen = (
+        MarkerDetection(id=3, pose=pose_dq(0.0, (0.1, 0.2, 2.5)), reprojection_error=0.3),
+        MarkerDetection(id=7, pose=pose_dq(math.pi, (-0.4, 0.0, 2.4)), reprojection_error=0.5),
+    )
     camera = Header(stamp_ns=STAMP_NS, frame="camera", seq=3, source="test")
-    view, _ = views_of(topics.VISION_MARKERS.name, "sim/vision/markers",
-                       MarkerDetections(header=camera, markers=seen))  # fmt: skip
+    view, _ = views_of(
+        topics.VISION_MARKERS.name,
+        "sim/vision/markers",
+        MarkerDetections(header=camera, markers=seen),
+    )
     frames = transforms_of(view)
     assert set(frames) == {"marker_3", "marker_7"}
     assert {f["parent_frame_id"] for f in frames.values()} == {"camera"}
@@ -258,8 +289,11 @@ def test_markers_are_frames_of_the_camera_and_placed_ones_of_the_world() -> None
     empty = MarkerDetections(header=camera)
     assert views_of(topics.WORLD_MARKERS.name, "sim/world/markers", empty) == []
     # The estimator's markers, placed in F0, are frames of the world beside the truth's.
-    (placed,) = views_of(topics.WORLD_MARKERS.name, "sim/world/markers",
-                         MarkerDetections(header=HEADER, markers=seen))  # fmt: skip
+    (placed,) = views_of(
+        topics.WORLD_MARKERS.name,
+        "sim/world/markers",
+        MarkerDetections(header=HEADER, markers=seen),
+    )
     frames = transforms_of(placed)
     assert set(frames) == {"estimate/marker_3", "estimate/marker_7"}
     assert {f["parent_frame_id"] for f in frames.values()} == {"world"}
@@ -276,8 +310,9 @@ def test_a_pose_goal_is_a_frame_and_a_position_goal_has_no_view() -> None:
 
 
 def test_topics_without_a_well_known_schema_have_no_view() -> None:
-    command = BaseCommand(header=HEADER, forward_velocity=0.1, angular_velocity=0.2,
-                          left_wheel=0.07, right_wheel=0.13)  # fmt: skip
+    command = BaseCommand(
+        header=HEADER, forward_velocity=0.1, angular_velocity=0.2, left_wheel=0.07, right_wheel=0.13
+    )
     assert views_of(topics.BASE_COMMAND.name, "sim/base/command", command) == []
 
 

@@ -32,11 +32,20 @@ def with_truth(session: dict[str, list], goal: np.ndarray, shift: float = 0.0) -
     """The session with a ground truth at each state: the state moved by ``shift`` in x (an
     estimator that far off), the goal and one obstacle as the simulator places them."""
     obstacle = scenarios.OBSTACLE
-    truth = [SimTruth(header=s.header, base_pose=(s.base_pose[0] + shift, *s.base_pose[1:]),
-                      arm_joints=s.arm_joints, end_effector=s.end_effector, contacts=0,
-                      in_contact=False, goal=tuple(goal), reference_pose=(0.0, 0.0, 0.0),
-                      obstacles=(Circle(x=obstacle.x, y=obstacle.y, radius=obstacle.radius),))
-             for s in session[ROBOT_STATE.name]]  # fmt: skip
+    truth = [
+        SimTruth(
+            header=s.header,
+            base_pose=(s.base_pose[0] + shift, *s.base_pose[1:]),
+            arm_joints=s.arm_joints,
+            end_effector=s.end_effector,
+            contacts=0,
+            in_contact=False,
+            goal=tuple(goal),
+            reference_pose=(0.0, 0.0, 0.0),
+            obstacles=(Circle(x=obstacle.x, y=obstacle.y, radius=obstacle.radius),),
+        )
+        for s in session[ROBOT_STATE.name]
+    ]
     return {**session, SIM_TRUTH.name: truth}
 
 
@@ -54,9 +63,12 @@ def test_a_converged_run_ends_hold_s_after_it_converged_and_is_judged_on_the_tru
     assert judged["final_error"] == pytest.approx(np.linalg.norm(x - goal), abs=1e-12)
     assert judged["estimator_error"]["position_m"] == pytest.approx(0.004, abs=1e-9)
     assert judged["contacts"] == 0 and judged["joint_limit_violations"] == 0
-    centre = min(np.hypot(s.base_pose[0] + 0.004 - scenarios.OBSTACLE.x,
-                          s.base_pose[1] - scenarios.OBSTACLE.y)
-                 for s in cut[ROBOT_STATE.name])  # fmt: skip
+    centre = min(
+        np.hypot(
+            s.base_pose[0] + 0.004 - scenarios.OBSTACLE.x, s.base_pose[1] - scenarios.OBSTACLE.y
+        )
+        for s in cut[ROBOT_STATE.name]
+    )
     gap = centre - scenarios.OBSTACLE.radius - ROBOT.base.body_radius
     assert judged["min_obstacle_clearance_m"] == pytest.approx(gap, abs=1e-4)
     stamps, u = commands(cut)
@@ -70,8 +82,14 @@ def test_a_recording_without_truth_says_so_and_judges_the_rest(runs):  # noqa: F
     _, session = runs["LP"]
     judged = judge(session, ROBOT)
     assert judged["truth"] == "absent"
-    for key in ("final_error", "contacts", "joint_limit_violations", "min_obstacle_clearance_m",
-                "arm_penetrations", "arm_clearance_m"):
+    for key in (
+        "final_error",
+        "contacts",
+        "joint_limit_violations",
+        "min_obstacle_clearance_m",
+        "arm_penetrations",
+        "arm_clearance_m",
+    ):
         assert judged[key] is None, key
     assert judged["estimator_error"]["samples"] == 0
     assert judged["converged"] and judged["final_error_estimated"] < 0.01
@@ -80,8 +98,10 @@ def test_a_recording_without_truth_says_so_and_judges_the_rest(runs):  # noqa: F
 
 def test_a_time_limit_ends_a_run_that_did_not_converge_at_the_limit(runs):  # noqa: F811
     _, session = runs["LP"]
-    early = {name: [m for m in messages if m.header.stamp_ns < START_NS + 2 * 10**9]
-             for name, messages in session.items()}  # fmt: skip
+    early = {
+        name: [m for m in messages if m.header.stamp_ns < START_NS + 2 * 10**9]
+        for name, messages in session.items()
+    }
     judged = judge(early, ROBOT, time_limit_s=1.0)
     assert not judged["converged"]
     last = the_run(early, 1.0)[0][CONTROL_DIAGNOSTICS.name][-1].header.stamp_ns
@@ -97,8 +117,10 @@ def test_a_run_that_converged_only_after_its_time_limit_is_judged_as_it_stood_at
     origin = origin_s(session)
     converged_s = the_run(session)[0][CONTROL_DIAGNOSTICS.name][-1].header.stamp_ns / 1e9
     limit_s = converged_s - origin - 0.5
-    in_time = {name: [m for m in messages if m.header.stamp_ns / 1e9 <= origin + limit_s]
-               for name, messages in session.items()}  # fmt: skip
+    in_time = {
+        name: [m for m in messages if m.header.stamp_ns / 1e9 <= origin + limit_s]
+        for name, messages in session.items()
+    }
     late, stopped = judge(session, ROBOT, time_limit_s=limit_s), judge(in_time, ROBOT, limit_s)
     assert judge(session, ROBOT)["converged"]
     assert not late["converged"] and not stopped["converged"]
@@ -112,10 +134,15 @@ def test_the_arms_clearance_and_penetrations_are_judged_from_the_truth(runs):  #
     height has the wrist or the hand at a negative clearance."""
     _, session = runs["LP"]
     truth = with_truth(session, ROBOT.fkm(scenarios.REACH_GOAL))[SIM_TRUTH.name]
-    heights = [ROBOT.link_points(np.array([*t.base_pose, *t.arm_joints]))[3:, 2].min()
-               for t in truth]  # fmt: skip
-    table = Plane(name="table", normal=(0.0, 0.0, 1.0), offset=float(min(heights)) + 0.01,
-                  footprint=((-5.0, -5.0), (5.0, -5.0), (5.0, 5.0), (-5.0, 5.0)))
+    heights = [
+        ROBOT.link_points(np.array([*t.base_pose, *t.arm_joints]))[3:, 2].min() for t in truth
+    ]
+    table = Plane(
+        name="table",
+        normal=(0.0, 0.0, 1.0),
+        offset=float(min(heights)) + 0.01,
+        footprint=((-5.0, -5.0), (5.0, -5.0), (5.0, 5.0), (-5.0, 5.0)),
+    )
     solids = Solids(planes=(table,))
     marked = [t.model_copy(update={"solids": solids, "arm_penetrations": 3}) for t in truth]
     judged = judge({**session, SIM_TRUTH.name: marked}, ROBOT)
@@ -136,22 +163,37 @@ def test_a_position_goal_passed_on_by_the_supervisor_converges_as_without_it(
     0.01 in the direct phase, as it did with no supervisor (before, only pose and reached
     phases counted: it converged HOLD_S after reached, or never)."""
     position = dq.translation(ROBOT.fkm(scenarios.REACH_GOAL))[1:]
-    run = integrate(LPLaw(ROBOT, LPParams()), scenarios.HOME, PositionTask(position),
-                    scenarios.DT, 1500, tolerance=1e-4)  # fmt: skip
+    run = integrate(
+        LPLaw(ROBOT, LPParams()),
+        scenarios.HOME,
+        PositionTask(position),
+        scenarios.DT,
+        1500,
+        tolerance=1e-4,
+    )
     session = session_of(run, "lp", PoseTask(ROBOT.fkm(scenarios.REACH_GOAL)))
     goal = session[CONTROL_GOAL.name][0]
-    session[CONTROL_GOAL.name] = [Goal(header=goal.header, task="position",
-                                       position=tuple(position))]  # fmt: skip
+    session[CONTROL_GOAL.name] = [
+        Goal(header=goal.header, task="position", position=tuple(position))
+    ]
     unsupervised = judge(load_session(write(tmp_path / "alone.mcap", session), JUDGED), ROBOT)
-    statuses = [SupervisorStatus(header=d.header.model_copy(update={"source": "supervisor"}),
-                                 phase="direct" if d.error_norm >= tolerance else "reached",
-                                 candidate=0, plans=0, replans=0, stalls=0,
-                                 error_norm=d.error_norm)
-                for d in session[CONTROL_DIAGNOSTICS.name]]  # fmt: skip
+    statuses = [
+        SupervisorStatus(
+            header=d.header.model_copy(update={"source": "supervisor"}),
+            phase="direct" if d.error_norm >= tolerance else "reached",
+            candidate=0,
+            plans=0,
+            replans=0,
+            stalls=0,
+            error_norm=d.error_norm,
+        )
+        for d in session[CONTROL_DIAGNOSTICS.name]
+    ]
     supervised = {**session, SUPERVISOR_STATUS.name: statuses}
     judged = judge(load_session(write(tmp_path / "supervised.mcap", supervised), JUDGED), ROBOT)
     assert unsupervised["converged"] and judged["converged"]
     assert judged["iterations"] == unsupervised["iterations"]
-    first_small = next(i for i, d in enumerate(session[CONTROL_DIAGNOSTICS.name])
-                       if d.error_norm < 0.01)  # fmt: skip
+    first_small = next(
+        i for i, d in enumerate(session[CONTROL_DIAGNOSTICS.name]) if d.error_norm < 0.01
+    )
     assert judged["iterations"] == first_small + round(HOLD_S / scenarios.DT) + 1

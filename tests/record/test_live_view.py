@@ -56,23 +56,31 @@ reads is not decoded)."""
 
 
 def header(seq: int) -> Header:
-    return Header(stamp_ns=FIRST_STAMP_NS + seq * 50_000_000, frame="world", seq=seq,
-                  source="test")  # fmt: skip
+    return Header(stamp_ns=FIRST_STAMP_NS + seq * 50_000_000, frame="world", seq=seq, source="test")
 
 
 def image(seq: int) -> CameraFrame:
-    return CameraFrame.model_validate({
-        "header": header(seq), "encoding": "mono8", "width": WIDTH, "height": HEIGHT,
-        "data": random.Random(seq).randbytes(WIDTH * HEIGHT),
-        "intrinsics": {"fx": 60.0, "fy": 60.0, "cx": 31.5, "cy": 23.5},
-    })  # fmt: skip
+    return CameraFrame.model_validate(
+        {
+            "header": header(seq),
+            "encoding": "mono8",
+            "width": WIDTH,
+            "height": HEIGHT,
+            "data": random.Random(seq).randbytes(WIDTH * HEIGHT),
+            "intrinsics": {"fx": 60.0, "fy": 60.0, "cx": 31.5, "cy": 23.5},
+        }
+    )
 
 
 def state(seq: int) -> RobotState:
-    return RobotState(header=header(seq), base_pose=(0.5 + 0.01 * seq, -0.25, 0.3),
-                      arm_joints=(0.1, -0.2, 0.3, -0.4, 0.5),
-                      end_effector=(1.0, 0.0, 0.0, 0.0, 0.0, 0.2, 0.1, 0.25),
-                      valid=True, age_s=0.0)  # fmt: skip
+    return RobotState(
+        header=header(seq),
+        base_pose=(0.5 + 0.01 * seq, -0.25, 0.3),
+        arm_joints=(0.1, -0.2, 0.3, -0.4, 0.5),
+        end_effector=(1.0, 0.0, 0.0, 0.0, 0.0, 0.2, 0.1, 0.25),
+        valid=True,
+        age_s=0.0,
+    )
 
 
 class System:
@@ -102,10 +110,15 @@ class System:
 def write_profile(directory: Path) -> Path:
     """A profile of the namespace, its router on a free loopback port."""
     profile = directory / "live.yaml"
-    profile.write_text(yaml.safe_dump({
-        "namespace": NAMESPACE, "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
-        "components": [{"name": "x", "module": "scripted_publisher", "role": "tool"}],
-    }))  # fmt: skip
+    profile.write_text(
+        yaml.safe_dump(
+            {
+                "namespace": NAMESPACE,
+                "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
+                "components": [{"name": "x", "module": "scripted_publisher", "role": "tool"}],
+            }
+        )
+    )
     return profile
 
 
@@ -155,9 +168,10 @@ async def watch(address: str, wanted: set[str]) -> tuple[dict, dict[str, tuple[i
     """As the Foxglove app: read serverInfo and the advertisements until the ``wanted``
     channels are there, subscribe to them, read ``WATCHED_MESSAGES`` at least, and return them
     by topic with the first (log time, payload) each sends."""
-    async with asyncio.timeout(DEADLINE_S), connect(
-        address, subprotocols=[Subprotocol("foxglove.sdk.v1")], max_size=None
-    ) as client:  # fmt: skip
+    async with (
+        asyncio.timeout(DEADLINE_S),
+        connect(address, subprotocols=[Subprotocol("foxglove.sdk.v1")], max_size=None) as client,
+    ):
         assert client.subprotocol == "foxglove.sdk.v1"
         server_info = json.loads(await client.recv())
         assert server_info["op"] == "serverInfo", server_info
@@ -169,9 +183,17 @@ async def watch(address: str, wanted: set[str]) -> tuple[dict, dict[str, tuple[i
         topic_of = dict(enumerate(sorted(wanted), start=1))
 
         async def subscribe(chosen: dict[int, str]) -> None:
-            await client.send(json.dumps({"op": "subscribe", "subscriptions": [
-                {"id": sid, "channelId": channels[topic]["id"]} for sid, topic in chosen.items()
-            ]}))  # fmt: skip
+            await client.send(
+                json.dumps(
+                    {
+                        "op": "subscribe",
+                        "subscriptions": [
+                            {"id": sid, "channelId": channels[topic]["id"]}
+                            for sid, topic in chosen.items()
+                        ],
+                    }
+                )
+            )
 
         await subscribe(topic_of)
         first: dict[str, tuple[int, bytes]] = {}
@@ -186,8 +208,13 @@ async def watch(address: str, wanted: set[str]) -> tuple[dict, dict[str, tuple[i
                 # foxglove-sdk 0.30 sends an advertisement before it records the channel as
                 # advertised to this client: a subscription that follows at once can be refused.
                 unknown = int(json.loads(message)["message"].removeprefix(UNKNOWN_CHANNEL))
-                await subscribe({sid: topic for sid, topic in topic_of.items()
-                                 if channels[topic]["id"] == unknown})  # fmt: skip
+                await subscribe(
+                    {
+                        sid: topic
+                        for sid, topic in topic_of.items()
+                        if channels[topic]["id"] == unknown
+                    }
+                )
         return channels, first
 
 
@@ -226,12 +253,14 @@ def test_a_websocket_client_sees_live_images_and_frames(system) -> None:
     frame, _ = running.published[log_time]
     raw_image = decoded(channels[IMAGE_VIEW], payload)
     assert (raw_image["width"], raw_image["height"], raw_image["encoding"]) == (
-        WIDTH, HEIGHT, "mono8")  # fmt: skip
+        WIDTH,
+        HEIGHT,
+        "mono8",
+    )
     assert raw_image["data"] == frame.data
     log_time, payload = first[FRAMES_VIEW]
     _, robot_state = running.published[log_time]
-    frames = {t["child_frame_id"]: t for t in decoded(channels[FRAMES_VIEW],
-                                                      payload)["transforms"]}  # fmt: skip
+    frames = {t["child_frame_id"]: t for t in decoded(channels[FRAMES_VIEW], payload)["transforms"]}
     assert set(frames) == {"estimate/base", "estimate/end_effector"}
     base = frames["estimate/base"]["translation"]
     assert (base["x"], base["y"]) == robot_state.base_pose[:2]
@@ -248,9 +277,19 @@ def test_a_websocket_client_sees_live_images_and_frames(system) -> None:
 
 
 def test_keys_that_match_no_topic_are_refused(tmp_path: Path) -> None:
-    done = subprocess.run([sys.executable, "-m", "parsimony.cli", "view",
-                           str(write_profile(tmp_path)),
-                           "--keys", "camera/imag"], capture_output=True, text=True,
-                          timeout=60)  # fmt: skip
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "parsimony.cli",
+            "view",
+            str(write_profile(tmp_path)),
+            "--keys",
+            "camera/imag",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert done.returncode == 2
     assert "keys: 'camera/imag' matches no topic" in done.stderr

@@ -32,8 +32,12 @@ from wbc.collision_model import point_positions
 KEY = "sim/world/obstacles"
 TRUTH_KEY = "sim/sim/truth"
 TABLE = Plane.of(scenarios.TABLE)
-SHELF = Plane(name="shelf", normal=(0.0, 0.0, -1.0), offset=-0.9,
-              footprint=((0.0, 1.0), (0.25, 1.4), (0.5, 1.0)))  # fmt: skip
+SHELF = Plane(
+    name="shelf",
+    normal=(0.0, 0.0, -1.0),
+    offset=-0.9,
+    footprint=((0.0, 1.0), (0.25, 1.4), (0.5, 1.0)),
+)
 """An underside 0.9 m up over a triangle given clockwise: the solid is above it."""
 WALL = Plane(name="wall", normal=(-0.6, -0.8, 0.0), offset=-1.5)
 POLE = Cylinder(name="pole", x=0.2, y=-0.3, radius=0.05, height=0.6)
@@ -45,10 +49,17 @@ def views(viewer: Viewer, key: str, topic: topics.Topic, message: Any) -> dict[s
     return {view.channel_suffix: view for view in viewer(topic.name, key, message)}
 
 
-def obstacles(seq: int = 3, circles: tuple[Circle, ...] = (), planes: tuple[Plane, ...] = (),
-              cylinders: tuple[Cylinder, ...] = ()) -> Obstacles:  # fmt: skip
-    return Obstacles(header=HEADER.model_copy(update={"seq": seq}), circles=circles,
-                     solids=Solids(planes=planes, cylinders=cylinders))  # fmt: skip
+def obstacles(
+    seq: int = 3,
+    circles: tuple[Circle, ...] = (),
+    planes: tuple[Plane, ...] = (),
+    cylinders: tuple[Cylinder, ...] = (),
+) -> Obstacles:
+    return Obstacles(
+        header=HEADER.model_copy(update={"seq": seq}),
+        circles=circles,
+        solids=Solids(planes=planes, cylinders=cylinders),
+    )
 
 
 def entities_by_name(update: dict[str, Any]) -> dict[str, dict[str, Any]]:
@@ -107,8 +118,10 @@ def test_a_table_is_its_top_over_the_footprint_and_the_solid_under_it() -> None:
     assert area(top) == pytest.approx(polygon_area(TABLE.footprint))
     # The solid under it, down to the floor: every vertex on its surface, the sides' area the
     # footprint's perimeter times the height.
-    perimeter = sum(math.dist(a, b) for a, b in zip(TABLE.footprint, TABLE.footprint[1:]
-                                                    + TABLE.footprint[:1], strict=True))
+    perimeter = sum(
+        math.dist(a, b)
+        for a, b in zip(TABLE.footprint, TABLE.footprint[1:] + TABLE.footprint[:1], strict=True)
+    )
     assert set(body[:, 2].round(9)) == {0.0, height}
     assert area(body) == pytest.approx(perimeter * height)
     (edges,) = table["lines"]
@@ -129,8 +142,11 @@ def test_an_underside_is_drawn_up_from_its_plane() -> None:
     assert SHELF.solid().clearance(body) == pytest.approx(0.0, abs=1e-9)
     # Just above the face is inside the solid, just below is not.
     centre = np.array([*np.mean(SHELF.footprint, axis=0), height])
-    assert SHELF.solid().clearance(centre + [0, 0, 0.01]) < 0 < SHELF.solid().clearance(
-        centre - [0, 0, 0.01])
+    assert (
+        SHELF.solid().clearance(centre + [0, 0, 0.01])
+        < 0
+        < SHELF.solid().clearance(centre - [0, 0, 0.01])
+    )
 
 
 def test_a_wall_is_a_thin_box_with_its_front_face_on_the_plane() -> None:
@@ -141,8 +157,12 @@ def test_a_wall_is_a_thin_box_with_its_front_face_on_the_plane() -> None:
     turn = box["pose"]["orientation"]
     normal = np.array(WALL.normal)
     assert rotate(turn, np.array([1.0, 0.0, 0.0])) == pytest.approx(normal)  # x: the normal
-    corners = np.array([centre + rotate(turn, size / 2 * np.array(signs))
-                        for signs in itertools.product((-1.0, 1.0), repeat=3)])  # fmt: skip
+    corners = np.array(
+        [
+            centre + rotate(turn, size / 2 * np.array(signs))
+            for signs in itertools.product((-1.0, 1.0), repeat=3)
+        ]
+    )
     depth = WALL.solid().clearance(corners)
     front = corners @ normal > centre @ normal
     assert depth[front] == pytest.approx(0.0, abs=1e-9)  # the front face on the plane
@@ -156,10 +176,12 @@ def test_a_pole_stands_from_the_floor_to_its_top_and_one_without_a_top_is_tall()
     found = entities_by_name(decode(drawn[SOLIDS_SUFFIX]))
     for pole, height in ((POLE, POLE.height), (MAST, UNBOUNDED_HEIGHT_M)):
         (cylinder,) = found[pole.name]["cylinders"]
-        assert vector(cylinder["size"], "xyz") == pytest.approx([2 * pole.radius,
-                                                                 2 * pole.radius, height])
-        assert vector(cylinder["pose"]["position"], "xyz") == pytest.approx([pole.x, pole.y,
-                                                                             height / 2])
+        assert vector(cylinder["size"], "xyz") == pytest.approx(
+            [2 * pole.radius, 2 * pole.radius, height]
+        )
+        assert vector(cylinder["pose"]["position"], "xyz") == pytest.approx(
+            [pole.x, pole.y, height / 2]
+        )
         top_centre = np.array([pole.x, pole.y, height])
         if pole.height is not None:
             assert pole.solid().clearance(top_centre) == pytest.approx(0.0)
@@ -168,24 +190,39 @@ def test_a_pole_stands_from_the_floor_to_its_top_and_one_without_a_top_is_tall()
 
 def test_the_solids_go_when_they_change_and_every_model_every_messages() -> None:
     viewer = Viewer()
-    sent = [SOLIDS_SUFFIX in views(viewer, KEY, topics.WORLD_OBSTACLES, message)
-            for message in (obstacles(1, planes=(TABLE,)), obstacles(2, planes=(TABLE,)),
-                            obstacles(3, planes=(TABLE, WALL)), obstacles(4, planes=(TABLE, WALL)),
-                            obstacles(MODEL_EVERY, planes=(TABLE, WALL)))]  # fmt: skip
+    sent = [
+        SOLIDS_SUFFIX in views(viewer, KEY, topics.WORLD_OBSTACLES, message)
+        for message in (
+            obstacles(1, planes=(TABLE,)),
+            obstacles(2, planes=(TABLE,)),
+            obstacles(3, planes=(TABLE, WALL)),
+            obstacles(4, planes=(TABLE, WALL)),
+            obstacles(MODEL_EVERY, planes=(TABLE, WALL)),
+        )
+    ]
     assert sent == [True, False, True, False, True]
     # The circles, which the estimator refines with every frame, go with every message.
     circles = (Circle(x=1.0, y=0.0, radius=0.1),)
-    assert CHANNEL_SUFFIX in views(viewer, KEY, topics.WORLD_OBSTACLES,
-                                   obstacles(5, circles, planes=(TABLE, WALL)))  # fmt: skip
+    assert CHANNEL_SUFFIX in views(
+        viewer, KEY, topics.WORLD_OBSTACLES, obstacles(5, circles, planes=(TABLE, WALL))
+    )
     # Another key has its own.
-    assert SOLIDS_SUFFIX in views(viewer, "lab/world/obstacles", topics.WORLD_OBSTACLES,
-                                  obstacles(6, planes=(TABLE, WALL)))  # fmt: skip
+    assert SOLIDS_SUFFIX in views(
+        viewer, "lab/world/obstacles", topics.WORLD_OBSTACLES, obstacles(6, planes=(TABLE, WALL))
+    )
 
 
 def truth(q: np.ndarray, solids: Solids, penetrating: bool, seq: int) -> SimTruth:
-    return SimTruth(header=HEADER.model_copy(update={"seq": seq}), base_pose=tuple(q[:3]),
-                    arm_joints=tuple(q[3:]), end_effector=tuple(ROBOT.fkm(q)), contacts=0,
-                    in_contact=False, solids=solids, arm_penetrating=penetrating)  # fmt: skip
+    return SimTruth(
+        header=HEADER.model_copy(update={"seq": seq}),
+        base_pose=tuple(q[:3]),
+        arm_joints=tuple(q[3:]),
+        end_effector=tuple(ROBOT.fkm(q)),
+        contacts=0,
+        in_contact=False,
+        solids=solids,
+        arm_penetrating=penetrating,
+    )
 
 
 def test_a_part_inside_a_solid_is_drawn_red_where_it_truly_is() -> None:
@@ -195,9 +232,17 @@ def test_a_part_inside_a_solid_is_drawn_red_where_it_truly_is() -> None:
     gripper = parts[names.index("gripper")]
     # A table top 5 cm over the gripper, a 10 cm square round it: the gripper is inside.
     x, y = gripper[:2]
-    table = Plane(name="low table", normal=(0.0, 0.0, 1.0), offset=float(gripper[2]) + 0.05,
-                  footprint=((x - 0.05, y - 0.05), (x + 0.05, y - 0.05), (x + 0.05, y + 0.05),
-                             (x - 0.05, y + 0.05)))  # fmt: skip
+    table = Plane(
+        name="low table",
+        normal=(0.0, 0.0, 1.0),
+        offset=float(gripper[2]) + 0.05,
+        footprint=(
+            (x - 0.05, y - 0.05),
+            (x + 0.05, y - 0.05),
+            (x + 0.05, y + 0.05),
+            (x - 0.05, y + 0.05),
+        ),
+    )
     viewer = Viewer(ROBOT)
     drawn = views(viewer, TRUTH_KEY, topics.SIM_TRUTH, truth(q, Solids(planes=(table,)), True, 1))
     update = decode(drawn[PENETRATIONS_SUFFIX])
@@ -208,11 +253,13 @@ def test_a_part_inside_a_solid_is_drawn_red_where_it_truly_is() -> None:
     assert "gripper" in inside and "base" not in inside
     centres = [vector(s["pose"]["position"], "xyz") for s in entity["spheres"]]
     assert any(np.allclose(c, gripper) for c in centres)
-    colours = {tuple(vector(s["color"], "rgba")) for s in [*entity["spheres"],
-                                                           *entity.get("lines", [])]}
+    colours = {
+        tuple(vector(s["color"], "rgba")) for s in [*entity["spheres"], *entity.get("lines", [])]
+    }
     assert colours == {(1.0, 0.0, 0.0, 1.0)}  # red
     # Out of it: one empty scene, then nothing until a part goes in again.
     clear = views(viewer, TRUTH_KEY, topics.SIM_TRUTH, truth(q, Solids(), False, 2))
     assert "entities" not in decode(clear[PENETRATIONS_SUFFIX])
-    assert PENETRATIONS_SUFFIX not in views(viewer, TRUTH_KEY, topics.SIM_TRUTH,
-                                            truth(q, Solids(), False, 3))  # fmt: skip
+    assert PENETRATIONS_SUFFIX not in views(
+        viewer, TRUTH_KEY, topics.SIM_TRUTH, truth(q, Solids(), False, 3)
+    )

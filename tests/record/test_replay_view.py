@@ -39,16 +39,30 @@ def watched(address: str, channel: str) -> tuple[int, bytes]:
     return asyncio.run(watch(address, {channel}))[1][channel]
 
 
-def test_a_replay_with_no_system_serves_its_own_router_and_is_watched_live(tmp_path: Path
-                                                                           ) -> None:  # fmt: skip
+def test_a_replay_with_no_system_serves_its_own_router_and_is_watched_live(tmp_path: Path) -> None:
     profile = write_profile(tmp_path)  # its router's port is free: nothing is running
     states = recording(tmp_path / "k.mcap")
     port = free_port()
-    replay = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "replay",
-                               str(tmp_path / "k.mcap"), "--profile", str(profile), "--loop",
-                               "--namespace", INTO, "--view", "--port", str(port)],
-                              stdin=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                              text=True)  # fmt: skip
+    replay = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "parsimony.cli",
+            "replay",
+            str(tmp_path / "k.mcap"),
+            "--profile",
+            str(profile),
+            "--loop",
+            "--namespace",
+            INTO,
+            "--view",
+            "--port",
+            str(port),
+        ],
+        stdin=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     said = StderrLines(replay)
     view = None
     try:
@@ -59,9 +73,21 @@ def test_a_replay_with_no_system_serves_its_own_router_and_is_watched_live(tmp_p
         log_time, payload = watched(address, channel)
         assert from_json(payload, RobotState) == states[log_time]
         # `parsimony view` of the profile reaches the replay's router, and watches it too.
-        view = subprocess.Popen([sys.executable, "-m", "parsimony.cli", "view", str(profile),
-                                 "--namespace", INTO, "--port", "0"], stderr=subprocess.PIPE,
-                                text=True)  # fmt: skip
+        view = subprocess.Popen(
+            [
+                sys.executable,
+                "-m",
+                "parsimony.cli",
+                "view",
+                str(profile),
+                "--namespace",
+                INTO,
+                "--port",
+                "0",
+            ],
+            stderr=subprocess.PIPE,
+            text=True,
+        )
         line = StderrLines(view).wait_for(" live at ")
         log_time, payload = watched(line.split(" live at ")[1].split()[0], channel)
         assert from_json(payload, RobotState) == states[log_time]
@@ -80,10 +106,15 @@ def test_without_a_profile_a_replay_goes_into_its_recorded_namespace(tmp_path: P
     with SessionWriter(tmp_path / "two.mcap") as writer:
         for namespace in (RECORDED, INTO):
             writer.write(topics.ROBOT_STATE.key(namespace), state(0))
-    done = subprocess.run([sys.executable, "-m", "parsimony.cli", "replay",
-                           str(tmp_path / "two.mcap")], capture_output=True, text=True,
-                          env={k: v for k, v in os.environ.items() if k != PROFILE_ENV},
-                          timeout=DEADLINE_S * 6)  # fmt: skip
+    done = subprocess.run(
+        [sys.executable, "-m", "parsimony.cli", "replay", str(tmp_path / "two.mcap")],
+        capture_output=True,
+        text=True,
+        env={k: v for k, v in os.environ.items() if k != PROFILE_ENV},
+        timeout=DEADLINE_S * 6,
+    )
     assert done.returncode == 2, done.stderr
-    assert done.stderr == (f"replay: {tmp_path / 'two.mcap'}: recorded in the namespaces "
-                           f"{INTO}, {RECORDED}: give --namespace\n")
+    assert done.stderr == (
+        f"replay: {tmp_path / 'two.mcap'}: recorded in the namespaces "
+        f"{INTO}, {RECORDED}: give --namespace\n"
+    )

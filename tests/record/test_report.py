@@ -247,9 +247,11 @@ def test_solids_in_the_truth_give_the_arms_clearance_by_part_over_time(runs, tmp
     clearances = arm_clearances(truth, ROBOT)
     assert clearances.shape == (len(truth), len(ROBOT.collision.names))
     assert dict(zip(ROBOT.collision.names, clearances.min(axis=0).round(4), strict=True)) == (
-        arm_clearance(truth, ROBOT))
-    result = write_report([("with solids", session), ("cascade", runs["cascade"][1])], ROBOT,
-                          tmp_path)  # fmt: skip
+        arm_clearance(truth, ROBOT)
+    )
+    result = write_report(
+        [("with solids", session), ("cascade", runs["cascade"][1])], ROBOT, tmp_path
+    )
     assert [path.name for path in result["figures"]] == [*FIGURES, "arm_clearance.png"]
     for name in ("base_path.png", "arm_clearance.png"):
         data = (tmp_path / name).read_bytes()
@@ -260,10 +262,22 @@ def test_solids_in_the_truth_give_the_arms_clearance_by_part_over_time(runs, tmp
 
 def legs(arm: tuple[float, ...]) -> list[Goal]:
     """A staging supervisor's drive legs: to a point, then a turn; no end-effector goal."""
-    return [Goal(header=header(START_NS, "world", 0), task="point", point=(0.5, 0.0), arm=arm,
-                 lookahead=0.1),
-            Goal(header=header(START_NS + 10**9, "world", 1), task="heading", heading=0.0,
-                 arm=arm, point=(0.5, 0.0))]  # fmt: skip
+    return [
+        Goal(
+            header=header(START_NS, "world", 0),
+            task="point",
+            point=(0.5, 0.0),
+            arm=arm,
+            lookahead=0.1,
+        ),
+        Goal(
+            header=header(START_NS + 10**9, "world", 1),
+            task="heading",
+            heading=0.0,
+            arm=arm,
+            point=(0.5, 0.0),
+        ),
+    ]
 
 
 def test_odd_recordings_give_every_figure_never_an_error(runs, tmp_path):
@@ -292,15 +306,21 @@ def test_the_base_path_starts_at_the_first_valid_state(runs):
     """Before its first camera fix the estimator says (0, 0), invalid: the path is drawn from
     the first valid state, not with a line from there."""
     states = runs["LP"][1][ROBOT_STATE.name]
-    moved = [s.model_copy(update={"base_pose": (s.base_pose[0] + 1.0, s.base_pose[1] + 2.0,
-                                                s.base_pose[2])}) for s in states]  # fmt: skip
-    before_fix = [s.model_copy(update={"base_pose": (0.0, 0.0, 0.0), "valid": False})
-                  for s in moved[:10]]  # fmt: skip
+    moved = [
+        s.model_copy(
+            update={"base_pose": (s.base_pose[0] + 1.0, s.base_pose[1] + 2.0, s.base_pose[2])}
+        )
+        for s in states
+    ]
+    before_fix = [
+        s.model_copy(update={"base_pose": (0.0, 0.0, 0.0), "valid": False}) for s in moved[:10]
+    ]
     session = {**runs["LP"][1], ROBOT_STATE.name: before_fix + moved[10:]}
     recording = report_module._recording("LP", session, None, ROBOT)
-    for name, where in (("base_path.png", moved[10].base_pose[:2]),
-                        ("end_effector_path.png", dq.translation(
-                            np.array(moved[10].end_effector))[1:3])):  # fmt: skip
+    for name, where in (
+        ("base_path.png", moved[10].base_pose[:2]),
+        ("end_effector_path.png", dq.translation(np.array(moved[10].end_effector))[1:3]),
+    ):
         figure = report_module._FIGURES[name]([recording], ROBOT)
         estimate = next(line for line in figure.axes[0].lines if line.get_label() == "estimate")
         np.testing.assert_array_equal(estimate.get_xydata()[0], where, err_msg=name)
@@ -308,11 +328,19 @@ def test_the_base_path_starts_at_the_first_valid_state(runs):
 
 
 def test_labels_that_do_not_match_the_files_are_said_in_one_line(tmp_path):
-    done = parsimony("report", str(tmp_path / "a.mcap"), str(tmp_path / "b.mcap"),
-                     "--labels", "one", "--out", str(tmp_path / "out"))  # fmt: skip
+    done = parsimony(
+        "report",
+        str(tmp_path / "a.mcap"),
+        str(tmp_path / "b.mcap"),
+        "--labels",
+        "one",
+        "--out",
+        str(tmp_path / "out"),
+    )
     assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
-    assert done.stderr == "report: --labels: expected 2 non-empty comma-separated labels, " \
-                          "got 'one'\n"
+    assert (
+        done.stderr == "report: --labels: expected 2 non-empty comma-separated labels, got 'one'\n"
+    )
 
 
 def test_a_report_beside_a_rerun_says_its_commands_were_not_in_a_closed_loop(runs, tmp_path):
@@ -325,8 +353,10 @@ def test_a_report_beside_a_rerun_says_its_commands_were_not_in_a_closed_loop(run
     assert done.returncode == 0, done.stderr
     done = parsimony("report", str(recording), str(rerun), "--out", str(out))
     assert done.returncode == 0, done.stderr
-    note = ("cascade (rerun): its commands were computed by `parsimony rerun` on the "
-            "recording's states, not in a closed loop")  # fmt: skip
+    note = (
+        "cascade (rerun): its commands were computed by `parsimony rerun` on the "
+        "recording's states, not in a closed loop"
+    )
     assert [line for line in done.stderr.splitlines() if note in line], done.stderr
     assert f"Note: {note}" in (out / "effort.md").read_text()
     judged = json.loads((out / "judged.json").read_text())

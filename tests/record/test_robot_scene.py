@@ -44,16 +44,19 @@ def test_with_the_robot_description_every_link_is_a_frame_of_the_kinematics() ->
     frames = transforms_of(view)
     links = [f"estimate/link_{i}" for i in range(ROBOT.arm_dof + 1)]
     poses = chain(frames, ["estimate/base", *links], "world")
-    for found, expected in zip(poses[1:], ROBOT.frames(np.array(state.configuration())),
-                               strict=True):  # fmt: skip
+    for found, expected in zip(
+        poses[1:], ROBOT.frames(np.array(state.configuration())), strict=True
+    ):
         assert same_pose(found, expected)
     assert frames["estimate/end_effector"]["parent_frame_id"] == "world"
 
 
 def test_the_model_goes_with_one_state_in_model_every() -> None:
     viewer = Viewer(ROBOT)
-    counts = [len(viewer(topics.ROBOT_STATE.name, KEY, robot_state(seq)))
-              for seq in range(2 * MODEL_EVERY)]  # fmt: skip
+    counts = [
+        len(viewer(topics.ROBOT_STATE.name, KEY, robot_state(seq)))
+        for seq in range(2 * MODEL_EVERY)
+    ]
     assert [seq for seq, n in enumerate(counts) if n == 2] == [0, MODEL_EVERY]
     frames, model = viewer(topics.ROBOT_STATE.name, KEY, robot_state(0))
     assert model.channel(KEY)[0] == f"{KEY}/model"
@@ -72,19 +75,32 @@ def test_the_model_goes_with_one_state_in_model_every() -> None:
 
 def status(seq: int, **fields: Any) -> SupervisorStatus:
     header = Header(stamp_ns=STAMP_NS + seq, frame="world", seq=seq, source="test")
-    return SupervisorStatus(header=header, phase=fields.pop("phase", "drive"), candidate=1,
-                            plans=1, replans=0, stalls=0, **fields)  # fmt: skip
+    return SupervisorStatus(
+        header=header,
+        phase=fields.pop("phase", "drive"),
+        candidate=1,
+        plans=1,
+        replans=0,
+        stalls=0,
+        **fields,
+    )
 
 
 def test_the_plan_is_the_way_and_the_candidates_ghost_sent_when_it_changes() -> None:
     viewer, key = Viewer(ROBOT), "sim/supervisor/status"
     q = np.array([0.4, -0.3, 0.5, 0.0, -0.3, 0.2, 0.1, 0.4])
-    planned = {"candidate_base": tuple(q[:3]), "candidate_arm": tuple(q[3:]),
-               "way": ((0.1, -0.5), (0.4, -0.3))}  # fmt: skip
+    planned = {
+        "candidate_base": tuple(q[:3]),
+        "candidate_arm": tuple(q[3:]),
+        "way": ((0.1, -0.5), (0.4, -0.3)),
+    }
     frames, scene = viewer(topics.SUPERVISOR_STATUS.name, key, status(1, **planned))
     assert scene.channel(key)[0] == f"{key}/scene"
-    poses = chain(transforms_of(frames), ["candidate/base", *(f"candidate/link_{i}"
-                                                               for i in range(6))], "world")
+    poses = chain(
+        transforms_of(frames),
+        ["candidate/base", *(f"candidate/link_{i}" for i in range(6))],
+        "world",
+    )
     for found, expected in zip(poses[1:], ROBOT.frames(q), strict=True):
         assert same_pose(found, expected)
     update = decode(scene)
@@ -99,21 +115,28 @@ def test_the_plan_is_the_way_and_the_candidates_ghost_sent_when_it_changes() -> 
     _, refresh = viewer(topics.SUPERVISOR_STATUS.name, key, status(MODEL_EVERY, **planned))
     assert decode(refresh)["entities"]
     # The plan is gone (a re-plan): the scene only deletes.
-    (gone,) = viewer(topics.SUPERVISOR_STATUS.name, key, status(MODEL_EVERY + 1,
-                                                                phase="planning"))  # fmt: skip
+    (gone,) = viewer(topics.SUPERVISOR_STATUS.name, key, status(MODEL_EVERY + 1, phase="planning"))
     assert "entities" not in decode(gone) and decode(gone)["deletions"]
 
 
 def test_each_marker_is_its_outline_and_id_on_the_image() -> None:
     camera = Header(stamp_ns=STAMP_NS, frame="camera", seq=3, source="test")
     corners = ((100.5, 50.25), (140.0, 52.0), (138.0, 90.0), (99.0, 88.5))
-    seen = (MarkerDetection(id=3, pose=pose_dq(0.0, (0.1, 0.2, 2.5)), reprojection_error=0.3,
-                            corners=corners),
-            MarkerDetection(id=7, pose=pose_dq(0.0, (0.4, 0.0, 2.4)), reprojection_error=0.5,
-                            corners=tuple((u + 200, v) for u, v in corners)))  # fmt: skip
+    seen = (
+        MarkerDetection(
+            id=3, pose=pose_dq(0.0, (0.1, 0.2, 2.5)), reprojection_error=0.3, corners=corners
+        ),
+        MarkerDetection(
+            id=7,
+            pose=pose_dq(0.0, (0.4, 0.0, 2.4)),
+            reprojection_error=0.5,
+            corners=tuple((u + 200, v) for u, v in corners),
+        ),
+    )
     key = "sim/vision/markers"
-    _, view = Viewer()(topics.VISION_MARKERS.name, key, MarkerDetections(header=camera,
-                                                                          markers=seen))
+    _, view = Viewer()(
+        topics.VISION_MARKERS.name, key, MarkerDetections(header=camera, markers=seen)
+    )
     assert view.channel(key)[0] == f"{key}/annotations"
     assert view.schema_name == "foxglove.ImageAnnotations"
     annotations = decode(view)

@@ -52,19 +52,30 @@ def header(stamp_ns: int, seq: int = 0) -> Header:
 
 
 def state(stamp_ns: int, seq: int = 0, base_x: float = 1.0) -> RobotState:
-    return RobotState(header=header(stamp_ns, seq), base_pose=(base_x, 2.0, 0.3),
-                      arm_joints=(0.1, -0.2, 0.3, -0.4, 0.5),
-                      end_effector=(1.0, 0, 0, 0, 0, 0, 0, 0), valid=True, age_s=0.0)  # fmt: skip
+    return RobotState(
+        header=header(stamp_ns, seq),
+        base_pose=(base_x, 2.0, 0.3),
+        arm_joints=(0.1, -0.2, 0.3, -0.4, 0.5),
+        end_effector=(1.0, 0, 0, 0, 0, 0, 0, 0),
+        valid=True,
+        age_s=0.0,
+    )
 
 
 def image(stamp_ns: int, encoding: str = "rgb8") -> CameraFrame:
     width, height = 64, 48
     size = width * height * (1 if encoding == "mono8" else 3)
     pixels = random.Random(stamp_ns).randbytes(size)
-    return CameraFrame.model_validate({
-        "header": header(stamp_ns), "encoding": encoding, "width": width, "height": height,
-        "data": pixels, "intrinsics": {"fx": 80.0, "fy": 80.0, "cx": 31.5, "cy": 23.5},
-    })  # fmt: skip
+    return CameraFrame.model_validate(
+        {
+            "header": header(stamp_ns),
+            "encoding": encoding,
+            "width": width,
+            "height": height,
+            "data": pixels,
+            "intrinsics": {"fx": 80.0, "fy": 80.0, "cx": 31.5, "cy": 23.5},
+        }
+    )
 
 
 def test_every_topic_type_reads_back_equal_in_log_time_order(tmp_path: Path) -> None:
@@ -90,10 +101,16 @@ def test_log_time_is_the_stamp_unless_given(tmp_path: Path) -> None:
 
 def jpeg_image(stamp_ns: int) -> CameraFrame:
     grey = np.random.default_rng(stamp_ns).integers(0, 256, (48, 64), dtype=np.uint8)
-    return CameraFrame.model_validate({
-        "header": header(stamp_ns), "encoding": "jpeg", "width": 64, "height": 48,
-        "data": jpeg(grey, 90), "intrinsics": {"fx": 80.0, "fy": 80.0, "cx": 31.5, "cy": 23.5},
-    })  # fmt: skip
+    return CameraFrame.model_validate(
+        {
+            "header": header(stamp_ns),
+            "encoding": "jpeg",
+            "width": 64,
+            "height": 48,
+            "data": jpeg(grey, 90),
+            "intrinsics": {"fx": 80.0, "fy": 80.0, "cx": 31.5, "cy": 23.5},
+        }
+    )
 
 
 def test_with_views_each_image_is_stored_once_and_reads_back_exactly(tmp_path: Path) -> None:
@@ -115,9 +132,14 @@ def test_with_views_each_image_is_stored_once_and_reads_back_exactly(tmp_path: P
 
 def test_floats_and_images_survive_bit_for_bit(tmp_path: Path) -> None:
     awkward = (0.1 + 0.2, 1 / 3, -0.0, 5e-324, 1.7976931348623157e308)
-    message = RobotState(header=header(1), base_pose=awkward[:3], arm_joints=awkward,
-                         end_effector=(math.cos(0.1), 0, 0, math.sin(0.1), 0, 0, 0, 0),
-                         valid=False, age_s=2.0 / 3.0)  # fmt: skip
+    message = RobotState(
+        header=header(1),
+        base_pose=awkward[:3],
+        arm_joints=awkward,
+        end_effector=(math.cos(0.1), 0, 0, math.sin(0.1), 0, 0, 0, 0),
+        valid=False,
+        age_s=2.0 / 3.0,
+    )
     frames = [image(2, "rgb8"), image(3, "bgr8"), image(4, "mono8")]
     path = tmp_path / "session.mcap"
     with SessionWriter(path) as writer:
@@ -165,8 +187,17 @@ def test_the_mcap_package_reads_the_file_with_every_schema(tmp_path: Path) -> No
     with SessionWriter(path) as writer:
         for message in EXAMPLES:
             writer.write(key_of(message), message)
-        writer.write_raw(Entry(f"{NAMESPACE}/notes", "Note", "jsonschema", b'{"type":"object"}',
-                               "json", b'{"text":"hello"}'), 5)  # fmt: skip
+        writer.write_raw(
+            Entry(
+                f"{NAMESPACE}/notes",
+                "Note",
+                "jsonschema",
+                b'{"type":"object"}',
+                "json",
+                b'{"text":"hello"}',
+            ),
+            5,
+        )
     with path.open("rb") as stream:
         reader = make_reader(stream)
         summary = reader.get_summary()
@@ -288,7 +319,8 @@ def test_what_the_recorder_lost_is_in_the_file_and_info_shows_it(tmp_path: Path)
     assert info(recovered)["dropped"] == info(path)["dropped"]
     shown = parsimony("info", str(path))
     assert "lost by the recorder: 7 (overflowed.camera/image), 2 (overwritten.sim/clock)" in (
-        shown.stdout)
+        shown.stdout
+    )
 
 
 def test_chunks_that_overlap_in_time_read_back_in_log_time_order(tmp_path: Path) -> None:
@@ -303,12 +335,15 @@ def test_chunks_that_overlap_in_time_read_back_in_log_time_order(tmp_path: Path)
             if log_time % 7 == 0:
                 writer.write(topics.CAMERA_IMAGE.key(NAMESPACE), image(log_time), views=True)
     with path.open("rb") as stream:
-        indexed = [(c.topic, m.log_time) for _, c, m in
-                   make_reader(stream).iter_messages(log_time_order=True)]  # fmt: skip
+        indexed = [
+            (c.topic, m.log_time)
+            for _, c, m in make_reader(stream).iter_messages(log_time_order=True)
+        ]
     streamed = list(read_session(path))
     assert [(r.key, r.log_time_ns) for r in streamed] == indexed
     assert [r.message.header.stamp_ns for r in streamed if r.message is not None] == sorted(
-        times + [t for t in times if t % 7 == 0])
+        times + [t for t in times if t % 7 == 0]
+    )
 
 
 def test_only_the_topics_asked_for_are_read(tmp_path: Path) -> None:

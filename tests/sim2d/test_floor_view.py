@@ -15,8 +15,10 @@ from wbc.staging import within
 
 
 def test_the_corners_of_the_seen_floor_project_onto_the_image_edges() -> None:
-    tilted = dq.mul(ceiling_pose(0.8, 0.15, 2.5), dq.pose(
-        dq.rotation_quaternion(0.1, [0.0, 1.0, 0.0]), [0.0, 0.0, 0.0]))  # fmt: skip
+    tilted = dq.mul(
+        ceiling_pose(0.8, 0.15, 2.5),
+        dq.pose(dq.rotation_quaternion(0.1, [0.0, 1.0, 0.0]), [0.0, 0.0, 0.0]),
+    )
     camera = PinholeCamera(tilted, width=640, height=480, cx=300.0, cy=250.0)
     corners = seen_floor(camera, 0.092)
     pixels = camera.project(np.column_stack((corners, np.full(4, 0.092))))
@@ -39,8 +41,7 @@ def test_a_camera_that_does_not_see_the_floor_whole_is_refused() -> None:
 
 
 def test_the_region_is_in_the_frame_of_the_reference_marker() -> None:
-    camera = PinholeCamera(ceiling_pose(1.0, 2.0, 2.0), width=600, height=600, cx=299.5,
-                           cy=299.5)  # fmt: skip
+    camera = PinholeCamera(ceiling_pose(1.0, 2.0, 2.0), width=600, height=600, cx=299.5, cy=299.5)
     half = 2.0 * 300.0 / 600.0  # the floor under the camera, 1 m each way
     region = camera_region(camera, (1.0, 2.0, math.pi / 2), 0.0, 0.1)
     assert within(region, (half - 0.1 - 1e-9, 0.0), (0.0, -(half - 0.1) + 1e-9))

@@ -155,8 +155,9 @@ def test_seeds_repeat_and_differ() -> None:
 
 
 @pytest.mark.parametrize(("name", "seed"), [("pose", None), ("obstacle", None), ("obstacle", 7)])
-def test_sim_params_are_the_simulators_typed_values_of_the_set_up(name: str, seed: int | None
-                                                                  ) -> None:  # fmt: skip
+def test_sim_params_are_the_simulators_typed_values_of_the_set_up(
+    name: str, seed: int | None
+) -> None:
     """What the simulator's declared parameters take as they are: no vector as text."""
     setup = scenario(name, ROBOT, seed)
     params = setup.sim_params()
@@ -186,8 +187,9 @@ def markers(setup: SimScenario) -> list[tuple[str, float, float, float, float]]:
         ("base", *base, s.base.height_m, s.base.size_m),
         ("bin", *setup.bin[:2], setup.goal_height or s.goal.height_m, s.goal.size_m),
     ]
-    found += [("obstacle", c.x, c.y, s.obstacles.height_m, s.obstacles.size_m)
-              for c in setup.obstacles]  # fmt: skip
+    found += [
+        ("obstacle", c.x, c.y, s.obstacles.height_m, s.obstacles.size_m) for c in setup.obstacles
+    ]
     return found
 
 

@@ -17,9 +17,12 @@ CLEAR_M = 0.8
 """No circle's centre comes this close to a point kept clear, m."""
 
 
-def crowd(keep_clear: tuple[tuple[float, float], ...], count: int = MAX_CIRCLES,
-          half_width: float = 5.0, seed: int = 0
-          ) -> tuple[tuple[float, float, float], ...]:  # fmt: skip
+def crowd(
+    keep_clear: tuple[tuple[float, float], ...],
+    count: int = MAX_CIRCLES,
+    half_width: float = 5.0,
+    seed: int = 0,
+) -> tuple[tuple[float, float, float], ...]:
     """``count`` circles (x, y, radius), their centres uniform over a square of ``half_width``
     about the origin, radii 0.05 to 0.15 m, none within ``CLEAR_M`` of the points of
     ``keep_clear`` (the robot's start and its goal)."""

@@ -37,11 +37,15 @@ from wbc.task import PoseTask
 
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 GAIN, MARGIN = 2.0, 0.03
-SHELF = Plane((0.0, 0.0, -1.0), -0.45, ((0.3, 0.2), (0.7, 0.2), (0.7, 0.6), (0.3, 0.6)),
-              "shelf")  # fmt: skip
+SHELF = Plane((0.0, 0.0, -1.0), -0.45, ((0.3, 0.2), (0.7, 0.2), (0.7, 0.6), (0.3, 0.6)), "shelf")
 """The solid above z = 0.45 over its footprint: a point under it meets its underside."""
-SOLIDS = (TABLE, Cylinder(0.45, 0.05, 0.04, 0.5, "pole"), Plane((-1.0, 0.0, 0.0), -0.7,
-          name="wall"), Cylinder(0.4, -0.2, 0.05, name="tall pole"), SHELF)  # fmt: skip
+SOLIDS = (
+    TABLE,
+    Cylinder(0.45, 0.05, 0.04, 0.5, "pole"),
+    Plane((-1.0, 0.0, 0.0), -0.7, name="wall"),
+    Cylinder(0.4, -0.2, 0.05, name="tall pole"),
+    SHELF,
+)
 
 
 def around(half_width: float) -> tuple[tuple[float, ...], tuple[float, ...]]:
@@ -78,8 +82,9 @@ def reference_rows(q: np.ndarray, solids: tuple[Solid, ...]) -> tuple[np.ndarray
                 if kind != SIDE:  # the rim: d = hypot(sqrt(D) - R, z - h)
                     beside, above = math.sqrt(squared) - solid.radius, point[3] - solid.height
                     distance, limit = math.hypot(beside, above), safe
-                    row = (beside / (2.0 * math.sqrt(squared)) * row
-                           + above * jacobian[3]) / distance  # fmt: skip
+                    row = (
+                        beside / (2.0 * math.sqrt(squared)) * row + above * jacobian[3]
+                    ) / distance
             matrix.append(-row)
             upper.append(GAIN * max(distance - limit, 0.0))
         if isinstance(solid, Cylinder):
@@ -87,17 +92,24 @@ def reference_rows(q: np.ndarray, solids: tuple[Solid, ...]) -> tuple[np.ndarray
             lines, low, high, reach = [solid.axis], [-math.inf], [top], solid.radius
         else:
             edges = solid.edges()
-            lines, low, high = [e.line for e in edges], [e.low for e in edges], [
-                e.high for e in edges]  # fmt: skip
+            lines, low, high = (
+                [e.line for e in edges],
+                [e.low for e in edges],
+                [e.high for e in edges],
+            )
             reach = 0.0
         if not lines:
             continue
         lines = np.array(lines)
         s, t, skew = closest_parameters(parts.lines, lines)
         for i, segment in enumerate(model.segments):
-            facing = ((skew[i] >= SKEW_MIN**2) & (parts.ends[i].min() <= s[i])
-                      & (s[i] <= parts.ends[i].max()) & (np.array(low) <= t[i])
-                      & (t[i] <= np.array(high)))  # fmt: skip
+            facing = (
+                (skew[i] >= SKEW_MIN**2)
+                & (parts.ends[i].min() <= s[i])
+                & (s[i] <= parts.ends[i].max())
+                & (np.array(low) <= t[i])
+                & (t[i] <= np.array(high))
+            )
             if not facing.any():
                 matrix.append(np.zeros(ROBOT.dof))
                 upper.append(math.inf)
@@ -106,8 +118,9 @@ def reference_rows(q: np.ndarray, solids: tuple[Solid, ...]) -> tuple[np.ndarray
             with np.errstate(divide="ignore", invalid="ignore"):
                 gap = np.where(facing, np.abs(a) / np.sqrt(skew[i]), np.inf)
             other = lines[int(np.argmin(gap))]
-            matrix.append(-line_to_line_distance_jacobian(parts.line_jacobians[i],
-                                                          parts.lines[i], other))  # fmt: skip
+            matrix.append(
+                -line_to_line_distance_jacobian(parts.line_jacobians[i], parts.lines[i], other)
+            )
             squared = line_to_line_squared_distance(parts.lines[i], other)
             upper.append(GAIN * max(squared - (reach + segment.radius + MARGIN) ** 2, 0.0))
     return np.array(matrix), np.array(upper)
@@ -123,11 +136,13 @@ def test_the_rows_are_those_of_the_parts_jacobians_near_and_far() -> None:
             matrix, upper = reference_rows(q, SOLIDS)
             assert np.array_equal(np.isinf(rows.upper), np.isinf(upper))
             finite = np.isfinite(upper)
-            np.testing.assert_allclose(rows.upper[finite], upper[finite], rtol=1e-12,
-                                       atol=1e-13)  # fmt: skip
+            np.testing.assert_allclose(rows.upper[finite], upper[finite], rtol=1e-12, atol=1e-13)
             np.testing.assert_allclose(rows.matrix, matrix, rtol=1e-10, atol=1e-12)
-            kinds |= {int(k) for solid in SOLIDS
-                      for k in solid.nearest(primitive_kinematics(ROBOT, q).points[:, 1:])[0]}
+            kinds |= {
+                int(k)
+                for solid in SOLIDS
+                for k in solid.nearest(primitive_kinematics(ROBOT, q).points[:, 1:])[0]
+            }
     assert kinds == {0, 1, 2, 3, 4}  # every kind of feature was met
 
 
@@ -142,8 +157,10 @@ class ReferenceRows:
 
 
 def reference_law() -> LPLaw:
-    constraints = [c if not isinstance(c, ArmObstacles) else ReferenceRows()
-                   for c in default_constraints(TABLE_PARAMS)]  # fmt: skip
+    constraints = [
+        c if not isinstance(c, ArmObstacles) else ReferenceRows()
+        for c in default_constraints(TABLE_PARAMS)
+    ]
     assert any(isinstance(c, ReferenceRows) for c in constraints)
     return LPLaw(ROBOT, TABLE_PARAMS, constraints=constraints)
 
@@ -173,4 +190,3 @@ def test_the_lp_commands_the_same_u_on_random_states_among_the_solids() -> None:
         theirs = reference_law().step(q, task, DT, SOLIDS)
         assert ours.status == theirs.status
         np.testing.assert_allclose(ours.u, theirs.u, atol=1e-9)
-

@@ -35,8 +35,9 @@ def test_no_solids_no_rows_and_the_rows_are_on_by_default() -> None:
     rows = ArmObstacles().rows(context(ROBOT, TABLE_START, ()))
     assert rows.matrix.shape == (0, ROBOT.dof) and not rows.engaged
     assert any(isinstance(c, ArmObstacles) for c in default_constraints(LPParams()))
-    assert not any(isinstance(c, ArmObstacles)
-                   for c in default_constraints(LPParams(arm_obstacles=False)))  # fmt: skip
+    assert not any(
+        isinstance(c, ArmObstacles) for c in default_constraints(LPParams(arm_obstacles=False))
+    )
 
 
 def test_one_row_per_pair_whatever_the_state() -> None:
@@ -77,8 +78,9 @@ def test_each_row_is_minus_the_rate_of_its_distance() -> None:
         rate = bound_rate(q, u)
         live = np.isfinite(rows.upper) & (rows.upper > 1e-3) & np.isfinite(rate)
         live &= np.abs(rate) < 1e3  # a switch of face between q - eps u and q + eps u
-        np.testing.assert_allclose(-(rows.matrix @ u)[live] * GAIN, rate[live], rtol=1e-5,
-                                   atol=1e-7)  # fmt: skip
+        np.testing.assert_allclose(
+            -(rows.matrix @ u)[live] * GAIN, rate[live], rtol=1e-5, atol=1e-7
+        )
         checked += int(live.sum())
     assert checked > 500
 
@@ -106,8 +108,9 @@ def test_a_point_is_held_by_the_feature_nearest_it() -> None:
     np.testing.assert_allclose(rows.matrix[gripper], -translation[3], atol=1e-12)
     clearance = part_clearances(ROBOT, TABLE_GOAL, (TABLE,))[:, 0]
     radius = ROBOT.collision.points[gripper].radius
-    assert rows.upper[gripper] == pytest.approx(GAIN * (clearance[gripper] + radius - radius
-                                                        - MARGIN))  # fmt: skip
+    assert rows.upper[gripper] == pytest.approx(
+        GAIN * (clearance[gripper] + radius - radius - MARGIN)
+    )
 
 
 def least_clearances(configurations: list[np.ndarray], solids: tuple) -> tuple[float, int]:
@@ -124,13 +127,13 @@ def test_the_arm_reaches_over_the_table_edge_without_touching_it() -> None:
     every part at least the margin off the table (less the step's first-order slack); blind to
     the table, its hand cuts through the edge on the way."""
     task = PoseTask(ROBOT.fkm(TABLE_GOAL))
-    guarded = integrate(LPLaw(ROBOT, TABLE_PARAMS), TABLE_START, task, DT, 1500,
-                        obstacles=(TABLE,))  # fmt: skip
+    guarded = integrate(LPLaw(ROBOT, TABLE_PARAMS), TABLE_START, task, DT, 1500, obstacles=(TABLE,))
     assert guarded.converged
     least, penetrations = least_clearances(guarded.configurations, (TABLE,))
     assert penetrations == 0 and least > TABLE_PARAMS.arm_obstacle_margin - 0.005
-    blind = integrate(LPLaw(ROBOT, WITHOUT_ARM_ROWS), TABLE_START, task, DT, 1500,
-                      obstacles=(TABLE,))  # fmt: skip
+    blind = integrate(
+        LPLaw(ROBOT, WITHOUT_ARM_ROWS), TABLE_START, task, DT, 1500, obstacles=(TABLE,)
+    )
     least, penetrations = least_clearances(blind.configurations, (TABLE,))
     assert blind.converged and penetrations > 0 and least < -0.01
 
@@ -141,8 +144,14 @@ def test_the_rows_hold_the_gripper_off_a_pole_it_is_driven_into() -> None:
     pole = Cylinder(0.42, 0.06, 0.04, name="pole")
     task = PoseTask(ROBOT.fkm(np.array([0.0, 0.0, 0.0, 0.0, -0.2, 0.2, 0.0, 0.5])))
     start = np.array([0.0, 0.0, 0.0, 0.6, -0.2, 0.2, 0.0, 0.5])
-    run = integrate(LPLaw(ROBOT, replace(TABLE_PARAMS, arm_obstacle_margin=MARGIN)), start,
-                    task, DT, 600, obstacles=(pole, Circle(2.0, 2.0, 0.1)))  # fmt: skip
+    run = integrate(
+        LPLaw(ROBOT, replace(TABLE_PARAMS, arm_obstacle_margin=MARGIN)),
+        start,
+        task,
+        DT,
+        600,
+        obstacles=(pole, Circle(2.0, 2.0, 0.1)),
+    )
     least, penetrations = least_clearances(run.configurations, (pole,))
     assert penetrations == 0 and least > MARGIN - 0.005
     assert not run.converged  # the goal lies inside the pole
@@ -153,6 +162,12 @@ def test_without_solids_the_constraint_changes_nothing() -> None:
     to the run without it: the commands of every run before this feature stay as they were."""
     task = PoseTask(ROBOT.fkm(REACH_GOAL))
     on = integrate(LPLaw(ROBOT, LPParams()), HOME, task, DT, 300, obstacles=(Circle(2, 2, 0.1),))
-    off = integrate(LPLaw(ROBOT, LPParams(arm_obstacles=False)), HOME, task, DT, 300,
-                    obstacles=(Circle(2, 2, 0.1),))  # fmt: skip
+    off = integrate(
+        LPLaw(ROBOT, LPParams(arm_obstacles=False)),
+        HOME,
+        task,
+        DT,
+        300,
+        obstacles=(Circle(2, 2, 0.1),),
+    )
     assert np.array_equal(on.velocities(), off.velocities())

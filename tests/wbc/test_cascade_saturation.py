@@ -24,22 +24,25 @@ def wheel_peak(u: np.ndarray, phi: float) -> float:
 
 
 @pytest.mark.parametrize("name", TASKS)
-def test_the_saturated_cascade_keeps_every_bound_the_lp_obeys_and_still_converges(name: str
-                                                                                   ) -> None:
+def test_the_saturated_cascade_keeps_every_bound_the_lp_obeys_and_still_converges(
+    name: str,
+) -> None:
     """As appendix B runs it, the cascade drives the base at 0.55 m/s on the position task
     (past the LP's 0.2 and the wheels' 0.5) and turns it at 2.08 rad/s on the pose task (past
     1.5); saturated, no step leaves a bound, 5.11 still holds, and the task converges."""
     bounds = MODEL.velocity_max
     free = integrate(CascadeLaw(MODEL, CascadeParams(eta=1.0)), HOME, TASKS[name], 4000)
     assert any(np.any(np.abs(out.u) > bounds + 1e-9) for out in free.outputs)  # unchanged
-    run = integrate(CascadeLaw(MODEL, CascadeParams(eta=1.0, saturate=True)), HOME, TASKS[name],
-                    4000)  # fmt: skip
+    run = integrate(
+        CascadeLaw(MODEL, CascadeParams(eta=1.0, saturate=True)), HOME, TASKS[name], 4000
+    )
     assert run.converged, run.final_error
     for q, out in zip(run.configurations, run.outputs, strict=True):
         assert np.all(np.abs(out.u) <= bounds + 1e-12), out.u
         assert wheel_peak(out.u, q[2]) <= MODEL.base.wheel_speed_max + 1e-12
         assert out.u[0] * math.sin(q[2]) - out.u[1] * math.cos(q[2]) == pytest.approx(
-            0.0, abs=1e-12)  # 5.11
+            0.0, abs=1e-12
+        )  # 5.11
 
 
 def test_the_base_slows_along_its_path_and_each_joint_is_clipped_alone() -> None:

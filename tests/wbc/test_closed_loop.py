@@ -92,8 +92,6 @@ def test_joint_limit_kept_by_lp_law_and_passed_by_pseudoinverse_law():
     assert max(q[elbow] for q in lp.configurations) <= 0.9 * MODEL.q_max[elbow] + 1e-9
 
 
-
-
 def base_clearance(run) -> np.ndarray:
     """Distance between the base's rim and the obstacle's edge at every step (m)."""
     centres = np.array(run.configurations)[:, :2]
@@ -107,8 +105,10 @@ def test_obstacle_lies_on_the_free_path():
     assert base_clearance(free).min() < 0.0
 
 
-@pytest.mark.parametrize(("params", "constraint"), [
-    (OBSTACLE_PARAMS, "obstacle_vector_field"), (BORDER_PARAMS, "obstacle_border")])  # fmt: skip
+@pytest.mark.parametrize(
+    ("params", "constraint"),
+    [(OBSTACLE_PARAMS, "obstacle_vector_field"), (BORDER_PARAMS, "obstacle_border")],
+)
 def test_an_obstacle_constraint_goes_round_the_obstacle_to_the_goal(params, constraint):
     law = LPLaw(MODEL, params)
     run = integrate(law, HOME, pose_task(MODEL, OBSTACLE_GOAL), 4000, obstacles=[OBSTACLE])
@@ -123,8 +123,9 @@ def test_the_default_obstacle_constraint_lets_the_base_near_no_faster_than_its_b
     changes by (d_{k+1} - d_k) / dt >= -eta_d d_k (a finite difference along the step taken),
     so d stays positive; every program is solved, and the run converges."""
     params = OBSTACLE_PARAMS
-    run = integrate(LPLaw(MODEL, params), HOME, pose_task(MODEL, OBSTACLE_GOAL), 4000,
-                    obstacles=[OBSTACLE])  # fmt: skip
+    run = integrate(
+        LPLaw(MODEL, params), HOME, pose_task(MODEL, OBSTACLE_GOAL), 4000, obstacles=[OBSTACLE]
+    )
     q = np.array(run.configurations)
     ahead = params.obstacle_lookahead
     points = q[:, :2] + ahead * np.column_stack((np.cos(q[:, 2]), np.sin(q[:, 2])))
@@ -165,8 +166,9 @@ SADDLE = np.array([-0.9022, -0.572, -0.0045, 0.0, 0.36, -0.8683, -0.0528, -0.400
 """Where seed 1 of the simulated obstacle experiment stalled: the base's point on the border
 of the obstacle, facing its centre, the goal straight behind it (error 0.65 for 60 s)."""
 SADDLE_OBSTACLE = Circle(-0.3888, -0.6056, 0.1)
-SADDLE_GOAL = dq.normalize(np.array([0.945648, 0.023547, -0.251532, -0.204763, -0.076033,
-                                     0.509034, -0.351501, 0.139184]))  # fmt: skip
+SADDLE_GOAL = dq.normalize(
+    np.array([0.945648, 0.023547, -0.251532, -0.204763, -0.076033, 0.509034, -0.351501, 0.139184])
+)
 
 
 def test_a_base_stalled_on_the_borders_saddle_goes_round_and_reaches_the_goal():

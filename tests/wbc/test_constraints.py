@@ -392,8 +392,13 @@ def point_distance(q: np.ndarray, obstacle: Circle, margin: float, lookahead: fl
 
 
 @NO_DEADLINE
-@given(st.floats(-1.5, -0.7), st.floats(-0.5, 0.5), angles, st.floats(0.0, 0.2),
-       st.lists(st.floats(-1.0, 1.0), min_size=8, max_size=8))  # fmt: skip
+@given(
+    st.floats(-1.5, -0.7),
+    st.floats(-0.5, 0.5),
+    angles,
+    st.floats(0.0, 0.2),
+    st.lists(st.floats(-1.0, 1.0), min_size=8, max_size=8),
+)
 def test_the_vector_field_row_is_minus_the_rate_of_the_distance(
     x: float, y: float, phi: float, lookahead: float, u: list[float]
 ) -> None:
@@ -403,8 +408,10 @@ def test_the_vector_field_row_is_minus_the_rate_of_the_distance(
     rows = VectorFieldObstacle(2.0, 0.05, lookahead).rows(context(q, obstacles=(obstacle,)))
     step = 1e-6
     direction = np.array(u)
-    rate = (point_distance(q + step * direction, obstacle, 0.05, lookahead)
-            - point_distance(q - step * direction, obstacle, 0.05, lookahead)) / (2 * step)
+    rate = (
+        point_distance(q + step * direction, obstacle, 0.05, lookahead)
+        - point_distance(q - step * direction, obstacle, 0.05, lookahead)
+    ) / (2 * step)
     assert (rows.matrix @ direction)[0] == pytest.approx(-rate, abs=1e-6)
     assert rows.upper[0] == pytest.approx(2.0 * point_distance(q, obstacle, 0.05, lookahead))
     assert rows.lower[0] == -np.inf and rows.engaged  # an inequality: u = 0 always meets it

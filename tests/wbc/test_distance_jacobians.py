@@ -47,8 +47,10 @@ def workspace(seed: int) -> tuple[np.ndarray, np.ndarray]:
     """A random plane (unit normal, offset) and a random line, both vec8."""
     rng = np.random.default_rng(seed)
     normal = rng.normal(size=3)
-    return (plane(normal / np.linalg.norm(normal), rng.uniform(-1.0, 1.0)),
-            line(rng.normal(size=3), rng.uniform(-1.0, 1.0, 3)))  # fmt: skip
+    return (
+        plane(normal / np.linalg.norm(normal), rng.uniform(-1.0, 1.0)),
+        line(rng.normal(size=3), rng.uniform(-1.0, 1.0, 3)),
+    )
 
 
 # --- Frames and parts -------------------------------------------------------------------------
@@ -61,8 +63,9 @@ def test_frame_poses_and_jacobians_match_dqrobotics_chains(frame: int) -> None:
         poses, jacobians = ROBOT.frame_kinematics(q)
         moving = 3 + frame
         np.testing.assert_allclose(poses[frame], body.fkm(q[:moving]).vec8(), atol=ORACLE_TOL)
-        np.testing.assert_allclose(jacobians[frame, :, :moving], body.pose_jacobian(q[:moving]),
-                                   atol=ORACLE_TOL)  # fmt: skip
+        np.testing.assert_allclose(
+            jacobians[frame, :, :moving], body.pose_jacobian(q[:moving]), atol=ORACLE_TOL
+        )
         np.testing.assert_array_equal(jacobians[frame, :, moving:], 0.0)
 
 
@@ -83,12 +86,14 @@ def test_part_jacobians_are_the_derivatives_of_the_parts() -> None:
         assert all(is_line(x) for x in parts.lines)
 
 
-def line_of(pose: np.ndarray, jacobian: np.ndarray, axis: np.ndarray
-            ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+def line_of(
+    pose: np.ndarray, jacobian: np.ndarray, axis: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """The line along ``axis`` through one frame and its Jacobian, by the stack version."""
     stack = pose[None], jacobian[None]
-    lines, jacobians = line_jacobians(*stack, axis[None], translations(stack[0]),
-                                      translation_jacobians(*stack))  # fmt: skip
+    lines, jacobians = line_jacobians(
+        *stack, axis[None], translations(stack[0]), translation_jacobians(*stack)
+    )
     return lines[0], jacobians[0]
 
 
@@ -97,13 +102,13 @@ def test_line_jacobian_matches_dqrobotics() -> None:
         poses, jacobians = ROBOT.frame_kinematics(q)
         for frame in range(6):
             for axis in (dq.I_, dq.J_, dq.K_):
-                expected = DQ_Kinematics.line_jacobian(jacobians[frame], DQ(poses[frame]),
-                                                       DQ(axis))  # fmt: skip
+                expected = DQ_Kinematics.line_jacobian(jacobians[frame], DQ(poses[frame]), DQ(axis))
                 found, jacobian = line_of(poses[frame], jacobians[frame], axis)
                 np.testing.assert_allclose(jacobian, expected, atol=ORACLE_TOL)
                 direction = dq.qmul(dq.qmul(poses[frame][:4], axis), dq.qconj(poses[frame][:4]))
-                np.testing.assert_allclose(found, line(direction, dq.translation(poses[frame])),
-                                           atol=1e-12)  # fmt: skip
+                np.testing.assert_allclose(
+                    found, line(direction, dq.translation(poses[frame])), atol=1e-12
+                )
 
 
 def test_segments_run_along_their_lines_from_end_to_end() -> None:
@@ -116,8 +121,9 @@ def test_segments_run_along_their_lines_from_end_to_end() -> None:
             foot = np.cross(parts.lines[i, 1:4], parts.lines[i, 5:8])
             for s, point in zip(parts.ends[i], (start, end), strict=True):
                 np.testing.assert_allclose(foot + s * parts.lines[i, 1:4], point, atol=1e-12)
-        np.testing.assert_allclose(np.abs(np.diff(parts.ends, axis=1)).ravel(), [0.1225, 0.17],
-                                   atol=1e-12)  # fmt: skip
+        np.testing.assert_allclose(
+            np.abs(np.diff(parts.ends, axis=1)).ravel(), [0.1225, 0.17], atol=1e-12
+        )
 
 
 # --- Distances and their Jacobians ------------------------------------------------------------
@@ -142,19 +148,31 @@ class PointDistance:
 
 
 POINT_DISTANCES = {
-    "plane": PointDistance(20, lambda i: workspace(i)[0], point_to_plane_distance,
-                           lambda jacobian, _, w: point_to_plane_distance_jacobian(jacobian, w),
-                           DQ_Kinematics.point_to_plane_distance_jacobian,
-                           DQ_Geometry.point_to_plane_distance),
-    "line": PointDistance(30, lambda i: workspace(i)[1], point_to_line_squared_distance,
-                          point_to_line_distance_jacobian,
-                          DQ_Kinematics.point_to_line_distance_jacobian,
-                          DQ_Geometry.point_to_line_squared_distance),
-    "point": PointDistance(50, corner, point_to_point_squared_distance,
-                           point_to_point_distance_jacobian,
-                           DQ_Kinematics.point_to_point_distance_jacobian,
-                           DQ_Geometry.point_to_point_squared_distance),
-}  # fmt: skip
+    "plane": PointDistance(
+        20,
+        lambda i: workspace(i)[0],
+        point_to_plane_distance,
+        lambda jacobian, _, w: point_to_plane_distance_jacobian(jacobian, w),
+        DQ_Kinematics.point_to_plane_distance_jacobian,
+        DQ_Geometry.point_to_plane_distance,
+    ),
+    "line": PointDistance(
+        30,
+        lambda i: workspace(i)[1],
+        point_to_line_squared_distance,
+        point_to_line_distance_jacobian,
+        DQ_Kinematics.point_to_line_distance_jacobian,
+        DQ_Geometry.point_to_line_squared_distance,
+    ),
+    "point": PointDistance(
+        50,
+        corner,
+        point_to_point_squared_distance,
+        point_to_point_distance_jacobian,
+        DQ_Kinematics.point_to_point_distance_jacobian,
+        DQ_Geometry.point_to_point_squared_distance,
+    ),
+}
 
 
 @pytest.mark.parametrize("part", range(POINTS))
@@ -166,13 +184,18 @@ def test_point_distance_jacobians_are_the_derivatives_and_dqrobotics(kind: str, 
         parts = primitive_kinematics(ROBOT, q)
         point, jacobian = parts.points[part], parts.point_jacobians[part]
         row = d.jacobian(jacobian, point, primitive)
-        np.testing.assert_allclose(row, central_difference(
-            lambda c, w=primitive: d.distance(primitive_kinematics(ROBOT, c).points[part], w),
-            q), atol=FD_TOL)  # fmt: skip
+        np.testing.assert_allclose(
+            row,
+            central_difference(
+                lambda c, w=primitive: d.distance(primitive_kinematics(ROBOT, c).points[part], w), q
+            ),
+            atol=FD_TOL,
+        )
         oracle = d.oracle_jacobian(jacobian, DQ(point), DQ(primitive))
         np.testing.assert_allclose(row, oracle.ravel(), atol=ORACLE_TOL)
         assert d.distance(point, primitive) == pytest.approx(
-            d.oracle_distance(DQ(point), DQ(primitive)), abs=1e-12)
+            d.oracle_distance(DQ(point), DQ(primitive)), abs=1e-12
+        )
 
 
 @pytest.mark.parametrize("segment", range(len(ROBOT.collision.segments)))
@@ -184,14 +207,20 @@ def test_line_to_line_jacobian_is_the_derivative_and_dqrobotics(segment: int) ->
         row = line_to_line_distance_jacobian(jacobian, robot_line, workspace_line)
         expected = central_difference(
             lambda c, w=workspace_line: line_to_line_squared_distance(
-                primitive_kinematics(ROBOT, c).lines[segment], w), q)  # fmt: skip
+                primitive_kinematics(ROBOT, c).lines[segment], w
+            ),
+            q,
+        )
         np.testing.assert_allclose(row, expected, atol=1e-6 * max(1.0, np.abs(row).max()))
-        oracle = DQ_Kinematics.line_to_line_distance_jacobian(jacobian, DQ(robot_line),
-                                                              DQ(workspace_line))  # fmt: skip
+        oracle = DQ_Kinematics.line_to_line_distance_jacobian(
+            jacobian, DQ(robot_line), DQ(workspace_line)
+        )
         np.testing.assert_allclose(row, oracle.ravel(), atol=1e-10 * max(1.0, np.abs(row).max()))
         assert line_to_line_squared_distance(robot_line, workspace_line) == pytest.approx(
             DQ_Geometry.line_to_line_squared_distance(DQ(robot_line), DQ(workspace_line)),
-            rel=1e-10, abs=1e-12)  # fmt: skip
+            rel=1e-10,
+            abs=1e-12,
+        )
 
 
 def test_distances_are_the_euclidean_ones() -> None:

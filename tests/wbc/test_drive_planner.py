@@ -52,8 +52,9 @@ def test_the_way_round_one_circle_is_the_tangent_arc_tangent_path() -> None:
 
 
 def test_an_open_way_is_straight_and_a_way_between_circles_takes_the_gap() -> None:
-    straight = plan_way(np.array([0.0, 0.0]), np.array([2.0, 0.0]), [Circle(1.0, 1.0, 0.1)],
-                        CLEARANCE)  # fmt: skip
+    straight = plan_way(
+        np.array([0.0, 0.0]), np.array([2.0, 0.0]), [Circle(1.0, 1.0, 0.1)], CLEARANCE
+    )
     assert straight.length == pytest.approx(2.0) and not straight.arcs
     # Two posts 1.2 m apart across the straight way, a gap wide enough between them: the way
     # goes through the gap, shorter than round either post.
@@ -85,8 +86,10 @@ def test_random_fields_give_ways_clear_of_every_grown_disc_and_no_shorter_than_s
 
 
 def test_an_enclosed_target_has_no_way_and_says_so() -> None:
-    ring = [Circle(2.0 + 0.9 * math.cos(a), 0.9 * math.sin(a), 0.08)
-            for a in np.linspace(0.0, 2.0 * math.pi, 30, endpoint=False)]  # fmt: skip
+    ring = [
+        Circle(2.0 + 0.9 * math.cos(a), 0.9 * math.sin(a), 0.08)
+        for a in np.linspace(0.0, 2.0 * math.pi, 30, endpoint=False)
+    ]
     way = plan_way(np.zeros(2), np.array([2.0, 0.0]), ring, CLEARANCE, 0.1)
     assert not way.found and math.isinf(way.length)
     assert "no way round the obstacles from (0.00, 0.00) to (2.00, 0.00)" in way.reason

@@ -36,7 +36,8 @@ def test_the_change_form_costs_w_times_the_one_norm_of_the_change() -> None:
     for _ in range(20):
         previous, u = rng.uniform(-1.0, 1.0, (2, MODEL.dof))
         assert term_cost(term, previous, u) == pytest.approx(
-            0.3 * np.abs(u - previous).sum(), abs=1e-12)
+            0.3 * np.abs(u - previous).sum(), abs=1e-12
+        )
 
 
 def test_speeding_up_costs_w_times_the_speed_gained_beyond_the_ramp_and_stopping_is_free() -> None:
@@ -99,10 +100,14 @@ def test_the_previous_u_outlives_a_reset_the_robot_does_not_stop_for_a_new_task(
     assert np.any((plain < low - 1e-6) | (plain > high + 1e-6))
 
 
-@pytest.mark.parametrize("params, task", [
-    (POSE, PoseTask(MODEL.fkm(REACH_GOAL))),
-    (POSITION, PositionTask(dq.translation(MODEL.fkm(REACH_GOAL))[1:])),
-], ids=["6.2.1 pose", "6.2.2 position"])  # fmt: skip
+@pytest.mark.parametrize(
+    "params, task",
+    [
+        (POSE, PoseTask(MODEL.fkm(REACH_GOAL))),
+        (POSITION, PositionTask(dq.translation(MODEL.fkm(REACH_GOAL))[1:])),
+    ],
+    ids=["6.2.1 pose", "6.2.2 position"],
+)
 def test_the_term_lowers_metric_4_on_the_same_run_and_keeps_it_parsimonious(params, task):
     """The runs of 6.2.1 and 6.2.2 with the term and without (the default): both converge,
     metric 4 of table 6.1, counted from rest, is lower with it, and the median nonzero entries

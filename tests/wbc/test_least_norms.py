@@ -44,12 +44,13 @@ def test_the_pseudoinverse_takes_the_least_2_norm_for_its_task_velocity(a, b) ->
         # Any other velocity of the same J u inside the allowed space is u + N z, J N z = 0:
         # u is orthogonal to every such N z.
         _, singular, vt = np.linalg.svd(task_jacobian @ basis)
-        null = basis @ vt[np.sum(singular > 1e-9 * singular[0]):].T
+        null = basis @ vt[np.sum(singular > 1e-9 * singular[0]) :].T
         assert np.allclose(null.T @ u, 0.0, atol=1e-9)
 
 
-def least_weighted_norm(law: LPLaw, q: np.ndarray, task: PoseTask, weights: np.ndarray,
-                        u_star: np.ndarray) -> float:  # fmt: skip
+def least_weighted_norm(
+    law: LPLaw, q: np.ndarray, task: PoseTask, weights: np.ndarray, u_star: np.ndarray
+) -> float:
     """min sum_i w_i |u_i| over u with J u = J u*, inside the law's rows (5.12, 5.15, 5.10)."""
     pose, jacobian = MODEL.kinematics(q)
     error, task_jacobian = task.error(pose, jacobian, q)
@@ -75,8 +76,15 @@ def least_weighted_norm(law: LPLaw, q: np.ndarray, task: PoseTask, weights: np.n
     a_ub = np.vstack((speed, -speed, np.ones((1, 2 * n))))
     b_ub = np.concatenate((upper, -lower, [norm_limit]))
     finite = np.isfinite(b_ub)
-    result = linprog(np.concatenate((weights, weights)), A_ub=a_ub[finite], b_ub=b_ub[finite],
-                     A_eq=a_eq, b_eq=b_eq, bounds=(0, None), method="highs")  # fmt: skip
+    result = linprog(
+        np.concatenate((weights, weights)),
+        A_ub=a_ub[finite],
+        b_ub=b_ub[finite],
+        A_eq=a_eq,
+        b_eq=b_eq,
+        bounds=(0, None),
+        method="highs",
+    )
     assert result.status == 0, result.message
     return float(result.fun)
 
@@ -93,4 +101,3 @@ def test_the_lp_takes_the_least_1_norm_for_its_task_velocity_inside_its_constrai
         weights[3] += params.waist_hold
         least = least_weighted_norm(law, q, task, weights, out.u)
         assert weights @ np.abs(out.u) <= least + 1e-8
-

@@ -22,8 +22,10 @@ def solve(
     velocity_cost: float = 0.0,
 ) -> LPSolution:
     """min ||J u - rhs||_1 + w ||u||_1 under the rows (rhs = -eta e, as the task gives it)."""
-    costs = [ResidualCost("task", jacobian, -rhs),
-             VelocityCost("velocity", np.full(jacobian.shape[1], velocity_cost))]  # fmt: skip
+    costs = [
+        ResidualCost("task", jacobian, -rhs),
+        VelocityCost("velocity", np.full(jacobian.shape[1], velocity_cost)),
+    ]
     return lp.solve(costs, rows)
 
 
@@ -200,8 +202,9 @@ def test_equality_rows_hold() -> None:
     The target (0.5, 0.5) is best met along the heading by u = (0.5, 0.5 tan phi, 0).
     """
     phi = 0.4
-    row = LinearRows("nonholonomic", np.array([[np.sin(phi), -np.cos(phi), 0.0]]), np.zeros(1),
-                     np.zeros(1))  # fmt: skip
+    row = LinearRows(
+        "nonholonomic", np.array([[np.sin(phi), -np.cos(phi), 0.0]]), np.zeros(1), np.zeros(1)
+    )
     speed = VelocityBounds("speed", np.full(3, -1.0), np.full(3, 1.0))
     jacobian = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
     solution = solve(WarmStartedLP(), jacobian, np.array([0.5, 0.5]), [row, speed])

@@ -105,9 +105,14 @@ def test_cascade_reference_does_not_wind_up_when_the_base_cannot_move():
 
 
 @pytest.mark.parametrize(
-    "field, value", [("eta", "fast"), ("nonholonomic", 1), ("obstacle_gain", True),
-                     ("waist_centring", float("inf"))],
-)  # fmt: skip
+    "field, value",
+    [
+        ("eta", "fast"),
+        ("nonholonomic", 1),
+        ("obstacle_gain", True),
+        ("waist_centring", float("inf")),
+    ],
+)
 def test_gains_of_the_wrong_type_or_not_finite_are_refused(field, value):
     with pytest.raises(ValueError, match=f"LPParams.{field}"):
         LPParams(**{field: value})
@@ -136,8 +141,9 @@ def test_the_cascades_point_tracks_the_reference_as_appendix_b_linearises_it():
 
     law = CascadeLaw(MODEL, params)
     first = law.step(start, task, DT).u  # the reference starts on the base: no error
-    np.testing.assert_allclose(point_velocity(start, first),
-                               reference_velocity(start, start), atol=1e-12)  # fmt: skip
+    np.testing.assert_allclose(
+        point_velocity(start, first), reference_velocity(start, start), atol=1e-12
+    )
     error, jacobian = task.error(*MODEL.kinematics(start), start)
     reference = start[:3] + DT * pinv_velocity(jacobian, error, params.eta)[:3]
     lagging = start.copy()

@@ -93,9 +93,11 @@ def test_base_target_lies_behind_the_goal_along_the_gripper_heading():
     target_x, target_y = term.target(pose)
     end_effector = dq.translation(pose)[1:3]
     heading = 0.3 + 0.2
-    np.testing.assert_allclose(end_effector - [target_x, target_y],
-                               0.36 * np.array([math.cos(heading), math.sin(heading)]),
-                               atol=1e-12)  # fmt: skip
+    np.testing.assert_allclose(
+        end_effector - [target_x, target_y],
+        0.36 * np.array([math.cos(heading), math.sin(heading)]),
+        atol=1e-12,
+    )
 
 
 def test_base_target_steers_in_bursts_from_its_on_heading_error_down_to_its_off():
@@ -138,11 +140,17 @@ def test_least_velocity_weighs_every_entry_of_u():
 
 
 @pytest.mark.parametrize(
-    "make", [lambda: WaistCentring(-1.0, 1.0), lambda: WaistCentring(0.02, 0.0),
-             lambda: BaseTarget(0.05, 2.0, -0.1, 0.15), lambda: BaseTarget(0.05, 2.0, 0.36, 0.0),
-             lambda: LeastVelocity(float("nan")), lambda: WaistHold(-1e-3),
-             lambda: BaseTarget(0.05, 2.0, 0.36, 0.15, on=0.1, off=0.2)],
-)  # fmt: skip
+    "make",
+    [
+        lambda: WaistCentring(-1.0, 1.0),
+        lambda: WaistCentring(0.02, 0.0),
+        lambda: BaseTarget(0.05, 2.0, -0.1, 0.15),
+        lambda: BaseTarget(0.05, 2.0, 0.36, 0.0),
+        lambda: LeastVelocity(float("nan")),
+        lambda: WaistHold(-1e-3),
+        lambda: BaseTarget(0.05, 2.0, 0.36, 0.15, on=0.1, off=0.2),
+    ],
+)
 def test_invalid_term_parameters_are_refused(make):
     with pytest.raises(ValueError):
         make()
@@ -150,13 +158,15 @@ def test_invalid_term_parameters_are_refused(make):
 
 def test_obstacle_circulation_acts_only_after_the_base_stalls_on_an_engaged_border():
     obstacle = Circle(0.45, 0.0, 0.1)
-    term = ObstacleCirculation(weight=0.2, speed=0.1, margin=0.05, lookahead=0.1,
-                               stall_speed=0.01, stall_time=0.1)  # fmt: skip
+    term = ObstacleCirculation(
+        weight=0.2, speed=0.1, margin=0.05, lookahead=0.1, stall_speed=0.01, stall_time=0.1
+    )
     q = HOME.copy()  # the point 0.1 ahead lies 0.35 from the centre: inside the border
 
     def step(at: np.ndarray):
-        ctx = StepContext(MODEL, at, np.ones(8), -np.ones(8), np.array([1.5, 0.0]), (obstacle,),
-                          None, 0.02)  # fmt: skip
+        ctx = StepContext(
+            MODEL, at, np.ones(8), -np.ones(8), np.array([1.5, 0.0]), (obstacle,), None, 0.02
+        )
         return term.cost(ctx)
 
     moving = [step(q + np.array([0.01 * k, 0, 0, 0, 0, 0, 0, 0])) for k in range(10)]

@@ -40,24 +40,28 @@ def test_table_clearance_is_the_distance_from_the_box() -> None:
 
 
 def test_table_clearance_at_known_points() -> None:
-    points = np.array([[0.8, 0.0, 0.5], [0.3, 0.0, 0.2], [0.4, 0.0, 0.5], [0.8, 0.0, 0.35],
-                       [0.52, 0.0, 0.1]])  # fmt: skip
-    np.testing.assert_allclose(TABLE.clearance(points),
-                               [0.1, 0.2, math.hypot(0.1, 0.1), -0.05, -0.02], atol=1e-12)
+    points = np.array(
+        [[0.8, 0.0, 0.5], [0.3, 0.0, 0.2], [0.4, 0.0, 0.5], [0.8, 0.0, 0.35], [0.52, 0.0, 0.1]]
+    )
+    np.testing.assert_allclose(
+        TABLE.clearance(points), [0.1, 0.2, math.hypot(0.1, 0.1), -0.05, -0.02], atol=1e-12
+    )
 
 
 def test_pole_clearance_at_known_points() -> None:
     points = np.array([[0.2, -0.1, 0.3], [0.2, -0.3, 0.9], [0.2, 0.0, 0.7], [0.2, -0.32, 0.5]])
-    np.testing.assert_allclose(POLE.clearance(points), [0.15, 0.3, math.hypot(0.25, 0.1), -0.03],
-                               atol=1e-12)  # fmt: skip
+    np.testing.assert_allclose(
+        POLE.clearance(points), [0.15, 0.3, math.hypot(0.25, 0.1), -0.03], atol=1e-12
+    )
     tall = Cylinder(0.2, -0.3, 0.05)
     assert tall.clearance(np.array([0.2, -0.1, 5.0]))[0] == pytest.approx(0.15)
 
 
 def test_a_wall_is_a_half_space() -> None:
     wall = Plane((-1.0, 0.0, 0.0), -1.5, name="wall")  # the solid is x > 1.5
-    np.testing.assert_allclose(wall.clearance(np.array([[1.0, 3.0, 0.2], [1.7, 0.0, 0.0]])),
-                               [0.5, -0.2], atol=1e-12)  # fmt: skip
+    np.testing.assert_allclose(
+        wall.clearance(np.array([[1.0, 3.0, 0.2], [1.7, 0.0, 0.0]])), [0.5, -0.2], atol=1e-12
+    )
     assert wall.edges() == ()
 
 
@@ -70,11 +74,14 @@ def test_every_face_bounds_the_clearance_from_below(solid: Plane | Cylinder) -> 
     if isinstance(solid, Plane):
         faces = solid.faces()
         assert len(faces) == 5
-        bounds = np.array([[point_to_plane_distance(np.r_[0.0, p], f) for f in faces]
-                           for p in points])  # fmt: skip
+        bounds = np.array(
+            [[point_to_plane_distance(np.r_[0.0, p], f) for f in faces] for p in points]
+        )
     else:
-        side = [math.sqrt(point_to_line_squared_distance(np.r_[0.0, p], solid.axis))
-                - solid.radius for p in points]  # fmt: skip
+        side = [
+            math.sqrt(point_to_line_squared_distance(np.r_[0.0, p], solid.axis)) - solid.radius
+            for p in points
+        ]
         bounds = np.column_stack((side, points[:, 2] - solid.height))
     assert np.all(bounds <= exact[:, None] + 1e-12)
     inside = exact < 0.0
@@ -101,8 +108,13 @@ def test_a_moved_obstacle_keeps_its_clearances(solid: Plane | Cylinder) -> None:
     moved = solid.moved(x, y, yaw)
     points = random_points(300, seed=3)
     c, s = math.cos(yaw), math.sin(yaw)
-    placed = np.column_stack((x + c * points[:, 0] - s * points[:, 1],
-                              y + s * points[:, 0] + c * points[:, 1], points[:, 2]))  # fmt: skip
+    placed = np.column_stack(
+        (
+            x + c * points[:, 0] - s * points[:, 1],
+            y + s * points[:, 0] + c * points[:, 1],
+            points[:, 2],
+        )
+    )
     np.testing.assert_allclose(moved.clearance(placed), solid.clearance(points), atol=1e-12)
     back = moved.moved(0.0, 0.0, -yaw).moved(-x * c - y * s, x * s - y * c, 0.0)
     np.testing.assert_allclose(back.clearance(points), solid.clearance(points), atol=1e-12)
@@ -117,29 +129,35 @@ def test_a_clockwise_footprint_is_taken_counter_clockwise() -> None:
 
 def test_a_shelf_underside_holds_the_solid_above() -> None:
     shelf = Plane((0.0, 0.0, -1.0), -1.2, ((0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)))
-    np.testing.assert_allclose(shelf.clearance(np.array([[0.5, 0.5, 1.0], [0.5, 0.5, 1.3]])),
-                               [0.2, -0.1], atol=1e-12)  # fmt: skip
+    np.testing.assert_allclose(
+        shelf.clearance(np.array([[0.5, 0.5, 1.0], [0.5, 0.5, 1.3]])), [0.2, -0.1], atol=1e-12
+    )
     assert shelf.edges()[4].low == pytest.approx(1.2) and shelf.edges()[4].high == math.inf
 
 
-@pytest.mark.parametrize(("make", "field"), [
-    (lambda: Plane((0.0, 0.0, 2.0), 0.3), "normal"),
-    (lambda: Plane((0.0, 0.0, math.nan), 0.3), "normal"),
-    (lambda: Plane((0.0, 0.0, 1.0), math.inf), "offset"),
-    (lambda: Plane((1.0, 0.0, 0.0), 0.3, ((0, 0), (1, 0), (1, 1))), "footprint"),
-    (lambda: Plane((0.0, 0.0, 1.0), 0.3, ((0, 0), (1, 0))), "footprint"),
-    (lambda: Plane((0.0, 0.0, 1.0), 0.3, ((0, 0), (2, 0), (1, 0.2), (2, 2), (0, 2))),
-     "footprint"),
-    (lambda: Plane((0.0, 0.0, 1.0), 0.3, ((0, 0), (1, 0), (1, 0), (0, 1))), "footprint"),
-    (lambda: Cylinder(0.0, 0.0, 0.0), "radius"),
-    (lambda: Cylinder(0.0, 0.0, 0.1, -1.0), "height"),
-    (lambda: Cylinder(math.nan, 0.0, 0.1), "x, y"),
-    (lambda: Cylinder(0.0, 0.0, 1e300), "radius"),
-    (lambda: Cylinder(0.0, 0.0, 0.1, 1e300), "height"),
-    (lambda: Cylinder(-1e300, 0.0, 0.1), "x, y"),
-    (lambda: Plane((0.0, 0.0, 1.0), -1e300), "offset"),
-    (lambda: Plane((0.0, 0.0, 1.0), 0.3, ((0, 0), (1e300, 0), (0, 1))), "footprint"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    ("make", "field"),
+    [
+        (lambda: Plane((0.0, 0.0, 2.0), 0.3), "normal"),
+        (lambda: Plane((0.0, 0.0, math.nan), 0.3), "normal"),
+        (lambda: Plane((0.0, 0.0, 1.0), math.inf), "offset"),
+        (lambda: Plane((1.0, 0.0, 0.0), 0.3, ((0, 0), (1, 0), (1, 1))), "footprint"),
+        (lambda: Plane((0.0, 0.0, 1.0), 0.3, ((0, 0), (1, 0))), "footprint"),
+        (
+            lambda: Plane((0.0, 0.0, 1.0), 0.3, ((0, 0), (2, 0), (1, 0.2), (2, 2), (0, 2))),
+            "footprint",
+        ),
+        (lambda: Plane((0.0, 0.0, 1.0), 0.3, ((0, 0), (1, 0), (1, 0), (0, 1))), "footprint"),
+        (lambda: Cylinder(0.0, 0.0, 0.0), "radius"),
+        (lambda: Cylinder(0.0, 0.0, 0.1, -1.0), "height"),
+        (lambda: Cylinder(math.nan, 0.0, 0.1), "x, y"),
+        (lambda: Cylinder(0.0, 0.0, 1e300), "radius"),
+        (lambda: Cylinder(0.0, 0.0, 0.1, 1e300), "height"),
+        (lambda: Cylinder(-1e300, 0.0, 0.1), "x, y"),
+        (lambda: Plane((0.0, 0.0, 1.0), -1e300), "offset"),
+        (lambda: Plane((0.0, 0.0, 1.0), 0.3, ((0, 0), (1e300, 0), (0, 1))), "footprint"),
+    ],
+)
 def test_bad_obstacles_are_refused_naming_the_field(make, field: str) -> None:
     with pytest.raises(ValueError, match=f"^{re.escape(field)}:"):
         make()
@@ -147,17 +165,17 @@ def test_bad_obstacles_are_refused_naming_the_field(make, field: str) -> None:
 
 def test_a_solid_larger_than_a_scene_is_refused_with_the_bound() -> None:
     """A scene is a few metres: a number beyond EXTENT_M (100 m) is a mistake, said so."""
-    with pytest.raises(ValueError, match=r"^radius: expected a number > 0 and <= 100 m, got "
-                                         r"1e\+300$"):  # fmt: skip
+    with pytest.raises(
+        ValueError,
+        match=r"^radius: expected a number > 0 and <= 100 m, got "
+        r"1e\+300$",
+    ):
         Cylinder(0.0, 0.0, 1e300)
     assert Cylinder(0.0, 0.0, EXTENT_M, EXTENT_M).radius == EXTENT_M
     assert Plane((0.0, 0.0, 1.0), -EXTENT_M).offset == -EXTENT_M
 
 
-
-
-def feature_distance(solid: Plane | Cylinder, point: np.ndarray, kind: int, index: int
-                     ) -> float:  # fmt: skip
+def feature_distance(solid: Plane | Cylinder, point: np.ndarray, kind: int, index: int) -> float:
     """The distance of ``point`` from the feature (``kind``, ``index``), by the distances of
     wbc.distance_jacobians."""
     vec4 = np.r_[0.0, point]
@@ -172,15 +190,19 @@ def feature_distance(solid: Plane | Cylinder, point: np.ndarray, kind: int, inde
     return radial if kind == SIDE else math.hypot(radial, point[2] - solid.height)
 
 
-@pytest.mark.parametrize("solid", [TABLE, POLE, Plane((0.0, 0.0, -1.0), -1.2, TABLE.footprint)],
-                         ids=["table", "pole", "shelf"])  # fmt: skip
+@pytest.mark.parametrize(
+    "solid",
+    [TABLE, POLE, Plane((0.0, 0.0, -1.0), -1.2, TABLE.footprint)],
+    ids=["table", "pole", "shelf"],
+)
 def test_the_nearest_feature_gives_the_exact_distance(solid: Plane | Cylinder) -> None:
     """Outside, the distance from the feature ``nearest`` names is the distance from the
     solid; inside, the face named is the one the point is least deep behind."""
     points = random_points(3000, seed=5)
     kinds, indices = solid.nearest(points)
-    found = [feature_distance(solid, p, k, i) for p, k, i in zip(points, kinds, indices,
-                                                                 strict=True)]  # fmt: skip
+    found = [
+        feature_distance(solid, p, k, i) for p, k, i in zip(points, kinds, indices, strict=True)
+    ]
     np.testing.assert_allclose(found, solid.clearance(points), atol=1e-12)
     expected = {FACE, EDGE, CORNER} if isinstance(solid, Plane) else {SIDE, FACE, RIM}
     assert set(kinds.tolist()) == expected

@@ -15,8 +15,7 @@ from wbc.scenarios import DT, HOME, REACH_GOAL, STARTS_AND_GOALS
 from wbc.task import PoseTask
 
 MODEL = robot()
-FREE = dict(nonholonomic=False, beta=1e3, obstacle_mode="off", base_target=0.0,
-            joint_gain=1e4)  # fmt: skip
+FREE = dict(nonholonomic=False, beta=1e3, obstacle_mode="off", base_target=0.0, joint_gain=1e4)
 """No row that binds near HOME: the base holonomic, the error bound and the joints far away."""
 
 
@@ -28,8 +27,10 @@ def test_where_no_row_binds_u_is_the_damped_least_squares_closed_form() -> None:
     output = QPLaw(MODEL, params).step(q, task, DT)
     pose, jacobian = MODEL.kinematics(q)
     error, task_jacobian = task.error(pose, jacobian, q)
-    closed = -np.linalg.solve(task_jacobian.T @ task_jacobian + params.damping * np.eye(8),
-                              task_jacobian.T @ (params.eta * error))  # fmt: skip
+    closed = -np.linalg.solve(
+        task_jacobian.T @ task_jacobian + params.damping * np.eye(8),
+        task_jacobian.T @ (params.eta * error),
+    )
     assert output.status == "optimal"
     assert np.all(np.abs(output.u) < 0.5 * MODEL.velocity_max)
     assert np.allclose(output.u, closed, atol=1e-7), (output.u, closed)

@@ -218,15 +218,23 @@ MISSING_FIELDS = [
 ]
 
 
-@pytest.mark.parametrize(("text", "said"), [
-    (b"arm: [1.0, 2.0\n", ":2:1: not YAML: expected ',' or ']', but got '<stream end>'"),
-    (b"- arm\n- base\n", ": a robot description is a mapping (arm:, base:, ...), this file "
-                         "holds a list"),
-    (b"little john\n", ": a robot description is a mapping (arm:, base:, ...), this file holds "
-                       "a str"),
-    (b"", ": a robot description is a mapping (arm:, base:, ...), this file holds nothing"),
-    (b"\x89PNG\r\n\x1a\n\xff", ": not UTF-8 text (byte 0)"),
-], ids=["not-yaml", "list", "text", "empty", "binary"])  # fmt: skip
+@pytest.mark.parametrize(
+    ("text", "said"),
+    [
+        (b"arm: [1.0, 2.0\n", ":2:1: not YAML: expected ',' or ']', but got '<stream end>'"),
+        (
+            b"- arm\n- base\n",
+            ": a robot description is a mapping (arm:, base:, ...), this file holds a list",
+        ),
+        (
+            b"little john\n",
+            ": a robot description is a mapping (arm:, base:, ...), this file holds a str",
+        ),
+        (b"", ": a robot description is a mapping (arm:, base:, ...), this file holds nothing"),
+        (b"\x89PNG\r\n\x1a\n\xff", ": not UTF-8 text (byte 0)"),
+    ],
+    ids=["not-yaml", "list", "text", "empty", "binary"],
+)
 def test_a_file_that_is_no_robot_description_is_one_line_naming_it(
     tmp_path: Path, text: bytes, said: str
 ) -> None:
@@ -304,13 +312,16 @@ def test_the_collision_parts_come_from_the_description(robot: MobileManipulator)
         (lambda c: c["points"][2].update(name="elbow"), "collision.points: names must differ"),
         (lambda c: c["segments"][0].update(axis="w"), "collision.segments[0].axis"),
         (lambda c: c["segments"][0].update(end="knee"), "collision.segments[0].end"),
-        (lambda c: c["segments"][0].update(axis="x"),
-         "collision.segments[0] (forearm): point wrist is 0.122 m off the x axis of frame 3"),
+        (
+            lambda c: c["segments"][0].update(axis="x"),
+            "collision.segments[0] (forearm): point wrist is 0.122 m off the x axis of frame 3",
+        ),
         (lambda c: c["segments"][1].update(frame=4), "collision.segments[1] (hand): point"),
     ],
-)  # fmt: skip
-def test_a_broken_collision_section_names_the_field(tmp_path: Path, description: dict,
-                                                    change, expected: str) -> None:  # fmt: skip
+)
+def test_a_broken_collision_section_names_the_field(
+    tmp_path: Path, description: dict, change, expected: str
+) -> None:
     broken = yaml.safe_load(yaml.safe_dump(description))
     change(broken["collision"])
     path = tmp_path / "broken_collision.yaml"

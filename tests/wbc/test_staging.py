@@ -40,10 +40,13 @@ def finite_difference(task, q: np.ndarray, step: float = 1e-6) -> np.ndarray:
     return np.column_stack(columns)
 
 
-@pytest.mark.parametrize("task", [
-    PointTask(np.array([0.4, -0.2]), np.array([0.1, -0.3, 0.2, 0.0, 0.4])),
-    HeadingTask(2.0, np.array([0.1, -0.3, 0.2, 0.0, 0.4]), np.array([0.0, 0.0])),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    "task",
+    [
+        PointTask(np.array([0.4, -0.2]), np.array([0.1, -0.3, 0.2, 0.0, 0.4])),
+        HeadingTask(2.0, np.array([0.1, -0.3, 0.2, 0.0, 0.4]), np.array([0.0, 0.0])),
+    ],
+)
 def test_drive_task_jacobians_are_the_derivatives_of_their_errors(task) -> None:
     q = np.array([0.3, -0.1, 0.7, 0.2, -0.4, 0.1, 0.3, -0.2])
     _, jacobian = task.error(*MODEL.kinematics(q), q)
@@ -131,8 +134,10 @@ def test_a_walled_off_goal_is_reported_at_once_with_no_way_and_the_robot_never_m
     goal_q = np.array([2.0, 0.0, 0.0, 0.0, -0.3, -0.4, 0.2, 0.3])
     goal = MODEL.fkm(goal_q)
     # A ring of posts 0.9 m round the goal, too close together for the base to pass.
-    ring = [Circle(2.0 + 0.9 * math.cos(a), 0.9 * math.sin(a), 0.08)
-            for a in np.linspace(0.0, 2.0 * math.pi, 30, endpoint=False)]  # fmt: skip
+    ring = [
+        Circle(2.0 + 0.9 * math.cos(a), 0.9 * math.sin(a), 0.08)
+        for a in np.linspace(0.0, 2.0 * math.pi, 30, endpoint=False)
+    ]
     supervisor = StagingSupervisor(MODEL, goal, ring)
     run = integrate_supervised(LPLaw(MODEL), supervisor, HOME, DT, STEPS, ring)
     assert supervisor.phase is Phase.UNREACHABLE and not run.converged and not run.outputs
@@ -239,8 +244,10 @@ def test_candidates_all_blocked_by_obstacles_are_named_as_such() -> None:
     goal = MODEL.fkm(goal_q)
     x, y = dq.translation(goal)[1:3]
     # A wide disc round the goal, the gripper's own spot left out: no base can stand near it.
-    ring = [Circle(x + 0.6 * math.cos(a), y + 0.6 * math.sin(a), 0.45)
-            for a in np.linspace(0.0, 2.0 * math.pi, 12, endpoint=False)]  # fmt: skip
+    ring = [
+        Circle(x + 0.6 * math.cos(a), y + 0.6 * math.sin(a), 0.45)
+        for a in np.linspace(0.0, 2.0 * math.pi, 12, endpoint=False)
+    ]
     blocked = plan(MODEL, HOME, goal, ring)
     assert not blocked.candidates and "of an obstacle" in blocked.reason, blocked.reason
 

@@ -27,8 +27,14 @@ from wbc.task import PoseTask, PositionTask
 
 MODEL = robot()
 STATES_PER_CASE = 25
-CASES = list(itertools.product((0.0, LPParams().velocity_cost), ("pose", "position"),
-                               (False, True), ("derivative", "error")))  # fmt: skip
+CASES = list(
+    itertools.product(
+        (0.0, LPParams().velocity_cost),
+        ("pose", "position"),
+        (False, True),
+        ("derivative", "error"),
+    )
+)
 
 
 def random_step(rng: np.random.Generator, kind: str, obstacle: bool, params: LPParams):
@@ -51,10 +57,12 @@ def vertex_bound(task_dof: int, costs: list, rows: list, active: tuple[str, ...]
     their limit."""
     secondary = sum(cost.matrix.shape[0] for cost in costs[1:] if isinstance(cost, ResidualCost))
     equalities = sum(
-        rows_.matrix.shape[0] for rows_ in rows
-        if isinstance(rows_, LinearRows) and rows_.engaged and np.array_equal(rows_.lower,
-                                                                              rows_.upper)
-    )  # fmt: skip
+        rows_.matrix.shape[0]
+        for rows_ in rows
+        if isinstance(rows_, LinearRows)
+        and rows_.engaged
+        and np.array_equal(rows_.lower, rows_.upper)
+    )
     bound_names = {rows_.name for rows_ in rows if isinstance(rows_, VelocityBounds)}
     norm_names = {rows_.name for rows_ in rows if isinstance(rows_, OneNormBound)}
     active_inequalities = sum(
@@ -66,8 +74,9 @@ def vertex_bound(task_dof: int, costs: list, rows: list, active: tuple[str, ...]
 @pytest.mark.parametrize(("weight", "kind", "obstacle", "bound"), CASES)
 def test_optimal_solutions_are_vertices(weight, kind, obstacle, bound):
     rng = np.random.default_rng(CASES.index((weight, kind, obstacle, bound)))
-    params = LPParams(velocity_cost=weight, error_bound=bound,
-                      obstacle_mode="border" if obstacle else "off")  # fmt: skip
+    params = LPParams(
+        velocity_cost=weight, error_bound=bound, obstacle_mode="border" if obstacle else "off"
+    )
     constraints, objectives = default_constraints(params), default_objectives(params)
     lp = WarmStartedLP()
     solved = 0

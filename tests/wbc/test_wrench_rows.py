@@ -27,13 +27,21 @@ ORACLE_TOL = 1e-12
 
 def with_offsets(robot: MobileManipulator) -> MobileManipulator:
     """The same robot with two more points, off their frames' origins."""
-    points = (*robot.collision.points,
-              CollisionPoint("finger", 5, (0.03, 0.012, -0.02), 0.01),
-              CollisionPoint("shoulder pad", 1, (-0.02, 0.05, 0.04), 0.02))  # fmt: skip
+    points = (
+        *robot.collision.points,
+        CollisionPoint("finger", 5, (0.03, 0.012, -0.02), 0.01),
+        CollisionPoint("shoulder pad", 1, (-0.02, 0.05, 0.04), 0.02),
+    )
     collision = replace(robot.collision, points=points)
-    return MobileManipulator(np.array(robot.dh), robot.base, robot.q_min[3:].copy(),
-                             robot.q_max[3:].copy(), robot.velocity_max[3:].copy(),
-                             robot.name, collision)  # fmt: skip
+    return MobileManipulator(
+        np.array(robot.dh),
+        robot.base,
+        robot.q_min[3:].copy(),
+        robot.q_max[3:].copy(),
+        robot.velocity_max[3:].copy(),
+        robot.name,
+        collision,
+    )
 
 
 def test_point_rows_are_the_weights_times_the_translation_jacobian() -> None:
@@ -43,9 +51,11 @@ def test_point_rows_are_the_weights_times_the_translation_jacobian() -> None:
         chain = robot.forward(q)
         parts = primitive_kinematics(robot, q, chain)
         weights = rng.normal(size=(len(parts.positions), 3))
-        rows = wrench_rows(chain, [point_wrench(p, w) for p, w in zip(parts.positions, weights,
-                                                                      strict=True)],
-                           parts.point_frames)  # fmt: skip
+        rows = wrench_rows(
+            chain,
+            [point_wrench(p, w) for p, w in zip(parts.positions, weights, strict=True)],
+            parts.point_frames,
+        )
         expected = np.einsum("ki,kin->kn", weights, parts.point_jacobians[:, 1:4])
         np.testing.assert_allclose(rows, expected, atol=ORACLE_TOL)
 
@@ -77,8 +87,9 @@ def test_rows_of_a_frame_match_dqrobotics_jacobians(frame: int) -> None:
         np.testing.assert_array_equal(row[moving:], 0.0)
         for axis in AXES.values():
             line_jacobian = DQ_Kinematics.line_jacobian(jacobian, pose, DQ(axis))
-            direction = dq.qmul(dq.qmul(chain.poses[frame][:4], axis),
-                                dq.qconj(chain.poses[frame][:4]))[1:]  # fmt: skip
+            direction = dq.qmul(
+                dq.qmul(chain.poses[frame][:4], axis), dq.qconj(chain.poses[frame][:4])
+            )[1:]
             line = np.r_[0.0, direction, 0.0, np.cross(origin, direction)]
             weights8 = rng.normal(size=8) * [0, 1, 1, 1, 0, 1, 1, 1]
             row = wrench_rows(chain, [line_wrench(line, weights8)], [frame])[0]
@@ -91,11 +102,14 @@ def test_segment_rows_are_the_weights_times_the_line_jacobian() -> None:
         chain = ROBOT.forward(q)
         parts = primitive_kinematics(ROBOT, q, chain)
         weights = rng.normal(size=(len(parts.line_list), 8)) * [0, 1, 1, 1, 0, 1, 1, 1]
-        rows = wrench_rows(chain, [line_wrench(x, w) for x, w in zip(parts.line_list, weights,
-                                                                     strict=True)],
-                           parts.segment_frames)  # fmt: skip
-        np.testing.assert_allclose(rows, np.einsum("ki,kin->kn", weights, parts.line_jacobians),
-                                   atol=ORACLE_TOL)  # fmt: skip
+        rows = wrench_rows(
+            chain,
+            [line_wrench(x, w) for x, w in zip(parts.line_list, weights, strict=True)],
+            parts.segment_frames,
+        )
+        np.testing.assert_allclose(
+            rows, np.einsum("ki,kin->kn", weights, parts.line_jacobians), atol=ORACLE_TOL
+        )
 
 
 def test_the_shared_forward_pass_gives_the_task_what_kinematics_gives() -> None:
@@ -110,8 +124,13 @@ def test_the_shared_forward_pass_gives_the_task_what_kinematics_gives() -> None:
 
 
 def test_a_model_without_parts_has_no_positions() -> None:
-    robot = MobileManipulator(np.array(ROBOT.dh), ROBOT.base, ROBOT.q_min[3:].copy(),
-                              ROBOT.q_max[3:].copy(), ROBOT.velocity_max[3:].copy(),
-                              collision=CollisionModel())  # fmt: skip
+    robot = MobileManipulator(
+        np.array(ROBOT.dh),
+        ROBOT.base,
+        ROBOT.q_min[3:].copy(),
+        ROBOT.q_max[3:].copy(),
+        ROBOT.velocity_max[3:].copy(),
+        collision=CollisionModel(),
+    )
     parts = primitive_kinematics(robot, configurations(ROBOT, 1, seed=7)[0])
     assert parts.points.shape == (0, 4) and parts.lines.shape == (0, 8)

@@ -37,9 +37,13 @@ def integrate(law, q0, task, steps: int, tolerance: float = 1e-3, obstacles=()) 
     return kinematic_run.integrate(law, q0, task, DT, steps, tolerance, obstacles)
 
 
-def configurations(model: MobileManipulator, count: int, seed: int,
-                   low: Sequence[float] = (-2.0, -2.0, -np.pi),
-                   high: Sequence[float] = (2.0, 2.0, np.pi)) -> np.ndarray:  # fmt: skip
+def configurations(
+    model: MobileManipulator,
+    count: int,
+    seed: int,
+    low: Sequence[float] = (-2.0, -2.0, -np.pi),
+    high: Sequence[float] = (2.0, 2.0, np.pi),
+) -> np.ndarray:
     """``count`` configurations: the base uniform between ``low`` and ``high`` (x, y, phi;
     by default anywhere in a 4 m square, facing anywhere), the arm over its joint box."""
     rng = np.random.default_rng(seed)
@@ -48,23 +52,30 @@ def configurations(model: MobileManipulator, count: int, seed: int,
     return np.hstack((base, arm))
 
 
-def context(model: MobileManipulator, q: np.ndarray, solids: tuple[Solid, ...] = (),
-            previous_u: np.ndarray | None = None) -> StepContext:  # fmt: skip
+def context(
+    model: MobileManipulator,
+    q: np.ndarray,
+    solids: tuple[Solid, ...] = (),
+    previous_u: np.ndarray | None = None,
+) -> StepContext:
     """A step's context at q with no error, goal or circle: what the terms and the rows that
     read q, the solids and u_prev see."""
-    return StepContext(model, q, np.zeros(8), np.zeros(8), np.zeros(2), (), None, DT, solids,
-                       previous_u=previous_u)  # fmt: skip
+    return StepContext(
+        model, q, np.zeros(8), np.zeros(8), np.zeros(2), (), None, DT, solids, previous_u=previous_u
+    )
 
 
-def central_difference(function: Callable[[np.ndarray], np.ndarray | float], q: np.ndarray,
-                       step: float = 1e-6) -> np.ndarray:  # fmt: skip
+def central_difference(
+    function: Callable[[np.ndarray], np.ndarray | float], q: np.ndarray, step: float = 1e-6
+) -> np.ndarray:
     """The derivative of ``function`` at q by central differences, one column per entry."""
     columns = []
     for i in range(q.size):
         offset = np.zeros_like(q)
         offset[i] = step
-        columns.append((np.asarray(function(q + offset)) - np.asarray(function(q - offset)))
-                       / (2.0 * step))  # fmt: skip
+        columns.append(
+            (np.asarray(function(q + offset)) - np.asarray(function(q - offset))) / (2.0 * step)
+        )
     return np.stack(columns, axis=-1)
 
 

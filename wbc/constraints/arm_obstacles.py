@@ -73,13 +73,19 @@ the row's Jacobian grows as 1 / sin^2."""
 @dataclass(frozen=True)
 class ArmObstacleGains:
     arm_obstacles: bool = gain(
-        True, doc="keep the robot's collision parts clear of the obstacles in 3-D "
-                  "(wbc.constraints.arm_obstacles; no rows where there are none)")
-    arm_obstacle_gain: float = gain(2.0, low=1e-3, high=100.0,
-                                    doc="eta of d' >= -eta (d - d_safe) for the parts, 1/s")
-    arm_obstacle_margin: float = gain(0.03, low=0.0, high=0.5,
-                                      doc="clearance kept between a part's surface and an "
-                                          "obstacle in 3-D, m")
+        True,
+        doc="keep the robot's collision parts clear of the obstacles in 3-D "
+        "(wbc.constraints.arm_obstacles; no rows where there are none)",
+    )
+    arm_obstacle_gain: float = gain(
+        2.0, low=1e-3, high=100.0, doc="eta of d' >= -eta (d - d_safe) for the parts, 1/s"
+    )
+    arm_obstacle_margin: float = gain(
+        0.03,
+        low=0.0,
+        high=0.5,
+        doc="clearance kept between a part's surface and an obstacle in 3-D, m",
+    )
 
 
 @dataclass(frozen=True)
@@ -115,11 +121,22 @@ def features(obstacle: Solid) -> Features:
     lines = np.array([e.line for e in edges]).reshape(-1, 8)
     zero = np.zeros((3, len(edges)))
     directions, moments, feet = lines[:, 1:4].T, lines[:, 5:8].T, foot(lines).T
-    pairing = np.block([[directions, moments, zero, feet], [zero, directions, zero, zero],
-                        [zero, zero, directions, zero]])  # fmt: skip
-    return Features(tuple(tuple(f.tolist()) for f in obstacle.faces()), corners,
-                    tuple(map(tuple, lines.tolist())), tuple(e.low for e in edges),
-                    tuple(e.high for e in edges), (reach,) * len(edges), pairing)  # fmt: skip
+    pairing = np.block(
+        [
+            [directions, moments, zero, feet],
+            [zero, directions, zero, zero],
+            [zero, zero, directions, zero],
+        ]
+    )
+    return Features(
+        tuple(tuple(f.tolist()) for f in obstacle.faces()),
+        corners,
+        tuple(map(tuple, lines.tolist())),
+        tuple(e.low for e in edges),
+        tuple(e.high for e in edges),
+        (reach,) * len(edges),
+        pairing,
+    )
 
 
 class ArmObstacles:
@@ -134,8 +151,11 @@ class ArmObstacles:
     @classmethod
     def of(cls, params: Any) -> ArmObstacles | None:
         """The term as the law's gains ``params`` ask for it, or None when they turn it off."""
-        return cls(params.arm_obstacle_gain, params.arm_obstacle_margin) \
-            if params.arm_obstacles else None  # fmt: skip
+        return (
+            cls(params.arm_obstacle_gain, params.arm_obstacle_margin)
+            if params.arm_obstacles
+            else None
+        )
 
     def __init__(self, gain: float = 2.0, margin: float = 0.03) -> None:
         if gain <= 0.0 or margin < 0.0:
@@ -184,8 +204,9 @@ class _Rows:
         (module docstring); ``found`` are its features."""
         parts = self.parts
         kinds, indices = obstacle.nearest(parts.positions)
-        for i, (point, kind, index) in enumerate(zip(parts.positions, kinds.tolist(),
-                                                     indices.tolist(), strict=True)):  # fmt: skip
+        for i, (point, kind, index) in enumerate(
+            zip(parts.positions, kinds.tolist(), indices.tolist(), strict=True)
+        ):
             safe = self.safe[i]
             if kind == FACE:
                 distance, weights = point_to_plane(point, found.faces[index])
@@ -197,8 +218,7 @@ class _Rows:
                 safe *= safe
             else:
                 assert isinstance(obstacle, Cylinder)
-                distance, weights, safe = _pole(point, obstacle, found.lines[0], safe,
-                                                kind == RIM)  # fmt: skip
+                distance, weights, safe = _pole(point, obstacle, found.lines[0], safe, kind == RIM)
             self.add(distance, safe, point_wrench(point, weights), parts.point_frames[i])
 
     def add_segments(self, found: Features) -> None:
@@ -240,8 +260,9 @@ class _Rows:
     def _segment_lines(self) -> Array:
         """Each segment's line as (l, m, l x m): what ``add_segments`` pairs with every solid's
         lines, the same for all of them."""
-        return np.array([(*line[1:4], *line[5:8], *line_foot(line))
-                         for line in self.parts.line_list])  # fmt: skip
+        return np.array(
+            [(*line[1:4], *line[5:8], *line_foot(line)) for line in self.parts.line_list]
+        )
 
     @functools.cached_property
     def _segment_spans(self) -> list[tuple[float, float]]:
@@ -264,8 +285,9 @@ def line_foot(line: Vector) -> Vector:
     return (ly * mz - lz * my, lz * mx - lx * mz, lx * my - ly * mx)
 
 
-def _pole(point: Vector, pole: Cylinder, axis: Vector, safe: float, rim: bool
-          ) -> tuple[float, Vector, float]:  # fmt: skip
+def _pole(
+    point: Vector, pole: Cylinder, axis: Vector, safe: float, rim: bool
+) -> tuple[float, Vector, float]:
     """(distance, weights, safe) beside a cylinder: its side, the squared distance D from the
     axis held from (R + safe)^2; its rim, d = sqrt((sqrt(D) - R)^2 + (z - h)^2) held from
     safe, whose weights are the chain rule of the two,
@@ -278,5 +300,8 @@ def _pole(point: Vector, pole: Cylinder, axis: Vector, safe: float, rim: bool
     beside, above = radial - pole.radius, point[2] - pole.height
     distance = math.hypot(beside, above)
     scale = beside / (2.0 * radial * distance)
-    return distance, (scale * weights[0], scale * weights[1],
-                      scale * weights[2] + above / distance), safe  # fmt: skip
+    return (
+        distance,
+        (scale * weights[0], scale * weights[1], scale * weights[2] + above / distance),
+        safe,
+    )

@@ -19,7 +19,8 @@ ErrorBoundMode = Literal["derivative", "error"]
 class ErrorBoundGains:
     beta: float = gain(15.0, low=1e-3, high=1e3, doc="bound gain of 5.10 / 5.7")
     error_bound: ErrorBoundMode = gain(
-        "derivative", doc="5.10 (bound on ||e'||_1) or the original 5.7 (bound on ||e||_1)")
+        "derivative", doc="5.10 (bound on ||e'||_1) or the original 5.7 (bound on ||e||_1)"
+    )
 
 
 class ErrorBound:
@@ -39,8 +40,7 @@ class ErrorBound:
 
     def __init__(self, beta: float, mode: ErrorBoundMode = "derivative") -> None:
         if beta <= 0.0 or mode not in get_args(ErrorBoundMode):
-            raise ValueError(f"error bound needs beta > 0 and a mode in "
-                             f"{get_args(ErrorBoundMode)}")  # fmt: skip
+            raise ValueError(f"error bound needs beta > 0 and a mode in {get_args(ErrorBoundMode)}")
         self.beta = beta
         self.mode = mode
         self.name = "error_derivative_bound" if mode == "derivative" else "error_bound"

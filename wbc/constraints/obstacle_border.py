@@ -81,8 +81,11 @@ class BorderObstacle:
     def of(cls, params: Any) -> BorderObstacle | None:
         """The term as the law's gains ``params`` ask for it, or None when they turn it off."""
         on = params.obstacle_mode == "border"
-        return cls(params.obstacle_gain, params.obstacle_margin,
-                   params.obstacle_lookahead) if on else None  # fmt: skip
+        return (
+            cls(params.obstacle_gain, params.obstacle_margin, params.obstacle_lookahead)
+            if on
+            else None
+        )
 
     def __init__(self, gain: float = 2.0, margin: float = 0.05, lookahead: float = 0.1) -> None:
         if gain <= 0.0 or margin < 0.0 or lookahead < 0.0:
@@ -101,7 +104,8 @@ class BorderObstacle:
         for row, obstacle in enumerate(context.obstacles):
             at = border(context, obstacle, self.margin, self.lookahead)
             if at.engaged:
-                matrix[row] = point_velocity_row(-2.0 * at.dx, -2.0 * at.dy, phi,
-                                                 self.lookahead, context.robot.dof)
+                matrix[row] = point_velocity_row(
+                    -2.0 * at.dx, -2.0 * at.dy, phi, self.lookahead, context.robot.dof
+                )
                 rhs[row] = self.gain * -at.f
         return LinearRows(self.name, matrix, rhs, rhs, engaged=bool(np.any(matrix)))

@@ -23,12 +23,21 @@ class ObstacleGains:
     obstacle_mode: ObstacleMode = gain(
         "vector_field",
         doc="obstacle constraint: the vector-field inequality d' >= -eta_d d (vector_field, "
-            "wbc.constraints.obstacle_vector_field), 5.28 (border), 5.19 (conservative) or none")
-    obstacle_gain: float = gain(2.0, low=1e-3, high=100.0,
-                                doc="lambda of 5.26 (border), eta_d (vector_field), gain on the "
-                                    "clearance (conservative), 1/s")
-    obstacle_margin: float = gain(0.05, low=0.0, high=1.0,
-                                  doc="extra clearance round each obstacle and the base, m")
-    obstacle_lookahead: float = gain(0.1, low=0.0, high=1.0,
-                                     doc="d: 5.28 and the vector-field inequality act on the "
-                                         "point d ahead of the wheel axle, m")
+        "wbc.constraints.obstacle_vector_field), 5.28 (border), 5.19 (conservative) or none",
+    )
+    obstacle_gain: float = gain(
+        2.0,
+        low=1e-3,
+        high=100.0,
+        doc="lambda of 5.26 (border), eta_d (vector_field), gain on the "
+        "clearance (conservative), 1/s",
+    )
+    obstacle_margin: float = gain(
+        0.05, low=0.0, high=1.0, doc="extra clearance round each obstacle and the base, m"
+    )
+    obstacle_lookahead: float = gain(
+        0.1,
+        low=0.0,
+        high=1.0,
+        doc="d: 5.28 and the vector-field inequality act on the point d ahead of the wheel axle, m",
+    )

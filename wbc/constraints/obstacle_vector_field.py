@@ -41,13 +41,15 @@ class VectorFieldObstacle:
     def of(cls, params: Any) -> VectorFieldObstacle | None:
         """The term as the law's gains ``params`` ask for it, or None when they turn it off."""
         on = params.obstacle_mode == "vector_field"
-        return cls(params.obstacle_gain, params.obstacle_margin,
-                   params.obstacle_lookahead) if on else None  # fmt: skip
+        return (
+            cls(params.obstacle_gain, params.obstacle_margin, params.obstacle_lookahead)
+            if on
+            else None
+        )
 
     def __init__(self, gain: float = 2.0, margin: float = 0.05, lookahead: float = 0.1) -> None:
         if gain <= 0.0 or margin < 0.0 or lookahead < 0.0:
-            raise ValueError("vector-field obstacle needs gain > 0, margin >= 0 and "
-                             "lookahead >= 0")  # fmt: skip
+            raise ValueError("vector-field obstacle needs gain > 0, margin >= 0 and lookahead >= 0")
         self.gain, self.margin, self.lookahead = gain, margin, lookahead
 
     def rows(self, context: StepContext) -> LinearRows:

@@ -46,30 +46,47 @@ def gripper_heading(goal_pose: np.ndarray) -> float:
 
 @dataclass(frozen=True)
 class BaseTargetGains:
-    base_target: float = gain(0.05, low=0.0, high=1.0,
-                              doc="weight of turning the base towards where it should stand "
-                                  "for a pose goal (wbc.objectives.base_target)")
+    base_target: float = gain(
+        0.05,
+        low=0.0,
+        high=1.0,
+        doc="weight of turning the base towards where it should stand "
+        "for a pose goal (wbc.objectives.base_target)",
+    )
     base_target_gain: float = gain(4.0, low=1e-3, high=100.0, doc="k of the base target, 1/s")
-    base_target_reach: float = gain(0.36, low=0.0, high=5.0,
-                                    doc="how far behind the goal, along the gripper's heading, "
-                                        "the base should stand, m: the mean horizontal reach "
-                                        "over the arm goals of `parsimony bench` (0.36 +- 0.08)")
-    base_target_stop: float = gain(0.15, low=1e-3, high=5.0,
-                                   doc="distance from the base target within which it is off "
-                                       "(full weight at twice), m")
-    base_target_on: float = gain(0.3, low=0.0, high=3.2,
-                                 doc="heading error above which the base target starts a "
-                                     "steering burst, rad (0: always on)")
-    base_target_off: float = gain(0.05, low=0.0, high=3.2,
-                                  doc="heading error below which a steering burst ends, rad")
+    base_target_reach: float = gain(
+        0.36,
+        low=0.0,
+        high=5.0,
+        doc="how far behind the goal, along the gripper's heading, "
+        "the base should stand, m: the mean horizontal reach "
+        "over the arm goals of `parsimony bench` (0.36 +- 0.08)",
+    )
+    base_target_stop: float = gain(
+        0.15,
+        low=1e-3,
+        high=5.0,
+        doc="distance from the base target within which it is off (full weight at twice), m",
+    )
+    base_target_on: float = gain(
+        0.3,
+        low=0.0,
+        high=3.2,
+        doc="heading error above which the base target starts a steering burst, rad (0: always on)",
+    )
+    base_target_off: float = gain(
+        0.05, low=0.0, high=3.2, doc="heading error below which a steering burst ends, rad"
+    )
 
     @staticmethod
     def check_together(params: object) -> None:
         """A burst ends below the heading error it starts at."""
         if params.base_target_on > 0.0 and not params.base_target_off < params.base_target_on:
-            raise ValueError(f"{type(params).__name__}.base_target_off must be below "
-                             f"base_target_on ({params.base_target_on}), got "
-                             f"{params.base_target_off}")  # fmt: skip
+            raise ValueError(
+                f"{type(params).__name__}.base_target_off must be below "
+                f"base_target_on ({params.base_target_on}), got "
+                f"{params.base_target_off}"
+            )
 
 
 class BaseTarget:
@@ -85,15 +102,32 @@ class BaseTarget:
     def of(cls, params: Any) -> BaseTarget | None:
         """The term as the law's gains ``params`` ask for it, or None when they turn it off."""
         on = params.base_target > 0.0
-        return cls(params.base_target, params.base_target_gain, params.base_target_reach,
-                   params.base_target_stop, params.base_target_on,
-                   params.base_target_off) if on else None  # fmt: skip
+        return (
+            cls(
+                params.base_target,
+                params.base_target_gain,
+                params.base_target_reach,
+                params.base_target_stop,
+                params.base_target_on,
+                params.base_target_off,
+            )
+            if on
+            else None
+        )
 
-    def __init__(self, weight: float, gain: float, reach: float, stop_distance: float,
-                 on: float = 0.0, off: float = 0.0) -> None:  # fmt: skip
+    def __init__(
+        self,
+        weight: float,
+        gain: float,
+        reach: float,
+        stop_distance: float,
+        on: float = 0.0,
+        off: float = 0.0,
+    ) -> None:
         if not (weight >= 0.0 and gain > 0.0 and reach >= 0.0 and stop_distance > 0.0):
-            raise ValueError("base target needs weight >= 0, gain > 0, reach >= 0 and "
-                             "stop_distance > 0")  # fmt: skip
+            raise ValueError(
+                "base target needs weight >= 0, gain > 0, reach >= 0 and stop_distance > 0"
+            )
         self.weight, self.gain = weight, gain
         self.reach, self.stop_distance = reach, stop_distance
         self.latch = Latch(on, off) if on > 0.0 else None
@@ -110,8 +144,10 @@ class BaseTarget:
             psi = gripper_heading(goal_pose)
             position = dq.translation(goal_pose)
             self._goal_pose = goal_pose
-            self._target = (position[1] - self.reach * math.cos(psi),
-                            position[2] - self.reach * math.sin(psi))  # fmt: skip
+            self._target = (
+                position[1] - self.reach * math.cos(psi),
+                position[2] - self.reach * math.sin(psi),
+            )
         return self._target
 
     def cost(self, context: StepContext) -> ResidualCost:

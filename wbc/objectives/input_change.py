@@ -45,15 +45,23 @@ InputChangeForm = Literal["change", "speeding_up"]
 
 @dataclass(frozen=True)
 class InputChangeGains:
-    input_change: float = gain(0.0, low=0.0, high=10.0,
-                               doc="w of the input change term, per unit of u "
-                                   "(wbc.objectives.input_change; 0: off)")
+    input_change: float = gain(
+        0.0,
+        low=0.0,
+        high=10.0,
+        doc="w of the input change term, per unit of u (wbc.objectives.input_change; 0: off)",
+    )
     input_change_form: InputChangeForm = gain(
-        "speeding_up", doc="what it prices: every change of u (change: w ||u - u_prev||_1), or "
-                           "speeding up faster than the ramp (speeding_up)")
-    input_change_ramp: float = gain(0.2, low=1e-3, high=100.0,
-                                    doc="T of speeding_up: the free ramp takes an entry from "
-                                        "rest to its speed bound in T, s")
+        "speeding_up",
+        doc="what it prices: every change of u (change: w ||u - u_prev||_1), or "
+        "speeding up faster than the ramp (speeding_up)",
+    )
+    input_change_ramp: float = gain(
+        0.2,
+        low=1e-3,
+        high=100.0,
+        doc="T of speeding_up: the free ramp takes an entry from rest to its speed bound in T, s",
+    )
 
 
 class InputChange:
@@ -69,14 +77,20 @@ class InputChange:
     def of(cls, params: Any) -> InputChange | None:
         """The term as the law's gains ``params`` ask for it, or None when they turn it off."""
         on = params.input_change > 0.0
-        return cls(params.input_change, params.input_change_form,
-                   params.input_change_ramp) if on else None  # fmt: skip
+        return (
+            cls(params.input_change, params.input_change_form, params.input_change_ramp)
+            if on
+            else None
+        )
 
-    def __init__(self, weight: float, form: InputChangeForm = "speeding_up",
-                 ramp_s: float = 0.2) -> None:  # fmt: skip
+    def __init__(
+        self, weight: float, form: InputChangeForm = "speeding_up", ramp_s: float = 0.2
+    ) -> None:
         if not (weight >= 0.0 and ramp_s > 0.0 and form in get_args(InputChangeForm)):
-            raise ValueError(f"input change needs weight >= 0, ramp_s > 0 and a form in "
-                             f"{get_args(InputChangeForm)}")  # fmt: skip
+            raise ValueError(
+                f"input change needs weight >= 0, ramp_s > 0 and a form in "
+                f"{get_args(InputChangeForm)}"
+            )
         self.weight, self.form, self.ramp_s = weight, form, ramp_s
         self._matrix: np.ndarray | None = None
 
@@ -96,8 +110,9 @@ class InputChange:
         if context.previous_u is None:
             return ResidualCost(self.name, self._matrix, np.zeros(2 * n), 0.0)
         low, high = self.band(context)
-        return ResidualCost(self.name, self._matrix, -np.concatenate((low, high)),
-                            0.5 * self.weight)
+        return ResidualCost(
+            self.name, self._matrix, -np.concatenate((low, high)), 0.5 * self.weight
+        )
 
     def reset(self) -> None:
         """Stateless: the previous u is the law's (``StepContext.previous_u``)."""

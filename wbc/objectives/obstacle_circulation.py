@@ -32,12 +32,17 @@ from wbc.step_context import StepContext
 
 @dataclass(frozen=True)
 class CirculationGains:
-    obstacle_circulation: float = gain(0.2, low=0.0, high=1.0,
-                                       doc="weight of going round an obstacle on the goal's "
-                                           "side while its border is engaged "
-                                           "(wbc.objectives.obstacle_circulation)")
-    circulation_speed: float = gain(0.1, low=0.0, high=1.0,
-                                    doc="the speed along the border that term asks for, m/s")
+    obstacle_circulation: float = gain(
+        0.2,
+        low=0.0,
+        high=1.0,
+        doc="weight of going round an obstacle on the goal's "
+        "side while its border is engaged "
+        "(wbc.objectives.obstacle_circulation)",
+    )
+    circulation_speed: float = gain(
+        0.1, low=0.0, high=1.0, doc="the speed along the border that term asks for, m/s"
+    )
 
 
 class ObstacleCirculation:
@@ -52,17 +57,41 @@ class ObstacleCirculation:
     def of(cls, params: Any) -> ObstacleCirculation | None:
         """The term as the law's gains ``params`` ask for it, or None when they turn it off."""
         on = params.obstacle_mode in ("border", "vector_field") and params.obstacle_circulation > 0
-        return cls(params.obstacle_circulation, params.circulation_speed, params.obstacle_margin,
-                   params.obstacle_lookahead) if on else None  # fmt: skip
+        return (
+            cls(
+                params.obstacle_circulation,
+                params.circulation_speed,
+                params.obstacle_margin,
+                params.obstacle_lookahead,
+            )
+            if on
+            else None
+        )
 
-    def __init__(self, weight: float, speed: float, margin: float, lookahead: float,
-                 stall_speed: float = 0.01, stall_time: float = 0.5,
-                 release: float = 0.3, near: float = 0.05) -> None:  # fmt: skip
-        if not (weight >= 0.0 and speed >= 0.0 and margin >= 0.0 and lookahead >= 0.0
-                and stall_speed >= 0.0 and stall_time >= 0.0 and release >= near >= 0.0
-                ):  # fmt: skip
-            raise ValueError("obstacle circulation needs weight, speed, margin, lookahead, "
-                             "stall_speed, stall_time >= 0 and release >= near >= 0")  # fmt: skip
+    def __init__(
+        self,
+        weight: float,
+        speed: float,
+        margin: float,
+        lookahead: float,
+        stall_speed: float = 0.01,
+        stall_time: float = 0.5,
+        release: float = 0.3,
+        near: float = 0.05,
+    ) -> None:
+        if not (
+            weight >= 0.0
+            and speed >= 0.0
+            and margin >= 0.0
+            and lookahead >= 0.0
+            and stall_speed >= 0.0
+            and stall_time >= 0.0
+            and release >= near >= 0.0
+        ):
+            raise ValueError(
+                "obstacle circulation needs weight, speed, margin, lookahead, "
+                "stall_speed, stall_time >= 0 and release >= near >= 0"
+            )
         self.weight, self.speed = weight, speed
         self.margin, self.lookahead = margin, lookahead
         self.stall_speed, self.stall_time = stall_speed, stall_time
@@ -78,8 +107,10 @@ class ObstacleCirculation:
     def cost(self, context: StepContext) -> ResidualCost:
         dof = context.robot.dof
         phi = float(context.q[2])
-        point = (float(context.q[0]) + self.lookahead * math.cos(phi),
-                 float(context.q[1]) + self.lookahead * math.sin(phi))  # fmt: skip
+        point = (
+            float(context.q[0]) + self.lookahead * math.cos(phi),
+            float(context.q[1]) + self.lookahead * math.sin(phi),
+        )
         moved = math.inf if self._point is None else math.dist(point, self._point)
         self._point = point
         for obstacle in context.obstacles:
@@ -89,8 +120,9 @@ class ObstacleCirculation:
             if self._side != 0.0 and at.h > 0.0 and norm < radius + self.release:
                 tangent = (-self._side * at.dy / norm, self._side * at.dx / norm)
                 row = point_velocity_row(*tangent, phi, self.lookahead, dof)
-                return ResidualCost(self.name, row[np.newaxis], np.array([-self.speed]),
-                                    self.weight)
+                return ResidualCost(
+                    self.name, row[np.newaxis], np.array([-self.speed]), self.weight
+                )
             if not (at.h > 0.0 and norm < radius + self.near):
                 continue
             slow = context.dt > 0.0 and moved < self.stall_speed * context.dt

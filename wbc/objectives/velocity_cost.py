@@ -14,10 +14,14 @@ from wbc.step_context import StepContext
 
 @dataclass(frozen=True)
 class VelocityCostGains:
-    velocity_cost: float = gain(1e-3, low=0.0, high=1.0,
-                                doc="w of w ||u||_1, the tie-break between optimal vertices; "
-                                    "0 with the other weights solves 5.29 exactly "
-                                    "(wbc.objectives.velocity_cost)")
+    velocity_cost: float = gain(
+        1e-3,
+        low=0.0,
+        high=1.0,
+        doc="w of w ||u||_1, the tie-break between optimal vertices; "
+        "0 with the other weights solves 5.29 exactly "
+        "(wbc.objectives.velocity_cost)",
+    )
 
 
 class LeastVelocity:

@@ -27,12 +27,17 @@ from wbc.step_context import StepContext
 
 @dataclass(frozen=True)
 class WaistCentringGains:
-    waist_centring: float = gain(0.0, low=0.0, high=1.0,
-                                 doc="weight of |q1' + k q1|: the waist/base-yaw self-motion "
-                                     "spent on a centred waist (wbc.objectives.waist_centring)")
+    waist_centring: float = gain(
+        0.0,
+        low=0.0,
+        high=1.0,
+        doc="weight of |q1' + k q1|: the waist/base-yaw self-motion "
+        "spent on a centred waist (wbc.objectives.waist_centring)",
+    )
     waist_gain: float = gain(1.0, low=1e-3, high=100.0, doc="k of the waist centring, 1/s")
-    waist_fade: float = gain(0.05, low=0.0, high=10.0,
-                             doc="||e||_1 below which the waist centring fades out (0: never)")
+    waist_fade: float = gain(
+        0.05, low=0.0, high=10.0, doc="||e||_1 below which the waist centring fades out (0: never)"
+    )
 
 
 class WaistCentring:
@@ -51,8 +56,7 @@ class WaistCentring:
     def of(cls, params: Any) -> WaistCentring | None:
         """The term as the law's gains ``params`` ask for it, or None when they turn it off."""
         on = params.waist_centring > 0.0
-        return cls(params.waist_centring, params.waist_gain,
-                   params.waist_fade) if on else None  # fmt: skip
+        return cls(params.waist_centring, params.waist_gain, params.waist_fade) if on else None
 
     def __init__(self, weight: float, gain: float, fade_error: float = 0.0) -> None:
         if not (weight >= 0.0 and gain > 0.0 and fade_error >= 0.0):

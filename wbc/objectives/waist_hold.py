@@ -24,9 +24,13 @@ from wbc.step_context import StepContext
 
 @dataclass(frozen=True)
 class WaistHoldGains:
-    waist_hold: float = gain(0.02, low=0.0, high=1.0,
-                             doc="extra weight of |q1'|: the task's yaw goes to the base, the "
-                                 "waist holds (wbc.objectives.waist_hold)")
+    waist_hold: float = gain(
+        0.02,
+        low=0.0,
+        high=1.0,
+        doc="extra weight of |q1'|: the task's yaw goes to the base, the "
+        "waist holds (wbc.objectives.waist_hold)",
+    )
 
 
 class WaistHold:
