@@ -41,13 +41,13 @@ from deploy import DEPLOY, query
 from messages import codec, process, topics
 from messages.obstacles import Solids
 from messages.topics import CONTROL_DIAGNOSTICS, ROBOT_STATE, SIM_TRUTH, SUPERVISOR_STATUS
-from parsimony.commands.record import recorder_component
 from parsimony.kinematic_demo import LP_PARAMS
 from parsimony.output import json_text
 from parsimony.outputs import written_whole
 from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import Profile, ProfileError, load_profile
+from profiles.recorder import recorder_component
 from record.judge import (
     CONVERGED_ERROR,
     HOLD_S,

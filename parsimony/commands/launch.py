@@ -14,9 +14,10 @@ import zenoh
 from deploy.graph import dataflow
 from deploy.launcher import Launcher
 from deploy.zenoh_error import zenoh_error_text
-from parsimony.commands.record import RECORDER, memory_file, with_recorder
+from parsimony.commands.record import memory_file
 from parsimony.outputs import writable_output
 from profiles.profile import Profile, ProfileError, load_profile
+from profiles.recorder import RECORDER, with_recorder
 
 EXIT_INVALID_PROFILE = 2
 

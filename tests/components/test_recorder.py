@@ -15,9 +15,9 @@ import zenoh
 from deploy import query
 from messages import codec, topics
 from messages.clock import Clock
-from parsimony.commands.record import recorder_component
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
+from profiles.recorder import recorder_component
 from tests.components.conftest import System
 
 if TYPE_CHECKING:

@@ -11,8 +11,8 @@ import pytest
 
 from deploy import DEPLOY
 from deploy.graph import dataflow
-from parsimony.commands.record import with_recorder
 from profiles.profile import ProfileError, load_profile
+from profiles.recorder import with_recorder
 
 
 def test_the_controllers_profile_wires_the_publisher_to_the_controller() -> None:
