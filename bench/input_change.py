@@ -25,8 +25,8 @@ import numpy as np
 
 from deploy import ROBOT_FILE
 from parsimony.goal_sets import FAMILIES, Attempt, attempt, goals, parsimony, shares
-from parsimony.kinematic_demo import input_change_gains
 from parsimony.output import emit, json_text, result_only_stdout, table
+from studies.gain_sets import input_change_gains
 from wbc.lp_law import LPLaw, LPParams
 from wbc.robot import MobileManipulator
 

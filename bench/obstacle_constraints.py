@@ -2,7 +2,7 @@
 
 Run as ``python -m bench.obstacle_constraints [--seeds N] [--kinematic-seeds M] [--workers W]
 [--json]``. Each variant (``VARIANTS``) is the obstacle experiment's law (6.2.3,
-``parsimony.kinematic_demo.LP_PARAMS``) with the gains it names. Each runs the obstacle
+``studies.gain_sets.LP_PARAMS``) with the gains it names. Each runs the obstacle
 experiment's set-up of seeds 0..M-1 kinematically (q += u dt at 50 Hz from the seed's start, to
 the goal above its bin, ``wbc.kinematic_run``), and of seeds 0..N-1 and ``HELD_OUT`` on the
 whole simulated loop (``parsimony experiment obstacle`` in lockstep, the controller told the
@@ -36,12 +36,12 @@ from bench.sim_experiments import experiment_or_none
 from messages.topics import CONTROL_DIAGNOSTICS, SUPERVISOR_STATUS
 from parsimony.experiment import PROFILES, TIME_LIMIT_S, Options
 from parsimony.goal_sets import MOVING_ERROR
-from parsimony.kinematic_demo import LP_PARAMS
 from parsimony.output import emit, json_text, result_only_stdout, table
 from parsimony.sessions import load_session
 from profiles.profile import load_profile
 from record.judge import CONVERGED_ERROR, JUDGED, converged_at, messages, origin_s, the_run
 from sim2d.scenarios import scenario
+from studies.gain_sets import LP_PARAMS
 from wbc.kinematic_run import integrate
 from wbc.lp_law import LPLaw
 from wbc.robot import MobileManipulator

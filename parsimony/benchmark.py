@@ -17,8 +17,8 @@ import numpy as np
 
 from deploy import ROBOT_FILE
 from parsimony.goal_sets import goal_report
-from parsimony.kinematic_demo import TABLE_PARAMS, WITHOUT_ARM_ROWS
 from parsimony.output import table
+from studies.gain_sets import TABLE_PARAMS, WITHOUT_ARM_ROWS
 from wbc import dq
 from wbc.cascade_law import CascadeLaw
 from wbc.constraints.arm_obstacles import ArmObstacles

@@ -41,7 +41,6 @@ from deploy import DEPLOY, query
 from messages import codec, process, topics
 from messages.obstacles import Solids
 from messages.topics import CONTROL_DIAGNOSTICS, ROBOT_STATE, SIM_TRUTH, SUPERVISOR_STATUS
-from parsimony.kinematic_demo import LP_PARAMS
 from parsimony.output import json_text
 from parsimony.outputs import written_whole
 from parsimony.sessions import load_session
@@ -62,6 +61,7 @@ from record.judge import (
 from record.report import write_report
 from record.session_reader import info, make_whole
 from sim2d.scenarios import SimScenario, scenario
+from studies.gain_sets import LP_PARAMS
 from wbc.cascade_law import CascadeParams
 from wbc.lp_law import LPParams
 from wbc.planar import inverse

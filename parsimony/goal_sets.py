@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from parsimony.goal_families import FAMILIES, OBSTACLE_FAMILIES, goals, obstacle_goals
-from parsimony.kinematic_demo import supervised_params
+from studies.gain_sets import supervised_params
 from wbc import dq
 from wbc.cascade_law import CascadeLaw
 from wbc.kinematic_run import ControlEffort, control_effort, integrate, integrate_supervised

@@ -1,4 +1,4 @@
-"""`parsimony demo`: the closed-loop kinematic demo (see parsimony.kinematic_demo)."""
+"""`parsimony demo`: the closed-loop kinematic demo (see studies.kinematic_demo)."""
 
 from __future__ import annotations
 
@@ -6,8 +6,8 @@ import argparse
 from pathlib import Path
 
 from deploy import ROBOT_FILE
-from parsimony.kinematic_demo import format_table, run_demo
 from parsimony.output import emit, json_text
+from studies.kinematic_demo import format_table, run_demo
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

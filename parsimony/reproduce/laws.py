@@ -18,7 +18,7 @@ from wbc.qp_law import QPLaw
 from wbc.robot import BASE_DOF, MobileManipulator
 
 LP = "LP"
-"""The default LP law of each experiment (``parsimony.kinematic_demo.LP_PARAMS``)."""
+"""The default LP law of each experiment (``studies.gain_sets.LP_PARAMS``)."""
 LP_5_29 = "LP 5.29"
 """5.29 as written: every term beside the task at 0 (``bare_5_29``)."""
 CASCADE = "cascade"

@@ -20,13 +20,13 @@ from pathlib import Path
 from typing import Any
 
 from parsimony.experiment import PROFILES, SESSION_FILE, Options, run_experiment
-from parsimony.kinematic_demo import LP_PARAMS
 from parsimony.reproduce import laws as L
 from parsimony.reproduce import rows as R
 from parsimony.reproduce.recorded import recorded
 from parsimony.reproduce.runs import NAMES, Experiment, laws_of
 from parsimony.reproduce.table import Row
 from record.judge import CONVERGED_ERROR, HOLD_S
+from studies.gain_sets import LP_PARAMS
 from wbc.cascade_law import CascadeLaw, CascadeParams
 from wbc.law_output import Law
 from wbc.lp_law import LPLaw

@@ -10,8 +10,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from parsimony.benchmark import UNBOUNDED_SPEED
-from parsimony.kinematic_demo import BORDER_PARAMS, LP_PARAMS, input_change_gains
 from parsimony.reproduce import laws as L
+from studies.gain_sets import BORDER_PARAMS, LP_PARAMS, input_change_gains
 from wbc import dq
 from wbc.cascade_law import CascadeLaw, CascadeParams
 from wbc.kinematic_run import Run, integrate

@@ -15,7 +15,7 @@ from deploy import ROBOT_FILE
 from messages.goal import Goal
 from messages.header import Header
 from messages.state import RobotState
-from parsimony.kinematic_demo import LP_PARAMS, input_change_gains
+from studies.gain_sets import LP_PARAMS, input_change_gains
 from wbc.cascade_law import CascadeLaw, CascadeParams
 from wbc.gains import gain_specs
 from wbc.lp_law import LPLaw, LPParams

@@ -12,7 +12,7 @@ import numpy as np
 from wbc_scenarios import configurations, context
 
 from deploy import ROBOT_FILE
-from parsimony.kinematic_demo import TABLE_PARAMS
+from studies.gain_sets import TABLE_PARAMS
 from wbc.constraints.arm_obstacles import SKEW_MIN, ArmObstacles
 from wbc.constraints.base import LinearRows
 from wbc.distance_jacobians import (

@@ -10,7 +10,7 @@ import pytest
 from wbc_scenarios import configurations, context
 
 from deploy import ROBOT_FILE
-from parsimony.kinematic_demo import TABLE_PARAMS, WITHOUT_ARM_ROWS
+from studies.gain_sets import TABLE_PARAMS, WITHOUT_ARM_ROWS
 from wbc.arm_clearance import PenetrationCount, part_clearances
 from wbc.constraints.arm_obstacles import ArmObstacles
 from wbc.kinematic_run import integrate

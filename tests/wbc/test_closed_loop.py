@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from wbc_scenarios import integrate, pose_task, position_task, robot
 
-from parsimony.kinematic_demo import BORDER_PARAMS, LP_PARAMS, OBSTACLE_PARAMS
+from studies.gain_sets import BORDER_PARAMS, LP_PARAMS, OBSTACLE_PARAMS
 from wbc import dq
 from wbc.cascade_law import CascadeLaw
 from wbc.lp_law import LPLaw, LPParams

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from wbc_scenarios import context, integrate, robot
 
-from parsimony.kinematic_demo import LP_PARAMS, input_change_gains
+from studies.gain_sets import LP_PARAMS, input_change_gains
 from wbc import dq
 from wbc.kinematic_run import control_effort
 from wbc.lp_law import LPLaw

@@ -10,7 +10,7 @@ import pytest
 from wbc_scenarios import robot
 
 from parsimony.goal_sets import FAMILIES, goals
-from parsimony.kinematic_demo import supervised_params
+from studies.gain_sets import supervised_params
 from tests.wbc.crowd import CHECK_GAP_S, crowd
 from wbc import dq
 from wbc.conditioning import smallest_singular_value
