@@ -14,7 +14,7 @@ camera publish on the real robot, every ``step_s`` of simulated time::
 
 It stops the robot when no command has arrived for ``command_timeout_s`` of simulated time.
 A ``start`` with a part of the robot inside one of the scene's solids is warned of, one line
-per solid naming it and saying what the robot will do (``wbc.start_inside``).
+per solid naming it and saying what the robot will do (``wbc.geometry.start_inside``).
 
 Time: ``real_time_factor`` 1 runs as fast as the wall clock, 2 twice as fast, 0 as fast as it
 can. With ``lockstep`` each step waits until the loop has answered it, acknowledged by stamps:
@@ -27,68 +27,46 @@ never replaced by the next before it is answered. Frames are drawn on a thread o
 while the loop answers the sensors of the same step (published first when the latency is a
 step or more). Only then does t advance, so a run does not
 depend on the machine's load. An answer missing for ``ack_timeout_s`` host seconds is counted
-(``lockstep_timeouts``) and the step goes on. The simulator starts when ``paused`` is set false
-(a profile may start it so).
+(``lockstep_timeouts``) and the step goes on; the waiting itself is the lockstep gate's
+(``components.lockstep_gate``). The simulator starts when ``paused`` is set false (a profile
+may start it so).
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
 
 import numpy as np
 
-from components.durations import Durations
+from components.lockstep_gate import COMMANDS, FRAME_ANSWERS, Awaited, LockstepGate
 from components.params import Param, ParamError
 from components.process_entry import run_component
 from components.pubsub import Input
 from components.runtime import Component, Node
-from components.sim_camera import SimCamera
+from components.sim_camera import FrameFormat, SimCamera
 from messages import topics
 from messages.base import ARM_JOINTS
 from messages.clock import Clock
 from messages.commands import ArmCommand, BaseCommand
 from messages.joints import JointStates
-from messages.lockstep import AnswerStamps
 from messages.obstacles import Circle as TruthCircle
 from messages.obstacles import Solids
 from messages.odometry import BaseOdometry
 from messages.truth import SimTruth
 from profiles.scene import Scene
+from sim2d.camera import ImageNoise
 from sim2d.scenarios import SEED_MAX, goal_above
 from sim2d.world import World, WorldSettings, wheel_distance_per_count
 from wbc.base_motion import dead_reckoning
 from wbc.obstacles import Circle
-from wbc.robot import MobileManipulator
 from wbc.start_inside import inside_at_start
+from wbc.robot import MobileManipulator
 
 JOINT_NAMES = tuple(f"q{i}" for i in range(1, ARM_JOINTS + 1))
 LOCKSTEP_CHECK_S = 0.05
 """How often the simulator looks for an answer that is overdue (host seconds)."""
 PAUSED_CLOCK_S = 0.1
 """How often a paused simulator publishes its clock (host seconds)."""
-
-
-FRAME_ANSWERS = tuple(topic.name for topic in topics.FRAME_ANSWERS)
-COMMANDS = ("base/command", "arm/command")
-
-
-@dataclass
-class Awaited:
-    """The answers a lockstep step waits for: the stamps that must reach ``stamp_ns``."""
-
-    stamp_ns: int
-    topics: tuple[str, ...]
-    since: float
-    deadline: float
-
-
-@dataclass
-class Frame:
-    """A camera frame published and not yet answered (lockstep), and when, host seconds."""
-
-    stamp_ns: int
-    published: float
 
 
 class Simulator(Component):
@@ -217,13 +195,17 @@ class Simulator(Component):
         )
         self.step_ns = round(p["step_s"] * 1e9)
         self.now_ns = time.time_ns() if p["host_epoch"] else 0
+        self.publishers = {t.name: node.publisher(t) for t in self.writes}
         self.camera = (
             SimCamera(
-                node,
+                self.scene,
                 self.robot,
                 self.obstacles,
+                p["goal_marker"],
+                ImageNoise(p["image_noise"], p["image_blur_px"]),
                 np.random.default_rng(p["seed"] + 1),
-                lambda frame: self.publishers["camera/image"].put(frame),
+                self.publishers[topics.CAMERA_IMAGE.name].put,
+                self._camera_failed,
             )
             if p["camera"]
             else None
@@ -234,20 +216,16 @@ class Simulator(Component):
         self.odometry_pose = (0.0, 0.0, 0.0)
         self.last_counts = self.world.encoder_counts
         self.last_command_ns: int | None = None
-        self.latency_ns = round(self.scene.camera.latency_s * 1e9)
-        self.awaited: Awaited | None = None
-        self.unanswered: Frame | None = None
+        self.gate = LockstepGate(
+            node.counters,
+            round(self.scene.camera.latency_s * 1e9),
+            lambda: node.params["ack_timeout_s"],
+        )
         self.frame_done = True
         self.sensors_ns: int | None = None
-        self.answered = AnswerStamps()
-        self.answer_times = {
-            k: Durations(node.counters, k) for k in ("frame", "frame_wait", "loop")
-        }
-        node.counters["lockstep_timeouts"] = 0
         node.counters["frames_skipped"] = 0
         node.counters["contacts"] = 0
         node.counters["arm_penetrations"] = 0
-        self.publishers = {t.name: node.publisher(t) for t in self.writes}
         for topic in self.reads:
             node.subscribe(topic.topic, self._answer_handler(topic.topic.name))
         self.base_command = self.arm_command = None
@@ -265,18 +243,18 @@ class Simulator(Component):
         the run can see that every reader of the simulator's topics is reached before the first
         step (a reader reached only later misses the first camera frame)."""
         if self.node.params["paused"]:
-            self.publishers["sim/clock"].put(Clock(stamp_ns=self.now_ns, paused=True))
+            self.publishers[topics.SIM_CLOCK.name].put(Clock(stamp_ns=self.now_ns, paused=True))
 
     def _paced_tick(self) -> None:
         """Timer at the real-time factor's pace: step unless paused or an answer is awaited."""
-        if self.awaited is None and not self.node.params["paused"]:
+        if not self.gate.waiting and not self.node.params["paused"]:
             self.step()
 
     def _kick(self) -> None:
         """As fast as possible (factor 0): queue the next step unless one is queued, the
         simulation is paused or an answer is awaited."""
         p = self.node.params
-        if p["real_time_factor"] or p["paused"] or self.awaited is not None or self._queued:
+        if p["real_time_factor"] or p["paused"] or self.gate.waiting or self._queued:
             return
         self._queued = True
         self.node.post(self._free_tick)
@@ -284,7 +262,7 @@ class Simulator(Component):
     def _free_tick(self) -> None:
         """One step, then the next after the events already waiting (commands, queries)."""
         self._queued = False
-        if self.awaited is None and not self.node.params["paused"]:
+        if not self.gate.waiting and not self.node.params["paused"]:
             self.step()
         self._kick()
 
@@ -295,7 +273,7 @@ class Simulator(Component):
         # On host time the stamps are the host's: the paced steps lag it under load.
         host = self.node.params["host_epoch"]
         self.now_ns = time.time_ns() if host else self.now_ns + self.step_ns
-        self.publishers["sim/clock"].put(Clock(stamp_ns=self.now_ns))
+        self.publishers[topics.SIM_CLOCK.name].put(Clock(stamp_ns=self.now_ns))
         self.frame_done = self.camera is None or self.now_ns < self.next_frame_ns
         self._go_on()
 
@@ -304,33 +282,25 @@ class Simulator(Component):
         sensors (after the answers of a frame whose latency has passed), the frame due (after
         the last frame's answers), then the wait for the commands. When the latency is a step
         or more, the sensors go first, so the loop runs while the frame is drawn."""
-        frame = self.unanswered
-        if frame is not None and self._has_answers(frame.stamp_ns):
-            self.unanswered = frame = None
-        if frame is not None and frame.stamp_ns + self.latency_ns <= self.now_ns:
-            return self._await(FRAME_ANSWERS, frame.stamp_ns)
-        if self.latency_ns >= self.step_ns:
+        gate, lockstep = self.gate, self.node.params["lockstep"]
+        if gate.frame_due(self.now_ns):
+            return
+        if gate.latency_ns >= self.step_ns:
             self._publish_sensors()
         if not self.frame_done:
-            if frame is not None:
-                return self._await(FRAME_ANSWERS, frame.stamp_ns)
+            if gate.frame_pending():
+                return
             self.frame_done = True
             self.next_frame_ns += self.frame_period_ns
-            lockstep = self.node.params["lockstep"]
-            self.camera.take(
-                self._header("camera", "camera/image"),
-                self.world.q,
-                self.now_ns / 1e9,
-                wait=lockstep,
-            )
+            self._take_frame(lockstep)
             if lockstep:
-                self.unanswered = Frame(self.now_ns, time.monotonic())
-                if self.latency_ns == 0:
-                    return self._await(FRAME_ANSWERS, self.now_ns)
+                gate.frame_taken(self.now_ns)
+                if gate.latency_ns == 0:
+                    return gate.wait(FRAME_ANSWERS, self.now_ns)
         self._publish_sensors()
-        if self.node.params["lockstep"]:
-            self._await(COMMANDS, self.now_ns)
-            self._check_answered()  # the commands may be in already
+        if lockstep:
+            gate.wait(COMMANDS, self.now_ns)
+            self._proceed(gate.check())  # the commands may be in already
 
     def _publish_sensors(self) -> None:
         """The joints, odometry and truth of the step, once."""
@@ -341,54 +311,31 @@ class Simulator(Component):
         self._publish_odometry()
         self._publish_truth()
 
-    def _has_answers(self, stamp_ns: int, names: tuple[str, ...] = FRAME_ANSWERS) -> bool:
-        return self.answered.answered(stamp_ns, names)
-
-    def _await(self, names: tuple[str, ...], stamp_ns: int) -> None:
-        now = time.monotonic()
-        self.awaited = Awaited(stamp_ns, names, now, now + self.node.params["ack_timeout_s"])
-
     def _answer_handler(self, name: str):
         def on_answer(message) -> None:
             if name in COMMANDS:
                 self._take_command(name, message)
-            stamp = message.header.stamp_ns
-            self.answered.note(name, stamp)
-            frame = self.unanswered
-            if name in FRAME_ANSWERS and frame is not None and self._has_answers(frame.stamp_ns):
-                # Host time from publishing a frame to its last answer (tracker and estimator).
-                self.answer_times["frame"].note(time.monotonic() - frame.published)
-            self._check_answered()
+            self._proceed(self.gate.note(name, message.header.stamp_ns))
 
         return on_answer
 
-    def _check_answered(self) -> None:
-        awaited = self.awaited
-        if awaited is not None and self._has_answers(awaited.stamp_ns, awaited.topics):
-            # Host time the step waited: for a frame's answers, or for the commands that
-            # answer the sensors (the loop through the estimator and the controller).
-            kind = "frame_wait" if awaited.topics == FRAME_ANSWERS else "loop"
-            self.answer_times[kind].note(time.monotonic() - awaited.since)
-            self._proceed()
-
-    def _proceed(self) -> None:
-        """The awaited answers are in (or overdue): go on with the step or the next one."""
-        awaited, self.awaited = self.awaited, None
-        if awaited is not None and awaited.topics == FRAME_ANSWERS:
-            self.unanswered = None
+    def _proceed(self, done: Awaited | None) -> None:
+        """A wait is over (answered or overdue): go on with the step or the next one."""
+        if done is None:
+            return
+        if done.frame:
             self._go_on()
         self._kick()
 
     def _check_overdue(self) -> None:
-        awaited = self.awaited
-        if awaited is not None and time.monotonic() > awaited.deadline:
-            missing = self.answered.missing(awaited.stamp_ns, awaited.topics)
-            self.node.count("lockstep_timeouts")
+        overdue = self.gate.overdue()
+        if overdue is not None:
+            awaited, missing = overdue
             self.node.warn(
                 "lockstep_timeouts",
                 f"no answer on {', '.join(missing)} for t={awaited.stamp_ns / 1e9:.3f} s; going on",
             )
-            self._proceed()
+            self._proceed(awaited)
         self._kick()  # also starts a run once ``paused`` is set false
 
     # -- commands in, sensors out ---------------------------------------------------------
@@ -410,14 +357,14 @@ class Simulator(Component):
         joints = arm.joint_velocities if arm else (0.0,) * ARM_JOINTS
         self.world.command(left, right, joints)
 
-    def _header(self, frame: str, publisher: str):
-        return self.node.header(frame, self.now_ns, self.publishers[publisher].next_seq)
+    def _header(self, frame: str, topic: topics.Topic):
+        return self.node.header(frame, self.now_ns, self.publishers[topic.name].next_seq)
 
     def _publish_joints(self) -> None:
         q = self.world.q
-        self.publishers["arm/joint_states"].put(
+        self.publishers[topics.ARM_JOINT_STATES.name].put(
             JointStates(
-                header=self._header("arm", "arm/joint_states"),
+                header=self._header("arm", topics.ARM_JOINT_STATES),
                 names=JOINT_NAMES,
                 positions=tuple(q[3:].tolist()),
                 velocities=tuple(self.world.joint_velocities.tolist()),
@@ -435,9 +382,9 @@ class Simulator(Component):
         )
         left, right = self.world.wheel_speeds
         x, y, phi = self.odometry_pose
-        self.publishers["base/odometry"].put(
+        self.publishers[topics.BASE_ODOMETRY.name].put(
             BaseOdometry(
-                header=self._header("odom", "base/odometry"),
+                header=self._header("odom", topics.BASE_ODOMETRY),
                 left_encoder=counts[0],
                 right_encoder=counts[1],
                 left_distance=counts[0] * self.metres_per_count,
@@ -454,9 +401,9 @@ class Simulator(Component):
         q = self.world.q
         self.node.counters["contacts"] = self.world.contacts
         self.node.counters["arm_penetrations"] = self.world.arm_penetrations
-        self.publishers["sim/truth"].put(
+        self.publishers[topics.SIM_TRUTH.name].put(
             SimTruth(
-                header=self._header("world", "sim/truth"),
+                header=self._header("world", topics.SIM_TRUTH),
                 base_pose=tuple(q[:3].tolist()),
                 arm_joints=tuple(q[3:].tolist()),
                 end_effector=tuple(self.world.end_effector.tolist()),
@@ -481,6 +428,26 @@ class Simulator(Component):
         return self.goal_of[1]
 
     # -- the camera -----------------------------------------------------------------------
+
+    def _take_frame(self, lockstep: bool) -> None:
+        """Hand the camera the frame of now (in real time skipped, and counted, while the last
+        is being drawn)."""
+        p, now_s = self.node.params, self.now_ns / 1e9
+        hidden = any(start <= now_s < end for start, end in p["hide_base_marker"])
+        taken = self.camera.take(
+            self._header("camera", topics.CAMERA_IMAGE),
+            self.world.q,
+            hidden,
+            FrameFormat(p["image_format"], p["jpeg_quality"]),
+            wait=lockstep,
+        )
+        if not taken:
+            self.node.count("frames_skipped")
+
+    def _camera_failed(self) -> None:
+        """On the camera thread, in its ``except`` block: a frame could not be drawn."""
+        self.node.count("errors.camera")
+        self.node.warn("errors.camera", "drawing a camera frame failed", True)
 
     def shutdown(self) -> None:
         if self.camera is not None:
