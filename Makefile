@@ -11,7 +11,7 @@ UV_VERSION := 0.13.8
 FOXGLOVE_CLIENT := tests/foxglove_client
 CLIENT_STAMP := $(FOXGLOVE_CLIENT)/node_modules/.installed
 
-.PHONY: demo test bench lint lock clean foxglove-client
+.PHONY: demo test docs bench lint lock clean foxglove-client
 
 # Each step that takes more than a second says what it does first (pip itself is quiet).
 $(STAMP): $(LOCK) pyproject.toml
@@ -44,6 +44,11 @@ test: $(STAMP) $(CLIENT_STAMP)
 	$(VENV)/bin/ruff format --check .
 	$(VENV)/bin/python -m pytest -q --durations=20
 
+# The documentation site (docs/, mkdocs.yml) into site/, strict: a broken link or a missing page
+# fails. make test builds it too (tests/test_docs.py). The banners about MkDocs' future are muted.
+docs: $(STAMP)
+	NO_MKDOCS_2_WARNING=1 DISABLE_MKDOCS_2_WARNING=true $(VENV)/bin/mkdocs build --strict
+
 bench: $(STAMP)
 	$(VENV)/bin/parsimony bench
 
@@ -59,4 +64,4 @@ lock: $(STAMP)
 		--universal --python-version 3.11 --generate-hashes --quiet -o $(LOCK)
 
 clean:
-	rm -rf $(VENV) build *.egg-info $(FOXGLOVE_CLIENT)/node_modules
+	rm -rf $(VENV) build site *.egg-info $(FOXGLOVE_CLIENT)/node_modules
