@@ -35,6 +35,7 @@ from pathlib import Path
 
 import yaml
 import zenoh
+from parsimony.experiment import DEPLOY, connect, launched, wait_alive, wait_reached
 
 from bench.figures import run_bench
 from deploy import query
@@ -42,13 +43,12 @@ from deploy.launcher import cpu_seconds
 from messages import codec, topics
 from messages.markers import MarkerDetections
 from messages.supervisor import SupervisorStatus
-from parsimony.experiment import DEPLOY, connect, launched, wait_alive, wait_reached
 from parsimony.output import table
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
-from record.foxglove_views import ANNOTATIONS_SUFFIX, SCENE_SUFFIX, Viewer
 from record.session_file import SessionWriter, entries
 from record.session_reader import info, read_session
+from scenes.foxglove_views import ANNOTATIONS_SUFFIX, SCENE_SUFFIX, Viewer
 from tests.foxglove_client.client import FoxgloveClient, missing, running_view
 from wbc.robot import MobileManipulator
 

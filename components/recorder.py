@@ -5,7 +5,7 @@ sample is dropped unless the writer falls that far behind, and then the loss is 
 (``overflowed.<topic>``) and written into the file (its ``DROPPED`` metadata, which
 ``parsimony info`` shows). Each message is written on the channel of its key with the
 project's schema, log time from its stamp (``record.session_file``), and beside it in
-Foxglove's well-known schemas (``record.foxglove_views``: images as ``foxglove.RawImage``,
+Foxglove's well-known schemas (``scenes.foxglove_views``: images as ``foxglove.RawImage``,
 frames as ``foxglove.FrameTransforms``, obstacles and the robot of the profile's description
 as ``foxglove.SceneUpdate``, markers on the image as ``foxglove.ImageAnnotations``), so that
 Foxglove's 3D, Image and Plot panels open the file as it is. ``keys`` limits the recording to
@@ -32,9 +32,9 @@ from components.process_entry import run_component
 from components.pubsub import Input
 from components.runtime import Component, Node
 from messages import topics
-from record.foxglove_views import Viewer
 from record.session_file import DROPPED, SessionWriter, stamp_of
 from record.session_span import Span, inside, outside_line
+from scenes.foxglove_views import Viewer
 from wbc.robot import MobileManipulator
 
 log = logging.getLogger("components")

@@ -10,7 +10,7 @@ from matplotlib.axes import Axes
 from matplotlib.patches import Circle, Polygon
 
 from messages.obstacles import Cylinder, Obstacles, Plane
-from record.obstacle_scene import OBSTACLE_RGB
+from scenes.obstacle_scene import OBSTACLE_RGB
 
 UNIT_TOLERANCE = 1e-9
 """Under this squared horizontal length a plane's normal is vertical."""

@@ -1,6 +1,6 @@
 """A Foxglove layout for the live view (and the recordings) of a namespace, made with
 foxglove-sdk's layout support (``foxglove.layouts``): it opens ready on the channels
-``record.foxglove_views`` gives.
+``scenes.foxglove_views`` gives.
 
     +---------------------------+---------------------+
     | 3-D: the robot (estimate  | the camera image,   |
@@ -22,7 +22,7 @@ from __future__ import annotations
 import foxglove.layouts as fl
 
 from messages import topics
-from record.foxglove_views import (
+from scenes.foxglove_views import (
     ANNOTATIONS_SUFFIX,
     CHANNEL_SUFFIX,
     MODEL_SUFFIX,

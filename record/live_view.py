@@ -3,7 +3,7 @@ only, carrying every message of the namespace's topics as it arrives.
 
 Each message goes out as a recording holds it (``record.session_file.entries``): on the channel
 of its key as JSON with the project's JSON Schema, and beside it each of its well-known views
-(``record.foxglove_views.Viewer``: images, frames, the robot drawn from its description,
+(``scenes.foxglove_views.Viewer``: images, frames, the robot drawn from its description,
 markers on the image, the supervisor's plan) on ``<key>/<suffix>``, logged at the message's
 stamp; an image goes once, in its view. A channel is created, and advertised to the clients,
 on its first message. A sample that does not decode is dropped, counted (``malformed``) and
@@ -38,8 +38,8 @@ import zenoh
 from foxglove.websocket import Capability
 
 from messages import codec, topics
-from record.foxglove_views import Viewer, everything, view_channel
 from record.session_file import Entry, entries, stamp_of
+from scenes.foxglove_views import Viewer, everything, view_channel
 
 HOST = "127.0.0.1"
 """The only address the server listens on."""

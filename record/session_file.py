@@ -4,7 +4,7 @@ The project's messages go in as JSON (message encoding ``json``, schema encoding
 ``jsonschema``, schema name the type's name, schema data its JSON Schema, ``bytes`` fields as
 base64 strings marked ``"contentEncoding": "base64"``), so Foxglove plots them as they are, and
 come back into their pydantic types exactly: Python writes a float as its shortest repr, which
-reads back bit for bit. Beside a message go its Foxglove views (``record.foxglove_views``), when
+reads back bit for bit. Beside a message go its Foxglove views (``scenes.foxglove_views``), when
 asked for, on channels of their own. Each image is stored once: a view that carries a field as
 it is (a frame's JPEG or pixels in its ``foxglove.CompressedImage`` or ``RawImage``) holds it,
 and the message's JSON leaves it out; the channel's metadata names the carrier
@@ -31,7 +31,7 @@ from pydantic import BaseModel
 
 from messages import topics
 from messages.schema import json_schema
-from record.foxglove_views import PLAIN, Viewer, everything, view_channel
+from scenes.foxglove_views import PLAIN, Viewer, everything, view_channel
 
 MESSAGE_ENCODING = "json"
 """The message encoding of the project's own channels."""
@@ -182,7 +182,7 @@ class SessionWriter:
     """An MCAP file being written: a context manager, ``close`` writes the footer.
 
     ``chunk_size`` is the uncompressed size (bytes) at which a chunk is closed on its own;
-    ``viewer`` makes the Foxglove views (``record.foxglove_views.Viewer``: give it the robot
+    ``viewer`` makes the Foxglove views (``scenes.foxglove_views.Viewer``: give it the robot
     description, and the file draws the robot).
     """
 

@@ -22,7 +22,6 @@ from mcap.stream_reader import StreamReader, breakup_chunk
 from mcap.writer import MCAP0_MAGIC, CompressionType, Writer
 
 from messages import topics
-from record.foxglove_views import carried
 from record.session_file import (
     CARRIED_FIELD,
     CARRIER,
@@ -34,6 +33,7 @@ from record.session_file import (
     topic_of,
 )
 from record.session_span import FAR_NS, Span, inside, outside_line
+from scenes.foxglove_views import carried
 
 
 class _ExactReads:

@@ -17,18 +17,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 import zenoh
+from parsimony.experiment import DEPLOY, connect, launched, wait_alive, wait_reached
 
 from bench.live_view import lockstep_profile
 from deploy import query
 from deploy.client_limits import GOAL_RATE, STATUS_CHARS
 from messages import codec, topics
 from messages.goal import Goal
-from parsimony.experiment import DEPLOY, connect, launched, wait_alive, wait_reached
 from profiles.profile import Profile, load_profile
 from record.session_reader import info
 from sim2d.scenarios import scenario
 from tests.foxglove_client.client import FoxgloveClient, decode, missing, running_view
-from tests.record.test_foxglove_views import chain, pose_of
+from tests.scenes.views_read import chain, pose_of
 from wbc import dq
 from wbc.planar import in_frame, offset_pose, planar_pose
 from wbc.robot import MobileManipulator

@@ -31,8 +31,8 @@ from parsimony.commands.layout import write_layout
 from parsimony.output import emit, json_text
 from parsimony.target_options import exit_code
 from profiles.profile import Profile, ProfileError, load_profile
-from record.foxglove_views import Viewer
 from record.live_view import DEFAULT_PORT, LiveView
+from scenes.foxglove_views import Viewer
 from wbc.robot import MobileManipulator
 
 

@@ -8,8 +8,6 @@ import math
 from pathlib import Path
 
 import numpy as np
-from test_foxglove_views import pose_dq
-from test_robot_scene import ROBOT, robot_state
 
 from deploy import DEPLOY
 from messages import topics
@@ -21,10 +19,11 @@ from messages.obstacles import Circle, Obstacles
 from messages.supervisor import SupervisorStatus
 from messages.truth import SimTruth
 from record.foxglove_layout import layout
-from record.foxglove_views import Viewer
 from record.session_file import SessionWriter
 from record.session_reader import info
+from scenes.foxglove_views import Viewer
 from tests.processes import parsimony
+from tests.scenes.views_read import ROBOT, pose_dq, robot_state
 from vision.images import jpeg
 
 NAMESPACE = "sim"

@@ -22,7 +22,6 @@ from typing import Any
 import pytest
 import yaml
 import zenoh
-from test_foxglove_views import decode  # the protobuf wire-format reader beside this test
 from websockets.asyncio.client import connect
 from websockets.typing import Subprotocol
 
@@ -32,8 +31,9 @@ from messages.header import Header
 from messages.state import RobotState
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
-from record.foxglove_views import View
 from record.session_file import CARRIED_FIELD, CARRIER, from_json, schema_of
+from scenes.foxglove_views import View
+from tests.scenes.views_read import decode
 
 NAMESPACE = "live"
 WIDTH, HEIGHT = 64, 48

@@ -16,17 +16,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 from mcap.reader import make_reader
+from parsimony.experiment import DEPLOY, PROFILES, Options, connect, experiment_profile
 
 from deploy import query
 from messages.obstacles import Plane
-from parsimony.experiment import DEPLOY, PROFILES, Options, connect, experiment_profile
 from parsimony.sessions import load_session
 from profiles.profile import load_profile
-from record.foxglove_views import MODEL_EVERY, View
 from record.session_reader import info
+from scenes.foxglove_views import MODEL_EVERY, View
 from sim2d.scenarios import scenario
 from tests.processes import process_gone
-from tests.record.test_foxglove_views import decode, vector
+from tests.scenes.views_read import decode, vector
 from wbc.planar import inverse
 from wbc.robot import MobileManipulator
 from wbc.supervisor_phase import Phase

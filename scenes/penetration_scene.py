@@ -14,11 +14,11 @@ from __future__ import annotations
 
 import numpy as np
 from foxglove import messages as fox
+from wbc.arm_clearance import part_clearances
 
 from messages.truth import SimTruth
-from record.foxglove_frames import replacing, timestamp
-from record.robot_scene import at, point
-from wbc.arm_clearance import part_clearances
+from scenes.foxglove_frames import replacing, timestamp
+from scenes.robot_scene import at, point
 from wbc.collision_model import point_positions
 from wbc.robot import MobileManipulator
 

@@ -1,5 +1,5 @@
-"""The robot drawn from its description (record.robot_scene), the markers on the image
-(record.marker_annotations) and the supervisor's plan (record.plan_views), as the views of a
+"""The robot drawn from its description (scenes.robot_scene), the markers on the image
+(scenes.marker_annotations) and the supervisor's plan (scenes.plan_views), as the views of a
 ``Viewer`` with the robot description: each read with nothing but its own schema."""
 
 from __future__ import annotations
@@ -8,8 +8,17 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from test_foxglove_views import (
+
+from messages import topics
+from messages.header import Header
+from messages.markers import MarkerDetection, MarkerDetections
+from messages.supervisor import SupervisorStatus
+from record.session_file import SessionWriter
+from record.session_reader import info
+from scenes.foxglove_views import MODEL_EVERY, Viewer
+from tests.scenes.views_read import (
     KEY,
+    ROBOT,
     STAMP_NS,
     chain,
     decode,
@@ -18,18 +27,6 @@ from test_foxglove_views import (
     transforms_of,
     vector,
 )
-
-from deploy import ROBOT_FILE
-from messages import topics
-from messages.header import Header
-from messages.markers import MarkerDetection, MarkerDetections
-from messages.supervisor import SupervisorStatus
-from record.foxglove_views import MODEL_EVERY, Viewer
-from record.session_file import SessionWriter
-from record.session_reader import info
-from wbc.robot import MobileManipulator
-
-ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 
 
 def same_pose(a: np.ndarray, b: np.ndarray) -> bool:

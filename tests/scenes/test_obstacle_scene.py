@@ -1,5 +1,5 @@
-"""The obstacles in Foxglove's 3-D panel (record.obstacle_scene) and the parts of the simulated
-robot inside them (record.penetration_scene), as the views of a ``Viewer``, each read with
+"""The obstacles in Foxglove's 3-D panel (scenes.obstacle_scene) and the parts of the simulated
+robot inside them (scenes.penetration_scene), as the views of a ``Viewer``, each read with
 nothing but its own schema: every drawn place and size follows from the obstacles message (or
 the ground truth) and the model of ``wbc.obstacles3d``."""
 
@@ -11,13 +11,11 @@ from typing import Any
 
 import numpy as np
 import pytest
-from test_foxglove_views import HEADER, decode, vector
-from test_robot_scene import ROBOT
 
 from messages import topics
 from messages.obstacles import Circle, Cylinder, Obstacles, Plane, Solids
 from messages.truth import SimTruth
-from record.foxglove_views import (
+from scenes.foxglove_views import (
     CHANNEL_SUFFIX,
     MODEL_EVERY,
     PENETRATIONS_SUFFIX,
@@ -25,7 +23,8 @@ from record.foxglove_views import (
     View,
     Viewer,
 )
-from record.obstacle_scene import CIRCLE_HEIGHT_M, UNBOUNDED_HEIGHT_M
+from scenes.obstacle_scene import CIRCLE_HEIGHT_M, UNBOUNDED_HEIGHT_M
+from tests.scenes.views_read import HEADER, ROBOT, decode, vector
 from wbc import dq, scenarios
 from wbc.collision_model import point_positions
 

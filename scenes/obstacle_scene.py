@@ -21,7 +21,7 @@ nothing else to show them.
 Each solid carries its name as a label. The circles (``circle_scene``) and the solids
 (``solid_scene``) go on channels of their own: the estimator sends the circles it sees with
 every camera frame, while the declared solids seldom change, and are sent when they do
-(``record.foxglove_views.Viewer``). Each update first deletes every entity of its channel, so
+(``scenes.foxglove_views.Viewer``). Each update first deletes every entity of its channel, so
 an obstacle that is gone disappears.
 """
 
@@ -33,8 +33,8 @@ import numpy as np
 from foxglove import messages as fox
 
 from messages.obstacles import Cylinder, Obstacles, Plane
-from record.foxglove_frames import replacing, timestamp
-from record.robot_scene import at
+from scenes.foxglove_frames import replacing, timestamp
+from scenes.robot_scene import at
 
 CIRCLE_HEIGHT_M = 0.3
 """How tall a circle is drawn when the message gives no height (the demo's obstacles)."""
@@ -46,7 +46,7 @@ WALL_SIDE_M = 3.0
 WALL_THICKNESS_M = 0.03
 OBSTACLE_RGB = (0.6, 0.4, 0.3)
 """Every obstacle's colour (here and in the report's figures): apart from the robots' (blue,
-green, orange), and not the red of a penetration (``record.penetration_scene``)."""
+green, orange), and not the red of a penetration (``scenes.penetration_scene``)."""
 OBSTACLE_COLOR = fox.Color(r=OBSTACLE_RGB[0], g=OBSTACLE_RGB[1], b=OBSTACLE_RGB[2], a=0.8)
 FACE_COLOR = fox.Color(r=OBSTACLE_RGB[0], g=OBSTACLE_RGB[1], b=OBSTACLE_RGB[2], a=0.7)
 """A solid's face: the plane the robot keeps clear of."""

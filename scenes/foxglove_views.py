@@ -32,9 +32,9 @@ panels open a recording (or a live view) with no plugin:
                            -> foxglove.SceneUpdate      its way and the candidate's ghost
                                                         (``scene``)
 
-The robot, its frames and its model are ``record.robot_scene``'s; the plan's
-``record.plan_views``'; the annotations ``record.marker_annotations``'; the obstacles'
-``record.obstacle_scene``'; the penetrations' ``record.penetration_scene``'. Each view is
+The robot, its frames and its model are ``scenes.robot_scene``'s; the plan's
+``scenes.plan_views``'; the annotations ``scenes.marker_annotations``'; the obstacles'
+``scenes.obstacle_scene``'; the penetrations' ``scenes.penetration_scene``'. Each view is
 protobuf, encoded by foxglove-sdk with its schema, and goes on the channel ``<key>/<suffix>``
 (``View.channel``): ``foxglove`` for the transforms, images and circles, the name above for
 the others, so no two views of a key share a channel.
@@ -59,12 +59,12 @@ from messages.obstacles import Obstacles
 from messages.state import RobotState
 from messages.supervisor import SupervisorStatus
 from messages.truth import SimTruth
-from record.foxglove_frames import planar_transform, pose_transform, timestamp
-from record.marker_annotations import marker_annotations
-from record.obstacle_scene import circle_scene, solid_scene
-from record.penetration_scene import penetrating, penetration_scene
-from record.plan_views import CANDIDATE_COLOR, CANDIDATE_PREFIX, plan_scene, plan_transforms
-from record.robot_scene import RobotDrawing
+from scenes.foxglove_frames import planar_transform, pose_transform, timestamp
+from scenes.marker_annotations import marker_annotations
+from scenes.obstacle_scene import circle_scene, solid_scene
+from scenes.penetration_scene import penetrating, penetration_scene
+from scenes.plan_views import CANDIDATE_COLOR, CANDIDATE_PREFIX, plan_scene, plan_transforms
+from scenes.robot_scene import RobotDrawing
 from wbc.planar import inverse
 from wbc.robot import MobileManipulator
 
@@ -263,7 +263,7 @@ def everything(suffix: str) -> bool:
 class Viewer:
     """The views of every topic's messages (the table of the module docstring). Given the
     robot description, the estimate and the truth are drawn as robots and the supervisor's
-    staging candidate as a ghost (``record.robot_scene``); without it, their bases and end
+    staging candidate as a ghost (``scenes.robot_scene``); without it, their bases and end
     effectors alone. A ``Viewer`` remembers the last plan, solids and penetrating parts of each
     key, to send them when they change: one writer or server uses one."""
 

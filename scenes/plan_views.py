@@ -11,8 +11,8 @@ import numpy as np
 from foxglove import messages as fox
 
 from messages.supervisor import SupervisorStatus
-from record.foxglove_frames import replacing, timestamp
-from record.robot_scene import RobotDrawing, at
+from scenes.foxglove_frames import replacing, timestamp
+from scenes.robot_scene import RobotDrawing, at
 
 CANDIDATE_PREFIX = "candidate/"
 CANDIDATE_COLOR = fox.Color(r=1.0, g=0.6, b=0.1, a=0.35)

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from foxglove import messages as fox
 
-from record.foxglove_frames import planar_transform, pose_transform, timestamp
+from scenes.foxglove_frames import planar_transform, pose_transform, timestamp
 from wbc.robot import BASE_DOF, MobileManipulator
 
 LINK_THICKNESS_M = 0.03

@@ -12,7 +12,7 @@ from __future__ import annotations
 from foxglove import messages as fox
 
 from messages.markers import MarkerDetections
-from record.foxglove_frames import timestamp
+from scenes.foxglove_frames import timestamp
 
 OUTLINE_COLOR = fox.Color(r=0.1, g=0.9, b=0.2, a=1.0)
 TEXT_COLOR = fox.Color(r=1.0, g=1.0, b=1.0, a=1.0)
