@@ -1,8 +1,10 @@
-"""The README's first hour, run exactly as written: a launch with its recording, two goals, the
-recording described, reported and replayed."""
+"""The README's first hour, run exactly as written: a launch with its recording, watched, two
+goals, the recording described, reported, re-run with another law, compared, replayed at another
+rate into a Foxglove view, the view's layout written, and the emulated hardware launched."""
 
 from __future__ import annotations
 
+import json
 import re
 import subprocess
 from pathlib import Path
@@ -24,8 +26,9 @@ def first_hour_block() -> str:
 
 def test_the_first_hour_of_the_readme_runs_as_written(tmp_path: Path) -> None:
     """In a folder of its own (``deploy`` and ``.venv`` as the root has them), ``bash -e``: every
-    command exits 0, the goals are reached, the recording is whole and holds them, the report
-    is written and the replay ends."""
+    command exits 0, the goals are reached, the recording is whole and holds them, the reports
+    are written (the rerun's labelled as such), the layout is Foxglove's, the replay ends and
+    the emulated hardware starts and stops."""
     for name in ("deploy", ".venv"):
         (tmp_path / name).symlink_to(ROOT / name)
     result = subprocess.run(
@@ -42,4 +45,13 @@ def test_the_first_hour_of_the_readme_runs_as_written(tmp_path: Path) -> None:
     assert re.search(r"^sim/goal/request\s+Goal\s+\d+\s+2\s", result.stdout, re.M), result.stdout
     assert (tmp_path / "first_report" / "judged.json").is_file()
     assert (tmp_path / "first_report" / "base_path.png").is_file()
+    # the cascade re-run on the recording's states, beside the LP in one report
+    assert (tmp_path / "cascade.mcap").is_file()
+    assert "cascade (rerun)" in (tmp_path / "compare" / "effort.md").read_text()
+    # the view's layout, on the profile's namespace (its publish-pose tool on goal/request)
+    layout = json.loads((tmp_path / "station.json").read_text())
+    assert "sim/goal/request" in json.dumps(layout["content"])
+    # the emulated hardware: the drivers on the emulated devices, stopped after its duration
+    assert re.search(r"\[launch\] started base_driver", result.stderr), result.stderr[-3000:]
+    assert re.search(r"\[launch\] started arm_driver", result.stderr), result.stderr[-3000:]
     assert "Traceback" not in result.stderr
