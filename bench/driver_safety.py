@@ -38,7 +38,6 @@ from deploy import DEPLOY, query
 from messages import codec, topics
 from messages.commands import ArmCommand, BaseCommand
 from messages.header import Header
-from parsimony.experiment import connect, launched
 from parsimony.output import result_only_stdout, table
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
@@ -46,6 +45,7 @@ from profiles.profile_files import read_profile_data
 from protocols import create_oi
 from sim2d.devices.ax_servos import AXChainEmulator, IntegratingJoints
 from sim2d.devices.create2 import Create2Emulator
+from studies.experiment import connect, launched
 
 METRES_PER_COUNT = create_oi.mm_per_count(0.072) / 1000.0
 RESET_AFTER_S = 1.0

@@ -35,7 +35,6 @@ from pathlib import Path
 
 import yaml
 import zenoh
-from parsimony.experiment import DEPLOY, connect, launched, wait_alive, wait_reached
 
 from bench.figures import run_bench
 from deploy import query
@@ -49,6 +48,7 @@ from profiles.profile import load_profile
 from record.session_file import SessionWriter, entries
 from record.session_reader import info, read_session
 from scenes.foxglove_views import ANNOTATIONS_SUFFIX, SCENE_SUFFIX, Viewer
+from studies.experiment import DEPLOY, connect, launched, wait_alive, wait_reached
 from tests.foxglove_client.client import FoxgloveClient, missing, running_view
 from wbc.robot import MobileManipulator
 

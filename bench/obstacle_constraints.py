@@ -34,13 +34,13 @@ import numpy as np
 
 from bench.sim_experiments import experiment_or_none
 from messages.topics import CONTROL_DIAGNOSTICS, SUPERVISOR_STATUS
-from parsimony.experiment import PROFILES, TIME_LIMIT_S, Options
 from parsimony.goal_sets import MOVING_ERROR
 from parsimony.output import emit, json_text, result_only_stdout, table
 from parsimony.sessions import load_session
 from profiles.profile import load_profile
 from record.judge import CONVERGED_ERROR, JUDGED, converged_at, messages, origin_s, the_run
 from sim2d.scenarios import scenario
+from studies.experiment import PROFILES, TIME_LIMIT_S, Options
 from studies.gain_sets import LP_PARAMS
 from wbc.kinematic_run import integrate
 from wbc.lp_law import LPLaw

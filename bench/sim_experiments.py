@@ -26,11 +26,11 @@ from pathlib import Path
 import numpy as np
 
 from deploy.query import QueryError
-from parsimony.experiment import PROFILES, SUPERVISED, Options, run_experiment
 from parsimony.output import emit, json_text, result_only_stdout, table
 from profiles.profile import ProfileError, load_profile
 from sim2d.camera import ImageNoise, PlacedMarker, Renderer, ceiling_camera
 from sim2d.scenarios import NAMES, scenario
+from studies.experiment import PROFILES, SUPERVISED, Options, run_experiment
 from vision.images import grey, jpeg
 from vision.markers import Intrinsics, MarkerDetector, plane_of, plane_pose, square_pose
 from wbc.planar import planar_pose

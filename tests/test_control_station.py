@@ -17,7 +17,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 import zenoh
-from parsimony.experiment import DEPLOY, connect, launched, wait_alive, wait_reached
 
 from bench.live_view import lockstep_profile
 from deploy import query
@@ -27,6 +26,7 @@ from messages.goal import Goal
 from profiles.profile import Profile, load_profile
 from record.session_reader import info
 from sim2d.scenarios import scenario
+from studies.experiment import DEPLOY, connect, launched, wait_alive, wait_reached
 from tests.foxglove_client.client import FoxgloveClient, decode, missing, running_view
 from tests.scenes.views_read import chain, pose_of
 from wbc import dq

@@ -18,10 +18,10 @@ import yaml
 
 from deploy import DEPLOY, query
 from messages import codec, topics
-from parsimony.experiment import connect, launched, wait_alive
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from profiles.profile_files import read_profile_data
+from studies.experiment import connect, launched, wait_alive
 
 
 def components(path: Path) -> dict[str, dict]:

@@ -23,9 +23,9 @@ from deploy import query
 from messages import codec, topics
 from messages.goal import Goal
 from messages.state import RobotState
-from parsimony.experiment import DEPLOY, connect, launched, wait_alive, wait_reached
 from profiles.endpoints import free_port
 from profiles.profile import Profile, load_profile
+from studies.experiment import DEPLOY, connect, launched, wait_alive, wait_reached
 from wbc import dq
 from wbc.planar import offset_of
 

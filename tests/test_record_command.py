@@ -21,11 +21,11 @@ from messages.clock import Clock
 from messages.goal import Goal
 from messages.header import Header
 from messages.process import EXIT_FOR_GOOD
-from parsimony.experiment import connect, launched
 from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.session_reader import info
+from studies.experiment import connect, launched
 from tests.processes import parsimony, process_gone
 
 

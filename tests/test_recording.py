@@ -20,11 +20,11 @@ from mcap.reader import make_reader
 from deploy import DEPLOY, query
 from messages import codec, process, topics
 from messages.process import EXIT_FOR_GOOD
-from parsimony.experiment import connect
 from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.session_reader import info, read_session, recover
+from studies.experiment import connect
 
 
 def parsimony(*arguments: str, timeout: float = 300) -> subprocess.CompletedProcess:

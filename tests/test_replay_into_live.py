@@ -14,10 +14,10 @@ from messages.clock import Clock
 from messages.commands import ArmCommand
 from messages.header import Header
 from messages.state import RobotState
-from parsimony.experiment import connect, launched
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.session_file import SessionWriter
+from studies.experiment import connect, launched
 from tests.processes import parsimony
 
 

@@ -1,5 +1,5 @@
 """`parsimony experiment`: a chapter 6 experiment on the whole simulated loop (see
-parsimony.experiment)."""
+studies.experiment)."""
 
 from __future__ import annotations
 
@@ -11,10 +11,10 @@ from pathlib import Path
 import yaml
 
 from deploy.query import QueryError
-from parsimony.experiment import PROFILES, TIME_LIMIT_S, Options, run_experiment
 from parsimony.output import emit, json_text
 from profiles.profile import ProfileError
 from sim2d.scenarios import NAMES, SEED_MAX
+from studies.experiment import PROFILES, TIME_LIMIT_S, Options, run_experiment
 from wbc.robot import RobotDescriptionError
 
 EXIT_NOT_CONVERGED = 1

@@ -11,11 +11,11 @@ from pathlib import Path
 from deploy import ROBOT_FILE
 from deploy.query import QueryError
 from parsimony.commands.experiment import time_limit
-from parsimony.experiment import PROFILES, TIME_LIMIT_S
 from parsimony.output import emit, json_text
 from parsimony.reproduce import NAMES, TRIALS, format_laws, format_rows, reproduce, write_figures
 from parsimony.reproduce.loop import LABELS, LOOP_LAWS, beside, loop, summary_line
 from profiles.profile import ProfileError, load_profile
+from studies.experiment import PROFILES, TIME_LIMIT_S
 from wbc.robot import MobileManipulator
 
 

@@ -1,6 +1,6 @@
 """`parsimony reproduce --loop`: the set-ups of section 6.2 on the whole simulated loop.
 
-Each law of the rows runs through ``parsimony.experiment`` in lockstep (simulator, camera,
+Each law of the rows runs through ``studies.experiment`` in lockstep (simulator, camera,
 vision tracker, state estimator and controller, each a process; the goal and the state seen by
 the camera), with the gains of its kinematic run (``runs.laws_of``, passed as the experiment's
 ``--gain``: one declaration). Each recording is read back (``recorded``) and given to the
@@ -19,13 +19,13 @@ import time
 from pathlib import Path
 from typing import Any
 
-from parsimony.experiment import PROFILES, SESSION_FILE, Options, run_experiment
 from parsimony.reproduce import laws as L
 from parsimony.reproduce import rows as R
 from parsimony.reproduce.recorded import recorded
 from parsimony.reproduce.runs import NAMES, Experiment, laws_of
 from parsimony.reproduce.table import Row
 from record.judge import CONVERGED_ERROR, HOLD_S
+from studies.experiment import PROFILES, SESSION_FILE, Options, run_experiment
 from studies.gain_sets import LP_PARAMS
 from wbc.cascade_law import CascadeLaw, CascadeParams
 from wbc.law_output import Law

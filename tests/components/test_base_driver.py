@@ -17,11 +17,11 @@ from deploy import query
 from messages import codec, topics
 from messages.commands import BaseCommand
 from messages.header import Header
-from parsimony.experiment import connect, launched
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from profiles.profile_files import read_profile_data
 from protocols import create_oi
+from studies.experiment import connect, launched
 
 METRES_PER_COUNT = create_oi.mm_per_count(0.072) / 1000.0
 STARTED = (

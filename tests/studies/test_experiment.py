@@ -16,7 +16,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 from mcap.reader import make_reader
-from parsimony.experiment import DEPLOY, PROFILES, Options, connect, experiment_profile
 
 from deploy import query
 from messages.obstacles import Plane
@@ -25,6 +24,7 @@ from profiles.profile import load_profile
 from record.session_reader import info
 from scenes.foxglove_views import MODEL_EVERY, View
 from sim2d.scenarios import scenario
+from studies.experiment import DEPLOY, PROFILES, Options, connect, experiment_profile
 from tests.processes import process_gone
 from tests.scenes.views_read import decode, vector
 from wbc.planar import inverse
