@@ -36,9 +36,9 @@ from bench.sim_experiments import experiment_or_none
 from messages.topics import CONTROL_DIAGNOSTICS, SUPERVISOR_STATUS
 from parsimony.goal_sets import MOVING_ERROR
 from parsimony.output import emit, json_text, result_only_stdout, table
-from parsimony.sessions import load_session
 from profiles.profile import load_profile
 from record.judge import CONVERGED_ERROR, JUDGED, converged_at, messages, origin_s, the_run
+from record.sessions import load_session
 from sim2d.scenarios import scenario
 from studies.experiment import PROFILES, TIME_LIMIT_S, Options
 from studies.gain_sets import LP_PARAMS

@@ -59,12 +59,12 @@ from messages.header import Header
 from messages.joints import JointStates
 from messages.odometry import BaseOdometry
 from parsimony.output import emit, json_text, result_only_stdout, table
-from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import Profile, ZenohSettings, load_profile
 from record.report import write_report
 from record.session_file import MESSAGE_ENCODING
 from record.session_reader import info, read_session
+from record.sessions import load_session
 from sim2d.camera import ImageNoise, PlacedMarker, ceiling_camera, render
 from studies.experiment import PROFILES, SESSION_FILE, TIME_LIMIT_S, Options, run_experiment
 from wbc.planar import planar_pose

@@ -1,6 +1,6 @@
 """A run judged from its recording alone: every figure ``report.json`` gives about a run.
 
-A session maps a topic name to its messages (``parsimony.sessions.load_session`` of
+A session maps a topic name to its messages (``record.sessions.load_session`` of
 ``JUDGED``). The run begins at its first ground truth (its first state on a robot without one)
 and ends ``HOLD_S`` after the controller's error fell under ``CONVERGED_ERROR`` for good, under
 a supervisor within its last pose phase (a drive leg's error is not the goal's); else at the

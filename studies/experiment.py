@@ -43,7 +43,6 @@ from messages.obstacles import Solids
 from messages.topics import CONTROL_DIAGNOSTICS, ROBOT_STATE, SIM_TRUTH, SUPERVISOR_STATUS
 from parsimony.output import json_text
 from parsimony.outputs import written_whole
-from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import Profile, ProfileError, load_profile
 from profiles.recorder import recorder_component
@@ -60,6 +59,7 @@ from record.judge import (
 )
 from record.report import write_report
 from record.session_reader import info, make_whole
+from record.sessions import load_session
 from sim2d.scenarios import SimScenario, scenario
 from studies.gain_sets import LP_PARAMS
 from wbc.cascade_law import CascadeParams

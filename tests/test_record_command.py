@@ -21,10 +21,10 @@ from messages.clock import Clock
 from messages.goal import Goal
 from messages.header import Header
 from messages.process import EXIT_FOR_GOOD
-from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.session_reader import info
+from record.sessions import load_session
 from studies.experiment import connect, launched
 from tests.processes import parsimony, process_gone
 

@@ -20,10 +20,10 @@ from mcap.reader import make_reader
 from deploy import DEPLOY, query
 from messages import codec, process, topics
 from messages.process import EXIT_FOR_GOOD
-from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.session_reader import info, read_session, recover
+from record.sessions import load_session
 from studies.experiment import connect
 
 

@@ -17,9 +17,9 @@ import zenoh
 
 from messages import codec, topics
 from messages.state import RobotState
-from parsimony.sessions import load_session
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
+from record.sessions import load_session
 from studies.experiment import DEPLOY, Options, connect, run_experiment, wait_alive
 from wbc import dq
 from wbc.planar import wrap

@@ -24,8 +24,8 @@ from messages.topics import CONTROL_DIAGNOSTICS
 from parsimony.reproduce import NOTES, TABLE_6_1
 from parsimony.reproduce.loop import folder
 from parsimony.reproduce.runs import laws_of
-from parsimony.sessions import load_session
 from record.judge import JUDGED, commands, messages, the_run
+from record.sessions import load_session
 from wbc.robot import MobileManipulator
 
 GOLDEN = Path(__file__).with_name("reproduce_golden.json")

@@ -12,11 +12,11 @@ from pathlib import Path
 from deploy import ROBOT_FILE
 from parsimony.commands.launch import positive_seconds
 from parsimony.output import emit, json_text
-from parsimony.sessions import load_session
 from profiles.profile import ProfileError, load_profile
 from record.judge import JUDGED, judge, open_loop, the_run
 from record.report import write_report
 from record.session_span import parted
+from record.sessions import load_session
 from wbc.robot import MobileManipulator
 
 

@@ -20,8 +20,8 @@ import numpy as np
 
 from components.control_step import task_of
 from messages.topics import CONTROL_DIAGNOSTICS, CONTROL_GOAL, ROBOT_STATE, SIM_TRUTH
-from parsimony.sessions import load_session
 from record.judge import JUDGED, commands, nearest, required, the_run
+from record.sessions import load_session
 from wbc import dq
 from wbc.kinematic_run import Run
 from wbc.law_output import LawOutput

@@ -18,8 +18,8 @@ from messages.topics import (
     SUPERVISOR_STATUS,
 )
 from messages.truth import SimTruth
-from parsimony.sessions import load_session
 from record.judge import HOLD_S, JUDGED, commands, effort, judge, origin_s, the_run
+from record.sessions import load_session
 from tests.record.test_far_stamps import write
 from tests.record.test_report import ROBOT, START_NS, runs, session_of  # noqa: F401 - fixture
 from wbc import dq, scenarios

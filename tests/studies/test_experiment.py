@@ -19,9 +19,9 @@ from mcap.reader import make_reader
 
 from deploy import query
 from messages.obstacles import Plane
-from parsimony.sessions import load_session
 from profiles.profile import load_profile
 from record.session_reader import info
+from record.sessions import load_session
 from scenes.foxglove_views import MODEL_EVERY, View
 from sim2d.scenarios import scenario
 from studies.experiment import DEPLOY, PROFILES, Options, connect, experiment_profile
