@@ -7,7 +7,7 @@ experiment's set-up of seeds 0..M-1 kinematically (q += u dt at 50 Hz from the s
 the goal above its bin, ``wbc.kinematic_run``), and of seeds 0..N-1 and ``HELD_OUT`` on the
 whole simulated loop (``parsimony experiment obstacle`` in lockstep, the controller told the
 variant's gains), W runs at a time. For each it prints the share that converged (``||e||`` under
-``record.judge.CONVERGED_ERROR`` within ``TIME_LIMIT_S`` of simulated time), the runs with a
+``analysis.judge.CONVERGED_ERROR`` within ``TIME_LIMIT_S`` of simulated time), the runs with a
 contact (the simulator's count; kinematically, a step with the base's disc over an obstacle's),
 the least clearance between the base's disc and the obstacle over every run, the median nonzero
 entries of u while moving (``||e|| > MOVING_ERROR``, every such step of every run pooled, as
@@ -31,13 +31,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from wbc.scenarios import DT
 
+from analysis.judge import CONVERGED_ERROR, JUDGED, converged_at, messages, origin_s, the_run
 from bench.sim_experiments import experiment_or_none
 from messages.topics import CONTROL_DIAGNOSTICS, SUPERVISOR_STATUS
 from parsimony.goal_sets import MOVING_ERROR
 from parsimony.output import emit, json_text, result_only_stdout, table
 from profiles.profile import load_profile
-from record.judge import CONVERGED_ERROR, JUDGED, converged_at, messages, origin_s, the_run
 from record.sessions import load_session
 from sim2d.scenarios import scenario
 from studies.experiment import PROFILES, TIME_LIMIT_S, Options
@@ -45,7 +46,6 @@ from studies.gain_sets import LP_PARAMS
 from wbc.kinematic_run import integrate
 from wbc.lp_law import LPLaw
 from wbc.robot import MobileManipulator
-from wbc.scenarios import DT
 from wbc.task import PoseTask
 
 VARIANTS: Mapping[str, Mapping[str, Any]] = {

@@ -48,6 +48,7 @@ import yaml
 import zenoh
 from pydantic import BaseModel
 
+from analysis.report import write_report
 from bench.long_sessions import memory_use, repeated_session
 from bench.pubsub_workers import NAMESPACE, WAIT_S, message
 from bench.sim_experiments import percentile
@@ -61,7 +62,6 @@ from messages.odometry import BaseOdometry
 from parsimony.output import emit, json_text, result_only_stdout, table
 from profiles.endpoints import free_port
 from profiles.profile import Profile, ZenohSettings, load_profile
-from record.report import write_report
 from record.session_file import MESSAGE_ENCODING
 from record.session_reader import info, read_session
 from record.sessions import load_session

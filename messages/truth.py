@@ -19,7 +19,7 @@ class SimTruth(Message):
     the base and an obstacle so far and whether one holds now (``in_contact``); and the scene
     as placed: the ``goal`` x_d (eq. 6.3: the bin marker's pose times the scene's offset), the
     reference marker F0's pose (x, y, yaw) and the ``obstacles``, so that a recording can be
-    judged from the file alone (``record.judge``). Recordings made before these fields read
+    judged from the file alone (``analysis.judge``). Recordings made before these fields read
     with none."""
 
     header: Header

@@ -5,7 +5,7 @@ It writes a profile that extends the simulation profile with the experiment's se
 ``DIR/launch.log``), unpauses the simulator once every component is alive, follows the run
 on Zenoh (the controller's diagnostics, the supervisor's status), stops when the controller's
 error has stayed under ``CONVERGED_ERROR`` for ``HOLD_S`` of simulated time or the time limit
-passes, and judges the run from its recording, ``DIR/session.mcap``, alone (``record.judge``:
+passes, and judges the run from its recording, ``DIR/session.mcap``, alone (``analysis.judge``:
 what ``parsimony report`` says of the same file), into ``DIR/report.json`` with the figures.
 
 By default the simulator runs in lockstep as fast as the loop answers; ``realtime`` runs it
@@ -34,6 +34,18 @@ from typing import IO, Any
 import yaml
 import zenoh
 
+from analysis.judge import (
+    CONVERGED_ERROR,
+    HOLD_S,
+    JUDGED,
+    commands_csv,
+    converged_at,
+    end_of_run,
+    judge,
+    recording_check,
+    the_run,
+)
+from analysis.report import write_report
 from components.cascade_controller import CascadeController
 from components.lp_controller import LPController
 from components.qp_controller import QPController
@@ -46,18 +58,6 @@ from parsimony.outputs import written_whole
 from profiles.endpoints import free_port
 from profiles.profile import Profile, ProfileError, load_profile
 from profiles.recorder import recorder_component
-from record.judge import (
-    CONVERGED_ERROR,
-    HOLD_S,
-    JUDGED,
-    commands_csv,
-    converged_at,
-    end_of_run,
-    judge,
-    recording_check,
-    the_run,
-)
-from record.report import write_report
 from record.session_reader import info, make_whole
 from record.sessions import load_session
 from sim2d.scenarios import SimScenario, scenario
@@ -325,7 +325,7 @@ def run_experiment(options: Options) -> dict[str, Any]:
         "recording": recording_check(facts, (start_ns, end_ns)),
     }
     run, _ = the_run(recorded, options.time_limit_s)
-    (options.out / "commands.csv").write_text(commands_csv(run))
+    (options.out / "commands.csv").write_text(commands_csv(run, robot))
     label = options.controller
     say("drawing the figures")
     if report["recording"]["missing"]:

@@ -19,12 +19,12 @@ from typing import Any
 import numpy as np
 import pytest
 
+from analysis.judge import JUDGED, commands, messages, the_run
 from deploy import ROBOT_FILE
 from messages.topics import CONTROL_DIAGNOSTICS
 from parsimony.reproduce import NOTES, TABLE_6_1
 from parsimony.reproduce.loop import folder
 from parsimony.reproduce.runs import laws_of
-from record.judge import JUDGED, commands, messages, the_run
 from record.sessions import load_session
 from wbc.robot import MobileManipulator
 

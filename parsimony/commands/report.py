@@ -1,5 +1,5 @@
 """`parsimony report FILE [FILE2] --out DIR`: the chapter 6 figures and table 6.1 of recorded
-sessions (see record.report), and each run judged from its file (record.judge) into
+sessions (see analysis.report), and each run judged from its file (analysis.judge) into
 ``DIR/judged.json``: what ``parsimony experiment`` wrote into its report.json of the same
 file."""
 
@@ -9,12 +9,12 @@ import argparse
 import sys
 from pathlib import Path
 
+from analysis.judge import JUDGED, judge, open_loop, the_run
+from analysis.report import write_report
 from deploy import ROBOT_FILE
 from parsimony.commands.launch import positive_seconds
 from parsimony.output import emit, json_text
 from profiles.profile import ProfileError, load_profile
-from record.judge import JUDGED, judge, open_loop, the_run
-from record.report import write_report
 from record.session_span import parted
 from record.sessions import load_session
 from wbc.robot import MobileManipulator

@@ -17,6 +17,7 @@ import math
 import sys
 from pathlib import Path
 
+from analysis.judge import RERUN_SOURCE
 from components.cascade_controller import CascadeController
 from components.control_step import ControlStep, Step, gains_of
 from components.controller import Controller, diagnostics_of
@@ -28,7 +29,6 @@ from messages.header import Header
 from messages.obstacles import obstacles_of
 from parsimony.output import emit
 from parsimony.outputs import writable_output, written_whole
-from record.judge import RERUN_SOURCE
 from record.session_file import Recorded, SessionWriter
 from record.session_reader import read_groups
 from wbc.robot import MobileManipulator, RobotDescriptionError

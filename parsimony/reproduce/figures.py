@@ -1,5 +1,5 @@
 """The figures of `parsimony reproduce`: each pair of runs through the report's own figures
-(``record.report``, as it draws a recording), the 2-norm and residual figure, and NOTES.md."""
+(``analysis.report``, as it draws a recording), the 2-norm and residual figure, and NOTES.md."""
 
 from __future__ import annotations
 
@@ -8,7 +8,9 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
+from wbc.scenarios import DT
 
+from analysis.report import write_report
 from messages.commands import ArmCommand, BaseCommand
 from messages.diagnostics import ControllerDiagnostics
 from messages.goal import Goal
@@ -20,10 +22,8 @@ from parsimony.reproduce import laws as L
 from parsimony.reproduce.dissertation import NOTES
 from parsimony.reproduce.measures import residuals
 from parsimony.reproduce.runs import Experiment
-from record.report import write_report
 from wbc.kinematic_run import Run
 from wbc.robot import MobileManipulator
-from wbc.scenarios import DT
 from wbc.task import PoseTask
 
 PAIRS = {

@@ -6,7 +6,7 @@ the camera), with the gains of its kinematic run (``runs.laws_of``, passed as th
 ``--gain``: one declaration). Each recording is read back (``recorded``) and given to the
 same row functions as the kinematic runs (``rows``); each row is labelled as on the loop and
 printed beside its kinematic one (``beside``). A run of the loop ends by the loop's rule
-(``record.judge``): ``HOLD_S`` after its error stayed under ``CONVERGED_ERROR``, else at the
+(``analysis.judge``): ``HOLD_S`` after its error stayed under ``CONVERGED_ERROR``, else at the
 time limit.
 """
 
@@ -19,19 +19,20 @@ import time
 from pathlib import Path
 from typing import Any
 
+from wbc.scenarios import OBSTACLE
+
+from analysis.judge import CONVERGED_ERROR, HOLD_S
 from parsimony.reproduce import laws as L
 from parsimony.reproduce import rows as R
 from parsimony.reproduce.recorded import recorded
 from parsimony.reproduce.runs import NAMES, Experiment, laws_of
 from parsimony.reproduce.table import Row
-from record.judge import CONVERGED_ERROR, HOLD_S
 from studies.experiment import PROFILES, SESSION_FILE, Options, run_experiment
 from studies.gain_sets import LP_PARAMS
 from wbc.cascade_law import CascadeLaw, CascadeParams
 from wbc.law_output import Law
 from wbc.lp_law import LPLaw
 from wbc.robot import MobileManipulator
-from wbc.scenarios import OBSTACLE
 
 PLACE = "on the loop"
 """How a row of the loop is labelled."""

@@ -1,10 +1,10 @@
 """A run of the whole loop read back from its recording, as the rows of `parsimony reproduce`
 take a kinematic run (``wbc.kinematic_run.Run``).
 
-The run is what ``record.judge`` judges (``the_run``: up to ``HOLD_S`` after the controller's
+The run is what ``analysis.judge`` judges (``the_run``: up to ``HOLD_S`` after the controller's
 error stayed under ``CONVERGED_ERROR``, else the time limit), from the controller's first step
 of its law on: one step per diagnostics that answers a state, with u as its commands carried it
-(``record.judge.commands``: the base's (v, omega) after the wheel speed limit, in F0), the
+(``analysis.judge.commands``: the base's (v, omega) after the wheel speed limit, in F0), the
 state the controller was given (the estimate, in F0), the task of the last goal it held, its
 diagnostics (status, rows at their bound, the law's step time, its error) and the simulator's
 true configuration at that stamp (in the simulator's world, the kinematic runs' frame).
@@ -18,9 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
+from analysis.judge import JUDGED, commands, nearest, required, the_run
 from components.control_step import task_of
 from messages.topics import CONTROL_DIAGNOSTICS, CONTROL_GOAL, ROBOT_STATE, SIM_TRUTH
-from record.judge import JUDGED, commands, nearest, required, the_run
 from record.sessions import load_session
 from wbc import dq
 from wbc.kinematic_run import Run

@@ -12,17 +12,17 @@ from pathlib import Path
 import pytest
 import yaml
 
+from analysis.judge import JUDGED, judge
 from messages import topics
 from messages.goal import Goal
 from messages.header import Header
 from messages.topics import CONTROL_GOAL, GOAL_REQUEST
 from profiles.endpoints import free_port
-from record.judge import JUDGED, judge
 from record.session_file import SessionWriter
 from record.session_span import FAR_NS, Span
 from record.sessions import load_session
+from tests.analysis.conftest import DT, FIGURES, ROBOT, START_NS, session_of
 from tests.processes import parsimony
-from tests.record.test_report import DT, FIGURES, ROBOT, START_NS, session_of
 from wbc import scenarios
 from wbc.kinematic_run import integrate
 from wbc.lp_law import LPLaw, LPParams

@@ -1,4 +1,4 @@
-"""The obstacles seen from above on a report's axes (``record.report``'s base path): the
+"""The obstacles seen from above on a report's axes (``analysis.report``'s base path): the
 base's circles, each table's (or underside's) footprint, each pole, each wall where it meets
 the floor."""
 

@@ -22,10 +22,10 @@ Times are in s from the session's first command.
                            obstacles: the circles, each table's (or underside's) footprint,
                            each pole, each wall where it meets the floor
     arm_clearance.png      each collision part's clearance from the nearest solid in 3-D over
-                           time, from the ground truth (``record.judge.arm_clearances``, whose
+                           time, from the ground truth (``analysis.judge.arm_clearances``, whose
                            least is the judge's ``arm_clearance_m``); written when a session's
                            truth has solids
-    effort.json, effort.md the four metrics of table 6.1 (``record.judge.effort_of_inputs``)
+    effort.json, effort.md the four metrics of table 6.1 (``analysis.judge.effort_of_inputs``)
 """
 
 from __future__ import annotations
@@ -41,17 +41,8 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
-from messages.goal import Goal
-from messages.topics import (
-    CONTROL_DIAGNOSTICS,
-    CONTROL_GOAL,
-    GOAL_REQUEST,
-    ROBOT_STATE,
-    SIM_TRUTH,
-    WORLD_OBSTACLES,
-)
-from record.floor_plan import draw_obstacles
-from record.judge import (
+from analysis.floor_plan import draw_obstacles
+from analysis.judge import (
     Array,
     Session,
     arm_clearances,
@@ -60,6 +51,15 @@ from record.judge import (
     messages,
     open_loop,
     required,
+)
+from messages.goal import Goal
+from messages.topics import (
+    CONTROL_DIAGNOSTICS,
+    CONTROL_GOAL,
+    GOAL_REQUEST,
+    ROBOT_STATE,
+    SIM_TRUTH,
+    WORLD_OBSTACLES,
 )
 from record.session_span import parted
 from wbc import dq
@@ -72,7 +72,7 @@ FORMULAS: Mapping[str, str] = {
     "metric3": r"$\int \lVert\ddot{q}\rVert_1\,dt$",
     "metric4": r"$\sqrt{\int \lVert\ddot{q}\rVert_2^2\,dt}$",
 }
-"""Table 6.1's metrics (``record.judge.METRICS``) as formulas."""
+"""Table 6.1's metrics (``analysis.judge.METRICS``) as formulas."""
 
 END_EFFECTOR_TASKS = ("pose", "position")
 """The goals that give the end effector a target (a drive leg's aims the base)."""
@@ -104,7 +104,7 @@ def write_report(
     ``ValueError`` naming it. Messages stamped far outside a session are left out
     (``record.session_span``). A figure the data cannot give (``ValueError``, an arithmetic
     fault) is not written and said in ``gaps``; ``notes`` say what a reader must know to read
-    the figures (a rerun's commands, ``record.judge.open_loop``). Returns ``{"figures":
+    the figures (a rerun's commands, ``analysis.judge.open_loop``). Returns ``{"figures":
     [paths], "effort": {label: metrics}, "gaps": {figure: why}, "notes": [lines]}``.
     """
     labels = [label for label, _ in sessions]
@@ -157,7 +157,7 @@ class _Recording:
     obstacles: list
     truth: list
     arm_clearance: tuple[Array, Array] | None
-    """(t, (samples, parts) clearances) of the ground truth (``record.judge.arm_clearances``)."""
+    """(t, (samples, parts) clearances) of the ground truth (``analysis.judge.arm_clearances``)."""
 
     def seconds(self, messages: Sequence[Any]) -> Array:
         """The stamps of ``messages`` in s from the first command."""

@@ -1,4 +1,4 @@
-"""record.judge on sessions of real kinematic runs of the LP (tests/record/test_report.py's):
+"""analysis.judge on sessions of real kinematic runs of the LP (tests/analysis/conftest.py's):
 a run judged from its messages alone, with the truth and without it, and under a supervisor
 from the file a recorder writes."""
 
@@ -6,7 +6,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import yaml
 
+from analysis.judge import HOLD_S, JUDGED, commands, commands_csv, effort, judge, origin_s, the_run
+from deploy import ROBOT_FILE
 from messages.goal import Goal
 from messages.obstacles import Circle, Plane, Solids
 from messages.supervisor import SupervisorStatus
@@ -18,13 +21,13 @@ from messages.topics import (
     SUPERVISOR_STATUS,
 )
 from messages.truth import SimTruth
-from record.judge import HOLD_S, JUDGED, commands, effort, judge, origin_s, the_run
 from record.sessions import load_session
+from tests.analysis.conftest import ROBOT, START_NS, session_of
 from tests.record.test_far_stamps import write
-from tests.record.test_report import ROBOT, START_NS, runs, session_of  # noqa: F401 - fixture
 from wbc import dq, scenarios
 from wbc.kinematic_run import effort_of, integrate
 from wbc.lp_law import LPLaw, LPParams
+from wbc.robot import MobileManipulator
 from wbc.task import PoseTask, PositionTask
 
 
@@ -197,3 +200,21 @@ def test_a_position_goal_passed_on_by_the_supervisor_converges_as_without_it(
         i for i, d in enumerate(session[CONTROL_DIAGNOSTICS.name]) if d.error_norm < 0.01
     )
     assert judged["iterations"] == first_small + round(HOLD_S / scenarios.DT) + 1
+
+
+def test_the_commands_csv_has_a_column_per_joint_of_the_robots_arm(runs, tmp_path):
+    _, session = runs["LP"]
+    lines = commands_csv(session, ROBOT).splitlines()
+    joints = [f"q{i}_dot" for i in range(1, ROBOT.arm_dof + 1)]
+    assert lines[0].split(",") == ["stamp_s", "forward", "angular", *joints]
+    assert {len(line.split(",")) for line in lines[1:]} == {len(lines[0].split(","))}
+    description = yaml.safe_load(ROBOT_FILE.read_text())
+    arm = description["arm"]
+    arm["dh"] = {key: values[:4] for key, values in arm["dh"].items()}
+    for key in ("joint_min", "joint_max", "velocity_max"):
+        arm[key] = arm[key][:4]
+    del description["collision"]
+    (tmp_path / "four_joints.yaml").write_text(yaml.safe_dump(description))
+    four = MobileManipulator.from_yaml(tmp_path / "four_joints.yaml")
+    header = commands_csv(session, four).splitlines()[0].split(",")
+    assert header[3:] == ["q1_dot", "q2_dot", "q3_dot", "q4_dot"]

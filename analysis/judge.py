@@ -23,6 +23,8 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
+from wbc.arm_clearance import part_clearances
+from wbc.obstacles import least_clearance
 
 from messages.topics import (
     ARM_COMMAND,
@@ -38,9 +40,7 @@ from messages.topics import (
 )
 from record.session_span import parted
 from wbc import dq
-from wbc.arm_clearance import part_clearances
 from wbc.kinematic_run import effort_of
-from wbc.obstacles import least_clearance
 from wbc.planar import in_frame, wrap
 from wbc.robot import MobileManipulator
 from wbc.supervisor_phase import Phase
@@ -397,10 +397,13 @@ def commands_digest(session: Session) -> str:
     return digest.hexdigest()
 
 
-def commands_csv(session: Session) -> str:
-    """Every command pair the controller sent, one row per stamp (s, m/s, rad/s)."""
+def commands_csv(session: Session, robot: MobileManipulator) -> str:
+    """Every command pair the controller sent, one row per stamp (s, m/s, rad/s), a column
+    per joint of the robot's arm (its description's)."""
     arm = {a.header.stamp_ns: a.joint_velocities for a in messages(session, ARM_COMMAND)}
-    lines = ["stamp_s,forward,angular," + ",".join(f"q{i}_dot" for i in range(1, 6))]
+    lines = [
+        "stamp_s,forward,angular," + ",".join(f"q{i}_dot" for i in range(1, robot.arm_dof + 1))
+    ]
     for b in messages(session, BASE_COMMAND):
         joints = arm.get(b.header.stamp_ns)
         if joints is not None:
