@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from parsimony.goal_families import FAMILIES, OBSTACLE_FAMILIES, goals, obstacle_goals
-from studies.gain_sets import supervised_params
+from studies.gain_sets import bare_5_29, supervised_params
 from wbc import dq
 from wbc.cascade_law import CascadeLaw
 from wbc.kinematic_run import ControlEffort, control_effort, integrate, integrate_supervised
@@ -243,10 +243,7 @@ def histogram(masks: list[int], dof: int) -> list[int]:
 
 def exact_5_29() -> LPParams:
     """5.29 as written, with the default law's eta, beta, k and b_l: no term beside the task,
-    5.28 on the axle centre with 5.10 (``parsimony.reproduce.laws.bare_5_29``, declared once
-    there; imported here, not above, as ``parsimony.reproduce`` imports this module)."""
-    from parsimony.reproduce.laws import bare_5_29
-
+    5.28 on the axle centre with 5.10 (``studies.gain_sets.bare_5_29``)."""
     return bare_5_29(LPParams())
 
 

@@ -11,7 +11,7 @@ from typing import Any
 
 from deploy import DEPLOY
 from profiles.profile import load_profile
-from wbc.lp_law import LPParams
+from wbc.lp_law import LPParams, default_objectives
 from wbc.objectives.input_change import InputChangeGains
 
 OBSTACLE_PARAMS = LPParams(
@@ -32,7 +32,7 @@ again (seed 1: error 0.65 after 60 s)."""
 BORDER_PARAMS = replace(OBSTACLE_PARAMS, obstacle_mode="border")
 """The same law with the border constraint 5.28 in place of the vector-field inequality, for
 comparison: its circulation term, 5.7 and the point 0.1 m ahead of the axle kept, so not 5.29
-as written (``parsimony.reproduce.laws.bare_5_29`` is)."""
+as written (``bare_5_29`` is)."""
 
 SUPERVISED_PROFILE = DEPLOY / "sim_supervised.yaml"
 """The profile of the LP under the staging supervisor, which declares that LP's gains."""
@@ -80,3 +80,25 @@ LP_PARAMS = {
 }
 """The LP law's gains in each experiment of section 6.2; an experiment under the supervisor
 takes its profile's (``supervised_params``)."""
+
+BARE = dict(
+    velocity_cost=0.0,
+    waist_hold=0.0,
+    waist_centring=0.0,
+    obstacle_circulation=0.0,
+    base_target=0.0,
+    input_change=0.0,
+    arm_obstacles=False,
+    obstacle_mode="border",
+    obstacle_lookahead=0.0,
+    error_bound="derivative",
+)
+"""What turns an LPParams into 5.29 as the dissertation writes it: no term beside the task
+residual, 5.28 on the axle centre (d = 0), 5.10, no rows of this project's."""
+
+
+def bare_5_29(params: LPParams) -> LPParams:
+    """``params`` (its eta, beta, k, b_l) with ``BARE``: the program of 5.29 and nothing else."""
+    bare = replace(params, **BARE)
+    assert not default_objectives(bare), default_objectives(bare)  # a new term must join BARE
+    return bare

@@ -10,7 +10,7 @@ import pytest
 from deploy import ROBOT_FILE
 from parsimony.goal_families import FAMILIES, goals
 from parsimony.goal_sets import LAWS, LIMIT_TOLERANCE, SUPERVISED, attempt, planning, shares
-from parsimony.reproduce.laws import describe
+from studies.reproduce.laws import describe
 from wbc.robot import MobileManipulator
 from wbc.scenarios import OBSTACLE
 

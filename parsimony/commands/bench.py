@@ -6,8 +6,8 @@ import argparse
 from pathlib import Path
 
 from deploy import ROBOT_FILE
-from parsimony.benchmark import format_report, run_bench
 from parsimony.output import emit, json_text
+from studies.benchmark import format_report, run_bench
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

@@ -1,5 +1,5 @@
-"""`parsimony reproduce`: every result of chapter 6 beside ours (see parsimony.reproduce);
-with ``--loop``, the rows of 6.2 also on the whole simulated loop (parsimony.reproduce.loop)."""
+"""`parsimony reproduce`: every result of chapter 6 beside ours (see studies.reproduce);
+with ``--loop``, the rows of 6.2 also on the whole simulated loop (studies.reproduce.loop)."""
 
 from __future__ import annotations
 
@@ -12,10 +12,10 @@ from deploy import ROBOT_FILE
 from deploy.query import QueryError
 from parsimony.commands.experiment import time_limit
 from parsimony.output import emit, json_text
-from parsimony.reproduce import NAMES, TRIALS, format_laws, format_rows, reproduce, write_figures
-from parsimony.reproduce.loop import LABELS, LOOP_LAWS, beside, loop, summary_line
 from profiles.profile import ProfileError, load_profile
 from studies.experiment import PROFILES, TIME_LIMIT_S
+from studies.reproduce import NAMES, TRIALS, format_laws, format_rows, reproduce, write_figures
+from studies.reproduce.loop import LABELS, LOOP_LAWS, beside, loop, summary_line
 from wbc.robot import MobileManipulator
 
 

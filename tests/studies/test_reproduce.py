@@ -1,9 +1,10 @@
 """`parsimony reproduce` as a user runs it: every result of chapter 6 is a row beside the
 dissertation's value, every law says what it ran, every figure is written, and every result
-that does not depend on the clock equals the golden one (tests/reproduce_golden.json, within
+that does not depend on the clock equals the golden one (tests/studies/reproduce_golden.json, within
 its tolerance): a change of result fails here and is a decision, not an accident.
 
-``python -m tests.test_reproduce --write`` runs the command and writes the golden results anew.
+``python -m tests.studies.test_reproduce --write`` runs the command and writes the golden
+results anew.
 """
 
 from __future__ import annotations
@@ -22,10 +23,10 @@ import pytest
 from analysis.judge import JUDGED, commands, messages, the_run
 from deploy import ROBOT_FILE
 from messages.topics import CONTROL_DIAGNOSTICS
-from parsimony.reproduce import NOTES, TABLE_6_1
-from parsimony.reproduce.loop import folder
-from parsimony.reproduce.runs import laws_of
 from record.sessions import load_session
+from studies.reproduce import NOTES, TABLE_6_1
+from studies.reproduce.loop import folder
+from studies.reproduce.runs import laws_of
 from wbc.robot import MobileManipulator
 
 GOLDEN = Path(__file__).with_name("reproduce_golden.json")

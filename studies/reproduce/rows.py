@@ -1,14 +1,14 @@
 """The rows of section 6.2 and table 6.1: each law's figures beside the dissertation's, from
-the runs of ``parsimony.reproduce.runs``."""
+the runs of ``studies.reproduce.runs``."""
 
 from __future__ import annotations
 
 from dataclasses import astuple
 
 from parsimony.goal_sets import MOVING_ERROR, SETTLING_S
-from parsimony.reproduce import laws as L
-from parsimony.reproduce import measures as M
-from parsimony.reproduce.dissertation import (
+from studies.reproduce import laws as L
+from studies.reproduce import measures as M
+from studies.reproduce.dissertation import (
     ABRUPT,
     CONTRADICTED,
     ENTRIES,
@@ -16,11 +16,11 @@ from parsimony.reproduce.dissertation import (
     PERIOD_MS,
     TABLE_6_1,
 )
-from parsimony.reproduce.runs import Experiment
-from parsimony.reproduce.table import Row
+from studies.reproduce.runs import Experiment
+from studies.reproduce.table import Row
+from wbc.geometry.scenarios import OBSTACLE, OBSTACLE_GOAL
 from wbc.kinematic_run import control_effort
 from wbc.robot import MobileManipulator
-from wbc.scenarios import OBSTACLE, OBSTACLE_GOAL
 
 MAIN = (L.LP, L.LP_5_29, L.CASCADE, L.SATURATED)
 """The laws of every row of 6.2: the default LP beside 5.29 as written, the cascade as the

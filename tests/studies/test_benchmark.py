@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 from deploy import ROBOT_FILE
-from parsimony.benchmark import convergence_test
-from parsimony.reproduce.efficiency import section_6_3
+from studies.benchmark import convergence_test
+from studies.reproduce.efficiency import section_6_3
 from wbc.robot import MobileManipulator
 
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)

@@ -11,9 +11,9 @@ import numpy as np
 
 from parsimony.goal_sets import MOVING_ERROR, SETTLING_S
 from wbc import dq
+from wbc.geometry.obstacles import Circle
 from wbc.kinematic_run import Run
 from wbc.law_output import entry_mask
-from wbc.obstacles import Circle
 from wbc.pinv_law import PINV_RCOND, nonholonomic_basis
 from wbc.robot import BASE_DOF, MobileManipulator
 from wbc.task import Task

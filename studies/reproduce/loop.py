@@ -19,17 +19,16 @@ import time
 from pathlib import Path
 from typing import Any
 
-from wbc.scenarios import OBSTACLE
-
 from analysis.judge import CONVERGED_ERROR, HOLD_S
-from parsimony.reproduce import laws as L
-from parsimony.reproduce import rows as R
-from parsimony.reproduce.recorded import recorded
-from parsimony.reproduce.runs import NAMES, Experiment, laws_of
-from parsimony.reproduce.table import Row
 from studies.experiment import PROFILES, SESSION_FILE, Options, run_experiment
 from studies.gain_sets import LP_PARAMS
+from studies.reproduce import laws as L
+from studies.reproduce import rows as R
+from studies.reproduce.recorded import recorded
+from studies.reproduce.runs import NAMES, Experiment, laws_of
+from studies.reproduce.table import Row
 from wbc.cascade_law import CascadeLaw, CascadeParams
+from wbc.geometry.scenarios import OBSTACLE
 from wbc.law_output import Law
 from wbc.lp_law import LPLaw
 from wbc.robot import MobileManipulator

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 from dataclasses import astuple
 
-from parsimony.reproduce import laws as L
-from parsimony.reproduce.measures import entry_counts
-from parsimony.reproduce.runs import Experiment
-from parsimony.reproduce.table import Row
+from studies.reproduce import laws as L
+from studies.reproduce.measures import entry_counts
+from studies.reproduce.runs import Experiment
+from studies.reproduce.table import Row
 from wbc.kinematic_run import control_effort
 
 

@@ -13,7 +13,7 @@ from parsimony.output import table
 class Row:
     """One result: the dissertation's value, ours, and which way the comparison should go.
     ``key`` names it for the golden results of the tests; ``laws`` are the labels of the laws
-    whose runs of ``experiment`` it reports (what each ran: ``parsimony.reproduce.laws``);
+    whose runs of ``experiment`` it reports (what each ran: ``studies.reproduce.laws``);
     ``timed`` marks a figure of the wall clock, which depends on the machine."""
 
     key: str

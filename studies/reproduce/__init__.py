@@ -1,7 +1,7 @@
 """`parsimony reproduce`: every result of chapter 6, the dissertation's beside ours.
 
 The set-ups of chapter 6 run kinematically (q += u dt at 50 Hz, on the robot of deploy/robots,
-from ``wbc.scenarios.HOME``) with the dissertation's gains (``runs``): 6.2.1 (pose), 6.2.2
+from ``wbc.geometry.scenarios.HOME``) with the dissertation's gains (``runs``): 6.2.1 (pose), 6.2.2
 (position), the joint limit of figure 6.10, 6.2.3 (obstacle), table 6.1, and section 6.3 as
 the dissertation ran it (``efficiency``). Every law is named by a label, and the command says
 what each label ran, its rows and terms read from the law itself (``laws``). Each row gives
@@ -16,19 +16,19 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from parsimony.reproduce.dissertation import NOTES, TABLE_6_1
-from parsimony.reproduce.efficiency import TRIALS, section_6_3
-from parsimony.reproduce.figures import write_figures
-from parsimony.reproduce.future_work import input_change_rows, qp_rows
-from parsimony.reproduce.rows import (
+from studies.reproduce.dissertation import NOTES, TABLE_6_1
+from studies.reproduce.efficiency import TRIALS, section_6_3
+from studies.reproduce.figures import write_figures
+from studies.reproduce.future_work import input_change_rows, qp_rows
+from studies.reproduce.rows import (
     effort_rows,
     joint_limit_rows,
     obstacle_rows,
     step_time_rows,
     task_rows,
 )
-from parsimony.reproduce.runs import NAMES, Experiment, experiments
-from parsimony.reproduce.table import Row, format_laws, format_rows
+from studies.reproduce.runs import NAMES, Experiment, experiments
+from studies.reproduce.table import Row, format_laws, format_rows
 from wbc.robot import MobileManipulator
 
 __all__ = [

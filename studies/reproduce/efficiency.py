@@ -9,18 +9,18 @@ from collections.abc import Callable
 
 import numpy as np
 
-from parsimony.benchmark import UNBOUNDED_SPEED
-from parsimony.reproduce import laws as L
-from parsimony.reproduce.dissertation import SECTION_6_3
-from parsimony.reproduce.table import Row
+from studies.gain_sets import bare_5_29
+from studies.reproduce import laws as L
+from studies.reproduce.dissertation import SECTION_6_3
+from studies.reproduce.table import Row
 from wbc.cascade_law import CascadeLaw, CascadeParams
 from wbc.constraints.error_bound import ErrorBound
+from wbc.geometry.scenarios import CONVERGENCE_GOAL, DT, HOME, REACH_GOAL
 from wbc.kinematic_run import integrate
 from wbc.law_output import Law
 from wbc.lp_law import LPLaw, LPParams
 from wbc.pinv_law import PinvParams, PseudoinverseLaw
 from wbc.robot import MobileManipulator
-from wbc.scenarios import CONVERGENCE_GOAL, DT, HOME, REACH_GOAL
 from wbc.task import PoseTask
 
 ETA, BETA = 5.0, 40.0
@@ -36,10 +36,10 @@ STEPS = 2000
 
 def laws(robot: MobileManipulator) -> dict[str, dict[str, Callable[[], Law]]]:
     """Each test's laws, as makers of a fresh law for each trial. None has a speed bound: 6.3
-    states none (``parsimony.benchmark.UNBOUNDED_SPEED``)."""
-    free = robot.with_velocity_max(np.full(robot.dof, UNBOUNDED_SPEED))
+    states none (``laws.UNBOUNDED_SPEED``)."""
+    free = robot.with_velocity_max(np.full(robot.dof, L.UNBOUNDED_SPEED))
     holonomic = LPParams(eta=ETA, beta=BETA, nonholonomic=False)
-    nonholonomic = L.bare_5_29(LPParams(eta=ETA, beta=BETA, joint_gain=1.0, safety_factor=0.99))
+    nonholonomic = bare_5_29(LPParams(eta=ETA, beta=BETA, joint_gain=1.0, safety_factor=0.99))
     return {
         "test 1": {
             "classic": lambda: PseudoinverseLaw(free, PinvParams(eta=ETA)),

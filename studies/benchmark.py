@@ -19,16 +19,11 @@ from deploy import ROBOT_FILE
 from parsimony.goal_sets import goal_report
 from parsimony.output import table
 from studies.gain_sets import TABLE_PARAMS, WITHOUT_ARM_ROWS
+from studies.reproduce import efficiency
 from wbc import dq
 from wbc.cascade_law import CascadeLaw
 from wbc.constraints.arm_obstacles import ArmObstacles
-from wbc.kinematic_run import integrate
-from wbc.law_output import Law
-from wbc.lp_law import LPLaw
-from wbc.pinv_law import PseudoinverseLaw
-from wbc.qp_law import QPLaw
-from wbc.robot import MobileManipulator
-from wbc.scenarios import (
+from wbc.geometry.scenarios import (
     DT,
     HOME,
     REACH_GOAL,
@@ -36,6 +31,12 @@ from wbc.scenarios import (
     TABLE_GOAL,
     TABLE_START,
 )
+from wbc.kinematic_run import integrate
+from wbc.law_output import Law
+from wbc.lp_law import LPLaw
+from wbc.pinv_law import PseudoinverseLaw
+from wbc.qp_law import QPLaw
+from wbc.robot import MobileManipulator
 from wbc.step_context import StepContext
 from wbc.task import PoseTask
 
@@ -237,12 +238,6 @@ def dqrobotics_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[s
     }
 
 
-UNBOUNDED_SPEED = 1e3
-"""The velocity bound of section 6.3's tests, rad/s or m/s: none is stated there, and the
-robot's own would hold the LP alone, since neither the classic law nor the cascade has any
-(test 2's LP on the robot's bounds ends 2000 iterations at ||e|| 0.094; unbounded it converges
-in 76)."""
-
 CONVERGENCE_NAMES = {
     ("test 1", "classic"): "holonomic/classic",
     ("test 1", "LP"): "holonomic/lp",
@@ -254,9 +249,7 @@ CONVERGENCE_NAMES = {
 
 def convergence_test(robot: MobileManipulator, trials: int) -> dict[str, dict[str, Any]]:
     """Section 6.3 as the dissertation ran it: the laws, goals and timing of
-    ``parsimony.reproduce.efficiency`` (declared there), ``trials`` runs of each law."""
-    from parsimony.reproduce import efficiency  # not above: reproduce imports this module
-
+    ``studies.reproduce.efficiency`` (declared there), ``trials`` runs of each law."""
     results = {}
     for test, makers in efficiency.laws(robot).items():
         task = PoseTask(robot.fkm(efficiency.GOALS[test]))

@@ -8,7 +8,6 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
-from wbc.scenarios import DT
 
 from analysis.report import write_report
 from messages.commands import ArmCommand, BaseCommand
@@ -18,10 +17,11 @@ from messages.header import Header
 from messages.obstacles import Circle as CircleMessage
 from messages.obstacles import Obstacles
 from messages.state import RobotState
-from parsimony.reproduce import laws as L
-from parsimony.reproduce.dissertation import NOTES
-from parsimony.reproduce.measures import residuals
-from parsimony.reproduce.runs import Experiment
+from studies.reproduce import laws as L
+from studies.reproduce.dissertation import NOTES
+from studies.reproduce.measures import residuals
+from studies.reproduce.runs import Experiment
+from wbc.geometry.scenarios import DT
 from wbc.kinematic_run import Run
 from wbc.robot import MobileManipulator
 from wbc.task import PoseTask

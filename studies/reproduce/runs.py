@@ -1,5 +1,5 @@
 """The kinematic runs of chapter 6's set-ups (q += u dt at 50 Hz from ``HOME``), each law by
-its label (``parsimony.reproduce.laws``) and with the words of what it ran."""
+its label (``studies.reproduce.laws``) and with the words of what it ran."""
 
 from __future__ import annotations
 
@@ -9,19 +9,18 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from parsimony.benchmark import UNBOUNDED_SPEED
-from parsimony.reproduce import laws as L
-from studies.gain_sets import BORDER_PARAMS, LP_PARAMS, input_change_gains
+from studies.gain_sets import BORDER_PARAMS, LP_PARAMS, bare_5_29, input_change_gains
+from studies.reproduce import laws as L
 from wbc import dq
 from wbc.cascade_law import CascadeLaw, CascadeParams
+from wbc.geometry.obstacles import Obstacle
+from wbc.geometry.scenarios import DT, HOME, JOINT_LIMIT_GOAL, OBSTACLE, OBSTACLE_GOAL, REACH_GOAL
 from wbc.kinematic_run import Run, integrate
 from wbc.law_output import Law
 from wbc.lp_law import LPLaw
-from wbc.obstacles import Obstacle
 from wbc.pinv_law import PinvParams, PseudoinverseLaw
 from wbc.qp_law import QPLaw, QPParams
 from wbc.robot import MobileManipulator
-from wbc.scenarios import DT, HOME, JOINT_LIMIT_GOAL, OBSTACLE, OBSTACLE_GOAL, REACH_GOAL
 from wbc.task import PoseTask, PositionTask, Task
 
 STEPS = 4000
@@ -35,7 +34,7 @@ NAMES = ("pose", "position", "joint_limit", "obstacle")
 @dataclass(frozen=True)
 class Experiment:
     """A set-up of chapter 6: its task, the runs of its laws and what each law ran. A run on
-    the whole loop (``parsimony.reproduce.loop``) gives the task of each of its steps (the goal
+    the whole loop (``studies.reproduce.loop``) gives the task of each of its steps (the goal
     the controller held) and its true configurations, where they are not the run's own."""
 
     name: str
@@ -100,18 +99,18 @@ def laws_of(robot: MobileManipulator, name: str) -> dict[str, Law]:
         return {
             L.LP: LPLaw(robot, LP_PARAMS["obstacle"]),
             L.LP_BORDER: LPLaw(robot, BORDER_PARAMS),
-            L.LP_5_29: LPLaw(robot, L.bare_5_29(pose)),
+            L.LP_5_29: LPLaw(robot, bare_5_29(pose)),
         }
     params = pose if name == "joint_limit" else LP_PARAMS[name]
     laws: dict[str, Law] = {
         L.LP: LPLaw(robot, params),
-        L.LP_5_29: LPLaw(robot, L.bare_5_29(params)),
+        L.LP_5_29: LPLaw(robot, bare_5_29(params)),
         L.CASCADE: CascadeLaw(robot, CascadeParams(eta=params.eta)),
         L.SATURATED: CascadeLaw(robot, CascadeParams(eta=params.eta, saturate=True)),
     }
     if name == "joint_limit":
         return laws
-    free = robot.with_velocity_max(np.full(robot.dof, UNBOUNDED_SPEED))
+    free = robot.with_velocity_max(np.full(robot.dof, L.UNBOUNDED_SPEED))
     return laws | {
         L.LP_FREE: LPLaw(free, params),
         L.PINV_5_11: PseudoinverseLaw(robot, PinvParams(eta=params.eta, nonholonomic=True)),
