@@ -23,8 +23,6 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
-from wbc.arm_clearance import part_clearances
-from wbc.obstacles import least_clearance
 
 from messages.topics import (
     ARM_COMMAND,
@@ -40,6 +38,8 @@ from messages.topics import (
 )
 from record.session_span import parted
 from wbc import dq
+from wbc.geometry.arm_clearance import part_clearances
+from wbc.geometry.obstacles import least_clearance
 from wbc.kinematic_run import effort_of
 from wbc.planar import in_frame, wrap
 from wbc.robot import MobileManipulator
@@ -271,8 +271,8 @@ def clearance(truth: Sequence, robot: MobileManipulator) -> float | None:
 def arm_clearances(truth: Sequence, robot: MobileManipulator) -> Array | None:
     """(samples, parts): the clearance of each collision part of the robot (``robot.collision
     .names``) from the nearest solid in 3-D at each ground-truth sample, m (negative: the depth
-    of a penetration), from the true configurations (``wbc.arm_clearance``); None without the
-    truth or solids."""
+    of a penetration), from the true configurations (``wbc.geometry.arm_clearance``); None without
+    the truth or solids."""
     if not truth or not truth[-1].solids.solids() or not robot.collision.names:
         return None
     solids = truth[-1].solids.solids()

@@ -31,7 +31,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from wbc.scenarios import DT
 
 from analysis.judge import CONVERGED_ERROR, JUDGED, converged_at, messages, origin_s, the_run
 from bench.sim_experiments import experiment_or_none
@@ -43,6 +42,7 @@ from record.sessions import load_session
 from sim2d.scenarios import scenario
 from studies.experiment import PROFILES, TIME_LIMIT_S, Options
 from studies.gain_sets import LP_PARAMS
+from wbc.geometry.scenarios import DT
 from wbc.kinematic_run import integrate
 from wbc.lp_law import LPLaw
 from wbc.robot import MobileManipulator

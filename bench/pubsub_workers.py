@@ -26,8 +26,8 @@ from messages.header import Header
 from messages.obstacles import Circle, Obstacles
 from messages.state import RobotState
 from profiles.profile import ZenohSettings
+from wbc.geometry.scenarios import NEAR_START, REACH_GOAL
 from wbc.robot import MobileManipulator
-from wbc.scenarios import NEAR_START, REACH_GOAL
 
 NAMESPACE = "bench"
 START = NEAR_START

@@ -149,8 +149,8 @@ class Controller(Component):
 
     def on_obstacles(self, message: Obstacles) -> None:
         """Take the obstacles every following step avoids; a message with a solid the law
-        cannot take (``wbc.obstacles3d``: a cylinder of radius 1e300) is refused in one line
-        (``refused_obstacles``), and the last obstacles kept."""
+        cannot take (``wbc.geometry.obstacles3d``: a cylinder of radius 1e300) is refused in one
+        line (``refused_obstacles``), and the last obstacles kept."""
         try:
             obstacles = obstacles_of(message)
         except ValueError as error:

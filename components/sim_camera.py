@@ -21,7 +21,7 @@ from messages.header import Header
 from profiles.scene import Scene
 from sim2d.camera import ImageNoise, PlacedMarker, Renderer, ceiling_camera
 from vision.images import jpeg
-from wbc.obstacles import Circle
+from wbc.geometry.obstacles import Circle
 from wbc.planar import compose, planar_pose
 from wbc.robot import MobileManipulator
 

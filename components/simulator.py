@@ -58,8 +58,8 @@ from sim2d.camera import ImageNoise
 from sim2d.scenarios import SEED_MAX, goal_above
 from sim2d.world import World, WorldSettings, wheel_distance_per_count
 from wbc.base_motion import dead_reckoning
-from wbc.obstacles import Circle
-from wbc.start_inside import inside_at_start
+from wbc.geometry.obstacles import Circle
+from wbc.geometry.start_inside import inside_at_start
 from wbc.robot import MobileManipulator
 
 JOINT_NAMES = tuple(f"q{i}" for i in range(1, ARM_JOINTS + 1))

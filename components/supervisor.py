@@ -50,7 +50,7 @@ from messages.obstacles import Obstacles, circles_of
 from messages.state import RobotState
 from messages.supervisor import ENDED, SupervisorStatus
 from wbc.drive_tasks import PointTask, offset_point
-from wbc.obstacles import Circle
+from wbc.geometry.obstacles import Circle
 from wbc.staging import Plan, StagingParams, within
 from wbc.staging_supervisor import PlanRequest, StagingSupervisor, SupervisorParams
 from wbc.supervisor_phase import Phase

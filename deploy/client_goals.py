@@ -30,7 +30,7 @@ from messages.base import UNIT_TOLERANCE
 from messages.goal import Goal
 from messages.header import Header
 from wbc import dq
-from wbc.obstacles import Circle
+from wbc.geometry.obstacles import Circle
 from wbc.staging import StagingParams, refusal
 
 IN_FRAME = ("foxglove.PoseInFrame",)

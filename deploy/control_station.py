@@ -55,7 +55,7 @@ from messages.obstacles import circles_of
 from profiles.access import tool_user
 from profiles.profile import Profile
 from wbc import dq
-from wbc.obstacles import Circle
+from wbc.geometry.obstacles import Circle
 from wbc.planar import offset_pose
 
 SOURCE = "view"

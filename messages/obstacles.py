@@ -1,5 +1,5 @@
 """Obstacles: circles in the plane of the base, and planes and vertical cylinders in 3-D that
-the robot's collision parts keep clear of (``wbc.obstacles3d``)."""
+the robot's collision parts keep clear of (``wbc.geometry.obstacles3d``)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from pydantic import Field, model_validator
 
 from messages.base import Finite, Message, Positive, Vector3
 from messages.header import Header
-from wbc import obstacles, obstacles3d
+from wbc.geometry import obstacles, obstacles3d
 
 
 class Circle(Message):

@@ -13,10 +13,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from wbc import dq
+from wbc.geometry.obstacles import Circle
+from wbc.geometry.scenarios import ARM_BOX, HOME
 from wbc.lp_law import LPParams
-from wbc.obstacles import Circle
 from wbc.robot import BASE_DOF, MobileManipulator
-from wbc.scenarios import ARM_BOX, HOME
 
 Array = np.ndarray
 

@@ -17,13 +17,13 @@ from parsimony.goal_families import FAMILIES, OBSTACLE_FAMILIES, goals, obstacle
 from studies.gain_sets import bare_5_29, supervised_params
 from wbc import dq
 from wbc.cascade_law import CascadeLaw
+from wbc.geometry.obstacles import Circle, least_clearance
+from wbc.geometry.scenarios import DT
 from wbc.kinematic_run import ControlEffort, control_effort, integrate, integrate_supervised
 from wbc.law_output import Law, entry_mask
 from wbc.lp_law import LPLaw, LPParams
-from wbc.obstacles import Circle, least_clearance
 from wbc.qp_law import QPLaw
 from wbc.robot import BASE_DOF, MobileManipulator
-from wbc.scenarios import DT
 from wbc.staging_supervisor import StagingSupervisor, SupervisorParams
 from wbc.task import PoseTask, PositionTask, Task
 

@@ -14,7 +14,7 @@ intersects its ray with). Sizes are the black square's side, m.
 
 ``arm_obstacles`` declares what no marker shows: planes (a wall, a table top over its
 footprint) and vertical cylinders (poles), in F0, that the robot's collision parts keep clear
-of (``wbc.obstacles3d``, ``wbc.constraints.arm_obstacles``)::
+of (``wbc.geometry.obstacles3d``, ``wbc.constraints.arm_obstacles``)::
 
     arm_obstacles:
       planes:    [{name: table, normal: [0, 0, 1], offset: 0.4,
@@ -143,8 +143,8 @@ class Scene(_Strict):
 
     @model_validator(mode="after")
     def _cylinders_are_solids(self) -> Scene:
-        """Each cylinder a solid of ``wbc.obstacles3d``, its sizes within the scene's extent
-        (``EXTENT_M``), as each plane's message checks itself; the error names the field."""
+        """Each cylinder a solid of ``wbc.geometry.obstacles3d``, its sizes within the scene's
+        extent (``EXTENT_M``), as each plane's message checks itself; the error names the field."""
         for index, cylinder in enumerate(self.arm_obstacles.cylinders):
             try:
                 cylinder.solid()

@@ -5,8 +5,8 @@ nothing else to show them.
     circle (the base's)        a cylinder of the circle's radius from the floor to the
                                circle's ``height`` (the obstacle's top, where its marker lies),
                                ``CIRCLE_HEIGHT_M`` when the message does not say
-    plane over a footprint     the solid as ``wbc.obstacles3d`` models it: under a table top,
-                               the prism of the footprint from the floor up to the top (the
+    plane over a footprint     the solid as ``wbc.geometry.obstacles3d`` models it: under a table
+                               top, the prism of the footprint from the floor up to the top (the
                                top face fairly opaque, the sides faint, the edges drawn); over
                                an underside, from it up ``UNBOUNDED_HEIGHT_M``
     plane without a footprint  (a wall, the floor) a thin box, ``WALL_SIDE_M`` square and

@@ -3,7 +3,7 @@ panel, from the ground truth alone (``SimTruth``: the true configuration and the
 simulator's world).
 
 A collision part (``wbc.collision_model``) penetrates when its clearance from a solid is
-negative (``wbc.arm_clearance.part_clearances``, what the simulator counts and the judge
+negative (``wbc.geometry.arm_clearance.part_clearances``, what the simulator counts and the judge
 reports). Each such point is drawn as its sphere, each segment as its capsule (a line as thick
 as its diameter, a sphere at each end), at their true places in the simulator's world. The
 truth says whether a part penetrates (``arm_penetrating``), so the parts are only looked for
@@ -14,12 +14,12 @@ from __future__ import annotations
 
 import numpy as np
 from foxglove import messages as fox
-from wbc.arm_clearance import part_clearances
 
 from messages.truth import SimTruth
 from scenes.foxglove_frames import replacing, timestamp
 from scenes.robot_scene import at, point
 from wbc.collision_model import point_positions
+from wbc.geometry.arm_clearance import part_clearances
 from wbc.robot import MobileManipulator
 
 PENETRATION_COLOR = fox.Color(r=1.0, g=0.0, b=0.0, a=1.0)

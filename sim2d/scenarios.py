@@ -1,15 +1,15 @@
 """The simulated set-ups of the chapter 6 experiments: where the robot starts, where the trash
 bin (marker F2) stands and where the obstacles are, in the simulator's world frame.
 
-The dissertation's set-up (``seed`` None) starts at ``wbc.scenarios.HOME``. The bin stands
+The dissertation's set-up (``seed`` None) starts at ``wbc.geometry.scenarios.HOME``. The bin stands
 under the pose of ``REACH_GOAL`` (pose and position experiments, 6.2.1 and 6.2.2), or
-``OBSTACLE_SHIFT`` further, past ``wbc.scenarios.OBSTACLE`` (6.2.3); the goal is then
+``OBSTACLE_SHIFT`` further, past ``wbc.geometry.scenarios.OBSTACLE`` (6.2.3); the goal is then
 x_d = x_2 x_d^2 with the scene's offset x_d^2 (eq. 6.3). A seed draws the start and the bin
 from ``START_RANGE`` and ``BIN_RANGE`` around them: the goal stays a pose the arm reaches
 above some base pose (the bin only moves and turns on the floor), inside the joint limits.
 
-'table' reaches over the edge of ``wbc.scenarios.TABLE`` from ``TABLE_START`` to the gripper
-of ``TABLE_GOAL``: its marker lies on the table top, under that gripper, and the set-up
+'table' reaches over the edge of ``wbc.geometry.scenarios.TABLE`` from ``TABLE_START`` to the
+gripper of ``TABLE_GOAL``: its marker lies on the table top, under that gripper, and the set-up
 carries its own offset x_d^2 (``goal_offset``) and the table (``solids``), which a profile's
 scene declares; a seed draws the bin from ``TABLE_BIN_RANGE`` (along the edge more than
 across it: the base must stop short of the table).
@@ -23,11 +23,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from wbc import dq
-from wbc.obstacles import Circle
-from wbc.obstacles3d import Solid
+from wbc.geometry.obstacles import Circle
+from wbc.geometry.obstacles3d import Solid
+from wbc.geometry.scenarios import HOME, OBSTACLE, REACH_GOAL, TABLE, TABLE_GOAL, TABLE_START
 from wbc.planar import offset_of, offset_pose, planar_of, planar_pose
 from wbc.robot import MobileManipulator
-from wbc.scenarios import HOME, OBSTACLE, REACH_GOAL, TABLE, TABLE_GOAL, TABLE_START
 
 SEED_MAX = 2**31
 """Seeds of a set-up and of the simulator's noise: 0 to SEED_MAX (numpy's RandomState bound)."""

@@ -1,7 +1,7 @@
 """A 2D pymunk world: a differential-drive base with no lateral slip, a kinematic arm, circular
-obstacles and wheel encoders. Pure simulation: no I/O. Solids in 3-D (``wbc.obstacles3d``) stop
-nothing: the world counts the penetrations of the robot's collision parts into them, from the
-kinematics (``wbc.arm_clearance``), as pymunk counts the base's contacts.
+obstacles and wheel encoders. Pure simulation: no I/O. Solids in 3-D (``wbc.geometry.obstacles3d``)
+stop nothing: the world counts the penetrations of the robot's collision parts into them, from the
+kinematics (``wbc.geometry.arm_clearance``), as pymunk counts the base's contacts.
 
 The base is a dynamic disc tied to a kinematic control body by a PivotJoint and a GearJoint
 (max_bias 0, max_force = friction), as in pymunk's tank example: the joints make the disc take
@@ -22,9 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 import pymunk
 
-from wbc.arm_clearance import PenetrationCount, part_clearances
-from wbc.obstacles import Circle
-from wbc.obstacles3d import Solid
+from wbc.geometry.arm_clearance import PenetrationCount, part_clearances
+from wbc.geometry.obstacles import Circle
+from wbc.geometry.obstacles3d import Solid
 from wbc.robot import BASE_DOF, BaseDescription, MobileManipulator
 
 BASE_COLLISION_TYPE = 1

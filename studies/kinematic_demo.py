@@ -16,14 +16,10 @@ from deploy import ROBOT_FILE
 from parsimony.output import table
 from studies.gain_sets import BORDER_PARAMS, LP_PARAMS, TABLE_PARAMS, WITHOUT_ARM_ROWS
 from wbc import dq
-from wbc.arm_clearance import PenetrationCount, part_clearances
 from wbc.cascade_law import CascadeLaw
-from wbc.kinematic_run import Run, control_effort, integrate
-from wbc.lp_law import LPLaw, LPParams
-from wbc.obstacles import Obstacle, least_clearance, split
-from wbc.pinv_law import PseudoinverseLaw
-from wbc.robot import MobileManipulator
-from wbc.scenarios import (
+from wbc.geometry.arm_clearance import PenetrationCount, part_clearances
+from wbc.geometry.obstacles import Obstacle, least_clearance, split
+from wbc.geometry.scenarios import (
     DT,
     HOME,
     JOINT_LIMIT_GOAL,
@@ -34,6 +30,10 @@ from wbc.scenarios import (
     TABLE_GOAL,
     TABLE_START,
 )
+from wbc.kinematic_run import Run, control_effort, integrate
+from wbc.lp_law import LPLaw, LPParams
+from wbc.pinv_law import PseudoinverseLaw
+from wbc.robot import MobileManipulator
 from wbc.task import PoseTask, PositionTask, Task
 
 STEPS = 4000

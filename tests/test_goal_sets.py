@@ -11,8 +11,8 @@ from deploy import ROBOT_FILE
 from parsimony.goal_families import FAMILIES, goals
 from parsimony.goal_sets import LAWS, LIMIT_TOLERANCE, SUPERVISED, attempt, planning, shares
 from studies.reproduce.laws import describe
+from wbc.geometry.scenarios import OBSTACLE
 from wbc.robot import MobileManipulator
-from wbc.scenarios import OBSTACLE
 
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 HELD_OUT_SEED = 3

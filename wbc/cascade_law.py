@@ -27,8 +27,8 @@ import numpy as np
 
 from wbc.base_motion import unicycle, wheel_speeds
 from wbc.gains import check_gains, gain
+from wbc.geometry.obstacles import Obstacle
 from wbc.law_output import LawOutput, summarise
-from wbc.obstacles import Obstacle
 from wbc.pinv_law import pinv_velocity
 from wbc.robot import BASE_DOF, MobileManipulator
 from wbc.task import MEASUREMENT_TOLERANCE, Task, same_task

@@ -9,7 +9,7 @@ A robot description may declare (``collision`` in deploy/robots/little_john.yaml
 frame after arm link i. A point is a sphere of ``radius`` round p = translation(x_i (1 + eps
 offset / 2)); a segment is the capsule of ``radius`` round the part of the frame's axis line
 l_ = l + eps p x l between its two points, which must lie on that line in every
-configuration (checked when the robot is built). ``wbc.robot_primitives`` gives their
+configuration (checked when the robot is built). ``wbc.geometry.robot_primitives`` gives their
 Jacobians.
 """
 

@@ -8,7 +8,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from wbc.obstacles import Circle
+from wbc.geometry.obstacles import Circle
 
 Array = np.ndarray
 

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from wbc.disc_geometry import TAU, TOUCH, bitangents, clear, covered, overlaps, segment_clear
-from wbc.obstacles import Circle
+from wbc.geometry.obstacles import Circle
 from wbc.validation import require_finite
 
 Array = np.ndarray

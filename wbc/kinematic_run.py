@@ -8,8 +8,8 @@ from typing import Protocol
 
 import numpy as np
 
+from wbc.geometry.obstacles import Obstacle
 from wbc.law_output import Law, LawOutput
-from wbc.obstacles import Obstacle
 from wbc.task import Task
 
 Array = np.ndarray

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 import numpy as np
 
 if TYPE_CHECKING:
-    from wbc.obstacles import Obstacle
+    from wbc.geometry.obstacles import Obstacle
     from wbc.task import Task
 
 Array = np.ndarray

@@ -18,6 +18,7 @@ from wbc.constraints.obstacle_border import BorderObstacle
 from wbc.constraints.obstacle_conservative import ConservativeObstacle
 from wbc.constraints.obstacle_vector_field import VectorFieldObstacle
 from wbc.gains import composed, gain
+from wbc.geometry.obstacles import Obstacle, split
 from wbc.law_output import LawOutput, summarise
 from wbc.linear_program import WarmStartedLP
 from wbc.objectives.base import ObjectiveTerm, ResidualCost
@@ -27,7 +28,6 @@ from wbc.objectives.obstacle_circulation import ObstacleCirculation
 from wbc.objectives.velocity_cost import LeastVelocity
 from wbc.objectives.waist_centring import WaistCentring
 from wbc.objectives.waist_hold import WaistHold
-from wbc.obstacles import Obstacle, split
 from wbc.robot import MobileManipulator
 from wbc.step_context import StepContext
 from wbc.task import PoseTask, Task, same_task
@@ -98,8 +98,8 @@ def program(
     and e' measured (e' = (e - e_last) / dt against the ``last`` error of the same task, else
     the commanded -eta e), the costs (the task's first, ||J u + eta e||) and the rows; with e
     and the new ``last``. ``obstacles`` mixes circles for the base and solids in 3-D
-    (``wbc.obstacles.split``). ``previous_u`` is the u the law gave at its previous step, for
-    the terms and rows that read it (``StepContext.previous_u``). The LP and the QP
+    (``wbc.geometry.obstacles.split``). ``previous_u`` is the u the law gave at its previous step,
+    for the terms and rows that read it (``StepContext.previous_u``). The LP and the QP
     (``wbc.qp_law``) solve the same one."""
     q = require_finite("configuration q", q)
     dt = float(dt)

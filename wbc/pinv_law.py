@@ -17,8 +17,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from wbc.gains import check_gains, gain
+from wbc.geometry.obstacles import Obstacle
 from wbc.law_output import LawOutput, summarise
-from wbc.obstacles import Obstacle
 from wbc.robot import MobileManipulator
 from wbc.task import Task
 from wbc.validation import require_finite

@@ -24,6 +24,7 @@ import numpy as np
 
 from wbc.constraints.base import Constraint, LinearRows, OneNormBound, VelocityBounds
 from wbc.gains import composed, gain
+from wbc.geometry.obstacles import Obstacle
 from wbc.law_output import LawOutput, summarise
 from wbc.lp_law import (
     CONSTRAINTS,
@@ -34,7 +35,6 @@ from wbc.lp_law import (
     program,
 )
 from wbc.objectives.base import ObjectiveTerm, ResidualCost, VelocityCost
-from wbc.obstacles import Obstacle
 from wbc.robot import MobileManipulator
 from wbc.task import Task
 

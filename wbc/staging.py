@@ -40,9 +40,9 @@ from wbc import dq
 from wbc.conditioning import smallest_singular_value
 from wbc.disc_geometry import segment_clear
 from wbc.drive_planner import OutOfBudget, Way, WayPlanner
+from wbc.geometry.obstacles import Circle
 from wbc.lp_law import LPParams
 from wbc.objectives.base_target import gripper_heading
-from wbc.obstacles import Circle
 from wbc.planar import wrap
 from wbc.robot import BASE_DOF, MobileManipulator
 

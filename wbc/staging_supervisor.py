@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from wbc.drive_tasks import HeadingTask, PointTask
-from wbc.obstacles import Circle
+from wbc.geometry.obstacles import Circle
 from wbc.planar import wrap
 from wbc.robot import MobileManipulator
 from wbc.staging import Candidate, Plan, StagingParams, plan, same_configuration, same_kind

@@ -6,8 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wbc.obstacles import Circle
-from wbc.obstacles3d import Solid
+from wbc.geometry.obstacles import Circle
+from wbc.geometry.obstacles3d import Solid
 from wbc.robot import Chain, MobileManipulator
 
 Array = np.ndarray
@@ -31,7 +31,7 @@ class StepContext:
     dt: float = 0.0
     """The step's period, s (0 where no step is taken, as in a test of one term)."""
     solids: tuple[Solid, ...] = ()
-    """The obstacles in 3-D the robot's collision parts keep clear of (wbc.obstacles3d)."""
+    """The obstacles in 3-D the robot's collision parts keep clear of (wbc.geometry.obstacles3d)."""
     previous_u: Array | None = None
     """The u the law returned at its previous step (u_prev), read-only: zero before a law's
     first step; None where no law steps (a term tested alone)."""

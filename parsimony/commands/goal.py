@@ -36,7 +36,7 @@ from parsimony.output import emit, json_text
 from parsimony.target_options import fail, profile_and_target, target_options
 from profiles.profile import Profile, ProfileError
 from wbc import dq
-from wbc.obstacles import Circle
+from wbc.geometry.obstacles import Circle
 from wbc.planar import offset_pose, planar_pose
 
 SOURCE = "parsimony"

@@ -24,7 +24,8 @@ from messages.truth import SimTruth
 from record.sessions import load_session
 from tests.analysis.conftest import ROBOT, START_NS, session_of
 from tests.record.test_far_stamps import write
-from wbc import dq, scenarios
+from wbc import dq
+from wbc.geometry import scenarios
 from wbc.kinematic_run import effort_of, integrate
 from wbc.lp_law import LPLaw, LPParams
 from wbc.robot import MobileManipulator

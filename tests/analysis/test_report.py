@@ -27,7 +27,8 @@ from messages.truth import SimTruth
 from record.session_file import SessionWriter
 from tests.analysis.conftest import DT, FIGURES, ROBOT, START_NS, header
 from tests.processes import parsimony
-from wbc import dq, scenarios
+from wbc import dq
+from wbc.geometry import scenarios
 from wbc.kinematic_run import effort_of
 
 REQUIRED = (ROBOT_STATE, CONTROL_GOAL, BASE_COMMAND, ARM_COMMAND, CONTROL_DIAGNOSTICS)

@@ -18,10 +18,10 @@ from messages.state import RobotState
 from studies.gain_sets import LP_PARAMS, input_change_gains
 from wbc.cascade_law import CascadeLaw, CascadeParams
 from wbc.gains import gain_specs
+from wbc.geometry.scenarios import DT, HOME, REACH_GOAL
 from wbc.lp_law import LPLaw, LPParams
 from wbc.qp_law import QPLaw, QPParams
 from wbc.robot import MobileManipulator
-from wbc.scenarios import DT, HOME, REACH_GOAL
 
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 STEP_NS = int(DT * 1e9)

@@ -30,8 +30,8 @@ from messages.header import Header
 from messages.state import RobotState
 from parsimony.commands import param
 from profiles.profile import load_profile
+from wbc.geometry.scenarios import NEAR_START, REACH_GOAL
 from wbc.robot import MobileManipulator
-from wbc.scenarios import NEAR_START, REACH_GOAL
 
 if TYPE_CHECKING:
     from tests.components.conftest import System

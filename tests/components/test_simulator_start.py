@@ -1,5 +1,6 @@
 """The simulator process says, one line per solid, when the robot starts inside a solid of
-its scene, and what the robot will do (wbc.start_inside); a clear start says nothing of it."""
+its scene, and what the robot will do (wbc.geometry.start_inside); a clear start says nothing of
+it."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ import pytest
 import yaml
 
 from deploy import DEPLOY
-from wbc.start_inside import CONSEQUENCE
+from wbc.geometry.start_inside import CONSEQUENCE
 
 if TYPE_CHECKING:
     from tests.components.conftest import System

@@ -28,9 +28,9 @@ from profiles.profile_files import read_profile_data
 from tests.wbc.crowd import CHECK_GAP_S, crowd
 from wbc import dq
 from wbc.drive_tasks import HeadingTask, PointTask, offset_point
+from wbc.geometry.scenarios import HOME, REACH_GOAL
 from wbc.planar import planar_pose
 from wbc.robot import MobileManipulator
-from wbc.scenarios import HOME, REACH_GOAL
 from wbc.staging import within
 from wbc.task import PoseTask, PositionTask, same_task
 

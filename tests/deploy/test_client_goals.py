@@ -12,9 +12,9 @@ import pytest
 from deploy.client_goals import GoalRefused, client_goal, marker_pose
 from messages.header import Header
 from wbc import dq
-from wbc.obstacles import Circle
+from wbc.geometry.obstacles import Circle
+from wbc.geometry.scenarios import HOME
 from wbc.planar import offset_pose, planar_pose
-from wbc.scenarios import HOME
 
 HEADER = Header(stamp_ns=5_000_000_000, frame="world", seq=0, source="view")
 OFFSET = offset_pose(0.0, 0.0, 0.471698, 0.0, -0.484884, 0.167468)

@@ -25,7 +25,7 @@ from messages import (
 )
 from messages.base import Message
 from messages.obstacles import Cylinder, Plane, Solids
-from wbc import obstacles3d
+from wbc.geometry import obstacles3d
 
 
 def _float_paths(value: Any, path: tuple[Any, ...] = ()) -> Iterator[tuple[Any, ...]]:
@@ -193,7 +193,7 @@ def test_obstacle_radius_is_positive() -> None:
 
 def test_a_plane_must_be_a_solid_wbc_accepts() -> None:
     """A unit normal, and a footprint only on a horizontal plane, convex: the error names the
-    field, as wbc.obstacles3d does."""
+    field, as wbc.geometry.obstacles3d does."""
     with pytest.raises(ValidationError, match="normal: expected a unit vector"):
         Plane(normal=(0.0, 0.0, 2.0), offset=0.4)
     with pytest.raises(ValidationError, match="footprint: only a horizontal plane"):

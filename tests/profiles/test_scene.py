@@ -145,7 +145,7 @@ POLE = {"name": "pole", "x": 0.2, "y": -0.3, "radius": 0.05, "height": 0.6}
 
 
 def test_a_scene_declares_planes_and_cylinders_for_the_arm(tmp_path: Path) -> None:
-    """Read into the obstacles of wbc.obstacles3d, in F0; none by default."""
+    """Read into the obstacles of wbc.geometry.obstacles3d, in F0; none by default."""
     scene = load_profile(
         write(
             tmp_path,

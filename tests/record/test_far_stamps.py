@@ -23,7 +23,7 @@ from record.session_span import FAR_NS, Span
 from record.sessions import load_session
 from tests.analysis.conftest import DT, FIGURES, ROBOT, START_NS, session_of
 from tests.processes import parsimony
-from wbc import scenarios
+from wbc.geometry import scenarios
 from wbc.kinematic_run import integrate
 from wbc.lp_law import LPLaw, LPParams
 from wbc.task import PoseTask

@@ -1,7 +1,7 @@
 """The obstacles in Foxglove's 3-D panel (scenes.obstacle_scene) and the parts of the simulated
 robot inside them (scenes.penetration_scene), as the views of a ``Viewer``, each read with
 nothing but its own schema: every drawn place and size follows from the obstacles message (or
-the ground truth) and the model of ``wbc.obstacles3d``."""
+the ground truth) and the model of ``wbc.geometry.obstacles3d``."""
 
 from __future__ import annotations
 
@@ -25,8 +25,9 @@ from scenes.foxglove_views import (
 )
 from scenes.obstacle_scene import CIRCLE_HEIGHT_M, UNBOUNDED_HEIGHT_M
 from tests.scenes.views_read import HEADER, ROBOT, decode, vector
-from wbc import dq, scenarios
+from wbc import dq
 from wbc.collision_model import point_positions
+from wbc.geometry import scenarios
 
 KEY = "sim/world/obstacles"
 TRUTH_KEY = "sim/sim/truth"

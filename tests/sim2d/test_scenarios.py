@@ -25,12 +25,12 @@ from sim2d.scenarios import (
     SimScenario,
     scenario,
 )
-from wbc.arm_clearance import part_clearances
 from wbc.disc_geometry import segment_clear
+from wbc.geometry.arm_clearance import part_clearances
+from wbc.geometry.scenarios import HOME, OBSTACLE, REACH_GOAL, TABLE, TABLE_GOAL, TABLE_START
 from wbc.lp_law import LPParams
 from wbc.planar import planar_of
 from wbc.robot import BASE_DOF, MobileManipulator
-from wbc.scenarios import HOME, OBSTACLE, REACH_GOAL, TABLE, TABLE_GOAL, TABLE_START
 from wbc.staging import plan
 
 REPO = Path(__file__).resolve().parents[2]

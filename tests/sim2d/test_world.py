@@ -9,8 +9,8 @@ import pytest
 
 from deploy import ROBOT_FILE
 from sim2d.world import World, WorldSettings, wheel_distance_per_count
-from wbc.obstacles import Circle
-from wbc.obstacles3d import Plane
+from wbc.geometry.obstacles import Circle
+from wbc.geometry.obstacles3d import Plane
 from wbc.robot import MobileManipulator
 
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)

@@ -1,8 +1,8 @@
 """The arm's obstacle rows as the constraint forms them (wbc/constraints/arm_obstacles.py: Python
-geometry, the wrench form of wbc/wrench_rows.py) are the rows formed from each part's Jacobian,
-J_t of 4.18 and DQ Robotics' line Jacobian, with the distance Jacobians of
-wbc/distance_jacobians.py and the closest points of wbc/plucker.py; the LP's commands are then
-the same, step by step and along the reach over the table."""
+geometry, the wrench form of wbc/geometry/wrench_rows.py) are the rows formed from each part's
+Jacobian, J_t of 4.18 and DQ Robotics' line Jacobian, with the distance Jacobians of
+wbc/geometry/distance_jacobians.py and the closest points of wbc/geometry/plucker.py; the LP's
+commands are then the same, step by step and along the reach over the table."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from deploy import ROBOT_FILE
 from studies.gain_sets import TABLE_PARAMS
 from wbc.constraints.arm_obstacles import SKEW_MIN, ArmObstacles
 from wbc.constraints.base import LinearRows
-from wbc.distance_jacobians import (
+from wbc.geometry.distance_jacobians import (
     line_to_line_distance_jacobian,
     line_to_line_squared_distance,
     point_to_line_distance_jacobian,
@@ -25,13 +25,13 @@ from wbc.distance_jacobians import (
     point_to_point_distance_jacobian,
     point_to_point_squared_distance,
 )
+from wbc.geometry.obstacles3d import CORNER, EDGE, FACE, SIDE, Cylinder, Plane, Solid
+from wbc.geometry.plucker import closest_parameters
+from wbc.geometry.robot_primitives import primitive_kinematics
+from wbc.geometry.scenarios import DT, TABLE, TABLE_GOAL, TABLE_START
 from wbc.kinematic_run import integrate
 from wbc.lp_law import LPLaw, default_constraints
-from wbc.obstacles3d import CORNER, EDGE, FACE, SIDE, Cylinder, Plane, Solid
-from wbc.plucker import closest_parameters
 from wbc.robot import MobileManipulator
-from wbc.robot_primitives import primitive_kinematics
-from wbc.scenarios import DT, TABLE, TABLE_GOAL, TABLE_START
 from wbc.step_context import StepContext
 from wbc.task import PoseTask
 

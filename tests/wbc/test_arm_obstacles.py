@@ -11,14 +11,14 @@ from wbc_scenarios import configurations, context
 
 from deploy import ROBOT_FILE
 from studies.gain_sets import TABLE_PARAMS, WITHOUT_ARM_ROWS
-from wbc.arm_clearance import PenetrationCount, part_clearances
 from wbc.constraints.arm_obstacles import ArmObstacles
+from wbc.geometry.arm_clearance import PenetrationCount, part_clearances
+from wbc.geometry.obstacles import Circle
+from wbc.geometry.obstacles3d import Cylinder, Plane
+from wbc.geometry.scenarios import DT, HOME, REACH_GOAL, TABLE, TABLE_GOAL, TABLE_START
 from wbc.kinematic_run import integrate
 from wbc.lp_law import LPLaw, LPParams, default_constraints
-from wbc.obstacles import Circle
-from wbc.obstacles3d import Cylinder, Plane
 from wbc.robot import MobileManipulator
-from wbc.scenarios import DT, HOME, REACH_GOAL, TABLE, TABLE_GOAL, TABLE_START
 from wbc.task import PoseTask
 
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)

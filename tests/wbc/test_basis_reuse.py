@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from wbc_scenarios import pose_task, position_task, robot
 
+from wbc.geometry.scenarios import DT, STARTS_AND_GOALS
 from wbc.lp_law import LPLaw
-from wbc.scenarios import DT, STARTS_AND_GOALS
 
 MODEL = robot()
 

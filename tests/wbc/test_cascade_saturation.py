@@ -11,8 +11,8 @@ from wbc_scenarios import integrate, pose_task, position_task, robot
 
 from wbc.base_motion import unicycle
 from wbc.cascade_law import CascadeLaw, CascadeParams, saturated
+from wbc.geometry.scenarios import HOME, REACH_GOAL
 from wbc.robot import BASE_DOF
-from wbc.scenarios import HOME, REACH_GOAL
 
 MODEL = robot()
 TASKS = {"pose": pose_task(MODEL, REACH_GOAL), "position": position_task(MODEL, REACH_GOAL)}

@@ -11,10 +11,17 @@ from wbc_scenarios import integrate, pose_task, position_task, robot
 from studies.gain_sets import BORDER_PARAMS, LP_PARAMS, OBSTACLE_PARAMS
 from wbc import dq
 from wbc.cascade_law import CascadeLaw
+from wbc.geometry.obstacles import Circle
+from wbc.geometry.scenarios import (
+    DT,
+    HOME,
+    JOINT_LIMIT_GOAL,
+    OBSTACLE,
+    OBSTACLE_GOAL,
+    STARTS_AND_GOALS,
+)
 from wbc.lp_law import LPLaw, LPParams
-from wbc.obstacles import Circle
 from wbc.pinv_law import PseudoinverseLaw
-from wbc.scenarios import DT, HOME, JOINT_LIMIT_GOAL, OBSTACLE, OBSTACLE_GOAL, STARTS_AND_GOALS
 from wbc.task import PoseTask, PositionTask
 
 MODEL = robot()

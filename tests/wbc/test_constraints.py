@@ -17,7 +17,7 @@ from wbc.constraints.nonholonomic import Nonholonomic
 from wbc.constraints.obstacle_border import BorderObstacle
 from wbc.constraints.obstacle_conservative import ConservativeObstacle
 from wbc.constraints.obstacle_vector_field import VectorFieldObstacle
-from wbc.obstacles import Circle
+from wbc.geometry.obstacles import Circle
 from wbc.robot import MobileManipulator
 from wbc.step_context import StepContext
 

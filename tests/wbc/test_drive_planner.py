@@ -10,7 +10,7 @@ import pytest
 
 from wbc.disc_geometry import segment_clear
 from wbc.drive_planner import WayPlanner, plan_way
-from wbc.obstacles import Circle
+from wbc.geometry.obstacles import Circle
 
 CLEARANCE = 0.215
 """The base's body radius and the LP's margin."""

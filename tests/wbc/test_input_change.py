@@ -12,10 +12,10 @@ from wbc_scenarios import context, integrate, robot
 
 from studies.gain_sets import LP_PARAMS, input_change_gains
 from wbc import dq
+from wbc.geometry.scenarios import DT, HOME, JOINT_LIMIT_GOAL, REACH_GOAL
 from wbc.kinematic_run import control_effort
 from wbc.lp_law import LPLaw
 from wbc.objectives.input_change import InputChange
-from wbc.scenarios import DT, HOME, JOINT_LIMIT_GOAL, REACH_GOAL
 from wbc.task import PoseTask, PositionTask
 
 MODEL = robot()

@@ -12,9 +12,9 @@ from scipy.optimize import linprog
 from wbc_scenarios import robot
 
 from wbc.constraints.base import LinearRows, OneNormBound, VelocityBounds
+from wbc.geometry.scenarios import DT
 from wbc.lp_law import LPLaw, LPParams
 from wbc.pinv_law import PinvParams, PseudoinverseLaw, nonholonomic_basis
-from wbc.scenarios import DT
 from wbc.step_context import StepContext
 from wbc.task import PoseTask
 

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from wbc_scenarios import pose_task, robot
 
+from wbc.geometry.obstacles import Circle
+from wbc.geometry.scenarios import DT, HOME, STARTS_AND_GOALS
 from wbc.lp_law import LPLaw, LPParams
-from wbc.obstacles import Circle
-from wbc.scenarios import DT, HOME, STARTS_AND_GOALS
 from wbc.task import PoseTask
 from wbc.validation import NonFiniteInputError
 

@@ -9,14 +9,14 @@ import pytest
 from wbc_scenarios import robot
 
 from wbc import dq
+from wbc.geometry.obstacles import Circle
+from wbc.geometry.scenarios import DT, HOME
 from wbc.lp_law import LPLaw, LPParams
 from wbc.objectives.base_target import BaseTarget, gripper_heading
 from wbc.objectives.obstacle_circulation import ObstacleCirculation
 from wbc.objectives.velocity_cost import LeastVelocity
 from wbc.objectives.waist_centring import WaistCentring
 from wbc.objectives.waist_hold import WaistHold
-from wbc.obstacles import Circle
-from wbc.scenarios import DT, HOME
 from wbc.step_context import StepContext
 from wbc.task import PoseTask, PositionTask
 

@@ -8,10 +8,10 @@ import math
 import numpy as np
 from wbc_scenarios import pose_task, robot
 
+from wbc.geometry.obstacles import Circle
+from wbc.geometry.scenarios import DT, HOME, REACH_GOAL, STARTS_AND_GOALS
 from wbc.kinematic_run import integrate
-from wbc.obstacles import Circle
 from wbc.qp_law import QPLaw, QPParams
-from wbc.scenarios import DT, HOME, REACH_GOAL, STARTS_AND_GOALS
 from wbc.task import PoseTask
 
 MODEL = robot()

@@ -15,11 +15,11 @@ from tests.wbc.crowd import CHECK_GAP_S, crowd
 from wbc import dq
 from wbc.conditioning import smallest_singular_value
 from wbc.drive_tasks import HeadingTask, PointTask, offset_point
+from wbc.geometry.obstacles import Circle
+from wbc.geometry.scenarios import DT, HOME, REACH_GOAL
 from wbc.kinematic_run import integrate, integrate_supervised
 from wbc.lp_law import LPLaw
-from wbc.obstacles import Circle
 from wbc.planar import planar_pose
-from wbc.scenarios import DT, HOME, REACH_GOAL
 from wbc.staging import StagingParams, arm_box, plan
 from wbc.staging_supervisor import Phase, StagingSupervisor, SupervisorParams
 from wbc.task import PoseTask

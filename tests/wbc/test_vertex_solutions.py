@@ -17,11 +17,11 @@ from wbc_scenarios import robot
 
 from wbc import dq
 from wbc.constraints.base import LinearRows, OneNormBound, VelocityBounds
+from wbc.geometry.obstacles import Circle
 from wbc.law_output import ZERO_THRESHOLD
 from wbc.linear_program import WarmStartedLP
 from wbc.lp_law import LPParams, default_constraints, default_objectives
 from wbc.objectives.base import ResidualCost
-from wbc.obstacles import Circle
 from wbc.step_context import StepContext
 from wbc.task import PoseTask, PositionTask
 

@@ -1,4 +1,4 @@
-"""The robot, tasks from the configurations of ``wbc.scenarios``, a kinematic integrator,
+"""The robot, tasks from the configurations of ``wbc.geometry.scenarios``, a kinematic integrator,
 random configurations, a step's context, central differences and DQ Robotics' chain: shared by
 the tests of ``wbc``."""
 
@@ -12,10 +12,10 @@ from dqrobotics.robot_modeling import DQ_HolonomicBase, DQ_SerialManipulatorDH, 
 
 from deploy import ROBOT_FILE
 from wbc import dq, kinematic_run
+from wbc.geometry.obstacles3d import Solid
+from wbc.geometry.scenarios import DT
 from wbc.kinematic_run import Run
-from wbc.obstacles3d import Solid
 from wbc.robot import MobileManipulator
-from wbc.scenarios import DT
 from wbc.step_context import StepContext
 from wbc.task import PoseTask, PositionTask
 

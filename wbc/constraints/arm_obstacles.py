@@ -6,8 +6,8 @@ a part and an obstacle, d' >= -eta (d - d_safe), i.e. the row
 
 (the max keeps u = 0 feasible when a part starts inside d_safe: it may then not come closer).
 The parts are the points and segments of ``robot.collision`` (``wbc.collision_model``), each a
-sphere or capsule of radius rho; the obstacles are ``wbc.obstacles3d``'s. The distances and
-their Jacobians are ``wbc.distance_jacobians``':
+sphere or capsule of radius rho; the obstacles are ``wbc.geometry.obstacles3d``'s. The distances and
+their Jacobians are ``wbc.geometry.distance_jacobians``':
 
     point - face            d = <p, n> - d_pi,       d_safe = rho + margin
     point - edge            D = ||p x l - m||^2,     D_safe = (rho + margin)^2       (squared)
@@ -18,8 +18,8 @@ their Jacobians are ``wbc.distance_jacobians``':
     segment - solid's edge  D = line to line, edge,  D_safe = (rho + margin)^2
 
 A point keeps one row per obstacle: on its distance from the feature of the solid nearest it
-(``nearest`` of wbc.obstacles3d: a face, an edge, a corner; a cylinder's side, top or rim), the
-Euclidean distance from the solid, continuously differentiable outside it, so a point held at
+(``nearest`` of wbc.geometry.obstacles3d: a face, an edge, a corner; a cylinder's side, top or rim),
+the Euclidean distance from the solid, continuously differentiable outside it, so a point held at
 a table's rim slides round it (on the largest face distance alone it stalls there). Inside, the
 face it is least deep behind. Planes bound a segment by its ends, which are points. Across a
 cylinder's axis or a table's rim or corner the segment's middle can come closer than either end:
@@ -31,12 +31,13 @@ length * ``SKEW_MIN``); else the row is off (0 u <= inf). Of a solid's edges, th
 is kept. So every (part, obstacle) pair has one row, whatever the state: the LP keeps its shape.
 Not guarded: a segment cutting the rim of a cylinder's top, both ends clear of it.
 
-Each row is -J_d = -w^T J for the weights w of its distance's rate (``wbc.distance_jacobians``)
-and its part's Jacobian J, formed as the wrench of w on the twists of the step's forward pass
-(``wbc.wrench_rows``), the task's own: every row of a step in one product. The geometry of a
-step (a few points, lines and features) is Python float arithmetic, where numpy's call overhead
-outweighs the work: the pairing of the segments with a table's 8 lines costs 11 us so, 33 us in
-masked arrays (`parsimony bench`'s states of the reach over the table, CPU time, one run).
+Each row is -J_d = -w^T J for the weights w of its distance's rate
+(``wbc.geometry.distance_jacobians``) and its part's Jacobian J, formed as the wrench of w on the
+twists of the step's forward pass (``wbc.geometry.wrench_rows``), the task's own: every row of a
+step in one product. The geometry of a step (a few points, lines and features) is Python float
+arithmetic, where numpy's call overhead outweighs the work: the pairing of the segments with a
+table's 8 lines costs 11 us so, 33 us in masked arrays (`parsimony bench`'s states of the reach over
+the table, CPU time, one run).
 """
 
 from __future__ import annotations
@@ -49,19 +50,19 @@ from typing import Any, ClassVar
 import numpy as np
 
 from wbc.constraints.base import LinearRows
-from wbc.distance_jacobians import (
+from wbc.gains import gain
+from wbc.geometry.distance_jacobians import (
     Vector,
     line_to_line,
     point_to_line,
     point_to_plane,
     point_to_point,
 )
-from wbc.gains import gain
-from wbc.obstacles3d import CORNER, EDGE, FACE, RIM, Cylinder, Edge, Solid
-from wbc.plucker import foot
-from wbc.robot_primitives import PrimitiveKinematics, primitive_kinematics
+from wbc.geometry.obstacles3d import CORNER, EDGE, FACE, RIM, Cylinder, Edge, Solid
+from wbc.geometry.plucker import foot
+from wbc.geometry.robot_primitives import PrimitiveKinematics, primitive_kinematics
+from wbc.geometry.wrench_rows import line_wrench, point_wrench, wrench_rows
 from wbc.step_context import StepContext
-from wbc.wrench_rows import line_wrench, point_wrench, wrench_rows
 
 Array = np.ndarray
 
@@ -111,7 +112,7 @@ class Features:
 @functools.cache
 def features(obstacle: Solid) -> Features:
     """A cylinder's axis up to its top, or a footprint's edges and corners
-    (``wbc.obstacles3d``)."""
+    (``wbc.geometry.obstacles3d``)."""
     if isinstance(obstacle, Cylinder):
         top = math.inf if obstacle.height is None else obstacle.height
         edges, reach, corners = [Edge(obstacle.axis, -math.inf, top)], obstacle.radius, ()
@@ -181,7 +182,7 @@ class _Rows:
     """The rows of one step, in the constraint's order: for each obstacle its points', then
     its segments' (if it has lines). A row that is on is the wrench of its distance's weights
     on its part's frame and the bound eta max(d - d_safe, 0); every such row is multiplied out
-    at the end, all in one product (``wbc.wrench_rows``)."""
+    at the end, all in one product (``wbc.geometry.wrench_rows``)."""
 
     def __init__(self, constraint: ArmObstacles, parts: PrimitiveKinematics) -> None:
         model = parts.robot.collision
@@ -226,7 +227,7 @@ class _Rows:
         solid's edges that it faces (of the solid's ``found`` features; module docstring);
         0 u <= inf for a segment that faces none. The closest points p + s l and p_z + t l_z
         of a segment's line and a line (p and p_z their feet, as in
-        ``wbc.plucker.closest_parameters``) are at
+        ``wbc.geometry.plucker.closest_parameters``) are at
         s = (b e + f) / c and t = (e + b f) / c, with b = <l, l_z>, e = <p, l_z>,
         f = <l, p_z> and c = 1 - b^2 = ||l x l_z||^2 (each foot is orthogonal to its line);
         the distance between the lines is |<l, m_z> + <m, l_z>| / sqrt(c)."""

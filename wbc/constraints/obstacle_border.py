@@ -10,7 +10,7 @@ import numpy as np
 
 from wbc.constraints.base import LinearRows
 from wbc.constraints.obstacle_gains import ObstacleGains
-from wbc.obstacles import Circle
+from wbc.geometry.obstacles import Circle
 from wbc.step_context import StepContext
 
 Array = np.ndarray

@@ -2,8 +2,8 @@
 that begin: what the simulator counts and the judge reports, from the kinematics alone.
 
 The clearance of a part from a solid is min over the part's points of (the exact signed
-distance of the point from the solid, ``wbc.obstacles3d``) - radius: a sphere's centre, or a
-capsule's axis sampled every ``SPACING`` from end to end (the sampled minimum exceeds the
+distance of the point from the solid, ``wbc.geometry.obstacles3d``) - radius: a sphere's centre, or
+a capsule's axis sampled every ``SPACING`` from end to end (the sampled minimum exceeds the
 capsule's by at most SPACING^2 / (8 rho) for a flat face: 0.5 mm at rho = 25 mm). Negative is a
 penetration, its depth.
 """
@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from wbc.collision_model import point_positions
-from wbc.obstacles3d import Solid
+from wbc.geometry.obstacles3d import Solid
 from wbc.robot import MobileManipulator
 
 Array = np.ndarray

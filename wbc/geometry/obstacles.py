@@ -1,5 +1,5 @@
 """Obstacles: circles in the plane of the base (section 5.5), and solids in 3-D for the arm
-(``wbc.obstacles3d``); a law takes any mix of them and each constraint keeps the kind it
+(``wbc.geometry.obstacles3d``); a law takes any mix of them and each constraint keeps the kind it
 handles."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wbc.obstacles3d import Cylinder, Plane, Solid
+from wbc.geometry.obstacles3d import Cylinder, Plane, Solid
 
 
 @dataclass(frozen=True)

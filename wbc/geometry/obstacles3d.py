@@ -1,10 +1,10 @@
 """Obstacles in 3-D for the arm (future work 3 of section 7.2): planes and vertical cylinders.
 
-A ``Plane`` of unit normal n and offset d is the DQ plane pi = n + eps d (``wbc.plucker.plane``);
-the obstacle is the solid behind it, {p : <p, n> < d}: a wall, or the floor. With a
-``footprint`` (a convex polygon in the xy plane; the normal then vertical, n = +-k) the solid is
-that half-space inside the polygon's vertical prism: a table top and what lies under it. A
-``Cylinder`` is a vertical pole round the axis line k + eps (c x k) through (x, y), of
+A ``Plane`` of unit normal n and offset d is the DQ plane pi = n + eps d
+(``wbc.geometry.plucker.plane``); the obstacle is the solid behind it, {p : <p, n> < d}: a wall, or
+the floor. With a ``footprint`` (a convex polygon in the xy plane; the normal then vertical,
+n = +-k) the solid is that half-space inside the polygon's vertical prism: a table top and what lies
+under it. A ``Cylinder`` is a vertical pole round the axis line k + eps (c x k) through (x, y), of
 ``radius``, from the floor up to ``height`` (None: no top).
 
 Each solid is the intersection of half-spaces, its faces (``faces``: DQ planes with outward
@@ -31,8 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from wbc.geometry.plucker import foot, line, plane
 from wbc.planar import compose
-from wbc.plucker import foot, line, plane
 
 Array = np.ndarray
 

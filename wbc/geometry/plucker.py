@@ -1,6 +1,6 @@
 """Plücker lines and planes as dual quaternions (Marinho, Adorno et al., T-RO 2019, arXiv
 1804.11270, section III; DQ Robotics). The Jacobian of a line on the robot is
-``wbc.robot_primitives.line_jacobians``.
+``wbc.geometry.robot_primitives.line_jacobians``.
 
 A line through the point p with unit direction l (pure quaternions) is l_ = l + eps m with the
 moment m = p x l. A plane with unit normal n whose points p satisfy <p, n> = d is pi = n + eps d

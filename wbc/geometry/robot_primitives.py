@@ -11,8 +11,8 @@ along the line, p_0 + s l with p_0 = l x m (so s = <p, l> at an end p).
 
 The positions come from the step's forward pass in Python floats (4 points and 2 lines: 13 us
 of CPU, where the array forms took 34 us). The rows of ``wbc.constraints.arm_obstacles`` need no
-more: ``wbc.wrench_rows`` forms them from the twists; J_t and J_l here are what those rows are
-held to (tests/wbc/test_wrench_rows.py).
+more: ``wbc.geometry.wrench_rows`` forms them from the twists; J_t and J_l here are what those rows
+are held to (tests/wbc/geometry/test_wrench_rows.py).
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ import numpy as np
 
 from wbc import dq
 from wbc.collision_model import AXES, offset_pose
-from wbc.distance_jacobians import Vector
+from wbc.geometry.distance_jacobians import Vector
 from wbc.robot import Chain, MobileManipulator, translation_jacobian
 
 Array = np.ndarray
@@ -51,7 +51,7 @@ _CROSS_SIGN = np.array([[0.0, 0, 0, 0], [0, 0, -1, 1], [0, 1, 0, -1], [0, -1, 1,
 
 
 def _cross_matrices(vectors: Array) -> Array:
-    """C4 (``wbc.plucker.crossmatrix4``) of each pure quaternion of a stack: (k, 4, 4)."""
+    """C4 (``wbc.geometry.plucker.crossmatrix4``) of each pure quaternion of a stack: (k, 4, 4)."""
     return vectors[:, _CROSS_INDEX] * _CROSS_SIGN
 
 
@@ -107,7 +107,7 @@ def _rotated(pose: Sequence[float], vector: Sequence[float]) -> Vector:
 class PrimitiveKinematics:
     """Where the parts are at one configuration (Python floats, and arrays when asked), and
     their Jacobians J_t and J_l (4.18 and DQ Robotics' line Jacobian) when asked. The rows of
-    ``wbc.constraints.arm_obstacles`` need only where they are (``wbc.wrench_rows``)."""
+    ``wbc.constraints.arm_obstacles`` need only where they are (``wbc.geometry.wrench_rows``)."""
 
     def __init__(self, robot: MobileManipulator, chain: Chain) -> None:
         model = robot.collision

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from wbc.obstacles import Circle
-from wbc.obstacles3d import Plane
+from wbc.geometry.obstacles import Circle
+from wbc.geometry.obstacles3d import Plane
 
 DT = 0.02
 """The control period of the dissertation's experiments: 50 Hz (section 6.3)."""

@@ -12,8 +12,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from wbc.arm_clearance import part_clearances
-from wbc.obstacles3d import Solid
+from wbc.geometry.arm_clearance import part_clearances
+from wbc.geometry.obstacles3d import Solid
 from wbc.robot import MobileManipulator
 
 CONSEQUENCE = (

@@ -9,14 +9,14 @@ Plücker line l + eps m fixed in frame i then move at
     p' = sum_c (w_c x p + v_c) u_c,   l' = sum_c (w_c x l) u_c,   m' = sum_c (v_c x l + w_c x m) u_c
 
 over the columns c that move frame i (the base's and joints 1..i). A distance whose rate is
-<g, p'>, or <g_l, l'> + <g_m, m'> (the weights of ``wbc.distance_jacobians``), has the row
+<g, p'>, or <g_l, l'> + <g_m, m'> (the weights of ``wbc.geometry.distance_jacobians``), has the row
 
     J_d = 2 [0, (p x g)^T, 0, g^T] T                              (a point)
     J_d = 2 [0, (l x g_l + m x g_m)^T, 0, (l x g_m)^T] T          (a line)
 
 with the columns after frame i zero: the gradient's wrench (a vec8 like T's columns) times the
 twists. It equals w^T J_t with J_t of 4.18 and w^T J_l with DQ Robotics' line Jacobian, ours
-(``wbc.robot_primitives``) and DQ Robotics' own (tests/wbc/test_wrench_rows.py).
+(``wbc.geometry.robot_primitives``) and DQ Robotics' own (tests/wbc/geometry/test_wrench_rows.py).
 Every row of a step is then one (rows, 8) x (8, dof) product, 6.5 us of CPU, where forming
 each part's J_t and J_l from the frames' Jacobians takes 95-100 us (over the states of
 `parsimony bench`'s reach over the table).
@@ -28,7 +28,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from wbc.distance_jacobians import Vector
+from wbc.geometry.distance_jacobians import Vector
 from wbc.robot import Chain
 
 Array = np.ndarray

@@ -1,6 +1,6 @@
-"""The distance Jacobians of the arm's parts (wbc/distance_jacobians.py, wbc/plucker.py,
-wbc/robot_primitives.py): central finite differences over random configurations, and DQ
-Robotics' DQ_Kinematics and DQ_Geometry, which have the same ones."""
+"""The distance Jacobians of the arm's parts (wbc/geometry/distance_jacobians.py,
+wbc/geometry/plucker.py, wbc/geometry/robot_primitives.py): central finite differences over random
+configurations, and DQ Robotics' DQ_Kinematics and DQ_Geometry, which have the same ones."""
 
 from __future__ import annotations
 
@@ -12,11 +12,11 @@ import pytest
 from dqrobotics import DQ
 from dqrobotics.robot_modeling import DQ_Kinematics
 from dqrobotics.utils import DQ_Geometry
-from wbc_scenarios import central_difference, configurations, oracle_chain
 
 from deploy import ROBOT_FILE
+from tests.wbc.wbc_scenarios import central_difference, configurations, oracle_chain
 from wbc import dq
-from wbc.distance_jacobians import (
+from wbc.geometry.distance_jacobians import (
     ParallelLinesError,
     line_to_line_distance_jacobian,
     line_to_line_squared_distance,
@@ -27,14 +27,14 @@ from wbc.distance_jacobians import (
     point_to_point_distance_jacobian,
     point_to_point_squared_distance,
 )
-from wbc.plucker import closest_parameters, is_line, line, plane
-from wbc.robot import MobileManipulator
-from wbc.robot_primitives import (
+from wbc.geometry.plucker import closest_parameters, is_line, line, plane
+from wbc.geometry.robot_primitives import (
     line_jacobians,
     primitive_kinematics,
     translation_jacobians,
     translations,
 )
+from wbc.robot import MobileManipulator
 
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 FD_TOL = 1e-7

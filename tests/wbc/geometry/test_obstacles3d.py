@@ -1,5 +1,6 @@
-"""Obstacles in 3-D (wbc/obstacles3d.py): their exact clearance against independent formulas,
-their faces as lower bounds of it, their edges, motion, and refusals that name the field."""
+"""Obstacles in 3-D (wbc/geometry/obstacles3d.py): their exact clearance against independent
+formulas, their faces as lower bounds of it, their edges, motion, and refusals that name the
+field."""
 
 from __future__ import annotations
 
@@ -9,13 +10,13 @@ import re
 import numpy as np
 import pytest
 
-from wbc.distance_jacobians import (
+from wbc.geometry.distance_jacobians import (
     point_to_line_squared_distance,
     point_to_plane_distance,
     point_to_point_squared_distance,
 )
-from wbc.obstacles3d import CORNER, EDGE, EXTENT_M, FACE, RIM, SIDE, Cylinder, Plane
-from wbc.plucker import foot
+from wbc.geometry.obstacles3d import CORNER, EDGE, EXTENT_M, FACE, RIM, SIDE, Cylinder, Plane
+from wbc.geometry.plucker import foot
 
 TABLE = Plane((0.0, 0.0, 1.0), 0.4, ((0.5, -0.4), (1.1, -0.4), (1.1, 0.4), (0.5, 0.4)), "table")
 """A 0.6 x 0.8 m table top 0.4 m high, its near edge at x = 0.5."""
@@ -177,7 +178,7 @@ def test_a_solid_larger_than_a_scene_is_refused_with_the_bound() -> None:
 
 def feature_distance(solid: Plane | Cylinder, point: np.ndarray, kind: int, index: int) -> float:
     """The distance of ``point`` from the feature (``kind``, ``index``), by the distances of
-    wbc.distance_jacobians."""
+    wbc.geometry.distance_jacobians."""
     vec4 = np.r_[0.0, point]
     if kind == FACE:
         return float(point_to_plane_distance(vec4, solid.faces()[index]))

@@ -1,18 +1,18 @@
-"""A robot that starts inside a solid (wbc.start_inside): one line per solid naming it, and
+"""A robot that starts inside a solid (wbc.geometry.start_inside): one line per solid naming it, and
 what the robot then does, checked on the laws: no part inside goes deeper, none is pushed out."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from wbc_scenarios import integrate, pose_task, robot
 
-from wbc.arm_clearance import part_clearances
+from tests.wbc.wbc_scenarios import integrate, pose_task, robot
+from wbc.geometry.arm_clearance import part_clearances
+from wbc.geometry.obstacles3d import Cylinder, Plane
+from wbc.geometry.scenarios import HOME, REACH_GOAL
+from wbc.geometry.start_inside import CONSEQUENCE, inside_at_start
 from wbc.lp_law import LPLaw
-from wbc.obstacles3d import Cylinder, Plane
 from wbc.qp_law import QPLaw
-from wbc.scenarios import HOME, REACH_GOAL
-from wbc.start_inside import CONSEQUENCE, inside_at_start
 
 MODEL = robot()
 WALL = Plane((-1.0, 0.0, 0.0), -0.15, name="wall")

@@ -1,8 +1,8 @@
-"""A distance's row from the twists of the forward pass (wbc/wrench_rows.py) equals its weights
-times the part's Jacobian: J_t of 4.18 and DQ Robotics' line Jacobian (wbc/robot_primitives.py),
-and DQ Robotics' own translation and line Jacobians on truncated DQ_WholeBody chains; a point
-with an offset in its frame included. The shared forward pass gives the task what
-``kinematics`` gives."""
+"""A distance's row from the twists of the forward pass (wbc/geometry/wrench_rows.py) equals its
+weights times the part's Jacobian: J_t of 4.18 and DQ Robotics' line Jacobian
+(wbc/geometry/robot_primitives.py), and DQ Robotics' own translation and line Jacobians on truncated
+DQ_WholeBody chains; a point with an offset in its frame included. The shared forward pass gives the
+task what ``kinematics`` gives."""
 
 from __future__ import annotations
 
@@ -12,14 +12,14 @@ import numpy as np
 import pytest
 from dqrobotics import DQ
 from dqrobotics.robot_modeling import DQ_Kinematics
-from wbc_scenarios import configurations, oracle_chain
 
 from deploy import ROBOT_FILE
+from tests.wbc.wbc_scenarios import configurations, oracle_chain
 from wbc import dq
 from wbc.collision_model import AXES, CollisionModel, CollisionPoint
+from wbc.geometry.robot_primitives import primitive_kinematics
+from wbc.geometry.wrench_rows import line_wrench, point_wrench, wrench_rows
 from wbc.robot import MobileManipulator
-from wbc.robot_primitives import primitive_kinematics
-from wbc.wrench_rows import line_wrench, point_wrench, wrench_rows
 
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 ORACLE_TOL = 1e-12
