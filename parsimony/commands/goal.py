@@ -1,6 +1,6 @@
 """`parsimony goal X Y Z`: send the robot a goal for its gripper, and follow it with --wait.
 
-The goal is built as a client's goal of the live view is (``deploy.client_goals``: finite, a
+The goal is built as a client's goal of the live view is (``view.client_goals``: finite, a
 unit quaternion, above the floor, not inside an obstacle nor farther than a plan may cover
 from the robot), stamped on the profile's clock (``deploy.tool_clock``) and sent the way the
 profile takes goals: on ``goal/request`` where a component (the staging supervisor) reads it,
@@ -21,7 +21,6 @@ import threading
 import numpy as np
 import zenoh
 
-from deploy.client_goals import GoalRefused, client_goal
 from deploy.goal_follower import GoalFollower, Outcome
 from deploy.graph import dataflow
 from deploy.query import QueryError, live_writers, overwritten_by
@@ -35,6 +34,7 @@ from messages.supervisor import SupervisorStatus
 from parsimony.output import emit, json_text
 from parsimony.target_options import fail, profile_and_target, target_options
 from profiles.profile import Profile, ProfileError
+from view.client_goals import GoalRefused, client_goal
 from wbc import dq
 from wbc.geometry.obstacles import Circle
 from wbc.planar import offset_pose, planar_pose

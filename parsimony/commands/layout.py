@@ -1,5 +1,5 @@
 """`parsimony layout PROFILE [-o FILE]`: the Foxglove layout of the profile's namespace
-(record.foxglove_layout): the 3-D panel on the robot, the annotated camera image, plots of the
+(view.foxglove_layout): the 3-D panel on the robot, the annotated camera image, plots of the
 task error and of the nonzero entries of u, the controller's diagnostics, the supervisor's
 status and a Parameters panel. Foxglove imports it from the file (Layouts, Import from file);
 without ``-o`` it is printed."""
@@ -12,7 +12,7 @@ from pathlib import Path
 
 from parsimony.output import emit
 from profiles.profile import ProfileError, load_profile
-from record.foxglove_layout import layout
+from view.foxglove_layout import layout
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

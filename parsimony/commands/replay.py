@@ -43,9 +43,9 @@ from parsimony.commands.view import namespace_argument, port_number, serving, wa
 from parsimony.target_options import fail, target_options
 from profiles.endpoints import endpoint_problem
 from profiles.profile import Profile, ProfileError, load_profile
-from record.live_view import DEFAULT_PORT
 from record.replay_keys import terminal_keys
 from record.replayer import ANSWERING, SENSORS, Player, Playing, Recording
+from view.live_view import DEFAULT_PORT
 from wbc.robot import MobileManipulator
 
 COMMANDS = (topics.BASE_COMMAND.name, topics.ARM_COMMAND.name)

@@ -1,5 +1,5 @@
 """`parsimony view PROFILE`: a Foxglove live view and control station of a running system
-(record.live_view, deploy.control_station): a WebSocket server on 127.0.0.1 that Foxglove
+(view.live_view, view.control_station): a WebSocket server on 127.0.0.1 that Foxglove
 opens as a live source, until Ctrl-C or SIGTERM. It draws the robot of the profile's
 description, lets its clients send goals on goal/request (when the user may write it) and set
 any running component's parameters. A replay into the profile's namespace is watched the same
@@ -24,15 +24,15 @@ from pathlib import Path
 import zenoh
 
 from components.rate_limited_log import RateLimitedLog
-from deploy.control_station import ControlStation
 from deploy.query import QueryError, Target
 from messages.topics import Topic, check_namespace, topics_matching
 from parsimony.commands.layout import write_layout
 from parsimony.output import emit, json_text
 from parsimony.target_options import exit_code
 from profiles.profile import Profile, ProfileError, load_profile
-from record.live_view import DEFAULT_PORT, LiveView
 from scenes.foxglove_views import Viewer
+from view.control_station import ControlStation
+from view.live_view import DEFAULT_PORT, LiveView
 from wbc.robot import MobileManipulator
 
 

@@ -11,14 +11,13 @@ import subprocess
 import sys
 from pathlib import Path
 
-from test_live_view import DEADLINE_S, StderrLines, state, watch, write_profile
-
 from messages import topics
 from messages.state import RobotState
 from parsimony.target_options import PROFILE_ENV
 from profiles.endpoints import free_port
 from record.replayer import Recording
 from record.session_file import SessionWriter, from_json
+from tests.view.test_live_view import DEADLINE_S, StderrLines, state, watch, write_profile
 
 RECORDED = "rec"
 INTO = "other"

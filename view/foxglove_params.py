@@ -17,7 +17,10 @@ from collections.abc import Callable, Iterable, Sequence
 import zenoh
 from foxglove import Parameter, ParameterType
 
-from deploy.client_limits import (
+from deploy.query import DEFAULT_TIMEOUT_S, QueryError, set_param, value_text
+from messages import topics
+from messages.process import ParamValue, decode_value
+from view.client_limits import (
     ECHO_CHARS,
     NAME_CHARS,
     PARAMETERS_AT_ONCE,
@@ -25,9 +28,6 @@ from deploy.client_limits import (
     cut,
     echo,
 )
-from deploy.query import DEFAULT_TIMEOUT_S, QueryError, set_param, value_text
-from messages import topics
-from messages.process import ParamValue, decode_value
 
 SEPARATOR = "."
 """Between a component's name and its parameter's in a Foxglove parameter's name."""

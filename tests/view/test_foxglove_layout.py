@@ -18,12 +18,12 @@ from messages.markers import MarkerDetection, MarkerDetections
 from messages.obstacles import Circle, Obstacles
 from messages.supervisor import SupervisorStatus
 from messages.truth import SimTruth
-from record.foxglove_layout import layout
 from record.session_file import SessionWriter
 from record.session_reader import info
 from scenes.foxglove_views import Viewer
 from tests.processes import parsimony
 from tests.scenes.views_read import ROBOT, pose_dq, robot_state
+from view.foxglove_layout import layout
 from vision.images import jpeg
 
 NAMESPACE = "sim"

@@ -1,16 +1,16 @@
 """What the clients of `parsimony view` may do beyond watching: send goals, set parameters.
 
-The listener of the live view's server (``record.live_view``):
+The listener of the live view's server (``view.live_view``):
 
 - Goals (``ClientPublish``): a client advertises a channel on goal/request (its key in the
   namespace, or its name) in JSON, a ``foxglove.PoseInFrame`` or ``foxglove.Pose`` (the 3-D
-  panel's publish-pose tool); each message is checked (``deploy.client_goals``) and put on
+  panel's publish-pose tool); each message is checked (``view.client_goals``) and put on
   goal/request, stamped on the namespace's clock (``deploy.tool_clock``). Only when the view's
   user may write goal/request (the profile's ``zenoh.access``): otherwise the capability is
   not advertised, and the server itself refuses any advertisement. A client sends at most
   ``client_limits.GOAL_RATE``; a goal over it is dropped, and the client told so.
 - Parameters (``Parameters``): every running component's, as ``component.name``
-  (``deploy.foxglove_params``); a set goes to the component, which checks it as it checks
+  (``view.foxglove_params``); a set goes to the component, which checks it as it checks
   ``parsimony param set``, when the view's user may set that component's parameters
   (``zenoh.access.parameters``). Foxglove's protocol has no read-only parameters: a view whose
   user may set none still lists them, and refuses every set.
@@ -44,9 +44,6 @@ from foxglove.websocket import (
     WebSocketServer,
 )
 
-from deploy.client_goals import ENCODING, SCHEMAS, GoalRefused, client_goal
-from deploy.client_limits import ECHO_CHARS, GOAL_RATE, STATUS_CHARS, Bucket, cut, echo
-from deploy.foxglove_params import running_parameters, set_parameters
 from deploy.tool_clock import ToolClock
 from deploy.zenoh_error import is_session_error, zenoh_error_text
 from messages import codec, topics
@@ -54,6 +51,9 @@ from messages.header import Header
 from messages.obstacles import circles_of
 from profiles.access import tool_user
 from profiles.profile import Profile
+from view.client_goals import ENCODING, SCHEMAS, GoalRefused, client_goal
+from view.client_limits import ECHO_CHARS, GOAL_RATE, STATUS_CHARS, Bucket, cut, echo
+from view.foxglove_params import running_parameters, set_parameters
 from wbc import dq
 from wbc.geometry.obstacles import Circle
 from wbc.planar import offset_pose

@@ -1,4 +1,4 @@
-"""deploy.foxglove_params.checked: a parameter set from a Foxglove client is refused, saying
+"""view.foxglove_params.checked: a parameter set from a Foxglove client is refused, saying
 what is wrong in a few words, before anything of it reaches Zenoh."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 from foxglove import Parameter, ParameterType
 
-from deploy.foxglove_params import SetRefused, checked
+from view.foxglove_params import SetRefused, checked
 
 RUNNING = ("controller.eta", "controller.obstacle_mode", "simulator.goal_marker")
 

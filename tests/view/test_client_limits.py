@@ -1,11 +1,11 @@
-"""deploy.client_limits: what an answer repeats of a client's values, and the goal rate, on a
+"""view.client_limits: what an answer repeats of a client's values, and the goal rate, on a
 clock the test gives (no wall-clock time)."""
 
 from __future__ import annotations
 
 import pytest
 
-from deploy.client_limits import ECHO_CHARS, TOLD_EVERY_S, Bucket, Rate, echo
+from view.client_limits import ECHO_CHARS, TOLD_EVERY_S, Bucket, Rate, echo
 
 RATE = Rate(per_s=2.0, burst=3)
 

@@ -20,7 +20,6 @@ import zenoh
 
 from bench.live_view import lockstep_profile
 from deploy import query
-from deploy.client_limits import GOAL_RATE, STATUS_CHARS
 from messages import codec, topics
 from messages.goal import Goal
 from profiles.profile import Profile, load_profile
@@ -29,6 +28,7 @@ from sim2d.scenarios import scenario
 from studies.experiment import DEPLOY, connect, launched, wait_alive, wait_reached
 from tests.foxglove_client.client import FoxgloveClient, decode, missing, running_view
 from tests.scenes.views_read import chain, pose_of
+from view.client_limits import GOAL_RATE, STATUS_CHARS
 from wbc import dq
 from wbc.planar import in_frame, offset_pose, planar_pose
 from wbc.robot import MobileManipulator

@@ -20,15 +20,15 @@ import zenoh
 
 from components.params import Param
 from components.runtime import Node
-from deploy.client_limits import GOAL_RATE, STATUS_CHARS
-from deploy.control_station import ControlStation
 from messages import codec, topics
 from messages.goal import Goal
 from parsimony.commands.view import stopped
 from profiles.endpoints import free_port
 from profiles.profile import Profile, load_profile
-from record.live_view import LiveView
 from tests.foxglove_client.client import DEADLINE_S, FoxgloveClient, missing
+from view.client_limits import GOAL_RATE, STATUS_CHARS
+from view.control_station import ControlStation
+from view.live_view import LiveView
 
 NAMESPACE = "limits"
 GOAL = json.dumps(

@@ -7,7 +7,7 @@ ROS), whose frame is in its header. It is taken as the
 place of a goal marker F2, so the goal is the one the state estimator would measure there,
 x_d = x_2 x_d^2 (eq. 6.3), with the scene's offset x_d^2 (the gripper over the bin), a pose
 task. It is refused, with the reason, when it is larger than a goal can be
-(``deploy.client_limits``), its JSON is not of those schemas (an object missing, a number
+(``view.client_limits``), its JSON is not of those schemas (an object missing, a number
 not finite, or out of range: a coordinate beyond ``FARTHEST_M``, checked before anything is
 computed from it), its frame is not ``world`` (F0, where the estimate is), its orientation is
 not a unit quaternion (within ``messages.base.UNIT_TOLERANCE``, as a goal's pose is checked),
@@ -25,10 +25,10 @@ from collections.abc import Sequence
 import numpy as np
 from pydantic import ValidationError
 
-from deploy.client_limits import ECHO_CHARS, GOAL_BYTES, cut, echo
 from messages.base import UNIT_TOLERANCE
 from messages.goal import Goal
 from messages.header import Header
+from view.client_limits import ECHO_CHARS, GOAL_BYTES, cut, echo
 from wbc import dq
 from wbc.geometry.obstacles import Circle
 from wbc.staging import StagingParams, refusal

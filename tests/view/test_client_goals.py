@@ -1,4 +1,4 @@
-"""deploy.client_goals: what a Foxglove client publishes on goal/request becomes the goal the
+"""view.client_goals: what a Foxglove client publishes on goal/request becomes the goal the
 state estimator would measure at that place (eq. 6.3), or is refused saying why."""
 
 from __future__ import annotations
@@ -9,8 +9,8 @@ import math
 import numpy as np
 import pytest
 
-from deploy.client_goals import GoalRefused, client_goal, marker_pose
 from messages.header import Header
+from view.client_goals import GoalRefused, client_goal, marker_pose
 from wbc import dq
 from wbc.geometry.obstacles import Circle
 from wbc.geometry.scenarios import HOME
