@@ -12,6 +12,8 @@ camera publish on the real robot, every ``step_s`` of simulated time::
     sim/truth          the real pose, joints, end effector, contacts and the arm's penetrations
                        into the scene's solids in 3-D (tests and reports only)
 
+The readings are made by ``components.sim_sensors``, the frames by ``components.sim_camera``.
+
 It stops the robot when no command has arrived for ``command_timeout_s`` of simulated time.
 A ``start`` with a part of the robot inside one of the scene's solids is warned of, one line
 per solid naming it and saying what the robot will do (``wbc.geometry.start_inside``).
@@ -44,25 +46,21 @@ from components.process_entry import run_component
 from components.pubsub import Input
 from components.runtime import Component, Node
 from components.sim_camera import FrameFormat, SimCamera
+from components.sim_sensors import SimSensors
 from messages import topics
 from messages.base import ARM_JOINTS
 from messages.clock import Clock
 from messages.commands import ArmCommand, BaseCommand
-from messages.joints import JointStates
 from messages.obstacles import Circle as TruthCircle
 from messages.obstacles import Solids
-from messages.odometry import BaseOdometry
-from messages.truth import SimTruth
 from profiles.scene import Scene
 from sim2d.camera import ImageNoise
-from sim2d.scenarios import SEED_MAX, goal_above
-from sim2d.world import World, WorldSettings, wheel_distance_per_count
-from wbc.base_motion import dead_reckoning
+from sim2d.scenarios import SEED_MAX
+from sim2d.world import World, WorldSettings
 from wbc.geometry.obstacles import Circle
 from wbc.geometry.start_inside import inside_at_start
 from wbc.robot import MobileManipulator
 
-JOINT_NAMES = tuple(f"q{i}" for i in range(1, ARM_JOINTS + 1))
 LOCKSTEP_CHECK_S = 0.05
 """How often the simulator looks for an answer that is overdue (host seconds)."""
 PAUSED_CLOCK_S = 0.1
@@ -171,15 +169,10 @@ class Simulator(Component):
         self.robot = MobileManipulator.from_yaml(node.profile.robot)
         self.scene: Scene = node.profile.scene
         self.obstacles = [Circle(*c) for c in p["obstacles"]]
-        self.truth_obstacles = tuple(
-            TruthCircle(x=c.x, y=c.y, radius=c.radius) for c in self.obstacles
-        )
         # The scene declares its solids in F0; this world has F0 at the reference pose.
         solids = tuple(
             solid.moved(*self.scene.reference_pose) for solid in self.scene.arm_obstacles.solids()
         )
-        self.truth_solids = Solids.of(solids)
-        self.goal_of: tuple[tuple, tuple[float, ...]] = ((), ())
         settings = WorldSettings(
             wheel_acceleration_max=p["wheel_acceleration_max"],
             encoder_noise_counts=p["encoder_noise_counts"],
@@ -212,9 +205,13 @@ class Simulator(Component):
         )
         self.frame_period_ns = round(1e9 / self.scene.camera.rate_hz)
         self.next_frame_ns = self.now_ns
-        self.metres_per_count = wheel_distance_per_count(self.robot.base, settings.counts_per_turn)
-        self.odometry_pose = (0.0, 0.0, 0.0)
-        self.last_counts = self.world.encoder_counts
+        self.sensors = SimSensors(
+            self.world,
+            self.scene,
+            tuple(TruthCircle(x=c.x, y=c.y, radius=c.radius) for c in self.obstacles),
+            Solids.of(solids),
+            settings.counts_per_turn,
+        )
         self.last_command_ns: int | None = None
         self.gate = LockstepGate(
             node.counters,
@@ -243,7 +240,7 @@ class Simulator(Component):
         the run can see that every reader of the simulator's topics is reached before the first
         step (a reader reached only later misses the first camera frame)."""
         if self.node.params["paused"]:
-            self.publishers[topics.SIM_CLOCK.name].put(Clock(stamp_ns=self.now_ns, paused=True))
+            self._put(topics.SIM_CLOCK, Clock(stamp_ns=self.now_ns, paused=True))
 
     def _paced_tick(self) -> None:
         """Timer at the real-time factor's pace: step unless paused or an answer is awaited."""
@@ -273,7 +270,7 @@ class Simulator(Component):
         # On host time the stamps are the host's: the paced steps lag it under load.
         host = self.node.params["host_epoch"]
         self.now_ns = time.time_ns() if host else self.now_ns + self.step_ns
-        self.publishers[topics.SIM_CLOCK.name].put(Clock(stamp_ns=self.now_ns))
+        self._put(topics.SIM_CLOCK, Clock(stamp_ns=self.now_ns))
         self.frame_done = self.camera is None or self.now_ns < self.next_frame_ns
         self._go_on()
 
@@ -307,9 +304,17 @@ class Simulator(Component):
         if self.sensors_ns == self.now_ns:
             return
         self.sensors_ns = self.now_ns
-        self._publish_joints()
-        self._publish_odometry()
-        self._publish_truth()
+        sensors = self.sensors
+        self._put(
+            topics.ARM_JOINT_STATES, sensors.joints(self._header("arm", topics.ARM_JOINT_STATES))
+        )
+        self._put(
+            topics.BASE_ODOMETRY, sensors.odometry(self._header("odom", topics.BASE_ODOMETRY))
+        )
+        self.node.counters["contacts"] = self.world.contacts
+        self.node.counters["arm_penetrations"] = self.world.arm_penetrations
+        header = self._header("world", topics.SIM_TRUTH)
+        self._put(topics.SIM_TRUTH, sensors.truth(header, self.node.params["goal_marker"]))
 
     def _answer_handler(self, name: str):
         def on_answer(message) -> None:
@@ -360,72 +365,8 @@ class Simulator(Component):
     def _header(self, frame: str, topic: topics.Topic):
         return self.node.header(frame, self.now_ns, self.publishers[topic.name].next_seq)
 
-    def _publish_joints(self) -> None:
-        q = self.world.q
-        self.publishers[topics.ARM_JOINT_STATES.name].put(
-            JointStates(
-                header=self._header("arm", topics.ARM_JOINT_STATES),
-                names=JOINT_NAMES,
-                positions=tuple(q[3:].tolist()),
-                velocities=tuple(self.world.joint_velocities.tolist()),
-            )
-        )
-
-    def _publish_odometry(self) -> None:
-        counts = self.world.encoder_counts
-        d_left, d_right = (
-            (c - c0) * self.metres_per_count for c, c0 in zip(counts, self.last_counts, strict=True)
-        )
-        self.last_counts = counts
-        self.odometry_pose = dead_reckoning(
-            *self.odometry_pose, d_left, d_right, self.robot.base.wheel_base
-        )
-        left, right = self.world.wheel_speeds
-        x, y, phi = self.odometry_pose
-        self.publishers[topics.BASE_ODOMETRY.name].put(
-            BaseOdometry(
-                header=self._header("odom", topics.BASE_ODOMETRY),
-                left_encoder=counts[0],
-                right_encoder=counts[1],
-                left_distance=counts[0] * self.metres_per_count,
-                right_distance=counts[1] * self.metres_per_count,
-                x=x,
-                y=y,
-                phi=phi,
-                forward_velocity=0.5 * (left + right),
-                angular_velocity=(right - left) / self.robot.base.wheel_base,
-            )
-        )
-
-    def _publish_truth(self) -> None:
-        q = self.world.q
-        self.node.counters["contacts"] = self.world.contacts
-        self.node.counters["arm_penetrations"] = self.world.arm_penetrations
-        self.publishers[topics.SIM_TRUTH.name].put(
-            SimTruth(
-                header=self._header("world", topics.SIM_TRUTH),
-                base_pose=tuple(q[:3].tolist()),
-                arm_joints=tuple(q[3:].tolist()),
-                end_effector=tuple(self.world.end_effector.tolist()),
-                contacts=self.world.contacts,
-                in_contact=self.world.in_contact,
-                goal=self._true_goal(),
-                reference_pose=self.scene.reference_pose,
-                obstacles=self.truth_obstacles,
-                solids=self.truth_solids,
-                arm_penetrations=self.world.arm_penetrations,
-                arm_penetrating=self.world.arm_penetrating,
-            )
-        )
-
-    def _true_goal(self) -> tuple[float, ...]:
-        """x_d in this world (eq. 6.3): the bin marker's pose times the scene's offset; worked
-        out again only when ``goal_marker`` changes."""
-        placed = self.node.params["goal_marker"]
-        if self.goal_of[0] != placed:
-            goal = goal_above(placed, self.scene.goal.height_m, self.scene.goal.offset)
-            self.goal_of = (placed, tuple(goal.tolist()))
-        return self.goal_of[1]
+    def _put(self, topic: topics.Topic, message) -> None:
+        self.publishers[topic.name].put(message)
 
     # -- the camera -----------------------------------------------------------------------
 
