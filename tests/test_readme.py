@@ -9,7 +9,7 @@ import re
 import subprocess
 from pathlib import Path
 
-from deploy import DEPLOY
+from profiles.deploy_files import DEPLOY
 
 ROOT = DEPLOY.parent
 SAFETY_NET_S = 900
@@ -52,6 +52,7 @@ def test_the_first_hour_of_the_readme_runs_as_written(tmp_path: Path) -> None:
     layout = json.loads((tmp_path / "station.json").read_text())
     assert "sim/goal/request" in json.dumps(layout["content"])
     # the emulated hardware: the drivers on the emulated devices, stopped after its duration
-    assert re.search(r"\[launch\] started base_driver", result.stderr), result.stderr[-3000:]
-    assert re.search(r"\[launch\] started arm_driver", result.stderr), result.stderr[-3000:]
+    for driver in ("base_driver", "arm_driver"):
+        assert f"[launch] {driver} alive" in result.stderr, result.stderr[-3000:]
+    assert "[launch] stopping (end of duration)" in result.stderr
     assert "Traceback" not in result.stderr
