@@ -52,15 +52,10 @@ HOLD_SPEED = 1
 """The Moving Speed of a held joint: the slowest there is (0 would mean full speed)."""
 
 
-def ids_of(text: object) -> tuple[int, ...]:
-    """``"1, 2, 3, 4, 5"`` as five servo ids, or ``ParamError``."""
-    try:
-        ids = tuple(int(v) for v in str(text).split(","))
-    except ValueError as error:
-        raise ParamError(f"ids: {error}") from error
-    if len(ids) != ARM_JOINTS or len(set(ids)) != ARM_JOINTS or not all(0 <= i < 254 for i in ids):
-        raise ParamError(f"ids: expected {ARM_JOINTS} distinct ids in 0..253, got {text!r}")
-    return ids
+def check_ids(ids: tuple[int, ...]) -> None:
+    """``ParamError`` unless the servo ids are distinct and in 0..253."""
+    if len(set(ids)) != len(ids) or not all(0 <= i < 254 for i in ids):
+        raise ParamError(f"ids: expected {ARM_JOINTS} distinct servo ids in 0..253, got {ids}")
 
 
 class ArmDriver(Component):
@@ -71,7 +66,15 @@ class ArmDriver(Component):
     params = (
         Param("port", str, "/dev/ttyUSB1", doc="serial port of the servo bus"),
         Param("baud", int, 1_000_000, low=9600, high=3_000_000, doc="bus speed, bit/s"),
-        Param("ids", str, "1, 2, 3, 4, 5", doc="servo ids of q1..q5", can_take=ids_of),
+        Param(
+            "ids",
+            tuple,
+            (1, 2, 3, 4, 5),
+            length=ARM_JOINTS,
+            integers=True,
+            doc="servo ids of q1..q5, [1, 2, 3, 4, 5]",
+            can_take=check_ids,
+        ),
         Param("rate_hz", float, 50.0, low=1.0, high=200.0, doc="joint state rate"),
         Param(
             "command_timeout_s",
@@ -120,7 +123,7 @@ class ArmDriver(Component):
             min(dxl.POSITION_MAX, math.floor(dxl.position_of_angle(q))) for q in self.high
         ]
         """The Goal Positions inside the joint limits (every goal written lies in them)."""
-        self.ids = ids_of(node.params["ids"])
+        self.ids: tuple[int, ...] = node.params["ids"]
         self.port = PortHandler(str(node.params["port"]))
         self.packet = PacketHandler(1.0)
         self.connected = False

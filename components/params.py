@@ -36,11 +36,32 @@ class ParamError(ValueError):
 @dataclass(frozen=True)
 class Param(GainSpec):
     """A declared parameter: a ``GainSpec`` (name, type, default, bounds, choices, doc; its
-    validator), with an optional ``can_take`` check."""
+    validator), with an optional ``can_take`` check. A vector (``tuple``) may hold
+    ``integers`` (servo ids) rather than floats, and may be ``optional``: empty for none."""
 
     can_take: Callable[[ParamValue], None] | None = field(default=None, compare=False)
     """Raises ``ParamError`` when a value of the right type could not take effect (a robot
     file that does not load): such a value is refused when set, not failed on later."""
+    integers: bool = False
+    """A vector of integers, held as ints (a float, even 1.0, is refused)."""
+    optional: bool = False
+    """A vector that may be empty, ``[]``: none given."""
+
+    def expected(self) -> str:
+        if self.type is not tuple or not (self.integers or self.optional):
+            return super().expected()
+        what = f"{self.length} {'integers' if self.integers else 'finite numbers'}"
+        return f"{what} in a list, or [] for none" if self.optional else f"{what} in a list"
+
+    def _vector(self, row: object) -> tuple:
+        if self.optional and isinstance(row, tuple | list) and not row:
+            return ()
+        numbers = super()._vector(row)
+        if not self.integers:
+            return numbers
+        if not all(isinstance(v, int) for v in row):  # super() refused bools and non-numbers
+            raise ValueError(row)
+        return tuple(row)
 
     @classmethod
     def of(cls, spec: GainSpec) -> Param:

@@ -6,7 +6,7 @@ arm joints ``q1..q5``; its end effector is left at ``IDENTITY_POSE`` (a
 consumer computes kinematics from the configuration). The goal is a position
 ``(goal_x, goal_y, goal_z)``, or with ``goal_task: pose`` the pose at that
 position rotated ``goal_yaw`` about the world z axis, unless ``goal_pose`` gives the
-whole pose as eight comma-separated numbers (a unit dual quaternion). Parameters changed
+whole pose as a list of eight numbers (a unit dual quaternion). Parameters changed
 with ``parsimony param set`` apply from the next message (``rate_hz`` from the next period).
 """
 
@@ -40,7 +40,14 @@ class ScriptedPublisher(Component):
         Param("goal_y", float, 0.0, doc="goal position y, m"),
         Param("goal_z", float, 0.5, doc="goal position z, m"),
         Param("goal_yaw", float, 0.0, doc="goal rotation about z for a pose task, rad"),
-        Param("goal_pose", str, "", doc="the pose task's goal: 8 comma-separated numbers"),
+        Param(
+            "goal_pose",
+            tuple,
+            (),
+            length=8,
+            optional=True,
+            doc="the pose task's goal: 8 numbers, a unit dual quaternion; [] for none",
+        ),
     )
 
     def __init__(self, node: Node) -> None:
@@ -66,8 +73,7 @@ class ScriptedPublisher(Component):
         )
         position = (p["goal_x"], p["goal_y"], p["goal_z"])
         if p["goal_task"] == "pose" and p["goal_pose"]:
-            pose = tuple(float(v) for v in str(p["goal_pose"]).split(","))
-            self.goal.put(Goal(header=header, task="pose", pose=pose))
+            self.goal.put(Goal(header=header, task="pose", pose=p["goal_pose"]))
         elif p["goal_task"] == "pose":
             rotation = dq.rotation_quaternion(float(p["goal_yaw"]), [0.0, 0.0, 1.0])
             pose = tuple(float(v) for v in dq.pose(rotation, position))

@@ -21,7 +21,7 @@ import yaml
 
 from components.lp_controller import LPController
 from components.runtime import Node
-from deploy import DEPLOY, ROBOT_FILE, query
+from launch import query
 from messages import codec, topics
 from messages.commands import ArmCommand, BaseCommand
 from messages.diagnostics import ControllerDiagnostics
@@ -29,6 +29,7 @@ from messages.goal import Goal
 from messages.header import Header
 from messages.state import RobotState
 from parsimony.commands import param
+from profiles.deploy_files import DEPLOY, ROBOT_FILE
 from profiles.profile import load_profile
 from wbc.geometry.scenarios import NEAR_START, REACH_GOAL
 from wbc.robot import MobileManipulator
@@ -184,8 +185,7 @@ def test_the_profile_starts_inside_the_joint_limits_with_the_pose_of_goal_q_as_g
     assert tuple(params[name] for name in names) == START
     assert np.all(ROBOT.q_min < START) and np.all(np.array(START) < ROBOT.q_max)
     assert np.all(ROBOT.q_min < GOAL_Q) and np.all(np.array(GOAL_Q) < ROBOT.q_max)
-    goal = [float(value) for value in params["goal_pose"].split(",")]
-    np.testing.assert_allclose(goal, GOAL_POSE, atol=1e-12)
+    np.testing.assert_allclose(params["goal_pose"], GOAL_POSE, atol=1e-12)
 
 
 @pytest.mark.parametrize(("profile", "law"), [(LP_PROFILE, "lp"), (CASCADE_PROFILE, "cascade")])

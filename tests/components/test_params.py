@@ -6,8 +6,12 @@ import math
 
 import pytest
 
+from components.arm_driver import ArmDriver
 from components.params import Param, ParamError, Parameters
+from components.scripted_publisher import ScriptedPublisher
 from messages.process import decode_value, encode_value
+from profiles.deploy_files import DEPLOY
+from profiles.profile import load_profile
 
 RATE = Param("rate_hz", float, 10.0, low=0.1, high=100.0)
 TASK = Param("task", str, "pose", choices=("pose", "position"))
@@ -118,3 +122,44 @@ def test_every_gain_of_a_law_is_a_parameter_with_the_bounds_its_dataclass_declar
         if spec.high is not None:
             with pytest.raises(ParamError, match=spec.name):
                 param.check(spec.high * 2 + 1)
+
+
+def test_the_arm_drivers_servo_ids_are_five_distinct_integers_and_say_so() -> None:
+    ids = Parameters(ArmDriver.params, {"ids": [5, 4, 3, 2, 1]})["ids"]
+    assert ids == (5, 4, 3, 2, 1) and all(type(i) is int for i in ids)
+    assert Parameters(ArmDriver.params, {}).set_text("ids", "[1, 2, 3, 4, 6]") == (1, 2, 3, 4, 6)
+    for value, message in [
+        ("1, 2, 3, 4, 5", "ids: expected 5 integers in a list, got '1, 2, 3, 4, 5'"),
+        ([1, 2, 3, 4, 5.0], "ids: expected 5 integers in a list"),
+        ([1, 2, 3, 4], "ids: expected 5 integers in a list"),
+        ([1, 1, 2, 3, 4], "ids: expected 5 distinct servo ids in 0..253, got (1, 1, 2, 3, 4)"),
+        ([1, 2, 3, 4, 254], "ids: expected 5 distinct servo ids in 0..253"),
+    ]:
+        with pytest.raises(ParamError) as error:
+            Parameters(ArmDriver.params, {"ids": value})
+        assert message in str(error.value)
+
+
+def test_the_scripted_goal_pose_is_eight_numbers_or_none() -> None:
+    assert Parameters(ScriptedPublisher.params, {})["goal_pose"] == ()
+    pose = Parameters(ScriptedPublisher.params, {"goal_pose": [1, 0, 0, 0, 0, 0, 0, 0.5]})
+    assert pose["goal_pose"] == (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.5)
+    assert pose.set_text("goal_pose", "[]") == ()
+    for value in ("1, 0, 0, 0, 0, 0, 0, 0", [1, 0, 0, 0, 0, 0, 0], [math.nan] * 8):
+        with pytest.raises(ParamError, match="goal_pose: expected 8 finite numbers in a list, or"):
+            Parameters(ScriptedPublisher.params, {"goal_pose": value})
+
+
+@pytest.mark.parametrize(
+    ("profile", "name", "component", "param", "length"),
+    [
+        ("hardware.yaml", "arm_driver", ArmDriver, "ids", 5),
+        ("controllers.yaml", "publisher", ScriptedPublisher, "goal_pose", 8),
+    ],
+)
+def test_the_profiles_that_set_a_vector_load_it_typed(
+    profile: str, name: str, component: type, param: str, length: int
+) -> None:
+    spec = load_profile(DEPLOY / profile).component(name)
+    value = Parameters(component.params, spec.params)[param]
+    assert isinstance(value, tuple) and len(value) == length
