@@ -100,7 +100,7 @@ class Supervisor(Component):
         Param(
             "pose_tolerance",
             float,
-            5e-3,
+            DEFAULTS.pose_tolerance,
             low=1e-5,
             high=0.5,
             doc="||e|| of the goal's task under which it counts as reached (||vec8(x - x_d)||"

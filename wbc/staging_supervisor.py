@@ -74,8 +74,10 @@ class SupervisorParams:
     """The alignment ends with the heading this close, rad."""
     arm_tolerance: float = 0.01
     """The approach ends with every arm joint this close to the candidate's, rad."""
-    pose_tolerance: float = 1e-3
-    """The goal is reached when ||vec8(x - x_d)|| is below this."""
+    pose_tolerance: float = 5e-3
+    """The goal is reached when ||vec8(x - x_d)|| is below this: the running supervisor's
+    default (``components.supervisor``), looser than a kinematic run's 1e-3 as a measured pose
+    jitters; a kinematic run passes its own (``goal_sets.TOLERANCE``)."""
     stall_window_s: float = 2.0
     stall_reduction: float = 0.03
     max_replans: int = 3

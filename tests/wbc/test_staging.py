@@ -25,6 +25,8 @@ from wbc.staging_supervisor import Phase, StagingSupervisor, SupervisorParams
 from wbc.task import PoseTask
 
 MODEL = robot()
+KINEMATIC = SupervisorParams(pose_tolerance=1e-3)
+"""A kinematic run's tolerance (the measured pose's default is looser)."""
 STEPS = int(60.0 / DT)
 
 
@@ -108,7 +110,7 @@ def test_candidates_keep_the_base_clear_of_obstacles() -> None:
 
 def test_a_goal_behind_the_robot_is_reached_through_lp_steps_within_the_limits() -> None:
     goal = MODEL.fkm(np.array([-0.7, 0.3, math.pi - 0.4, 0.2, -0.3, -0.4, 0.2, 0.3]))
-    supervisor = StagingSupervisor(MODEL, goal)
+    supervisor = StagingSupervisor(MODEL, goal, params=KINEMATIC)
     run = integrate_supervised(LPLaw(MODEL), supervisor, HOME, DT, STEPS)
     assert run.converged and supervisor.phase is Phase.REACHED
     assert [e.detail for e in supervisor.events if e.kind == "phase"][-1] == "pose"
@@ -119,7 +121,7 @@ def test_a_goal_behind_the_robot_is_reached_through_lp_steps_within_the_limits()
     assert np.all(np.abs(u) <= MODEL.velocity_max + 1e-9)
     assert all(out.status == "optimal" for out in run.outputs)
     x = MODEL.fkm(run.configurations[-1])
-    assert np.linalg.norm(x - dq.nearest_equivalent(goal, x)) < 1e-3
+    assert np.linalg.norm(x - dq.nearest_equivalent(goal, x)) < KINEMATIC.pose_tolerance
 
 
 def test_a_goal_no_configuration_reaches_is_reported_at_once_and_gives_no_task() -> None:
@@ -165,7 +167,7 @@ def test_the_supervisor_drives_round_a_circle_on_the_straight_way_without_contac
     goal = MODEL.fkm(np.array([1.4, 0.0, 0.0, 0.0, -0.3, -0.4, 0.2, 0.3]))
     post = Circle(0.7, 0.02, 0.1)
     law = LPLaw(MODEL, supervised_params())
-    supervisor = StagingSupervisor(MODEL, goal, [post])
+    supervisor = StagingSupervisor(MODEL, goal, [post], params=KINEMATIC)
     run = integrate_supervised(law, supervisor, HOME, DT, STEPS, [post])
     assert run.converged and supervisor.phase is Phase.REACHED, supervisor.events
     way = supervisor.tried[0].way
@@ -177,7 +179,7 @@ def test_the_supervisor_drives_round_a_circle_on_the_straight_way_without_contac
     assert gap.min() > 0.0
     assert all(out.status == "optimal" for out in run.outputs)
     x = MODEL.fkm(run.configurations[-1])
-    assert np.linalg.norm(x - dq.nearest_equivalent(goal, x)) < 1e-3
+    assert np.linalg.norm(x - dq.nearest_equivalent(goal, x)) < KINEMATIC.pose_tolerance
 
 
 def test_the_pose_task_alone_is_what_runs_once_the_base_stands_at_its_candidate() -> None:
