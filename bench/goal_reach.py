@@ -7,10 +7,12 @@ two) is drawn from each seed (2 is the bench's; the default law's terms were tun
 and each law runs every goal as ``parsimony bench`` runs it (60 s at 50 Hz): the default LP,
 each ``--variant`` (LPParams() with those gains changed, on the same goals) and, with
 ``--supervised``, the LP under the staging supervisor. Printed per set and law: the share
-reached inside every limit and the median nonzero entries of u while moving; per family and
-law, the goals missed: with the goal's gripper within FOLDED m of its base (the arm bent back
-over it), with a joint at the edge of the law's joint box (which), and with the base's heading
-more than HEADING_OFF from the goal configuration's when the run ended.
+reached inside every limit and the median nonzero entries of u while moving; then per family
+and law, over all its sets (the note on goal reach quotes these): the share reached, the worst
+and the best set, the median nonzero entries while moving, and the goals missed: with the
+goal's gripper within FOLDED m of its base (the arm bent back over it), with a joint at the
+edge of the law's joint box (which), and with the base's heading more than HEADING_OFF from
+the goal configuration's when the run ended.
 """
 
 from __future__ import annotations
@@ -105,11 +107,21 @@ def measure(
                     )
             for name, runs in found.items():
                 pairs, attempts = [run[0] for run in runs], [run[1] for run in runs]
+                sets = [
+                    row["reached inside every limit"]
+                    for row in rows
+                    if row["family"] == family and row["law"] == name
+                ]
                 missed.append(
                     {
                         "family": family,
                         "law": name,
+                        "seeds": ",".join(map(str, seeds)),
                         "goals": len(runs),
+                        "reached": shares(attempts)["within_joint_and_speed_limits"],
+                        "worst set": min(sets),
+                        "best set": max(sets),
+                        "nonzero moving": parsimony(attempts, robot.dof)["median_nonzero_moving"],
                         **misses(pairs, attempts, robot),
                     }
                 )

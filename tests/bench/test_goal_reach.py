@@ -20,7 +20,8 @@ def run(*args: str) -> subprocess.CompletedProcess[str]:
 
 def test_the_bench_says_how_often_each_law_reaches_each_set_and_why_it_misses() -> None:
     """Goals with the arm bent back over the base: the LP alone misses one of the four of
-    seed 2, its base turned away, where the supervised LP reaches all."""
+    seed 2, its base turned away, where the supervised LP reaches all; the family's summary
+    says so over its sets."""
     done = run(
         "--families",
         WIDE,
@@ -41,6 +42,10 @@ def test_the_bench_says_how_often_each_law_reaches_each_set_and_why_it_misses() 
     assert rows["lp + staging supervisor"]["reached inside every limit"] == 1.0
     misses = {row["law"]: row for row in report["misses"]}
     assert misses["lp"]["missed"] == 1 and misses["lp"]["base heading off"] == 1
+    assert misses["lp"]["seeds"] == "2" and misses["lp"]["goals"] == 4
+    assert misses["lp"]["reached"] == misses["lp"]["worst set"] == 0.75
+    assert misses["lp + staging supervisor"]["reached"] == 1.0
+    assert misses["lp"]["nonzero moving"] <= 7
     assert "missed" not in misses["lp + staging supervisor"]
     assert f"bench: {WIDE}, seed 2" in done.stderr  # progress goes to stderr
 
