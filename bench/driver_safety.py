@@ -34,11 +34,12 @@ from pathlib import Path
 import yaml
 
 from bench.figures import run_bench, spread
-from deploy import DEPLOY, query
+from launch import query
 from messages import codec, topics
 from messages.commands import ArmCommand, BaseCommand
 from messages.header import Header
 from parsimony.output import result_only_stdout, table
+from profiles.deploy_files import DEPLOY
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from profiles.profile_files import read_profile_data

@@ -26,10 +26,10 @@ from typing import Any
 
 import numpy as np
 
-from deploy import ROBOT_FILE
 from parsimony.goal_families import FAMILIES, goals
 from parsimony.goal_sets import LAWS, SUPERVISED, Attempt, attempt, parsimony, shares
 from parsimony.output import emit, json_text, result_only_stdout, table
+from profiles.deploy_files import ROBOT_FILE
 from wbc import dq
 from wbc.lp_law import LPLaw, LPParams
 from wbc.planar import wrap

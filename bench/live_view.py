@@ -37,8 +37,8 @@ import yaml
 import zenoh
 
 from bench.figures import run_bench
-from deploy import query
-from deploy.launcher import cpu_seconds
+from launch import query
+from launch.launcher import cpu_seconds
 from messages import codec, topics
 from messages.markers import MarkerDetections
 from messages.supervisor import SupervisorStatus

@@ -17,7 +17,6 @@ from typing import Any
 
 import zenoh
 
-from deploy import ROBOT_FILE
 from messages import codec, topics
 from messages.base import IDENTITY_POSE
 from messages.camera import CameraFrame, CameraIntrinsics
@@ -25,6 +24,7 @@ from messages.goal import Goal
 from messages.header import Header
 from messages.obstacles import Circle, Obstacles
 from messages.state import RobotState
+from profiles.deploy_files import ROBOT_FILE
 from profiles.profile import ZenohSettings
 from wbc.geometry.scenarios import NEAR_START, REACH_GOAL
 from wbc.robot import MobileManipulator

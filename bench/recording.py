@@ -53,7 +53,7 @@ from bench.long_sessions import memory_use, repeated_session
 from bench.pubsub_workers import NAMESPACE, WAIT_S, message
 from bench.sim_experiments import percentile
 from components.simulator import JOINT_NAMES
-from deploy import query
+from launch import query
 from messages import codec, topics
 from messages.camera import CameraFrame, CameraIntrinsics
 from messages.header import Header

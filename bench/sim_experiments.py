@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from deploy.query import QueryError
+from launch.query import QueryError
 from parsimony.output import emit, json_text, result_only_stdout, table
 from profiles.profile import ProfileError, load_profile
 from sim2d.camera import ImageNoise, PlacedMarker, Renderer, ceiling_camera

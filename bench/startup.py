@@ -22,9 +22,9 @@ import yaml
 import zenoh
 
 from bench.figures import run_bench, spread
-from deploy import DEPLOY
 from messages import process, topics
 from parsimony.output import result_only_stdout, table
+from profiles.deploy_files import DEPLOY
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from profiles.profile_files import read_profile_data

@@ -51,7 +51,7 @@ from bench.pubsub_workers import (
     subscriber_main,
 )
 from components.runtime import Node
-from deploy import query
+from launch import query
 from messages import topics
 from messages.process import stop
 from parsimony.output import emit, json_text, result_only_stdout, table

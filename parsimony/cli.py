@@ -9,7 +9,7 @@ import sys
 
 from mcap.exceptions import McapError
 
-from deploy.query import QueryError
+from launch.query import QueryError
 from parsimony.output import result_only_stdout
 from parsimony.target_options import exit_code
 

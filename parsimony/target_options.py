@@ -6,7 +6,7 @@ import argparse
 import os
 import sys
 
-from deploy.query import DEFAULT_TIMEOUT_S, NoRouter, QueryError, Target
+from launch.query import DEFAULT_TIMEOUT_S, NoRouter, QueryError, Target
 from profiles.profile import Profile, ProfileError, load_profile
 
 PROFILE_ENV = "PARSIMONY_PROFILE"

@@ -190,7 +190,7 @@ class RestartPolicy(StrictModel):
 def _param_value(value: object) -> ParamValue:
     """A parameter's value as a profile gives it: a number, a flag, a word, or a list (of
     numbers, or of lists of numbers); what the component declares is checked later
-    (``deploy.graph.dataflow``)."""
+    (``launch.graph.dataflow``)."""
 
     def numbers(row: object) -> bool:
         return isinstance(row, list | tuple) and all(

@@ -15,9 +15,9 @@ from typing import Any
 
 import numpy as np
 
-from deploy import ROBOT_FILE
 from parsimony.goal_sets import goal_report
 from parsimony.output import table
+from profiles.deploy_files import ROBOT_FILE
 from studies.gain_sets import TABLE_PARAMS, WITHOUT_ARM_ROWS
 from studies.reproduce import efficiency
 from wbc import dq

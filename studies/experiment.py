@@ -49,12 +49,13 @@ from analysis.report import write_report
 from components.cascade_controller import CascadeController
 from components.lp_controller import LPController
 from components.qp_controller import QPController
-from deploy import DEPLOY, query
+from launch import query
 from messages import codec, process, topics
 from messages.obstacles import Solids
 from messages.topics import CONTROL_DIAGNOSTICS, ROBOT_STATE, SIM_TRUTH, SUPERVISOR_STATUS
 from parsimony.output import json_text
 from parsimony.outputs import written_whole
+from profiles.deploy_files import DEPLOY
 from profiles.endpoints import free_port
 from profiles.profile import Profile, ProfileError, load_profile
 from profiles.recorder import recorder_component

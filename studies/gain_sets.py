@@ -9,7 +9,7 @@ import functools
 from dataclasses import replace
 from typing import Any
 
-from deploy import DEPLOY
+from profiles.deploy_files import DEPLOY
 from profiles.profile import load_profile
 from wbc.lp_law import LPParams, default_objectives
 from wbc.objectives.input_change import InputChangeGains

@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from deploy import ROBOT_FILE
 from parsimony.output import table
+from profiles.deploy_files import ROBOT_FILE
 from studies.gain_sets import BORDER_PARAMS, LP_PARAMS, TABLE_PARAMS, WITHOUT_ARM_ROWS
 from wbc import dq
 from wbc.cascade_law import CascadeLaw

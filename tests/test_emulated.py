@@ -16,8 +16,9 @@ from pathlib import Path
 import pytest
 import yaml
 
-from deploy import DEPLOY, query
+from launch import query
 from messages import codec, topics
+from profiles.deploy_files import DEPLOY
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from profiles.profile_files import read_profile_data

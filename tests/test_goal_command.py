@@ -19,7 +19,7 @@ import pytest
 import yaml
 import zenoh
 
-from deploy import query
+from launch import query
 from messages import codec, topics
 from messages.goal import Goal
 from messages.state import RobotState

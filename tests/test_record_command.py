@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from deploy.query import live_components, statuses
+from launch.query import live_components, statuses
 from messages import codec, topics
 from messages.clock import Clock
 from messages.goal import Goal

@@ -17,9 +17,10 @@ import yaml
 import zenoh
 from mcap.reader import make_reader
 
-from deploy import DEPLOY, query
+from launch import query
 from messages import codec, process, topics
 from messages.process import EXIT_FOR_GOOD
+from profiles.deploy_files import DEPLOY
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.session_reader import info, read_session, recover

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import yaml
 
-from deploy.query import live_components
+from launch.query import live_components
 from messages import topics
 from messages.clock import Clock
 from messages.commands import ArmCommand

@@ -5,7 +5,7 @@ The listener of the live view's server (``view.live_view``):
 - Goals (``ClientPublish``): a client advertises a channel on goal/request (its key in the
   namespace, or its name) in JSON, a ``foxglove.PoseInFrame`` or ``foxglove.Pose`` (the 3-D
   panel's publish-pose tool); each message is checked (``view.client_goals``) and put on
-  goal/request, stamped on the namespace's clock (``deploy.tool_clock``). Only when the view's
+  goal/request, stamped on the namespace's clock (``launch.tool_clock``). Only when the view's
   user may write goal/request (the profile's ``zenoh.access``): otherwise the capability is
   not advertised, and the server itself refuses any advertisement. A client sends at most
   ``client_limits.GOAL_RATE``; a goal over it is dropped, and the client told so.
@@ -44,8 +44,8 @@ from foxglove.websocket import (
     WebSocketServer,
 )
 
-from deploy.tool_clock import ToolClock
-from deploy.zenoh_error import is_session_error, zenoh_error_text
+from launch.tool_clock import ToolClock
+from launch.zenoh_error import is_session_error, zenoh_error_text
 from messages import codec, topics
 from messages.header import Header
 from messages.obstacles import circles_of

@@ -3,7 +3,7 @@ the panel carried to the component as `parsimony param set` carries it.
 
 A parameter is named ``<component>.<name>`` (``controller.eta``). The values come from one query
 of every component's parameter queryables; a set is the component's own set
-(``deploy.query.set_param``): the component parses and checks the value against its
+(``launch.query.set_param``): the component parses and checks the value against its
 declaration (type, bounds, choices) and answers the value it now has, or why it refused it.
 Before that, ``checked`` refuses what must not reach Zenoh or the component (a name no running
 component has, or too long: a key of 64 KiB panics Zenoh; a value of no parameter's type, or
@@ -17,7 +17,7 @@ from collections.abc import Callable, Iterable, Sequence
 import zenoh
 from foxglove import Parameter, ParameterType
 
-from deploy.query import DEFAULT_TIMEOUT_S, QueryError, set_param, value_text
+from launch.query import DEFAULT_TIMEOUT_S, QueryError, set_param, value_text
 from messages import topics
 from messages.process import ParamValue, decode_value
 from view.client_limits import (

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import yaml
 
-from deploy.query import QueryError
+from launch.query import QueryError
 from parsimony.output import emit, json_text
 from profiles.profile import ProfileError
 from sim2d.scenarios import NAMES, SEED_MAX

@@ -2,10 +2,10 @@
 
 The goal is built as a client's goal of the live view is (``view.client_goals``: finite, a
 unit quaternion, above the floor, not inside an obstacle nor farther than a plan may cover
-from the robot), stamped on the profile's clock (``deploy.tool_clock``) and sent the way the
+from the robot), stamped on the profile's clock (``launch.tool_clock``) and sent the way the
 profile takes goals: on ``goal/request`` where a component (the staging supervisor) reads it,
 else on ``control/goal``. With --wait it follows ``supervisor/status``
-(``deploy.goal_follower``), its phases and the goal's error on stderr, until the goal is
+(``launch.goal_follower``), its phases and the goal's error on stderr, until the goal is
 reached (exit 0) or ends otherwise: unreachable, refused, aborted (exit 1). Input that cannot
 be used exits 2.
 """
@@ -21,10 +21,10 @@ import threading
 import numpy as np
 import zenoh
 
-from deploy.goal_follower import GoalFollower, Outcome
-from deploy.graph import dataflow
-from deploy.query import QueryError, live_writers, overwritten_by
-from deploy.tool_clock import ToolClock
+from launch.goal_follower import GoalFollower, Outcome
+from launch.graph import dataflow
+from launch.query import QueryError, live_writers, overwritten_by
+from launch.tool_clock import ToolClock
 from messages import codec, topics
 from messages.goal import Goal
 from messages.header import Header

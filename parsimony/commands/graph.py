@@ -8,7 +8,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from deploy.graph import dataflow
+from launch.graph import dataflow
 from parsimony.output import emit, json_text
 from profiles.profile import ProfileError, load_profile
 

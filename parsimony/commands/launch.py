@@ -11,9 +11,9 @@ from pathlib import Path
 
 import zenoh
 
-from deploy.graph import dataflow
-from deploy.launcher import Launcher
-from deploy.zenoh_error import zenoh_error_text
+from launch.graph import dataflow
+from launch.launcher import Launcher
+from launch.zenoh_error import zenoh_error_text
 from parsimony.commands.record import memory_file
 from parsimony.outputs import writable_output
 from profiles.profile import Profile, ProfileError, load_profile

@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 import json
 
-from deploy.graph import component_class
-from deploy.query import QueryError, status_of
+from launch.graph import component_class
+from launch.query import QueryError, status_of
 from parsimony.output import emit, json_text
 from parsimony.target_options import fail, profile_and_target, target_options
 from profiles.profile import ProfileError

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import yaml
 
-from deploy.graph import component_class
-from deploy.query import QueryError, all_params, get_param, set_param, value_text
+from launch.graph import component_class
+from launch.query import QueryError, all_params, get_param, set_param, value_text
 from parsimony.output import emit, json_text
 from parsimony.target_options import fail, profile_and_target, target_options
 from profiles.access import DEFAULT_TOOL_USER, USER_ENV

@@ -13,7 +13,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from deploy.query import QueryError, Target
+from launch.query import QueryError, Target
 from messages.process import PARENT_PID_ENV
 from messages.topics import topics_matching
 from parsimony.output import emit

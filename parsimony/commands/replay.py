@@ -34,9 +34,9 @@ from pathlib import Path
 
 import zenoh
 
-from deploy.graph import component_class
-from deploy.query import NoRouter, QueryError, Target, live_components
-from deploy.zenoh_error import zenoh_error_text
+from launch.graph import component_class
+from launch.query import NoRouter, QueryError, Target, live_components
+from launch.zenoh_error import zenoh_error_text
 from messages import topics
 from parsimony.commands.launch import positive, positive_seconds
 from parsimony.commands.view import namespace_argument, port_number, serving, watched_profile

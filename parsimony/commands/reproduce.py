@@ -8,10 +8,10 @@ import sys
 from dataclasses import asdict
 from pathlib import Path
 
-from deploy import ROBOT_FILE
-from deploy.query import QueryError
+from launch.query import QueryError
 from parsimony.commands.experiment import time_limit
 from parsimony.output import emit, json_text
+from profiles.deploy_files import ROBOT_FILE
 from profiles.profile import ProfileError, load_profile
 from studies.experiment import PROFILES, TIME_LIMIT_S
 from studies.reproduce import NAMES, TRIALS, format_laws, format_rows, reproduce, write_figures

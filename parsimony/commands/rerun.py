@@ -23,12 +23,12 @@ from components.control_step import ControlStep, Step, gains_of
 from components.controller import Controller, diagnostics_of
 from components.lp_controller import LPController
 from components.qp_controller import QPController
-from deploy import ROBOT_FILE
 from messages.commands import ArmCommand, BaseCommand
 from messages.header import Header
 from messages.obstacles import obstacles_of
 from parsimony.output import emit
 from parsimony.outputs import writable_output, written_whole
+from profiles.deploy_files import ROBOT_FILE
 from record.session_file import Recorded, SessionWriter
 from record.session_reader import read_groups
 from wbc.robot import MobileManipulator, RobotDescriptionError

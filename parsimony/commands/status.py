@@ -8,8 +8,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from deploy.alive import wait_alive
-from deploy.query import (
+from launch.alive import wait_alive
+from launch.query import (
     DEFAULT_ROUTER,
     DEFAULT_TIMEOUT_S,
     QueryError,

@@ -14,9 +14,9 @@ import numpy as np
 import zenoh
 from pydantic import BaseModel, ValidationError
 
-from deploy.graph import dataflow
-from deploy.query import QueryError, live_writers, overwritten_by
-from deploy.tool_clock import ToolClock
+from launch.graph import dataflow
+from launch.query import QueryError, live_writers, overwritten_by
+from launch.tool_clock import ToolClock
 from messages import codec, topics
 from parsimony.output import emit, json_text
 from parsimony.target_options import fail, profile_and_target, target_options

@@ -24,7 +24,7 @@ from pathlib import Path
 import zenoh
 
 from components.rate_limited_log import RateLimitedLog
-from deploy.query import QueryError, Target
+from launch.query import QueryError, Target
 from messages.topics import Topic, check_namespace, topics_matching
 from parsimony.commands.layout import write_layout
 from parsimony.output import emit, json_text

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import pytest
 
-from deploy import ROBOT_FILE
 from messages.commands import ArmCommand, BaseCommand
 from messages.diagnostics import ControllerDiagnostics
 from messages.goal import Goal
@@ -19,6 +18,7 @@ from messages.topics import (
     CONTROL_GOAL,
     ROBOT_STATE,
 )
+from profiles.deploy_files import ROBOT_FILE
 from wbc.base_motion import unicycle, wheel_speeds
 from wbc.cascade_law import CascadeLaw
 from wbc.geometry import scenarios

@@ -9,7 +9,6 @@ import pytest
 import yaml
 
 from analysis.judge import HOLD_S, JUDGED, commands, commands_csv, effort, judge, origin_s, the_run
-from deploy import ROBOT_FILE
 from messages.goal import Goal
 from messages.obstacles import Circle, Plane, Solids
 from messages.supervisor import SupervisorStatus
@@ -21,6 +20,7 @@ from messages.topics import (
     SUPERVISOR_STATUS,
 )
 from messages.truth import SimTruth
+from profiles.deploy_files import ROBOT_FILE
 from record.sessions import load_session
 from tests.analysis.conftest import ROBOT, START_NS, session_of
 from tests.record.test_far_stamps import write

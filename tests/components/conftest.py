@@ -17,8 +17,8 @@ import yaml
 import zenoh
 from pydantic import BaseModel
 
-from deploy import DEPLOY
 from messages import codec, topics
+from profiles.deploy_files import DEPLOY
 from profiles.endpoints import free_port
 from profiles.profile import Profile, load_profile
 from profiles.profile_files import read_profile_data

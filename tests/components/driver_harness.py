@@ -9,8 +9,9 @@ from typing import TYPE_CHECKING
 
 import yaml
 
-from deploy import DEPLOY, query
+from launch import query
 from messages.status import ComponentStatus
+from profiles.deploy_files import DEPLOY
 from profiles.profile_files import read_profile_data
 from protocols import create_oi
 from sim2d.devices.pty_link import PtyLink

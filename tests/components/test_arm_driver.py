@@ -14,10 +14,10 @@ from conftest import System
 from driver_harness import driver_system, status
 
 from components.arm_driver import HOLD_SPEED
-from deploy import ROBOT_FILE
 from messages import codec, topics
 from messages.commands import ArmCommand
 from messages.header import Header
+from profiles.deploy_files import ROBOT_FILE
 from protocols import dynamixel_v1 as dxl
 from protocols.dynamixel_v1 import Address, StatusFault
 from sim2d.devices.ax_servos import AXChainEmulator, IntegratingJoints

@@ -13,7 +13,7 @@ import yaml
 from conftest import Inbox, System
 from driver_harness import DEPLOY, FakeLink, driver_system, frame, status
 
-from deploy import query
+from launch import query
 from messages import codec, topics
 from messages.commands import BaseCommand
 from messages.header import Header

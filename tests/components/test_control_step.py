@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 from components.control_step import ControlStep
-from deploy import ROBOT_FILE
 from messages.goal import Goal
 from messages.header import Header
 from messages.state import RobotState
+from profiles.deploy_files import ROBOT_FILE
 from studies.gain_sets import LP_PARAMS, input_change_gains
 from wbc.cascade_law import CascadeLaw, CascadeParams
 from wbc.gains import gain_specs

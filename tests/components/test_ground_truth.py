@@ -3,8 +3,8 @@ estimator and controller, so they see the world only through the sensors."""
 
 from __future__ import annotations
 
-from deploy import DEPLOY
 from messages import topics
+from profiles.deploy_files import DEPLOY
 
 
 def test_no_estimator_or_controller_may_read_the_ground_truth(deployed) -> None:

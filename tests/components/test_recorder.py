@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 import yaml
 import zenoh
 
-from deploy import query
+from launch import query
 from messages import codec, topics
 from messages.clock import Clock
 from profiles.endpoints import free_port

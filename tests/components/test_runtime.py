@@ -15,7 +15,7 @@ from components.params import Param
 from components.pubsub import Input
 from components.rate_limited_log import RateLimitedLog
 from components.runtime import Node
-from deploy import query
+from launch import query
 from messages import codec, topics
 from messages.base import IDENTITY_POSE
 from messages.goal import Goal

@@ -13,7 +13,6 @@ from typing import TYPE_CHECKING
 import pytest
 import yaml
 
-from deploy import DEPLOY
 from messages import codec, topics
 from messages.base import ARM_JOINTS
 from messages.clock import Clock
@@ -21,6 +20,7 @@ from messages.commands import ArmCommand, BaseCommand
 from messages.header import Header
 from messages.odometry import BaseOdometry
 from messages.truth import SimTruth
+from profiles.deploy_files import DEPLOY
 from wbc.robot import MobileManipulator
 
 if TYPE_CHECKING:

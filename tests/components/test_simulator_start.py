@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import pytest
 import yaml
 
-from deploy import DEPLOY
+from profiles.deploy_files import DEPLOY
 from wbc.geometry.start_inside import CONSEQUENCE
 
 if TYPE_CHECKING:

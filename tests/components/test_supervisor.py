@@ -16,14 +16,14 @@ from driver_harness import status as component_status
 from components.control_step import task_of
 from components.controller import goal_of
 from components.robot_sight import sight_region
-from deploy import DEPLOY, ROBOT_FILE
-from deploy.query import status_of
+from launch.query import status_of
 from messages import codec, topics
 from messages.goal import Goal
 from messages.header import Header
 from messages.obstacles import Circle, Obstacles
 from messages.state import RobotState
 from messages.supervisor import SupervisorStatus
+from profiles.deploy_files import DEPLOY, ROBOT_FILE
 from profiles.profile_files import read_profile_data
 from tests.wbc.crowd import CHECK_GAP_S, crowd
 from wbc import dq

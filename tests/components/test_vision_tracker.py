@@ -13,10 +13,11 @@ import numpy as np
 import pytest
 import yaml
 
-from deploy import DEPLOY, query
+from launch import query
 from messages import codec, topics
 from messages.camera import CameraFrame, CameraIntrinsics
 from messages.header import Header
+from profiles.deploy_files import DEPLOY
 from profiles.profile_files import read_profile_data
 from sim2d.camera import (
     ImageNoise,

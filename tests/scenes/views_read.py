@@ -10,9 +10,9 @@ from typing import Any
 
 import numpy as np
 
-from deploy import ROBOT_FILE
 from messages.header import Header
 from messages.state import RobotState
+from profiles.deploy_files import ROBOT_FILE
 from scenes.foxglove_views import View
 from wbc import dq
 from wbc.robot import MobileManipulator

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from components.simulator import Simulator
-from deploy import ROBOT_FILE
+from profiles.deploy_files import ROBOT_FILE
 from profiles.profile import load_profile
 from profiles.scene import Scene
 from sim2d.camera import PinholeCamera, ceiling_camera

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from deploy import ROBOT_FILE
+from profiles.deploy_files import ROBOT_FILE
 from sim2d.world import World, WorldSettings, wheel_distance_per_count
 from wbc.geometry.obstacles import Circle
 from wbc.geometry.obstacles3d import Plane

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from deploy import ROBOT_FILE
+from profiles.deploy_files import ROBOT_FILE
 from studies.benchmark import convergence_test
 from studies.reproduce.efficiency import section_6_3
 from wbc.robot import MobileManipulator

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from mcap.reader import make_reader
 
-from deploy import query
+from launch import query
 from messages.obstacles import Plane
 from profiles.profile import load_profile
 from record.session_reader import info

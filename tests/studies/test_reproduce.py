@@ -21,8 +21,8 @@ import numpy as np
 import pytest
 
 from analysis.judge import JUDGED, commands, messages, the_run
-from deploy import ROBOT_FILE
 from messages.topics import CONTROL_DIAGNOSTICS
+from profiles.deploy_files import ROBOT_FILE
 from record.sessions import load_session
 from studies.reproduce import NOTES, TABLE_6_1
 from studies.reproduce.loop import folder

@@ -19,7 +19,7 @@ import pytest
 import zenoh
 
 from bench.live_view import lockstep_profile
-from deploy import query
+from launch import query
 from messages import codec, topics
 from messages.goal import Goal
 from profiles.profile import Profile, load_profile

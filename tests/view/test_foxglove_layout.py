@@ -9,7 +9,6 @@ from pathlib import Path
 
 import numpy as np
 
-from deploy import DEPLOY
 from messages import topics
 from messages.camera import CameraFrame
 from messages.diagnostics import ControllerDiagnostics
@@ -18,6 +17,7 @@ from messages.markers import MarkerDetection, MarkerDetections
 from messages.obstacles import Circle, Obstacles
 from messages.supervisor import SupervisorStatus
 from messages.truth import SimTruth
+from profiles.deploy_files import DEPLOY
 from record.session_file import SessionWriter
 from record.session_reader import info
 from scenes.foxglove_views import Viewer

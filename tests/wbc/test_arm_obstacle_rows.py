@@ -11,7 +11,7 @@ import math
 import numpy as np
 from wbc_scenarios import configurations, context
 
-from deploy import ROBOT_FILE
+from profiles.deploy_files import ROBOT_FILE
 from studies.gain_sets import TABLE_PARAMS
 from wbc.constraints.arm_obstacles import SKEW_MIN, ArmObstacles
 from wbc.constraints.base import LinearRows

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from wbc_scenarios import configurations, context
 
-from deploy import ROBOT_FILE
+from profiles.deploy_files import ROBOT_FILE
 from studies.gain_sets import TABLE_PARAMS, WITHOUT_ARM_ROWS
 from wbc.constraints.arm_obstacles import ArmObstacles
 from wbc.geometry.arm_clearance import PenetrationCount, part_clearances

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from deploy import ROBOT_FILE
+from profiles.deploy_files import ROBOT_FILE
 from wbc.constraints.base import LinearRows, OneNormBound, VelocityBounds
 from wbc.constraints.error_bound import ErrorBound
 from wbc.constraints.joint_limits import JointLimits

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from deploy import ROBOT_FILE
+from profiles.deploy_files import ROBOT_FILE
 from sim2d.world import World, WorldSettings, wheel_distance_per_count
 from wbc import dq
 from wbc.base_motion import dead_reckoning

@@ -17,7 +17,7 @@ from dqrobotics.robot_modeling import (
 )
 from wbc_scenarios import central_difference
 
-from deploy import ROBOT_FILE
+from profiles.deploy_files import ROBOT_FILE
 from wbc import dq
 from wbc.robot import MobileManipulator, RobotDescriptionError, translation_jacobian
 

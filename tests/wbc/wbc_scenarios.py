@@ -10,7 +10,7 @@ import numpy as np
 from dqrobotics import DQ
 from dqrobotics.robot_modeling import DQ_HolonomicBase, DQ_SerialManipulatorDH, DQ_WholeBody
 
-from deploy import ROBOT_FILE
+from profiles.deploy_files import ROBOT_FILE
 from wbc import dq, kinematic_run
 from wbc.geometry.obstacles3d import Solid
 from wbc.geometry.scenarios import DT

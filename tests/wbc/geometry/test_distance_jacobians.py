@@ -13,7 +13,7 @@ from dqrobotics import DQ
 from dqrobotics.robot_modeling import DQ_Kinematics
 from dqrobotics.utils import DQ_Geometry
 
-from deploy import ROBOT_FILE
+from profiles.deploy_files import ROBOT_FILE
 from tests.wbc.wbc_scenarios import central_difference, configurations, oracle_chain
 from wbc import dq
 from wbc.geometry.distance_jacobians import (

@@ -13,7 +13,7 @@ import pytest
 from dqrobotics import DQ
 from dqrobotics.robot_modeling import DQ_Kinematics
 
-from deploy import ROBOT_FILE
+from profiles.deploy_files import ROBOT_FILE
 from tests.wbc.wbc_scenarios import configurations, oracle_chain
 from wbc import dq
 from wbc.collision_model import AXES, CollisionModel, CollisionPoint

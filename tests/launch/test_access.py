@@ -14,15 +14,16 @@ import pytest
 import yaml
 import zenoh
 
-from deploy import ROBOT_FILE, query
+from launch import query
 from messages import codec, topics
 from messages.goal import Goal
 from messages.header import Header
+from profiles.deploy_files import ROBOT_FILE
 from profiles.profile import ProfileError, ZenohSettings, load_profile
-from tests.deploy.conftest import free_port
+from tests.launch.conftest import free_port
 
 if TYPE_CHECKING:
-    from tests.deploy.conftest import LaunchFixture
+    from tests.launch.conftest import LaunchFixture
 
 
 def access_profile(directory: Path) -> Path:

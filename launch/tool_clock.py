@@ -14,7 +14,7 @@ import time
 
 import zenoh
 
-from deploy.query import QueryError
+from launch.query import QueryError
 from messages import codec, topics
 from messages.header import Header
 from profiles.profile import Profile

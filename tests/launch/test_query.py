@@ -16,7 +16,7 @@ import pytest
 import yaml
 import zenoh
 
-from deploy import query
+from launch import query
 from messages import codec
 from messages.goal import Goal
 from parsimony.commands import param, status

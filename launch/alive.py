@@ -10,7 +10,7 @@ from collections.abc import Callable, Sequence
 
 import zenoh
 
-from deploy.query import NoRouter, QueryError, Target, live_components
+from launch.query import NoRouter, QueryError, Target, live_components
 from messages import topics
 
 ROUTER_RETRY_S = 0.2

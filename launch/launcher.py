@@ -39,7 +39,7 @@ from typing import IO
 
 import zenoh
 
-from deploy.query import statuses
+from launch.query import statuses
 from messages import process, topics
 from messages.process import (
     EXIT_CONFIG_ERROR,

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from deploy import DEPLOY
-from deploy.graph import dataflow
+from launch.graph import dataflow
+from profiles.deploy_files import DEPLOY
 from profiles.profile import ProfileError, load_profile
 from profiles.recorder import with_recorder
 

@@ -10,11 +10,12 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from deploy import ROBOT_FILE, query
+from launch import query
+from profiles.deploy_files import ROBOT_FILE
 from tests.processes import parsimony
 
 if TYPE_CHECKING:
-    from tests.deploy.conftest import LaunchFixture, ProfileWriter
+    from tests.launch.conftest import LaunchFixture, ProfileWriter
 
 PUB = {"name": "pub", "module": "scripted_publisher", "role": "tool", "params": {"rate_hz": 50.0}}
 CTL = {"name": "ctl", "module": "lp_controller", "role": "controller"}

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import zenoh
 
-from deploy.graph import dataflow
-from deploy.zenoh_error import zenoh_error_text
+from launch.graph import dataflow
+from launch.zenoh_error import zenoh_error_text
 from messages import codec, topics
 from messages.process import ParamValue, decode_value
 from messages.status import ComponentStatus
@@ -82,7 +82,7 @@ def live_components(
 def live_writers(
     session: zenoh.Session, profile: Profile, topic: str, timeout_s: float = DEFAULT_TIMEOUT_S
 ) -> list[str]:
-    """The components of ``profile`` that declare they write ``topic`` (``deploy.graph``, its
+    """The components of ``profile`` that declare they write ``topic`` (``launch.graph``, its
     remaps too) and whose liveliness token is present: what a tool publishes there, they
     overwrite with their next message."""
     writers = dataflow(profile).writers(topic)

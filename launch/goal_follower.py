@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import zenoh
 
-from deploy.query import QueryError, status_of
+from launch.query import QueryError, status_of
 from messages import codec, topics
 from messages.supervisor import ENDED, SupervisorStatus
 from wbc.supervisor_phase import Phase

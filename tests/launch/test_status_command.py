@@ -13,15 +13,16 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from deploy import ROBOT_FILE, query
+from launch import query
 from messages import topics
 from messages.header import Header
 from messages.status import ComponentStatus
 from parsimony.commands import status
+from profiles.deploy_files import ROBOT_FILE
 from profiles.endpoints import free_port
 
 if TYPE_CHECKING:
-    from tests.deploy.conftest import LaunchFixture, ProfileWriter
+    from tests.launch.conftest import LaunchFixture, ProfileWriter
 
 
 def command(*argv: str) -> int:

@@ -19,8 +19,8 @@ from pathlib import Path
 import pytest
 import yaml
 
-from deploy import DEPLOY, ROBOT_FILE
-from tests.deploy.conftest import LAUNCH
+from profiles.deploy_files import DEPLOY, ROBOT_FILE
+from tests.launch.conftest import LAUNCH
 
 ROBOT_ADDRESS, STATION_ADDRESS = "10.213.0.1", "10.213.0.2"
 

@@ -11,12 +11,13 @@ from typing import TYPE_CHECKING
 
 import yaml
 
-from deploy import ROBOT_FILE, query
-from tests.deploy.conftest import free_port
+from launch import query
+from profiles.deploy_files import ROBOT_FILE
+from tests.launch.conftest import free_port
 from tests.processes import process_gone
 
 if TYPE_CHECKING:
-    from tests.deploy.conftest import LaunchFixture, ProfileWriter
+    from tests.launch.conftest import LaunchFixture, ProfileWriter
 
 
 def publisher(name: str, role: str = "tool", **fields: object) -> dict[str, object]:

@@ -1,0 +1,9 @@
+"""Where the deploy profiles, the robot descriptions and the lab's files are: ``deploy/``,
+beside these packages in the source tree and as package data when installed."""
+
+from pathlib import Path
+
+DEPLOY = Path(__file__).resolve().parent.parent / "deploy"
+"""The profiles (YAML), ``robots/`` (the robot descriptions) and ``lab/`` (the lab's files)."""
+ROBOT_FILE = DEPLOY / "robots" / "little_john.yaml"
+"""The description of the robot every profile here runs."""
