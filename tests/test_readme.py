@@ -9,6 +9,8 @@ import re
 import subprocess
 from pathlib import Path
 
+import pytest
+
 from profiles.deploy_files import DEPLOY
 
 ROOT = DEPLOY.parent
@@ -24,6 +26,7 @@ def first_hour_block() -> str:
     return match.group(1)
 
 
+@pytest.mark.heavy  # minutes: two launches, two goals, a report of two runs, a replay
 def test_the_first_hour_of_the_readme_runs_as_written(tmp_path: Path) -> None:
     """In a folder of its own (``deploy`` and ``.venv`` as the root has them), ``bash -e``: every
     command exits 0, the goals are reached, the recording is whole and holds them, the reports
