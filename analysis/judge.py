@@ -42,8 +42,8 @@ from wbc.geometry.arm_clearance import part_clearances
 from wbc.geometry.obstacles import least_clearance
 from wbc.kinematic_run import effort_of
 from wbc.planar import in_frame, wrap
+from wbc.planning.supervisor_phase import Phase
 from wbc.robot import MobileManipulator
-from wbc.supervisor_phase import Phase
 
 Array = np.ndarray
 Session = Mapping[str, Sequence[Any]]

@@ -42,9 +42,9 @@ from messages.goal import Goal
 from messages.header import Header
 from messages.obstacles import Obstacles, obstacles_of
 from messages.state import RobotState
-from wbc.drive_tasks import HeadingTask, PointTask
 from wbc.gains import gain_specs
 from wbc.law_output import Law
+from wbc.planning.drive_tasks import HeadingTask, PointTask
 from wbc.robot import MobileManipulator
 from wbc.task import PoseTask, PositionTask, Task
 

@@ -1,7 +1,7 @@
 """The staging supervisor: the operator's goal in, the controller's goal out, phase by phase.
 
 It reads the goal the operator (or the state estimator, remapped) gives on ``goal/request``,
-the robot state and the obstacles, and for a pose goal runs ``wbc.staging_supervisor``: it
+the robot state and the obstacles, and for a pose goal runs ``wbc.planning.staging_supervisor``: it
 plans where the base should stand and publishes on ``control/goal`` the task of each phase
 (drive, turn, approach, then the pose task itself), with every robot state, so that the
 controller, which alone commands the robot, steps the LP on it. A goal of another kind (a
@@ -49,11 +49,11 @@ from messages.goal import Goal
 from messages.obstacles import Obstacles, circles_of
 from messages.state import RobotState
 from messages.supervisor import ENDED, SupervisorStatus
-from wbc.drive_tasks import PointTask, offset_point
 from wbc.geometry.obstacles import Circle
-from wbc.staging import Plan, StagingParams, within
-from wbc.staging_supervisor import PlanRequest, StagingSupervisor, SupervisorParams
-from wbc.supervisor_phase import Phase
+from wbc.planning.drive_tasks import PointTask, offset_point
+from wbc.planning.staging import Plan, StagingParams, within
+from wbc.planning.staging_supervisor import PlanRequest, StagingSupervisor, SupervisorParams
+from wbc.planning.supervisor_phase import Phase
 from wbc.task import MEASUREMENT_TOLERANCE, PoseTask, Task, same_task
 
 log = logging.getLogger("components.supervisor")

@@ -18,7 +18,7 @@ import zenoh
 from launch.query import QueryError, status_of
 from messages import codec, topics
 from messages.supervisor import ENDED, SupervisorStatus
-from wbc.supervisor_phase import Phase
+from wbc.planning.supervisor_phase import Phase
 
 POLL_S = 0.05
 """How often (host seconds) the supervisor's counters are asked while the goal is on its way."""

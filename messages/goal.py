@@ -25,7 +25,7 @@ class Goal(Message):
     end-effector position ``position`` (m). ``point``: the point ``lookahead`` (m) ahead of
     the wheel axle to ``point`` (x, y) with the arm going to ``arm`` (rad). ``heading``: the
     base turned to ``heading`` (rad) where it stands, at ``point``, the arm going to ``arm``
-    (the legs of a staging plan, ``wbc.drive_tasks``). ``eta`` is the error gain (1/s) and
+    (the legs of a staging plan, ``wbc.planning.drive_tasks``). ``eta`` is the error gain (1/s) and
     ``beta`` the bound of ``||u||_1 <= beta ||e'||_1`` (5.10); ``None`` keeps the
     controller's own.
     """

@@ -9,7 +9,7 @@ from pydantic import Field
 from messages.base import ArmVector, Finite, Message, NonNegative
 from messages.header import Header
 from messages.obstacles import MAX_CIRCLES
-from wbc.supervisor_phase import Phase
+from wbc.planning.supervisor_phase import Phase
 
 ENDED = ("refused", "aborted")
 """The phases of a goal the supervisor gave up on before the planner could: ``refused`` when
@@ -21,7 +21,7 @@ PHASES = ("idle", "direct", *ENDED, *(phase.value for phase in Phase))
 PhaseName = Literal[PHASES]  # type: ignore[valid-type]
 """``idle`` before any goal; ``direct`` for a goal that is not a pose (a position...), passed
 on to the controller as it is, then ``reached``; ``ENDED``; else one of
-``wbc.supervisor_phase.Phase`` for a pose goal."""
+``wbc.planning.supervisor_phase.Phase`` for a pose goal."""
 
 StateName = Literal["none", "valid", "degraded", "invalid"]
 """The robot state the supervisor has: ``none`` (none yet, or none for a while), ``valid``,
@@ -30,14 +30,14 @@ marker) or ``invalid`` (no fix: no goal is driven)."""
 
 MAX_WAY = 8 * MAX_CIRCLES + 3
 """The most points a status's way may hold: a planned way passes each of at most
-``MAX_CIRCLES`` discs once, on an arc drawn as at most 8 corners (``wbc.drive_planner``'s
+``MAX_CIRCLES`` discs once, on an arc drawn as at most 8 corners (``wbc.planning.drive_planner``'s
 pieces of at most pi/4), between the point the base left its start for, the staging point and
 the candidate's base."""
 
 
 class SupervisorStatus(Message):
-    """The phase of the current goal (``wbc.staging_supervisor``), published as it changes, with
-    every robot state that follows, and at least every ``STATUS_EVERY_S`` of the supervisor
+    """The phase of the current goal (``wbc.planning.staging_supervisor``), published as it changes,
+    with every robot state that follows, and at least every ``STATUS_EVERY_S`` of the supervisor
     (components.supervisor) while no state comes.
 
     ``phase`` is a ``PhaseName``; ``candidate`` numbers the staging candidate being driven to

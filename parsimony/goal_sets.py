@@ -22,9 +22,9 @@ from wbc.geometry.scenarios import DT
 from wbc.kinematic_run import ControlEffort, control_effort, integrate, integrate_supervised
 from wbc.law_output import Law, entry_mask
 from wbc.lp_law import LPLaw, LPParams
+from wbc.planning.staging_supervisor import StagingSupervisor, SupervisorParams
 from wbc.qp_law import QPLaw
 from wbc.robot import BASE_DOF, MobileManipulator
-from wbc.staging_supervisor import StagingSupervisor, SupervisorParams
 from wbc.task import PoseTask, PositionTask, Task
 
 Array = np.ndarray
@@ -256,8 +256,8 @@ LAWS: dict[str, Callable[[MobileManipulator], Law]] = {
     "cascade": lambda robot: CascadeLaw(robot),
 }
 """The laws compared: the default LP, LP 5.29 as written (``exact_5_29``), the LP under the
-staging supervisor (wbc.staging_supervisor) with its gains, the QP of the same rows and terms
-(wbc.qp_law), the cascade."""
+staging supervisor (wbc.planning.staging_supervisor) with its gains, the QP of the same rows and
+terms (wbc.qp_law), the cascade."""
 POSITION_LAWS = ("lp", "lp 5.29 exactly", "qp", "cascade")
 """The laws run on the position task of each family's goals (6.2.2)."""
 

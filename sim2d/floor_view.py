@@ -1,5 +1,5 @@
 """The floor a ceiling camera sees: its image's corners cast on a horizontal plane, and that
-quadrilateral as the half-planes a point keeps inside to stay in sight (``wbc.staging``'s
+quadrilateral as the half-planes a point keeps inside to stay in sight (``wbc.planning.staging``'s
 region, which keeps the base where the camera fixes it)."""
 
 from __future__ import annotations

@@ -40,7 +40,7 @@ SUPERVISED_PROFILE = DEPLOY / "sim_supervised.yaml"
 
 @functools.cache
 def supervised_params() -> LPParams:
-    """The LP law's gains under the staging supervisor (wbc.staging_supervisor), as
+    """The LP law's gains under the staging supervisor (wbc.planning.staging_supervisor), as
     ``SUPERVISED_PROFILE`` gives its controller (declared there once, the reasons beside)."""
     controller = load_profile(SUPERVISED_PROFILE).component("controller")
     return LPParams(

@@ -12,7 +12,7 @@ not finite, or out of range: a coordinate beyond ``FARTHEST_M``, checked before 
 computed from it), its frame is not ``world`` (F0, where the estimate is), its orientation is
 not a unit quaternion (within ``messages.base.UNIT_TOLERANCE``, as a goal's pose is checked),
 the goal lies below the floor, or the supervisor would refuse it at once
-(``wbc.staging.refusal``: in an obstacle, farther than a plan may cover from the base). A
+(``wbc.planning.staging.refusal``: in an obstacle, farther than a plan may cover from the base). A
 refusal repeats at most ``client_limits.ECHO_CHARS`` of any string the client sent.
 """
 
@@ -31,7 +31,7 @@ from messages.header import Header
 from view.client_limits import ECHO_CHARS, GOAL_BYTES, cut, echo
 from wbc import dq
 from wbc.geometry.obstacles import Circle
-from wbc.staging import StagingParams, refusal
+from wbc.planning.staging import StagingParams, refusal
 
 IN_FRAME = ("foxglove.PoseInFrame",)
 STAMPED = ("geometry_msgs/PoseStamped", "geometry_msgs/msg/PoseStamped")

@@ -63,7 +63,7 @@ def integrate(
 
 
 class Supervisor(Protocol):
-    """What hands a law its task step by step (wbc.staging_supervisor)."""
+    """What hands a law its task step by step (wbc.planning.staging_supervisor)."""
 
     @property
     def reached(self) -> bool: ...

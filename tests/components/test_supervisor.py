@@ -25,13 +25,13 @@ from messages.state import RobotState
 from messages.supervisor import SupervisorStatus
 from profiles.deploy_files import DEPLOY, ROBOT_FILE
 from profiles.profile_files import read_profile_data
-from tests.wbc.crowd import CHECK_GAP_S, crowd
+from tests.wbc.planning.crowd import CHECK_GAP_S, crowd
 from wbc import dq
-from wbc.drive_tasks import HeadingTask, PointTask, offset_point
 from wbc.geometry.scenarios import HOME, REACH_GOAL
 from wbc.planar import planar_pose
+from wbc.planning.drive_tasks import HeadingTask, PointTask, offset_point
+from wbc.planning.staging import within
 from wbc.robot import MobileManipulator
-from wbc.staging import within
 from wbc.task import PoseTask, PositionTask, same_task
 
 MODEL = MobileManipulator.from_yaml(ROBOT_FILE)

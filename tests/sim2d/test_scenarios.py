@@ -25,13 +25,13 @@ from sim2d.scenarios import (
     SimScenario,
     scenario,
 )
-from wbc.disc_geometry import segment_clear
 from wbc.geometry.arm_clearance import part_clearances
 from wbc.geometry.scenarios import HOME, OBSTACLE, REACH_GOAL, TABLE, TABLE_GOAL, TABLE_START
 from wbc.lp_law import LPParams
 from wbc.planar import planar_of
+from wbc.planning.disc_geometry import segment_clear
+from wbc.planning.staging import plan
 from wbc.robot import BASE_DOF, MobileManipulator
-from wbc.staging import plan
 
 REPO = Path(__file__).resolve().parents[2]
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)

@@ -28,8 +28,8 @@ from studies.experiment import DEPLOY, PROFILES, Options, connect, experiment_pr
 from tests.processes import process_gone
 from tests.scenes.views_read import decode, vector
 from wbc.planar import inverse
+from wbc.planning.supervisor_phase import Phase
 from wbc.robot import MobileManipulator
-from wbc.supervisor_phase import Phase
 
 ONE_DEGREE = math.radians(1.0)
 

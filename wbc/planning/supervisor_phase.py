@@ -1,5 +1,5 @@
-"""The phases of the staging supervisor (``wbc.staging_supervisor``), on their own so that a
-message schema names them without importing the planner."""
+"""The phases of the staging supervisor (``wbc.planning.staging_supervisor``), on their own so that
+a message schema names them without importing the planner."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
-"""The base's way round circles (wbc/drive_planner.py): clear of every grown disc, no longer
-than the shortest way, and a reason where there is none."""
+"""The base's way round circles (wbc/planning/drive_planner.py): clear of every grown disc, no
+longer than the shortest way, and a reason where there is none."""
 
 from __future__ import annotations
 
@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from wbc.disc_geometry import segment_clear
-from wbc.drive_planner import WayPlanner, plan_way
 from wbc.geometry.obstacles import Circle
+from wbc.planning.disc_geometry import segment_clear
+from wbc.planning.drive_planner import WayPlanner, plan_way
 
 CLEARANCE = 0.215
 """The base's body radius and the LP's margin."""

@@ -7,21 +7,21 @@ import time
 
 import numpy as np
 import pytest
-from wbc_scenarios import robot
 
 from parsimony.goal_sets import FAMILIES, goals
 from studies.gain_sets import supervised_params
-from tests.wbc.crowd import CHECK_GAP_S, crowd
+from tests.wbc.planning.crowd import CHECK_GAP_S, crowd
+from tests.wbc.wbc_scenarios import robot
 from wbc import dq
 from wbc.conditioning import smallest_singular_value
-from wbc.drive_tasks import HeadingTask, PointTask, offset_point
 from wbc.geometry.obstacles import Circle
 from wbc.geometry.scenarios import DT, HOME, REACH_GOAL
 from wbc.kinematic_run import integrate, integrate_supervised
 from wbc.lp_law import LPLaw
 from wbc.planar import planar_pose
-from wbc.staging import StagingParams, arm_box, plan
-from wbc.staging_supervisor import Phase, StagingSupervisor, SupervisorParams
+from wbc.planning.drive_tasks import HeadingTask, PointTask, offset_point
+from wbc.planning.staging import StagingParams, arm_box, plan
+from wbc.planning.staging_supervisor import Phase, StagingSupervisor, SupervisorParams
 from wbc.task import PoseTask
 
 MODEL = robot()

@@ -1,4 +1,4 @@
-"""Discs in the plane, for the way planner (wbc.drive_planner): their common tangents, and
+"""Discs in the plane, for the way planner (wbc.planning.drive_planner): their common tangents, and
 whether a segment or an arc keeps out of them."""
 
 from __future__ import annotations

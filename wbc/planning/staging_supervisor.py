@@ -1,11 +1,11 @@
 """Above the local law: drive to a staging candidate by LP sub-tasks, then run the pose task.
 
-For a pose goal x_d the supervisor takes the best candidate q_c of wbc.staging and hands the
-law one task per phase, every command still one LP step:
+For a pose goal x_d the supervisor takes the best candidate q_c of wbc.planning.staging and hands
+the law one task per phase, every command still one LP step:
 
     planning  no task: the caller holds the robot while the plan of ``pending`` runs, on
               any thread (``PlanRequest.run``), and hands it back (``take``)
-    drive     legs along the candidate's way round the obstacles (wbc.drive_planner),
+    drive     legs along the candidate's way round the obstacles (wbc.planning.drive_planner),
               waypoint by waypoint, the last to the staging point (a final leg behind q_c's
               base on its heading, or ahead of it), the arm going to q_c's: each leg a
               PointTask of the point d ahead of the axle, after a HeadingTask that turns the
@@ -36,12 +36,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from wbc.drive_tasks import HeadingTask, PointTask
 from wbc.geometry.obstacles import Circle
 from wbc.planar import wrap
+from wbc.planning.drive_tasks import HeadingTask, PointTask
+from wbc.planning.staging import Candidate, Plan, StagingParams, plan, same_configuration, same_kind
+from wbc.planning.supervisor_phase import Phase
 from wbc.robot import MobileManipulator
-from wbc.staging import Candidate, Plan, StagingParams, plan, same_configuration, same_kind
-from wbc.supervisor_phase import Phase
 from wbc.task import PoseTask, Task
 
 Array = np.ndarray

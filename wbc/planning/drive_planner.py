@@ -39,8 +39,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wbc.disc_geometry import TAU, TOUCH, bitangents, clear, covered, overlaps, segment_clear
 from wbc.geometry.obstacles import Circle
+from wbc.planning.disc_geometry import (
+    TAU,
+    TOUCH,
+    bitangents,
+    clear,
+    covered,
+    overlaps,
+    segment_clear,
+)
 from wbc.validation import require_finite
 
 Array = np.ndarray

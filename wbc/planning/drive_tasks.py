@@ -1,4 +1,4 @@
-"""Tasks on the base and the arm's joints, for the legs of a staging plan (wbc.staging).
+"""Tasks on the base and the arm's joints, for the legs of a staging plan (wbc.planning.staging).
 
 A differential-drive base cannot steer its wheel axle's centre, but it can steer a point
 ahead of it: p = (x + d cos phi, y + d sin phi) moves as

@@ -14,8 +14,8 @@ gripper to over the arm's back: with the wrist rolled, the base of a configurati
 may face any way from the gripper's heading, and the arm folded back puts the gripper behind
 the base. Candidates whose base, staging point or final leg comes within reach of an obstacle
 are left out, and so are those with no way round the obstacles to their staging point
-(wbc.drive_planner), and those whose base, staging point or way leaves the ``region`` the base
-must keep to (the floor the camera sees, where the base keeps its fixes). Each candidate is
+(wbc.planning.drive_planner), and those whose base, staging point or way leaves the ``region`` the
+base must keep to (the floor the camera sees, where the base keeps its fixes). Each candidate is
 scored, lower first:
 
     travel + heading_weight * turning + conditioning_weight * max(0, 1 - sigma_6 / sigma_floor)
@@ -38,12 +38,12 @@ from scipy.optimize import least_squares
 
 from wbc import dq
 from wbc.conditioning import smallest_singular_value
-from wbc.disc_geometry import segment_clear
-from wbc.drive_planner import OutOfBudget, Way, WayPlanner
 from wbc.geometry.obstacles import Circle
 from wbc.lp_law import LPParams
 from wbc.objectives.base_target import gripper_heading
 from wbc.planar import wrap
+from wbc.planning.disc_geometry import segment_clear
+from wbc.planning.drive_planner import OutOfBudget, Way, WayPlanner
 from wbc.robot import BASE_DOF, MobileManipulator
 
 Array = np.ndarray
