@@ -1,6 +1,8 @@
 """The simulator process (real Zenoh, the test as its controller): in lockstep simulated time
 waits for the commands of each step, the ground truth follows the commanded wheel speeds as a
-differential drive does, and the wheel odometry it publishes agrees with the truth."""
+differential drive does, and the wheel odometry it publishes agrees with the truth; a start
+inside a solid of its scene is warned of, one line per solid naming it and saying what the
+robot will do (wbc.geometry.start_inside), and a clear start says nothing of it."""
 
 from __future__ import annotations
 
@@ -21,6 +23,7 @@ from messages.header import Header
 from messages.odometry import BaseOdometry
 from messages.truth import SimTruth
 from profiles.deploy_files import DEPLOY
+from wbc.geometry.start_inside import CONSEQUENCE
 from wbc.robot import MobileManipulator
 
 if TYPE_CHECKING:
@@ -31,6 +34,10 @@ STEP_NS = round(STEP_S * 1e9)
 SPEED = 0.2
 """The wheels' speed, m/s: within the robot's limit, reached in 0.2 s at 1 m/s^2."""
 DEADLINE_S = 30.0
+SLAB = {"name": "slab", "normal": [0, 0, 1], "offset": 0.3}
+"""Everything below 0.3 m, wherever F0 lies: the base of any start is inside it."""
+POLE = {"name": "pole", "x": 5.0, "y": 5.0, "radius": 0.05, "height": 1.0}
+"""Far from the start."""
 
 
 def lockstep_sim() -> str:
@@ -156,3 +163,29 @@ def test_the_wheel_odometry_agrees_with_the_truth(controller: Controller) -> Non
     assert truth.base_pose[1] > 0.01  # the arc turned left
     assert math.dist((odometry.x, odometry.y), truth.base_pose[:2]) < 0.005
     assert odometry.phi == pytest.approx(truth.base_pose[2], abs=0.01)
+
+
+def sim_with(arm_obstacles: dict) -> str:
+    """deploy/sim.yaml's text with these solids in its scene."""
+    data = yaml.safe_load((DEPLOY / "sim.yaml").read_text())
+    data["scene"]["arm_obstacles"] = arm_obstacles
+    return yaml.safe_dump(data, sort_keys=False)
+
+
+@pytest.mark.parametrize("planes", [[SLAB], []], ids=["through the robot", "clear"])
+def test_a_start_inside_a_solid_is_warned_of_in_one_line_naming_it(
+    deployed: Callable[[str], System], planes: list
+) -> None:
+    system = deployed(sim_with({"planes": planes, "cylinders": [POLE]}))
+    liveliness = system.liveliness()
+    system.start("simulator")
+    liveliness.wait_for("simulator", alive=True)  # warned while it starts, before it is alive
+    lines = [
+        line for line in system.log("simulator").splitlines() if "the robot starts inside" in line
+    ]
+    if not planes:
+        assert lines == []
+        return
+    assert len(lines) == 1, lines
+    assert "the robot starts inside 'slab' (scene.arm_obstacles.planes[0]): its base" in lines[0]
+    assert lines[0].endswith(CONSEQUENCE)
