@@ -28,7 +28,7 @@ import numpy as np
 
 from parsimony.goal_families import FAMILIES, goals
 from parsimony.goal_sets import LAWS, SUPERVISED, Attempt, attempt, parsimony, shares
-from parsimony.output import emit, json_text, result_only_stdout, table
+from parsimony.stdout import emit, json_text, result_only_stdout, table
 from profiles.deploy_files import ROBOT_FILE
 from wbc import dq
 from wbc.lp_law import LPLaw, LPParams

@@ -42,7 +42,7 @@ from launch.launcher import cpu_seconds
 from messages import codec, topics
 from messages.markers import MarkerDetections
 from messages.supervisor import SupervisorStatus
-from parsimony.output import table
+from parsimony.stdout import table
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.session_file import SessionWriter, entries

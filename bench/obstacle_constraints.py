@@ -36,7 +36,7 @@ from analysis.judge import CONVERGED_ERROR, JUDGED, converged_at, messages, orig
 from bench.sim_experiments import experiment_or_none
 from messages.topics import CONTROL_DIAGNOSTICS, SUPERVISOR_STATUS
 from parsimony.goal_sets import MOVING_ERROR
-from parsimony.output import emit, json_text, result_only_stdout, table
+from parsimony.stdout import emit, json_text, result_only_stdout, table
 from profiles.profile import load_profile
 from record.sessions import load_session
 from sim2d.scenarios import scenario

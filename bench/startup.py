@@ -23,7 +23,7 @@ import zenoh
 
 from bench.figures import run_bench, spread
 from messages import process, topics
-from parsimony.output import result_only_stdout, table
+from parsimony.stdout import result_only_stdout, table
 from profiles.deploy_files import DEPLOY
 from profiles.endpoints import free_port
 from profiles.profile import load_profile

@@ -54,7 +54,7 @@ from components.runtime import Node
 from launch import query
 from messages import topics
 from messages.process import stop
-from parsimony.output import emit, json_text, result_only_stdout, table
+from parsimony.stdout import emit, json_text, result_only_stdout, table
 from profiles.endpoints import free_port
 from profiles.profile import ZenohSettings, load_profile
 

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from parsimony.goal_sets import goal_report
-from parsimony.output import table
+from parsimony.stdout import table
 from profiles.deploy_files import ROBOT_FILE
 from studies.gain_sets import TABLE_PARAMS, WITHOUT_ARM_ROWS
 from studies.reproduce import efficiency

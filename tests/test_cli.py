@@ -93,7 +93,7 @@ def test_a_library_writing_to_file_descriptor_1_reaches_stderr():
     """What C code writes to fd 1 while a command runs is routed to stderr, not the result."""
     code = (
         "import os, sys\n"
-        "from parsimony.output import emit, result_only_stdout\n"
+        "from parsimony.stdout import emit, result_only_stdout\n"
         "with result_only_stdout():\n"
         "    os.write(1, b'banner from C\\n')\n"
         "    print('a log line')\n"

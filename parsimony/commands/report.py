@@ -12,7 +12,7 @@ from pathlib import Path
 from analysis.judge import JUDGED, judge, open_loop, the_run
 from analysis.report import write_report
 from parsimony.commands.launch import positive_seconds
-from parsimony.output import emit, json_text
+from parsimony.stdout import emit, json_text
 from profiles.deploy_files import ROBOT_FILE
 from profiles.profile import ProfileError, load_profile
 from record.session_span import parted

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from launch.query import QueryError
 from parsimony.commands.experiment import time_limit
-from parsimony.output import emit, json_text
+from parsimony.stdout import emit, json_text
 from profiles.deploy_files import ROBOT_FILE
 from profiles.profile import ProfileError, load_profile
 from studies.experiment import PROFILES, TIME_LIMIT_S

@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from parsimony.output import table
+from parsimony.stdout import table
 
 
 @dataclass(frozen=True)
