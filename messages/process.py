@@ -18,7 +18,6 @@ from messages.base import Finite
 ParamValue = bool | int | Finite | str | tuple[Finite, ...] | tuple[tuple[Finite, ...], ...]
 """A parameter's value: a flag, a number, a word, a vector of numbers or a list of vectors;
 pydantic keeps the exact type (``True`` stays a bool, ``1`` an int)."""
-"""A parameter's value."""
 
 EXIT_CONFIG_ERROR = 2
 """Exit code of a component refused by its configuration; the launcher never restarts it."""
