@@ -98,12 +98,6 @@ class EmulatedRobot(Simulator):
     def _apply_commands(self) -> None:
         """The devices command the world (see ``step``)."""
 
-    def _publish_joints(self) -> None:
-        """The arm driver publishes them."""
-
-    def _publish_odometry(self) -> None:
-        """The base driver publishes it."""
-
     def shutdown(self) -> None:
         self.create.stop()
         self.servos.stop()

@@ -305,12 +305,12 @@ class Simulator(Component):
             return
         self.sensors_ns = self.now_ns
         sensors = self.sensors
-        self._put(
-            topics.ARM_JOINT_STATES, sensors.joints(self._header("arm", topics.ARM_JOINT_STATES))
-        )
-        self._put(
-            topics.BASE_ODOMETRY, sensors.odometry(self._header("odom", topics.BASE_ODOMETRY))
-        )
+        if topics.ARM_JOINT_STATES.name in self.publishers:  # not where drivers publish them
+            header = self._header("arm", topics.ARM_JOINT_STATES)
+            self._put(topics.ARM_JOINT_STATES, sensors.joints(header))
+        if topics.BASE_ODOMETRY.name in self.publishers:
+            header = self._header("odom", topics.BASE_ODOMETRY)
+            self._put(topics.BASE_ODOMETRY, sensors.odometry(header))
         self.node.counters["contacts"] = self.world.contacts
         self.node.counters["arm_penetrations"] = self.world.arm_penetrations
         header = self._header("world", topics.SIM_TRUTH)
