@@ -148,12 +148,13 @@ class FoxgloveClient:
             }
 
     def messages(self, topic: str) -> list[tuple[int, bytes]]:
-        """(log time, payload) of every message heard on ``topic`` so far."""
+        """(log time, payload) of every message heard on ``topic`` so far (one still in flight
+        when its subscription ended names no topic: the client no longer knows it)."""
         with self._changed:
             return [
                 (int(e["logTime"]), base64.b64decode(e["data"]))
                 for e in self.events
-                if e["event"] == "message" and e["topic"] == topic
+                if e["event"] == "message" and e.get("topic") == topic
             ]
 
     def message(
@@ -163,7 +164,7 @@ class FoxgloveClient:
         event = self.wait_for(
             lambda e: (
                 e["event"] == "message"
-                and e["topic"] == topic
+                and e.get("topic") == topic
                 and found(int(e["logTime"]), base64.b64decode(e["data"]))
             ),
             what or f"a message on {topic}",
