@@ -52,9 +52,9 @@ from analysis.report import write_report
 from bench.long_sessions import memory_use, repeated_session
 from bench.pubsub_workers import NAMESPACE, WAIT_S, message
 from bench.sim_experiments import percentile
-from components.simulator import JOINT_NAMES
 from launch import query
 from messages import codec, topics
+from messages.base import JOINT_NAMES
 from messages.camera import CameraFrame, CameraIntrinsics
 from messages.header import Header
 from messages.joints import JointStates

@@ -37,13 +37,12 @@ from components.process_entry import run_component
 from components.pubsub import Input
 from components.runtime import Component, Node
 from messages import topics
-from messages.base import ARM_JOINTS
+from messages.base import ARM_JOINTS, JOINT_NAMES
 from messages.commands import ArmCommand
 from messages.joints import JointStates
 from protocols import dynamixel_v1 as dxl
 from wbc.robot import BASE_DOF, MobileManipulator
 
-JOINT_NAMES = tuple(f"q{i}" for i in range(1, ARM_JOINTS + 1))
 ERROR_BITS = {int(bit): bit.name.lower() for bit in dxl.StatusError}
 """The status-packet error bits of protocol 1.0, by the name they are counted under."""
 READ_BYTES = 4

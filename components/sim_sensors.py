@@ -5,7 +5,7 @@ truth (tests and reports only)."""
 
 from __future__ import annotations
 
-from messages.base import ARM_JOINTS
+from messages.base import JOINT_NAMES
 from messages.header import Header
 from messages.joints import JointStates
 from messages.obstacles import Circle, Solids
@@ -15,8 +15,6 @@ from profiles.scene import Scene
 from sim2d.scenarios import goal_above
 from sim2d.world import World, wheel_distance_per_count
 from wbc.base_motion import dead_reckoning
-
-JOINT_NAMES = tuple(f"q{i}" for i in range(1, ARM_JOINTS + 1))
 
 
 class SimSensors:

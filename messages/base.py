@@ -22,6 +22,9 @@ UNIT_TOLERANCE = 1e-6
 ARM_JOINTS = 5
 """Number of joints of the arm; joint vectors have exactly this length."""
 
+JOINT_NAMES = tuple(f"q{i}" for i in range(1, ARM_JOINTS + 1))
+"""The arm's joint names in joint-state messages, q1 at the waist."""
+
 Finite = Annotated[float, AllowInfNan(False)]
 """Any finite float."""
 

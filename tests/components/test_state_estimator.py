@@ -16,7 +16,7 @@ import pytest
 import yaml
 
 from messages import codec, topics
-from messages.base import ARM_JOINTS
+from messages.base import ARM_JOINTS, JOINT_NAMES
 from messages.clock import Clock
 from messages.header import Header
 from messages.joints import JointStates
@@ -92,7 +92,7 @@ class Sensors:
             self.markers.put(codec.encode(self.frame()))
         if not odometry:
             return None
-        names = tuple(f"q{i}" for i in range(1, ARM_JOINTS + 1))
+        names = JOINT_NAMES
         zeros = (0.0,) * ARM_JOINTS
         joints = JointStates(
             header=self.header("arm"), names=names, positions=zeros, velocities=zeros
