@@ -100,6 +100,35 @@ def test_base_target_lies_behind_the_goal_along_the_gripper_heading():
     )
 
 
+def test_base_target_sets_back_less_for_a_gripper_high_above_the_floor():
+    goal = np.array([1.0, 0.5, 0.3, 0.2, -0.9, -1.0, 0.0, 0.0])  # the arm bent back, up
+    pose = MODEL.fkm(goal)
+    height = dq.translation(pose)[3]
+    assert height > 0.6
+    end_effector = dq.translation(pose)[1:3]
+    heading = gripper_heading(pose)
+    for shrink in (0.0, 1.0, 100.0):
+        term = BaseTarget(0.05, 2.0, 0.36, 0.15, high=0.55, shrink=shrink)
+        set_back = max(0.0, 0.36 - shrink * (height - 0.55))
+        np.testing.assert_allclose(
+            end_effector - term.target(pose),
+            set_back * np.array([math.cos(heading), math.sin(heading)]),
+            atol=1e-12,
+        )
+
+
+def test_base_target_ahead_only_never_turns_the_base_round_to_a_target_behind_it():
+    goal = np.array([1.0, 0.0, 0.0, 0.0, -0.4, 0.1, 0.0, 0.6])
+    pose = MODEL.fkm(goal)
+    target_x, _ = BaseTarget(0.05, 4.0, 0.36, 0.15).target(pose)
+    past = np.concatenate(([target_x + 0.5, 0.0, 0.0], HOME[3:]))  # the target 0.5 m behind
+    turning = BaseTarget(0.05, 4.0, 0.36, 0.15)
+    assert turning.cost(context(past, pose, np.ones(8))).weight == pytest.approx(0.05)
+    ahead_only = BaseTarget(0.05, 4.0, 0.36, 0.15, ahead_only=True)
+    assert ahead_only.cost(context(past, pose, np.ones(8))).weight == 0.0
+    assert ahead_only.cost(context(HOME, pose, np.ones(8))).weight == pytest.approx(0.05)
+
+
 def test_base_target_steers_in_bursts_from_its_on_heading_error_down_to_its_off():
     goal = np.array([1.0, 0.0, 0.0, 0.0, -0.4, 0.1, 0.0, 0.6])
     pose = MODEL.fkm(goal)
