@@ -1,6 +1,7 @@
 """The README's first hour, run exactly as written: a launch with its recording, watched, two
-goals, the recording described, reported, re-run with another law, compared, replayed at another
-rate into a Foxglove view, the view's layout written, and the emulated hardware launched."""
+goals, the live view, the recording described, reported, re-run with another law, compared,
+replayed at another rate into a Foxglove view, the view's layout written, and the emulated
+hardware launched."""
 
 from __future__ import annotations
 
@@ -51,6 +52,9 @@ def test_the_first_hour_of_the_readme_runs_as_written(tmp_path: Path) -> None:
     # the cascade re-run on the recording's states, beside the LP in one report
     assert (tmp_path / "cascade.mcap").is_file()
     assert "cascade (rerun)" in (tmp_path / "compare" / "effort.md").read_text()
+    # the live view served on the profile's port, and stopped after its duration
+    assert "view: sim live at ws://127.0.0.1:8765" in result.stderr, result.stderr[-3000:]
+    assert "messages shown" in result.stderr
     # the view's layout, on the profile's namespace (its publish-pose tool on goal/request)
     layout = json.loads((tmp_path / "station.json").read_text())
     assert "sim/goal/request" in json.dumps(layout["content"])

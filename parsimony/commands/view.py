@@ -1,14 +1,14 @@
 """`parsimony view PROFILE`: a Foxglove live view and control station of a running system
-(view.live_view, view.control_station): a WebSocket server on 127.0.0.1 that Foxglove
-opens as a live source, until Ctrl-C or SIGTERM. It draws the robot of the profile's
+(view.live_view, view.control_station): a WebSocket server on 127.0.0.1 that Foxglove opens as a
+live source, until Ctrl-C or SIGTERM (or ``--duration S``). It draws the robot of the profile's
 description, lets its clients send goals on goal/request (when the user may write it) and set
 any running component's parameters. A replay into the profile's namespace is watched the same
 way (``--namespace NS``: a replay into a namespace of its own). It runs ``--nice`` steps below
 the loop's priority (10 by default), so that on a busy machine the loop takes the CPU first.
-``--layout FILE`` writes the Foxglove layout of the namespace (``parsimony layout``);
-``--json`` prints what the view did when it stops (messages, the handler's times, the goals sent,
-refused and dropped, the station's errors), as it says on stderr. It exits 1 when the station's
-Zenoh session failed and no new one could be opened."""
+``--layout FILE`` writes the Foxglove layout of the namespace (``parsimony layout``); ``--json``
+prints what the view did when it stops (messages, the handler's times, the goals sent, refused
+and dropped, the station's errors), as it says on stderr. It exits 1 when the station's Zenoh
+session failed and no new one could be opened."""
 
 from __future__ import annotations
 
@@ -26,6 +26,7 @@ import zenoh
 from components.rate_limited_log import RateLimitedLog
 from launch.query import QueryError, Target
 from messages.topics import Topic, check_namespace, topics_matching
+from parsimony.commands.launch import positive_seconds
 from parsimony.commands.layout import write_layout
 from parsimony.stdout import emit, json_text
 from parsimony.target_options import exit_code
@@ -83,6 +84,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         help=f"run N steps below the loop's priority (default {NICE})",
     )
     parser.add_argument(
+        "--duration", type=positive_seconds, metavar="S", help="stop after S seconds"
+    )
+    parser.add_argument(
         "--json", action="store_true", help="when it stops, print what it did as JSON"
     )
     return parser
@@ -110,6 +114,9 @@ def run(args: argparse.Namespace) -> int:
     target = Target(profile.namespace, profile.zenoh)
     os.nice(args.nice)
     previous = signal.signal(signal.SIGTERM, _interrupt)
+    if args.duration is not None:
+        signal.signal(signal.SIGALRM, _interrupt)
+        signal.setitimer(signal.ITIMER_REAL, args.duration)
     try:
         with (
             target.open() as session,
@@ -122,6 +129,7 @@ def run(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         pass  # before the server was up
     finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGTERM, previous)
     return 0
 
