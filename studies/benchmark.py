@@ -15,10 +15,10 @@ from typing import Any
 
 import numpy as np
 
-from parsimony.goal_sets import goal_report
 from parsimony.stdout import table
 from profiles.deploy_files import ROBOT_FILE
 from studies.gain_sets import TABLE_PARAMS, WITHOUT_ARM_ROWS
+from studies.goal_sets import goal_report
 from studies.reproduce import efficiency
 from wbc import dq
 from wbc.cascade_law import CascadeLaw

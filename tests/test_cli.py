@@ -9,7 +9,7 @@ import sys
 import pytest
 
 from parsimony.cli import COMMANDS
-from parsimony.goal_sets import LAWS, POSITION_LAWS
+from studies.goal_sets import LAWS, POSITION_LAWS
 
 
 def run_cli(*args: str) -> subprocess.CompletedProcess[str]:

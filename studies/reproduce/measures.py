@@ -9,7 +9,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from parsimony.goal_sets import MOVING_ERROR, SETTLING_S
+from studies.goal_sets import MOVING_ERROR, SETTLING_S
 from wbc import dq
 from wbc.geometry.obstacles import Circle
 from wbc.kinematic_run import Run

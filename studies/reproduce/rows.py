@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import astuple
 
-from parsimony.goal_sets import MOVING_ERROR, SETTLING_S
+from studies.goal_sets import MOVING_ERROR, SETTLING_S
 from studies.reproduce import laws as L
 from studies.reproduce import measures as M
 from studies.reproduce.dissertation import (

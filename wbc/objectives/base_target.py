@@ -19,7 +19,7 @@ every step, as a band's edge would, kept 8 entries in most moving steps; in burs
 0.05 rad, k 4) the 'ahead' goals of `parsimony bench` are reached as often (0.94) with 7.
 
 A goal high above the floor leaves the arm little horizontal reach: over the 1,800 goals of the
-three families ahead (``parsimony.goal_families``, seeds 2-7) the gripper stands 0.37 m from
+three families ahead (``studies.goal_families``, seeds 2-7) the gripper stands 0.37 m from
 its base at a height of 0.5 m, 0.21 at 0.65 and 0.11 at 0.7. Set back 0.36 m, the target then
 lies behind the base's own goal: the base drives past it and turns round to face it.
 ``base_target_shrink`` shortens the set-back by that much per metre of the goal gripper's height
@@ -28,7 +28,7 @@ steers towards a target behind the base. Both are off by default: on the held-ou
 of 'ahead, wide arm' they raise the share reached from 0.72 to 0.82 (7 entries while moving),
 short of the 0.9 sought, while 'ahead, any arm start' goes from 0.947 to 0.937 on the same
 seeds and the 'ahead' goals of `parsimony bench` (seed 2) from 0.94 to 0.92
-(``bench.goal_reach``).
+(``studies.bench.goal_reach``).
 """
 
 from __future__ import annotations

@@ -8,8 +8,8 @@ import time
 import numpy as np
 import pytest
 
-from parsimony.goal_sets import FAMILIES, goals
 from studies.gain_sets import supervised_params
+from studies.goal_sets import FAMILIES, goals
 from tests.wbc.planning.crowd import CHECK_GAP_S, crowd
 from tests.wbc.wbc_scenarios import robot
 from wbc import dq

@@ -1,6 +1,6 @@
 """Zenoh latency between processes on loopback, and the latency of a real controller loop.
 
-Run as ``python -m bench.zenoh_latency [--mode peer|client]``. This process opens a router;
+Run as ``python -m studies.bench.zenoh_latency [--mode peer|client]``. This process opens a router;
 a publisher process and a subscriber process connect to it as components do: in ``peer``
 mode (the profile default) they link directly and the router only brokers, in ``client``
 mode every sample goes through the router. Every
@@ -42,21 +42,21 @@ import numpy as np
 import yaml
 import zenoh
 
-from bench.pubsub_workers import (
-    NAMESPACE,
-    ROBOT,
-    WAIT_S,
-    Phase,
-    publisher_main,
-    subscriber_main,
-)
 from components.runtime import Node
 from launch import query
 from messages import topics
 from messages.process import stop
 from parsimony.stdout import emit, json_text, result_only_stdout, table
+from profiles.deploy_files import ROBOT_FILE
 from profiles.endpoints import free_port
 from profiles.profile import ZenohSettings, load_profile
+from studies.bench.pubsub_workers import (
+    NAMESPACE,
+    WAIT_S,
+    Phase,
+    publisher_main,
+    subscriber_main,
+)
 
 SETTLE_S = 1.0
 """How long the subscriber may stay silent after the last publication before we count."""
@@ -167,7 +167,7 @@ def controller_loop(
         component = {"name": "controller", "module": "lp_controller", "role": "controller"}
         sink = {"name": "sink", "module": "scripted_publisher", "role": "tool"}  # never run
         data = {"namespace": NAMESPACE, "zenoh": {"router": settings.router, "mode": settings.mode}}
-        data |= {"robot": str(ROBOT), "components": [component, sink]}
+        data |= {"robot": str(ROBOT_FILE), "components": [component, sink]}
         profile.write_text(yaml.safe_dump(data))
         command = [sys.executable, "-m", "components.lp_controller", "--profile", str(profile)]
         process = subprocess.Popen([*command, "--name", "controller", "--log-level", "WARNING"])

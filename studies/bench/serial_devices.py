@@ -1,6 +1,6 @@
 """Serial round trips on the emulated devices, through the clients the drivers use.
 
-Run as ``python -m bench.serial_devices [--json]``. On the AX-18A chain emulator at 1 Mbps
+Run as ``python -m studies.bench.serial_devices [--json]``. On the AX-18A chain emulator at 1 Mbps
 (return delay 500 us, the servos' default), with ROBOTIS's dynamixel-sdk: one servo's
 present position and speed (a 4-byte read), the Sync Write of five goals and speeds, and the
 joint-state rate one read per servo allows. On the Create 2 emulator, with pyserial: a Drive

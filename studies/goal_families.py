@@ -2,7 +2,7 @@
 
 A goal is the end-effector pose of a goal configuration: the base placed some distance and
 bearing from the start, at some heading, with the arm in a box of joint angles; so every goal
-is reachable. ``parsimony.goal_sets`` runs the laws on them.
+is reachable. ``studies.goal_sets`` runs the laws on them.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """The drivers' safety figures, on the emulated devices, through ``parsimony launch``.
 
-Run as ``python -m bench.driver_safety [--runs N] [--json]``. The bench plays the controller
+Run as ``python -m studies.bench.driver_safety [--runs N] [--json]``. The bench plays the controller
 (commands at 50 Hz) and hosts the emulated Create 2 and AX-18A chain, whose backends note when
 they were told what (host monotonic time):
 
@@ -33,7 +33,6 @@ from pathlib import Path
 
 import yaml
 
-from bench.figures import run_bench, spread
 from launch import query
 from messages import codec, topics
 from messages.commands import ArmCommand, BaseCommand
@@ -46,6 +45,7 @@ from profiles.profile_files import read_profile_data
 from protocols import create_oi
 from sim2d.devices.ax_servos import AXChainEmulator, IntegratingJoints
 from sim2d.devices.create2 import Create2Emulator
+from studies.bench.figures import run_bench, spread
 from studies.experiment import connect, launched
 
 METRES_PER_COUNT = create_oi.mm_per_count(0.072) / 1000.0

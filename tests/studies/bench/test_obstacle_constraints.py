@@ -6,7 +6,7 @@ import json
 import subprocess
 import sys
 
-from bench.obstacle_constraints import VARIANTS
+from studies.bench.obstacle_constraints import VARIANTS
 
 
 def test_the_bench_prints_one_row_per_constraint_as_json_alone() -> None:
@@ -15,7 +15,7 @@ def test_the_bench_prints_one_row_per_constraint_as_json_alone() -> None:
     command = [
         sys.executable,
         "-m",
-        "bench.obstacle_constraints",
+        "studies.bench.obstacle_constraints",
         "--seeds",
         "0",
         "--kinematic-seeds",

@@ -1,7 +1,7 @@
 """Recording, replay and report speed: record throughput, replay timing error, report time.
 
-Run as ``python -m bench.recording [--quick] [--json]``. This process opens a router on a free
-loopback port and runs the real commands as processes:
+Run as ``python -m studies.bench.recording [--quick] [--json]``. This process opens a router on a
+free loopback port and runs the real commands as processes:
 
 1. ``parsimony record`` records while this process publishes, as fast as it can for 10 s,
    joint states, odometry and robot states in turn, (a) alone and (b) beside frames of
@@ -17,7 +17,7 @@ loopback port and runs the real commands as processes:
 3. ``parsimony report``'s work (``load_session``, ``write_report``) on that recording repeated
    to span 60 s (``repeated_session``): median and each of 3 runs.
 
-4. Memory (``bench.long_sessions``): the recording repeated to span 30 and 120 s, and
+4. Memory (``studies.bench.long_sessions``): the recording repeated to span 30 and 120 s, and
    ``parsimony info``, ``report``, ``rerun`` and ``replay --rate 64`` run on each as processes:
    the peak resident memory of each (``ru_maxrss``, MB), and its ratio longest to shortest. A
    command that streams the file stays near 1 however long the session.
@@ -49,9 +49,6 @@ import zenoh
 from pydantic import BaseModel
 
 from analysis.report import write_report
-from bench.long_sessions import memory_use, repeated_session
-from bench.pubsub_workers import NAMESPACE, WAIT_S, message
-from bench.sim_experiments import percentile
 from launch import query
 from messages import codec, topics
 from messages.base import JOINT_NAMES
@@ -66,6 +63,9 @@ from record.session_file import MESSAGE_ENCODING
 from record.session_reader import info, read_session
 from record.sessions import load_session
 from sim2d.camera import ImageNoise, PlacedMarker, ceiling_camera, render
+from studies.bench.long_sessions import memory_use, repeated_session
+from studies.bench.pubsub_workers import NAMESPACE, WAIT_S, message
+from studies.bench.sim_experiments import percentile
 from studies.experiment import PROFILES, SESSION_FILE, TIME_LIMIT_S, Options, run_experiment
 from wbc.planar import planar_pose
 from wbc.robot import MobileManipulator

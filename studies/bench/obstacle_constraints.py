@@ -1,7 +1,7 @@
 """The obstacle constraints compared on the same set-ups: 5.28, the vector-field inequality, 5.19.
 
-Run as ``python -m bench.obstacle_constraints [--seeds N] [--kinematic-seeds M] [--workers W]
-[--json]``. Each variant (``VARIANTS``) is the obstacle experiment's law (6.2.3,
+Run as ``python -m studies.bench.obstacle_constraints [--seeds N] [--kinematic-seeds M]
+[--workers W] [--json]``. Each variant (``VARIANTS``) is the obstacle experiment's law (6.2.3,
 ``studies.gain_sets.LP_PARAMS``) with the gains it names. Each runs the obstacle
 experiment's set-up of seeds 0..M-1 kinematically (q += u dt at 50 Hz from the seed's start, to
 the goal above its bin, ``wbc.kinematic_run``), and of seeds 0..N-1 and ``HELD_OUT`` on the
@@ -33,15 +33,15 @@ from typing import Any
 import numpy as np
 
 from analysis.judge import CONVERGED_ERROR, JUDGED, converged_at, messages, origin_s, the_run
-from bench.sim_experiments import experiment_or_none
 from messages.topics import CONTROL_DIAGNOSTICS, SUPERVISOR_STATUS
-from parsimony.goal_sets import MOVING_ERROR
 from parsimony.stdout import emit, json_text, result_only_stdout, table
 from profiles.profile import load_profile
 from record.sessions import load_session
 from sim2d.scenarios import scenario
+from studies.bench.sim_experiments import experiment_or_none
 from studies.experiment import PROFILES, TIME_LIMIT_S, Options
 from studies.gain_sets import LP_PARAMS
+from studies.goal_sets import MOVING_ERROR
 from wbc.geometry.scenarios import DT
 from wbc.kinematic_run import integrate
 from wbc.lp_law import LPLaw

@@ -1,4 +1,4 @@
-"""The two processes of ``bench.zenoh_latency``: a publisher and a subscriber.
+"""The two processes of ``studies.bench.zenoh_latency``: a publisher and a subscriber.
 
 Each connects to the bench's router as a component does (``ZenohSettings.component_config``,
 the profile's ``mode``) and serves requests from a queue: the

@@ -1,4 +1,4 @@
-"""The share of random pose goals (``parsimony.goal_families``) a law reaches inside the
+"""The share of random pose goals (``studies.goal_families``) a law reaches inside the
 robot's limits, and how parsimonious its u is on the way.
 """
 
@@ -13,8 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from parsimony.goal_families import FAMILIES, OBSTACLE_FAMILIES, goals, obstacle_goals
 from studies.gain_sets import bare_5_29, supervised_params
+from studies.goal_families import FAMILIES, OBSTACLE_FAMILIES, goals, obstacle_goals
 from wbc import dq
 from wbc.cascade_law import CascadeLaw
 from wbc.geometry.obstacles import Circle, least_clearance

@@ -11,7 +11,7 @@ WIDE = "ahead, wide arm"
 
 def run(*args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [sys.executable, "-m", "bench.goal_reach", *args],
+        [sys.executable, "-m", "studies.bench.goal_reach", *args],
         capture_output=True,
         text=True,
         timeout=600,

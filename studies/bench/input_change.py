@@ -1,9 +1,9 @@
 """The LP with and without its input change term (future work 1 of 7.2), on the same goals.
 
-Run as ``python -m bench.input_change [--goals N] [--workers W] [--variants A,B] [--json]``.
+Run as ``python -m studies.bench.input_change [--goals N] [--workers W] [--variants A,B] [--json]``.
 Each variant of the LP law (``VARIANTS``: the default law, the same law with the input change
 term of deploy/sim_smooth.yaml, and the term's ``change`` form at two weights) is run on the
-'ahead' goals of ``parsimony bench`` (``parsimony.goal_sets``: the same seed, the same runs of
+'ahead' goals of ``parsimony bench`` (``studies.goal_sets``: the same seed, the same runs of
 60 s at 50 Hz), for the pose task and the position task of each goal. Printed per variant and
 task: the share of goals reached inside every limit, the median nonzero entries of u while
 moving (||e|| > 0.05) and over the last 2 s, and on the goals both the variant and the default
@@ -23,10 +23,10 @@ from typing import Any
 
 import numpy as np
 
-from parsimony.goal_sets import FAMILIES, Attempt, attempt, goals, parsimony, shares
 from parsimony.stdout import emit, json_text, result_only_stdout, table
 from profiles.deploy_files import ROBOT_FILE
 from studies.gain_sets import input_change_gains
+from studies.goal_sets import FAMILIES, Attempt, attempt, goals, parsimony, shares
 from wbc.lp_law import LPLaw, LPParams
 from wbc.robot import MobileManipulator
 
@@ -134,7 +134,8 @@ def main(argv: list[str] | None = None) -> int:
     unknown = [name for name in names if name not in VARIANTS]
     if unknown or args.goals < 1 or args.workers < 1:
         print(
-            f"bench.input_change: unknown variants {unknown}, or --goals or --workers below 1",
+            f"studies.bench.input_change: unknown variants {unknown}, "
+            "or --goals or --workers below 1",
             file=sys.stderr,
         )
         return 2

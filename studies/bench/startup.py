@@ -1,6 +1,6 @@
 """Each component's start-up: from the process's start to its liveliness token, and its imports.
 
-Run as ``python -m bench.startup [--runs N] [--json]``. Every component of
+Run as ``python -m studies.bench.startup [--runs N] [--json]``. Every component of
 deploy/emulated.yaml, and the staging supervisor, is started on its own (as the launcher
 starts it, ``python -m components.<module> --profile P --name N``) against a router of the
 bench's, ``--runs`` times each: ``alive_ms`` is the time until the router sees its
@@ -21,13 +21,13 @@ from pathlib import Path
 import yaml
 import zenoh
 
-from bench.figures import run_bench, spread
 from messages import process, topics
 from parsimony.stdout import result_only_stdout, table
 from profiles.deploy_files import DEPLOY
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from profiles.profile_files import read_profile_data
+from studies.bench.figures import run_bench, spread
 
 
 def bench_profile(directory: Path) -> Path:

@@ -1,6 +1,6 @@
 """What `parsimony view` costs the loop, and what it holds for a client that reads nothing.
 
-Run as ``python -m bench.live_view [--runs N] [--json]`` (node and ``make foxglove-client``:
+Run as ``python -m studies.bench.live_view [--runs N] [--json]`` (node and ``make foxglove-client``:
 the client is Foxglove's own, ``tests/foxglove_client``). One system of
 deploy/sim_supervised.yaml in lockstep (the simulator steps as fast as the loop answers), with
 a recorder, on the 6.2.1 set-up, on a namespace and port of its own. ``--runs`` rounds of three
@@ -36,7 +36,6 @@ from pathlib import Path
 import yaml
 import zenoh
 
-from bench.figures import run_bench
 from launch import query
 from launch.launcher import cpu_seconds
 from messages import codec, topics
@@ -48,6 +47,7 @@ from profiles.profile import load_profile
 from record.session_file import SessionWriter, entries
 from record.session_reader import info, read_session
 from scenes.foxglove_views import ANNOTATIONS_SUFFIX, SCENE_SUFFIX, Viewer
+from studies.bench.figures import run_bench
 from studies.experiment import DEPLOY, connect, launched, wait_alive, wait_reached
 from tests.foxglove_client.client import FoxgloveClient, missing, running_view
 from wbc.robot import MobileManipulator
@@ -264,7 +264,7 @@ def recording_cost(path: Path, robot: MobileManipulator, directory: Path) -> dic
 
 def measure(runs: int) -> dict:
     if missing():
-        raise SystemExit(f"bench.live_view: {missing()}")
+        raise SystemExit(f"studies.bench.live_view: {missing()}")
     with tempfile.TemporaryDirectory() as tmp:
         directory = Path(tmp)
         path = lockstep_profile(directory)

@@ -1,8 +1,8 @@
 """How often the LP reaches the goals ahead, set by set, and why it misses the others.
 
-Run as ``python -m bench.goal_reach [--families 'A;B'] [--seeds 2,3,4] [--goals N]
+Run as ``python -m studies.bench.goal_reach [--families 'A;B'] [--seeds 2,3,4] [--goals N]
 [--variant 'gain=value,...']... [--supervised] [--workers W] [--json]``. Each family of
-``parsimony.goal_families`` (the goals ahead by default: the bench's 'ahead' and issue 33's
+``studies.goal_families`` (the goals ahead by default: the bench's 'ahead' and issue 33's
 two) is drawn from each seed (2 is the bench's; the default law's terms were tuned on seed 1),
 and each law runs every goal as ``parsimony bench`` runs it (60 s at 50 Hz): the default LP,
 each ``--variant`` (LPParams() with those gains changed, on the same goals) and, with
@@ -26,10 +26,10 @@ from typing import Any
 
 import numpy as np
 
-from parsimony.goal_families import FAMILIES, goals
-from parsimony.goal_sets import LAWS, SUPERVISED, Attempt, attempt, parsimony, shares
 from parsimony.stdout import emit, json_text, result_only_stdout, table
 from profiles.deploy_files import ROBOT_FILE
+from studies.goal_families import FAMILIES, goals
+from studies.goal_sets import LAWS, SUPERVISED, Attempt, attempt, parsimony, shares
 from wbc import dq
 from wbc.lp_law import LPLaw, LPParams
 from wbc.planar import wrap
@@ -148,7 +148,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--families",
         default=";".join(AHEAD),
-        help="';'-separated families of parsimony.goal_families",
+        help="';'-separated families of studies.goal_families",
     )
     parser.add_argument("--seeds", default="2,3,4", help="comma-separated seeds (default 2,3,4)")
     parser.add_argument("--goals", type=int, default=100, help="goals per set (default 100)")
@@ -167,12 +167,12 @@ def main(argv: list[str] | None = None) -> int:
         seeds = [int(seed) for seed in args.seeds.split(",")]
         variants = {"lp": {}, **{text: variant(text) for text in args.variant}}
     except (TypeError, ValueError) as error:
-        print(f"bench.goal_reach: {error}", file=sys.stderr)
+        print(f"studies.bench.goal_reach: {error}", file=sys.stderr)
         return 2
     unknown = [family for family in families if family not in FAMILIES]
     if unknown or args.goals < 1 or args.workers < 1:
         print(
-            f"bench.goal_reach: unknown families {unknown} (known: {'; '.join(FAMILIES)}), "
+            f"studies.bench.goal_reach: unknown families {unknown} (known: {'; '.join(FAMILIES)}), "
             "or --goals or --workers below 1",
             file=sys.stderr,
         )

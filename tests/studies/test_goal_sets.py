@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from parsimony.goal_families import FAMILIES, goals
-from parsimony.goal_sets import LAWS, LIMIT_TOLERANCE, SUPERVISED, attempt, planning, shares
 from profiles.deploy_files import ROBOT_FILE
+from studies.goal_families import FAMILIES, goals
+from studies.goal_sets import LAWS, LIMIT_TOLERANCE, SUPERVISED, attempt, planning, shares
 from studies.reproduce.laws import describe
 from wbc.geometry.scenarios import OBSTACLE
 from wbc.robot import MobileManipulator

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from bench.recording import gap_errors_ms
+from studies.bench.recording import gap_errors_ms
 
 MS = 1_000_000
 

@@ -1,6 +1,6 @@
 """The chapter 6 experiments on the whole simulated loop, over many seeds, and the loop's speed.
 
-Run as ``python -m bench.sim_experiments [--seeds N] [--workers W] [--json]``. For each
+Run as ``python -m studies.bench.sim_experiments [--seeds N] [--workers W] [--json]``. For each
 experiment and law it runs ``parsimony experiment`` in lockstep, recorder on, for seeds
 0..N-1, W at a time (each system in its own process, namespace and router port), and prints the
 share that converged, contacts, the worst estimator error in steady state, the real-time factor
