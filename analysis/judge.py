@@ -40,7 +40,7 @@ from record.session_span import parted
 from wbc import dq
 from wbc.geometry.arm_clearance import part_clearances
 from wbc.geometry.obstacles import least_clearance
-from wbc.kinematic_run import effort_of
+from wbc.laws.kinematic_run import effort_of
 from wbc.planar import in_frame, wrap
 from wbc.planning.supervisor_phase import Phase
 from wbc.robot import MobileManipulator

@@ -1,4 +1,4 @@
-"""The classic cascade controller as a process: appendix B (``wbc.cascade_law``).
+"""The classic cascade controller as a process: appendix B (``wbc.laws.cascade_law``).
 
 Run as ``python -m components.cascade_controller --profile P --name N``; everything but
 the law is the controller shell of ``components.controller``. A goal's
@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from components.controller import CONTROLLER_PARAMS, Controller, law_params
 from components.process_entry import run_component
-from wbc.cascade_law import CascadeLaw, CascadeParams
+from wbc.laws.cascade_law import CascadeLaw, CascadeParams
 
 
 class CascadeController(Controller):

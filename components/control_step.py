@@ -26,9 +26,9 @@ from messages.base import ARM_JOINTS
 from messages.goal import Goal
 from messages.state import RobotState
 from wbc.base_motion import unicycle, wheel_speeds
-from wbc.gains import gain_specs
 from wbc.geometry.obstacles import Obstacle
-from wbc.law_output import Law, LawOutput
+from wbc.laws.gains import gain_specs
+from wbc.laws.law_output import Law, LawOutput
 from wbc.planning.drive_tasks import HeadingTask, PointTask
 from wbc.robot import MobileManipulator
 from wbc.task import MEASUREMENT_TOLERANCE, PoseTask, PositionTask, Task, same_task

@@ -1,6 +1,6 @@
 """The shell every controller process shares: ``robot/state`` in, base and arm commands out.
 
-A controller module only names its law (``wbc.lp_law``, ``wbc.cascade_law``...) and
+A controller module only names its law (``wbc.laws.lp_law``, ``wbc.laws.cascade_law``...) and
 declares its parameters; the mathematics stays in ``wbc``. Each ``robot/state`` is one
 control step (``components.control_step``, the same step ``parsimony rerun`` runs), with a
 ``control/diagnostics`` message saying what the law did and every gain in force.
@@ -42,8 +42,8 @@ from messages.goal import Goal
 from messages.header import Header
 from messages.obstacles import Obstacles, obstacles_of
 from messages.state import RobotState
-from wbc.gains import gain_specs
-from wbc.law_output import Law
+from wbc.laws.gains import gain_specs
+from wbc.laws.law_output import Law
 from wbc.planning.drive_tasks import HeadingTask, PointTask
 from wbc.robot import MobileManipulator
 from wbc.task import PoseTask, PositionTask, Task
@@ -59,7 +59,7 @@ def robot_loads(path: object) -> None:
 
 
 def law_params(gains_type: type) -> tuple[Param, ...]:
-    """A law's gains as run-time parameters, as its dataclass declares them (``wbc.gains``)."""
+    """A law's gains as run-time parameters, as its dataclass declares them (``wbc.laws.gains``)."""
     return tuple(Param.of(spec) for spec in gain_specs(gains_type))
 
 

@@ -1,4 +1,4 @@
-"""The parsimonious controller as a process: the LP law of chapter 5 (``wbc.lp_law``).
+"""The parsimonious controller as a process: the LP law of chapter 5 (``wbc.laws.lp_law``).
 
 Run as ``python -m components.lp_controller --profile P --name N``; everything but the
 law is the controller shell of ``components.controller``. Every gain of ``LPParams`` is a
@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from components.controller import CONTROLLER_PARAMS, Controller, law_params
 from components.process_entry import run_component
-from wbc.lp_law import LPLaw, LPParams
+from wbc.laws.lp_law import LPLaw, LPParams
 
 
 class LPController(Controller):

@@ -20,7 +20,7 @@ from pathlib import Path
 import yaml
 
 from messages.process import ParamValue
-from wbc.gains import GainSpec, shown
+from wbc.laws.gains import GainSpec, shown
 from wbc.robot import MobileManipulator
 
 log = logging.getLogger("components")

@@ -1,5 +1,5 @@
 """The QP controller as a process: the same rows and terms as the LP as a quadratic program
-(``wbc.qp_law``), for the comparison of chapter 7's future work 5.
+(``wbc.laws.qp_law``), for the comparison of chapter 7's future work 5.
 
 Run as ``python -m components.qp_controller --profile P --name N``; everything but the law is
 the controller shell of ``components.controller``. Every gain of ``QPParams`` is a run-time
@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from components.controller import CONTROLLER_PARAMS, Controller, law_params
 from components.process_entry import run_component
-from wbc.qp_law import QPLaw, QPParams
+from wbc.laws.qp_law import QPLaw, QPParams
 
 
 class QPController(Controller):

@@ -32,7 +32,7 @@ from profiles.access import EVERY_COMPONENT, AccessSettings, insert
 from profiles.endpoints import endpoint_problem
 from profiles.profile_files import ProfileError, read_profile_data
 from profiles.scene import Scene
-from wbc.gains import shown
+from wbc.laws.gains import shown
 
 COMPONENT_PACKAGE = "components"
 """The package of component modules: ``module: echo`` means ``components.echo``."""

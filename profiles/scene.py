@@ -14,7 +14,7 @@ intersects its ray with). Sizes are the black square's side, m.
 
 ``arm_obstacles`` declares what no marker shows: planes (a wall, a table top over its
 footprint) and vertical cylinders (poles), in F0, that the robot's collision parts keep clear
-of (``wbc.geometry.obstacles3d``, ``wbc.constraints.arm_obstacles``)::
+of (``wbc.geometry.obstacles3d``, ``wbc.laws.constraints.arm_obstacles``)::
 
     arm_obstacles:
       planes:    [{name: table, normal: [0, 0, 1], offset: 0.4,

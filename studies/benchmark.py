@@ -21,8 +21,6 @@ from studies.gain_sets import TABLE_PARAMS, WITHOUT_ARM_ROWS
 from studies.goal_sets import goal_report
 from studies.reproduce import efficiency
 from wbc import dq
-from wbc.cascade_law import CascadeLaw
-from wbc.constraints.arm_obstacles import ArmObstacles
 from wbc.geometry.scenarios import (
     DT,
     HOME,
@@ -31,13 +29,15 @@ from wbc.geometry.scenarios import (
     TABLE_GOAL,
     TABLE_START,
 )
-from wbc.kinematic_run import integrate
-from wbc.law_output import Law
-from wbc.lp_law import LPLaw
-from wbc.pinv_law import PseudoinverseLaw
-from wbc.qp_law import QPLaw
+from wbc.laws.cascade_law import CascadeLaw
+from wbc.laws.constraints.arm_obstacles import ArmObstacles
+from wbc.laws.kinematic_run import integrate
+from wbc.laws.law_output import Law
+from wbc.laws.lp_law import LPLaw
+from wbc.laws.pinv_law import PseudoinverseLaw
+from wbc.laws.qp_law import QPLaw
+from wbc.laws.step_context import StepContext
 from wbc.robot import MobileManipulator
-from wbc.step_context import StepContext
 from wbc.task import PoseTask
 
 GOAL = REACH_GOAL
@@ -106,7 +106,7 @@ def step_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str, fl
 
 def arm_row_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str, float]]:
     """The LP step with and without the rows that keep the arm clear of the table
-    (wbc.constraints.arm_obstacles), taking turns BLOCK steps each over the states of the
+    (wbc.laws.constraints.arm_obstacles), taking turns BLOCK steps each over the states of the
     guarded reach over the table's edge, and those rows alone (6 rows: 4 points, 2 segments)
     from the step's forward pass, as the law shares it with them. Each step is timed by the
     wall clock and by the process's CPU time (``cpu_*``), which a loaded machine disturbs
@@ -320,7 +320,7 @@ def format_report(report: dict) -> str:
         for name, figures in report["dqrobotics"].items()
     ]
     arm = [
-        {"reach over the table (wbc.constraints.arm_obstacles)": name, **figures}
+        {"reach over the table (wbc.laws.constraints.arm_obstacles)": name, **figures}
         for name, figures in report["arm_rows"].items()
     ]
     parts = [

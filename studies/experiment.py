@@ -63,8 +63,8 @@ from record.session_reader import info, make_whole
 from record.sessions import load_session
 from sim2d.scenarios import SimScenario, scenario
 from studies.gain_sets import LP_PARAMS
-from wbc.cascade_law import CascadeParams
-from wbc.lp_law import LPParams
+from wbc.laws.cascade_law import CascadeParams
+from wbc.laws.lp_law import LPParams
 from wbc.planar import inverse
 from wbc.robot import MobileManipulator
 

@@ -11,14 +11,14 @@ from typing import Any
 
 from profiles.deploy_files import DEPLOY
 from profiles.profile import load_profile
-from wbc.lp_law import LPParams, default_objectives
-from wbc.objectives.input_change import InputChangeGains
+from wbc.laws.lp_law import LPParams, default_objectives
+from wbc.laws.objectives.input_change import InputChangeGains
 
 OBSTACLE_PARAMS = LPParams(
     base_target=0.0, waist_hold=0.0, waist_centring=0.02, error_bound="error"
 )
 """The obstacle experiment's law (6.2.3): the default obstacle constraint, the vector-field
-inequality of wbc.constraints.obstacle_vector_field, in place of 5.28 (python -m
+inequality of wbc.laws.constraints.obstacle_vector_field, in place of 5.28 (python -m
 studies.bench.obstacle_constraints compares them), the circulation term that takes the base round an
 obstacle it stalled by, and no base target term, whose straight-line heading towards where the
 base should stand fights the detour. The waist is centred through the self-motion instead of
@@ -56,7 +56,7 @@ POSE_PARAMS = LPParams(eta=0.6, beta=15.0)
 """The LP law's gains of the pose experiment (6.2.1 gives eta 0.6 and beta 15)."""
 TABLE_PARAMS = POSE_PARAMS
 """Reaching over a table (future work 3 of 7.2): the pose experiment's law, whose rows of
-wbc.constraints.arm_obstacles keep the arm and the base clear of the table."""
+wbc.laws.constraints.arm_obstacles keep the arm and the base clear of the table."""
 WITHOUT_ARM_ROWS = replace(TABLE_PARAMS, arm_obstacles=False)
 """The same law blind to the table, for comparison."""
 
@@ -66,7 +66,7 @@ SMOOTH_PROFILE = DEPLOY / "sim_smooth.yaml"
 
 @functools.cache
 def input_change_gains() -> dict[str, Any]:
-    """The input change term's gains (wbc.objectives.input_change) as ``SMOOTH_PROFILE`` gives
+    """The input change term's gains (wbc.laws.objectives.input_change) as ``SMOOTH_PROFILE`` gives
     its controller: what turns the term on in any LPParams (``dataclasses.replace``)."""
     controller = load_profile(SMOOTH_PROFILE).component("controller")
     return {f.name: controller.params[f.name] for f in dataclasses.fields(InputChangeGains)}

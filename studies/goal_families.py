@@ -15,7 +15,7 @@ import numpy as np
 from wbc import dq
 from wbc.geometry.obstacles import Circle
 from wbc.geometry.scenarios import ARM_BOX, HOME
-from wbc.lp_law import LPParams
+from wbc.laws.lp_law import LPParams
 from wbc.robot import BASE_DOF, MobileManipulator
 
 Array = np.ndarray

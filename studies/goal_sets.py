@@ -16,14 +16,14 @@ import numpy as np
 from studies.gain_sets import bare_5_29, supervised_params
 from studies.goal_families import FAMILIES, OBSTACLE_FAMILIES, goals, obstacle_goals
 from wbc import dq
-from wbc.cascade_law import CascadeLaw
 from wbc.geometry.obstacles import Circle, least_clearance
 from wbc.geometry.scenarios import DT
-from wbc.kinematic_run import ControlEffort, control_effort, integrate, integrate_supervised
-from wbc.law_output import Law, entry_mask
-from wbc.lp_law import LPLaw, LPParams
+from wbc.laws.cascade_law import CascadeLaw
+from wbc.laws.kinematic_run import ControlEffort, control_effort, integrate, integrate_supervised
+from wbc.laws.law_output import Law, entry_mask
+from wbc.laws.lp_law import LPLaw, LPParams
+from wbc.laws.qp_law import QPLaw
 from wbc.planning.staging_supervisor import StagingSupervisor, SupervisorParams
-from wbc.qp_law import QPLaw
 from wbc.robot import BASE_DOF, MobileManipulator
 from wbc.task import PoseTask, PositionTask, Task
 
@@ -257,7 +257,7 @@ LAWS: dict[str, Callable[[MobileManipulator], Law]] = {
 }
 """The laws compared: the default LP, LP 5.29 as written (``exact_5_29``), the LP under the
 staging supervisor (wbc.planning.staging_supervisor) with its gains, the QP of the same rows and
-terms (wbc.qp_law), the cascade."""
+terms (wbc.laws.qp_law), the cascade."""
 POSITION_LAWS = ("lp", "lp 5.29 exactly", "qp", "cascade")
 """The laws run on the position task of each family's goals (6.2.2)."""
 

@@ -16,7 +16,6 @@ from parsimony.stdout import table
 from profiles.deploy_files import ROBOT_FILE
 from studies.gain_sets import BORDER_PARAMS, LP_PARAMS, TABLE_PARAMS, WITHOUT_ARM_ROWS
 from wbc import dq
-from wbc.cascade_law import CascadeLaw
 from wbc.geometry.arm_clearance import PenetrationCount, part_clearances
 from wbc.geometry.obstacles import Obstacle, least_clearance, split
 from wbc.geometry.scenarios import (
@@ -30,9 +29,10 @@ from wbc.geometry.scenarios import (
     TABLE_GOAL,
     TABLE_START,
 )
-from wbc.kinematic_run import Run, control_effort, integrate
-from wbc.lp_law import LPLaw, LPParams
-from wbc.pinv_law import PseudoinverseLaw
+from wbc.laws.cascade_law import CascadeLaw
+from wbc.laws.kinematic_run import Run, control_effort, integrate
+from wbc.laws.lp_law import LPLaw, LPParams
+from wbc.laws.pinv_law import PseudoinverseLaw
 from wbc.robot import MobileManipulator
 from wbc.task import PoseTask, PositionTask, Task
 

@@ -31,7 +31,7 @@ from profiles.deploy_files import ROBOT_FILE
 from studies.goal_families import FAMILIES, goals
 from studies.goal_sets import LAWS, SUPERVISED, Attempt, attempt, parsimony, shares
 from wbc import dq
-from wbc.lp_law import LPLaw, LPParams
+from wbc.laws.lp_law import LPLaw, LPParams
 from wbc.planar import wrap
 from wbc.robot import MobileManipulator
 

@@ -27,7 +27,7 @@ from parsimony.stdout import emit, json_text, result_only_stdout, table
 from profiles.deploy_files import ROBOT_FILE
 from studies.gain_sets import input_change_gains
 from studies.goal_sets import FAMILIES, Attempt, attempt, goals, parsimony, shares
-from wbc.lp_law import LPLaw, LPParams
+from wbc.laws.lp_law import LPLaw, LPParams
 from wbc.robot import MobileManipulator
 
 VARIANTS: dict[str, dict[str, Any]] = {

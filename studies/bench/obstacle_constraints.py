@@ -4,7 +4,7 @@ Run as ``python -m studies.bench.obstacle_constraints [--seeds N] [--kinematic-s
 [--workers W] [--json]``. Each variant (``VARIANTS``) is the obstacle experiment's law (6.2.3,
 ``studies.gain_sets.LP_PARAMS``) with the gains it names. Each runs the obstacle
 experiment's set-up of seeds 0..M-1 kinematically (q += u dt at 50 Hz from the seed's start, to
-the goal above its bin, ``wbc.kinematic_run``), and of seeds 0..N-1 and ``HELD_OUT`` on the
+the goal above its bin, ``wbc.laws.kinematic_run``), and of seeds 0..N-1 and ``HELD_OUT`` on the
 whole simulated loop (``parsimony experiment obstacle`` in lockstep, the controller told the
 variant's gains), W runs at a time. For each it prints the share that converged (``||e||`` under
 ``analysis.judge.CONVERGED_ERROR`` within ``TIME_LIMIT_S`` of simulated time), the runs with a
@@ -43,8 +43,8 @@ from studies.experiment import PROFILES, TIME_LIMIT_S, Options
 from studies.gain_sets import LP_PARAMS
 from studies.goal_sets import MOVING_ERROR
 from wbc.geometry.scenarios import DT
-from wbc.kinematic_run import integrate
-from wbc.lp_law import LPLaw
+from wbc.laws.kinematic_run import integrate
+from wbc.laws.lp_law import LPLaw
 from wbc.robot import MobileManipulator
 from wbc.task import PoseTask
 
@@ -66,8 +66,8 @@ VARIANTS: Mapping[str, Mapping[str, Any]] = {
 }
 """Each law compared: the obstacle experiment's gains with these in their place. 5.28 with the
 rate bound 5.10 and no circulation term is the dissertation's; 5.7 bounds ||u||_1 by the error
-instead (the experiment's), the circulation term (wbc.objectives.obstacle_circulation) takes a
-base that stalled by an obstacle round it; the VFI is wbc.constraints.obstacle_vector_field."""
+instead (the experiment's), the circulation term (wbc.laws.objectives.obstacle_circulation) takes a
+base that stalled by an obstacle round it; the VFI is wbc.laws.constraints.obstacle_vector_field."""
 HELD_OUT = (772,)
 """A seed apart from 0..N-1: start, obstacle and bin near one line (5.28 stalled at 0.56)."""
 

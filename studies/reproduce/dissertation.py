@@ -4,7 +4,7 @@ sets its own beside."""
 from __future__ import annotations
 
 METRICS = ("velocity_l1", "velocity_l2", "acceleration_l1", "acceleration_l2")
-"""Table 6.1's metrics 1..4, as ``wbc.kinematic_run.ControlEffort`` names them."""
+"""Table 6.1's metrics 1..4, as ``wbc.laws.kinematic_run.ControlEffort`` names them."""
 
 TABLE_6_1 = {
     "pose": {"PINV": (1.9796, 0.2960, 0.0026, 0.00013), "LP": (1.4944, 0.3267, 0.0012, 0.00004)},

@@ -13,13 +13,13 @@ from studies.gain_sets import bare_5_29
 from studies.reproduce import laws as L
 from studies.reproduce.dissertation import SECTION_6_3
 from studies.reproduce.table import Row
-from wbc.cascade_law import CascadeLaw, CascadeParams
-from wbc.constraints.error_bound import ErrorBound
 from wbc.geometry.scenarios import CONVERGENCE_GOAL, DT, HOME, REACH_GOAL
-from wbc.kinematic_run import integrate
-from wbc.law_output import Law
-from wbc.lp_law import LPLaw, LPParams
-from wbc.pinv_law import PinvParams, PseudoinverseLaw
+from wbc.laws.cascade_law import CascadeLaw, CascadeParams
+from wbc.laws.constraints.error_bound import ErrorBound
+from wbc.laws.kinematic_run import integrate
+from wbc.laws.law_output import Law
+from wbc.laws.lp_law import LPLaw, LPParams
+from wbc.laws.pinv_law import PinvParams, PseudoinverseLaw
 from wbc.robot import MobileManipulator
 from wbc.task import PoseTask
 

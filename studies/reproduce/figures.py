@@ -22,7 +22,7 @@ from studies.reproduce.dissertation import NOTES
 from studies.reproduce.measures import residuals
 from studies.reproduce.runs import Experiment
 from wbc.geometry.scenarios import DT
-from wbc.kinematic_run import Run
+from wbc.laws.kinematic_run import Run
 from wbc.robot import MobileManipulator
 from wbc.task import PoseTask
 

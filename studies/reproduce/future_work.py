@@ -9,7 +9,7 @@ from studies.reproduce import laws as L
 from studies.reproduce.measures import entry_counts
 from studies.reproduce.runs import Experiment
 from studies.reproduce.table import Row
-from wbc.kinematic_run import control_effort
+from wbc.laws.kinematic_run import control_effort
 
 
 def qp_rows(experiment: Experiment) -> list[Row]:

@@ -7,12 +7,12 @@ import dataclasses
 
 import numpy as np
 
-from wbc.cascade_law import CascadeLaw
 from wbc.geometry.obstacles import Obstacle, split
-from wbc.law_output import Law
-from wbc.lp_law import LPLaw, LPParams, default_constraints, default_objectives
-from wbc.pinv_law import PseudoinverseLaw
-from wbc.qp_law import QPLaw
+from wbc.laws.cascade_law import CascadeLaw
+from wbc.laws.law_output import Law
+from wbc.laws.lp_law import LPLaw, LPParams, default_constraints, default_objectives
+from wbc.laws.pinv_law import PseudoinverseLaw
+from wbc.laws.qp_law import QPLaw
 from wbc.robot import BASE_DOF, MobileManipulator
 
 LP = "LP"

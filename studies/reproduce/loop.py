@@ -27,10 +27,10 @@ from studies.reproduce import rows as R
 from studies.reproduce.recorded import recorded
 from studies.reproduce.runs import NAMES, Experiment, laws_of
 from studies.reproduce.table import Row
-from wbc.cascade_law import CascadeLaw, CascadeParams
 from wbc.geometry.scenarios import OBSTACLE
-from wbc.law_output import Law
-from wbc.lp_law import LPLaw
+from wbc.laws.cascade_law import CascadeLaw, CascadeParams
+from wbc.laws.law_output import Law
+from wbc.laws.lp_law import LPLaw
 from wbc.robot import MobileManipulator
 
 PLACE = "on the loop"

@@ -12,9 +12,9 @@ import numpy as np
 from studies.goal_sets import MOVING_ERROR, SETTLING_S
 from wbc import dq
 from wbc.geometry.obstacles import Circle
-from wbc.kinematic_run import Run
-from wbc.law_output import entry_mask
-from wbc.pinv_law import PINV_RCOND, nonholonomic_basis
+from wbc.laws.kinematic_run import Run
+from wbc.laws.law_output import entry_mask
+from wbc.laws.pinv_law import PINV_RCOND, nonholonomic_basis
 from wbc.robot import BASE_DOF, MobileManipulator
 from wbc.task import Task
 
@@ -23,7 +23,7 @@ ENTRIES = ("x'", "y'", "phi'", "q1'", "q2'", "q3'", "q4'", "q5'")
 TOLERANCE = 1e-9
 """How near its bound an entry of u counts as on it."""
 ERROR_BOUNDS = ("error_derivative_bound", "error_bound")
-"""The names of the rows 5.10 and 5.7 (``wbc.constraints.error_bound``)."""
+"""The names of the rows 5.10 and 5.7 (``wbc.laws.constraints.error_bound``)."""
 
 
 def median(values: list[float]) -> float:
@@ -31,7 +31,7 @@ def median(values: list[float]) -> float:
 
 
 def both_rules(masks: list[int]) -> list[float]:
-    """The median count of ``masks`` (entry masks, ``wbc.law_output.entry_mask``) as
+    """The median count of ``masks`` (entry masks, ``wbc.laws.law_output.entry_mask``) as
     [entries of u, entries with x' and y' as one]."""
     return [
         median([m.bit_count() for m in masks]),

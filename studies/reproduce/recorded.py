@@ -1,5 +1,5 @@
 """A run of the whole loop read back from its recording, as the rows of `parsimony reproduce`
-take a kinematic run (``wbc.kinematic_run.Run``).
+take a kinematic run (``wbc.laws.kinematic_run.Run``).
 
 The run is what ``analysis.judge`` judges (``the_run``: up to ``HOLD_S`` after the controller's
 error stayed under ``CONVERGED_ERROR``, else the time limit), from the controller's first step
@@ -23,8 +23,8 @@ from components.control_step import task_of
 from messages.topics import CONTROL_DIAGNOSTICS, CONTROL_GOAL, ROBOT_STATE, SIM_TRUTH
 from record.sessions import load_session
 from wbc import dq
-from wbc.kinematic_run import Run
-from wbc.law_output import LawOutput
+from wbc.laws.kinematic_run import Run
+from wbc.laws.law_output import LawOutput
 from wbc.task import PoseTask, PositionTask, Task
 
 

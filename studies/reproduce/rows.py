@@ -19,7 +19,7 @@ from studies.reproduce.dissertation import (
 from studies.reproduce.runs import Experiment
 from studies.reproduce.table import Row
 from wbc.geometry.scenarios import OBSTACLE, OBSTACLE_GOAL
-from wbc.kinematic_run import control_effort
+from wbc.laws.kinematic_run import control_effort
 from wbc.robot import MobileManipulator
 
 MAIN = (L.LP, L.LP_5_29, L.CASCADE, L.SATURATED)

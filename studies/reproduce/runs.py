@@ -12,14 +12,14 @@ import numpy as np
 from studies.gain_sets import BORDER_PARAMS, LP_PARAMS, bare_5_29, input_change_gains
 from studies.reproduce import laws as L
 from wbc import dq
-from wbc.cascade_law import CascadeLaw, CascadeParams
 from wbc.geometry.obstacles import Obstacle
 from wbc.geometry.scenarios import DT, HOME, JOINT_LIMIT_GOAL, OBSTACLE, OBSTACLE_GOAL, REACH_GOAL
-from wbc.kinematic_run import Run, integrate
-from wbc.law_output import Law
-from wbc.lp_law import LPLaw
-from wbc.pinv_law import PinvParams, PseudoinverseLaw
-from wbc.qp_law import QPLaw, QPParams
+from wbc.laws.cascade_law import CascadeLaw, CascadeParams
+from wbc.laws.kinematic_run import Run, integrate
+from wbc.laws.law_output import Law
+from wbc.laws.lp_law import LPLaw
+from wbc.laws.pinv_law import PinvParams, PseudoinverseLaw
+from wbc.laws.qp_law import QPLaw, QPParams
 from wbc.robot import MobileManipulator
 from wbc.task import PoseTask, PositionTask, Task
 

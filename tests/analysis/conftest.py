@@ -20,10 +20,10 @@ from messages.topics import (
 )
 from profiles.deploy_files import ROBOT_FILE
 from wbc.base_motion import unicycle, wheel_speeds
-from wbc.cascade_law import CascadeLaw
 from wbc.geometry import scenarios
-from wbc.kinematic_run import Run, integrate
-from wbc.lp_law import LPLaw, LPParams
+from wbc.laws.cascade_law import CascadeLaw
+from wbc.laws.kinematic_run import Run, integrate
+from wbc.laws.lp_law import LPLaw, LPParams
 from wbc.robot import MobileManipulator
 from wbc.task import PoseTask
 

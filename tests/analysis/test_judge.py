@@ -26,8 +26,8 @@ from tests.analysis.conftest import ROBOT, START_NS, session_of
 from tests.record.test_far_stamps import write
 from wbc import dq
 from wbc.geometry import scenarios
-from wbc.kinematic_run import effort_of, integrate
-from wbc.lp_law import LPLaw, LPParams
+from wbc.laws.kinematic_run import effort_of, integrate
+from wbc.laws.lp_law import LPLaw, LPParams
 from wbc.robot import MobileManipulator
 from wbc.task import PoseTask, PositionTask
 

@@ -29,7 +29,7 @@ from tests.analysis.conftest import DT, FIGURES, ROBOT, START_NS, header
 from tests.processes import parsimony
 from wbc import dq
 from wbc.geometry import scenarios
-from wbc.kinematic_run import effort_of
+from wbc.laws.kinematic_run import effort_of
 
 REQUIRED = (ROBOT_STATE, CONTROL_GOAL, BASE_COMMAND, ARM_COMMAND, CONTROL_DIAGNOSTICS)
 

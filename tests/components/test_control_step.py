@@ -16,11 +16,11 @@ from messages.header import Header
 from messages.state import RobotState
 from profiles.deploy_files import ROBOT_FILE
 from studies.gain_sets import LP_PARAMS, input_change_gains
-from wbc.cascade_law import CascadeLaw, CascadeParams
-from wbc.gains import gain_specs
 from wbc.geometry.scenarios import DT, HOME, REACH_GOAL
-from wbc.lp_law import LPLaw, LPParams
-from wbc.qp_law import QPLaw, QPParams
+from wbc.laws.cascade_law import CascadeLaw, CascadeParams
+from wbc.laws.gains import gain_specs
+from wbc.laws.lp_law import LPLaw, LPParams
+from wbc.laws.qp_law import QPLaw, QPParams
 from wbc.robot import MobileManipulator
 
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
@@ -106,7 +106,7 @@ def test_a_goal_whose_gain_leaves_its_bounds_is_refused_naming_the_field_and_the
 ) -> None:
     """eta or beta of 1e300 or 1e-300 passes the goal's schema (a positive number): refused
     (ValueError), and every step until the next goal commands zero with the status ``goal
-    refused`` and the gain's bounds, as ``wbc.gains`` declares them."""
+    refused`` and the gain's bounds, as ``wbc.laws.gains`` declares them."""
     control = ControlStep("lp", LPLaw, ROBOT, LPParams())
     control.take_goal(GOAL)
     with pytest.raises(ValueError, match=name):

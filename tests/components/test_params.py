@@ -102,7 +102,7 @@ def test_reply_values_round_trip_with_their_type(value: object) -> None:
 def test_every_gain_of_a_law_is_a_parameter_with_the_bounds_its_dataclass_declares(controller):
     import importlib
 
-    from wbc.gains import gain_specs
+    from wbc.laws.gains import gain_specs
 
     module = importlib.import_module(f"components.{controller}")
     component = next(

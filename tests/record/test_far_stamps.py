@@ -24,8 +24,8 @@ from record.sessions import load_session
 from tests.analysis.conftest import DT, FIGURES, ROBOT, START_NS, session_of
 from tests.processes import parsimony
 from wbc.geometry import scenarios
-from wbc.kinematic_run import integrate
-from wbc.lp_law import LPLaw, LPParams
+from wbc.laws.kinematic_run import integrate
+from wbc.laws.lp_law import LPLaw, LPParams
 from wbc.task import PoseTask
 
 NAMESPACE = "far"

@@ -27,7 +27,7 @@ from sim2d.scenarios import (
 )
 from wbc.geometry.arm_clearance import part_clearances
 from wbc.geometry.scenarios import HOME, OBSTACLE, REACH_GOAL, TABLE, TABLE_GOAL, TABLE_START
-from wbc.lp_law import LPParams
+from wbc.laws.lp_law import LPParams
 from wbc.planar import planar_of
 from wbc.planning.disc_geometry import segment_clear
 from wbc.planning.staging import plan

@@ -13,10 +13,10 @@ from studies.gain_sets import (
     input_change_gains,
     supervised_params,
 )
-from wbc.constraints.error_bound import ErrorBound
-from wbc.constraints.obstacle_border import BorderObstacle
-from wbc.lp_law import default_constraints, default_objectives
-from wbc.objectives.input_change import InputChange
+from wbc.laws.constraints.error_bound import ErrorBound
+from wbc.laws.constraints.obstacle_border import BorderObstacle
+from wbc.laws.lp_law import default_constraints, default_objectives
+from wbc.laws.objectives.input_change import InputChange
 
 
 def test_the_supervised_gains_are_those_its_profile_gives_its_controller() -> None:

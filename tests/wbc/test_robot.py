@@ -15,9 +15,9 @@ from dqrobotics.robot_modeling import (
     DQ_SerialManipulatorDH,
     DQ_WholeBody,
 )
-from wbc_scenarios import central_difference
 
 from profiles.deploy_files import ROBOT_FILE
+from tests.wbc.wbc_scenarios import central_difference
 from wbc import dq
 from wbc.robot import MobileManipulator, RobotDescriptionError, translation_jacobian
 

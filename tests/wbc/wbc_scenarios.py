@@ -11,12 +11,13 @@ from dqrobotics import DQ
 from dqrobotics.robot_modeling import DQ_HolonomicBase, DQ_SerialManipulatorDH, DQ_WholeBody
 
 from profiles.deploy_files import ROBOT_FILE
-from wbc import dq, kinematic_run
+from wbc import dq
 from wbc.geometry.obstacles3d import Solid
 from wbc.geometry.scenarios import DT
-from wbc.kinematic_run import Run
+from wbc.laws import kinematic_run
+from wbc.laws.kinematic_run import Run
+from wbc.laws.step_context import StepContext
 from wbc.robot import MobileManipulator
-from wbc.step_context import StepContext
 from wbc.task import PoseTask, PositionTask
 
 

@@ -24,12 +24,12 @@ line holds for lines that are not parallel (s > 0).
 Each Jacobian is a weight vector w times the primitive's Jacobian, J_d = w^T J_t (w = vec4(n),
 2 vec4(p - c), 2 vec4(l x (p x l - m))) or w^T J_l (an 8-vector): ``point_to_plane``,
 ``point_to_line``, ``point_to_point`` and ``line_to_line`` give (distance, w) in Python floats,
-the form the rows of ``wbc.constraints.arm_obstacles`` take them in (``wbc.geometry.wrench_rows``
-then multiplies them out without forming J_t or J_l); the ``*_jacobian`` functions multiply them by
-a part's Jacobian. On 3-vectors Python's float arithmetic beats numpy's call overhead: a step's
-point rows against the table (each of 4 points' nearest feature, distance and weights) take
-13 us so, against 85 us as masked arrays times each point's J_t (CPU time over the states of
-`parsimony bench`'s reach over the table, the two in turn).
+the form the rows of ``wbc.laws.constraints.arm_obstacles`` take them in
+(``wbc.geometry.wrench_rows`` then multiplies them out without forming J_t or J_l); the
+``*_jacobian`` functions multiply them by a part's Jacobian. On 3-vectors Python's float arithmetic
+beats numpy's call overhead: a step's point rows against the table (each of 4 points' nearest
+feature, distance and weights) take 13 us so, against 85 us as masked arrays times each point's J_t
+(CPU time over the states of `parsimony bench`'s reach over the table, the two in turn).
 """
 
 from __future__ import annotations

@@ -10,9 +10,9 @@ Plücker line l + eps t_i x l with l = r a r* and the line Jacobian of DQ Roboti
 along the line, p_0 + s l with p_0 = l x m (so s = <p, l> at an end p).
 
 The positions come from the step's forward pass in Python floats (4 points and 2 lines: 13 us
-of CPU, where the array forms took 34 us). The rows of ``wbc.constraints.arm_obstacles`` need no
-more: ``wbc.geometry.wrench_rows`` forms them from the twists; J_t and J_l here are what those rows
-are held to (tests/wbc/geometry/test_wrench_rows.py).
+of CPU, where the array forms took 34 us). The rows of ``wbc.laws.constraints.arm_obstacles`` need
+no more: ``wbc.geometry.wrench_rows`` forms them from the twists; J_t and J_l here are what those
+rows are held to (tests/wbc/geometry/test_wrench_rows.py).
 """
 
 from __future__ import annotations
@@ -107,7 +107,8 @@ def _rotated(pose: Sequence[float], vector: Sequence[float]) -> Vector:
 class PrimitiveKinematics:
     """Where the parts are at one configuration (Python floats, and arrays when asked), and
     their Jacobians J_t and J_l (4.18 and DQ Robotics' line Jacobian) when asked. The rows of
-    ``wbc.constraints.arm_obstacles`` need only where they are (``wbc.geometry.wrench_rows``)."""
+    ``wbc.laws.constraints.arm_obstacles`` need only where they are
+    (``wbc.geometry.wrench_rows``)."""
 
     def __init__(self, robot: MobileManipulator, chain: Chain) -> None:
         model = robot.collision

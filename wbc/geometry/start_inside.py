@@ -1,6 +1,6 @@
 """A robot that starts inside a solid in 3-D, said in one line per solid.
 
-The arm obstacle rows (``wbc.constraints.arm_obstacles``) ask d' >= -eta max(d - d_safe, 0)
+The arm obstacle rows (``wbc.laws.constraints.arm_obstacles``) ask d' >= -eta max(d - d_safe, 0)
 of each part's distance d from each solid: a part inside one (d < 0) may come no deeper, but
 no row pushes it out. So the part moves only outwards or along the solid, and where the task
 asks for motion deeper in, that motion is held: the robot may stop short of its goal.

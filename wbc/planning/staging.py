@@ -39,8 +39,8 @@ from scipy.optimize import least_squares
 from wbc import dq
 from wbc.conditioning import smallest_singular_value
 from wbc.geometry.obstacles import Circle
-from wbc.lp_law import LPParams
-from wbc.objectives.base_target import gripper_heading
+from wbc.laws.lp_law import LPParams
+from wbc.laws.objectives.base_target import gripper_heading
 from wbc.planar import wrap
 from wbc.planning.disc_geometry import segment_clear
 from wbc.planning.drive_planner import OutOfBudget, Way, WayPlanner

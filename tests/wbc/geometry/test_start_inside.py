@@ -11,8 +11,8 @@ from wbc.geometry.arm_clearance import part_clearances
 from wbc.geometry.obstacles3d import Cylinder, Plane
 from wbc.geometry.scenarios import HOME, REACH_GOAL
 from wbc.geometry.start_inside import CONSEQUENCE, inside_at_start
-from wbc.lp_law import LPLaw
-from wbc.qp_law import QPLaw
+from wbc.laws.lp_law import LPLaw
+from wbc.laws.qp_law import QPLaw
 
 MODEL = robot()
 WALL = Plane((-1.0, 0.0, 0.0), -0.15, name="wall")

@@ -16,8 +16,8 @@ from wbc import dq
 from wbc.conditioning import smallest_singular_value
 from wbc.geometry.obstacles import Circle
 from wbc.geometry.scenarios import DT, HOME, REACH_GOAL
-from wbc.kinematic_run import integrate, integrate_supervised
-from wbc.lp_law import LPLaw
+from wbc.laws.kinematic_run import integrate, integrate_supervised
+from wbc.laws.lp_law import LPLaw
 from wbc.planar import planar_pose
 from wbc.planning.drive_tasks import HeadingTask, PointTask, offset_point
 from wbc.planning.staging import StagingParams, arm_box, plan

@@ -1,0 +1,56 @@
+"""What a constraint of the LP (5.29) returns: rows on the whole-body velocity u.
+
+A constraint is a small object with a ``name`` and ``rows(context)``; it returns one of three
+kinds of rows on the whole-body velocity u, and the LP builder only stacks them:
+``LinearRows`` (lower <= A u <= upper, an equality where lower == upper),
+``VelocityBounds`` (lower <= u <= upper, entry by entry) or
+``OneNormBound`` (||u||_1 <= limit, written 1'u_P + 1'u_N <= limit on the split u = u_P - u_N).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from wbc.laws.step_context import StepContext
+
+Array = np.ndarray
+
+
+@dataclass(frozen=True)
+class LinearRows:
+    """lower <= matrix u <= upper; ``engaged`` is False when the rows are switched off."""
+
+    name: str
+    matrix: Array
+    lower: Array
+    upper: Array
+    engaged: bool = True
+
+
+@dataclass(frozen=True)
+class VelocityBounds:
+    """lower <= u <= upper, one pair per entry of u."""
+
+    name: str
+    lower: Array
+    upper: Array
+
+
+@dataclass(frozen=True)
+class OneNormBound:
+    """||u||_1 <= limit."""
+
+    name: str
+    limit: float
+
+
+Rows = LinearRows | VelocityBounds | OneNormBound
+
+
+class Constraint(Protocol):
+    name: str
+
+    def rows(self, context: StepContext) -> Rows: ...
