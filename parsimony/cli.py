@@ -10,7 +10,7 @@ import sys
 from mcap.exceptions import McapError
 
 from launch.query import QueryError
-from parsimony.stdout import result_only_stdout
+from outputs.stdout import result_only_stdout
 from parsimony.target_options import exit_code
 
 COMMANDS = (

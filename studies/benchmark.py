@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from parsimony.stdout import table
+from outputs.stdout import table
 from profiles.deploy_files import ROBOT_FILE
 from studies.gain_sets import TABLE_PARAMS, WITHOUT_ARM_ROWS
 from studies.goal_sets import goal_report

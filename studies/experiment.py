@@ -53,8 +53,8 @@ from launch import query
 from messages import codec, process, topics
 from messages.obstacles import Solids
 from messages.topics import CONTROL_DIAGNOSTICS, ROBOT_STATE, SIM_TRUTH, SUPERVISOR_STATUS
-from parsimony.output_files import written_whole
-from parsimony.stdout import json_text
+from outputs.files import written_whole
+from outputs.stdout import json_text
 from profiles.deploy_files import DEPLOY
 from profiles.endpoints import free_port
 from profiles.profile import Profile, ProfileError, load_profile

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from parsimony.stdout import table
+from outputs.stdout import table
 from profiles.deploy_files import ROBOT_FILE
 from studies.gain_sets import BORDER_PARAMS, LP_PARAMS, TABLE_PARAMS, WITHOUT_ARM_ROWS
 from wbc import dq

@@ -37,6 +37,7 @@ def test_help_lists_every_subcommand():
         assert name in result.stdout
 
 
+@pytest.mark.heavy  # minutes: every law's steps, convergence and goal sets
 def test_bench_prints_step_times_and_the_convergence_test_as_json():
     result = run_cli("bench", "--json", "--repeats", "50", "--trials", "1", "--goals", "2")
     assert result.returncode == 0, result.stderr
@@ -93,7 +94,7 @@ def test_a_library_writing_to_file_descriptor_1_reaches_stderr():
     """What C code writes to fd 1 while a command runs is routed to stderr, not the result."""
     code = (
         "import os, sys\n"
-        "from parsimony.stdout import emit, result_only_stdout\n"
+        "from outputs.stdout import emit, result_only_stdout\n"
         "with result_only_stdout():\n"
         "    os.write(1, b'banner from C\\n')\n"
         "    print('a log line')\n"

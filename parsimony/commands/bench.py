@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from parsimony.stdout import emit, json_text
+from outputs.stdout import emit, json_text
 from profiles.deploy_files import ROBOT_FILE
 from studies.benchmark import format_report, run_bench
 

@@ -11,7 +11,7 @@ from pathlib import Path
 import yaml
 
 from launch.query import QueryError
-from parsimony.stdout import emit, json_text
+from outputs.stdout import emit, json_text
 from profiles.profile import ProfileError
 from sim2d.scenarios import NAMES, SEED_MAX
 from studies.experiment import PROFILES, TIME_LIMIT_S, Options, run_experiment

@@ -31,7 +31,7 @@ from messages.header import Header
 from messages.obstacles import circles_of
 from messages.state import RobotState
 from messages.supervisor import SupervisorStatus
-from parsimony.stdout import emit, json_text
+from outputs.stdout import emit, json_text
 from parsimony.target_options import fail, profile_and_target, target_options
 from profiles.profile import Profile, ProfileError
 from view.client_goals import GoalRefused, client_goal

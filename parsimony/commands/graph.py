@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 
 from launch.graph import dataflow
-from parsimony.stdout import emit, json_text
+from outputs.stdout import emit, json_text
 from profiles.profile import ProfileError, load_profile
 
 

@@ -7,7 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from parsimony.stdout import emit, json_text, table
+from outputs.stdout import emit, json_text, table
 from record.session_reader import info
 
 

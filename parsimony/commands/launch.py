@@ -14,8 +14,8 @@ import zenoh
 from launch.graph import dataflow
 from launch.launcher import Launcher
 from launch.zenoh_error import zenoh_error_text
+from outputs.files import writable_output
 from parsimony.commands.record import memory_file
-from parsimony.output_files import writable_output
 from profiles.profile import Profile, ProfileError, load_profile
 from profiles.recorder import RECORDER, with_recorder
 

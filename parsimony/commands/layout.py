@@ -10,7 +10,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from parsimony.stdout import emit
+from outputs.stdout import emit
 from profiles.profile import ProfileError, load_profile
 from view.foxglove_layout import layout
 

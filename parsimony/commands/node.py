@@ -7,7 +7,7 @@ import json
 
 from launch.graph import component_class
 from launch.query import QueryError, status_of
-from parsimony.stdout import emit, json_text
+from outputs.stdout import emit, json_text
 from parsimony.target_options import fail, profile_and_target, target_options
 from profiles.profile import ProfileError
 

@@ -10,7 +10,7 @@ import yaml
 
 from launch.graph import component_class
 from launch.query import QueryError, all_params, get_param, set_param, value_text
-from parsimony.stdout import emit, json_text
+from outputs.stdout import emit, json_text
 from parsimony.target_options import fail, profile_and_target, target_options
 from profiles.access import DEFAULT_TOOL_USER, USER_ENV
 from profiles.profile import ProfileError

@@ -16,8 +16,8 @@ from pathlib import Path
 from launch.query import QueryError, Target
 from messages.process import PARENT_PID_ENV
 from messages.topics import topics_matching
-from parsimony.output_files import writable_output, written_whole
-from parsimony.stdout import emit
+from outputs.files import writable_output, written_whole
+from outputs.stdout import emit
 from profiles.profile import ProfileError
 from profiles.recorder import RECORDER, with_recorder
 from record.session_reader import recover

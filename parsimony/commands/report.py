@@ -11,8 +11,8 @@ from pathlib import Path
 
 from analysis.judge import JUDGED, judge, open_loop, the_run
 from analysis.report import write_report
+from outputs.stdout import emit, json_text
 from parsimony.commands.launch import positive_seconds
-from parsimony.stdout import emit, json_text
 from profiles.deploy_files import ROBOT_FILE
 from profiles.profile import ProfileError, load_profile
 from record.session_span import parted

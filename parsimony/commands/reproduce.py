@@ -9,8 +9,8 @@ from dataclasses import asdict
 from pathlib import Path
 
 from launch.query import QueryError
+from outputs.stdout import emit, json_text
 from parsimony.commands.experiment import time_limit
-from parsimony.stdout import emit, json_text
 from profiles.deploy_files import ROBOT_FILE
 from profiles.profile import ProfileError, load_profile
 from studies.experiment import PROFILES, TIME_LIMIT_S

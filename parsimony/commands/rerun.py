@@ -26,8 +26,8 @@ from components.qp_controller import QPController
 from messages.commands import ArmCommand, BaseCommand
 from messages.header import Header
 from messages.obstacles import obstacles_of
-from parsimony.output_files import writable_output, written_whole
-from parsimony.stdout import emit
+from outputs.files import writable_output, written_whole
+from outputs.stdout import emit
 from profiles.deploy_files import ROBOT_FILE
 from record.session_file import Recorded, SessionWriter
 from record.session_reader import read_groups

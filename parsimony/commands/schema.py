@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from messages.schema import export_schemas, schema_index
-from parsimony.stdout import emit, json_text
+from outputs.stdout import emit, json_text
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

@@ -18,8 +18,8 @@ from launch.query import (
     statuses,
 )
 from messages.status import ComponentStatus
+from outputs.stdout import emit, json_text, table
 from parsimony.commands.launch import positive_seconds
-from parsimony.stdout import emit, json_text, table
 from parsimony.target_options import fail
 from profiles.profile import ProfileError, load_profile
 

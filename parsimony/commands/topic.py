@@ -18,7 +18,7 @@ from launch.graph import dataflow
 from launch.query import QueryError, live_writers, overwritten_by
 from launch.tool_clock import ToolClock
 from messages import codec, topics
-from parsimony.stdout import emit, json_text
+from outputs.stdout import emit, json_text
 from parsimony.target_options import fail, profile_and_target, target_options
 from profiles.profile import Profile, ProfileError
 

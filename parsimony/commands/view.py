@@ -26,9 +26,9 @@ import zenoh
 from components.rate_limited_log import RateLimitedLog
 from launch.query import QueryError, Target
 from messages.topics import Topic, check_namespace, topics_matching
+from outputs.stdout import emit, json_text
 from parsimony.commands.launch import positive_seconds
 from parsimony.commands.layout import write_layout
-from parsimony.stdout import emit, json_text
 from parsimony.target_options import exit_code
 from profiles.profile import Profile, ProfileError, load_profile
 from scenes.foxglove_views import Viewer

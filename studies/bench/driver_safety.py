@@ -37,7 +37,7 @@ from launch import query
 from messages import codec, topics
 from messages.commands import ArmCommand, BaseCommand
 from messages.header import Header
-from parsimony.stdout import result_only_stdout, table
+from outputs.stdout import result_only_stdout, table
 from profiles.deploy_files import DEPLOY
 from profiles.endpoints import free_port
 from profiles.profile import load_profile

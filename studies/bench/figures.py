@@ -8,7 +8,7 @@ from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 
-from parsimony.stdout import emit, json_text
+from outputs.stdout import emit, json_text
 
 
 def spread(values: Sequence[float], digits: int = 1) -> dict[str, float | int | None]:

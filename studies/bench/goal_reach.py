@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from parsimony.stdout import emit, json_text, result_only_stdout, table
+from outputs.stdout import emit, json_text, result_only_stdout, table
 from profiles.deploy_files import ROBOT_FILE
 from studies.goal_families import FAMILIES, goals
 from studies.goal_sets import LAWS, SUPERVISED, Attempt, attempt, parsimony, shares

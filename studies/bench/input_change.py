@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from parsimony.stdout import emit, json_text, result_only_stdout, table
+from outputs.stdout import emit, json_text, result_only_stdout, table
 from profiles.deploy_files import ROBOT_FILE
 from studies.gain_sets import input_change_gains
 from studies.goal_sets import FAMILIES, Attempt, attempt, goals, parsimony, shares

@@ -41,7 +41,7 @@ from launch.launcher import cpu_seconds
 from messages import codec, topics
 from messages.markers import MarkerDetections
 from messages.supervisor import SupervisorStatus
-from parsimony.stdout import table
+from outputs.stdout import table
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.session_file import SessionWriter, entries

@@ -34,7 +34,7 @@ import numpy as np
 
 from analysis.judge import CONVERGED_ERROR, JUDGED, converged_at, messages, origin_s, the_run
 from messages.topics import CONTROL_DIAGNOSTICS, SUPERVISOR_STATUS
-from parsimony.stdout import emit, json_text, result_only_stdout, table
+from outputs.stdout import emit, json_text, result_only_stdout, table
 from profiles.profile import load_profile
 from record.sessions import load_session
 from sim2d.scenarios import scenario

@@ -56,7 +56,7 @@ from messages.camera import CameraFrame, CameraIntrinsics
 from messages.header import Header
 from messages.joints import JointStates
 from messages.odometry import BaseOdometry
-from parsimony.stdout import emit, json_text, result_only_stdout, table
+from outputs.stdout import emit, json_text, result_only_stdout, table
 from profiles.endpoints import free_port
 from profiles.profile import Profile, ZenohSettings, load_profile
 from record.session_file import MESSAGE_ENCODING

@@ -18,7 +18,7 @@ import numpy as np
 import serial
 from dynamixel_sdk import COMM_SUCCESS, GroupSyncWrite, PacketHandler, PortHandler
 
-from parsimony.stdout import emit, json_text, result_only_stdout
+from outputs.stdout import emit, json_text, result_only_stdout
 from protocols import create_oi
 from protocols import dynamixel_v1 as dxl
 from sim2d.devices.ax_servos import AXChainEmulator

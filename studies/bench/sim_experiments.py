@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from launch.query import QueryError
-from parsimony.stdout import emit, json_text, result_only_stdout, table
+from outputs.stdout import emit, json_text, result_only_stdout, table
 from profiles.profile import ProfileError, load_profile
 from sim2d.camera import ImageNoise, PlacedMarker, Renderer, ceiling_camera
 from sim2d.scenarios import NAMES, scenario

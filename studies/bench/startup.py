@@ -22,7 +22,7 @@ import yaml
 import zenoh
 
 from messages import process, topics
-from parsimony.stdout import result_only_stdout, table
+from outputs.stdout import result_only_stdout, table
 from profiles.deploy_files import DEPLOY
 from profiles.endpoints import free_port
 from profiles.profile import load_profile

@@ -46,7 +46,7 @@ from components.runtime import Node
 from launch import query
 from messages import topics
 from messages.process import stop
-from parsimony.stdout import emit, json_text, result_only_stdout, table
+from outputs.stdout import emit, json_text, result_only_stdout, table
 from profiles.deploy_files import ROBOT_FILE
 from profiles.endpoints import free_port
 from profiles.profile import ZenohSettings, load_profile

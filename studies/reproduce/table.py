@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from parsimony.stdout import table
+from outputs.stdout import table
 
 
 @dataclass(frozen=True)
