@@ -8,6 +8,8 @@ handed out first, so none of them starts last and finishes after all the others.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import pytest
 
 SHARED_SCOPES = ("module", "package", "session")
@@ -36,10 +38,12 @@ def _shared_group(item: pytest.Item) -> str | None:
     return None if widest is None else widest[1]
 
 
-@pytest.hookimpl(tryfirst=True)
-def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+@pytest.hookimpl(wrapper=True)
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> Iterator[None]:
+    """Grouped before any other plugin's hook runs: xdist reads the groups in its own."""
     for item in items:
         group = _shared_group(item)
         if group is not None and item.get_closest_marker("xdist_group") is None:
             item.add_marker(pytest.mark.xdist_group(group))
     items.sort(key=lambda item: item.get_closest_marker("heavy") is None)  # stable
+    return (yield)
