@@ -29,7 +29,7 @@ from studies.reproduce.loop import folder
 from studies.reproduce.runs import laws_of
 from wbc.robot import MobileManipulator
 
-pytestmark = pytest.mark.heavy  # two runs of minutes each, one per worker
+pytestmark = pytest.mark.heavy  # two runs of minutes each
 GOLDEN = Path(__file__).with_name("reproduce_golden.json")
 TRIALS = 2
 """Trials of section 6.3 in the test: its timed rows are checked for form alone."""
