@@ -25,7 +25,7 @@ from profiles.profile_files import read_profile_data
 
 M = TypeVar("M", bound=BaseModel)
 
-DEADLINE_S = 10.0
+DEADLINE_S = 60.0
 """Generous limit for anything that involves starting a process on a loaded machine."""
 
 

@@ -17,7 +17,7 @@ from protocols import create_oi
 from sim2d.devices.pty_link import PtyLink
 
 if TYPE_CHECKING:
-    from conftest import System
+    from tests.components.conftest import System
 
 
 def driver_system(deployed, tmp_path: Path, name: str, port: Path, **params: object) -> System:

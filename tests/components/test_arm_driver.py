@@ -10,8 +10,6 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import pytest
-from conftest import System
-from driver_harness import driver_system, status
 
 from components.arm_driver import HOLD_SPEED
 from messages import codec, topics
@@ -21,6 +19,8 @@ from profiles.deploy_files import ROBOT_FILE
 from protocols import dynamixel_v1 as dxl
 from protocols.dynamixel_v1 import Address, StatusFault
 from sim2d.devices.ax_servos import AXChainEmulator, IntegratingJoints
+from tests.components.conftest import System
+from tests.components.driver_harness import driver_system, status
 from wbc.robot import MobileManipulator
 
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)

@@ -10,8 +10,6 @@ import time
 from pathlib import Path
 
 import yaml
-from conftest import Inbox, System
-from driver_harness import DEPLOY, FakeLink, driver_system, frame, status
 
 from launch import query
 from messages import codec, topics
@@ -22,6 +20,8 @@ from profiles.profile import load_profile
 from profiles.profile_files import read_profile_data
 from protocols import create_oi
 from studies.experiment import connect, launched
+from tests.components.conftest import Inbox, System
+from tests.components.driver_harness import DEPLOY, FakeLink, driver_system, frame, status
 
 METRES_PER_COUNT = create_oi.mm_per_count(0.072) / 1000.0
 STARTED = (

@@ -40,7 +40,7 @@ if TYPE_CHECKING:
 LP_PROFILE = DEPLOY / "controllers.yaml"
 CASCADE_PROFILE = DEPLOY / "controllers_cascade.yaml"
 
-DEADLINE_S = 10.0
+DEADLINE_S = 60.0
 """Generous limit for anything that involves starting a process on a loaded machine."""
 
 START = tuple(NEAR_START.tolist())

@@ -10,8 +10,6 @@ import msgpack
 import numpy as np
 import pytest
 import yaml
-from conftest import DEADLINE_S, System
-from driver_harness import status as component_status
 
 from components.control_step import task_of
 from components.controller import goal_of
@@ -25,6 +23,8 @@ from messages.state import RobotState
 from messages.supervisor import SupervisorStatus
 from profiles.deploy_files import DEPLOY, ROBOT_FILE
 from profiles.profile_files import read_profile_data
+from tests.components.conftest import DEADLINE_S, System
+from tests.components.driver_harness import status as component_status
 from tests.wbc.planning.crowd import CHECK_GAP_S, crowd
 from wbc import dq
 from wbc.geometry.scenarios import HOME, REACH_GOAL

@@ -17,7 +17,7 @@ import yaml
 
 from profiles.endpoints import free_port
 
-DEADLINE_S = 10.0
+DEADLINE_S = 60.0
 """Generous limit for anything that starts processes on a loaded machine."""
 
 LAUNCH = (
