@@ -82,11 +82,13 @@ def section_6_3(robot: MobileManipulator, trials: int) -> tuple[list[Row], list[
         found = {label: timed(make, task, trials) for label, make in makers.items()}
         theirs = SECTION_6_3[test]
         kind = "holonomic" if test == "test 1" else "nonholonomic"
+        goal = ", ".join(f"{v:g}" for v in GOALS[test])
         rows += [
             Row(
                 f"6.3.{test}.iterations",
                 "6.3",
-                f"{test} ({kind}): iterations to ||e|| < 1e-3 (classic, LP), each over its trials",
+                f"{test} ({kind}; goal: the pose of q = [{goal}]): iterations to ||e|| < 1e-3 "
+                "(classic, LP), each over its trials",
                 theirs["iterations"],
                 [found["classic"]["iterations"], found["LP"]["iterations"]],
                 "the same for both",
