@@ -86,6 +86,11 @@ TIME_LIMIT_S = 60.0
 """Simulated seconds after which a run that has not converged stops."""
 STARTUP_S = 60.0
 """Host seconds the components may take to come up."""
+LOCKSTEP_WATCHDOG_S = 30.0
+"""Host seconds a component of a lockstep run may answer no status query before the launcher
+takes it for hung (the profile's default is 3 s): the loop waits for its slowest member, and on a
+machine shared with other work a sound controller was seen silent for 3 s, killed and restarted
+mid-run, which cut its recording's diagnostics in two."""
 SESSION_FILE = "session.mcap"
 """The recording of a run, beside its report."""
 
@@ -197,6 +202,7 @@ def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict
         "extends": str(base.resolve()),
         "namespace": f"experiment{os.getpid()}",
         "startup_timeout_s": STARTUP_S,  # the launcher's and this module's wait are one
+        **({} if options.realtime else {"watchdog_s": LOCKSTEP_WATCHDOG_S}),
         "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
         "components": components,
     } | ({"scene": scene} if scene else {})

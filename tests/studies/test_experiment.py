@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 from mcap.reader import make_reader
 
 from launch import query
@@ -24,7 +25,14 @@ from record.session_reader import info
 from record.sessions import load_session
 from scenes.foxglove_views import MODEL_EVERY, View
 from sim2d.scenarios import scenario
-from studies.experiment import DEPLOY, PROFILES, Options, connect, experiment_profile
+from studies.experiment import (
+    DEPLOY,
+    LOCKSTEP_WATCHDOG_S,
+    PROFILES,
+    Options,
+    connect,
+    experiment_profile,
+)
 from tests.processes import process_gone
 from tests.scenes.views_read import decode, vector
 from wbc.planar import inverse
@@ -385,6 +393,19 @@ def test_the_cascade_takes_its_declared_gains(tmp_path: Path) -> None:
         "module": "cascade_controller",
         "params": {"eta": 1.0, "saturate": True},
     }
+
+
+def test_a_lockstep_run_is_not_killed_for_being_slow_on_a_busy_machine(tmp_path: Path) -> None:
+    """In lockstep the launcher's watchdog waits LOCKSTEP_WATCHDOG_S for a status answer, not the
+    profile's 3 s (a controller starved that long was killed and restarted mid-run); a run in
+    real time keeps the profile's."""
+    robot = MobileManipulator.from_yaml(load_profile(PROFILES["lp"]).robot)
+    for realtime, watchdog_s in ((False, LOCKSTEP_WATCHDOG_S), (True, 3.0)):
+        options = Options("pose", out=tmp_path, realtime=realtime)
+        data = experiment_profile(options, PROFILES["lp"], scenario("pose", robot))
+        written = tmp_path / "profile.yaml"
+        written.write_text(yaml.safe_dump(data))
+        assert load_profile(written).watchdog_s == watchdog_s
 
 
 def test_an_experiment_does_not_write_over_a_directory_that_holds_files(tmp_path: Path) -> None:
