@@ -42,7 +42,7 @@ foxglove-client: $(CLIENT_STAMP)
 test: $(STAMP) $(CLIENT_STAMP)
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
-	$(VENV)/bin/python -m pytest -q -n 3 --dist loadfile --durations=20
+	$(VENV)/bin/python -m pytest -q -n 2 --dist loadfile --durations=20
 
 # The documentation site (docs/, mkdocs.yml) into site/, strict: a broken link or a missing page
 # fails. make test builds it too (tests/test_docs.py). The banners about MkDocs' future are muted.

@@ -48,7 +48,7 @@ from messages import topics
 from messages.goal import Goal
 from messages.obstacles import Obstacles, circles_of
 from messages.state import RobotState
-from messages.supervisor import ENDED, SupervisorStatus
+from messages.supervisor import ENDED, IDLE, SupervisorStatus
 from wbc.geometry.obstacles import Circle
 from wbc.planning.drive_tasks import PointTask, offset_point
 from wbc.planning.staging import Plan, StagingParams, within
@@ -346,7 +346,7 @@ class Supervisor(Component):
         """What the supervisor does now: ``idle`` with no goal, else the goal's phase."""
         request, supervisor = self.request, self.supervisor
         if request is None:
-            phase = "idle"
+            phase = IDLE
             reason = self.sight.missing(stamp_ns) or "no goal on goal/request yet"
         elif self.ended is not None:
             phase, reason = self.ended

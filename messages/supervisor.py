@@ -17,7 +17,9 @@ it came (no valid robot state, a target outside the camera's view), ``aborted`` 
 (the state went invalid). Like ``unreachable``, each stays until the next goal, the robot held
 where it stands."""
 
-PHASES = ("idle", "direct", *ENDED, *(phase.value for phase in Phase))
+IDLE = "idle"
+"""The phase of a supervisor with no goal."""
+PHASES = (IDLE, "direct", *ENDED, *(phase.value for phase in Phase))
 PhaseName = Literal[PHASES]  # type: ignore[valid-type]
 """``idle`` before any goal; ``direct`` for a goal that is not a pose (a position...), passed
 on to the controller as it is, then ``reached``; ``ENDED``; else one of

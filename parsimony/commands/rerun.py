@@ -23,6 +23,7 @@ from components.control_step import ControlStep, Step, gains_of
 from components.controller import Controller, diagnostics_of
 from components.lp_controller import LPController
 from components.qp_controller import QPController
+from messages import topics
 from messages.commands import ArmCommand, BaseCommand
 from messages.header import Header
 from messages.obstacles import obstacles_of
@@ -37,9 +38,13 @@ LAWS: dict[str, type[Controller]] = {
     c.law_name: c for c in (LPController, CascadeController, QPController)
 }
 """The controllers whose law can be run again, by law name."""
-OUTPUTS = ("base/command", "arm/command", "control/diagnostics")
+OUTPUTS = tuple(
+    t.name for t in (topics.BASE_COMMAND, topics.ARM_COMMAND, topics.CONTROL_DIAGNOSTICS)
+)
 """The topics the law writes; the recorded ones move to ``<key>/recorded``."""
-BEFORE_STATE = ("control/goal", "world/obstacles", "control/diagnostics")
+BEFORE_STATE = tuple(
+    t.name for t in (topics.CONTROL_GOAL, topics.WORLD_OBSTACLES, topics.CONTROL_DIAGNOSTICS)
+)
 """Taken before the state of the same stamp: the estimator publishes the goal and obstacles
 a state holds for before it, and the diagnostics answering it carry the gains it ran with."""
 
@@ -97,21 +102,21 @@ class Offline:
         name, key, message = record.topic_name, record.key, record.message
         if name in OUTPUTS:
             out.write(f"{key}/recorded", message, record.log_time_ns)
-            if name == "control/diagnostics" and message.law == self.name:
+            if name == topics.CONTROL_DIAGNOSTICS.name and message.law == self.name:
                 self.stepper.set_gains(gains_of(self.gains_type, message.parameters, None))
                 self.recorded_gains = True
             return
         out.write(key, message, record.log_time_ns)
-        if name == "control/goal":
+        if name == topics.CONTROL_GOAL.name:
             try:
                 self.stepper.take_goal(message)  # a goal the law refuses: no goal, as live
             except ValueError:
                 return
             if not self.recorded_gains:  # the defaults, the goal's eta and beta over them
                 self.stepper.set_gains(gains_of(self.gains_type, {}, message))
-        elif name == "world/obstacles":
+        elif name == topics.WORLD_OBSTACLES.name:
             self.stepper.take_obstacles(obstacles_of(message))
-        elif name == "robot/state":
+        elif name == topics.ROBOT_STATE.name:
             stamp = message.header.stamp_ns
             step = self.stepper.step(message, stamp, math.inf)
             write_step(out, key[: -len(name) - 1], self.name, step, self.stepper.gains)

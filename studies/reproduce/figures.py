@@ -10,6 +10,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from analysis.report import write_report
+from messages import topics
 from messages.commands import ArmCommand, BaseCommand
 from messages.diagnostics import ControllerDiagnostics
 from messages.goal import Goal
@@ -80,17 +81,17 @@ def session_of(run: Run, experiment: Experiment, robot: MobileManipulator) -> di
         else Goal(header=header(0), task="position", position=tuple(task.position.tolist()))
     )
     session: dict[str, list] = {
-        "control/goal": [goal],
-        "robot/state": [],
-        "base/command": [],
-        "arm/command": [],
-        "control/diagnostics": [],
+        topics.CONTROL_GOAL.name: [goal],
+        topics.ROBOT_STATE.name: [],
+        topics.BASE_COMMAND.name: [],
+        topics.ARM_COMMAND.name: [],
+        topics.CONTROL_DIAGNOSTICS.name: [],
     }
     if experiment.obstacles:
         circles = tuple(CircleMessage(x=c.x, y=c.y, radius=c.radius) for c in experiment.obstacles)
-        session["world/obstacles"] = [Obstacles(header=header(0), circles=circles)]
+        session[topics.WORLD_OBSTACLES.name] = [Obstacles(header=header(0), circles=circles)]
     for k, (q, out) in enumerate(zip(run.configurations, run.outputs, strict=True)):
-        session["robot/state"].append(
+        session[topics.ROBOT_STATE.name].append(
             RobotState(
                 header=header(k),
                 base_pose=tuple(q[:3].tolist()),
@@ -101,7 +102,7 @@ def session_of(run: Run, experiment: Experiment, robot: MobileManipulator) -> di
             )
         )
         forward = float(out.u[0] * math.cos(q[2]) + out.u[1] * math.sin(q[2]))
-        session["base/command"].append(
+        session[topics.BASE_COMMAND.name].append(
             BaseCommand(
                 header=header(k, "base"),
                 forward_velocity=forward,
@@ -110,10 +111,10 @@ def session_of(run: Run, experiment: Experiment, robot: MobileManipulator) -> di
                 right_wheel=0.0,
             )
         )
-        session["arm/command"].append(
+        session[topics.ARM_COMMAND.name].append(
             ArmCommand(header=header(k, "arm"), joint_velocities=tuple(out.u[3:].tolist()))
         )
-        session["control/diagnostics"].append(
+        session[topics.CONTROL_DIAGNOSTICS.name].append(
             ControllerDiagnostics(
                 header=header(k),
                 law="reproduce",

@@ -13,7 +13,7 @@ import yaml
 
 from launch import query
 from profiles.deploy_files import ROBOT_FILE
-from tests.launch.conftest import free_port
+from tests.launch.conftest import DEADLINE_S, free_port
 from tests.processes import process_gone
 
 if TYPE_CHECKING:
@@ -53,7 +53,7 @@ def test_a_killed_component_comes_back_at_once_then_after_a_backoff_until_restar
     os.kill(int(match.group(1)), signal.SIGKILL)
     launched.wait_for(r"\[launch\] pub exited with -9; no restarts left \(2/2\)")
     launched.wait_for(r"\[launch\] stopping \(no component left running\)")
-    assert launched.process.wait(10.0) == 1
+    assert launched.process.wait(DEADLINE_S) == 1
     assert "[launch] failed: pub" in launched.text()
 
 
@@ -133,7 +133,7 @@ def test_duration_ends_the_launch_cleanly(
     """Whether or not pub was alive by then (on a loaded machine it may not be in 1.5 s): a
     SIGTERM before its handler is set is a clean stop too."""
     launched = launch(write_profile([publisher("pub")]), "--duration", "1.5")
-    assert launched.process.wait(10.0) == 0
+    assert launched.process.wait(DEADLINE_S) == 0
     launched.wait_for(r"\[launch\] stopping \(end of duration\)")
     launched.wait_for(r"\[launch\] pub stopped \((0|-15)\)")
 
@@ -149,7 +149,7 @@ def test_the_launcher_warns_of_a_topic_read_and_never_written(
         r"^\d\d:\d\d:\d\d\.\d{3} \[launch\] warning: test/robot/state is read "
         r"by ctl and written by no component"
     )
-    assert launched.process.wait(10.0) == 0
+    assert launched.process.wait(DEADLINE_S) == 0
     assert "test/base/command is read" not in launched.text()
 
 
@@ -164,7 +164,7 @@ def test_a_component_that_never_comes_alive_fails_the_launch_by_name(
     profile.write_text(yaml.safe_dump(data))
     launched = launch(profile)
     launched.wait_for(r"\[launch\] stopping \(start-up failed: pub not alive after 2\.0 s")
-    assert launched.process.wait(10.0) == 1
+    assert launched.process.wait(DEADLINE_S) == 1
     assert "[launch] failed: pub" in launched.text()
 
 
@@ -183,7 +183,7 @@ def test_a_configuration_error_at_start_up_fails_the_whole_launch(
     launched = launch(write_profile([publisher("good"), bad]))
     launched.wait_for(r"\[launch\] bad exited with 2; configuration error, not restarting")
     launched.wait_for(r"\[launch\] stopping \(start-up failed: bad failed during start-up\)")
-    assert launched.process.wait(10.0) == 1
+    assert launched.process.wait(DEADLINE_S) == 1
     launched.wait_for(r"\[launch\] good stopped")
 
 
@@ -232,7 +232,7 @@ def test_components_stop_when_the_launcher_is_killed(
     launched.process.kill()
     launched.process.wait()
     pid = int(match.group(1))
-    deadline = time.monotonic() + 10.0
+    deadline = time.monotonic() + DEADLINE_S
     while not process_gone(pid):
         assert time.monotonic() < deadline, "component outlived its launcher by 10 s"
         time.sleep(0.02)
@@ -242,7 +242,7 @@ def test_an_invalid_profile_is_refused_before_anything_starts(
     write_profile: ProfileWriter, launch: LaunchFixture
 ) -> None:
     launched = launch(write_profile([publisher("pub", restart={"policy": "sometimes"})]))
-    assert launched.process.wait(10.0) == 2
+    assert launched.process.wait(DEADLINE_S) == 2
     text = launched.text()
     assert "components[0].restart.policy" in text and "'on-failure'" in text
     assert "started" not in text

@@ -40,9 +40,18 @@ def emulator(arm: IntegratingJoints) -> Iterator[AXChainEmulator]:
     assert chain.counters["handler_errors"] == 0
 
 
+class PatientPort(PortHandler):
+    """The SDK's own port, waiting up to a second for a status packet instead of the few
+    milliseconds it sets per packet: the emulator's thread may be starved on a busy machine, and
+    a test's verdict must not depend on that."""
+
+    def setPacketTimeout(self, packet_length: int) -> None:  # noqa: N802 (the SDK's name)
+        self.setPacketTimeoutMillis(1000.0)
+
+
 @pytest.fixture
 def port(emulator: AXChainEmulator) -> Iterator[PortHandler]:
-    handler = PortHandler(emulator.port)
+    handler = PatientPort(emulator.port)
     assert handler.openPort()
     assert handler.setBaudRate(1_000_000)
     yield handler
