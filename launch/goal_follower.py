@@ -17,7 +17,7 @@ import zenoh
 
 from launch.query import QueryError, status_of
 from messages import codec, topics
-from messages.supervisor import ENDED, SupervisorStatus
+from messages.supervisor import ENDED, IDLE, SupervisorStatus
 from wbc.planning.supervisor_phase import Phase
 
 POLL_S = 0.05
@@ -100,6 +100,8 @@ class GoalFollower:
                 ) from None
             if self._refused:
                 return Outcome("refused", status.last_refusal, status)
+            if status.phase == IDLE:
+                continue  # published before the goal was taken, and delivered after
             progress(status)
             if status.phase in DONE:
                 return Outcome(status.phase, status.reason, status)
