@@ -24,6 +24,9 @@ REVOLUTE = 0.0
 """Joint type code of a revolute joint in the 5th row of the DH table (as in DQ Robotics)."""
 
 BASE_DOF = 3
+BASE_KINDS = ("differential", "omnidirectional", "fixed")
+"""differential: nonholonomic (the 5.12 row); omnidirectional: holonomic; fixed: never moves."""
+JOINT_TYPES = ("revolute", "prismatic")
 
 
 class RobotDescriptionError(ValueError):
@@ -75,7 +78,8 @@ _HALF_K_CONJ = _HALF_K @ dq.C8
 
 @dataclass(frozen=True)
 class BaseDescription:
-    """The differential-drive base: geometry and the bounds on u_b = [x', y', phi']."""
+    """The base: its kind (``BASE_KINDS``), geometry and the bounds on u_b = [x', y', phi']; the
+    wheel fields are a differential base's."""
 
     height: float
     body_radius: float
@@ -83,6 +87,7 @@ class BaseDescription:
     wheel_radius: float
     wheel_speed_max: float
     velocity_max: Array
+    kind: str = "differential"
 
 
 class Chain:
@@ -136,12 +141,17 @@ class MobileManipulator:
         arm_velocity_max: Array,
         name: str = "robot",
         collision: CollisionModel = CollisionModel(),  # noqa: B008 (frozen, so sharing is safe)
+        joint_names: tuple[str, ...] | None = None,
     ) -> None:
         self.name = name
         self.dh = _readonly(dh, (5, dh.shape[1]), "dh")
         if np.any(self.dh[4] != REVOLUTE):
             raise RobotDescriptionError("dh: only revolute joints are supported")
         self.arm_dof = self.dh.shape[1]
+        self.joint_names = joint_names or tuple(f"q{i + 1}" for i in range(self.arm_dof))
+        """The arm joints' names, as the description names them (a DH table's: q1..qn)."""
+        self.joint_types = ("revolute",) * self.arm_dof
+        """``JOINT_TYPES`` of each arm joint."""
         self.dof = BASE_DOF + self.arm_dof
         self.base = base
         self.base_height = base.height
@@ -180,6 +190,7 @@ class MobileManipulator:
             bounds[BASE_DOF:],
             self.name,
             self.collision,
+            self.joint_names,
         )
 
     @classmethod
