@@ -110,7 +110,10 @@ class Node:
         self._session = zenoh.open(self.profile.zenoh.component_config(self.name))
         clock = self.clock
         if isinstance(clock, SimClock):
-            self.subscribe(topics.SIM_CLOCK, lambda tick: clock.advance(tick.stamp_ns, tick.paused))
+            self.subscribe(
+                topics.SIM_CLOCK,
+                lambda tick: clock.advance(tick.stamp_ns, tick.paused, tick.lockstep),
+            )
         return self
 
     def __exit__(self, *_exc: object) -> None:

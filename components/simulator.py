@@ -270,7 +270,9 @@ class Simulator(Component):
         # On host time the stamps are the host's: the paced steps lag it under load.
         host = self.node.params["host_epoch"]
         self.now_ns = time.time_ns() if host else self.now_ns + self.step_ns
-        self._put(topics.SIM_CLOCK, Clock(stamp_ns=self.now_ns))
+        self._put(
+            topics.SIM_CLOCK, Clock(stamp_ns=self.now_ns, lockstep=self.node.params["lockstep"])
+        )
         self.frame_done = self.camera is None or self.now_ns < self.next_frame_ns
         self._go_on()
 

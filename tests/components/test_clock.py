@@ -82,6 +82,19 @@ def test_a_paused_simulators_held_time_is_not_a_stall() -> None:
     assert clock.stalled_s() >= 0.05
 
 
+def test_a_lockstep_simulators_held_time_is_not_a_stall() -> None:
+    """In lockstep the simulator's time stands while the loop answers its step: a component
+    that took that for a stall would command zero at the step's stamp, and the simulator would
+    take that zero for the controller's answer (a rerun would then differ from its run)."""
+    clock = SimClock()
+    clock.advance(5 * MS, lockstep=True)
+    time.sleep(0.05)
+    assert clock.stalled_s() == 0.0
+    clock.advance(5 * MS)  # the simulator left lockstep, and its time does not move
+    time.sleep(0.05)
+    assert clock.stalled_s() >= 0.05
+
+
 def test_an_alarm_fires_once_after_its_last_set_and_not_after_a_cancel() -> None:
     clock = SimClock()
     timers = Timers(clock)
