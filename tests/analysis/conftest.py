@@ -4,8 +4,11 @@ them (``session_of``), as the judge and the report read them."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
+from messages import topics
 from messages.commands import ArmCommand, BaseCommand
 from messages.diagnostics import ControllerDiagnostics
 from messages.goal import Goal
@@ -16,9 +19,11 @@ from messages.topics import (
     BASE_COMMAND,
     CONTROL_DIAGNOSTICS,
     CONTROL_GOAL,
+    GOAL_REQUEST,
     ROBOT_STATE,
 )
 from profiles.deploy_files import ROBOT_FILE
+from record.session_file import SessionWriter
 from wbc.base_motion import unicycle, wheel_speeds
 from wbc.geometry import scenarios
 from wbc.laws.cascade_law import CascadeLaw
@@ -104,3 +109,19 @@ def runs() -> dict[str, tuple[Run, dict[str, list]]]:
         assert run.converged
         result[label] = (run, session_of(run, label, task))
     return result
+
+
+def write(
+    path: Path, session: dict[str, list], poison: Goal | None = None, namespace: str = "far"
+) -> Path:
+    """``session`` as a recorder of ``namespace`` writes it, in stamp order, ``poison`` on
+    goal/request half way through (when it came)."""
+    recorded = sorted(
+        (m.header.stamp_ns, topic, m) for topic, found in session.items() for m in found
+    )
+    with SessionWriter(path) as writer:
+        for index, (_, topic, message) in enumerate(recorded):
+            if poison is not None and index == len(recorded) // 2:
+                writer.write(GOAL_REQUEST.key(namespace), poison)
+            writer.write(topics.TOPICS[topic].key(namespace), message)
+    return path

@@ -22,8 +22,7 @@ from messages.topics import (
 from messages.truth import SimTruth
 from profiles.deploy_files import ROBOT_FILE
 from record.sessions import load_session
-from tests.analysis.conftest import ROBOT, START_NS, session_of
-from tests.record.test_far_stamps import write
+from tests.analysis.conftest import ROBOT, START_NS, session_of, write
 from wbc import dq
 from wbc.geometry import scenarios
 from wbc.laws.kinematic_run import effort_of, integrate

@@ -13,15 +13,13 @@ import pytest
 import yaml
 
 from analysis.judge import JUDGED, judge
-from messages import topics
 from messages.goal import Goal
 from messages.header import Header
 from messages.topics import CONTROL_GOAL, GOAL_REQUEST
 from profiles.endpoints import free_port
-from record.session_file import SessionWriter
 from record.session_span import FAR_NS, Span
 from record.sessions import load_session
-from tests.analysis.conftest import DT, FIGURES, ROBOT, START_NS, session_of
+from tests.analysis.conftest import DT, FIGURES, ROBOT, START_NS, session_of, write
 from tests.processes import parsimony
 from wbc.geometry import scenarios
 from wbc.laws.kinematic_run import integrate
@@ -29,20 +27,6 @@ from wbc.laws.lp_law import LPLaw, LPParams
 from wbc.task import PoseTask
 
 NAMESPACE = "far"
-
-
-def write(path: Path, session: dict[str, list], poison: Goal | None = None) -> Path:
-    """``session`` as a recorder writes it, in stamp order, ``poison`` on goal/request half
-    way through (when it came)."""
-    recorded = sorted(
-        (m.header.stamp_ns, topic, m) for topic, found in session.items() for m in found
-    )
-    with SessionWriter(path) as writer:
-        for index, (_, topic, message) in enumerate(recorded):
-            if poison is not None and index == len(recorded) // 2:
-                writer.write(GOAL_REQUEST.key(NAMESPACE), poison)
-            writer.write(topics.TOPICS[topic].key(NAMESPACE), message)
-    return path
 
 
 def header(stamp_ns: int, source: str) -> Header:
