@@ -17,7 +17,7 @@ from parsimony.target_options import PROFILE_ENV
 from profiles.endpoints import free_port
 from record.replayer import Recording
 from record.session_file import SessionWriter, from_json
-from tests.view.test_live_view import DEADLINE_S, StderrLines, state, watch, write_profile
+from tests.view.live_view_client import DEADLINE_S, StderrLines, state, watch, write_profile
 
 RECORDED = "rec"
 INTO = "other"
