@@ -8,9 +8,9 @@ time limit, or at the last step. What is judged against the simulator's ground t
 (``sim/truth``, which no component of the loop reads: the true final error, the estimator's
 error in the steady state, contacts, joints at their hard stops, clearance) is None, and
 ``truth`` says ``absent``, for a recording without it (a real robot's). The control inputs
-u = [x', y', phi', q1'..q5'] join the base and arm commands of one stamp with x' = v cos(phi),
-y' = v sin(phi), phi the heading of the nearest state: the estimate the controller turned u
-into wheel speeds with.
+u = [x', y', phi', a velocity per arm joint of the robot's description] join the base and arm
+commands of one stamp with x' = v cos(phi), y' = v sin(phi), phi the heading of the nearest
+state: the estimate the controller turned u into wheel speeds with.
 """
 
 from __future__ import annotations
@@ -399,11 +399,9 @@ def commands_digest(session: Session) -> str:
 
 def commands_csv(session: Session, robot: MobileManipulator) -> str:
     """Every command pair the controller sent, one row per stamp (s, m/s, rad/s), a column
-    per joint of the robot's arm (its description's)."""
+    per joint of the robot's arm, named as its description names it (``<name>_dot``)."""
     arm = {a.header.stamp_ns: a.joint_velocities for a in messages(session, ARM_COMMAND)}
-    lines = [
-        "stamp_s,forward,angular," + ",".join(f"q{i}_dot" for i in range(1, robot.arm_dof + 1))
-    ]
+    lines = ["stamp_s,forward,angular," + ",".join(f"{n}_dot" for n in robot.joint_names)]
     for b in messages(session, BASE_COMMAND):
         joints = arm.get(b.header.stamp_ns)
         if joints is not None:

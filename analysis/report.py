@@ -6,7 +6,7 @@ A session maps a topic name (``messages.topics``) to the messages recorded on it
 is the operator's, ``goal/request``, when a staging supervisor stood between it and
 ``control/goal`` (whose drive legs are not the goal), else ``control/goal``.
 Commands and diagnostics carry the stamp of the state they answer, so the control input
-u = [x', y', phi', q1'..q5'] of a stamp joins the base and arm commands of that stamp with
+u = [x', y', phi', one per arm joint] of a stamp joins the base and arm commands of that stamp with
 x' = v cos(phi), y' = v sin(phi), phi' = omega, phi the heading of the nearest state.
 Times are in s from the session's first command.
 
@@ -15,7 +15,8 @@ Times are in s from the session's first command.
     control_inputs.png     u over time (figs. 6.6, 6.11)
     nonzero_entries.png    nonzero entries of u per iteration, and the practical count (6.7, 6.8)
     error.png              e = x - x_d of the end effector, or p - p_d for a position task (6.9)
-    joints.png             q1..q5 against their limits, dashed green (6.10)
+    joints.png             each arm joint, named as the robot's description names it, against
+                           its limits, dashed green (6.10)
     end_effector_path.png  x-y of the end effector and the goal (6.14)
     base_path.png          x-y of the base from its first valid estimate (before the first
                            camera fix the estimate is a placeholder at (0, 0)) and the
@@ -77,12 +78,22 @@ FORMULAS: Mapping[str, str] = {
 END_EFFECTOR_TASKS = ("pose", "position")
 """The goals that give the end effector a target (a drive leg's aims the base)."""
 
-INPUT_NAMES = ("x'", "y'", "phi'", "q1'", "q2'", "q3'", "q4'", "q5'")
-"""The entries of u, in order."""
+BASE_INPUTS = ("x'", "y'", "phi'")
+"""The base's entries of u, first."""
+
+
+def input_names(robot: MobileManipulator) -> tuple[str, ...]:
+    """The entries of u, in order: the base's, then each arm joint's by its name."""
+    return BASE_INPUTS + tuple(f"{name}'" for name in robot.joint_names)
+
+
+def joint_unit(robot: MobileManipulator, joint: int) -> str:
+    """The unit of arm joint ``joint`` (0-based): m for a prismatic joint, else rad."""
+    return "m" if robot.joint_types[joint] == "prismatic" else "rad"
 
 
 def control_inputs(session: Session) -> tuple[Array, Array]:
-    """(t, u): times in s from the first command, and one row u = [x', y', phi', q1'..q5']
+    """(t, u): times in s from the first command, and one row u = [x', y', phi', arm joints']
     per stamp that has both a base and an arm command."""
     stamps, u = commands(session)
     return (stamps - stamps[0]) * 1e-9, u
@@ -190,6 +201,12 @@ def _recording(
             f"the robot description has {robot.arm_dof} arm joints, the "
             f"recording's states {len(states[0].arm_joints)}"
         )
+    names = tuple(getattr(states[0], "joint_names", None) or robot.joint_names)
+    if names != robot.joint_names:
+        raise ValueError(
+            f"the robot description's joints are {', '.join(robot.joint_names)}, the "
+            f"recording's states' {', '.join(names)}"
+        )
     recorded = messages(session, SIM_TRUTH)
     truth = recorded if truth_frame is not None else []
     clearance = arm_clearances(recorded, robot)  # the same in any frame: no truth_frame needed
@@ -231,11 +248,11 @@ def _panels(recordings: Sequence[_Recording], rows: int, height: float, **share:
     return figure, axes
 
 
-def _control_inputs_figure(recordings: Sequence[_Recording], _: MobileManipulator) -> Figure:
+def _control_inputs_figure(recordings: Sequence[_Recording], robot: MobileManipulator) -> Figure:
     figure, axes = _panels(recordings, 1, 4.0, sharey=True)
     for ax, rec in zip(axes[0], recordings, strict=True):
         t = rec.command_seconds()
-        for column, name in enumerate(INPUT_NAMES):
+        for column, name in enumerate(input_names(robot)):
             ax.plot(t, rec.u[:, column], label=name, linewidth=1.0)
         ax.set(xlabel="t (s)", ylabel="u (m/s, rad/s)")
         ax.legend(ncols=4, fontsize="small")
@@ -316,7 +333,9 @@ def _goal_position(goal: Goal) -> Array:
 
 def _joints_figure(recordings: Sequence[_Recording], robot: MobileManipulator) -> Figure:
     joints = robot.arm_dof
-    figure, axes = _panels(recordings, joints, 2.0 * joints, sharex="col", sharey="row")
+    height = 2.0 * min(joints, 5) + 1.2 * max(joints - 5, 0)  # a long arm's panels lower
+    figure, axes = _panels(recordings, joints, height, sharex="col", sharey="row")
+
     for column, rec in enumerate(recordings):
         t = rec.seconds(rec.states)
         q = np.array([s.arm_joints for s in rec.states])
@@ -324,7 +343,8 @@ def _joints_figure(recordings: Sequence[_Recording], robot: MobileManipulator) -
             ax.plot(t, q[:, joint], linewidth=1.0)
             for limit in (robot.q_min[3 + joint], robot.q_max[3 + joint]):
                 ax.axhline(limit, color="green", linestyle="--", linewidth=1.0)
-            ax.set_ylabel(f"q{joint + 1} (rad)")
+            ax.set_ylabel(f"{robot.joint_names[joint]} ({joint_unit(robot, joint)})")
+
         axes[-1, column].set_xlabel("t (s)")
     return figure
 
