@@ -1,5 +1,5 @@
 """The distance Jacobians of the arm's parts (wbc/geometry/distance_jacobians.py,
-wbc/geometry/plucker.py, wbc/geometry/robot_primitives.py): central finite differences over random
+and the frames' Jacobians they start from): central finite differences over random
 configurations, and DQ Robotics' DQ_Kinematics and DQ_Geometry, which have the same ones."""
 
 from __future__ import annotations
@@ -15,7 +15,6 @@ from dqrobotics.utils import DQ_Geometry
 
 from profiles.deploy_files import ROBOT_FILE
 from tests.wbc.wbc_scenarios import central_difference, configurations, oracle_chain
-from wbc import dq
 from wbc.geometry.distance_jacobians import (
     ParallelLinesError,
     line_to_line_distance_jacobian,
@@ -27,12 +26,9 @@ from wbc.geometry.distance_jacobians import (
     point_to_point_distance_jacobian,
     point_to_point_squared_distance,
 )
-from wbc.geometry.plucker import closest_parameters, is_line, line, plane
+from wbc.geometry.plucker import line, plane
 from wbc.geometry.robot_primitives import (
-    line_jacobians,
     primitive_kinematics,
-    translation_jacobians,
-    translations,
 )
 from wbc.robot import MobileManipulator
 
@@ -74,56 +70,6 @@ def test_frame_jacobians_are_the_derivatives_of_the_frames() -> None:
         _, jacobians = ROBOT.frame_kinematics(q)
         expected = central_difference(lambda c: ROBOT.frame_kinematics(c)[0], q)
         np.testing.assert_allclose(jacobians, expected, atol=FD_TOL)
-
-
-def test_part_jacobians_are_the_derivatives_of_the_parts() -> None:
-    for q in configurations(ROBOT, 10, seed=12):
-        parts = primitive_kinematics(ROBOT, q)
-        points = central_difference(lambda c: primitive_kinematics(ROBOT, c).points, q)
-        lines = central_difference(lambda c: primitive_kinematics(ROBOT, c).lines, q)
-        np.testing.assert_allclose(parts.point_jacobians, points, atol=FD_TOL)
-        np.testing.assert_allclose(parts.line_jacobians, lines, atol=FD_TOL)
-        assert all(is_line(x) for x in parts.lines)
-
-
-def line_of(
-    pose: np.ndarray, jacobian: np.ndarray, axis: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """The line along ``axis`` through one frame and its Jacobian, by the stack version."""
-    stack = pose[None], jacobian[None]
-    lines, jacobians = line_jacobians(
-        *stack, axis[None], translations(stack[0]), translation_jacobians(*stack)
-    )
-    return lines[0], jacobians[0]
-
-
-def test_line_jacobian_matches_dqrobotics() -> None:
-    for q in configurations(ROBOT, 50, seed=13):
-        poses, jacobians = ROBOT.frame_kinematics(q)
-        for frame in range(6):
-            for axis in (dq.I_, dq.J_, dq.K_):
-                expected = DQ_Kinematics.line_jacobian(jacobians[frame], DQ(poses[frame]), DQ(axis))
-                found, jacobian = line_of(poses[frame], jacobians[frame], axis)
-                np.testing.assert_allclose(jacobian, expected, atol=ORACLE_TOL)
-                direction = dq.qmul(dq.qmul(poses[frame][:4], axis), dq.qconj(poses[frame][:4]))
-                np.testing.assert_allclose(
-                    found, line(direction, dq.translation(poses[frame])), atol=1e-12
-                )
-
-
-def test_segments_run_along_their_lines_from_end_to_end() -> None:
-    """The forearm is the elbow-wrist segment on z of frame 3, the hand the wrist-gripper one
-    on x of frame 5; their ends' parameters along the line are 0.1225 and 0.17 m apart."""
-    for q in configurations(ROBOT, 10, seed=14):
-        parts = primitive_kinematics(ROBOT, q)
-        for i, segment in enumerate(ROBOT.collision.segments):
-            start, end = parts.points[segment.start, 1:], parts.points[segment.end, 1:]
-            foot = np.cross(parts.lines[i, 1:4], parts.lines[i, 5:8])
-            for s, point in zip(parts.ends[i], (start, end), strict=True):
-                np.testing.assert_allclose(foot + s * parts.lines[i, 1:4], point, atol=1e-12)
-        np.testing.assert_allclose(
-            np.abs(np.diff(parts.ends, axis=1)).ravel(), [0.1225, 0.17], atol=1e-12
-        )
 
 
 # --- Distances and their Jacobians ------------------------------------------------------------
@@ -241,19 +187,3 @@ def test_parallel_lines_have_no_distance_jacobian() -> None:
     pole = line([0, 0, 1], [1, 0, 0])
     with pytest.raises(ParallelLinesError, match="parallel"):
         line_to_line_distance_jacobian(np.ones((8, 8)), line([0, 0, -1], [2, 0, 0]), pole)
-
-
-def test_closest_parameters_give_the_common_perpendicular() -> None:
-    first, second = line([1, 0, 0], [0, 0, 1]), line([0, 1, 0], [2, 0, -1])
-    s, t, skew = closest_parameters(first, second)
-    np.testing.assert_allclose([s.item(), t.item(), skew.item()], [2.0, 0.0, 1.0], atol=1e-12)
-    _, _, parallel = closest_parameters(first, line([-1, 0, 0], [0, 1, 0]))
-    assert parallel.item() == pytest.approx(0.0)
-    many, _, _ = closest_parameters(np.array([first, second]), np.array([second, first]))
-    np.testing.assert_allclose(many, [[2.0, np.nan], [np.nan, 0.0]], atol=1e-12)  # parallel: nan
-
-
-def test_line_of_a_pose_passes_through_its_origin_along_its_axis() -> None:
-    pose = dq.pose(dq.rotation_quaternion(np.pi / 2, [0, 1, 0]), [1.0, 2.0, 3.0])
-    z_axis, _ = line_of(pose, np.zeros((8, 8)), dq.K_)
-    np.testing.assert_allclose(z_axis, line([1, 0, 0], [1, 2, 3]), atol=1e-12)
