@@ -1,5 +1,6 @@
-"""The cascade of appendix B held to the robot's limits (``CascadeParams.saturate``): the LP's
-bounds on u and the wheel speed limit, read from the robot's description, never a NaN clamped."""
+"""The cascade of appendix B (wbc/laws/cascade_law.py) held to the robot's limits
+(``CascadeParams.saturate``): the LP's bounds on u and the wheel speed limit, read from the
+robot's description, never a NaN clamped."""
 
 from __future__ import annotations
 
