@@ -9,15 +9,22 @@ foxglove-sdk's layout support (``foxglove.layouts``): it opens ready on the chan
     | obstacles; publish        |                     |
     | pose -> goal/request      +---------------------+
     |                           | task error | nonzero|
+    |                           +---------------------+
+    |                           | arm joints          |
     +-------------+-------------+------------+--------+
     | controller's diagnostics | supervisor | parameters |
     +-------------+-------------+------------+--------+
+
+The arm joints' plot has a series per joint of the robot's description, by its name (none
+without a description).
 
 Foxglove imports it as a file (Layouts, Import from file); its topics are keys of one
 namespace, so each profile has its own (``parsimony layout PROFILE``).
 """
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 import foxglove.layouts as fl
 
@@ -102,6 +109,16 @@ def plot(namespace: str, title: str, fields: dict[str, str]) -> fl.PlotPanel:
     return fl.PlotPanel(title=title, config=fl.PlotConfig(paths=series, show_legend=True))
 
 
+def joints(namespace: str, joint_names: Sequence[str]) -> fl.PlotPanel:
+    """The estimate's arm joints over time, a series per joint named as the robot's
+    description names it (``robot/state``'s ``arm_joints``, index-aligned with the names)."""
+    series = [
+        fl.PlotSeries(value=path(namespace, topics.ROBOT_STATE, f"arm_joints[{i}]"), label=name)
+        for i, name in enumerate(joint_names)
+    ]
+    return fl.PlotPanel(title="Arm joints", config=fl.PlotConfig(paths=series, show_legend=True))
+
+
 def messages_of(namespace: str, topic: topics.Topic, title: str) -> fl.RawMessagesPanel:
     return fl.RawMessagesPanel(
         title=title, config=fl.RawMessagesConfig(topic_path=f'"{channel(namespace, topic)}"')
@@ -115,8 +132,9 @@ def split(direction: str, *items: tuple[float, fl.Content]) -> fl.SplitContainer
     )
 
 
-def layout(namespace: str) -> fl.Layout:
-    """The layout of the module docstring, on the channels of ``namespace``."""
+def layout(namespace: str, joint_names: Sequence[str] = ()) -> fl.Layout:
+    """The layout of the module docstring, on the channels of ``namespace``, the arm joints'
+    plot on ``joint_names`` (the robot's description's; none: no such plot)."""
     plots = split(
         "row",
         (1, plot(namespace, "Task error", {"||e||": "error_norm"})),
@@ -129,9 +147,12 @@ def layout(namespace: str) -> fl.Layout:
             ),
         ),
     )
+    if joint_names:
+        plots = split("column", (1, plots), (1, joints(namespace, joint_names)))
     top = split(
         "row", (3, three_d(namespace)), (2, split("column", (3, camera(namespace)), (2, plots)))
     )
+
     bottom = split(
         "row",
         (2, messages_of(namespace, topics.CONTROL_DIAGNOSTICS, "Controller")),

@@ -107,7 +107,8 @@ def run(args: argparse.Namespace) -> int:
         chosen = topics_matching(args.keys)
         robot = MobileManipulator.from_yaml(profile.robot) if profile.robot else None
         if args.layout is not None:
-            write_layout(profile.namespace, args.layout, args.force)
+            names = robot.joint_names if robot else ()
+            write_layout(profile.namespace, args.layout, args.force, names)
     except (ProfileError, ValueError, OSError) as error:
         print(f"view: {error}", file=sys.stderr)
         return 2

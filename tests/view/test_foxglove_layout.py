@@ -131,7 +131,7 @@ def test_every_topic_the_layout_names_is_a_channel_of_the_namespace(tmp_path: Pa
         for topic, message in one_of_each():
             writer.write(topic.key(NAMESPACE), message, views=True)
     channels = {c["key"] for c in info(path)["channels"]}
-    document = json.loads(layout(NAMESPACE).to_json())
+    document = json.loads(layout(NAMESPACE, ROBOT.joint_names).to_json())
     named = named_topics(document)
     publish = f"{NAMESPACE}/goal/request"  # the client's, not the namespace's
     assert publish in named
@@ -160,9 +160,18 @@ def test_parsimony_layout_prints_or_writes_it(tmp_path: Path) -> None:
     profile = DEPLOY / "sim_station.yaml"
     printed = parsimony("layout", str(profile))
     assert printed.returncode == 0, printed.stderr
-    assert json.loads(printed.stdout) == json.loads(layout(NAMESPACE).to_json())
+    assert json.loads(printed.stdout) == json.loads(layout(NAMESPACE, ROBOT.joint_names).to_json())
     target = tmp_path / "station.json"
     assert parsimony("layout", str(profile), "-o", str(target)).returncode == 0
     assert json.loads(target.read_text()) == json.loads(printed.stdout)
     again = parsimony("layout", str(profile), "-o", str(target))
     assert again.returncode == 2 and "--force" in again.stderr
+
+
+def test_the_joints_plot_has_a_series_per_joint_of_the_description() -> None:
+    document = json.loads(layout(NAMESPACE, ("shoulder", "elbow", "slide")).to_json())
+    text = json.dumps(document)
+    assert '"Arm joints"' in text
+    for i, name in enumerate(("shoulder", "elbow", "slide")):
+        assert f'robot/state\\".arm_joints[{i}]' in text and f'"{name}"' in text
+    assert '"Arm joints"' not in json.dumps(json.loads(layout(NAMESPACE).to_json()))
