@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 from wbc.geometry.obstacles import Circle
-from wbc.planning.disc_geometry import segment_clear
 from wbc.planning.drive_planner import WayPlanner, plan_way
 
 CLEARANCE = 0.215
@@ -116,9 +115,3 @@ def test_a_start_in_the_slack_first_leaves_it_straight_away_from_the_obstacle() 
     rest = polyline(way)[1:]
     for a, b in zip(rest, rest[1:], strict=False):
         assert distance_to_segment(np.zeros(2), a, b) >= circle.radius + CLEARANCE + 0.1 - 1e-9
-
-
-def test_segment_clear_keeps_the_clearance() -> None:
-    circle = [Circle(0.0, 0.0, 0.1)]
-    assert segment_clear(np.array([-1.0, 0.32]), np.array([1.0, 0.32]), circle, CLEARANCE)
-    assert not segment_clear(np.array([-1.0, 0.3]), np.array([1.0, 0.3]), circle, CLEARANCE)
