@@ -1,15 +1,13 @@
-"""`parsimony bench`: what one control step costs, and the convergence test of section 6.3.
-
-Step times are taken on a replay of a closed-loop trajectory, so the LP's warm start sees the
-small changes it sees in a control loop. Every figure comes from one run on this machine.
+"""`parsimony bench`: what one control step costs (on Little John and on every robot of the
+zoo, studies.step_timing), the convergence test of section 6.3, goal shares. Every figure comes
+from one run on this machine.
 """
 
 from __future__ import annotations
 
-import copy
 import sys
 import time
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +18,14 @@ from profiles.deploy_files import ROBOT_FILE
 from studies.gain_sets import TABLE_PARAMS, WITHOUT_ARM_ROWS
 from studies.goal_sets import goal_report
 from studies.reproduce import efficiency
+from studies.step_timing import (
+    blocks,
+    lp_breakdown,
+    percentiles,
+    step_times,
+    time_calls,
+    zoo_step_times,
+)
 from wbc import dq
 from wbc.geometry.scenarios import (
     DT,
@@ -29,79 +35,14 @@ from wbc.geometry.scenarios import (
     TABLE_GOAL,
     TABLE_START,
 )
-from wbc.laws.cascade_law import CascadeLaw
 from wbc.laws.constraints.arm_obstacles import ArmObstacles
 from wbc.laws.kinematic_run import integrate
-from wbc.laws.law_output import Law
 from wbc.laws.lp_law import LPLaw
-from wbc.laws.pinv_law import PseudoinverseLaw
-from wbc.laws.qp_law import QPLaw
 from wbc.laws.step_context import StepContext
 from wbc.robot import MobileManipulator
 from wbc.task import PoseTask
 
 GOAL = REACH_GOAL
-
-
-def percentiles(samples_s: list[float]) -> dict[str, float]:
-    """Median and p99 of durations in seconds, in microseconds."""
-    values = np.asarray(samples_s) * 1e6
-    return {"median_us": float(np.median(values)), "p99_us": float(np.percentile(values, 99))}
-
-
-def time_calls(call: Callable[[], object], repeats: int) -> list[float]:
-    samples = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        call()
-        samples.append(time.perf_counter() - start)
-    return samples
-
-
-BLOCK = 100
-"""Steps each law takes in turn: long enough to run with warm caches, short enough that a
-drift of the machine's speed reaches every law alike."""
-
-
-def blocks(
-    trajectory: Sequence[np.ndarray], repeats: int, laws: Iterable[Law]
-) -> Iterator[Sequence[np.ndarray]]:
-    """``repeats`` states of ``trajectory`` in slices of BLOCK, wrapping round to its start,
-    where every law is reset."""
-    position = done = 0
-    while done < repeats:
-        if position == 0:
-            for law in laws:
-                law.reset()
-        block = trajectory[position : position + min(BLOCK, repeats - done)]
-        yield block
-        done += len(block)
-        position = (position + len(block)) % len(trajectory)
-
-
-def step_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str, float]]:
-    """Whole control steps (model, Jacobian, rows, solve) along a recorded LP trajectory.
-
-    The laws take turns, BLOCK steps each, over the same states.
-    """
-    task = PoseTask(robot.fkm(GOAL))
-    trajectory = integrate(LPLaw(robot), HOME, task, DT, 3000).configurations
-    laws = {
-        "lp": LPLaw(robot),
-        "qp": QPLaw(robot),
-        "classic": PseudoinverseLaw(robot),
-        "cascade": CascadeLaw(robot),
-    }
-    samples: dict[str, list[float]] = {name: [] for name in laws}
-    for block in blocks(trajectory, repeats, laws.values()):
-        for name, law in laws.items():
-            for q in block:
-                start = time.perf_counter()
-                law.step(q, task, DT)
-                samples[name].append(time.perf_counter() - start)
-    results = {name: percentiles(values) for name, values in samples.items()}
-    results["kinematics"] = percentiles(time_calls(lambda: robot.kinematics(GOAL), repeats))
-    return results
 
 
 def arm_row_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str, float]]:
@@ -157,53 +98,6 @@ def arm_row_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str,
         }
         for name in names
     }
-
-
-def lp_breakdown(robot: MobileManipulator, repeats: int) -> dict[str, float]:
-    """Median microseconds of one LP step spent in each part, the rest being Python glue.
-
-    The law's own objects are wrapped with timers: the forward pass (fkm and J), the rows of
-    the constraints and objective terms, the vertex (the kept basis tested, or the calls into
-    HiGHS: model update, basis, run, solution) and HiGHS alone; ``highs_runs`` is the share of
-    steps that called HiGHS.
-    """
-    task = PoseTask(robot.fkm(GOAL))
-    trajectory = integrate(LPLaw(robot), HOME, task, DT, 3000).configurations
-    law = LPLaw(robot)
-    law.step(HOME, task, DT)
-    spent = {"kinematics": 0.0, "rows": 0.0, "vertex": 0.0, "highs": 0.0}
-
-    def timed(part: str, call: Callable) -> Callable:
-        def wrapper(*args: object) -> object:
-            start = time.perf_counter()
-            result = call(*args)
-            spent[part] += time.perf_counter() - start
-            return result
-
-        return wrapper
-
-    law.robot = copy.copy(robot)
-    law.robot.forward = timed("kinematics", robot.forward)  # type: ignore[method-assign]
-    for item in [*law.constraints, *law.objectives]:  # type: ignore[misc]
-        method = "rows" if hasattr(item, "rows") else "cost"
-        setattr(item, method, timed("rows", getattr(item, method)))
-    law._lp._vertex = timed("vertex", law._lp._vertex)  # type: ignore[method-assign]
-    law._lp._run = timed("highs", law._lp._run)  # type: ignore[method-assign]
-    parts: dict[str, list[float]] = {name: [] for name in (*spent, "glue", "total")}
-    while len(parts["total"]) < repeats:
-        law.reset()
-        for q in trajectory[: repeats - len(parts["total"])]:
-            spent.update(dict.fromkeys(spent, 0.0))
-            start = time.perf_counter()
-            law.step(q, task, DT)
-            total = time.perf_counter() - start
-            for name, value in spent.items():
-                parts[name].append(value)
-            parts["glue"].append(total - spent["kinematics"] - spent["rows"] - spent["vertex"])
-            parts["total"].append(total)
-    result = {name: float(np.median(values) * 1e6) for name, values in parts.items()}
-    result["highs_runs"] = float(np.mean(np.array(parts["highs"]) > 0.0))
-    return result
 
 
 def dqrobotics_times(robot: MobileManipulator, repeats: int) -> dict[str, dict[str, float]]:
@@ -265,8 +159,34 @@ def convergence_test(robot: MobileManipulator, trials: int) -> dict[str, dict[st
     return results
 
 
-def run_bench(repeats: int, trials: int, goals: int, robot_file: Path = ROBOT_FILE) -> dict:
-    """Every figure of `parsimony bench`, measured in this run; progress goes to stderr."""
+def run_bench(
+    repeats: int,
+    trials: int,
+    goals: int,
+    robot_file: Path = ROBOT_FILE,
+    zoo: Sequence[Path] | None = None,
+    zoo_only: bool = False,
+) -> dict:
+    """Every figure of `parsimony bench`, measured in this run; progress goes to stderr.
+
+    ``zoo``: the robot descriptions whose step times are taken (None: every one of
+    deploy/robots); ``zoo_only``: those step times and nothing else (a quick run)."""
+    report = {} if zoo_only else robot_figures(repeats, trials, goals, robot_file)
+    zoo = robot_descriptions() if zoo is None else zoo
+    if zoo:
+        progress(f"control steps on {len(zoo)} robots")
+        report["zoo"] = zoo_step_times(zoo, repeats)
+    return report
+
+
+def robot_descriptions() -> list[Path]:
+    """Every robot description of deploy/robots, by name."""
+    return sorted(ROBOT_FILE.parent.glob("*.yaml"))
+
+
+def robot_figures(repeats: int, trials: int, goals: int, robot_file: Path) -> dict:
+    """The figures of one robot: step times, the LP step's parts, the arm's rows, section 6.3,
+    goal shares."""
     robot = MobileManipulator.from_yaml(robot_file)
     progress("control steps")
     steps = step_times(robot, repeats)
@@ -311,6 +231,42 @@ def progress(what: str) -> None:
 
 def format_report(report: dict) -> str:
     """The figures as tables, one per section."""
+    parts = robot_tables(report) if "step" in report else []
+    if "zoo" in report:
+        parts += ["", *zoo_tables(report["zoo"])] if parts else zoo_tables(report["zoo"])
+    return "\n".join(parts)
+
+
+def zoo_tables(zoo: dict) -> list[str]:
+    """Each robot's step time by law, and the LP step's parts, us."""
+    laws = ("lp", "qp", "classic", "cascade")
+    steps = [
+        {
+            "robot (zoo)": name,
+            "DOF": row["dof"],
+            "base": row["base"],
+            **{
+                f"{law} {figure}": row["step"][law][f"{figure}_us"] if law in row["step"] else None
+                for law in laws
+                for figure in ("median", "p99")
+            },
+            "LP / classic": row["lp_over_classic"],
+        }
+        for name, row in zoo.items()
+    ]
+    parts = [
+        {"LP step, median us by part": name, **row["lp_breakdown_us"]} for name, row in zoo.items()
+    ]
+    return [
+        "Control step by robot, us (median, p99; laws in turn on one trajectory)",
+        table(steps, floatfmt=".1f"),
+        "",
+        table(parts, floatfmt=".2f"),
+    ]
+
+
+def robot_tables(report: dict) -> list[str]:
+    """The tables of ``robot_figures``."""
     steps = [
         {"control step (model + Jacobian + rows + solve)": name, **figures}
         for name, figures in report["step"].items()
@@ -397,4 +353,4 @@ def format_report(report: dict) -> str:
             if law.startswith("lp") and row.get("failures"):
                 parts.append(f"{law}: not reached, by reason:")
                 parts += [f"  {n} x {reason}" for reason, n in row["failures"].items()]
-    return "\n".join(parts)
+    return parts

@@ -18,11 +18,21 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         "--goals", type=int, default=100, help="random goals per family and law (0: none)"
     )
     parser.add_argument("--robot", type=Path, default=ROBOT_FILE, help="robot description")
+    parser.add_argument(
+        "--zoo",
+        nargs="+",
+        type=Path,
+        metavar="ROBOT",
+        help="the robot descriptions timed law by law (default: every one of deploy/robots)",
+    )
+    parser.add_argument(
+        "--zoo-only", action="store_true", help="only the step times of each robot (a quick run)"
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     return parser
 
 
 def run(args: argparse.Namespace) -> int:
-    report = run_bench(args.repeats, args.trials, args.goals, args.robot)
+    report = run_bench(args.repeats, args.trials, args.goals, args.robot, args.zoo, args.zoo_only)
     emit(json_text(report, indent=2) if args.json else format_report(report))
     return 0

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import math
+
 from profiles.deploy_files import ROBOT_FILE
-from studies.benchmark import convergence_test
+from studies.benchmark import convergence_test, format_report, robot_descriptions, run_bench
 from studies.reproduce.efficiency import section_6_3
 from wbc.robot import MobileManipulator
 
@@ -23,3 +25,23 @@ def test_the_bench_runs_section_6_3_as_reproduce_runs_it():
         bench["nonholonomic/lp"]["iterations"],
     ] == rows["6.3.test 2.iterations"]
     assert all(law["converged_trials"] == 1 for law in bench.values())
+
+
+def test_the_zoo_bench_times_every_law_on_every_robot():
+    """A quick run over the zoo: on every robot every law's step has a finite median and p99,
+    and the LP's ratio to the classic law's is given; a differential base adds the cascade."""
+    robots = robot_descriptions()
+    assert ROBOT_FILE in robots
+    zoo = run_bench(20, 0, 0, zoo=robots, zoo_only=True)["zoo"]
+    assert len(zoo) == len(robots)
+    for row in zoo.values():
+        laws = {"lp", "qp", "classic"} | ({"cascade"} if row["base"] == "differential" else set())
+        assert laws <= row["step"].keys()
+        for law in laws:
+            figures = row["step"][law]
+            assert 0.0 < figures["median_us"] <= figures["p99_us"] < math.inf
+        assert 0.0 < row["lp_over_classic"] < math.inf
+        assert row["dof"] == row["arm_dof"] + 3
+        parts = row["lp_breakdown_us"]
+        assert min(parts["kinematics"], parts["rows"], parts["vertex"]) > 0.0
+    assert "LP / classic" in format_report({"zoo": zoo})

@@ -1,0 +1,201 @@
+"""What one control step costs, law by law: on Little John's trajectory and on every robot of the
+zoo (deploy/robots), the laws taking turns over the same states.
+
+Step times are taken on a replay of a closed-loop LP trajectory, so the LP's warm start sees the
+small changes it sees in a control loop. Every figure comes from one run on this machine.
+"""
+
+from __future__ import annotations
+
+import copy
+import time
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from profiles.deploy_files import ROBOT_FILE
+from wbc.geometry.scenarios import DT, HOME, REACH_GOAL
+from wbc.laws.cascade_law import CascadeLaw
+from wbc.laws.kinematic_run import integrate
+from wbc.laws.law_output import Law
+from wbc.laws.lp_law import LPLaw
+from wbc.laws.pinv_law import PseudoinverseLaw
+from wbc.laws.qp_law import QPLaw
+from wbc.robot import BASE_DOF, MobileManipulator
+from wbc.task import PoseTask
+
+Array = np.ndarray
+TRAJECTORY_STEPS = 3000
+"""The longest LP trajectory replayed (it stops earlier where the goal is reached)."""
+
+
+def percentiles(samples_s: list[float]) -> dict[str, float]:
+    """Median and p99 of durations in seconds, in microseconds."""
+    values = np.asarray(samples_s) * 1e6
+    return {"median_us": float(np.median(values)), "p99_us": float(np.percentile(values, 99))}
+
+
+def time_calls(call: Callable[[], object], repeats: int) -> list[float]:
+    samples = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        call()
+        samples.append(time.perf_counter() - start)
+    return samples
+
+
+BLOCK = 100
+"""Steps each law takes in turn: long enough to run with warm caches, short enough that a
+drift of the machine's speed reaches every law alike."""
+
+
+def blocks(
+    trajectory: Sequence[Array], repeats: int, laws: Iterable[Law]
+) -> Iterator[Sequence[Array]]:
+    """``repeats`` states of ``trajectory`` in slices of BLOCK, wrapping round to its start,
+    where every law is reset."""
+    position = done = 0
+    while done < repeats:
+        if position == 0:
+            for law in laws:
+                law.reset()
+        block = trajectory[position : position + min(BLOCK, repeats - done)]
+        yield block
+        done += len(block)
+        position = (position + len(block)) % len(trajectory)
+
+
+def base_kind(robot: MobileManipulator) -> str:
+    """The base's kind (wbc.robot.BASE_KINDS); a description that names none: differential."""
+    return str(getattr(robot.base, "kind", "differential"))
+
+
+def laws_for(robot: MobileManipulator) -> dict[str, Law]:
+    """The laws timed on ``robot``: the LP, the QP, the classic law (the pseudoinverse) and,
+    where the base is differential, the cascade of appendix B."""
+    laws: dict[str, Law] = {
+        "lp": LPLaw(robot),
+        "qp": QPLaw(robot),
+        "classic": PseudoinverseLaw(robot),
+    }
+    if base_kind(robot) == "differential":
+        laws["cascade"] = CascadeLaw(robot)
+    return laws
+
+
+def scenario(robot: MobileManipulator) -> tuple[Array, Array]:
+    """A start and a goal configuration for any robot: the arm a tenth of its range off the
+    middle of its limits, joint by joint in alternate directions (no straight, singular chain),
+    and the goal the arm moved by up to a fifth of its range (a fixed seed) and, unless the base
+    is fixed, the base 0.4 m ahead, 0.1 m left, turned 0.2 rad."""
+    low, high = robot.q_min[BASE_DOF:], robot.q_max[BASE_DOF:]
+    middle, span = 0.5 * (low + high), high - low
+    signs = np.where(np.arange(robot.arm_dof) % 2 == 0, 1.0, -1.0)
+    arm = middle + 0.1 * span * signs
+    moved = arm + 0.2 * span * np.random.default_rng(0).uniform(-1.0, 1.0, robot.arm_dof)
+    moved = np.clip(moved, low + 0.1 * span, high - 0.1 * span)
+    base = np.zeros(BASE_DOF) if base_kind(robot) == "fixed" else np.array([0.4, 0.1, 0.2])
+    return np.concatenate((np.zeros(BASE_DOF), arm)), np.concatenate((base, moved))
+
+
+def trajectory(
+    robot: MobileManipulator, start: Array, goal: Array, steps: int = TRAJECTORY_STEPS
+) -> list[Array]:
+    """The states of a closed-loop LP run from ``start`` towards the pose of ``goal``, at most
+    ``steps`` (a bench of fewer steps than TRAJECTORY_STEPS replays no more than it times)."""
+    task = PoseTask(robot.fkm(goal))
+    return integrate(LPLaw(robot), start, task, DT, min(steps, TRAJECTORY_STEPS)).configurations
+
+
+def step_times(
+    robot: MobileManipulator, repeats: int, start: Array = HOME, goal: Array = REACH_GOAL
+) -> dict[str, dict[str, float]]:
+    """Whole control steps (model, Jacobian, rows, solve) along a recorded LP trajectory from
+    ``start`` towards the pose of ``goal``, and the kinematics alone at ``goal``.
+
+    The laws take turns, BLOCK steps each, over the same states.
+    """
+    task = PoseTask(robot.fkm(goal))
+    states = trajectory(robot, start, goal, repeats)
+    laws = laws_for(robot)
+    samples: dict[str, list[float]] = {name: [] for name in laws}
+    for block in blocks(states, repeats, laws.values()):
+        for name, law in laws.items():
+            for q in block:
+                begin = time.perf_counter()
+                law.step(q, task, DT)
+                samples[name].append(time.perf_counter() - begin)
+    results = {name: percentiles(values) for name, values in samples.items()}
+    results["kinematics"] = percentiles(time_calls(lambda: robot.kinematics(goal), repeats))
+    return results
+
+
+def lp_breakdown(
+    robot: MobileManipulator, repeats: int, start: Array = HOME, goal: Array = REACH_GOAL
+) -> dict[str, float]:
+    """Median microseconds of one LP step spent in each part, the rest being Python glue.
+
+    The law's own objects are wrapped with timers: the forward pass (fkm and J), the rows of
+    the constraints and objective terms, the vertex (the kept basis tested, or the calls into
+    HiGHS: model update, basis, run, solution) and HiGHS alone; ``highs_runs`` is the share of
+    steps that called HiGHS.
+    """
+    task = PoseTask(robot.fkm(goal))
+    states = trajectory(robot, start, goal, repeats)
+    law = LPLaw(robot)
+    law.step(start, task, DT)
+    spent = {"kinematics": 0.0, "rows": 0.0, "vertex": 0.0, "highs": 0.0}
+
+    def timed(part: str, call: Callable) -> Callable:
+        def wrapper(*args: object) -> object:
+            begin = time.perf_counter()
+            result = call(*args)
+            spent[part] += time.perf_counter() - begin
+            return result
+
+        return wrapper
+
+    law.robot = copy.copy(robot)
+    law.robot.forward = timed("kinematics", robot.forward)  # type: ignore[method-assign]
+    for item in [*law.constraints, *law.objectives]:  # type: ignore[misc]
+        method = "rows" if hasattr(item, "rows") else "cost"
+        setattr(item, method, timed("rows", getattr(item, method)))
+    law._lp._vertex = timed("vertex", law._lp._vertex)  # type: ignore[method-assign]
+    law._lp._run = timed("highs", law._lp._run)  # type: ignore[method-assign]
+    parts: dict[str, list[float]] = {name: [] for name in (*spent, "glue", "total")}
+    while len(parts["total"]) < repeats:
+        law.reset()
+        for q in states[: repeats - len(parts["total"])]:
+            spent.update(dict.fromkeys(spent, 0.0))
+            begin = time.perf_counter()
+            law.step(q, task, DT)
+            total = time.perf_counter() - begin
+            for name, value in spent.items():
+                parts[name].append(value)
+            parts["glue"].append(total - spent["kinematics"] - spent["rows"] - spent["vertex"])
+            parts["total"].append(total)
+    result = {name: float(np.median(values) * 1e6) for name, values in parts.items()}
+    result["highs_runs"] = float(np.mean(np.array(parts["highs"]) > 0.0))
+    return result
+
+
+def zoo_step_times(robot_files: Iterable[Path], repeats: int) -> dict[str, dict]:
+    """Per robot of the zoo (by its name): its size, each law's step time on its own
+    ``scenario`` (Little John's: its experiments' HOME and REACH_GOAL, as ``step_times``), the
+    LP's median over the classic law's (same run) and the LP step's parts."""
+    results = {}
+    for path in robot_files:
+        robot = MobileManipulator.from_yaml(path)
+        own = Path(path).resolve() == ROBOT_FILE.resolve()
+        start, goal = (HOME, REACH_GOAL) if own else scenario(robot)
+        steps = step_times(robot, repeats, start, goal)
+        results[robot.name] = {
+            "dof": robot.dof,
+            "arm_dof": robot.arm_dof,
+            "base": base_kind(robot),
+            "step": steps,
+            "lp_over_classic": steps["lp"]["median_us"] / steps["classic"]["median_us"],
+            "lp_breakdown_us": lp_breakdown(robot, repeats, start, goal),
+        }
+    return results
