@@ -13,6 +13,14 @@ gripper of ``TABLE_GOAL``: its marker lies on the table top, under that gripper,
 carries its own offset x_d^2 (``goal_offset``) and the table (``solids``), which a profile's
 scene declares; a seed draws the bin from ``TABLE_BIN_RANGE`` (along the edge more than
 across it: the base must stop short of the table).
+
+These configurations are Little John's (``DECLARED_FOR``). Another robot's set-up is derived
+from its description (``derived``): it starts at the origin with its arm bent away from the
+middle of its joint ranges, and its goal is the pose of its gripper at another configuration
+inside its limits, the base ``AHEAD`` of the start (a fixed base's where it starts): a goal it
+reaches by construction. The bin lies under that pose and the set-up carries its own offset,
+as 'table''s does. 'pose', 'position' and (on a mobile base) 'obstacle' are derived; the other
+set-ups are Little John's scenes.
 """
 
 from __future__ import annotations
@@ -61,6 +69,24 @@ BIN_RANGE = np.array([0.1, 0.1, 0.2])
 TABLE_BIN_RANGE = np.array([0.03, 0.1, 0.2])
 """The same for 'table'."""
 
+DECLARED_FOR = "little_john"
+"""The robot whose configurations ``wbc.geometry.scenarios`` declares (by its description's
+name); every other robot's set-up is ``derived``."""
+DERIVED = ("pose", "position", "obstacle")
+"""The set-ups derived for another robot ('obstacle' on a mobile base)."""
+AHEAD = (0.45, 0.05, -0.15)
+"""A derived goal's base (x, y, phi) from the start's, m and rad."""
+START_BEND = 0.3
+GOAL_BEND = 0.6
+"""How far a derived start's and goal's revolute joints sit from the middle of their ranges,
+rad, in alternating directions (different ones for the goal); a prismatic joint's, as a share
+of its range (``_bent``); every joint stays inside ``LIMIT_SHARE`` of its range."""
+LIMIT_SHARE = 0.8
+"""The share of each joint's range, about its middle, a derived configuration stays in."""
+DRAW = 0.1
+"""A seed moves a derived start's and goal's arm joints by U(-DRAW, DRAW) rad (a prismatic
+joint by that share of its range), and a mobile base's as ``START_RANGE``."""
+
 
 @dataclass(frozen=True)
 class SimScenario:
@@ -104,6 +130,8 @@ def scenario(name: str, robot: MobileManipulator, seed: int | None = None) -> Si
     """The set-up of experiment ``name`` (one of ``NAMES``); a ``seed`` draws a variant."""
     if name not in NAMES:
         raise ValueError(f"no experiment {name!r}; choose one of {', '.join(NAMES)}")
+    if robot.name != DECLARED_FOR:
+        return derived(name, robot, seed)
     if name == "table":
         return _table(robot, seed)
     x, y, yaw = planar_of(robot.fkm(REACH_GOAL))
@@ -151,3 +179,73 @@ def _drawn(
     rng = np.random.default_rng(seed)
     moved = start + rng.uniform(-START_RANGE, START_RANGE)  # the start's draw first
     return moved, bin_pose + rng.uniform(-bin_range, bin_range)
+
+
+def derived(name: str, robot: MobileManipulator, seed: int | None = None) -> SimScenario:
+    """Set-up ``name`` (one of ``DERIVED``) for a robot other than ``DECLARED_FOR``: from its
+    start, the pose of its gripper at its goal configuration (the module docstring); a seed
+    draws both configurations (``DRAW``). ``ValueError`` naming what it can choose."""
+    mobile = robot.base.kind != "fixed"
+    choices = DERIVED if mobile else DERIVED[:2]
+    if name not in choices:
+        raise ValueError(
+            f"the {name!r} set-up is {DECLARED_FOR}'s; for {robot.name} choose {', '.join(choices)}"
+        )
+    start, goal_q = _bent(robot, START_BEND, 1.0), _bent(robot, GOAL_BEND, -1.0)
+    goal_q[:3] = AHEAD if mobile else start[:3]
+    if seed is not None:
+        rng = np.random.default_rng(seed)
+        for q in (start, goal_q):
+            q += rng.uniform(-1.0, 1.0, robot.dof) * _draw_range(robot, mobile)
+            np.clip(q, *_inside(robot), out=q)
+    pose = robot.fkm(goal_q)
+    x, y, yaw = planar_of(pose)
+    obstacles: tuple[Circle, ...] = ()
+    if name == "obstacle":  # the bin past an obstacle on the way, as Little John's
+        shift = np.array([*OBSTACLE_SHIFT, 0.0])
+        pose = dq.normalize(dq.mul(planar_pose(*shift, 0.0), pose))
+        x, y, yaw = planar_of(pose)
+        obstacles = (OBSTACLE,)
+    offset = offset_of(dq.mul(dq.conj(planar_pose(x, y, yaw, 0.0)), pose))
+    task = "position" if name == "position" else "pose"
+    return SimScenario(
+        name,
+        task,
+        tuple(float(v) for v in start),
+        (x, y, yaw),
+        obstacles,
+        goal_height=0.0,
+        goal_offset=tuple(round(v, 9) for v in offset),
+    )
+
+
+def _inside(robot: MobileManipulator) -> tuple[np.ndarray, np.ndarray]:
+    """The bounds ``LIMIT_SHARE`` of each arm joint's range about its middle (the base's
+    unbounded)."""
+    low, high = robot.q_min.copy(), robot.q_max.copy()
+    middle, half = 0.5 * (low[3:] + high[3:]), 0.5 * LIMIT_SHARE * (high[3:] - low[3:])
+    low[3:], high[3:] = middle - half, middle + half
+    return low, high
+
+
+def _bent(robot: MobileManipulator, bend: float, sign: float) -> np.ndarray:
+    """A configuration at the origin, each arm joint ``bend`` from the middle of its range in
+    alternating directions (starting with ``sign``), inside ``_inside``."""
+    low, high = _inside(robot)
+    q = np.zeros(robot.dof)
+    for i, kind in enumerate(robot.joint_types):
+        j = 3 + i
+        middle, span = 0.5 * (low[j] + high[j]), high[j] - low[j]
+        step = bend * span if kind == "prismatic" else bend
+        q[j] = np.clip(middle + sign * (-1.0) ** i * step, low[j], high[j])
+    return q
+
+
+def _draw_range(robot: MobileManipulator, mobile: bool) -> np.ndarray:
+    """How far a seed moves each coordinate of a derived configuration (``DRAW``)."""
+    spans = robot.q_max[3:] - robot.q_min[3:]
+    arm = [
+        DRAW * s if k == "prismatic" else DRAW
+        for k, s in zip(robot.joint_types, spans, strict=True)
+    ]
+    return np.concatenate((START_RANGE[:3] if mobile else np.zeros(3), arm))
