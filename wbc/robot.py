@@ -1,22 +1,49 @@
-"""The whole-body kinematic model of chapter 4: a holonomic base model carrying a DH arm.
+"""The whole-body kinematic model of chapter 4: a holonomic base model carrying a serial arm.
 
-Configuration q = [x, y, phi, q1..q5] (m, m, rad, rad...). The end-effector pose is
-x_3^0 = x_1^0 x_2^1 x_3^2 (4.6): the base pose (4.1), the constant base-height displacement
-(4.2) and the arm's DH product (4.4). The nonholonomic constraint is not in the model: the
-laws impose it (5.12).
+Configuration q = [x, y, phi, q1..qn] (m, m, rad, then rad or m per joint). The end-effector
+pose is x_3^0 = x_1^0 x_2^1 x_3^2 (4.6): the base pose (4.1), the constant base-height
+displacement (4.2) and the arm's product of links (4.4), each c(q_i) A_i + s(q_i) B_i whether a
+DH table or a URDF chain gave it (``wbc.serial_chain``; the description is read by
+``wbc.robot_description``). The nonholonomic constraint of a differential base is not in the
+model: the laws impose it (5.12); a fixed base's bounds on u_b are 0.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from wbc import dq
 from wbc.collision_model import CollisionModel, check_segments, collision_model
+from wbc.robot_description import (
+    BASE_KINDS,
+    BaseDescription,
+    read_arm,
+    read_base,
+    read_mapping,
+)
+from wbc.serial_chain import (
+    JOINT_TYPES,
+    RobotDescriptionError,
+    SerialChain,
+    from_dh,
+    readonly,
+)
+
+__all__ = [
+    "BASE_DOF",
+    "BASE_KINDS",
+    "JOINT_TYPES",
+    "REVOLUTE",
+    "BaseDescription",
+    "Chain",
+    "MobileManipulator",
+    "RobotDescriptionError",
+    "translation_jacobian",
+]
 
 Array = np.ndarray
 
@@ -24,70 +51,6 @@ REVOLUTE = 0.0
 """Joint type code of a revolute joint in the 5th row of the DH table (as in DQ Robotics)."""
 
 BASE_DOF = 3
-BASE_KINDS = ("differential", "omnidirectional", "fixed")
-"""differential: nonholonomic (the 5.12 row); omnidirectional: holonomic; fixed: never moves."""
-JOINT_TYPES = ("revolute", "prismatic")
-
-
-class RobotDescriptionError(ValueError):
-    """A robot description file is missing a field or has a value of the wrong shape."""
-
-
-def _readonly(values: object, shape: tuple[int, ...], what: str, allow_inf: bool = False) -> Array:
-    array = np.array(values, dtype=float)
-    if array.shape != shape:
-        raise RobotDescriptionError(f"{what}: expected shape {shape}, got {array.shape}")
-    if np.any(np.isnan(array)) or not (allow_inf or np.all(np.isfinite(array))):
-        raise RobotDescriptionError(f"{what}: values must be finite, got {array.tolist()}")
-    array.flags.writeable = False
-    return array
-
-
-def _mapping(path: Path) -> dict:
-    """The YAML mapping in the file at ``path``; ``RobotDescriptionError`` naming the file if it
-    is not text, not YAML or not a mapping (``OSError`` if it cannot be read)."""
-    try:
-        data = yaml.safe_load(path.read_bytes().decode("utf-8"))
-    except UnicodeDecodeError as error:
-        raise RobotDescriptionError(f"{path}: not UTF-8 text (byte {error.start})") from None
-    except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else str(path)
-        problem = getattr(error, "problem", None) or str(error).splitlines()[0]
-        raise RobotDescriptionError(f"{where}: not YAML: {problem}") from None
-    if not isinstance(data, dict):
-        found = "nothing" if data is None else f"a {type(data).__name__}"
-        raise RobotDescriptionError(
-            f"{path}: a robot description is a mapping (arm:, base:, ...), this file holds {found}"
-        )
-    return data
-
-
-def _dh_link(theta: float, d: float, a: float, alpha: float) -> Array:
-    """r_theta p_d p_a r_alpha: one DH link Rz(theta) Tz(d) Tx(a) Rx(alpha) (4.4)."""
-    r_theta = dq.from_parts(dq.rotation_quaternion(theta, [0, 0, 1]), np.zeros(4))
-    p_d = dq.pose(dq.ONE[:4], [0.0, 0.0, d])
-    p_a = dq.pose(dq.ONE[:4], [a, 0.0, 0.0])
-    r_alpha = dq.from_parts(dq.rotation_quaternion(alpha, [1, 0, 0]), np.zeros(4))
-    return dq.mul(dq.mul(dq.mul(r_theta, p_d), p_a), r_alpha)
-
-
-_HALF_K = 0.5 * dq.hamiplus8(np.concatenate((dq.K_, np.zeros(4))))
-_HALF_K_CONJ = _HALF_K @ dq.C8
-
-
-@dataclass(frozen=True)
-class BaseDescription:
-    """The base: its kind (``BASE_KINDS``), geometry and the bounds on u_b = [x', y', phi']; the
-    wheel fields are a differential base's."""
-
-    height: float
-    body_radius: float
-    wheel_base: float
-    wheel_radius: float
-    wheel_speed_max: float
-    velocity_max: Array
-    kind: str = "differential"
 
 
 class Chain:
@@ -130,11 +93,13 @@ class Chain:
 
 
 class MobileManipulator:
-    """Forward kinematics (4.6), pose Jacobian (4.9) and translation Jacobian (4.18)."""
+    """Forward kinematics (4.6), pose Jacobian (4.9) and translation Jacobian (4.18) of a base
+    (``BASE_KINDS``) carrying a serial arm of revolute and prismatic joints
+    (``wbc.serial_chain``: a DH table's or a URDF chain's)."""
 
     def __init__(
         self,
-        dh: Array,
+        chain: Array | SerialChain,
         base: BaseDescription,
         joint_min: Array,
         joint_max: Array,
@@ -144,29 +109,33 @@ class MobileManipulator:
         joint_names: tuple[str, ...] | None = None,
     ) -> None:
         self.name = name
-        self.dh = _readonly(dh, (5, dh.shape[1]), "dh")
-        if np.any(self.dh[4] != REVOLUTE):
-            raise RobotDescriptionError("dh: only revolute joints are supported")
-        self.arm_dof = self.dh.shape[1]
-        self.joint_names = joint_names or tuple(f"q{i + 1}" for i in range(self.arm_dof))
-        """The arm joints' names, as the description names them (a DH table's: q1..qn)."""
-        self.joint_types = ("revolute",) * self.arm_dof
-        """``JOINT_TYPES`` of each arm joint."""
+        self.chain = chain if isinstance(chain, SerialChain) else from_dh(chain, joint_names)
+        self.dh = self.chain.dh
+        """The DH table (5, n) when one gave the arm, else None."""
+        self.arm_dof = self.chain.dof
         self.dof = BASE_DOF + self.arm_dof
+        self.joint_names = self.chain.names
+        """The arm joints' names, as the description names them (a DH table's: q1..qn)."""
+        self.joint_types = self.chain.types
+        """``JOINT_TYPES`` of each arm joint."""
+        if base.kind not in BASE_KINDS:
+            raise RobotDescriptionError(f"base.kind: expected one of {BASE_KINDS}, got {base.kind}")
+        if base.kind == "fixed" and np.any(base.velocity_max != 0.0):
+            raise RobotDescriptionError("base.velocity_max: a fixed base never moves: give zeros")
         self.base = base
         self.base_height = base.height
         inf = np.full(BASE_DOF, np.inf)
-        self.q_min = _readonly(np.concatenate((-inf, joint_min)), (self.dof,), "joint_min", True)
-        self.q_max = _readonly(np.concatenate((inf, joint_max)), (self.dof,), "joint_max", True)
+        self.q_min = readonly(np.concatenate((-inf, joint_min)), (self.dof,), "joint_min", True)
+        self.q_max = readonly(np.concatenate((inf, joint_max)), (self.dof,), "joint_max", True)
         if np.any(self.q_min > self.q_max):
             raise RobotDescriptionError("joint_min must not exceed joint_max")
-        self.velocity_max = _readonly(
+        self.velocity_max = readonly(
             np.concatenate((base.velocity_max, arm_velocity_max)), (self.dof,), "velocity_max"
         )
-        links = np.stack([dq.hamiplus8(_dh_link(*self.dh[:4, i])) for i in range(self.arm_dof)])
-        # H+(r_z(q) L) = cos(q/2) H+(L) + sin(q/2) H+(k) H+(L), with r_z(q) = cos(q/2) + k sin(q/2).
-        self._link_cos = links
-        self._link_sin = np.matmul(2.0 * _HALF_K, links)
+        self._link_cos, self._link_sin = self.chain.link_cos, self.chain.link_sin
+        prismatic = self.chain.prismatic
+        self._prismatic = prismatic if prismatic.any() else None
+        self._axis_ops, self._shared_axis = self.chain.axis_ops, self.chain.shared_axis
         self._frame_columns = (
             np.arange(self.dof)[None, None, :]
             < BASE_DOF + np.arange(self.arm_dof + 1)[:, None, None]
@@ -177,48 +146,40 @@ class MobileManipulator:
         """The parts that obstacles in 3-D must clear (``wbc.collision_model``)."""
 
     def with_velocity_max(self, velocity_max: Array) -> MobileManipulator:
-        """The same robot with other bounds on u (section 6.3's tests impose none)."""
-        bounds = np.asarray(velocity_max, dtype=float)
+        """The same robot with other bounds on u (section 6.3's tests impose none); a fixed
+        base's stay 0."""
+        bounds = np.array(velocity_max, dtype=float)
+        if self.base.kind == "fixed":
+            bounds[:BASE_DOF] = 0.0
         base = replace(
-            self.base, velocity_max=_readonly(bounds[:BASE_DOF], (3,), "base.velocity_max")
+            self.base, velocity_max=readonly(bounds[:BASE_DOF], (3,), "base.velocity_max")
         )
         return MobileManipulator(
-            np.array(self.dh),
+            self.chain,
             base,
             self.q_min[BASE_DOF:].copy(),
             self.q_max[BASE_DOF:].copy(),
             bounds[BASE_DOF:],
             self.name,
             self.collision,
-            self.joint_names,
         )
 
     @classmethod
     def from_yaml(cls, path: str | Path) -> MobileManipulator:
-        """Build the model from a robot description such as deploy/robots/little_john.yaml."""
+        """Build the model from a robot description such as deploy/robots/little_john.yaml
+        (``wbc.robot_description``); ``RobotDescriptionError`` naming the file and the field."""
         path = Path(path)
-        data = _mapping(path)
+        data = read_mapping(path)
         try:
-            arm, base = data["arm"], data["base"]
-            table = arm["dh"]
-            types = [REVOLUTE if t == "revolute" else -1.0 for t in table["type"]]
-            dh = np.array([table["theta"], table["d"], table["a"], table["alpha"], types], float)
-            description = BaseDescription(
-                height=float(base["height"]),
-                body_radius=float(base["body_radius"]),
-                wheel_base=float(base["wheel_base"]),
-                wheel_radius=0.5 * float(base["wheel_diameter"]),
-                wheel_speed_max=float(base["wheel_speed_max"]),
-                velocity_max=_readonly(base["velocity_max"], (3,), "base.velocity_max"),
-            )
+            arm = read_arm(data, path.parent)
             return cls(
-                dh,
-                description,
-                np.array(arm["joint_min"], float),
-                np.array(arm["joint_max"], float),
-                np.array(arm["velocity_max"], float),
+                arm.chain,
+                read_base(data),
+                arm.joint_min,
+                arm.joint_max,
+                arm.velocity_max,
                 name=str(data.get("name", path.stem)),
-                collision=collision_model(data.get("collision"), dh.shape[1] + 1),
+                collision=collision_model(data.get("collision"), arm.chain.dof + 1),
             )
         except (KeyError, TypeError, ValueError) as error:
             if isinstance(error, RobotDescriptionError):
@@ -250,9 +211,14 @@ class MobileManipulator:
         )
 
     def _arm_link_operators(self, q_arm: Array) -> Array:
-        """H+(x_i) for every arm link, x_i = r_z(q_i) (r_theta_i p_d_i p_a_i r_alpha_i)."""
+        """H+(x_i^{i-1}) = c(q_i) A_i + s(q_i) B_i for every arm link (``wbc.serial_chain``)."""
         half = 0.5 * q_arm[:, None, None]
-        return np.cos(half) * self._link_cos + np.sin(half) * self._link_sin
+        if self._prismatic is None:
+            return np.cos(half) * self._link_cos + np.sin(half) * self._link_sin
+        c, s = np.cos(half), np.sin(half)
+        c[self._prismatic] = 1.0
+        s[self._prismatic] = q_arm[self._prismatic, None, None]
+        return c * self._link_cos + s * self._link_sin
 
     def kinematics(self, q: Array) -> tuple[Array, Array]:
         """(vec8 x, J) for configuration q: the pose x = x_3^0 (4.6) and its Jacobian (4.9).
@@ -283,8 +249,11 @@ class MobileManipulator:
     def _twists(self, q: Array, prefixes: Array) -> Array:
         """T (8 x dof), the twists of kinematics' docstring, from H+ of the poses before each
         arm joint (``prefixes``, n x 8 x 8)."""
-        # vec(x k x*) = H+(x) H+(k) C8 vec(x), for every prefix pose x = H+(x) e_1.
-        axes = np.matmul(prefixes, (_HALF_K_CONJ @ prefixes[:, :, 0].T).T[:, :, None])
+        # vec(x L x*) = H+(x) H+(L) C8 vec(x), for every prefix pose x = H+(x) e_1.
+        if self._shared_axis is not None:
+            axes = np.matmul(prefixes, (self._shared_axis @ prefixes[:, :, 0].T).T[:, :, None])
+        else:
+            axes = np.matmul(prefixes, np.matmul(self._axis_ops, prefixes[:, :, :1]))
         twists = np.zeros((8, self.dof))
         twists[5, 0] = twists[6, 1] = twists[3, 2] = 0.5
         twists[5, 2], twists[6, 2] = 0.5 * q[1], -0.5 * q[0]
@@ -315,15 +284,10 @@ class MobileManipulator:
         return [top, *(link[:, 0].copy() for link in self._arm_link_operators(q[BASE_DOF:]))]
 
     def link_outline(self, link: int) -> Array:
-        """The DH link ``link`` (1 to arm_dof) as three points (3, 3) in its own frame i, m:
-        the origin of frame i-1, the point d along z_{i-1} from it, and the origin of frame i.
-
-        Frame i-1's origin is at R_x(alpha)^T Rz(theta)^T (-Rz(theta) (a, 0, d)) =
-        -(a, d sin alpha, d cos alpha) from frame i's, whatever q_i (a rotation about z_{i-1}
-        turns the whole link); the point after d is -(a, 0, 0)."""
-        _, d, a, alpha = self.dh[:4, link - 1]
-        origin_before = -np.array([a, d * math.sin(alpha), d * math.cos(alpha)])
-        return np.array([origin_before, [-a, 0.0, 0.0], [0.0, 0.0, 0.0]])
+        """The arm link ``link`` (1 to arm_dof) as three points (3, 3) in its own frame i, m,
+        fixed there whatever q_i: for a DH link the origin of frame i-1, the point d along
+        z_{i-1} from it and the origin of frame i (``wbc.serial_chain``)."""
+        return self.chain.outlines[link - 1].copy()
 
     def fkm(self, q: Array) -> Array:
         """vec8 of the end-effector pose x_3^0 = x_1^0 x_2^1 x_3^2 (4.6)."""

@@ -282,13 +282,52 @@ def test_invalid_field_names_file_and_field(
     assert field[1] in str(raised.value)
 
 
-def test_prismatic_joint_is_rejected(tmp_path: Path, description: dict) -> None:
-    broken = yaml.safe_load(yaml.safe_dump(description))
-    broken["arm"]["dh"]["type"][2] = "prismatic"
+def _with_prismatic(tmp_path: Path, description: dict) -> MobileManipulator:
+    """Little John with its third joint made prismatic (d3 + q3 along z_2)."""
+    changed = yaml.safe_load(yaml.safe_dump(description))
+    changed["arm"]["dh"]["type"][2] = "prismatic"
+    changed["arm"]["dh"]["names"] = ["waist", "shoulder", "slide", "roll", "pitch"]
     path = tmp_path / "prismatic_robot.yaml"
-    path.write_text(yaml.safe_dump(broken))
-    with pytest.raises(RobotDescriptionError, match="revolute"):
-        MobileManipulator.from_yaml(path)
+    path.write_text(yaml.safe_dump(changed))
+    return MobileManipulator.from_yaml(path)
+
+
+def test_a_prismatic_dh_joint_matches_dqrobotics(tmp_path: Path, description: dict) -> None:
+    """Type 1 of DQ Robotics' DH table: the joint adds q to d; poses and Jacobians agree."""
+    robot = _with_prismatic(tmp_path, description)
+    assert robot.joint_types == ("revolute", "revolute", "prismatic", "revolute", "revolute")
+    assert robot.joint_names == ("waist", "shoulder", "slide", "roll", "pitch")
+    arm = DQ_SerialManipulatorDH(np.array(robot.dh))
+    base = DQ_HolonomicBase()
+    base.set_frame_displacement(1 + E_ * 0.5 * 0.170 * k_)
+    oracle = DQ_WholeBody(base)
+    oracle.add(arm)
+    for q in random_configurations(robot, 100, seed=11):
+        np.testing.assert_allclose(robot.fkm(q), oracle.fkm(q).vec8(), rtol=0, atol=ORACLE_TOL)
+        np.testing.assert_allclose(
+            robot.pose_jacobian(q), oracle.pose_jacobian(q), rtol=0, atol=ORACLE_TOL
+        )
+
+
+def test_a_prismatic_joint_jacobian_is_the_derivative_of_fkm(
+    tmp_path: Path, description: dict
+) -> None:
+    robot = _with_prismatic(tmp_path, description)
+    for q in random_configurations(robot, 20, seed=12):
+        np.testing.assert_allclose(
+            robot.pose_jacobian(q),
+            central_difference(robot.fkm, q),
+            rtol=0,
+            atol=FINITE_DIFFERENCE_TOL,
+        )
+        _, jacobians = robot.frame_kinematics(q)
+        for i in range(robot.arm_dof + 1):
+            np.testing.assert_allclose(
+                jacobians[i],
+                central_difference(lambda q, i=i: robot.frames(q)[i], q),
+                rtol=0,
+                atol=FINITE_DIFFERENCE_TOL,
+            )
 
 
 def test_the_collision_parts_come_from_the_description(robot: MobileManipulator) -> None:
