@@ -12,22 +12,8 @@ import pytest
 import yaml
 import zenoh
 
-from profiles.endpoints import is_local_endpoint
 from profiles.profile import ProfileError, ZenohSettings, load_profile
-
-PUB = {"name": "pub", "module": "scripted_publisher", "role": "tool"}
-
-
-def write(tmp_path: Path, data: object) -> Path:
-    path = tmp_path / "profile.yaml"
-    path.write_text(yaml.safe_dump(data))
-    return path
-
-
-def refusal(tmp_path: Path, data: object) -> str:
-    with pytest.raises(ProfileError) as error:
-        load_profile(write(tmp_path, data))
-    return str(error.value)
+from tests.profiles.profile_yaml import PUB, refusal, write
 
 
 def test_a_minimal_profile_gets_safe_defaults(tmp_path: Path) -> None:
@@ -128,26 +114,6 @@ def test_missing_namespace_is_named(tmp_path: Path) -> None:
     assert "namespace: Field required" in refusal(tmp_path, {"components": [PUB]})
 
 
-def test_yaml_syntax_errors_give_the_line(tmp_path: Path) -> None:
-    path = tmp_path / "broken.yaml"
-    path.write_text("namespace: sim\ncomponents:\n  - {name: pub, module: x\n  - other\n")
-    with pytest.raises(ProfileError, match=r"broken\.yaml:5:1: YAML syntax error: expected ','"):
-        load_profile(path)
-
-
-def test_an_alias_bomb_and_a_file_that_is_not_utf8_are_refused_at_once(tmp_path: Path) -> None:
-    bomb = tmp_path / "bomb.yaml"
-    lines = ['a0: &a0 ["x", "x", "x", "x", "x", "x", "x", "x", "x"]']
-    lines += [f"a{i}: &a{i} [{', '.join([f'*a{i - 1}'] * 9)}]" for i in range(1, 9)]
-    bomb.write_text("\n".join(lines) + "\n")  # 9**9 strings once expanded
-    with pytest.raises(ProfileError, match=r"bomb\.yaml: expands to more than 100000 values"):
-        load_profile(bomb)
-    latin = tmp_path / "latin.yaml"
-    latin.write_bytes("namespace: régl\n".encode("latin-1"))
-    with pytest.raises(ProfileError, match=r"latin\.yaml: not UTF-8 text \(byte 12\)"):
-        load_profile(latin)
-
-
 def test_a_huge_wrong_value_is_not_echoed_whole(tmp_path: Path) -> None:
     said = refusal(
         tmp_path,
@@ -157,12 +123,6 @@ def test_a_huge_wrong_value_is_not_echoed_whole(tmp_path: Path) -> None:
         },
     )
     assert "components[0].params" in said and len(said) < 1000, said[:2000]
-
-
-def test_a_profile_that_is_not_a_mapping_or_not_there_is_refused(tmp_path: Path) -> None:
-    assert "expected a mapping at the top level, got list" in refusal(tmp_path, [1, 2])
-    with pytest.raises(ProfileError, match="cannot read profile"):
-        load_profile(tmp_path / "absent.yaml")
 
 
 @pytest.mark.parametrize(
@@ -182,43 +142,6 @@ def test_remote_endpoints_and_multicast_are_refused(
     message = refusal(tmp_path, {"namespace": "sim", "zenoh": zenoh, "components": [PUB]})
     assert "allow_remote: true" in message
     assert ZenohSettings(**zenoh, allow_remote=True).allow_remote
-
-
-@pytest.mark.parametrize(
-    "endpoint",
-    [
-        "tcp/127.0.0.1:7447",
-        "tcp/127.0.0.2:1",
-        "tcp/[::1]:7447",
-        "udp/127.0.0.1:0",
-        "unixsock-stream//tmp/parsimony.sock",
-    ],
-)
-def test_loopback_and_unix_socket_endpoints_are_local(endpoint: str) -> None:
-    assert is_local_endpoint(endpoint)
-
-
-@pytest.mark.parametrize(
-    ("endpoint", "reason"),
-    [
-        ("tcp/127.0.0.1:7450#iface=eth0", "options (#...) are not allowed"),
-        ("udp/127.0.0.1:7447#iface=lo", "options (#...) are not allowed"),
-        ("tcp/127.0.0.1:7447?prio=1", "metadata (?...)"),
-        ("tcp/localhost:7447", "not a literal IP address"),
-        ("tcp/127.0.0.1", "host:port"),
-        ("tcp/127.0.0.1:99999", "host:port"),
-        ("serial//dev/ttyUSB0", "unknown protocol"),
-        ("127.0.0.1:7447", "expected <protocol>/<address>"),
-    ],
-)
-def test_endpoints_not_provably_local_are_refused_with_the_reason(
-    tmp_path: Path, endpoint: str, reason: str
-) -> None:
-    assert not is_local_endpoint(endpoint)
-    message = refusal(
-        tmp_path, {"namespace": "sim", "zenoh": {"listen": [endpoint]}, "components": [PUB]}
-    )
-    assert "zenoh.listen[0]" in message and reason in message
 
 
 def test_a_router_on_port_0_is_refused(tmp_path: Path) -> None:
@@ -297,68 +220,6 @@ def test_a_component_may_wait_for_others_of_its_role_or_an_earlier_one(tmp_path:
     ]
     profile = load_profile(write(tmp_path, {"namespace": "sim", "components": components}))
     assert [profile.start_depth(spec) for spec in profile.components] == [0, 1, 2]
-
-
-def test_a_profile_extends_another_and_says_only_what_differs(tmp_path: Path) -> None:
-    (tmp_path / "robots").mkdir()
-    (tmp_path / "robots" / "robot.yaml").write_text("links: []\n")
-    base = {
-        "namespace": "sim",
-        "robot": "robots/robot.yaml",
-        "zenoh": {"router": ["tcp/127.0.0.1:7600"]},
-        "components": [
-            {**PUB, "params": {"rate_hz": 50.0, "goal_task": "pose"}},
-            {
-                "name": "ctl",
-                "module": "lp_controller",
-                "role": "controller",
-                "params": {"eta": 0.6},
-            },
-        ],
-    }
-    (tmp_path / "base.yaml").write_text(yaml.safe_dump(base))
-    child_dir = tmp_path / "variants"
-    child_dir.mkdir()
-    child = {
-        "extends": "../base.yaml",
-        "zenoh": {"mode": "client"},
-        "components": [
-            {"name": "ctl", "module": "cascade_controller"},
-            {"name": "pub", "params": {"rate_hz": 10.0}},
-            {"name": "extra", "module": "scripted_publisher", "role": "tool", "enabled": False},
-        ],
-    }
-    path = child_dir / "child.yaml"
-    path.write_text(yaml.safe_dump(child))
-    profile = load_profile(path)
-    assert profile.namespace == "sim" and profile.zenoh.mode == "client"
-    assert profile.zenoh.router == ["tcp/127.0.0.1:7600"]
-    assert profile.robot == tmp_path / "robots" / "robot.yaml"  # relative to base.yaml
-    assert [spec.name for spec in profile.components] == ["pub", "ctl", "extra"]
-    assert profile.component("ctl").module == "cascade_controller"
-    assert profile.component("ctl").params == {"eta": 0.6}
-    assert profile.component("pub").params == {"rate_hz": 10.0, "goal_task": "pose"}
-    assert [spec.name for spec in profile.start_order()] == ["ctl", "pub"]
-
-
-def test_extends_that_is_missing_or_circular_is_refused(tmp_path: Path) -> None:
-    assert "extends: no profile at" in refusal(tmp_path, {"extends": "nowhere.yaml"})
-    (tmp_path / "a.yaml").write_text(yaml.safe_dump({"extends": "b.yaml"}))
-    (tmp_path / "b.yaml").write_text(yaml.safe_dump({"extends": "a.yaml"}))
-    with pytest.raises(ProfileError, match="in a circle"):
-        load_profile(tmp_path / "a.yaml")
-
-
-def test_an_invalid_override_names_its_field(tmp_path: Path) -> None:
-    (tmp_path / "base.yaml").write_text(yaml.safe_dump({"namespace": "sim", "components": [PUB]}))
-    message = refusal(
-        tmp_path,
-        {
-            "extends": "base.yaml",
-            "components": [{"name": "pub", "restart": {"policy": "sometimes"}}],
-        },
-    )
-    assert "components[0].restart.policy" in message
 
 
 @pytest.mark.parametrize(
