@@ -4,6 +4,7 @@ chain (``wbc.urdf_chain``), its joints' bounds, and the base (``BASE_KINDS``).
     arm:  dh: {theta, d, a, alpha, type (revolute | prismatic), names (optional)}
           joint_min, joint_max, velocity_max
       or  urdf: {file (beside the description), base_link, tip_link}   (bounds from the URDF)
+          velocity_max (optional: a commanded cap under the URDF's velocity limits)
     base: kind (differential by default), height, body_radius, velocity_max (not for fixed);
           a differential base's wheel_base, wheel_diameter, wheel_speed_max
 
@@ -142,12 +143,20 @@ def read_arm(data: Mapping[str, Any], folder: Path) -> ArmDescription:
         raise RobotDescriptionError("arm: expected one of dh or urdf (a DH table or a URDF file)")
     if "urdf" in arm:
         urdf = _section(arm, "urdf", "arm.")
-        given = sorted({"joint_min", "joint_max", "velocity_max"} & set(arm))
+        given = sorted({"joint_min", "joint_max"} & set(arm))
         if given:
-            raise RobotDescriptionError(f"arm.{given[0]}: a URDF arm's bounds come from its URDF")
+            raise RobotDescriptionError(f"arm.{given[0]}: a URDF arm's limits come from its URDF")
         ends = [str(_field(urdf, key, "arm.urdf")) for key in ("base_link", "tip_link")]
         read = read_urdf_arm(folder / str(_field(urdf, "file", "arm.urdf")), *ends)
-        chain, bounds = read.chain, (read.lower, read.upper, read.velocity)
+        speed = read.velocity
+        if "velocity_max" in arm:
+            speed = readonly(arm["velocity_max"], (read.chain.dof,), "arm.velocity_max")
+            if np.any(speed > read.velocity):
+                raise RobotDescriptionError(
+                    f"arm.velocity_max: a commanded cap, at most the URDF's velocity limits "
+                    f"{read.velocity.tolist()}, got {speed.tolist()}"
+                )
+        chain, bounds = read.chain, (read.lower, read.upper, speed)
     else:
         chain = _dh_chain(_section(arm, "dh", "arm."))
         keys = ("joint_min", "joint_max", "velocity_max")

@@ -4,11 +4,12 @@ read with yourdfpy, its joints' limits and velocity limits from the file.
 Each movable joint on the path is F M(q) G (``wbc.serial_chain``): F its origin, after the
 fixed joints since the movable one before it (folded in); M its rotation about or translation
 along its axis; G the identity, but for the last joint the fixed joints from it to the tip. So
-frame i is the child link of the i-th movable joint and the last frame the tip link.
+frame i is the child link of the i-th movable joint and the last frame the tip link. Joints
+that branch off the path (a gripper's fingers) move nothing on it and are left out.
 
-Refused, naming the field: a link or a joint that is not in the file, a tip not below the base,
-a link of the path with two movable children (a branching chain), a continuous, floating,
-planar or mimic joint, a missing limit or velocity limit, a value that is not finite.
+Refused, naming the field: a link that is not in the file, a tip not below the base (no serial
+chain joins them: they lie on two branches), a continuous, floating, planar or mimic joint on
+the path, a missing limit or velocity limit, a value that is not finite.
 """
 
 from __future__ import annotations
@@ -107,13 +108,6 @@ def _path(robot: yourdfpy.Robot, base_link: str, tip_link: str, where: str) -> l
         found.append(joint)
         link = joint.parent
     found.reverse()
-    for joint in found:
-        movers = [j.name for j in robot.joints if j.parent == joint.parent and j.type != "fixed"]
-        if len(movers) > 1:
-            raise RobotDescriptionError(
-                f"{where}: link {joint.parent!r} branches into the movable joints "
-                f"{', '.join(movers)}: the chain from base_link to tip_link must be serial"
-            )
     return found
 
 

@@ -100,6 +100,13 @@ class CascadeLaw:
     _reference: Array | None = field(default=None, init=False, repr=False)
     _task: Task | None = field(default=None, init=False, repr=False)
 
+    def __post_init__(self) -> None:
+        if self.robot.base.kind != "differential":
+            raise ValueError(
+                f"the cascade law (appendix B) linearises a differential base; robot "
+                f"{self.robot.name}'s base.kind is {self.robot.base.kind}: use lp, qp or classic"
+            )
+
     def set_params(self, params: CascadeParams) -> None:
         self.params = params
 

@@ -4,7 +4,8 @@ With ``nonholonomic`` it takes the pseudoinverse of the Jacobian of the velociti
 allows instead: u = N (J N)^+ (-eta e), the columns of N an orthonormal basis of them (the
 base's forward speed along its heading, its yaw, the arm joints). Not in the dissertation: it
 is the least 2-norm u the nonholonomic robot can take for the task, the 2-norm baseline the
-cascade of appendix B only approximates (table 6.1's metric 2).
+cascade of appendix B only approximates (table 6.1's metric 2). A fixed base's u_b is 0 (the
+pseudoinverse of the arm's columns); an omnidirectional base has no 5.11 to obey.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ import numpy as np
 from wbc.geometry.obstacles import Obstacle
 from wbc.laws.gains import check_gains, gain
 from wbc.laws.law_output import LawOutput, summarise
-from wbc.robot import MobileManipulator
+from wbc.robot import BASE_DOF, MobileManipulator
 from wbc.task import Task
 from wbc.validation import require_finite
 
@@ -32,6 +33,17 @@ PINV_RCOND = 1e-9
 def pinv_velocity(task_jacobian: Array, error: Array, eta: float) -> Array:
     """u = -J^+ eta e (5.3)."""
     return -eta * (np.linalg.pinv(task_jacobian, rcond=PINV_RCOND) @ error)
+
+
+def velocity_basis(robot: MobileManipulator, phi: float, nonholonomic: bool) -> Array | None:
+    """N spanning the u the robot's base allows (None: every u): a fixed base's arm joints
+    alone; a differential base's under 5.11 when ``nonholonomic``; an omnidirectional base's
+    every u, whatever ``nonholonomic``."""
+    if robot.base.kind == "fixed":
+        return np.eye(robot.dof)[:, BASE_DOF:]
+    if nonholonomic and robot.base.kind == "differential":
+        return nonholonomic_basis(phi, robot.dof)
+    return None
 
 
 def nonholonomic_basis(phi: float, dof: int) -> Array:
@@ -77,8 +89,8 @@ class PseudoinverseLaw:
         q = require_finite("configuration q", q)
         pose, jacobian = self.robot.kinematics(q)
         error, task_jacobian = task.error(pose, jacobian, q)
-        if self.params.nonholonomic:
-            basis = nonholonomic_basis(float(q[2]), self.robot.dof)
+        basis = velocity_basis(self.robot, float(q[2]), self.params.nonholonomic)
+        if basis is not None:
             u = basis @ pinv_velocity(task_jacobian @ basis, error, self.params.eta)
         else:
             u = pinv_velocity(task_jacobian, error, self.params.eta)

@@ -1,4 +1,5 @@
-"""The nonholonomic constraint of the differential-drive base (5.11, 5.12)."""
+"""The nonholonomic constraint of the differential-drive base (5.11, 5.12); none for an
+omnidirectional base (holonomic) or a fixed one (its bounds on u_b are 0), whatever the gain."""
 
 from __future__ import annotations
 
@@ -32,6 +33,9 @@ class Nonholonomic:
         return cls() if params.nonholonomic else None
 
     def rows(self, context: StepContext) -> LinearRows:
+        if context.robot.base.kind != "differential":
+            empty = np.zeros(0)
+            return LinearRows(self.name, np.zeros((0, context.robot.dof)), empty, empty, False)
         phi = float(context.q[2])
         row = np.zeros((1, context.robot.dof))
         row[0, 0], row[0, 1] = math.sin(phi), -math.cos(phi)
