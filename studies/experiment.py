@@ -105,6 +105,9 @@ class Options:
     realtime: bool = False
     time_limit_s: float = TIME_LIMIT_S
     hide_base_marker: tuple[float, float] | None = None
+    robot: Path | None = None
+    """The robot's description in place of the profile's (``robot:``): another robot is a
+    profile change; its set-up is derived from it (``sim2d.scenarios.derived``)."""
     gains: Mapping[str, Any] = dataclasses.field(default_factory=dict)
     """Gains of the law (``GAINS``' names) that replace the experiment's: another law on the
     same set-up, such as another obstacle constraint (``obstacle_mode``) or the cascade held
@@ -198,8 +201,10 @@ def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict
             "host_epoch": True,
         }
         components += [{"name": n, "params": {"port": str(p)}} for n, p in links.items()]
+    robot = {"robot": str(options.robot.resolve())} if options.robot is not None else {}
     return {
         "extends": str(base.resolve()),
+        **robot,
         "namespace": f"experiment{os.getpid()}",
         "startup_timeout_s": STARTUP_S,  # the launcher's and this module's wait are one
         **({} if options.realtime else {"watchdog_s": LOCKSTEP_WATCHDOG_S}),
@@ -267,9 +272,12 @@ def run_experiment(options: Options) -> dict[str, Any]:
         )
     say(f"setting up the {options.name} experiment")
     base = options.profile or SUPERVISED.get(options.name) or PROFILES[options.controller]
-    base_profile = load_profile(base)
-    robot = MobileManipulator.from_yaml(base_profile.robot)
-    setup = scenario(options.name, robot, options.seed)
+    robot_file = options.robot or load_profile(base).robot
+    robot = MobileManipulator.from_yaml(robot_file)
+    try:
+        setup = scenario(options.name, robot, options.seed)
+    except ValueError as error:  # a set-up the robot has none of
+        raise ProfileError(str(error)) from None
     composed = experiment_profile(options, base, setup)  # a bad gain is refused before
     options.out.mkdir(parents=True, exist_ok=True)  # anything is written
     profile_path = options.out / "profile.yaml"
@@ -316,6 +324,7 @@ def run_experiment(options: Options) -> dict[str, Any]:
     start_ns = min((s.header.stamp_ns for s in recorded.get(ROBOT_STATE.name, [])), default=end_ns)
     report = {
         "experiment": options.name,
+        "robot": robot.name,
         "controller": options.controller,
         "seed": options.seed,
         "mode": "realtime" if options.realtime else "lockstep",
@@ -371,8 +380,13 @@ def connect(profile: Profile, launcher: subprocess.Popen) -> zenoh.Session:
         try:
             return query.Target(profile.namespace, profile.zenoh).open()
         except query.QueryError:
-            if launcher.poll() is not None or time.monotonic() > deadline:
+            if launcher.poll() is not None:  # it refused the profile, or failed at once
+                raise RuntimeError(
+                    f"the launch stopped (exit {launcher.returncode}); see its log"
+                ) from None
+            if time.monotonic() > deadline:
                 raise
+
             time.sleep(0.2)  # the launcher opens its router first thing
 
 
