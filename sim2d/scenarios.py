@@ -17,10 +17,11 @@ across it: the base must stop short of the table).
 These configurations are Little John's (``DECLARED_FOR``). Another robot's set-up is derived
 from its description (``derived``): it starts at the origin with its arm bent away from the
 middle of its joint ranges, and its goal is the pose of its gripper at another configuration
-inside its limits, the base ``AHEAD`` of the start (a fixed base's where it starts): a goal it
-reaches by construction. The bin lies under that pose and the set-up carries its own offset,
-as 'table''s does. 'pose', 'position' and (on a mobile base) 'obstacle' are derived; the other
-set-ups are Little John's scenes.
+inside its limits (its first joint turned so that the gripper lies ahead, ``_ahead``), the base
+``AHEAD`` of the start (a fixed base's where it starts): a goal it reaches by construction.
+The bin lies under that pose and the set-up carries its own offset, as 'table''s does. 'pose',
+'position' and (on a mobile base) 'obstacle' are derived; the other set-ups are Little John's
+scenes.
 """
 
 from __future__ import annotations
@@ -191,8 +192,8 @@ def derived(name: str, robot: MobileManipulator, seed: int | None = None) -> Sim
         raise ValueError(
             f"the {name!r} set-up is {DECLARED_FOR}'s; for {robot.name} choose {', '.join(choices)}"
         )
-    start, goal_q = _bent(robot, START_BEND, 1.0), _bent(robot, GOAL_BEND, -1.0)
-    goal_q[:3] = AHEAD if mobile else start[:3]
+    start = _bent(robot, START_BEND, 1.0)
+    goal_q = _ahead(robot, _bent(robot, GOAL_BEND, -1.0), AHEAD if mobile else start[:3])
     if seed is not None:
         rng = np.random.default_rng(seed)
         for q in (start, goal_q):
@@ -239,6 +240,27 @@ def _bent(robot: MobileManipulator, bend: float, sign: float) -> np.ndarray:
         step = bend * span if kind == "prismatic" else bend
         q[j] = np.clip(middle + sign * (-1.0) ** i * step, low[j], high[j])
     return q
+
+
+TURNS = (0.0, 0.5 * np.pi, -0.5 * np.pi, np.pi)
+"""The first joint's turns from a derived goal's bend that ``_ahead`` tries."""
+
+
+def _ahead(robot: MobileManipulator, q: np.ndarray, base: Sequence[float]) -> np.ndarray:
+    """``q`` on ``base`` with its first arm joint turned (``TURNS``, inside ``_inside``) so
+    that the gripper lies most ahead of the base and least aside (x - |y| in the base's
+    frame): where the ceiling camera sees the bin, as Little John's."""
+    low, high = _inside(robot)
+    candidates = []
+    for turn in TURNS:
+        turned = q.copy()
+        turned[:3] = 0.0
+        turned[3] = np.clip(q[3] + turn, low[3], high[3])
+        x, y, _ = planar_of(robot.fkm(turned))
+        candidates.append((x - abs(y), turn, turned))
+    _, _, best = max(candidates, key=lambda c: (c[0], -abs(c[1])))
+    best[:3] = base
+    return best
 
 
 def _draw_range(robot: MobileManipulator, mobile: bool) -> np.ndarray:

@@ -6,10 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from profiles.deploy_files import DEPLOY
-
-ROBOTS = DEPLOY / "robots"
-"""The zoo: one description per robot, named by its file's stem."""
+from profiles.deploy_files import ROBOTS_DIR, zoo
 
 
 def robot_file(text: str) -> Path:
@@ -19,10 +16,10 @@ def robot_file(text: str) -> Path:
     path = Path(text)
     if path.suffix in (".yaml", ".yml") or len(path.parts) > 1:
         return path
-    found = ROBOTS / f"{text}.yaml"
+    found = ROBOTS_DIR / f"{text}.yaml"
     if not found.is_file():
-        zoo = ", ".join(sorted(p.stem for p in ROBOTS.glob("*.yaml")))
+        names = ", ".join(p.stem for p in zoo())
         raise argparse.ArgumentTypeError(
-            f"no robot {text!r} in the zoo ({zoo}); or give a description's path"
+            f"no robot {text!r} in the zoo ({names}); or give a description's path"
         )
     return found

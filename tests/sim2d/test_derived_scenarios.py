@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from profiles.deploy_files import DEPLOY
+from profiles.deploy_files import zoo
 from sim2d.scenarios import DECLARED_FOR, DERIVED, NAMES, goal_above, scenario
 from tests.sim2d.test_scenarios import camera, markers, scene
 from wbc import dq
@@ -17,7 +17,7 @@ from wbc.laws.lp_law import LPLaw
 from wbc.robot import MobileManipulator
 from wbc.task import PoseTask, PositionTask
 
-OTHERS = sorted(p for p in (DEPLOY / "robots").glob("*.yaml") if p.stem != DECLARED_FOR)
+OTHERS = [p for p in zoo() if p.stem != DECLARED_FOR]
 """The zoo but Little John, whose set-ups are declared (tests/sim2d/test_scenarios.py)."""
 DT, STEPS = 0.02, 3000
 """The experiments' control period, and a run's 60 s."""
