@@ -47,7 +47,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
 from foxglove import messages as fox
 from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
 
@@ -204,7 +203,7 @@ def state_frames(drawing: RobotDrawing | None, state: RobotState) -> fox.FrameTr
     if drawing is None:
         base = planar_transform("world", "estimate/base", state.base_pose, stamp)
         return fox.FrameTransforms(transforms=[base, end_effector])
-    q = np.array(state.configuration())
+    q = drawing.configuration(state)
     return fox.FrameTransforms(transforms=[*drawing.transforms(q, stamp), end_effector])
 
 
@@ -218,8 +217,8 @@ def truth_frames(drawing: RobotDrawing | None, truth: SimTruth) -> fox.FrameTran
     if drawing is None:
         transforms.append(planar_transform(parent, "truth/base", truth.base_pose, stamp))
     else:
-        q = np.array(truth.configuration())
-        transforms += drawing.transforms(q, stamp)
+        transforms += drawing.transforms(drawing.configuration(truth), stamp)
+
     transforms.append(pose_transform(parent, "truth/end_effector", truth.end_effector, stamp))
     if truth.goal is not None:
         transforms.append(pose_transform(parent, "truth/goal", truth.goal, stamp))

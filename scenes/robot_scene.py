@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from foxglove import messages as fox
@@ -73,6 +74,18 @@ class RobotDrawing:
     def links(self) -> list[str]:
         """Every frame of the robot below its base: link_0 (the base top) to link_n."""
         return [self.frame(f"link_{i}") for i in range(self.robot.arm_dof + 1)]
+
+    def configuration(self, message: Any) -> np.ndarray:
+        """The q of a state or a truth (``configuration()``) of this robot; ``ValueError``
+        naming both when its joints are not the description's (by name, when it names them)."""
+        names = tuple(getattr(message, "joint_names", None) or ())
+        expected = self.robot.joint_names
+        if (names and names != expected) or len(message.arm_joints) != len(expected):
+            found = ", ".join(names) or f"{len(message.arm_joints)} unnamed"
+            raise ValueError(
+                f"its arm joints are {found}; the robot description's are {', '.join(expected)}"
+            )
+        return np.array(message.configuration())
 
     def transforms(self, q: np.ndarray, stamp_ns: int) -> list[fox.FrameTransform]:
         """The base on the floor, then every link in the one before it, at configuration q."""
