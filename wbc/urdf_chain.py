@@ -14,15 +14,20 @@ the path, a missing limit or velocity limit, a value that is not finite.
 
 from __future__ import annotations
 
+import contextlib
 import math
+import sys
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import yourdfpy
 
 from wbc import dq
 from wbc.serial_chain import ChainJoint, RobotDescriptionError, SerialChain, from_joints
+
+if TYPE_CHECKING:
+    import yourdfpy
 
 Array = np.ndarray
 
@@ -40,15 +45,21 @@ class UrdfArm:
 
 
 def load(path: Path) -> yourdfpy.Robot:
-    """The URDF's robot (links and joints, no meshes); ``RobotDescriptionError`` if unreadable."""
+    """The URDF's robot (links and joints, no meshes); ``RobotDescriptionError`` if unreadable.
+    What yourdfpy prints about a file it cannot parse goes to stderr (stdout is for JSON)."""
+    import yourdfpy  # a second of CPU (trimesh, networkx): only for a URDF arm, not every start
+
+    if not path.is_file():
+        raise RobotDescriptionError(f"arm.urdf.file: no file {path}")
     try:
-        urdf = yourdfpy.URDF.load(
-            str(path),
-            build_scene_graph=False,
-            load_meshes=False,
-            build_collision_scene_graph=False,
-            load_collision_meshes=False,
-        )
+        with contextlib.redirect_stdout(sys.stderr):
+            urdf = yourdfpy.URDF.load(
+                str(path),
+                build_scene_graph=False,
+                load_meshes=False,
+                build_collision_scene_graph=False,
+                load_collision_meshes=False,
+            )
     except OSError as error:
         raise RobotDescriptionError(
             f"arm.urdf.file: cannot read {path}: {error.strerror or error}"
