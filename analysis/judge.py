@@ -391,7 +391,7 @@ def commands_digest(session: Session) -> str:
     digest = hashlib.sha256()
     for topic in (BASE_COMMAND, ARM_COMMAND):
         for command in messages(session, topic):
-            values = command.model_dump(exclude={"header"})
+            values = command.model_dump(exclude={"header", "joint_names"})
             digest.update(struct.pack("<q", command.header.stamp_ns))
             digest.update(repr(sorted(values.items())).encode())
     return digest.hexdigest()

@@ -32,12 +32,12 @@ from collections.abc import Collection, Sequence
 
 from dynamixel_sdk import COMM_SUCCESS, GroupSyncWrite, PacketHandler, PortHandler
 
+from components.joint_check import joints_match
 from components.params import Param, ParamError
 from components.process_entry import run_component
 from components.pubsub import Input
 from components.runtime import Component, Node
 from messages import topics
-from messages.base import ARM_JOINTS, JOINT_NAMES
 from messages.commands import ArmCommand
 from messages.joints import JointStates
 from protocols import dynamixel_v1 as dxl
@@ -48,13 +48,14 @@ ERROR_BITS = {int(bit): bit.name.lower() for bit in dxl.StatusError}
 READ_BYTES = 4
 """Present Position and Present Speed, from address 36."""
 HOLD_SPEED = 1
+DEFAULT_IDS = (1, 2, 3, 4, 5)
 """The Moving Speed of a held joint: the slowest there is (0 would mean full speed)."""
 
 
 def check_ids(ids: tuple[int, ...]) -> None:
     """``ParamError`` unless the servo ids are distinct and in 0..253."""
     if len(set(ids)) != len(ids) or not all(0 <= i < 254 for i in ids):
-        raise ParamError(f"ids: expected {ARM_JOINTS} distinct servo ids in 0..253, got {ids}")
+        raise ParamError(f"ids: expected {len(ids)} distinct servo ids in 0..253, got {ids}")
 
 
 class ArmDriver(Component):
@@ -68,8 +69,8 @@ class ArmDriver(Component):
         Param(
             "ids",
             tuple,
-            (1, 2, 3, 4, 5),
-            length=ARM_JOINTS,
+            DEFAULT_IDS,
+            length=len(DEFAULT_IDS),
             integers=True,
             doc="servo ids of q1..q5, [1, 2, 3, 4, 5]",
             can_take=check_ids,
@@ -123,6 +124,10 @@ class ArmDriver(Component):
         ]
         """The Goal Positions inside the joint limits (every goal written lies in them)."""
         self.ids: tuple[int, ...] = node.params["ids"]
+        if len(self.ids) != robot.arm_dof:
+            raise ParamError(f"ids: expected one servo id per joint of {robot.joint_names}")
+        self.names = robot.joint_names
+        joints = robot.arm_dof
         self.port = PortHandler(str(node.params["port"]))
         self.packet = PacketHandler(1.0)
         self.connected = False
@@ -141,9 +146,9 @@ class ArmDriver(Component):
             node.counters[f"servo_faults.{fault}"] = 0
         for name in ERROR_BITS.values():
             node.counters[f"servo_error.{name}"] = 0
-        self.present: list[float | None] = [None] * ARM_JOINTS
+        self.present: list[float | None] = [None] * joints
         """The last good reading of each joint (inside its limits)."""
-        self.held: list[int | None] = [None] * ARM_JOINTS
+        self.held: list[int | None] = [None] * joints
         """The goal a stopped joint holds, units; None while it moves."""
         self.fault = ""
         """Why the arm holds whatever it is told; empty when every servo answers well."""
@@ -217,7 +222,7 @@ class ArmDriver(Component):
             return
         readings, faults = [], {}
         try:
-            for index in range(ARM_JOINTS):
+            for index in range(len(self.ids)):
                 reading = self._reading(index)
                 if isinstance(reading, str):
                     faults[index] = reading
@@ -235,7 +240,7 @@ class ArmDriver(Component):
         self.output.put(
             JointStates(
                 header=self.node.header("arm", None, self.output.next_seq),
-                names=JOINT_NAMES,
+                names=self.names,
                 positions=tuple(p for p, _ in readings),
                 velocities=tuple(v for _, v in readings),
             )
@@ -265,7 +270,7 @@ class ArmDriver(Component):
         self.node.warn("holding", f"every servo answers again (was: {self.fault})")
         self.fault = ""
         self.node.state = "running"
-        self.held = [None] * ARM_JOINTS
+        self.held = [None] * len(self.ids)
         self.hold()
         self._enable_torque()
 
@@ -278,12 +283,17 @@ class ArmDriver(Component):
 
     def on_command(self, command: ArmCommand) -> None:
         """Goals ahead of the present positions at the commanded speeds, in one Sync Write."""
+        if not joints_match(
+            self.node, "refused_commands", "arm/command", command.joint_names, self.names
+        ):
+            self.hold()
+            return
         velocities = command.joint_velocities
-        if len(velocities) != ARM_JOINTS or not all(math.isfinite(v) for v in velocities):
+        if len(velocities) != len(self.ids) or not all(math.isfinite(v) for v in velocities):
             self.node.count("non_finite_commands")
             self.node.warn(
                 "non_finite_commands",
-                f"expected {ARM_JOINTS} finite joint velocities, got {velocities}; holding",
+                f"expected {len(self.ids)} finite joint velocities, got {velocities}; holding",
             )
             self.hold()
             return
@@ -358,8 +368,9 @@ class ArmDriver(Component):
             self.holding = True
             self.node.count("holds")
         self.timeout.cancel()
-        self._read_stopping(range(ARM_JOINTS), failed)
-        self._sync_write([self._held(i) for i in range(ARM_JOINTS)], [HOLD_SPEED] * ARM_JOINTS)
+        joints = range(len(self.ids))
+        self._read_stopping(joints, failed)
+        self._sync_write([self._held(i) for i in joints], [HOLD_SPEED] * len(joints))
 
     def _sync_write(self, goals: Sequence[int], speeds: Sequence[int]) -> None:
         if not self.connected:  # a read on the way found the port gone

@@ -8,7 +8,8 @@ clock, shared by the controller process (``components.controller``) and ``parsim
 with ``dt`` the difference of consecutive state stamps, clamped to [1 ms, 0.2 s] (0.02 s at
 the first step). The step commands zero, and says why (``status``, ``reason``), whenever its
 output cannot be trusted: the state is older than the stale timeout, it is not ``valid``,
-there is no goal (none yet, or the last one was refused), the law raises or returns a status
+its joints are not the robot's (``REFUSED_STATE``), there is no goal (none yet, or the last
+one was refused), the law raises or returns a status
 other than ``optimal``, or a command would not be finite.
 """
 
@@ -22,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from messages.base import ARM_JOINTS
+from components.joint_check import mismatch
 from messages.goal import Goal
 from messages.state import RobotState
 from wbc.base_motion import unicycle, wheel_speeds
@@ -40,6 +41,8 @@ DT_MIN_S, DT_MAX_S = 1e-3, 0.2
 GOAL_OVERRIDES = ("eta", "beta")
 """The gains a goal may set while it holds."""
 ZERO_WHEELS = (0.0, 0.0, 0.0, 0.0)
+REFUSED_STATE = "refused state"
+"""The status of a step on a state whose joints are not the robot's (zero sent)."""
 
 
 def task_of(goal: Goal) -> Task:
@@ -67,8 +70,16 @@ class Step:
     output: LawOutput | None = None
 
     @classmethod
-    def zero(cls, stamp_ns: int, status: str, reason: str, output: LawOutput | None = None) -> Step:
-        return cls(stamp_ns, ZERO_WHEELS, (0.0,) * ARM_JOINTS, status, reason, output)
+    def zero(
+        cls,
+        stamp_ns: int,
+        arm_dof: int,
+        status: str,
+        reason: str,
+        output: LawOutput | None = None,
+    ) -> Step:
+        """Zero commands to the base and to the ``arm_dof`` joints, and why."""
+        return cls(stamp_ns, ZERO_WHEELS, (0.0,) * arm_dof, status, reason, output)
 
 
 class ControlStep:
@@ -139,7 +150,13 @@ class ControlStep:
         """Zero commands stamped ``stamp_ns``, for ``status`` and ``reason``, sent without a
         step (no state, a stopped clock, a bad parameter); the law is told (``Law.stopped``)."""
         self.law.stopped()
-        return Step.zero(stamp_ns, status, reason)
+        return self._halt(stamp_ns, status, reason)
+
+    def _halt(
+        self, stamp_ns: int, status: str, reason: str, output: LawOutput | None = None
+    ) -> Step:
+        """Zero commands to the base and to every joint of the robot, and why."""
+        return Step.zero(stamp_ns, self.robot.arm_dof, status, reason, output)
 
     def _commands(self, state: RobotState, now_ns: int, stale_timeout_s: float) -> Step:
         stamp = state.header.stamp_ns
@@ -147,17 +164,20 @@ class ControlStep:
         self.last_stamp_ns = stamp
         age_s = (now_ns - stamp) / 1e9
         if age_s > stale_timeout_s:
-            return Step.zero(
+            return self._halt(
                 stamp, "stale", f"robot/state is {age_s:.2f} s old (timeout {stale_timeout_s} s)"
             )
+        why = mismatch(state.joint_names, self.robot.joint_names)
+        if why:
+            return self._halt(stamp, REFUSED_STATE, f"robot/state refused: it has {why}")
         if not state.valid:
-            return Step.zero(
+            return self._halt(
                 stamp, "invalid state", "robot/state is not valid (the estimator has no fix)"
             )
         if self.task is None and self.refusal:
-            return Step.zero(stamp, "goal refused", self.refusal)
+            return self._halt(stamp, "goal refused", self.refusal)
         if self.task is None:
-            return Step.zero(stamp, "no goal", "no control/goal received yet")
+            return self._halt(stamp, "no goal", "no control/goal received yet")
         try:
             output = self.law.step(
                 np.array(state.configuration()),
@@ -166,18 +186,20 @@ class ControlStep:
                 self.obstacles,
             )
         except Exception as error:  # noqa: BLE001 - any failure of the law holds the robot
-            return Step.zero(stamp, "error", f"the {self.name} law raised: {error}")
+            return self._halt(stamp, "error", f"the {self.name} law raised: {error}")
         if not output.ok:
-            return Step.zero(
+            return self._halt(
                 stamp, output.status, f"the {self.name} law returned {output.status}", output
             )
         u = output.u
-        if u.shape != (3 + ARM_JOINTS,):
-            return Step.zero(
-                stamp, "error", f"u has shape {u.shape}; the arm command takes {ARM_JOINTS} joints"
+        if u.shape != (3 + self.robot.arm_dof,):
+            return self._halt(
+                stamp,
+                "error",
+                f"u has shape {u.shape}; the arm command takes {self.robot.arm_dof} joints",
             )
         if not np.all(np.isfinite(u)):  # before any conversion, which would raise
-            return Step.zero(
+            return self._halt(
                 stamp,
                 "non-finite",
                 f"the {self.name} law reported optimal with a non-finite u {u} (a law error)",
@@ -187,7 +209,7 @@ class ControlStep:
             base = wheel_speeds(*speeds, self.robot.base)
             wheels = (base.forward, base.angular, base.left_wheel, base.right_wheel)
         if not all(math.isfinite(w) for w in wheels):
-            return Step.zero(
+            return self._halt(
                 stamp, "non-finite", f"the {self.name} law's u {u} gives non-finite base speeds"
             )
         return Step(stamp, wheels, tuple(u[3:].tolist()), "optimal", "", output)

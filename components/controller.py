@@ -8,7 +8,9 @@ control step (``components.control_step``, the same step ``parsimony rerun`` run
 The controller commands zero, and says why in the diagnostics' ``status`` and ``reason``,
 whenever it cannot trust its output (``ControlStep.step``), and also while states stop
 arriving (a 10 Hz timer checks); a law that raises is counted as ``law_errors``, a command
-that would not be finite as ``non_finite_commands``, a goal it refuses as ``refused_goals``.
+that would not be finite as ``non_finite_commands``, a goal it refuses as ``refused_goals``,
+a state whose joints are not the robot description's as ``refused_states`` (the names
+expected logged).
 
 Commands and diagnostics carry the stamp of the state they answer, so their age on
 arrival measures the whole loop; zeros sent by the timer carry the current time.
@@ -27,6 +29,7 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from components.control_step import (
+    REFUSED_STATE,
     ControlStep,
     Step,
     gain_values,
@@ -50,6 +53,12 @@ from wbc.task import PoseTask, PositionTask, Task
 
 STALE_CHECK_PERIOD_S = 0.1
 """How often the controller checks that states still arrive."""
+STEP_COUNTERS = {
+    "error": "law_errors",
+    "non-finite": "non_finite_commands",
+    REFUSED_STATE: "refused_states",
+}
+"""The counter of each step status that is counted and logged (zero sent)."""
 
 
 def robot_loads(path: object) -> None:
@@ -124,6 +133,7 @@ class Controller(Component):
         node.counters["law_errors"] = 0
         node.counters["refused_goals"] = 0
         node.counters["refused_obstacles"] = 0
+        node.counters["refused_states"] = 0
         self.state_input = node.subscribe(topics.ROBOT_STATE, self.on_state)
         node.subscribe(topics.CONTROL_GOAL, self.on_goal)
         node.subscribe(topics.WORLD_OBSTACLES, self.on_obstacles)
@@ -172,7 +182,7 @@ class Controller(Component):
         step = self.stepper.step(
             state, self.node.clock.now_ns(), self.node.params["stale_timeout_s"]
         )
-        counter = {"error": "law_errors", "non-finite": "non_finite_commands"}.get(step.status)
+        counter = STEP_COUNTERS.get(step.status)
         if counter is not None:
             self.node.count(counter)
             self.node.warn(counter, f"{step.reason}; zero sent")
@@ -229,6 +239,7 @@ class Controller(Component):
             ArmCommand(
                 header=self.node.header("arm", step.stamp_ns, arm.next_seq),
                 joint_velocities=step.joints,
+                joint_names=self.robot.joint_names,
             )
         )
         self.diagnostics.put(

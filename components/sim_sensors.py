@@ -5,7 +5,6 @@ truth (tests and reports only)."""
 
 from __future__ import annotations
 
-from messages.base import JOINT_NAMES
 from messages.header import Header
 from messages.joints import JointStates
 from messages.obstacles import Circle, Solids
@@ -40,7 +39,7 @@ class SimSensors:
     def joints(self, header: Header) -> JointStates:
         return JointStates(
             header=header,
-            names=JOINT_NAMES,
+            names=self.world.robot.joint_names,
             positions=tuple(self.world.q[3:].tolist()),
             velocities=tuple(self.world.joint_velocities.tolist()),
         )

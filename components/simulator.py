@@ -40,6 +40,7 @@ import time
 
 import numpy as np
 
+from components.joint_check import joints_match
 from components.lockstep_gate import COMMANDS, FRAME_ANSWERS, Awaited, LockstepGate
 from components.params import Param, ParamError
 from components.process_entry import run_component
@@ -48,7 +49,6 @@ from components.runtime import Component, Node
 from components.sim_camera import FrameFormat, SimCamera
 from components.sim_sensors import SimSensors
 from messages import topics
-from messages.base import ARM_JOINTS
 from messages.clock import Clock
 from messages.commands import ArmCommand, BaseCommand
 from messages.obstacles import Circle as TruthCircle
@@ -223,6 +223,7 @@ class Simulator(Component):
         node.counters["frames_skipped"] = 0
         node.counters["contacts"] = 0
         node.counters["arm_penetrations"] = 0
+        node.counters["refused_arm_commands"] = 0
         for topic in self.reads:
             node.subscribe(topic.topic, self._answer_handler(topic.topic.name))
         self.base_command = self.arm_command = None
@@ -348,10 +349,20 @@ class Simulator(Component):
     # -- commands in, sensors out ---------------------------------------------------------
 
     def _take_command(self, name: str, message: BaseCommand | ArmCommand) -> None:
+        """Hold a command until the next; an arm command whose joints are not the robot's is
+        refused (``refused_arm_commands``): the last one holds, until its timeout."""
         if name == COMMANDS[0]:
             self.base_command = message
-        else:
+        elif joints_match(
+            self.node,
+            "refused_arm_commands",
+            "arm/command",
+            message.joint_names,
+            self.robot.joint_names,
+        ):
             self.arm_command = message
+        else:
+            return
         self.last_command_ns = self.now_ns
 
     def _apply_commands(self) -> None:
@@ -361,7 +372,7 @@ class Simulator(Component):
             return
         base, arm = self.base_command, self.arm_command
         left, right = (base.left_wheel, base.right_wheel) if base else (0.0, 0.0)
-        joints = arm.joint_velocities if arm else (0.0,) * ARM_JOINTS
+        joints = arm.joint_velocities if arm else (0.0,) * self.robot.arm_dof
         self.world.command(left, right, joints)
 
     def _header(self, frame: str, topic: topics.Topic):

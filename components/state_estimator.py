@@ -36,12 +36,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from components.joint_check import joints_match
 from components.params import Param, ParamError
 from components.process_entry import run_component
 from components.pubsub import Input
 from components.runtime import Component, Node
 from messages import topics
-from messages.base import ARM_JOINTS, IDENTITY_POSE
+from messages.base import IDENTITY_POSE
 from messages.goal import Goal
 from messages.joints import JointStates
 from messages.markers import MarkerDetection, MarkerDetections
@@ -145,6 +146,7 @@ class StateEstimator(Component):
             "duplicates",
             "degraded_states",
             "joints_behind",
+            "refused_joint_states",
         ):
             node.counters[name] = 0
         node.subscribe(topics.VISION_MARKERS, self.on_markers)
@@ -267,8 +269,13 @@ class StateEstimator(Component):
     # -- odometry and joints ---------------------------------------------------------------
 
     def on_joints(self, message: JointStates) -> None:
-        if len(message.positions) != ARM_JOINTS:
-            raise ValueError(f"expected {ARM_JOINTS} joints, got {len(message.positions)}")
+        """Keep the newest joints; joints that are not the robot's are refused
+        (``refused_joint_states``)."""
+        names = self.robot.joint_names
+        if not joints_match(
+            self.node, "refused_joint_states", "arm/joint_states", message.names, names
+        ):
+            return
         self.joints = tuple(message.positions)
         self.joints_ns = message.header.stamp_ns
 
@@ -294,7 +301,7 @@ class StateEstimator(Component):
         if degraded:
             self.node.count("degraded_states")
         base = pose if pose is not None else (0.0, 0.0, 0.0)
-        joints = self.joints if self.joints is not None else (0.0,) * ARM_JOINTS
+        joints = self.joints if self.joints is not None else (0.0,) * self.robot.arm_dof
         q = np.array([*base, *joints])
         end_effector = tuple(self.robot.fkm(q).tolist()) if valid else IDENTITY_POSE
         self.state.put(
@@ -302,6 +309,7 @@ class StateEstimator(Component):
                 header=self.node.header(WORLD_FRAME, stamp_ns, self.state.next_seq),
                 base_pose=base,
                 arm_joints=joints,
+                joint_names=self.robot.joint_names,
                 end_effector=end_effector,
                 valid=valid,
                 age_s=max(age_s, 0.0),

@@ -6,7 +6,7 @@ Typical use in a component::
     state = decode(sample.payload.to_bytes(), RobotState, str(sample.key_expr))
 """
 
-from messages.base import ARM_JOINTS, IDENTITY_POSE, Message
+from messages.base import IDENTITY_POSE, Message
 from messages.camera import CHANNELS, CameraFrame, CameraIntrinsics
 from messages.clock import Clock
 from messages.codec import FORMAT_TAG, FORMAT_VERSION, DecodeError, decode, encode
@@ -54,7 +54,6 @@ from messages.topics import (
 
 __all__ = [
     "ARM_COMMAND",
-    "ARM_JOINTS",
     "ARM_JOINT_STATES",
     "BASE_COMMAND",
     "BASE_ODOMETRY",

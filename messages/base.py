@@ -3,13 +3,14 @@
 Every float on the wire is finite: NaN and +-inf are rejected at validation, so
 a controller never has to ask whether its input is a number. Fixed-size vectors
 are tuples of that length, so a model is immutable all the way down (dicts
-excepted). Units are SI, angles are radians.
+excepted). Units are SI, angles are radians. The arm's joints are as many as its
+robot description names: no joint count is fixed here.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Annotated
+from typing import Annotated, Any
 
 from pydantic import AfterValidator, AllowInfNan, BaseModel, ConfigDict, Field
 
@@ -18,12 +19,6 @@ UINT64_MAX = 2**64 - 1
 
 UNIT_TOLERANCE = 1e-6
 """How far a unit dual quaternion may stray from ``x * conj(x) == 1``."""
-
-ARM_JOINTS = 5
-"""Number of joints of the arm; joint vectors have exactly this length."""
-
-JOINT_NAMES = tuple(f"q{i}" for i in range(1, ARM_JOINTS + 1))
-"""The arm's joint names in joint-state messages, q1 at the waist."""
 
 Finite = Annotated[float, AllowInfNan(False)]
 """Any finite float."""
@@ -40,8 +35,32 @@ Count = Annotated[int, Field(ge=0, le=UINT64_MAX)]
 Vector3 = tuple[Finite, Finite, Finite]
 """A point or vector in R^3, metres unless a field says otherwise."""
 
-ArmVector = tuple[Finite, Finite, Finite, Finite, Finite]
-"""One value per arm joint, ``ARM_JOINTS`` long (rad or rad/s)."""
+ArmVector = Annotated[tuple[Finite, ...], Field(min_length=1)]
+"""One value per arm joint, as many as the robot has (rad or m, rad/s or m/s)."""
+
+
+def default_joint_names(count: int) -> tuple[str, ...]:
+    """``q1 .. q<count>``: the names of a DH table's joints when it names none, and of a
+    message's joints when its sender named none (recordings made before messages named them)."""
+    return tuple(f"q{i}" for i in range(1, count + 1))
+
+
+def check_joint_names(names: tuple[str, ...], values: tuple[float, ...], field: str) -> None:
+    """Refuse ``names`` unless they are unique and as many as ``values`` (``field``'s)."""
+    if len(names) != len(values):
+        raise ValueError(f"joint_names has {len(names)} names, {field} {len(values)} values")
+    if len(set(names)) != len(names):
+        raise ValueError(f"joint_names {names} are not unique")
+
+
+def with_default_joint_names(data: Any, field: str) -> Any:
+    """``data`` (a model's input) with ``joint_names`` filled in as ``default_joint_names``
+    of ``field``'s length when it has none."""
+    if isinstance(data, dict) and "joint_names" not in data:
+        values = data.get(field)
+        if isinstance(values, (tuple, list)):
+            return {**data, "joint_names": default_joint_names(len(values))}
+    return data
 
 
 def _check_unit(dq: tuple[float, ...]) -> tuple[float, ...]:

@@ -2,7 +2,17 @@
 
 from __future__ import annotations
 
-from messages.base import ArmVector, Finite, Message
+from typing import Any
+
+from pydantic import model_validator
+
+from messages.base import (
+    ArmVector,
+    Finite,
+    Message,
+    check_joint_names,
+    with_default_joint_names,
+)
 from messages.header import Header
 
 
@@ -18,7 +28,20 @@ class BaseCommand(Message):
 
 
 class ArmCommand(Message):
-    """Arm joint velocities, rad/s, one per joint."""
+    """Arm joint velocities, rad/s (m/s for a prismatic joint), one per joint, named by
+    ``joint_names`` as the robot's description names them (index-aligned; ``q1 .. qn`` when
+    the sender named none)."""
 
     header: Header
     joint_velocities: ArmVector
+    joint_names: tuple[str, ...]
+
+    @model_validator(mode="before")
+    @classmethod
+    def _default_names(cls, data: Any) -> Any:
+        return with_default_joint_names(data, "joint_velocities")
+
+    @model_validator(mode="after")
+    def _names_aligned(self) -> ArmCommand:
+        check_joint_names(self.joint_names, self.joint_velocities, "joint_velocities")
+        return self

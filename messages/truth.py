@@ -36,5 +36,5 @@ class SimTruth(Message):
     arm_penetrating: bool = False
 
     def configuration(self) -> list[float]:
-        """The true whole-body configuration ``q = [x, y, phi, q1, ..., q5]``."""
+        """The true whole-body configuration ``q = [x, y, phi, q1, ..., qn]``."""
         return [*self.base_pose, *self.arm_joints]

@@ -51,7 +51,7 @@ from pydantic import BaseModel
 from analysis.report import write_report
 from launch import query
 from messages import codec, topics
-from messages.base import JOINT_NAMES
+from messages.base import default_joint_names
 from messages.camera import CameraFrame, CameraIntrinsics
 from messages.header import Header
 from messages.joints import JointStates
@@ -145,7 +145,7 @@ def small_message(topic: topics.Topic, seq: int) -> BaseModel:
     if topic is topics.ARM_JOINT_STATES:
         return JointStates(
             header=header,
-            names=JOINT_NAMES,
+            names=default_joint_names(5),
             positions=(0.1, 0.2, 0.3, 0.4, 0.5),
             velocities=(0.0, 0.01, 0.02, 0.03, 0.04),
         )

@@ -16,7 +16,6 @@ import pytest
 import yaml
 
 from messages import codec, topics
-from messages.base import ARM_JOINTS
 from messages.clock import Clock
 from messages.commands import ArmCommand, BaseCommand
 from messages.header import Header
@@ -113,7 +112,7 @@ class Controller:
             left_wheel=left,
             right_wheel=right,
         )
-        arm = ArmCommand(header=header, joint_velocities=(0.0,) * ARM_JOINTS)
+        arm = ArmCommand(header=header, joint_velocities=(0.0,) * 5)  # Little John
         with self._lock:
             self.answered_ns = stamp
         self.base.put(codec.encode(base))

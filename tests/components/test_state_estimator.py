@@ -16,7 +16,7 @@ import pytest
 import yaml
 
 from messages import codec, topics
-from messages.base import ARM_JOINTS, JOINT_NAMES
+from messages.base import default_joint_names
 from messages.clock import Clock
 from messages.header import Header
 from messages.joints import JointStates
@@ -92,8 +92,8 @@ class Sensors:
             self.markers.put(codec.encode(self.frame()))
         if not odometry:
             return None
-        names = JOINT_NAMES
-        zeros = (0.0,) * ARM_JOINTS
+        names = default_joint_names(5)  # Little John's
+        zeros = (0.0,) * len(names)
         joints = JointStates(
             header=self.header("arm"), names=names, positions=zeros, velocities=zeros
         )

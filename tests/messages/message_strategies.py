@@ -102,6 +102,35 @@ def joint_states(draw: st.DrawFn) -> JointStates:
     )
 
 
+@st.composite
+def arm_joints(draw: st.DrawFn) -> dict[str, tuple]:
+    """One to fourteen uniquely named joints and a value each: ``joint_names`` and ``values``."""
+    joint_names = tuple(draw(st.lists(names, unique=True, min_size=1, max_size=14)))
+    return {"joint_names": joint_names, "values": draw(vectors(len(joint_names)))}
+
+
+@st.composite
+def robot_states(draw: st.DrawFn) -> RobotState:
+    joints = draw(arm_joints())
+    return RobotState(
+        header=draw(headers),
+        base_pose=draw(vectors(3)),
+        arm_joints=joints["values"],
+        joint_names=joints["joint_names"],
+        end_effector=draw(unit_dual_quaternions()),
+        valid=draw(st.booleans()),
+        age_s=draw(non_negative),
+    )
+
+
+@st.composite
+def arm_commands(draw: st.DrawFn) -> ArmCommand:
+    joints = draw(arm_joints())
+    return ArmCommand(
+        header=draw(headers), joint_velocities=joints["values"], joint_names=joints["joint_names"]
+    )
+
+
 def goals() -> st.SearchStrategy[Goal]:
     gain = st.none() | positive
     pose_goals = st.builds(
@@ -149,15 +178,7 @@ MESSAGES: dict[type[Message], st.SearchStrategy[Message]] = {
         angular_velocity=finite,
     ),
     JointStates: joint_states(),
-    RobotState: st.builds(
-        RobotState,
-        header=headers,
-        base_pose=vectors(3),
-        arm_joints=vectors(5),
-        end_effector=unit_dual_quaternions(),
-        valid=st.booleans(),
-        age_s=non_negative,
-    ),
+    RobotState: robot_states(),
     Obstacles: st.builds(
         Obstacles,
         header=headers,
@@ -174,7 +195,7 @@ MESSAGES: dict[type[Message], st.SearchStrategy[Message]] = {
         left_wheel=finite,
         right_wheel=finite,
     ),
-    ArmCommand: st.builds(ArmCommand, header=headers, joint_velocities=vectors(5)),
+    ArmCommand: arm_commands(),
     ControllerDiagnostics: st.builds(
         ControllerDiagnostics,
         header=headers,

@@ -15,6 +15,7 @@ from pydantic import ValidationError
 from messages import (
     IDENTITY_POSE,
     MESSAGE_TYPES,
+    ArmCommand,
     CameraFrame,
     Circle,
     Goal,
@@ -92,10 +93,45 @@ def test_configuration_is_base_pose_then_arm_joints() -> None:
     assert STATE.configuration() == [1.0, 2.0, 0.3, 0.1, -0.2, 0.3, -0.4, 0.5]
 
 
-@pytest.mark.parametrize("length", [4, 6])
-def test_arm_joints_are_exactly_five(length: int) -> None:
-    with pytest.raises(ValidationError, match="arm_joints"):
-        RobotState.model_validate(STATE.model_dump() | {"arm_joints": [0.0] * length})
+@pytest.mark.parametrize("length", [1, 4, 7, 12])
+def test_arm_joints_are_as_many_as_the_robot_names(length: int) -> None:
+    names = tuple(f"joint_{i}" for i in range(length))
+    state = RobotState.model_validate(
+        STATE.model_dump() | {"arm_joints": [0.0] * length, "joint_names": names}
+    )
+    assert state.joint_names == names and len(state.configuration()) == 3 + length
+    command = ArmCommand(header=HEADER, joint_velocities=(0.1,) * length, joint_names=names)
+    assert command.joint_names == names
+
+
+def test_joints_named_by_no_one_are_q1_to_qn() -> None:
+    """A sender (or a recording) that names no joint: a DH table's default names."""
+    fields = STATE.model_dump()
+    del fields["joint_names"]
+    assert RobotState.model_validate(fields | {"arm_joints": [0.0] * 3}).joint_names == (
+        "q1",
+        "q2",
+        "q3",
+    )
+    assert ArmCommand(header=HEADER, joint_velocities=(0.0, 0.0)).joint_names == ("q1", "q2")
+
+
+@pytest.mark.parametrize(
+    ("fields", "complaint"),
+    [
+        ({"arm_joints": []}, "at least 1 item"),
+        ({"joint_names": ("q1", "q2")}, "2 names, arm_joints 5 values"),
+        ({"joint_names": ("a", "b", "c", "d", "a")}, "not unique"),
+    ],
+)
+def test_joint_names_line_up_with_the_joints(fields: dict[str, Any], complaint: str) -> None:
+    with pytest.raises(ValidationError, match=complaint):
+        RobotState.model_validate(STATE.model_dump() | fields)
+    command = {"joint_velocities": fields.get("arm_joints", (0.0,) * 5)}
+    with pytest.raises(ValidationError, match=complaint.replace("arm_joints", "joint_velocities")):
+        ArmCommand(
+            header=HEADER, **command, **{k: v for k, v in fields.items() if k != "arm_joints"}
+        )
 
 
 @given(pose=unit_dual_quaternions())

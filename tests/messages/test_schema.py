@@ -57,7 +57,9 @@ def test_cli_writes_valid_json_files(
     files = sorted(tmp_path.glob("*.json"))
     assert len(files) == len(MESSAGE_TYPES) + 1
     documents = {path.name: json.loads(path.read_text()) for path in files}
-    assert documents["RobotState.json"]["properties"]["arm_joints"]["maxItems"] == 5
+    state = documents["RobotState.json"]["properties"]
+    assert state["arm_joints"]["minItems"] == 1 and "maxItems" not in state["arm_joints"]
+    assert state["joint_names"]["type"] == "array"  # no joint count fixed: the robot's names
     assert documents["index.json"]["topics"]["robot/state"] == "RobotState"
     assert sorted(capsys.readouterr().out.split()) == [str(path) for path in files]
 
