@@ -176,3 +176,8 @@ def robot_state(seq: int = 3) -> RobotState:
         valid=True,
         age_s=0.01,
     )
+
+
+def same_pose(a: np.ndarray, b: np.ndarray) -> bool:
+    """The same pose (a unit dual quaternion and its negation are one)."""
+    return bool(np.allclose(a, b, atol=1e-12) or np.allclose(a, -b, atol=1e-12))
