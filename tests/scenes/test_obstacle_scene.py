@@ -14,19 +14,15 @@ import pytest
 
 from messages import topics
 from messages.obstacles import Circle, Cylinder, Obstacles, Plane, Solids
-from messages.truth import SimTruth
 from scenes.foxglove_views import (
     CHANNEL_SUFFIX,
     MODEL_EVERY,
-    PENETRATIONS_SUFFIX,
     SOLIDS_SUFFIX,
-    View,
     Viewer,
 )
 from scenes.obstacle_scene import CIRCLE_HEIGHT_M, UNBOUNDED_HEIGHT_M
-from tests.scenes.views_read import HEADER, ROBOT, decode, vector
+from tests.scenes.views_read import HEADER, ROBOT, decode, vector, views
 from wbc import dq
-from wbc.collision_model import point_positions
 from wbc.geometry import scenarios
 
 KEY = "sim/world/obstacles"
@@ -43,10 +39,6 @@ WALL = Plane(name="wall", normal=(-0.6, -0.8, 0.0), offset=-1.5)
 POLE = Cylinder(name="pole", x=0.2, y=-0.3, radius=0.05, height=0.6)
 MAST = Cylinder(name="mast", x=-0.5, y=0.5, radius=0.04)
 """A pole with no top."""
-
-
-def views(viewer: Viewer, key: str, topic: topics.Topic, message: Any) -> dict[str, View]:
-    return {view.channel_suffix: view for view in viewer(topic.name, key, message)}
 
 
 def obstacles(
@@ -209,57 +201,4 @@ def test_the_solids_go_when_they_change_and_every_model_every_messages() -> None
     # Another key has its own.
     assert SOLIDS_SUFFIX in views(
         viewer, "lab/world/obstacles", topics.WORLD_OBSTACLES, obstacles(6, planes=(TABLE, WALL))
-    )
-
-
-def truth(q: np.ndarray, solids: Solids, penetrating: bool, seq: int) -> SimTruth:
-    return SimTruth(
-        header=HEADER.model_copy(update={"seq": seq}),
-        base_pose=tuple(q[:3]),
-        arm_joints=tuple(q[3:]),
-        end_effector=tuple(ROBOT.fkm(q)),
-        contacts=0,
-        in_contact=False,
-        solids=solids,
-        arm_penetrating=penetrating,
-    )
-
-
-def test_a_part_inside_a_solid_is_drawn_red_where_it_truly_is() -> None:
-    q = np.array([0.7, -0.4, 0.5, 0.2, -0.6, 0.2, -1.0, 0.4])
-    names = ROBOT.collision.names
-    parts = point_positions(ROBOT.frames(q), ROBOT.collision)
-    gripper = parts[names.index("gripper")]
-    # A table top 5 cm over the gripper, a 10 cm square round it: the gripper is inside.
-    x, y = gripper[:2]
-    table = Plane(
-        name="low table",
-        normal=(0.0, 0.0, 1.0),
-        offset=float(gripper[2]) + 0.05,
-        footprint=(
-            (x - 0.05, y - 0.05),
-            (x + 0.05, y - 0.05),
-            (x + 0.05, y + 0.05),
-            (x - 0.05, y + 0.05),
-        ),
-    )
-    viewer = Viewer(ROBOT)
-    drawn = views(viewer, TRUTH_KEY, topics.SIM_TRUTH, truth(q, Solids(planes=(table,)), True, 1))
-    update = decode(drawn[PENETRATIONS_SUFFIX])
-    assert [d.get("type") for d in update["deletions"]] == [1]
-    (entity,) = update["entities"]
-    assert entity["frame_id"] == "truth/world"  # the simulator's world, where the truth stands
-    inside = entity["metadata"][0]["value"].split(", ")
-    assert "gripper" in inside and "base" not in inside
-    centres = [vector(s["pose"]["position"], "xyz") for s in entity["spheres"]]
-    assert any(np.allclose(c, gripper) for c in centres)
-    colours = {
-        tuple(vector(s["color"], "rgba")) for s in [*entity["spheres"], *entity.get("lines", [])]
-    }
-    assert colours == {(1.0, 0.0, 0.0, 1.0)}  # red
-    # Out of it: one empty scene, then nothing until a part goes in again.
-    clear = views(viewer, TRUTH_KEY, topics.SIM_TRUTH, truth(q, Solids(), False, 2))
-    assert "entities" not in decode(clear[PENETRATIONS_SUFFIX])
-    assert PENETRATIONS_SUFFIX not in views(
-        viewer, TRUTH_KEY, topics.SIM_TRUTH, truth(q, Solids(), False, 3)
     )

@@ -10,10 +10,11 @@ from typing import Any
 
 import numpy as np
 
+from messages import topics
 from messages.header import Header
 from messages.state import RobotState
 from profiles.deploy_files import ROBOT_FILE
-from scenes.foxglove_views import View
+from scenes.foxglove_views import View, Viewer
 from wbc import dq
 from wbc.robot import MobileManipulator
 
@@ -181,3 +182,8 @@ def robot_state(seq: int = 3) -> RobotState:
 def same_pose(a: np.ndarray, b: np.ndarray) -> bool:
     """The same pose (a unit dual quaternion and its negation are one)."""
     return bool(np.allclose(a, b, atol=1e-12) or np.allclose(a, -b, atol=1e-12))
+
+
+def views(viewer: Viewer, key: str, topic: topics.Topic, message: Any) -> dict[str, View]:
+    """The views ``viewer`` makes of ``message``, by channel suffix."""
+    return {view.channel_suffix: view for view in viewer(topic.name, key, message)}
