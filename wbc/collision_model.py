@@ -5,8 +5,9 @@ A robot description may declare (``collision`` in deploy/robots/little_john.yaml
     points:   {name, frame, offset [x, y, z] in the frame (default 0), radius}
     segments: {name, frame, axis (x, y or z of the frame), start, end (two point names), radius}
 
-``frame`` i is the i-th pose of ``MobileManipulator.frames``: 0 the base top x_2^0, i the DH
-frame after arm link i. A point is a sphere of ``radius`` round p = translation(x_i (1 + eps
+``frame`` i is the i-th pose of ``MobileManipulator.frames``: 0 the base top x_2^0, i the frame
+after arm link i (a DH table's frame i; a URDF chain's child link of its i-th movable joint, the
+last its tip link). A point is a sphere of ``radius`` round p = translation(x_i (1 + eps
 offset / 2)); a segment is the capsule of ``radius`` round the part of the frame's axis line
 l_ = l + eps p x l between its two points, which must lie on that line in every
 configuration (checked when the robot is built). ``wbc.geometry.robot_primitives`` gives their

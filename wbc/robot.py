@@ -56,7 +56,7 @@ BASE_DOF = 3
 class Chain:
     """One pass of the forward kinematics at q: the end effector's pose x = x_3^0 (4.6), its
     Jacobian J = H-(x) T (4.9) and the twists T (8, dof) of ``MobileManipulator.kinematics``;
-    and, when first read, the poses x_i (n + 1, 8) of the base top and of every DH frame (the
+    and, when first read, the poses x_i (n + 1, 8) of the base top and of every arm frame (the
     last is x) and their Jacobians. Frame i moves with the base and joints 1..i: J_i = H-(x_i) T
     with the columns of joints i + 1..n zero (``columns``). A plain class with slots and the
     frames' arrays built when read: the LP step builds one whether any row reads the frames or
@@ -268,7 +268,7 @@ class MobileManipulator:
         return chain.poses, chain.frame_jacobians
 
     def frames(self, q: Array) -> list[Array]:
-        """Poses of the base top x_2^0 and of every DH frame after it; the last is x_3^0."""
+        """Poses of the base top x_2^0 and of every arm frame after it; the last is x_3^0."""
         q = self._check(q)
         poses = [self.base_pose(q)]
         for link in self._arm_link_operators(q[BASE_DOF:]):
@@ -277,8 +277,9 @@ class MobileManipulator:
 
     def link_transforms(self, q: Array) -> list[Array]:
         """Each frame of ``frames(q)`` in the one before it, the first in the base frame x_1^0:
-        the base top x_2^1 (4.2), then every DH link x_i^{i-1} = r_z(q_i) r_theta p_d p_a
-        r_alpha (4.4). After the planar base pose (4.1) their product is ``frames(q)``."""
+        the base top x_2^1 (4.2), then every arm link x_i^{i-1} (4.4; for a DH link r_z(q_i)
+        r_theta p_d p_a r_alpha). After the planar base pose (4.1) their product is
+        ``frames(q)``."""
         q = self._check(q)
         top = dq.pose(dq.ONE[:4], [0.0, 0.0, self.base.height])
         return [top, *(link[:, 0].copy() for link in self._arm_link_operators(q[BASE_DOF:]))]
@@ -286,7 +287,9 @@ class MobileManipulator:
     def link_outline(self, link: int) -> Array:
         """The arm link ``link`` (1 to arm_dof) as three points (3, 3) in its own frame i, m,
         fixed there whatever q_i: for a DH link the origin of frame i-1, the point d along
-        z_{i-1} from it and the origin of frame i (``wbc.serial_chain``)."""
+        z_{i-1} from it and the origin of frame i; for a URDF link the foot of frame i-1's
+        origin on the joint's axis, the joint's origin and frame i's (``wbc.serial_chain``; a
+        prismatic link is drawn as at q_i = 0)."""
         return self.chain.outlines[link - 1].copy()
 
     def fkm(self, q: Array) -> Array:
@@ -303,7 +306,7 @@ class MobileManipulator:
         return translation_jacobian(pose, jacobian)
 
     def link_points(self, q: Array) -> Array:
-        """World positions (n + 1, 3) of the base top and every DH frame origin."""
+        """World positions (n + 1, 3) of the base top and every arm frame's origin."""
         return np.array([dq.translation(pose)[1:] for pose in self.frames(q)])
 
 

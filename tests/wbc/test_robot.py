@@ -433,3 +433,13 @@ def test_each_link_in_the_one_before_composes_into_the_frames(robot: MobileManip
             rotation = dq.rotation_matrix(dq.rotation(frames[i]))
             start = rotation @ robot.link_outline(i)[0] + dq.translation(frames[i])[1:]
             assert np.allclose(start, dq.translation(frames[i - 1])[1:], atol=ORACLE_TOL)
+
+
+def test_other_velocity_bounds_keep_the_description(robot: MobileManipulator) -> None:
+    """Section 6.3's unbounded robot is the same chain, joints and base kind."""
+    free = robot.with_velocity_max(np.full(robot.dof, 9.0))
+    assert (free.joint_names, free.joint_types) == (robot.joint_names, robot.joint_types)
+    assert free.base.kind == robot.base.kind == "differential" and free.chain is robot.chain
+    np.testing.assert_array_equal(free.velocity_max, 9.0)
+    q = random_configurations(robot, 1, seed=13)[0]
+    np.testing.assert_array_equal(free.kinematics(q)[1], robot.kinematics(q)[1])
