@@ -387,11 +387,12 @@ def effort_of_inputs(stamps_ns: Array, u: Array) -> dict[str, float] | None:
 
 def commands_digest(session: Session) -> str:
     """SHA-256 of every command's stamp and values in stamp order: two runs that sent the same
-    commands have the same digest."""
+    commands have the same digest (a field at its default, such as a differential base's
+    ``lateral_velocity`` 0, is left out: the digests of older runs hold)."""
     digest = hashlib.sha256()
     for topic in (BASE_COMMAND, ARM_COMMAND):
         for command in messages(session, topic):
-            values = command.model_dump(exclude={"header", "joint_names"})
+            values = command.model_dump(exclude={"header", "joint_names"}, exclude_defaults=True)
             digest.update(struct.pack("<q", command.header.stamp_ns))
             digest.update(repr(sorted(values.items())).encode())
     return digest.hexdigest()

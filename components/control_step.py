@@ -1,9 +1,12 @@
 """One control step: a pure function of the law, the state, the goal, the obstacles and the
 clock, shared by the controller process (``components.controller``) and ``parsimony rerun``::
 
-    u = law.step(q, task, dt, obstacles)          u = [x', y', phi', q1'..q5']
+    u = law.step(q, task, dt, obstacles)          u = [x', y', phi', q1'..qn']
     base/command = wheel_speeds(unicycle(x', y', phi', phi))        (m/s, rad/s)
-    arm/command  = u[3:]                                            (rad/s)
+    arm/command  = u[3:]                        (rad/s, m/s; the description's joint_names)
+
+for a differential base; an omnidirectional base is commanded (x', y') turned into its own
+frame (forward, lateral) and phi', a fixed base nothing (``base_command``).
 
 with ``dt`` the difference of consecutive state stamps, clamped to [1 ms, 0.2 s] (0.02 s at
 the first step). The step commands zero, and says why (``status``, ``reason``), whenever its
@@ -31,7 +34,7 @@ from wbc.geometry.obstacles import Obstacle
 from wbc.laws.gains import gain_specs
 from wbc.laws.law_output import Law, LawOutput
 from wbc.planning.drive_tasks import HeadingTask, PointTask
-from wbc.robot import MobileManipulator
+from wbc.robot import BaseDescription, MobileManipulator
 from wbc.task import MEASUREMENT_TOLERANCE, PoseTask, PositionTask, Task, same_task
 
 FIRST_DT_S = 0.02
@@ -43,6 +46,26 @@ GOAL_OVERRIDES = ("eta", "beta")
 ZERO_WHEELS = (0.0, 0.0, 0.0, 0.0)
 REFUSED_STATE = "refused state"
 """The status of a step on a state whose joints are not the robot's (zero sent)."""
+
+
+def base_command(
+    u_b: np.ndarray, phi: float, base: BaseDescription
+) -> tuple[tuple[float, float, float, float], float]:
+    """What the base is told for u_b = [x', y', phi'] at heading ``phi``: (forward, angular,
+    left wheel, right wheel) and the lateral speed. A differential base: v and omega of the
+    unicycle (5.11), as wheel speeds under their limit; an omnidirectional one: (x', y') in its
+    own frame, no wheels; a fixed one: nothing. NaN where a speed would not be finite."""
+    if base.kind == "fixed":
+        return ZERO_WHEELS, 0.0
+    if base.kind == "omnidirectional":
+        c, s = math.cos(phi), math.sin(phi)
+        forward, lateral = c * u_b[0] + s * u_b[1], -s * u_b[0] + c * u_b[1]
+        return (float(forward), float(u_b[2]), 0.0, 0.0), float(lateral)
+    speeds, wheels = unicycle(u_b[0], u_b[1], u_b[2], phi), (math.nan,) * 4
+    if all(math.isfinite(v) for v in speeds):  # v may overflow where u does not
+        velocity = wheel_speeds(*speeds, base)
+        wheels = (velocity.forward, velocity.angular, velocity.left_wheel, velocity.right_wheel)
+    return wheels, 0.0
 
 
 def task_of(goal: Goal) -> Task:
@@ -59,8 +82,8 @@ def task_of(goal: Goal) -> Task:
 @dataclass(frozen=True)
 class Step:
     """What one step commands: the base's (forward, angular, left wheel, right wheel) and the
-    arm's joint speeds, the outcome (``optimal`` or why zero was sent) and the law's output
-    when there is one."""
+    arm's joint speeds, the outcome (``optimal`` or why zero was sent), the law's output
+    when there is one and an omnidirectional base's ``lateral`` speed (m/s)."""
 
     stamp_ns: int
     wheels: tuple[float, float, float, float]
@@ -68,6 +91,7 @@ class Step:
     status: str
     reason: str = ""
     output: LawOutput | None = None
+    lateral: float = 0.0
 
     @classmethod
     def zero(
@@ -204,15 +228,12 @@ class ControlStep:
                 "non-finite",
                 f"the {self.name} law reported optimal with a non-finite u {u} (a law error)",
             )
-        speeds, wheels = unicycle(u[0], u[1], u[2], state.base_pose[2]), (math.nan,) * 4
-        if all(math.isfinite(v) for v in speeds):  # v may overflow where u does not
-            base = wheel_speeds(*speeds, self.robot.base)
-            wheels = (base.forward, base.angular, base.left_wheel, base.right_wheel)
-        if not all(math.isfinite(w) for w in wheels):
+        wheels, lateral = base_command(u[:3], state.base_pose[2], self.robot.base)
+        if not all(math.isfinite(w) for w in (*wheels, lateral)):
             return self._halt(
                 stamp, "non-finite", f"the {self.name} law's u {u} gives non-finite base speeds"
             )
-        return Step(stamp, wheels, tuple(u[3:].tolist()), "optimal", "", output)
+        return Step(stamp, wheels, tuple(u[3:].tolist()), "optimal", "", output, lateral)
 
 
 def gains_of(gains_type: type, values: Mapping[str, Any], goal: Goal | None) -> Any:

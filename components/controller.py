@@ -233,6 +233,7 @@ class Controller(Component):
                 angular_velocity=angular,
                 left_wheel=left,
                 right_wheel=right,
+                lateral_velocity=step.lateral,
             )
         )
         arm.put(

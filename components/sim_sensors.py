@@ -1,7 +1,8 @@
 """What the simulator's sensors read off its world each step, as the real robot's drivers
-report it: the servos' joint states, the Create's wheel odometry (the encoder counts, with the
-world's noise and slip, the distances and the pose dead-reckoned from them) and the ground
-truth (tests and reports only)."""
+report it: the servos' joint states (named as the robot's description names them), the
+Create's wheel odometry (the encoder counts, with the world's noise and slip, the distances and
+the pose dead-reckoned from them; an omnidirectional or fixed base reports its pose from where
+it started, no wheels) and the ground truth (tests and reports only)."""
 
 from __future__ import annotations
 
@@ -30,8 +31,11 @@ class SimSensors:
     ) -> None:
         self.world, self.scene = world, scene
         self.obstacles, self.solids = obstacles, solids
+        self.wheels = world.robot.base.kind == "differential"
         self.wheel_base = world.robot.base.wheel_base
-        self.metres_per_count = wheel_distance_per_count(world.robot.base, counts_per_turn)
+        self.metres_per_count = (
+            wheel_distance_per_count(world.robot.base, counts_per_turn) if self.wheels else 0.0
+        )
         self.odometry_pose = (0.0, 0.0, 0.0)
         self.last_counts = world.encoder_counts
         self.goal_of: tuple[tuple, tuple[float, ...]] = ((), ())
@@ -45,7 +49,23 @@ class SimSensors:
         )
 
     def odometry(self, header: Header) -> BaseOdometry:
-        """The counts, the distances and the pose dead-reckoned since the last reading."""
+        """The counts, the distances and the pose dead-reckoned since the last reading; a base
+        without wheels: its pose from where it started and its velocity."""
+        if not self.wheels:
+            x, y, phi = self.world.odometry_pose
+            forward, _, angular = self.world.base_velocity
+            return BaseOdometry(
+                header=header,
+                left_encoder=0,
+                right_encoder=0,
+                left_distance=0.0,
+                right_distance=0.0,
+                x=x,
+                y=y,
+                phi=phi,
+                forward_velocity=forward,
+                angular_velocity=angular,
+            )
         counts = self.world.encoder_counts
         d_left, d_right = (
             (c - c0) * self.metres_per_count for c, c0 in zip(counts, self.last_counts, strict=True)

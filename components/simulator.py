@@ -13,6 +13,11 @@ camera publish on the real robot, every ``step_s`` of simulated time::
                        into the scene's solids in 3-D (tests and reports only)
 
 The readings are made by ``components.sim_sensors``, the frames by ``components.sim_camera``.
+The robot is the profile's ``robot:`` description: its joints (any number, revolute or
+prismatic, named as the description names them) and its base, driven by the wheel speeds of
+``base/command`` when differential, by its forward, lateral and angular velocities when
+omnidirectional, never moved when fixed. An ``arm/command`` whose joints are not the robot's
+is refused (``refused_arm_commands``, one line naming the joints expected).
 
 It stops the robot when no command has arrived for ``command_timeout_s`` of simulated time.
 A ``start`` with a part of the robot inside one of the scene's solids is warned of, one line
@@ -45,6 +50,7 @@ from components.lockstep_gate import COMMANDS, FRAME_ANSWERS, Awaited, LockstepG
 from components.params import Param, ParamError
 from components.process_entry import run_component
 from components.pubsub import Input
+from components.robot_vector import RobotVector, of_robot
 from components.runtime import Component, Node
 from components.sim_camera import FrameFormat, SimCamera
 from components.sim_sensors import SimSensors
@@ -59,12 +65,21 @@ from sim2d.scenarios import SEED_MAX
 from sim2d.world import World, WorldSettings
 from wbc.geometry.obstacles import Circle
 from wbc.geometry.start_inside import inside_at_start
-from wbc.robot import MobileManipulator
+from wbc.robot import BASE_DOF, MobileManipulator
 
 LOCKSTEP_CHECK_S = 0.05
 """How often the simulator looks for an answer that is overdue (host seconds)."""
 PAUSED_CLOCK_S = 0.1
 """How often a paused simulator publishes its clock (host seconds)."""
+
+
+def start_of(robot: MobileManipulator, start: tuple[float, ...]) -> np.ndarray:
+    """q0 from the ``start`` parameter: the whole configuration, or the base's pose alone with
+    every joint at 0 (or its nearest limit)."""
+    if len(start) == BASE_DOF:
+        return np.concatenate((start, np.clip(0.0, robot.q_min[BASE_DOF:], robot.q_max[BASE_DOF:])))
+    names = ", ".join(robot.joint_names)
+    return np.array(of_robot("start", start, robot.dof, f"x, y, phi, {names}; or x, y, phi"))
 
 
 class Simulator(Component):
@@ -112,12 +127,13 @@ class Simulator(Component):
             doc="stop the robot after this long without a command, s (simulated)",
         ),
         Param("seed", int, 0, low=0, high=SEED_MAX, doc="noise seed"),
-        Param(
+        RobotVector(
             "start",
             tuple,
             (0.0, 0.0, 0.0, 0.0, -0.2, 0.2, 0.0, 0.5),
-            length=8,
-            doc="q0 = [x, y, phi, q1..q5]",
+            least=3,
+            doc="q0 = [x, y, phi, a position per arm joint]; [x, y, phi]: every joint at 0 "
+            "(or its nearest limit)",
         ),
         Param("obstacles", list, (), length=3, doc="obstacle circles [[x, y, radius], ...], m"),
         Param(
@@ -178,7 +194,7 @@ class Simulator(Component):
             encoder_noise_counts=p["encoder_noise_counts"],
             wheel_slip=p["wheel_slip"],
         )
-        start = np.array(p["start"])
+        start = start_of(self.robot, p["start"])
         for index, line in enumerate(
             inside_at_start(self.robot, start, solids, self.scene.solid_labels())
         ):
@@ -371,9 +387,15 @@ class Simulator(Component):
             self.world.stop()
             return
         base, arm = self.base_command, self.arm_command
-        left, right = (base.left_wheel, base.right_wheel) if base else (0.0, 0.0)
         joints = arm.joint_velocities if arm else (0.0,) * self.robot.arm_dof
-        self.world.command(left, right, joints)
+        if self.robot.base.kind == "differential":
+            left, right = (base.left_wheel, base.right_wheel) if base else (0.0, 0.0)
+            self.world.command(left, right, joints)
+        elif base is None:
+            self.world.drive(0.0, 0.0, 0.0, joints)
+        else:
+            velocity = (base.forward_velocity, base.lateral_velocity, base.angular_velocity)
+            self.world.drive(*velocity, joints)
 
     def _header(self, frame: str, topic: topics.Topic):
         return self.node.header(frame, self.now_ns, self.publishers[topic.name].next_seq)

@@ -20,7 +20,9 @@ and arm where they stood, so the robot stops, and says why on ``supervisor/statu
 A goal is taken on the first robot state after it: without a valid one (no camera fix yet,
 or no state for ``STATE_TIMEOUT_S``) it is refused, and a goal under way when the state goes
 invalid is aborted (the robot does not drive off again on its own when a fix comes back; the
-same goal sent again is taken anew). A request refused as malformed (a NaN, a pose that is
+same goal sent again is taken anew). A state whose joints are not the robot description's is
+refused (``refused_states``, one line naming the joints expected), and so is a goal whose arm
+is not as many joints. A request refused as malformed (a NaN, a pose that is
 not a unit dual quaternion...) leaves the current goal as it is and is reported on the status
 with its reason (``refusals``, ``last_refusal``). A goal moved by more than
 ``MEASUREMENT_TOLERANCE`` is a new goal and is planned afresh; a restarted supervisor reports
@@ -39,6 +41,7 @@ import numpy as np
 
 from components.control_step import task_of
 from components.controller import goal_of
+from components.joint_check import joints_match
 from components.params import Param, ParamError, load_robot
 from components.process_entry import run_component
 from components.pubsub import Input
@@ -153,7 +156,7 @@ class Supervisor(Component):
         self._published = 0
         """Statuses published since the last tick of the status timer."""
         self.last_refusal = ""
-        for name in (*COUNTED.values(), "refusals", "aborted"):
+        for name in (*COUNTED.values(), "refusals", "aborted", "refused_states"):
             node.counters[name] = 0
         node.subscribe(topics.GOAL_REQUEST, self.on_request, on_reject=self.on_refused)
         node.subscribe(topics.WORLD_OBSTACLES, self.on_obstacles)
@@ -182,7 +185,11 @@ class Supervisor(Component):
         self._publish(self.node.clock.now_ns())
 
     def on_state(self, state: RobotState) -> None:
-        """Take a new goal, advance the phases, publish the controller's goal and the status."""
+        """Take a new goal, advance the phases, publish the controller's goal and the status.
+        A state whose joints are not the robot's is refused (``refused_states``)."""
+        names = self.robot.joint_names
+        if not joints_match(self.node, "refused_states", "robot/state", state.joint_names, names):
+            return
         stamp, request = state.header.stamp_ns, self.request
         self._t = stamp / 1e9
         self.sight.saw(state)
@@ -257,6 +264,11 @@ class Supervisor(Component):
         plan says so itself)."""
         if request.task == "pose":
             return ""
+        if request.arm is not None and len(request.arm) != self.robot.arm_dof:
+            return (
+                f"the {request.task} goal's arm has {len(request.arm)} joints, the robot's "
+                f"are {self.robot.arm_dof} ({', '.join(self.robot.joint_names)})"
+            )
         x, y = request.position[:2] if request.task == "position" else request.point
         distance, limit = math.hypot(x - q[0], y - q[1]), StagingParams.max_distance
         if not distance <= limit:

@@ -17,14 +17,17 @@ from messages.header import Header
 
 
 class BaseCommand(Message):
-    """Base velocity: forward (m/s) and angular (rad/s), and the same as the
-    linear speed of the left and right wheels (m/s)."""
+    """Base velocity in the base's frame: forward (m/s), angular (rad/s) and, for an
+    omnidirectional base, ``lateral_velocity`` (m/s, to the base's left; 0 for the others);
+    for a differential base the same as the linear speed of the left and right wheels (m/s),
+    0 for the others."""
 
     header: Header
     forward_velocity: Finite
     angular_velocity: Finite
     left_wheel: Finite
     right_wheel: Finite
+    lateral_velocity: Finite = 0.0
 
 
 class ArmCommand(Message):

@@ -1,5 +1,6 @@
-"""A 2D pymunk world: a differential-drive base with no lateral slip, a kinematic arm, circular
-obstacles and wheel encoders. Pure simulation: no I/O. Solids in 3-D (``wbc.geometry.obstacles3d``)
+"""A 2D pymunk world: a base of the robot's kind, a kinematic arm of its joints (revolute or
+prismatic), circular obstacles and, for a differential base, wheel encoders. Pure simulation:
+no I/O. Solids in 3-D (``wbc.geometry.obstacles3d``)
 stop nothing: the world counts the penetrations of the robot's collision parts into them, from the
 kinematics (``wbc.geometry.arm_clearance``), as pymunk counts the base's contacts.
 
@@ -8,6 +9,11 @@ The base is a dynamic disc tied to a kinematic control body by a PivotJoint and 
 the control body's velocity, so the base rolls without sliding sideways (5.11) unless an
 obstacle pushes harder than the friction force. Wheel speeds (l, r) drive it as a unicycle,
 v = (r + l)/2, omega = (r - l)/b (b the wheel base).
+
+An omnidirectional base is the same disc with the control body driven by the commanded
+(forward, lateral, angular) velocity in the base's frame instead of by wheels (``drive``); its
+odometry is the base's pose relative to where it started (no wheels to count). A fixed base is
+a kinematic body that never moves.
 
 Chipmunk integrates positions with the velocities solved in the previous step (semi-implicit
 Euler), so the base moves with a wheel command one step after it is set.
@@ -98,6 +104,7 @@ class World:
         self._space = pymunk.Space()
         self._space.collision_slop = CONTACT_SLOP
         self._space.iterations = SOLVER_ITERATIONS
+        self._start = tuple(float(v) for v in q0[:BASE_DOF])
         self._body, self._control = self._add_base(q0[:BASE_DOF])
         for obstacle in obstacles:
             shape = pymunk.Circle(
@@ -113,6 +120,7 @@ class World:
         self._arm_velocity = np.zeros(robot.arm_dof)
         self._wheel_targets = (0.0, 0.0)
         self._wheels = (0.0, 0.0)
+        self._body_velocity = (0.0, 0.0, 0.0)
         self._counts = np.zeros(2)
         self._contacts = 0
         self._touching = 0
@@ -122,12 +130,19 @@ class World:
         self._count_penetrations()
 
     def _add_base(self, pose: np.ndarray) -> tuple[pymunk.Body, pymunk.Body]:
-        """The base disc and the kinematic body whose velocity it follows through two joints."""
+        """The base disc and the kinematic body whose velocity it follows through two joints;
+        a fixed base's disc is a kinematic body that never moves (its own control body)."""
         mass, radius = self.settings.base_mass, self.robot.base.body_radius
-        body = pymunk.Body(mass, pymunk.moment_for_circle(mass, 0.0, radius))
+        if self.robot.base.kind == "fixed":
+            body = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+        else:
+            body = pymunk.Body(mass, pymunk.moment_for_circle(mass, 0.0, radius))
         body.position, body.angle = (pose[0], pose[1]), pose[2]
         shape = pymunk.Circle(body, radius)
         shape.collision_type, shape.friction = BASE_COLLISION_TYPE, CONTACT_FRICTION
+        if self.robot.base.kind == "fixed":
+            self._space.add(body, shape)
+            return body, body
         control = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
         control.position, control.angle = body.position, body.angle
         pivot = pymunk.PivotJoint(control, body, (0.0, 0.0), (0.0, 0.0))
@@ -149,24 +164,47 @@ class World:
         self, left_wheel: float, right_wheel: float, joint_velocities: Sequence[float]
     ) -> None:
         """Hold wheel speed targets (m/s, clipped to +-wheel_speed_max) and arm joint velocities
-        (rad/s) until the next command."""
-        qdot = np.array(joint_velocities, dtype=float)
-        if qdot.shape != (self.robot.arm_dof,) or not np.all(np.isfinite(qdot)):
-            raise ValueError(
-                f"joint_velocities must be {self.robot.arm_dof} finite values, got {qdot.tolist()}"
-            )
+        (rad/s, m/s for a prismatic joint) until the next command (a differential base's)."""
+        if self.robot.base.kind != "differential":
+            raise ValueError(f"a {self.robot.base.kind} base has no wheels to command")
         if not (math.isfinite(left_wheel) and math.isfinite(right_wheel)):
             raise ValueError(f"wheel speeds must be finite, got {left_wheel}, {right_wheel}")
+        self._arm_command = self._joint_velocities(joint_velocities)
         limit = self.robot.base.wheel_speed_max
         self._wheel_targets = (
             min(max(left_wheel, -limit), limit),
             min(max(right_wheel, -limit), limit),
         )
-        self._arm_command = qdot
+
+    def drive(
+        self, forward: float, lateral: float, angular: float, joint_velocities: Sequence[float]
+    ) -> None:
+        """Hold the base's velocity in its own frame (forward and lateral m/s, angular rad/s,
+        each clipped to the base's bound on u_b) and the arm joint velocities until the next
+        command: an omnidirectional base's; a fixed base takes the joints and never moves."""
+        if self.robot.base.kind == "differential":
+            raise ValueError("a differential base is commanded by its wheels")
+        velocity = np.array([forward, lateral, angular], dtype=float)
+        if not np.all(np.isfinite(velocity)):
+            raise ValueError(f"base velocity must be finite, got {velocity.tolist()}")
+        self._arm_command = self._joint_velocities(joint_velocities)
+        bound = self.robot.base.velocity_max
+        self._body_velocity = tuple(np.clip(velocity, -bound, bound).tolist())
+
+    def _joint_velocities(self, joint_velocities: Sequence[float]) -> np.ndarray:
+        qdot = np.array(joint_velocities, dtype=float)
+        if qdot.shape != (self.robot.arm_dof,) or not np.all(np.isfinite(qdot)):
+            raise ValueError(
+                f"joint_velocities must be {self.robot.arm_dof} finite values, got {qdot.tolist()}"
+            )
+        return qdot
 
     def stop(self) -> None:
-        """Zero the wheel and joint targets; the wheels slow down at the acceleration limit."""
-        self.command(0.0, 0.0, np.zeros(self.robot.arm_dof))
+        """Zero the base and joint targets; wheels slow down at the acceleration limit."""
+        if self.robot.base.kind == "differential":
+            self.command(0.0, 0.0, np.zeros(self.robot.arm_dof))
+        else:
+            self.drive(0.0, 0.0, 0.0, np.zeros(self.robot.arm_dof))
 
     def step(self, dt: float) -> None:
         """Advance the world by dt seconds: wheels, base physics, arm, encoders."""
@@ -177,11 +215,16 @@ class World:
             _accelerate(self._wheels[0], self._wheel_targets[0], step_max),
             _accelerate(self._wheels[1], self._wheel_targets[1], step_max),
         )
-        self._drive_control_body(dt)
+        kind = self.robot.base.kind
+        if kind == "differential":
+            self._drive_control_body(dt)
+        elif kind == "omnidirectional":
+            self._drive_body_velocity(dt)
         before = (self._body.position, self._body.angle)
         self._space.step(dt)
         self._step_arm(dt)
-        self._step_encoders(*before)
+        if kind == "differential":
+            self._step_encoders(*before)
         self._time += dt
         self._count_penetrations()
 
@@ -199,6 +242,15 @@ class World:
         heading = self._body.angle + self._body.angular_velocity * dt + half_turn
         speed = forward * _sinc(half_turn)
         self._control.velocity = (speed * math.cos(heading), speed * math.sin(heading))
+        self._control.angular_velocity = angular
+
+    def _drive_body_velocity(self, dt: float) -> None:
+        """Control velocity: the commanded (forward, lateral) turned into the world frame at
+        the heading of the middle of the step in which the base moves with it, the next."""
+        forward, lateral, angular = self._body_velocity
+        heading = self._body.angle + self._body.angular_velocity * dt + 0.5 * angular * dt
+        c, s = math.cos(heading), math.sin(heading)
+        self._control.velocity = (c * forward - s * lateral, s * forward + c * lateral)
         self._control.angular_velocity = angular
 
     def _step_arm(self, dt: float) -> None:
@@ -226,7 +278,7 @@ class World:
 
     @property
     def q(self) -> np.ndarray:
-        """Ground truth [x, y, phi, q1..q5]; phi is continuous, not wrapped."""
+        """Ground truth [x, y, phi, q1..qn]; phi is continuous, not wrapped."""
         x, y = self._body.position
         return np.concatenate(([x, y, self._body.angle], self._q_arm))
 
@@ -234,6 +286,23 @@ class World:
     def end_effector(self) -> np.ndarray:
         """vec8 of the end-effector pose, robot.fkm(q) (4.6)."""
         return self.robot.fkm(self.q)
+
+    @property
+    def odometry_pose(self) -> tuple[float, float, float]:
+        """The base's pose in the frame of its start pose: what an omnidirectional or fixed
+        base's odometry reads (exact: no wheels slip)."""
+        x0, y0, phi0 = self._start
+        x, y = self._body.position
+        dx, dy = x - x0, y - y0
+        c, s = math.cos(phi0), math.sin(phi0)
+        return c * dx + s * dy, -s * dx + c * dy, self._body.angle - phi0
+
+    @property
+    def base_velocity(self) -> tuple[float, float, float]:
+        """The base's (forward, lateral, angular) velocity in its own frame, m/s and rad/s."""
+        vx, vy = self._body.velocity
+        c, s = math.cos(self._body.angle), math.sin(self._body.angle)
+        return c * vx + s * vy, -s * vx + c * vy, self._body.angular_velocity
 
     @property
     def wheel_speeds(self) -> tuple[float, float]:

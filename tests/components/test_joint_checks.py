@@ -14,8 +14,10 @@ from components.arm_driver import ArmDriver
 from components.control_step import REFUSED_STATE, ControlStep
 from components.lp_controller import LPController
 from components.runtime import Component, Node
+from components.scripted_publisher import ScriptedPublisher
 from components.simulator import Simulator
 from components.state_estimator import StateEstimator
+from components.supervisor import Supervisor
 from messages.commands import ArmCommand
 from messages.header import Header
 from messages.joints import JointStates
@@ -68,17 +70,20 @@ def test_the_control_step_answers_a_state_of_other_joints_with_zero(wrong: str) 
 @pytest.fixture(scope="module")
 def components() -> Iterator[dict[str, Component]]:
     """The receiving components of the simulated profile, on open nodes, not started."""
-    profile = load_profile(DEPLOY / "sim.yaml")
+    profile = load_profile(DEPLOY / "sim_supervised.yaml")
     made = {}
     with (
         Node(profile, "simulator", Simulator.params) as sim,
         Node(profile, "state_estimator", StateEstimator.params) as estimator,
         Node(profile, "controller", LPController.params) as controller,
+        Node(profile, "supervisor", Supervisor.params) as supervisor,
     ):
         made["simulator"] = Simulator(sim)
         made["state_estimator"] = StateEstimator(estimator)
         made["controller"] = LPController(controller)
+        made["supervisor"] = Supervisor(supervisor)
         yield made
+        made["supervisor"].shutdown()
         made["simulator"].shutdown()
 
 
@@ -90,6 +95,7 @@ RECEIVERS: dict[str, tuple[str, Callable[[Component], Callable], Callable]] = {
     ),
     "state_estimator": ("refused_joint_states", lambda c: c.on_joints, joint_states),
     "controller": ("refused_states", lambda c: c.on_state, state),
+    "supervisor": ("refused_states", lambda c: c.on_state, state),
 }
 
 
@@ -132,3 +138,16 @@ def test_the_arm_driver_holds_on_a_command_of_other_joints(
             driver.on_command(command(WRONG["wrong names"]))
         assert node.counters["refused_commands"] == 1
         assert EXPECTED in caplog.text
+
+
+def test_the_scripted_publisher_sends_no_state_of_another_size(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    profile = load_profile(DEPLOY / "controllers.yaml")
+    with Node(profile, "publisher", ScriptedPublisher.params) as node:
+        publisher = ScriptedPublisher(node)
+        node.params.set("joints", [0.1, 0.2, 0.3])
+        with caplog.at_level(logging.WARNING):
+            publisher.publish()
+        assert node.counters["refused_states"] == 1
+        assert "3 given, " + EXPECTED in caplog.text

@@ -6,11 +6,12 @@ ahead of it: p = (x + d cos phi, y + d sin phi) moves as
     p' = [cos phi, sin phi] v + d [-sin phi, cos phi] phi'
 
 for forward speed v, a map that is invertible for d > 0. ``PointTask`` drives p to a point
-with e = [p - p_d, q_a - q_a,d] (7 rows: the base's two and the five joints'), which the
-robot's 7 velocities (v, phi', q1'..q5') meet exactly. ``HeadingTask`` turns the base in
-place, e = [wrap(phi - phi_d), q_a - q_a,d]: with its six rows the forward speed stays free
-and the least-velocity term keeps it at zero. Each Jacobian is the derivative of its error
-with respect to q = [x, y, phi, q1..q5].
+with e = [p - p_d, q_a - q_a,d] (2 + n rows: the base's two and the n joints' of the arm),
+which the robot's 2 + n velocities (v, phi', q1'..qn') meet exactly. ``HeadingTask`` turns
+the base in place, e = [wrap(phi - phi_d), q_a - q_a,d]: with its 1 + n rows the forward
+speed stays free and the least-velocity term keeps it at zero. Each Jacobian is the
+derivative of its error with respect to q = [x, y, phi, q1..qn]; n is the length of the
+task's arm configuration (the robot's joints).
 """
 
 from __future__ import annotations
@@ -27,13 +28,21 @@ from wbc.validation import require_finite
 
 Array = np.ndarray
 
-ARM_DOF = 5
+
+def arm_configuration(values: object) -> Array:
+    """A read-only arm configuration: one or more finite joint positions."""
+    array = require_finite("arm configuration", values)
+    if array.ndim != 1 or array.size == 0:
+        raise ValueError(f"arm configuration must be a vector of joints, got shape {array.shape}")
+    return frozen_vector("arm configuration", array, array.size)
 
 
 def _arm_rows(q: Array, arm: Array) -> tuple[Array, Array]:
-    """q_a - q_a,d and its Jacobian [0 I]."""
-    rows = np.zeros((ARM_DOF, BASE_DOF + ARM_DOF))
-    rows[:, BASE_DOF:] = np.eye(ARM_DOF)
+    """q_a - q_a,d and its Jacobian [0 I]; ``q`` must have the arm's joints."""
+    if q.shape != (BASE_DOF + arm.size,):
+        raise ValueError(f"q has {q.size} entries, the task's arm {arm.size} joints")
+    rows = np.zeros((arm.size, BASE_DOF + arm.size))
+    rows[:, BASE_DOF:] = np.eye(arm.size)
     return q[BASE_DOF:] - arm, rows
 
 
@@ -46,18 +55,21 @@ def offset_point(q: Array, lookahead: float) -> Array:
 @dataclass(frozen=True)
 class PointTask:
     """Drive the point ``lookahead`` ahead of the axle to ``point`` (x, y) with the arm going
-    to ``arm`` (5 joint angles): e = [p - p_d, q_a - q_a,d]."""
+    to ``arm`` (a position per joint): e = [p - p_d, q_a - q_a,d]."""
 
     point: Array
     arm: Array
     lookahead: float = 0.1
-    dof = 7
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "point", frozen_vector("drive point", self.point, 2))
-        object.__setattr__(self, "arm", frozen_vector("arm configuration", self.arm, ARM_DOF))
+        object.__setattr__(self, "arm", arm_configuration(self.arm))
         if not self.lookahead > 0.0:
             raise ValueError(f"lookahead must be > 0, got {self.lookahead}")
+
+    @property
+    def dof(self) -> int:
+        return 2 + self.arm.size
 
     @property
     def goal_position(self) -> Array:
@@ -69,7 +81,7 @@ class PointTask:
 
     def error(self, pose: Array, jacobian: Array, q: Array) -> tuple[Array, Array]:
         phi = float(q[2])
-        point_rows = np.zeros((2, BASE_DOF + ARM_DOF))
+        point_rows = np.zeros((2, BASE_DOF + self.arm.size))
         point_rows[0, 0] = point_rows[1, 1] = 1.0
         point_rows[0, 2] = -self.lookahead * math.sin(phi)
         point_rows[1, 2] = self.lookahead * math.cos(phi)
@@ -86,12 +98,15 @@ class HeadingTask:
     heading: float
     arm: Array
     position: Array
-    dof = 6
 
     def __post_init__(self) -> None:
         require_finite("heading", np.array([self.heading]))
-        object.__setattr__(self, "arm", frozen_vector("arm configuration", self.arm, ARM_DOF))
+        object.__setattr__(self, "arm", arm_configuration(self.arm))
         object.__setattr__(self, "position", frozen_vector("turning position", self.position, 2))
+
+    @property
+    def dof(self) -> int:
+        return 1 + self.arm.size
 
     @property
     def goal_position(self) -> Array:
@@ -102,7 +117,7 @@ class HeadingTask:
         return np.concatenate(([self.heading], self.arm))
 
     def error(self, pose: Array, jacobian: Array, q: Array) -> tuple[Array, Array]:
-        heading_row = np.zeros((1, BASE_DOF + ARM_DOF))
+        heading_row = np.zeros((1, BASE_DOF + self.arm.size))
         heading_row[0, 2] = 1.0
         arm_error, arm_rows = _arm_rows(q, self.arm)
         error = np.concatenate(([wrap(float(q[2]) - self.heading)], arm_error))

@@ -4,7 +4,7 @@ The LP law is local: from a base that faces away from a goal, or stands where th
 reach it at a joint's limit, its steps stall. A staging candidate is a whole configuration q_c
 with fkm(q_c) = x_d, found by a bounded inverse-kinematics search from several starts:
 
-    min ||vec8(fkm(q)) - vec8(x_d)||^2  over  z = (x, y, phi, q2, q3, q4, q5),  q1 = 0,
+    min ||vec8(fkm(q)) - vec8(x_d)||^2  over  z = (x, y, phi, q2, ..., qn),  q1 = 0,
 
 each arm joint kept a margin inside the LP's joint box b_l [q-, q+] (5.14), so that the
 pose task started from q_c has room on every joint. The waist is held at 0: it turns the arm
@@ -47,8 +47,12 @@ from wbc.robot import BASE_DOF, MobileManipulator
 
 Array = np.ndarray
 
-FREE = [0, 1, 2, 4, 5, 6, 7]
-"""The entries of q the search moves: the base and every arm joint but the waist."""
+
+def free_entries(dof: int) -> list[int]:
+    """The entries of q (``dof`` of them) the search moves: the base and every arm joint but
+    the waist."""
+    return [*range(BASE_DOF), *range(BASE_DOF + 1, dof)]
+
 
 NEAR_HEADING = 0.3
 """A base within a final leg of its candidate, facing it this closely and this close to its
@@ -176,19 +180,20 @@ def solve_ik(
 
     q = np.array(start, dtype=float)
     q[BASE_DOF] = 0.0
+    free = free_entries(robot.dof)
     goal = dq.nearest_equivalent(goal_pose, robot.fkm(q))
 
     def residual(z: Array) -> Array:
-        q[FREE] = z
+        q[free] = z
         return robot.fkm(q) - goal
 
     def jacobian(z: Array) -> Array:
-        q[FREE] = z
-        return robot.pose_jacobian(q)[:, FREE]
+        q[free] = z
+        return robot.pose_jacobian(q)[:, free]
 
     result = least_squares(
         residual,
-        q[FREE],
+        q[free],
         jac=jacobian,
         bounds=bounds,
         method="trf",
@@ -199,7 +204,7 @@ def solve_ik(
     )
     if not math.sqrt(2.0 * result.cost) < tolerance:
         return None
-    q[FREE] = result.x
+    q[free] = result.x
     q[2] = wrap(q[2])
     return q.copy()
 
