@@ -126,12 +126,16 @@ class Offline:
         elif name == topics.ROBOT_STATE.name:
             stamp = message.header.stamp_ns
             step = self.stepper.step(message, stamp, math.inf)
-            write_step(out, key[: -len(name) - 1], self.name, step, self.stepper.gains)
+            names = self.stepper.robot.joint_names
+            write_step(out, key[: -len(name) - 1], self.name, step, self.stepper.gains, names)
             self.steps += 1
 
 
-def write_step(out: SessionWriter, namespace: str, law: str, step: Step, gains) -> None:
-    """The commands and diagnostics of one step, stamped with its state's stamp."""
+def write_step(
+    out: SessionWriter, namespace: str, law: str, step: Step, gains, joint_names: tuple[str, ...]
+) -> None:
+    """The commands and diagnostics of one step, stamped with its state's stamp, the arm's
+    joints named ``joint_names`` (the robot's description's)."""
     header = Header(stamp_ns=step.stamp_ns, frame="world", seq=0, source=f"{RERUN_SOURCE}{law}")
     forward, angular, left, right = step.wheels
     out.write(
@@ -144,5 +148,6 @@ def write_step(out: SessionWriter, namespace: str, law: str, step: Step, gains) 
             right_wheel=right,
         ),
     )
-    out.write(f"{namespace}/arm/command", ArmCommand(header=header, joint_velocities=step.joints))
+    arm = ArmCommand(header=header, joint_velocities=step.joints, joint_names=joint_names)
+    out.write(f"{namespace}/arm/command", arm)
     out.write(f"{namespace}/control/diagnostics", diagnostics_of(step, law, gains, header))
