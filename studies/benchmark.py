@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from outputs.stdout import table
+from profiles import deploy_files
 from profiles.deploy_files import ROBOT_FILE
 from studies.gain_sets import TABLE_PARAMS, WITHOUT_ARM_ROWS
 from studies.goal_sets import goal_report
@@ -172,16 +173,11 @@ def run_bench(
     ``zoo``: the robot descriptions whose step times are taken (None: every one of
     deploy/robots); ``zoo_only``: those step times and nothing else (a quick run)."""
     report = {} if zoo_only else robot_figures(repeats, trials, goals, robot_file)
-    zoo = robot_descriptions() if zoo is None else zoo
+    zoo = deploy_files.zoo() if zoo is None else zoo
     if zoo:
         progress(f"control steps on {len(zoo)} robots")
         report["zoo"] = zoo_step_times(zoo, repeats)
     return report
-
-
-def robot_descriptions() -> list[Path]:
-    """Every robot description of deploy/robots, by name."""
-    return sorted(ROBOT_FILE.parent.glob("*.yaml"))
 
 
 def robot_figures(repeats: int, trials: int, goals: int, robot_file: Path) -> dict:

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import math
 
-from profiles.deploy_files import ROBOT_FILE
-from studies.benchmark import convergence_test, format_report, robot_descriptions, run_bench
+from profiles.deploy_files import ROBOT_FILE, zoo
+from studies.benchmark import convergence_test, format_report, run_bench
 from studies.reproduce.efficiency import section_6_3
 from wbc.robot import MobileManipulator
 
@@ -30,11 +30,11 @@ def test_the_bench_runs_section_6_3_as_reproduce_runs_it():
 def test_the_zoo_bench_times_every_law_on_every_robot():
     """A quick run over the zoo: on every robot every law's step has a finite median and p99,
     and the LP's ratio to the classic law's is given; a differential base adds the cascade."""
-    robots = robot_descriptions()
+    robots = zoo()
     assert ROBOT_FILE in robots
-    zoo = run_bench(20, 0, 0, zoo=robots, zoo_only=True)["zoo"]
-    assert len(zoo) == len(robots)
-    for row in zoo.values():
+    timed = run_bench(20, 0, 0, zoo=robots, zoo_only=True)["zoo"]
+    assert len(timed) == len(robots)
+    for row in timed.values():
         laws = {"lp", "qp", "classic"} | ({"cascade"} if row["base"] == "differential" else set())
         assert laws <= row["step"].keys()
         for law in laws:
@@ -44,4 +44,4 @@ def test_the_zoo_bench_times_every_law_on_every_robot():
         assert row["dof"] == row["arm_dof"] + 3
         parts = row["lp_breakdown_us"]
         assert min(parts["kinematics"], parts["rows"], parts["vertex"]) > 0.0
-    assert "LP / classic" in format_report({"zoo": zoo})
+    assert "LP / classic" in format_report({"zoo": timed})

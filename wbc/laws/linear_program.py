@@ -79,11 +79,13 @@ class _Layout:
     all, dense; ``varying`` is a view of its last rows, as passed to HiGHS.
     """
 
-    def __init__(
-        self, n: int, residual_rows: tuple[int, ...], linear_rows: int, norm_rows: int
-    ) -> None:
-        self.key = (n, residual_rows, linear_rows, norm_rows)
+    def __init__(self, n: int, residual_count: int, counts: list[int], norm_rows: int) -> None:
+        self.key = (n, residual_count, counts, norm_rows)
+        """What makes two steps' problems one shape: n, the residual costs' count, the rows of
+        each residual cost and linear rows, and the one-norm rows."""
         self.n, self.norm_rows = n, norm_rows
+        residual_rows = counts[:residual_count]
+        linear_rows = sum(counts[residual_count:])
         residual_total = self.residual_rows = sum(residual_rows)
         self.columns = 2 * n + residual_total
         self.static_rows = n + norm_rows
@@ -107,8 +109,20 @@ class _Layout:
         self.cost = np.zeros(self.columns)
         self.row_weight = np.zeros(residual_total)
         """w_b of the residual cost each residual row belongs to."""
+        starts = np.cumsum([0, *residual_rows]).tolist()
+        self._slices = [slice(a, b) for a, b in zip(starts, starts[1:], strict=False)]
+        self._weights: list[float] = []
+        self.stacked = np.zeros((self.varying_rows, n))
+        """A_b and A of the varying rows, stacked."""
         self.col_lower = np.zeros(self.columns)
         self.col_upper = np.full(self.columns, INF)
+
+    def weigh(self, weights: list[float]) -> None:
+        """Set ``row_weight`` from the weight of each residual cost (kept while they hold)."""
+        if weights != self._weights:
+            for rows, weight in zip(self._slices, weights, strict=True):
+                self.row_weight[rows] = weight
+            self._weights = weights
 
 
 class WarmStartedLP:
@@ -124,6 +138,9 @@ class WarmStartedLP:
             self._highs.setOptionValue(option, value)
         self._layout: _Layout | None = None
         self._basis: KeptBasis | None = None
+        self._costs: list[VelocityCost] = []
+        self._cost_key: tuple[int, ...] = ()
+        self._cost_sums: tuple[Array, Array] = (np.zeros(0), np.zeros(0))
 
     def reset(self) -> None:
         """Forget the previous basis: the next solve starts cold."""
@@ -131,46 +148,46 @@ class WarmStartedLP:
 
     def solve(self, costs: list[Cost], rows: list[Rows]) -> LPSolution:
         """Minimise the sum of ``costs`` over u subject to ``rows`` (5.29)."""
-        residuals = [cost for cost in costs if isinstance(cost, ResidualCost)]
-        velocity_costs = [cost for cost in costs if isinstance(cost, VelocityCost)]
-        linear = [rows_ for rows_ in rows if isinstance(rows_, LinearRows)]
-        norms = [rows_ for rows_ in rows if isinstance(rows_, OneNormBound)]
-        bounds = [rows_ for rows_ in rows if isinstance(rows_, VelocityBounds)]
+        residuals: list[ResidualCost] = []
+        velocity_costs: list[VelocityCost] = []
+        for cost in costs:
+            (residuals if type(cost) is ResidualCost else velocity_costs).append(cost)
+        linear: list[LinearRows] = []
+        norms: list[OneNormBound] = []
+        bounds: list[VelocityBounds] = []
+        kinds = {LinearRows: linear, OneNormBound: norms, VelocityBounds: bounds}
+        for rows_ in rows:
+            kinds[type(rows_)].append(rows_)  # type: ignore[attr-defined]
         n = residuals[0].matrix.shape[1]
-        layout = self._layout_for(
-            n,
-            tuple(cost.matrix.shape[0] for cost in residuals),
-            sum(rows_.matrix.shape[0] for rows_ in linear),
-            len(norms),
-        )
+        stacked = [cost.matrix for cost in residuals] + [rows_.matrix for rows_ in linear]
+        layout = self._layout_for(n, stacked, len(residuals), len(norms))
         u_lower, u_upper = layout.lower[:n], layout.upper[:n]
-        u_lower.fill(-INF)
-        u_upper.fill(INF)
-        for bound in bounds:
-            np.maximum(u_lower, bound.lower, out=u_lower)
-            np.minimum(u_upper, bound.upper, out=u_upper)
-        if (u_lower > u_upper).any():
+        if len(bounds) == 1:
+            u_lower[:], u_upper[:] = bounds[0].lower, bounds[0].upper
+        else:
+            u_lower.fill(-INF)
+            u_upper.fill(INF)
+            for bound in bounds:
+                np.maximum(u_lower, bound.lower, out=u_lower)
+                np.minimum(u_upper, bound.upper, out=u_upper)
+        if np.count_nonzero(u_lower > u_upper):
             return _failed(n, "infeasible")
         layout.upper[n : layout.static_rows] = [bound.limit for bound in norms]
 
-        matrix, row = layout.varying, 0
-        lower, upper = layout.lower[layout.static_rows :], layout.upper[layout.static_rows :]
-        for cost in residuals:
-            count = cost.matrix.shape[0]
-            matrix[row : row + count, :n] = cost.matrix
-            np.negative(cost.matrix, out=matrix[row : row + count, n : 2 * n])
-            np.negative(cost.offset, out=upper[row : row + count])
-            layout.row_weight[row : row + count] = cost.weight
-            row += count
-        for rows_ in linear:
-            count = rows_.matrix.shape[0]
-            matrix[row : row + count, :n] = rows_.matrix
-            np.negative(rows_.matrix, out=matrix[row : row + count, n : 2 * n])
-            lower[row : row + count] = rows_.lower
-            upper[row : row + count] = rows_.upper
-            row += count
-        positive = sum((cost.weights for cost in velocity_costs), np.zeros(n))
-        negative = sum((cost.negative_weights for cost in velocity_costs), np.zeros(n))
+        # The varying rows: [A_b -A_b -I_b] of every residual cost, then [A -A 0] of the rows.
+        residual_rows, static = layout.residual_rows, layout.static_rows
+        matrix = layout.varying
+        np.concatenate(stacked, out=layout.stacked)
+        matrix[:, :n] = layout.stacked
+        matrix[:, n : 2 * n] = -layout.stacked
+        lower, upper = layout.lower[static:], layout.upper[static:]
+        np.concatenate([cost.offset for cost in residuals], out=upper[:residual_rows])
+        np.negative(upper[:residual_rows], out=upper[:residual_rows])
+        if linear:
+            np.concatenate([rows_.lower for rows_ in linear], out=lower[residual_rows:])
+            np.concatenate([rows_.upper for rows_ in linear], out=upper[residual_rows:])
+        layout.weigh([cost.weight for cost in residuals])
+        positive, negative = self._velocity_costs(velocity_costs, n)
         _fill_costs(layout, positive, negative)
         status, values = self._vertex(layout)
         if values is None:
@@ -182,15 +199,29 @@ class WarmStartedLP:
         u_positive, u_negative = values[:n] - common, values[n : 2 * n] - common
         u = u_positive - u_negative
         # The constant -sum_b w_b 1'b_b; the residual rows' upper bounds hold -b.
-        offsets = -float(layout.row_weight @ upper[: layout.residual_rows])
+        offsets = -float(layout.row_weight @ upper[:residual_rows])
         objective = float(layout.cost @ values) - offsets
-        active = _active(u, float(u_positive.sum() + u_negative.sum()), linear, norms, bounds)
+        split_sum = float(np.add.reduce(u_positive) + np.add.reduce(u_negative))
+        active = _active(u, split_sum, linear, norms, bounds)
         return LPSolution(u, status, objective, active, u_positive, u_negative)
 
+    def _velocity_costs(self, costs: list[VelocityCost], n: int) -> tuple[Array, Array]:
+        """c_P and c_N, the sums of the velocity costs' weights, kept while the terms return the
+        same costs (the same objects, held here so that no other takes their ids) for u of n."""
+        key = (n, *[id(cost) for cost in costs])
+        if key != self._cost_key:
+            self._costs, self._cost_key = costs, key
+            self._cost_sums = (
+                sum((cost.weights for cost in costs), np.zeros(n)),
+                sum((cost.negative_weights for cost in costs), np.zeros(n)),
+            )
+        return self._cost_sums
+
     def _layout_for(
-        self, n: int, residual_rows: tuple[int, ...], linear_rows: int, norm_rows: int
+        self, n: int, stacked: list[Array], residual_count: int, norm_rows: int
     ) -> _Layout:
-        key = (n, residual_rows, linear_rows, norm_rows)
+        """The layout of this step's shape: the last one while the shape holds."""
+        key = (n, residual_count, [matrix.shape[0] for matrix in stacked], norm_rows)
         if self._layout is None or self._layout.key != key:
             self._build(_Layout(*key))
         assert self._layout is not None
@@ -279,7 +310,7 @@ def _fill_costs(layout: _Layout, positive: Array, negative: Array) -> None:
     """u_P: c_P - sum_b w_b 1'A_b, u_N: c_N + sum_b w_b 1'A_b, y_b: 2 w_b (rows weighted by
     w), with c_P and c_N the velocity costs of each entry's two directions."""
     n, cost = layout.n, layout.cost
-    column_sums = layout.row_weight @ layout.varying[: layout.residual_rows, :n]
+    column_sums = layout.row_weight @ layout.stacked[: layout.residual_rows]
     np.subtract(positive, column_sums, out=cost[:n])
     np.add(negative, column_sums, out=cost[n : 2 * n])
     np.multiply(2.0, layout.row_weight, out=cost[2 * n :])
@@ -309,18 +340,17 @@ def _active(
         # An infinite bound is never within the tolerance of u; a degenerate one never counts.
         at_bound = np.minimum(u - bound.lower, bound.upper - u) <= ACTIVE_TOLERANCE
         at_bound &= bound.upper - bound.lower > ACTIVE_TOLERANCE
-        if at_bound.any():
+        if np.count_nonzero(at_bound):
             active += [f"{bound.name}[{i}]" for i in np.flatnonzero(at_bound)]
     return tuple(active)
 
 
 def _tight(rows: LinearRows, u: Array) -> bool:
     """An equality, or an inequality one of whose rows sits on a finite bound."""
-    if np.array_equal(rows.lower, rows.upper):
+    if rows.lower is rows.upper or (
+        rows.lower.shape == rows.upper.shape and not np.count_nonzero(rows.lower != rows.upper)
+    ):
         return True
     value = rows.matrix @ u
-    return bool(
-        np.any(
-            np.minimum(np.abs(value - rows.lower), np.abs(rows.upper - value)) <= ACTIVE_TOLERANCE
-        )
-    )
+    distance = np.minimum(np.abs(value - rows.lower), np.abs(rows.upper - value))
+    return bool(np.count_nonzero(distance <= ACTIVE_TOLERANCE))

@@ -60,7 +60,7 @@ from wbc.geometry.obstacles3d import CORNER, EDGE, FACE, RIM, Cylinder, Edge, So
 from wbc.geometry.plucker import foot
 from wbc.geometry.robot_primitives import PrimitiveKinematics, primitive_kinematics
 from wbc.geometry.wrench_rows import line_wrench, point_wrench, wrench_rows
-from wbc.laws.constraints.base import LinearRows
+from wbc.laws.constraints.base import LinearRows, no_rows
 from wbc.laws.gains import gain
 from wbc.laws.step_context import StepContext
 
@@ -167,8 +167,7 @@ class ArmObstacles:
         robot, solids = context.robot, context.solids
         model = robot.collision
         if not solids or not (model.points or model.segments):
-            empty = np.zeros(0)
-            return LinearRows(self.name, np.zeros((0, robot.dof)), empty, empty, engaged=False)
+            return no_rows(self.name, robot.dof)
         rows = _Rows(self, primitive_kinematics(robot, context.q, context.chain))
         for obstacle in solids:
             found = features(obstacle)

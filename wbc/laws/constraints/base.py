@@ -9,6 +9,7 @@ kinds of rows on the whole-body velocity u, and the LP builder only stacks them:
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -28,6 +29,14 @@ class LinearRows:
     lower: Array
     upper: Array
     engaged: bool = True
+
+
+@functools.cache
+def no_rows(name: str, dof: int) -> LinearRows:
+    """No row (switched off), for u of ``dof`` entries: one read-only value per name and size."""
+    matrix, bounds = np.zeros((0, dof)), np.zeros(0)
+    matrix.flags.writeable = bounds.flags.writeable = False
+    return LinearRows(name, matrix, bounds, bounds, engaged=False)
 
 
 @dataclass(frozen=True)

@@ -47,4 +47,4 @@ class ErrorBound:
 
     def rows(self, context: StepContext) -> OneNormBound:
         measure = context.error_rate if self.mode == "derivative" else context.error
-        return OneNormBound(self.name, self.beta * float(np.abs(measure).sum()))
+        return OneNormBound(self.name, self.beta * float(np.add.reduce(np.abs(measure))))

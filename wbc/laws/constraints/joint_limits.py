@@ -10,6 +10,9 @@ import numpy as np
 from wbc.laws.constraints.base import VelocityBounds
 from wbc.laws.gains import gain
 from wbc.laws.step_context import StepContext
+from wbc.robot import MobileManipulator
+
+Array = np.ndarray
 
 
 @dataclass(frozen=True)
@@ -42,14 +45,24 @@ class JointLimits:
             raise ValueError("joint limits need gain > 0 and 0 < safety_factor <= 1")
         self.gain = gain
         self.safety_factor = safety_factor
+        self._robot: MobileManipulator | None = None
+        self._limits: tuple[Array, Array, Array] = (np.zeros(0),) * 3
+
+    def _scaled(self, robot: MobileManipulator) -> tuple[Array, Array, Array]:
+        """k b_l q-, k b_l q+ and -q'+ of ``robot``, kept for the robot last seen."""
+        if robot is not self._robot:
+            scale = self.gain * self.safety_factor
+            self._limits = (scale * robot.q_min, scale * robot.q_max, -robot.velocity_max)
+            self._robot = robot
+        return self._limits
 
     def rows(self, context: StepContext) -> VelocityBounds:
-        robot = context.robot
-        speed = robot.velocity_max
+        speed = context.robot.velocity_max
+        low, high, slowest = self._scaled(context.robot)
         scaled_q = self.gain * context.q
         # k (b_l q-+ - q), infinite for the base's x, y, phi; then held inside [-q'+, q'+].
-        lower = np.maximum(self.gain * self.safety_factor * robot.q_min - scaled_q, -speed)
-        upper = np.minimum(self.gain * self.safety_factor * robot.q_max - scaled_q, speed)
+        lower = np.maximum(low - scaled_q, slowest)
+        upper = np.minimum(high - scaled_q, speed)
         np.minimum(lower, speed, out=lower)
-        np.maximum(upper, -speed, out=upper)
+        np.maximum(upper, slowest, out=upper)
         return VelocityBounds(self.name, np.minimum(lower, upper), np.maximum(lower, upper))

@@ -23,7 +23,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from wbc.laws.constraints.base import LinearRows
+from wbc.laws.constraints.base import LinearRows, no_rows
 from wbc.laws.constraints.obstacle_border import point_velocity_row
 from wbc.laws.constraints.obstacle_gains import ObstacleGains
 from wbc.laws.step_context import StepContext
@@ -54,6 +54,8 @@ class VectorFieldObstacle:
 
     def rows(self, context: StepContext) -> LinearRows:
         count, dof = len(context.obstacles), context.robot.dof
+        if count == 0:
+            return no_rows(self.name, dof)
         matrix, upper = np.zeros((count, dof)), np.zeros(count)
         phi = float(context.q[2])
         px = float(context.q[0]) + self.lookahead * math.cos(phi)

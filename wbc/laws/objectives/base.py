@@ -10,6 +10,7 @@ are >= 0, so the sum stays convex and its minimiser a vertex.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -28,6 +29,24 @@ class ResidualCost:
     matrix: Array
     offset: Array
     weight: float = 1.0
+
+
+@functools.cache
+def unit_row(dof: int, column: int) -> Array:
+    """The read-only row (1, dof) that picks entry ``column`` of u."""
+    row = np.zeros((1, dof))
+    row[0, column] = 1.0
+    row.flags.writeable = False
+    return row
+
+
+@functools.cache
+def no_cost(name: str, dof: int) -> ResidualCost:
+    """A term that asks nothing (weight 0) of u of ``dof`` entries, holding its place among
+    the rows: one read-only value per name and size."""
+    matrix, offset = np.zeros((1, dof)), np.zeros(1)
+    matrix.flags.writeable = offset.flags.writeable = False
+    return ResidualCost(name, matrix, offset, 0.0)
 
 
 @dataclass(frozen=True)

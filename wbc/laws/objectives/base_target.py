@@ -41,7 +41,7 @@ import numpy as np
 
 from wbc import dq
 from wbc.laws.gains import gain
-from wbc.laws.objectives.base import Latch, ResidualCost
+from wbc.laws.objectives.base import Latch, ResidualCost, unit_row
 from wbc.laws.step_context import StepContext
 from wbc.planar import wrap
 
@@ -187,8 +187,7 @@ class BaseTarget:
         return self._target
 
     def cost(self, context: StepContext) -> ResidualCost:
-        row = np.zeros((1, context.robot.dof))
-        row[0, 2] = 1.0
+        row = unit_row(context.robot.dof, 2)
         if context.goal_pose is None:
             return ResidualCost(self.name, row, np.zeros(1), 0.0)
         x, y, phi = context.q[:3].tolist()

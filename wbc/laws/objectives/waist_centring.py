@@ -20,7 +20,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from wbc.laws.gains import gain
-from wbc.laws.objectives.base import ResidualCost
+from wbc.laws.objectives.base import ResidualCost, unit_row
 from wbc.laws.step_context import StepContext
 from wbc.robot import BASE_DOF
 
@@ -64,8 +64,7 @@ class WaistCentring:
         self.weight, self.gain, self.fade_error = weight, gain, fade_error
 
     def cost(self, context: StepContext) -> ResidualCost:
-        row = np.zeros((1, context.robot.dof))
-        row[0, BASE_DOF] = 1.0
+        row = unit_row(context.robot.dof, BASE_DOF)
         fade = 1.0
         if self.fade_error > 0.0:
             fade = min(1.0, float(np.abs(context.error).sum()) / self.fade_error)
