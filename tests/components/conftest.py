@@ -118,33 +118,48 @@ def system(tmp_path: Path) -> Iterator[System]:
         system.stop_processes()
 
 
-@pytest.fixture
-def deployed(tmp_path: Path) -> Iterator[Callable[[str], System]]:
-    """``deployed(profile)``: a profile of ``deploy/`` (its path, or its YAML text) with its
-    router open.
+def _deployer(stack: ExitStack, directory: Path) -> Callable[[str | Path], System]:
+    """``deploy(profile)``: a profile of ``deploy/`` (its path, or its YAML text) copied into
+    ``directory`` with its router open until ``stack`` closes.
 
     The copy's router moves to a free loopback port and its robot path becomes absolute
     (the copy lives in a temporary directory); nothing else changes. The processes
-    started are stopped at teardown.
+    started are stopped when ``stack`` closes.
     """
+
+    def deploy(profile: str | Path) -> System:
+        if isinstance(profile, Path):
+            data: dict[str, Any] = read_profile_data(profile)
+        else:
+            data = yaml.safe_load(profile)
+            data["robot"] = str(DEPLOY / data["robot"])
+        data["zenoh"]["router"] = [f"tcp/127.0.0.1:{free_port()}"]
+        path = directory / f"deployed{len(list(directory.glob('*.yaml')))}.yaml"
+        path.write_text(yaml.safe_dump(data, sort_keys=False))
+        profile = load_profile(path)
+        router = stack.enter_context(zenoh.open(profile.zenoh.router_config()))
+        system = System(path, profile, router)
+        stack.callback(system.stop_processes)
+        return system
+
+    return deploy
+
+
+@pytest.fixture
+def deployed(tmp_path: Path) -> Iterator[Callable[[str | Path], System]]:
+    """``deployed(profile)``: a profile of ``deploy/`` with its router open, for one test
+    (``_deployer``)."""
     with ExitStack() as stack:
+        yield _deployer(stack, tmp_path)
 
-        def deploy(profile: str | Path) -> System:
-            if isinstance(profile, Path):
-                data: dict[str, Any] = read_profile_data(profile)
-            else:
-                data = yaml.safe_load(profile)
-                data["robot"] = str(DEPLOY / data["robot"])
-            data["zenoh"]["router"] = [f"tcp/127.0.0.1:{free_port()}"]
-            path = tmp_path / f"deployed{len(list(tmp_path.glob('*.yaml')))}.yaml"
-            path.write_text(yaml.safe_dump(data, sort_keys=False))
-            profile = load_profile(path)
-            router = stack.enter_context(zenoh.open(profile.zenoh.router_config()))
-            system = System(path, profile, router)
-            stack.callback(system.stop_processes)
-            return system
 
-        yield deploy
+@pytest.fixture(scope="module")
+def deployed_for_module(
+    tmp_path_factory: pytest.TempPathFactory,
+) -> Iterator[Callable[[str | Path], System]]:
+    """``deployed`` for a system the tests of a module share (started once)."""
+    with ExitStack() as stack:
+        yield _deployer(stack, tmp_path_factory.mktemp("deployed"))
 
 
 class LivelinessLog:
