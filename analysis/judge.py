@@ -9,8 +9,9 @@ time limit, or at the last step. What is judged against the simulator's ground t
 error in the steady state, contacts, joints at their hard stops, clearance) is None, and
 ``truth`` says ``absent``, for a recording without it (a real robot's). The control inputs
 u = [x', y', phi', a velocity per arm joint of the robot's description] join the base and arm
-commands of one stamp with x' = v cos(phi), y' = v sin(phi), phi the heading of the nearest
-state: the estimate the controller turned u into wheel speeds with.
+commands of one stamp with x' = v cos(phi) - l sin(phi), y' = v sin(phi) + l cos(phi) (l the
+lateral speed of an omnidirectional base, else 0), phi the heading of the nearest state: the
+estimate the controller turned u into the base's command with.
 """
 
 from __future__ import annotations
@@ -352,7 +353,11 @@ def commands(session: Session) -> tuple[Array, Array]:
     v = np.array([base[s].forward_velocity for s in stamps])
     omega = np.array([base[s].angular_velocity for s in stamps])
     joints = np.array([arm[s].joint_velocities for s in stamps])
-    return stamps, np.column_stack((v * np.cos(phi), v * np.sin(phi), omega, joints))
+    if not any(base[s].lateral_velocity for s in stamps):  # as a differential base's always
+        return stamps, np.column_stack((v * np.cos(phi), v * np.sin(phi), omega, joints))
+    side = np.array([base[s].lateral_velocity for s in stamps])  # to the base's left
+    cos, sin = np.cos(phi), np.sin(phi)
+    return stamps, np.column_stack((v * cos - side * sin, v * sin + side * cos, omega, joints))
 
 
 def required(session: Session, topic: Topic) -> list:
@@ -399,14 +404,18 @@ def commands_digest(session: Session) -> str:
 
 
 def commands_csv(session: Session, robot: MobileManipulator) -> str:
-    """Every command pair the controller sent, one row per stamp (s, m/s, rad/s), a column
-    per joint of the robot's arm, named as its description names it (``<name>_dot``)."""
+    """Every command pair the controller sent, one row per stamp (s, m/s, rad/s), the lateral
+    speed after the angular on an omnidirectional base, a column per joint of the robot's arm,
+    named as its description names it (``<name>_dot``)."""
     arm = {a.header.stamp_ns: a.joint_velocities for a in messages(session, ARM_COMMAND)}
-    lines = ["stamp_s,forward,angular," + ",".join(f"{n}_dot" for n in robot.joint_names)]
+    lateral = robot.base.kind == "omnidirectional"
+    base = "stamp_s,forward,angular," + ("lateral," if lateral else "")
+    lines = [base + ",".join(f"{n}_dot" for n in robot.joint_names)]
     for b in messages(session, BASE_COMMAND):
         joints = arm.get(b.header.stamp_ns)
         if joints is not None:
-            values = (b.forward_velocity, b.angular_velocity, *joints)
+            side = (b.lateral_velocity,) if lateral else ()
+            values = (b.forward_velocity, b.angular_velocity, *side, *joints)
             lines.append(f"{b.header.stamp_ns / 1e9:.3f}," + ",".join(repr(v) for v in values))
     return "\n".join(lines) + "\n"
 

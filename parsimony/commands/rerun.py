@@ -146,6 +146,7 @@ def write_step(
             angular_velocity=angular,
             left_wheel=left,
             right_wheel=right,
+            lateral_velocity=step.lateral,
         ),
     )
     arm = ArmCommand(header=header, joint_velocities=step.joints, joint_names=joint_names)
