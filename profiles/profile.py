@@ -265,9 +265,11 @@ class Profile(StrictModel):
     scene: Scene | None = None
     """The markers and camera of the workspace, for the components that see them."""
     clock: Literal["wall", "sim"] = "wall"
-    startup_timeout_s: float = Field(default=10.0, gt=0.0)
+    startup_timeout_s: float = Field(default=30.0, gt=0.0)
     """Seconds the launcher gives every component to become alive (its liveliness token seen
-    by the router) before it fails the launch, naming those that are not."""
+    by the router) before it fails the launch, naming those that are not. A component starts
+    in about a second on an idle machine (its imports) and took over 10 s on a shared one;
+    one that exits before it is alive fails the launch at once, whatever this is."""
     watchdog_s: float = Field(default=3.0, gt=0.0)
     """A component alive but answering no status query for this long (a stopped process, a
     handler that never returns) is hung: the launcher kills it and restarts it by its policy."""
