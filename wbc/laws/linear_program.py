@@ -122,6 +122,7 @@ class _Layout:
         if weights != self._weights:
             for rows, weight in zip(self._slices, weights, strict=True):
                 self.row_weight[rows] = weight
+            np.multiply(2.0, self.row_weight, out=self.cost[2 * self.n :])
             self._weights = weights
 
 
@@ -183,9 +184,8 @@ class WarmStartedLP:
         lower, upper = layout.lower[static:], layout.upper[static:]
         np.concatenate([cost.offset for cost in residuals], out=upper[:residual_rows])
         np.negative(upper[:residual_rows], out=upper[:residual_rows])
-        if linear:
-            np.concatenate([rows_.lower for rows_ in linear], out=lower[residual_rows:])
-            np.concatenate([rows_.upper for rows_ in linear], out=upper[residual_rows:])
+        _stack([rows_.lower for rows_ in linear], lower[residual_rows:])
+        _stack([rows_.upper for rows_ in linear], upper[residual_rows:])
         layout.weigh([cost.weight for cost in residuals])
         positive, negative = self._velocity_costs(velocity_costs, n)
         _fill_costs(layout, positive, negative)
@@ -201,8 +201,7 @@ class WarmStartedLP:
         # The constant -sum_b w_b 1'b_b; the residual rows' upper bounds hold -b.
         offsets = -float(layout.row_weight @ upper[:residual_rows])
         objective = float(layout.cost @ values) - offsets
-        split_sum = float(np.add.reduce(u_positive) + np.add.reduce(u_negative))
-        active = _active(u, split_sum, linear, norms, bounds)
+        active = _active(u, sum(np.abs(u).tolist()), linear, norms, bounds)
         return LPSolution(u, status, objective, active, u_positive, u_negative)
 
     def _velocity_costs(self, costs: list[VelocityCost], n: int) -> tuple[Array, Array]:
@@ -307,13 +306,22 @@ class WarmStartedLP:
 
 
 def _fill_costs(layout: _Layout, positive: Array, negative: Array) -> None:
-    """u_P: c_P - sum_b w_b 1'A_b, u_N: c_N + sum_b w_b 1'A_b, y_b: 2 w_b (rows weighted by
-    w), with c_P and c_N the velocity costs of each entry's two directions."""
+    """u_P: c_P - sum_b w_b 1'A_b, u_N: c_N + sum_b w_b 1'A_b (rows weighted by w), with c_P
+    and c_N the velocity costs of each entry's two directions; y_b's 2 w_b are set with the
+    weights (``_Layout.weigh``)."""
     n, cost = layout.n, layout.cost
     column_sums = layout.row_weight @ layout.stacked[: layout.residual_rows]
     np.subtract(positive, column_sums, out=cost[:n])
     np.add(negative, column_sums, out=cost[n : 2 * n])
-    np.multiply(2.0, layout.row_weight, out=cost[2 * n :])
+
+
+def _stack(parts: list[Array], out: Array) -> None:
+    """``parts`` end to end into ``out`` (a single part or none copied without concatenate)."""
+    filled = [part for part in parts if part.size]
+    if len(filled) == 1:
+        out[:] = filled[0]
+    elif filled:
+        np.concatenate(filled, out=out)
 
 
 def _failed(n: int, status: str) -> LPSolution:
@@ -336,12 +344,18 @@ def _active(
     """
     active = [rows.name for rows in linear if rows.engaged and _tight(rows, u)]
     active += [bound.name for bound in norms if split_sum >= bound.limit - ACTIVE_TOLERANCE]
+    values = u.tolist()
     for bound in bounds:
         # An infinite bound is never within the tolerance of u; a degenerate one never counts.
-        at_bound = np.minimum(u - bound.lower, bound.upper - u) <= ACTIVE_TOLERANCE
-        at_bound &= bound.upper - bound.lower > ACTIVE_TOLERANCE
-        if np.count_nonzero(at_bound):
-            active += [f"{bound.name}[{i}]" for i in np.flatnonzero(at_bound)]
+        # On Python floats: the same IEEE arithmetic, and at 8 to 40 entries faster than NumPy.
+        active += [
+            f"{bound.name}[{i}]"
+            for i, (x, low, high) in enumerate(
+                zip(values, bound.lower.tolist(), bound.upper.tolist(), strict=True)
+            )
+            if (x - low <= ACTIVE_TOLERANCE or high - x <= ACTIVE_TOLERANCE)
+            and high - low > ACTIVE_TOLERANCE
+        ]
     return tuple(active)
 
 
