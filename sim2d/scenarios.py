@@ -20,8 +20,8 @@ middle of its joint ranges, and its goal is the pose of its gripper at another c
 inside its limits (its first joint turned so that the gripper lies ahead, ``_ahead``), the base
 ``AHEAD`` of the start (a fixed base's where it starts): a goal it reaches by construction.
 The bin lies under that pose and the set-up carries its own offset, as 'table''s does. 'pose',
-'position' and (on a mobile base) 'obstacle' are derived; the other set-ups are Little John's
-scenes.
+'position' and, on a mobile base small enough for the camera's view to hold the way past the
+obstacle, 'obstacle' are derived; the other set-ups are Little John's scenes.
 """
 
 from __future__ import annotations
@@ -84,6 +84,12 @@ rad, in alternating directions (different ones for the goal); a prismatic joint'
 of its range (``_bent``); every joint stays inside ``LIMIT_SHARE`` of its range."""
 LIMIT_SHARE = 0.8
 """The share of each joint's range, about its middle, a derived configuration stays in."""
+OBSTACLE_MARGIN_M = 0.1
+"""A derived 'obstacle' set-up's least gap between the obstacle and the base's body at the start
+and at the goal's base (``_obstacle_way``)."""
+OBSTACLE_WAY_MAX_M = 1.5
+"""The longest way ``_obstacle_way`` may take, m: beyond it the bin leaves the ceiling camera's
+view, and a robot whose body needs more has no 'obstacle' set-up."""
 DRAW = 0.1
 """A seed moves a derived start's and goal's arm joints by U(-DRAW, DRAW) rad (a prismatic
 joint by that share of its range), and a mobile base's as ``START_RANGE``."""
@@ -187,7 +193,8 @@ def derived(name: str, robot: MobileManipulator, seed: int | None = None) -> Sim
     start, the pose of its gripper at its goal configuration (the module docstring); a seed
     draws both configurations (``DRAW``). ``ValueError`` naming what it can choose."""
     mobile = robot.base.kind != "fixed"
-    choices = DERIVED if mobile else DERIVED[:2]
+    fits = mobile and _obstacle_way_m(robot) <= OBSTACLE_WAY_MAX_M
+    choices = DERIVED if fits else DERIVED[:2]
     if name not in choices:
         raise ValueError(
             f"the {name!r} set-up is {DECLARED_FOR}'s; for {robot.name} choose {', '.join(choices)}"
@@ -203,10 +210,10 @@ def derived(name: str, robot: MobileManipulator, seed: int | None = None) -> Sim
     x, y, yaw = planar_of(pose)
     obstacles: tuple[Circle, ...] = ()
     if name == "obstacle":  # the bin past an obstacle on the way, as Little John's
-        shift = np.array([*OBSTACLE_SHIFT, 0.0])
-        pose = dq.normalize(dq.mul(planar_pose(*shift, 0.0), pose))
+        shift, obstacle = _obstacle_way(robot, goal_q[:2])
+        pose = dq.normalize(dq.mul(planar_pose(*shift, 0.0, 0.0), pose))
         x, y, yaw = planar_of(pose)
-        obstacles = (OBSTACLE,)
+        obstacles = (obstacle,)
     offset = offset_of(dq.mul(dq.conj(planar_pose(x, y, yaw, 0.0)), pose))
     task = "position" if name == "position" else "pose"
     return SimScenario(
@@ -218,6 +225,21 @@ def derived(name: str, robot: MobileManipulator, seed: int | None = None) -> Sim
         goal_height=0.0,
         goal_offset=tuple(round(v, 9) for v in offset),
     )
+
+
+def _obstacle_way(robot: MobileManipulator, base_xy: np.ndarray) -> tuple[np.ndarray, Circle]:
+    """'obstacle''s shift of the goal from the base at ``base_xy`` (``OBSTACLE_SHIFT``'s
+    direction), and its obstacle (``OBSTACLE``'s size) half way from the start to the shifted
+    base: Little John's own, scaled up for a larger body so that neither end touches it."""
+    way = base_xy + np.array(OBSTACLE_SHIFT)
+    way = way * max(1.0, _obstacle_way_m(robot) / float(np.linalg.norm(way)))
+    middle = 0.5 * way
+    return way - base_xy, Circle(float(middle[0]), float(middle[1]), OBSTACLE.radius)
+
+
+def _obstacle_way_m(robot: MobileManipulator) -> float:
+    """The least way from the start to the goal's base past the obstacle half way, m."""
+    return 2.0 * (robot.base.body_radius + OBSTACLE.radius + OBSTACLE_MARGIN_M)
 
 
 def _inside(robot: MobileManipulator) -> tuple[np.ndarray, np.ndarray]:

@@ -24,7 +24,9 @@ DT, STEPS = 0.02, 3000
 
 
 def names_for(robot: MobileManipulator) -> tuple[str, ...]:
-    return DERIVED if robot.base.kind != "fixed" else DERIVED[:2]
+    """'obstacle' but on a fixed base, or a body too large for the way past the obstacle."""
+    small = robot.base.kind != "fixed" and robot.base.body_radius < 0.5
+    return DERIVED if small else DERIVED[:2]
 
 
 @pytest.mark.parametrize("path", OTHERS, ids=[p.stem for p in OTHERS])
