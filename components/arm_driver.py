@@ -1,4 +1,7 @@
-"""The arm driver: five AX-18A servos, Dynamixel protocol 1.0, through ROBOTIS's dynamixel-sdk.
+"""The arm driver: AX-18A servos, one per joint of the robot's arm, Dynamixel protocol 1.0,
+through ROBOTIS's dynamixel-sdk. Which servo drives which joint, from which zero and which way,
+is the robot description's ``servos:`` section (``wbc.servo_map``: servo angle = offset +
+direction * q); the ``ids`` parameter, when set, overrides its ids.
 
 Every 1/``rate_hz`` s it reads each servo's present position, speed and load on its own (bulk
 and sync read do not exist for AX servos in protocol 1.0) and publishes ``arm/joint_states``.
@@ -10,7 +13,7 @@ present one in the direction of motion (``lookahead_s`` of the commanded speed, 
 A joint whose speed rounds to Moving Speed 0 (which would mean full speed) holds: its goal is
 its position read when it stops (not a reading from before: a joint still moving would move
 back to it after the stop), kept while it stays stopped, so it does not creep. All
-five goals and speeds go in one Sync Write, and every goal written lies inside the robot
+the goals and speeds go in one Sync Write, and every goal written lies inside the robot
 description's joint limits. With no command for ``command_timeout_s`` the arm holds.
 
 Each answer is checked (``protocols.dynamixel_v1.status_fault``): a servo that is silent (for
@@ -36,26 +39,27 @@ from components.joint_check import joints_match
 from components.params import Param, ParamError
 from components.process_entry import run_component
 from components.pubsub import Input
+from components.robot_vector import RobotVector, of_robot
 from components.runtime import Component, Node
 from messages import topics
 from messages.commands import ArmCommand
 from messages.joints import JointStates
 from protocols import dynamixel_v1 as dxl
 from wbc.robot import BASE_DOF, MobileManipulator
+from wbc.servo_map import ServoMap
 
 ERROR_BITS = {int(bit): bit.name.lower() for bit in dxl.StatusError}
 """The status-packet error bits of protocol 1.0, by the name they are counted under."""
 READ_BYTES = 4
 """Present Position and Present Speed, from address 36."""
 HOLD_SPEED = 1
-DEFAULT_IDS = (1, 2, 3, 4, 5)
 """The Moving Speed of a held joint: the slowest there is (0 would mean full speed)."""
 
 
 def check_ids(ids: tuple[int, ...]) -> None:
     """``ParamError`` unless the servo ids are distinct and in 0..253."""
     if len(set(ids)) != len(ids) or not all(0 <= i < 254 for i in ids):
-        raise ParamError(f"ids: expected {len(ids)} distinct servo ids in 0..253, got {ids}")
+        raise ParamError(f"ids: expected distinct servo ids in 0..253, got {ids}")
 
 
 class ArmDriver(Component):
@@ -66,13 +70,13 @@ class ArmDriver(Component):
     params = (
         Param("port", str, "/dev/ttyUSB1", doc="serial port of the servo bus"),
         Param("baud", int, 1_000_000, low=9600, high=3_000_000, doc="bus speed, bit/s"),
-        Param(
+        RobotVector(
             "ids",
             tuple,
-            DEFAULT_IDS,
-            length=len(DEFAULT_IDS),
+            (),
             integers=True,
-            doc="servo ids of q1..q5, [1, 2, 3, 4, 5]",
+            optional=True,
+            doc="a servo id per arm joint; [] takes the robot description's servos.ids",
             can_take=check_ids,
         ),
         Param("rate_hz", float, 50.0, low=1.0, high=200.0, doc="joint state rate"),
@@ -118,16 +122,22 @@ class ArmDriver(Component):
         robot = MobileManipulator.from_yaml(node.profile.robot)
         self.low, self.high = robot.q_min[BASE_DOF:], robot.q_max[BASE_DOF:]
         self.speed_max = robot.velocity_max[BASE_DOF:]
-        self.goal_low = [max(0, math.ceil(dxl.position_of_angle(q))) for q in self.low]
+        self.names, joints = robot.joint_names, robot.arm_dof
+        servos = ServoMap.of(node.profile.robot, joints)
+        if node.params["ids"]:
+            names = ", ".join(self.names)
+            servos = servos.with_ids(of_robot("ids", node.params["ids"], joints, names))
+        self.servos = servos
+        self.ids = servos.ids
+        ends = [
+            sorted((servos.servo_angle(i, self.low[i]), servos.servo_angle(i, self.high[i])))
+            for i in range(joints)
+        ]
+        self.goal_low = [max(0, math.ceil(dxl.position_of_angle(low))) for low, _ in ends]
         self.goal_high = [
-            min(dxl.POSITION_MAX, math.floor(dxl.position_of_angle(q))) for q in self.high
+            min(dxl.POSITION_MAX, math.floor(dxl.position_of_angle(high))) for _, high in ends
         ]
         """The Goal Positions inside the joint limits (every goal written lies in them)."""
-        self.ids: tuple[int, ...] = node.params["ids"]
-        if len(self.ids) != robot.arm_dof:
-            raise ParamError(f"ids: expected one servo id per joint of {robot.joint_names}")
-        self.names = robot.joint_names
-        joints = robot.arm_dof
         self.port = PortHandler(str(node.params["port"]))
         self.packet = PacketHandler(1.0)
         self.connected = False
@@ -253,7 +263,7 @@ class ArmDriver(Component):
         data, fault = self._read(servo)
         if fault is not None:
             return f"servo {servo} {fault}"
-        position = dxl.angle_of_units(data[0] | data[1] << 8)
+        position = self.servos.joint_position(index, dxl.angle_of_units(data[0] | data[1] << 8))
         low, high = self.low[index], self.high[index]
         margin = self.node.params["limit_margin"]
         if not low - margin <= position <= high + margin:
@@ -263,7 +273,8 @@ class ArmDriver(Component):
                 f"[{low:.3f}, {high:.3f}]"
             )
         self.present[index] = position
-        return position, dxl.rad_s_of_speed_units(data[2] | data[3] << 8)
+        speed = dxl.rad_s_of_speed_units(data[2] | data[3] << 8)
+        return position, self.servos.directions[index] * speed
 
     def _recover(self) -> None:
         """Every servo answers again: goals where the joints are now, then torque on."""
@@ -352,9 +363,10 @@ class ArmDriver(Component):
             self.held[index] = self._inside_limits(index, present)
         return self.held[index]
 
-    def _inside_limits(self, index: int, angle: float) -> int:
-        """The Goal Position of ``angle`` (finite), clamped to the joint's limits in units."""
-        units = dxl.position_units(angle)
+    def _inside_limits(self, index: int, q: float) -> int:
+        """The Goal Position of joint position ``q`` (finite), clamped to the joint's limits in
+        units."""
+        units = dxl.position_units(self.servos.servo_angle(index, q))
         return min(max(units, self.goal_low[index]), self.goal_high[index])
 
     def hold(self, failed: Collection[int] = ()) -> None:

@@ -1,5 +1,6 @@
 """The simulator with its robot behind serial devices: an emulated Create 2 and an emulated
-chain of five AX-18A servos, each on a pseudo-terminal, moving the simulated world.
+chain of AX-18A servos, one per joint of the robot's arm (placed as its description's
+``servos:`` say), each on a pseudo-terminal, moving the simulated world.
 
 Everything of ``components.simulator`` but the sensor topics: the world, the ceiling camera,
 ``sim/clock`` and ``sim/truth``. The base and arm drivers open the emulators' ports (at the
@@ -25,17 +26,19 @@ from messages import topics
 from sim2d.devices.ax_servos import AXChainEmulator
 from sim2d.devices.create2 import Create2Emulator
 from sim2d.world import World
+from wbc.servo_map import ServoMap
 
 
 class WorldDevices:
-    """The emulators' view of the world (both backends): wheel speeds and joint velocities
-    in, encoder counts and joint angles out, under one lock against the stepping thread."""
+    """The emulators' view of the world (both backends): wheel speeds and servo velocities
+    in, encoder counts and servo angles out, under one lock against the stepping thread. The
+    servos map to the joints as the robot description's ``servos`` say (``wbc.servo_map``)."""
 
-    def __init__(self, world: World) -> None:
-        self.world = world
+    def __init__(self, world: World, servos: ServoMap) -> None:
+        self.world, self.servos = world, servos
         self.lock = threading.Lock()
         self.wheels = (0.0, 0.0)
-        self.joints = (0.0,) * 5
+        self.joints = (0.0,) * world.robot.arm_dof
 
     def set_wheel_speeds(self, left: float, right: float) -> None:
         with self.lock:
@@ -46,12 +49,16 @@ class WorldDevices:
             return self.world.encoder_counts
 
     def joint_positions(self) -> Sequence[float]:
+        """The servos' angles (rad), one per joint."""
         with self.lock:
-            return tuple(self.world.q[3:].tolist())
+            q = self.world.q[3:].tolist()
+        return tuple(self.servos.servo_angle(i, v) for i, v in enumerate(q))
 
     def set_joint_velocities(self, velocities: Sequence[float]) -> None:
+        """The servos' velocities (rad/s), one per joint."""
+        joints = tuple(d * v for d, v in zip(self.servos.directions, velocities, strict=True))
         with self.lock:
-            self.joints = tuple(velocities)
+            self.joints = joints
 
 
 class EmulatedRobot(Simulator):
@@ -74,12 +81,13 @@ class EmulatedRobot(Simulator):
                 "robot runs at 1.0 with host_epoch true"
             )
         super().__init__(node)
-        self.devices = WorldDevices(self.world)
+        servos = ServoMap.of(node.profile.robot, self.robot.arm_dof)
+        self.devices = WorldDevices(self.world, servos)
         links = [Path(str(node.params[name])) for name in ("create_link", "servo_link")]
         for link in links:
             link.parent.mkdir(parents=True, exist_ok=True)
         self.create = Create2Emulator(self.devices, links[0])
-        self.servos = AXChainEmulator(self.devices, link=links[1])
+        self.servos = AXChainEmulator(self.devices, servos.ids, link=links[1])
         self.create.start()
         self.servos.start()
         for name in ("create_bad_bytes", "servo_bad_checksums"):

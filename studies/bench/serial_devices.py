@@ -2,8 +2,9 @@
 
 Run as ``python -m studies.bench.serial_devices [--json]``. On the AX-18A chain emulator at 1 Mbps
 (return delay 500 us, the servos' default), with ROBOTIS's dynamixel-sdk: one servo's
-present position and speed (a 4-byte read), the Sync Write of five goals and speeds, and the
-joint-state rate one read per servo allows. On the Create 2 emulator, with pyserial: a Drive
+present position and speed (a 4-byte read), the Sync Write of a goal and speed per servo of
+Little John's five (its description's ``servos``), and the joint-state rate one read per servo
+allows. On the Create 2 emulator, with pyserial: a Drive
 Direct written until the wheels take it, and the mean period of the encoder stream.
 """
 
@@ -19,12 +20,16 @@ import serial
 from dynamixel_sdk import COMM_SUCCESS, GroupSyncWrite, PacketHandler, PortHandler
 
 from outputs.stdout import emit, json_text, result_only_stdout
+from profiles.deploy_files import ROBOT_FILE
 from protocols import create_oi
 from protocols import dynamixel_v1 as dxl
 from sim2d.devices.ax_servos import AXChainEmulator
 from sim2d.devices.create2 import Create2Emulator
+from wbc.servo_map import ServoMap
 
 SAMPLES = 300
+SERVOS = ServoMap.of(ROBOT_FILE, 5).ids
+"""Little John's servo ids, q1 to q5."""
 
 
 class StillArm:
@@ -56,26 +61,26 @@ def figures(values_us: list[float]) -> dict[str, float]:
 
 
 def servo_bus() -> dict:
-    with AXChainEmulator(StillArm()) as chain:
+    with AXChainEmulator(StillArm(), SERVOS) as chain:
         port, packet = PortHandler(chain.port), PacketHandler(1.0)
         port.openPort()
         port.setBaudRate(1_000_000)
         reads, writes = [], []
         for index in range(SAMPLES):
-            servo = 1 + index % 5
+            servo = SERVOS[index % len(SERVOS)]
             start = time.perf_counter()
             _, result, _ = packet.readTxRx(port, servo, dxl.Address.PRESENT_POSITION, 4)
             reads.append((time.perf_counter() - start) * 1e6)
             if result != COMM_SUCCESS:
                 raise RuntimeError(packet.getTxRxResult(result))
             group = GroupSyncWrite(port, packet, dxl.Address.GOAL_POSITION, 4)
-            for servo_id in range(1, 6):
+            for servo_id in SERVOS:
                 group.addParam(servo_id, [0, 2, 100, 0])
             start = time.perf_counter()
             group.txPacket()
             writes.append((time.perf_counter() - start) * 1e6)
         port.closePort()
-    cycle_us = 5 * float(np.median(reads)) + float(np.median(writes))
+    cycle_us = len(SERVOS) * float(np.median(reads)) + float(np.median(writes))
     return {
         "read_one_servo": figures(reads),
         "sync_write_five": figures(writes),

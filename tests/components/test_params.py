@@ -124,16 +124,19 @@ def test_every_gain_of_a_law_is_a_parameter_with_the_bounds_its_dataclass_declar
                 param.check(spec.high * 2 + 1)
 
 
-def test_the_arm_drivers_servo_ids_are_five_distinct_integers_and_say_so() -> None:
+def test_the_arm_drivers_servo_ids_are_distinct_integers_or_none_and_say_so() -> None:
+    """One per joint of the robot (checked where the driver loads it); [] keeps the robot
+    description's servos.ids."""
     ids = Parameters(ArmDriver.params, {"ids": [5, 4, 3, 2, 1]})["ids"]
     assert ids == (5, 4, 3, 2, 1) and all(type(i) is int for i in ids)
     assert Parameters(ArmDriver.params, {}).set_text("ids", "[1, 2, 3, 4, 6]") == (1, 2, 3, 4, 6)
+    assert Parameters(ArmDriver.params, {})["ids"] == ()
+    expected = "ids: expected 1 or more integers in a list, or [] for none"
     for value, message in [
-        ("1, 2, 3, 4, 5", "ids: expected 5 integers in a list, got '1, 2, 3, 4, 5'"),
-        ([1, 2, 3, 4, 5.0], "ids: expected 5 integers in a list"),
-        ([1, 2, 3, 4], "ids: expected 5 integers in a list"),
-        ([1, 1, 2, 3, 4], "ids: expected 5 distinct servo ids in 0..253, got (1, 1, 2, 3, 4)"),
-        ([1, 2, 3, 4, 254], "ids: expected 5 distinct servo ids in 0..253"),
+        ("1, 2, 3, 4, 5", f"{expected}, got '1, 2, 3, 4, 5'"),
+        ([1, 2, 3, 4, 5.0], expected),
+        ([1, 1, 2, 3, 4], "ids: expected distinct servo ids in 0..253, got (1, 1, 2, 3, 4)"),
+        ([1, 2, 3, 4, 254], "ids: expected distinct servo ids in 0..253"),
     ]:
         with pytest.raises(ParamError) as error:
             Parameters(ArmDriver.params, {"ids": value})
@@ -153,7 +156,6 @@ def test_the_scripted_goal_pose_is_eight_numbers_or_none() -> None:
 @pytest.mark.parametrize(
     ("profile", "name", "component", "param", "length"),
     [
-        ("hardware.yaml", "arm_driver", ArmDriver, "ids", 5),
         ("controllers.yaml", "publisher", ScriptedPublisher, "goal_pose", 8),
     ],
 )
