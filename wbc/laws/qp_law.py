@@ -181,7 +181,12 @@ class WarmStartedQP:
             self._active = None
             return np.zeros(n), NON_FINITE, None
         self._active = np.where(np.abs(np.asarray(info["lam"])) > 0, ACTIVE, 0)
-        return g[:n] - g[n:], "optimal", float(objective)
+        # An entry whose bounds meet (a fixed base's u_b) is that bound exactly, not DAQP's
+        # 1e-15 round-off beside it: a zero the counts of nonzero entries see as zero.
+        u = g[:n] - g[n:]
+        pinned = lower[0] == upper[0]
+        u[pinned] = lower[0][pinned]
+        return u, "optimal", float(objective)
 
 
 def _objective(split: Array, costs: list, damping: float) -> tuple[Array, Array]:
