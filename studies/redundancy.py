@@ -228,9 +228,11 @@ def study(
     workers: int = 2,
     seed: int = SEED,
     time_limit_s: float = TIME_LIMIT_S,
+    families: tuple[str, ...] = tuple(TASKS),
 ) -> dict[str, dict]:
-    """For every robot of ``paths``: its DOF, and per family and law the ``summary`` of its
-    ``count`` goals. ``workers`` > 1 runs the goals in that many processes."""
+    """For every robot of ``paths``: its DOF, and per family (of ``families``) and law the
+    ``summary`` of its ``count`` goals. ``workers`` > 1 runs the goals in that many
+    processes."""
     report: dict[str, dict] = {}
     pool = multiprocessing.get_context("spawn").Pool(workers) if workers > 1 else None
     mapped = pool.map if pool else map
@@ -239,12 +241,12 @@ def study(
             robot = _robot(path)
             pairs = draw(robot, count, seed)
             rows: dict[str, dict] = {}
-            for family, task_dof in TASKS.items():
+            for family in families:
                 rows[family] = {}
                 for law in LAWS:
                     progress(f"{robot.name}: {family} goals, {law}")
                     jobs = [(path, law, family, *pair, time_limit_s) for pair in pairs]
-                    rows[family][law] = summary(list(mapped(run_one, jobs)), task_dof)
+                    rows[family][law] = summary(list(mapped(run_one, jobs)), TASKS[family])
             report[robot.name] = {
                 "description": path.name,
                 "base": base_kind(robot),

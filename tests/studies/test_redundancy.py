@@ -106,7 +106,13 @@ def test_the_command_prints_a_report_its_table_and_figure_and_two_reports_merged
 
 
 @pytest.mark.parametrize(
-    "argv", [["--robots", "no_such_robot"], ["--goals", "0"], ["--time-limit", "-1"]]
+    "argv",
+    [
+        ["--robots", "no_such_robot"],
+        ["--goals", "0"],
+        ["--time-limit", "-1"],
+        ["--families", "joint"],
+    ],
 )
 def test_bad_arguments_are_one_line_and_exit_2(
     argv: list[str], capsys: pytest.CaptureFixture[str]
