@@ -129,8 +129,9 @@ class ControlStep:
 
     def take_goal(self, goal: Goal) -> None:
         """Follow ``goal``; a goal the law cannot take (``ValueError``, naming the field and
-        what it must be: its ``eta`` or ``beta`` outside the bounds the gains declare, or a
-        task the law refuses) drops the current one, and the steps until the next goal say
+        what it must be: its ``eta`` or ``beta`` outside the bounds the gains declare, an
+        ``arm`` of another size than the robot's, or a task the law refuses) drops the current
+        one, and the steps until the next goal say
         why (status ``goal refused``)."""
         try:
             declared = {spec.name: spec for spec in gain_specs(type(self.gains))}
@@ -138,6 +139,9 @@ class ControlStep:
                 value = getattr(goal, name)
                 if value is not None and name in declared:
                     declared[name].check(value)
+            if goal.arm is not None and len(goal.arm) != self.robot.arm_dof:
+                names = ", ".join(self.robot.joint_names)
+                raise ValueError(f"arm: {len(goal.arm)} joints, the robot's are {names}")
             task = task_of(goal)
         except ValueError as error:
             self.goal = self.task = None

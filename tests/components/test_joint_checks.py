@@ -19,6 +19,7 @@ from components.simulator import Simulator
 from components.state_estimator import StateEstimator
 from components.supervisor import Supervisor
 from messages.commands import ArmCommand
+from messages.goal import Goal
 from messages.header import Header
 from messages.joints import JointStates
 from messages.state import RobotState
@@ -151,3 +152,12 @@ def test_the_scripted_publisher_sends_no_state_of_another_size(
             publisher.publish()
         assert node.counters["refused_states"] == 1
         assert "3 given, " + EXPECTED in caplog.text
+
+
+def test_a_goal_whose_arm_is_not_the_robots_size_is_refused() -> None:
+    control = ControlStep("lp", LPLaw, ROBOT, LPParams())
+    goal = Goal(header=HEADER, task="point", point=(1.0, 0.0), arm=(0.0,) * 7, lookahead=0.1)
+    with pytest.raises(ValueError, match="arm: 7 joints, the robot's are q1, q2, q3, q4, q5"):
+        control.take_goal(goal)
+    step = control.step(state(ROBOT.joint_names), HEADER.stamp_ns, 0.5)
+    assert step.status == "goal refused" and "arm: 7 joints" in step.reason
