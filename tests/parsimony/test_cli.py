@@ -1,4 +1,5 @@
-"""The `parsimony` command as a user runs it: a real process."""
+"""The `parsimony` command as a user runs it: a real process (what it refuses before it runs
+anything: its entry point in the test's process, tests/parsimony/in_process.py)."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ import pytest
 
 from parsimony.cli import COMMANDS
 from studies.goal_sets import LAWS, POSITION_LAWS
+from tests.parsimony.in_process import refused
 
 
 def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
@@ -39,9 +41,15 @@ def test_help_lists_every_subcommand():
 
 @pytest.mark.heavy  # minutes: every law's steps, convergence and goal sets
 def test_bench_prints_step_times_and_the_convergence_test_as_json():
-    result = run_cli("bench", "--json", "--repeats", "50", "--trials", "1", "--goals", "2")
+    """One goal per family and law, the zoo's step times on one robot (every figure's form is
+    checked; the numbers are the bench's to say)."""
+    zoo = "deploy/robots/youbot.yaml"
+    result = run_cli(
+        "bench", "--json", "--repeats", "50", "--trials", "1", "--goals", "1", "--zoo", zoo
+    )
     assert result.returncode == 0, result.stderr
     report = standard_json(result.stdout)  # a median of no steps is null
+    assert list(report["zoo"]) == ["youbot"]
     for law in ("lp", "qp", "classic", "cascade", "kinematics"):
         assert 0.0 < report["step"][law]["median_us"] <= report["step"][law]["p99_us"]
     assert report["ratios"]["lp_over_classic"] > 0.0 and report["ratios"]["qp_over_classic"] > 0
@@ -82,12 +90,11 @@ def test_bench_table_names_each_figure():
     assert "lp_over_classic" in result.stdout and "LP step, median us by part" in result.stdout
 
 
-@pytest.mark.parametrize("command", [("demo", "--json"), ("schema",)])
-def test_json_commands_print_nothing_but_json(command):
+def test_json_commands_print_nothing_but_json(demo: subprocess.CompletedProcess[str]):
     """The whole of stdout parses, whatever a library prints (HiGHS 1.16 prints a banner)."""
-    result = run_cli(*command)
-    assert result.returncode == 0, result.stderr
-    json.loads(result.stdout)
+    for result in (demo, run_cli("schema")):
+        assert result.returncode == 0, result.stderr
+        json.loads(result.stdout)
 
 
 def test_a_library_writing_to_file_descriptor_1_reaches_stderr():
@@ -108,10 +115,15 @@ def test_a_library_writing_to_file_descriptor_1_reaches_stderr():
     assert "banner from C" in result.stderr and "a log line" in result.stderr
 
 
-def test_demo_reports_every_experiment_and_exits_zero():
-    result = run_cli("demo", "--json")
-    assert result.returncode == 0, result.stdout + result.stderr
-    rows = {(row["experiment"], row["law"]): row for row in json.loads(result.stdout)}
+@pytest.fixture(scope="module")
+def demo() -> subprocess.CompletedProcess[str]:
+    """`parsimony demo --json`, once for the module."""
+    return run_cli("demo", "--json")
+
+
+def test_demo_reports_every_experiment_and_exits_zero(demo: subprocess.CompletedProcess[str]):
+    assert demo.returncode == 0, demo.stdout + demo.stderr
+    rows = {(row["experiment"], row["law"]): row for row in json.loads(demo.stdout)}
     assert rows[("pose", "LP")]["converged"] and rows[("position", "LP")]["converged"]
     for law in ("LP vector field", "LP border"):
         assert rows[("obstacle", law)]["converged"]
@@ -125,10 +137,10 @@ def test_demo_reports_every_experiment_and_exits_zero():
 
 
 @pytest.mark.parametrize("duration", ["nan", "inf", "-1", "0", "soon"])
-def test_launch_refuses_a_duration_that_is_not_a_positive_number_of_seconds(duration):
-    result = run_cli("launch", "deploy/controllers.yaml", "--duration", duration)
-    assert result.returncode == 2
-    assert "--duration" in result.stderr and repr(duration) in result.stderr
+def test_launch_refuses_a_duration_that_is_not_a_positive_number_of_seconds(duration, capsys):
+    code, _, err = refused(["launch", "deploy/controllers.yaml", "--duration", duration], capsys)
+    assert code == 2
+    assert "--duration" in err and repr(duration) in err
 
 
 def test_status_of_a_misspelt_profile_says_the_file_does_not_exist():
@@ -156,8 +168,9 @@ def test_zenoh_errors_reach_the_user_as_one_readable_line():
         ),
     ],
 )
-def test_goal_refuses_input_it_cannot_use_with_exit_2(argv: tuple[str, ...], error: str) -> None:
+def test_goal_refuses_input_it_cannot_use_with_exit_2(
+    argv: tuple[str, ...], error: str, capsys: pytest.CaptureFixture[str]
+) -> None:
     """Before anything is sent, and with no running system to ask."""
-    result = run_cli("goal", *argv)
-    assert result.returncode == 2, result.stderr
-    assert error in result.stderr and "Traceback" not in result.stderr
+    code, _, err = refused(["goal", *argv], capsys)
+    assert code == 2 and error in err, err

@@ -17,7 +17,6 @@ import yaml
 from mcap.reader import make_reader
 
 from messages.obstacles import Plane
-from parsimony.cli import main
 from profiles.profile import load_profile
 from record.session_reader import info
 from record.sessions import load_session
@@ -30,6 +29,7 @@ from studies.experiment import (
     Options,
     experiment_profile,
 )
+from tests.parsimony.in_process import refused
 from tests.scenes.views_read import decode, vector
 from tests.studies.experiments import assert_sound, experiment, run_here
 from wbc.planar import inverse
@@ -282,18 +282,9 @@ def test_usage_errors_exit_2_and_say_why(
 ) -> None:
     """The command's own entry point, in this process (a traceback would fail the test)."""
     extra = [] if bad == ["pose"] else ["--out", str(tmp_path)]
-    assert command_exit(["experiment", *bad, *extra]) == 2
-    out, err = capsys.readouterr()
-    assert why in err and out == "", err
+    code, out, err = refused(["experiment", *bad, *extra], capsys)
+    assert code == 2 and why in err and out == "", err
     assert not any(tmp_path.iterdir())  # refused before anything was written
-
-
-def command_exit(argv: list[str]) -> int:
-    """The exit status of `parsimony ARGV` (``parsimony.cli.main``; argparse exits by itself)."""
-    try:
-        return main(argv)
-    except SystemExit as exit:
-        return int(exit.code or 0)
 
 
 def test_the_cascade_takes_its_declared_gains(tmp_path: Path) -> None:
@@ -327,6 +318,6 @@ def test_an_experiment_does_not_write_over_a_directory_that_holds_files(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     (tmp_path / "report.json").write_text("{}")
-    assert command_exit(["experiment", "pose", "--out", str(tmp_path)]) == 2
-    assert "give --force" in capsys.readouterr().err
+    code, _, err = refused(["experiment", "pose", "--out", str(tmp_path)], capsys)
+    assert code == 2 and "give --force" in err, err
     assert (tmp_path / "report.json").read_text() == "{}"
