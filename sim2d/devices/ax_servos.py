@@ -268,15 +268,19 @@ class AXServo:
 
 
 class AXChainEmulator(SerialDevice):
+    """A servo per joint of ``backend``, answering to ``ids`` in the joints' order (1..n when
+    None)."""
+
     def __init__(
         self,
         backend: ServoBackend,
-        ids: Sequence[int] = (1, 2, 3, 4, 5),
+        ids: Sequence[int] | None = None,
         link: Path | None = None,
         return_delay_us: float = 500.0,
     ) -> None:
         self._backend = backend
         positions = backend.joint_positions()
+        ids = range(1, len(positions) + 1) if ids is None else ids
         self.servos = [
             AXServo(servo_id, return_delay_us, position)
             for servo_id, position in zip(ids, positions, strict=True)
