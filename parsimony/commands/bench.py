@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from outputs.stdout import emit, json_text
 from profiles.deploy_files import ROBOT_FILE
 from studies.benchmark import format_report, run_bench
+from wbc.robot import MobileManipulator, RobotDescriptionError
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -33,6 +35,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
 
 
 def run(args: argparse.Namespace) -> int:
+    for path in args.zoo or ():  # a description that cannot be used stops the bench at once
+        try:
+            MobileManipulator.from_yaml(path)
+        except RobotDescriptionError as error:
+            print(f"parsimony bench: {error}", file=sys.stderr)
+            return 2
     report = run_bench(args.repeats, args.trials, args.goals, args.robot, args.zoo, args.zoo_only)
     emit(json_text(report, indent=2) if args.json else format_report(report))
     return 0
