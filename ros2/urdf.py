@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -85,7 +86,8 @@ def _rpy(rotation: Array) -> tuple[float, float, float]:
 
 
 def _numbers(values) -> str:
-    return " ".join(f"{float(v):.17g}" for v in values)
+    """Numbers to 17 digits, rounding noise below 1e-15 written as 0."""
+    return " ".join(f"{float(v):.17g}" if abs(v) > 1e-15 else "0" for v in values)
 
 
 def _origin(parent: ET.Element, transform: Array) -> None:
@@ -113,55 +115,79 @@ def _cylinder(link: ET.Element, start: Array, end: Array, radius: float) -> None
     ET.SubElement(geometry, "cylinder", radius=_numbers([radius]), length=_numbers([length]))
 
 
-def _fixed(robot_xml: ET.Element, name: str, parent: str, child: str, transform: Array) -> None:
-    joint = ET.SubElement(robot_xml, "joint", name=name, type="fixed")
-    _origin(joint, transform)
-    ET.SubElement(joint, "parent", link=parent)
-    ET.SubElement(joint, "child", link=child)
+@dataclass(frozen=True)
+class Joint:
+    """One joint of the URDF's tree: fixed, or moved by arm joint ``index`` (0-based) about or
+    along ``axis`` in its own frame, placed at ``origin`` (4x4) in its parent link."""
+
+    name: str
+    kind: str
+    parent: str
+    child: str
+    origin: Array
+    axis: Array | None = None
+    index: int | None = None
+
+    def transform(self, q_arm: Array) -> Array:
+        """The child link's pose in its parent's at the arm's joint values ``q_arm``."""
+        if self.index is None:
+            return self.origin
+        value, motion = float(q_arm[self.index]), np.eye(4)
+        if self.kind == "prismatic":
+            motion[:3, 3] = value * self.axis
+        else:
+            x, y, z = self.axis
+            skew = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+            motion[:3, :3] += math.sin(value) * skew + (1.0 - math.cos(value)) * skew @ skew
+        return self.origin @ motion
 
 
-def urdf(robot: MobileManipulator, camera: tuple[str, int, Array] | None = None) -> str:
-    """The URDF text of ``robot``; ``camera`` = (frame name, model frame 0..n it is fixed to,
-    its 4x4 pose there) adds a camera frame."""
-    root = ET.Element("robot", name=robot.name)
-    ET.SubElement(root, "link", name=ROOT)
-    base = ET.SubElement(root, "link", name=BASE)
-    height = robot.base.height
-    if height > 0.0 and robot.base.body_radius > 0.0:
-        start, end = np.array([0.0, 0.0, -height]), np.zeros(3)
-        _cylinder(base, start, end, robot.base.body_radius)
-    _fixed(root, "base_top", ROOT, BASE, _translation([0.0, 0.0, height]))
+def joints(robot: MobileManipulator, camera: tuple[str, int, Array] | None = None) -> list[Joint]:
+    """The URDF's joints, parents first (the module's docstring); ``camera`` = (frame name,
+    model frame 0..n it is fixed to, its 4x4 pose there) adds a camera frame."""
+    found = [Joint("base_top", "fixed", ROOT, BASE, _translation([0.0, 0.0, robot.base.height]))]
     for i in range(1, robot.arm_dof + 1):
         name = robot.joint_names[i - 1]
         before, axis, after = joint_placement(robot, i)
-        low, high = robot.q_min[BASE_DOF + i - 1], robot.q_max[BASE_DOF + i - 1]
         kind = robot.joint_types[i - 1]
+        low, high = robot.q_min[BASE_DOF + i - 1], robot.q_max[BASE_DOF + i - 1]
         if kind == "revolute" and not (np.isfinite(low) and np.isfinite(high)):
             kind = "continuous"
         separate = not np.allclose(after, np.eye(4), rtol=0.0, atol=_IDENTITY_TOLERANCE)
         child = f"{name}_motion" if separate else link_name(i)
+        found.append(Joint(name, kind, link_name(i - 1), child, before, axis, i - 1))
         if separate:
-            ET.SubElement(root, "link", name=child)
-        joint = ET.SubElement(root, "joint", name=name, type=kind)
-        _origin(joint, before)
-        ET.SubElement(joint, "parent", link=link_name(i - 1))
-        ET.SubElement(joint, "child", link=child)
-        ET.SubElement(joint, "axis", xyz=_numbers(axis))
-        limit = {"effort": "0", "velocity": _numbers([robot.velocity_max[BASE_DOF + i - 1]])}
-        if kind != "continuous":
-            limit |= {"lower": _numbers([low]), "upper": _numbers([high])}
-        ET.SubElement(joint, "limit", limit)
-        link = ET.SubElement(root, "link", name=link_name(i))
-        outline = robot.link_outline(i)
-        for start, end in zip(outline[:-1], outline[1:], strict=True):
-            _cylinder(link, start, end, LINK_RADIUS)
-        if separate:
-            _fixed(root, f"{name}_frame", child, link_name(i), after)
-    ET.SubElement(root, "link", name=END_EFFECTOR)
-    _fixed(root, END_EFFECTOR, link_name(robot.arm_dof), END_EFFECTOR, np.eye(4))
+            found.append(Joint(f"{name}_frame", "fixed", child, link_name(i), after))
+    found.append(Joint(END_EFFECTOR, "fixed", link_name(robot.arm_dof), END_EFFECTOR, np.eye(4)))
     if camera is not None:
         frame, parent, pose = camera
-        ET.SubElement(root, "link", name=frame)
-        _fixed(root, frame, link_name(parent), frame, np.asarray(pose, dtype=float))
+        found.append(Joint(frame, "fixed", link_name(parent), frame, np.asarray(pose, float)))
+    return found
+
+
+def urdf(robot: MobileManipulator, camera: tuple[str, int, Array] | None = None) -> str:
+    """The URDF text of ``robot`` (``joints``' tree, each arm link drawn along its outline)."""
+    root = ET.Element("robot", name=robot.name)
+    ET.SubElement(root, "link", name=ROOT)
+    for joint in joints(robot, camera):
+        link = ET.SubElement(root, "link", name=joint.child)
+        if joint.child == BASE and robot.base.height > 0.0 and robot.base.body_radius > 0.0:
+            below = np.array([0.0, 0.0, -robot.base.height])
+            _cylinder(link, below, np.zeros(3), robot.base.body_radius)
+        elif joint.child.startswith("link_"):
+            outline = robot.link_outline(int(joint.child.removeprefix("link_")))
+            for start, end in zip(outline[:-1], outline[1:], strict=True):
+                _cylinder(link, start, end, LINK_RADIUS)
+        element = ET.SubElement(root, "joint", name=joint.name, type=joint.kind)
+        _origin(element, joint.origin)
+        ET.SubElement(element, "parent", link=joint.parent)
+        ET.SubElement(element, "child", link=joint.child)
+        if joint.index is not None:
+            ET.SubElement(element, "axis", xyz=_numbers(joint.axis))
+            k = BASE_DOF + joint.index
+            limit = {"effort": "0", "velocity": _numbers([robot.velocity_max[k]])}
+            if joint.kind != "continuous":
+                limit |= {"lower": _numbers([robot.q_min[k]]), "upper": _numbers([robot.q_max[k]])}
+            ET.SubElement(element, "limit", limit)
     ET.indent(root)
     return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import yourdfpy
 
-from ros2.urdf import END_EFFECTOR, link_name, matrix, planar, urdf
+from ros2.urdf import END_EFFECTOR, joints, link_name, matrix, planar, urdf
 from wbc.robot import BASE_DOF, BaseDescription, MobileManipulator
 
 ROBOTS = sorted(Path("deploy/robots").glob("*.yaml"))
@@ -67,3 +67,13 @@ def test_prismatic_joints_and_a_camera_frame():
     expected = matrix(robot.frames(q)[-1]) @ camera
     found = model.get_transform("camera", "base_footprint")
     np.testing.assert_allclose(found, expected, rtol=0.0, atol=1e-12)
+
+
+def test_joint_transforms_are_yourdfpys():
+    robot = MobileManipulator.from_yaml("deploy/robots/open_manipulator_x.yaml")
+    model = load(urdf(robot))
+    q_arm = np.random.default_rng(1).uniform(robot.q_min[BASE_DOF:], robot.q_max[BASE_DOF:])
+    model.update_cfg(q_arm)
+    for joint in joints(robot):
+        found = model.get_transform(joint.child, joint.parent)
+        np.testing.assert_allclose(joint.transform(q_arm), found, rtol=0.0, atol=1e-12)
