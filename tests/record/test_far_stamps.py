@@ -1,11 +1,14 @@
 """A message stamped far outside its session (a goal stamped on the wall clock in a simulated
-session, as `topic pub` once did) is said in one line naming its topic by `info`, `replay`,
-`report` and the judge, and left out: `info` gives the session's true span, a replay ends, a
-report is written whole."""
+session, as `topic pub` once did) is said in one line naming its topic by the recorder, `info`,
+`replay`, `report` and the judge, and left out: `info` gives the session's true span, a replay
+ends, a report is written whole."""
 
 from __future__ import annotations
 
 import json
+import signal
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -13,12 +16,18 @@ import pytest
 import yaml
 
 from analysis.judge import JUDGED, judge
+from launch.query import live_components, statuses
+from messages import codec, topics
+from messages.clock import Clock
 from messages.goal import Goal
 from messages.header import Header
 from messages.topics import CONTROL_GOAL, GOAL_REQUEST
 from profiles.endpoints import free_port
+from profiles.profile import load_profile
+from record.session_reader import info
 from record.session_span import FAR_NS, Span
 from record.sessions import load_session
+from studies.experiment import connect, launched
 from tests.analysis.conftest import DT, FIGURES, ROBOT, START_NS, session_of, write
 from tests.processes import parsimony
 from wbc.geometry import scenarios
@@ -126,3 +135,61 @@ def test_the_session_is_the_stretch_without_a_days_gap_that_holds_the_most() -> 
     assert span.session() == (FAR_NS * 3, FAR_NS * 3 + 99)
     span.add(FAR_NS * 3 + 99 + FAR_NS)  # a day later: the same session, one day longer
     assert span.session() == (FAR_NS * 3, FAR_NS * 4 + 99)
+
+
+def test_the_recorder_says_once_which_topic_was_stamped_far_outside_the_session(
+    tmp_path: Path,
+) -> None:
+    """On simulated time, a goal stamped on the wall clock (as `topic pub` stamped it) is
+    recorded and said in one line naming its topic; `info` leaves it out of the span."""
+    profile = tmp_path / "sim.yaml"
+    profile.write_text(
+        yaml.safe_dump(
+            {
+                "namespace": "rec",
+                "clock": "sim",
+                "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
+                "components": [
+                    {
+                        "name": "pub",
+                        "module": "scripted_publisher",
+                        "role": "tool",
+                        "params": {"rate_hz": 50.0},
+                    }
+                ],
+            }
+        )
+    )
+    out = tmp_path / "far.mcap"
+    with launched(profile) as launcher, connect(load_profile(profile), launcher) as session:
+        command = subprocess.Popen(
+            [sys.executable, "-m", "parsimony.cli", "record", str(profile), "-o", str(out)],
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        while "recorder" not in live_components(session, "rec", 0.5):
+            assert command.poll() is None
+        clock = session.declare_publisher(topics.SIM_CLOCK.key("rec"))
+        goals = session.declare_publisher(topics.GOAL_REQUEST.key("rec"))
+        for tick in range(1, 101):  # a simulated second
+            clock.put(codec.encode(Clock(stamp_ns=tick * 10_000_000)))
+            if tick in (50, 60):
+                goal = Goal(
+                    header=Header(stamp_ns=time.time_ns(), frame="world", seq=tick, source="topic"),
+                    task="position",
+                    position=(1.0, 0.0, 0.5),
+                )
+                goals.put(codec.encode(goal))
+        deadline = time.monotonic() + 60.0  # a safety net: the recorder counts them in 0.1 s
+        while statuses(session, "rec")["recorder"].counters.get("outside.goal/request") != 2:
+            assert command.poll() is None and time.monotonic() < deadline, "never counted"
+            time.sleep(0.1)  # the recorder's queue is written in its own time
+        command.send_signal(signal.SIGINT)
+        _, stderr = command.communicate()
+    assert command.returncode == 0, stderr
+    lines = [line for line in stderr.splitlines() if "far outside the session" in line]
+    assert len(lines) == 1 and "1 message of goal/request" in lines[0], stderr
+    found = info(out)
+    assert list(found["outside"]) == ["rec/goal/request"]
+    assert found["outside"]["rec/goal/request"]["messages"] == 2
+    assert found["end_ns"] <= 100 * 10_000_000

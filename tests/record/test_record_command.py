@@ -10,16 +10,15 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 import yaml
+import zenoh
 
 from launch.query import live_components, statuses
-from messages import codec, topics
-from messages.clock import Clock
-from messages.goal import Goal
-from messages.header import Header
 from messages.process import EXIT_FOR_GOOD
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
@@ -50,92 +49,53 @@ def system_profile(tmp_path: Path) -> Path:
     return path
 
 
+@dataclass
+class System:
+    """A launched system of one publisher (100 Hz), which each test's `parsimony record`
+    records while it runs."""
+
+    profile: Path
+    launcher: subprocess.Popen
+    session: zenoh.Session
+
+
+@pytest.fixture(scope="module")
+def system(tmp_path_factory: pytest.TempPathFactory) -> Iterator[System]:
+    profile = system_profile(tmp_path_factory.mktemp("system"))
+    with launched(profile) as launcher, connect(load_profile(profile), launcher) as session:
+        while "pub" not in live_components(session, "rec", 0.5):
+            assert launcher.poll() is None
+        yield System(profile, launcher, session)
+
+
 @pytest.mark.parametrize("how", [signal.SIGKILL, signal.SIGTERM, signal.SIGINT])
-def test_the_recorder_stops_with_the_record_command(tmp_path: Path, how: signal.Signals) -> None:
+def test_the_recorder_stops_with_the_record_command(
+    system: System, tmp_path: Path, how: signal.Signals
+) -> None:
     """However `parsimony record` ends (kill -9 too), its recorder stops and nothing is left
     in the temporary directory; on SIGINT or SIGTERM the command passes the signal on and the
     file gets its footer."""
-    profile = system_profile(tmp_path)
     out = tmp_path / "k.mcap"
     temporary = tmp_path / "tmp"
     temporary.mkdir()
-    with launched(profile) as launcher, connect(load_profile(profile), launcher) as session:
-        command = subprocess.Popen(
-            [sys.executable, "-m", "parsimony.cli", "record", str(profile), "-o", str(out)],
-            env={**os.environ, "TMPDIR": str(temporary)},
-        )
-        while "recorder" not in live_components(session, "rec", 0.5):
-            assert command.poll() is None
-        while not out.exists() or info(out)["messages"] < 50:
-            time.sleep(0.1)  # recording: at least a chunk flushed
-        child = statuses(session, "rec")["recorder"].pid
-        command.send_signal(how)
-        command.wait()
-        while not process_gone(child):
-            time.sleep(0.1)  # the recorder goes too (the test fails by hanging if not)
+    command = subprocess.Popen(
+        [sys.executable, "-m", "parsimony.cli", "record", str(system.profile), "-o", str(out)],
+        env={**os.environ, "TMPDIR": str(temporary)},
+    )
+    while not out.exists() or info(out)["messages"] < 50:
+        assert command.poll() is None
+        time.sleep(0.1)  # recording: at least a chunk flushed
+    child = statuses(system.session, "rec")["recorder"].pid
+    command.send_signal(how)
+    command.wait()
+    while not process_gone(child):
+        time.sleep(0.1)  # the recorder goes too (the test fails by hanging if not)
+    assert system.launcher.poll() is None  # the recorded system runs on
     assert list(temporary.iterdir()) == []
     if how != signal.SIGKILL:
         assert command.returncode == 0
         assert info(out)["complete"], "the recorder wrote its footer"
     assert load_session(out)["robot/state"]
-
-
-def test_the_recorder_says_once_which_topic_was_stamped_far_outside_the_session(
-    tmp_path: Path,
-) -> None:
-    """On simulated time, a goal stamped on the wall clock (as `topic pub` stamped it) is
-    recorded and said in one line naming its topic; `info` leaves it out of the span."""
-    profile = tmp_path / "sim.yaml"
-    profile.write_text(
-        yaml.safe_dump(
-            {
-                "namespace": "rec",
-                "clock": "sim",
-                "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
-                "components": [
-                    {
-                        "name": "pub",
-                        "module": "scripted_publisher",
-                        "role": "tool",
-                        "params": {"rate_hz": 50.0},
-                    }
-                ],
-            }
-        )
-    )
-    out = tmp_path / "far.mcap"
-    with launched(profile) as launcher, connect(load_profile(profile), launcher) as session:
-        command = subprocess.Popen(
-            [sys.executable, "-m", "parsimony.cli", "record", str(profile), "-o", str(out)],
-            stderr=subprocess.PIPE,
-            text=True,
-        )
-        while "recorder" not in live_components(session, "rec", 0.5):
-            assert command.poll() is None
-        clock = session.declare_publisher(topics.SIM_CLOCK.key("rec"))
-        goals = session.declare_publisher(topics.GOAL_REQUEST.key("rec"))
-        for tick in range(1, 101):  # a simulated second
-            clock.put(codec.encode(Clock(stamp_ns=tick * 10_000_000)))
-            if tick in (50, 60):
-                goal = Goal(
-                    header=Header(stamp_ns=time.time_ns(), frame="world", seq=tick, source="topic"),
-                    task="position",
-                    position=(1.0, 0.0, 0.5),
-                )
-                goals.put(codec.encode(goal))
-        deadline = time.monotonic() + 60.0  # a safety net: the recorder counts them in 0.1 s
-        while statuses(session, "rec")["recorder"].counters.get("outside.goal/request") != 2:
-            assert command.poll() is None and time.monotonic() < deadline, "never counted"
-            time.sleep(0.1)  # the recorder's queue is written in its own time
-        command.send_signal(signal.SIGINT)
-        _, stderr = command.communicate()
-    assert command.returncode == 0, stderr
-    lines = [line for line in stderr.splitlines() if "far outside the session" in line]
-    assert len(lines) == 1 and "1 message of goal/request" in lines[0], stderr
-    found = info(out)
-    assert list(found["outside"]) == ["rec/goal/request"]
-    assert found["outside"]["rec/goal/request"]["messages"] == 2
-    assert found["end_ns"] <= 100 * 10_000_000
 
 
 def test_record_without_a_router_says_so_and_exits_2(tmp_path: Path) -> None:
@@ -144,18 +104,19 @@ def test_record_without_a_router_says_so_and_exits_2(tmp_path: Path) -> None:
     assert not (tmp_path / "k.mcap").exists()
 
 
-def test_no_command_writes_over_its_input_or_an_existing_file(tmp_path: Path) -> None:
-    profile = system_profile(tmp_path)
+def test_no_command_writes_over_its_input_or_an_existing_file(
+    system: System, tmp_path: Path
+) -> None:
+    profile = system.profile
     recording = tmp_path / "k.mcap"
-    with launched(profile) as launcher, connect(load_profile(profile), launcher):
-        command = subprocess.Popen(
-            [sys.executable, "-m", "parsimony.cli", "record", str(profile), "-o", str(recording)]
-        )
-        while not recording.exists() or info(recording)["messages"] < 50:
-            assert command.poll() is None
-            time.sleep(0.1)
-        command.send_signal(signal.SIGINT)
-        assert command.wait() == 0
+    command = subprocess.Popen(
+        [sys.executable, "-m", "parsimony.cli", "record", str(profile), "-o", str(recording)]
+    )
+    while not recording.exists() or info(recording)["messages"] < 50:
+        assert command.poll() is None
+        time.sleep(0.1)
+    command.send_signal(signal.SIGINT)
+    assert command.wait() == 0
     kept = recording.read_bytes()
     for arguments in (
         ["rerun", str(recording), "--controller", "lp", "-o", str(recording)],
@@ -210,7 +171,9 @@ def test_a_robot_file_that_is_no_description_is_one_line_from_report_and_rerun(
     )
 
 
-def test_record_onto_a_full_disk_says_so_in_one_line_and_its_file_recovers(tmp_path: Path) -> None:
+def test_record_onto_a_full_disk_says_so_in_one_line_and_its_file_recovers(
+    system: System, tmp_path: Path
+) -> None:
     """`parsimony record` onto a real 64 KiB tmpfs, mounted by the test in a mount namespace
     of its own (``unshare``): the recorder stops for good when the disk is full, the command
     exits non-zero with one line saying so, no traceback, and the file recovers."""
@@ -220,7 +183,7 @@ def test_record_onto_a_full_disk_says_so_in_one_line_and_its_file_recovers(tmp_p
     )
     if not probe or probe.returncode != 0:
         pytest.skip("no mount namespace here to mount a tmpfs in")
-    profile = system_profile(tmp_path)
+    profile = system.profile
     disk = tmp_path / "disk"
     disk.mkdir()
     recovered = tmp_path / "recovered.mcap"
@@ -230,10 +193,7 @@ def test_record_onto_a_full_disk_says_so_in_one_line_and_its_file_recovers(tmp_p
         f"code=$?; {sys.executable} -m parsimony.cli record --recover {disk}/k.mcap "
         f"-o {recovered} >&2; exit $code"
     )
-    with launched(profile) as launcher, connect(load_profile(profile), launcher) as session:
-        while "pub" not in live_components(session, "rec", 0.5):
-            assert launcher.poll() is None
-        done = subprocess.run([unshare, "-rm", "sh", "-c", script], capture_output=True, text=True)
+    done = subprocess.run([unshare, "-rm", "sh", "-c", script], capture_output=True, text=True)
     assert done.returncode == EXIT_FOR_GOOD, done.stderr
     assert "Traceback" not in done.stderr, done.stderr
     full = [line for line in done.stderr.splitlines() if "No space left on device" in line]
