@@ -13,7 +13,6 @@ import sys
 import time
 from pathlib import Path
 
-import pytest
 import yaml
 
 from launch import query
@@ -60,10 +59,9 @@ def test_emulated_differs_from_hardware_by_device_paths_and_camera_source_only()
     assert load_profile(DEPLOY / "emulated.yaml").clock == "wall"
 
 
-@pytest.mark.parametrize("seed", ["1", "2"])
-def test_the_pose_experiment_converges_through_the_emulated_devices(
-    tmp_path: Path, seed: str
-) -> None:
+def test_the_pose_experiment_converges_through_the_emulated_devices(tmp_path: Path) -> None:
+    """In real time (the emulated devices keep the wall clock), on one seed's set-up: a second
+    seed drew a like drive forward to a like bin and proved nothing more, for 24 s."""
     command = [
         sys.executable,
         "-m",
@@ -74,7 +72,7 @@ def test_the_pose_experiment_converges_through_the_emulated_devices(
         str(DEPLOY / "emulated.yaml"),
         "--realtime",
         "--seed",
-        seed,
+        "1",
         "--json",
         "--out",
         str(tmp_path),
