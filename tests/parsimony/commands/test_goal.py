@@ -94,7 +94,9 @@ def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Station]:
                 "components": [
                     {
                         "name": "simulator",
-                        "params": {"lockstep": True, "real_time_factor": 0.0, "paused": True},
+                        # Paced at the wall clock's rate: the loop does not run flat out
+                        # (two cores) while a test waits on a command or on the planner.
+                        "params": {"lockstep": True, "real_time_factor": 1.0, "paused": True},
                     }
                 ],
             }
