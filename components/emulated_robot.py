@@ -18,7 +18,7 @@ import threading
 from collections.abc import Sequence
 from pathlib import Path
 
-from components.params import Param, ParamError
+from components.params import Param, ParamError, load_robot
 from components.process_entry import run_component
 from components.runtime import Node
 from components.simulator import Simulator
@@ -79,6 +79,12 @@ class EmulatedRobot(Simulator):
             raise ParamError(
                 "real_time_factor: the drivers keep the host's time; the emulated "
                 "robot runs at 1.0 with host_epoch true"
+            )
+        kind = load_robot(node.profile.robot).base.kind if node.profile.robot else "differential"
+        if kind != "differential":
+            raise ParamError(
+                f"robot: the emulated Create 2 drives a differential base, not the {kind} base "
+                f"of {node.profile.robot}"
             )
         super().__init__(node)
         servos = ServoMap.of(node.profile.robot, self.robot.arm_dof)

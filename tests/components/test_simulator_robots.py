@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from components.emulated_robot import EmulatedRobot
 from components.params import ParamError
 from components.runtime import Node
 from components.simulator import Simulator
@@ -103,3 +104,11 @@ def test_a_start_of_another_robots_size_is_refused(tmp_path: Path) -> None:
     with Node(profile, "simulator", Simulator.params) as node:
         with pytest.raises(ParamError, match=r"start: expected 10 values \(x, y, phi, q1, "):
             Simulator(node)
+
+
+def test_the_emulated_create_refuses_a_base_that_is_not_differential(tmp_path: Path) -> None:
+    path = tmp_path / "emulated_youbot.yaml"
+    path.write_text(f"extends: {DEPLOY / 'emulated.yaml'}\nrobot: {ROBOTS_DIR / 'youbot'}.yaml\n")
+    with Node(load_profile(path), "simulator", EmulatedRobot.params) as node:
+        with pytest.raises(ParamError, match="drives a differential base, not the omnidirectional"):
+            EmulatedRobot(node)
