@@ -30,6 +30,7 @@ COMMANDS = (
     "replay",
     "rerun",
     "report",
+    "export",
     "view",
     "layout",
     "reproduce",

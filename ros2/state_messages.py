@@ -1,0 +1,106 @@
+"""The robot's state as ROS 2 Jazzy messages (rosbags' message classes): /joint_states
+(sensor_msgs/JointState), /tf (tf2_msgs/TFMessage: world -> base_footprint, then every joint
+of the URDF's tree, ``ros2.urdf.joints``) and /odom (nav_msgs/Odometry of base_footprint in
+world, its twist in base_footprint from the state before)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from messages.state import RobotState
+from ros2.urdf import ROOT, Joint, planar
+from ros2.wire import typestore
+from wbc import dq
+
+Array = np.ndarray
+
+WORLD = "world"
+JOINT_STATES = ("/joint_states", "sensor_msgs/msg/JointState")
+TF = ("/tf", "tf2_msgs/msg/TFMessage")
+ODOM = ("/odom", "nav_msgs/msg/Odometry")
+TOPICS = (JOINT_STATES, TF, ODOM)
+"""(topic, ROS 2 type) of every topic made from a state."""
+
+
+def _types():
+    return typestore().types
+
+
+def header(stamp_ns: int, frame: str):
+    """std_msgs/Header at ``stamp_ns`` (ns since the epoch) in ``frame``."""
+    types = _types()
+    stamp = types["builtin_interfaces/msg/Time"](sec=stamp_ns // 10**9, nanosec=stamp_ns % 10**9)
+    return types["std_msgs/msg/Header"](stamp=stamp, frame_id=frame)
+
+
+def _quaternion(rotation: Array):
+    w, x, y, z = dq.quaternion_of_matrix(rotation)
+    return _types()["geometry_msgs/msg/Quaternion"](x=x, y=y, z=z, w=w)
+
+
+def _vector(kind: str, values) -> object:
+    x, y, z = (float(v) for v in values)
+    return _types()[f"geometry_msgs/msg/{kind}"](x=x, y=y, z=z)
+
+
+def joint_state(state: RobotState, names: tuple[str, ...]):
+    """sensor_msgs/JointState of the arm's joints, named as the URDF names them."""
+    return _types()["sensor_msgs/msg/JointState"](
+        header=header(state.header.stamp_ns, ""),
+        name=list(names),
+        position=np.array(state.arm_joints, dtype=np.float64),
+        velocity=np.zeros(0),
+        effort=np.zeros(0),
+    )
+
+
+def tf_message(state: RobotState, tree: list[Joint]):
+    """tf2_msgs/TFMessage: the base on the floor in the world, then every joint's transform
+    at the state's joint values."""
+    types = _types()
+    q_arm = np.array(state.arm_joints)
+    pairs = [(WORLD, ROOT, planar(*state.base_pose))]
+    pairs += [(joint.parent, joint.child, joint.transform(q_arm)) for joint in tree]
+    transforms = [
+        types["geometry_msgs/msg/TransformStamped"](
+            header=header(state.header.stamp_ns, parent),
+            child_frame_id=child,
+            transform=types["geometry_msgs/msg/Transform"](
+                translation=_vector("Vector3", pose[:3, 3]), rotation=_quaternion(pose[:3, :3])
+            ),
+        )
+        for parent, child, pose in pairs
+    ]
+    return types["tf2_msgs/msg/TFMessage"](transforms=transforms)
+
+
+def odometry(state: RobotState, before: RobotState | None):
+    """nav_msgs/Odometry: base_footprint's pose in the world, and its twist in base_footprint
+    from the state ``before`` (zero without one); covariances unknown (zero)."""
+    types = _types()
+    x, y, phi = state.base_pose
+    twist = np.zeros(6)
+    if before is not None and state.header.stamp_ns > before.header.stamp_ns:
+        dt = (state.header.stamp_ns - before.header.stamp_ns) * 1e-9
+        dx, dy = (x - before.base_pose[0]) / dt, (y - before.base_pose[1]) / dt
+        c, s = math.cos(phi), math.sin(phi)
+        turn = math.remainder(phi - before.base_pose[2], 2.0 * math.pi)
+        twist[:2] = (c * dx + s * dy, -s * dx + c * dy)
+        twist[5] = turn / dt
+    pose = types["geometry_msgs/msg/Pose"](
+        position=types["geometry_msgs/msg/Point"](x=float(x), y=float(y), z=0.0),
+        orientation=_quaternion(planar(x, y, phi)[:3, :3]),
+    )
+    velocity = types["geometry_msgs/msg/Twist"](
+        linear=_vector("Vector3", twist[:3]), angular=_vector("Vector3", twist[3:])
+    )
+    return types["nav_msgs/msg/Odometry"](
+        header=header(state.header.stamp_ns, WORLD),
+        child_frame_id=ROOT,
+        pose=types["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=np.zeros(36)),
+        twist=types["geometry_msgs/msg/TwistWithCovariance"](
+            twist=velocity, covariance=np.zeros(36)
+        ),
+    )

@@ -1,0 +1,129 @@
+"""`parsimony export SESSION --ros2 -o DIR`: a recorded session as a ROS 2 bag, read back by
+rosbags' own reader message for message."""
+
+import json
+
+import numpy as np
+import pytest
+from rosbags.rosbag2 import Reader
+
+from messages.header import Header
+from messages.state import RobotState
+from messages.topics import ROBOT_STATE
+from parsimony.cli import main
+from profiles.deploy_files import ROBOT_FILE
+from record.session_file import SessionWriter
+from ros2.urdf import ROOT, joints, link_name, matrix, planar
+from ros2.wire import typestore
+from wbc.robot import BASE_DOF, MobileManipulator
+
+ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
+START_NS, DT_NS, STEPS = 1_700_000_000_000_000_000, 20_000_000, 25
+
+
+def configurations() -> np.ndarray:
+    """A base driving forward while turning and the arm's joints sweeping."""
+    t = np.arange(STEPS) * DT_NS * 1e-9
+    q = np.zeros((STEPS, ROBOT.dof))
+    q[:, 2] = 0.5 * t
+    q[:, 0] = np.cumsum(0.2 * np.cos(q[:, 2])) * DT_NS * 1e-9
+    q[:, 1] = np.cumsum(0.2 * np.sin(q[:, 2])) * DT_NS * 1e-9
+    q[:, BASE_DOF:] = 0.3 * np.sin(t[:, None] + np.arange(ROBOT.arm_dof))
+    return q
+
+
+def state(seq: int, q: np.ndarray, valid: bool = True) -> RobotState:
+    return RobotState(
+        header=Header(stamp_ns=START_NS + seq * DT_NS, frame="world", seq=seq, source="test"),
+        base_pose=tuple(q[:BASE_DOF]),
+        arm_joints=tuple(q[BASE_DOF:]),
+        end_effector=tuple(ROBOT.fkm(q)),
+        valid=valid,
+        age_s=0.0,
+    )
+
+
+@pytest.fixture(scope="module")
+def session(tmp_path_factory) -> tuple:
+    path = tmp_path_factory.mktemp("session") / "run.mcap"
+    qs = configurations()
+    with SessionWriter(path) as writer:
+        writer.write(ROBOT_STATE.key("far"), state(0, qs[0], valid=False))  # before a fix
+        for seq, q in enumerate(qs):
+            writer.write(ROBOT_STATE.key("far"), state(seq + 1, q))
+    return path, qs
+
+
+def export(argv: list[str], capsys) -> tuple[int, str, str]:
+    try:
+        code = main(argv)
+    except SystemExit as exit:
+        code = int(exit.code or 0)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_bag_read_back_message_for_message(session, tmp_path, capsys):
+    path, qs = session
+    bag = tmp_path / "bag"
+    code, out, err = export(["export", str(path), "--ros2", "-o", str(bag), "--json"], capsys)
+    assert code == 0, err
+    result = json.loads(out)
+    assert result["topics"] == {"/joint_states": STEPS, "/tf": STEPS, "/odom": STEPS}
+    assert result["invalid_states_left_out"] == 1 and "1 states without a fix" in err
+    assert result["start_ns"] == START_NS + DT_NS
+    assert result["duration_s"] == pytest.approx((STEPS - 1) * DT_NS * 1e-9)
+    assert (bag / "metadata.yaml").is_file() and result["size_bytes"] > 0
+    store, tree = typestore(), joints(ROBOT)
+    read: dict[str, list] = {}
+    with Reader(bag) as reader:
+        assert reader.duration == (STEPS - 1) * DT_NS + 1
+        for connection in reader.connections:
+            assert connection.msgdef.format.name == "MSG"  # ros2msg schemas
+            assert connection.digest == store.hash_rihs01(connection.msgtype)
+        for connection, stamp, data in reader.messages():
+            message = store.deserialize_cdr(data, connection.msgtype)
+            read.setdefault(connection.topic, []).append((stamp, message))
+    for seq, q in enumerate(qs):
+        stamp = START_NS + (seq + 1) * DT_NS
+        (at, joint_state), (_, tf), (_, odom) = (
+            read[t][seq] for t in ("/joint_states", "/tf", "/odom")
+        )
+        assert (
+            at == stamp
+            and joint_state.header.stamp.sec * 10**9 + joint_state.header.stamp.nanosec == stamp
+        )
+        assert joint_state.name == list(ROBOT.joint_names)
+        np.testing.assert_array_equal(joint_state.position, q[BASE_DOF:])
+        poses = {ROOT: planar(*q[:BASE_DOF])}
+        for transform in tf.transforms:
+            t, r = transform.transform.translation, transform.transform.rotation
+            local = matrix(np.concatenate(([r.w, r.x, r.y, r.z], np.zeros(4))))
+            local[:3, 3] = (t.x, t.y, t.z)
+            parent = transform.header.frame_id
+            poses[transform.child_frame_id] = local if parent == "world" else poses[parent] @ local
+        assert len(tf.transforms) == len(tree) + 1
+        for i, frame in enumerate(ROBOT.frames(q)):
+            np.testing.assert_allclose(poses[link_name(i)], matrix(frame), atol=1e-9)
+        position = odom.pose.pose.position
+        assert (position.x, position.y) == (q[0], q[1]) and odom.child_frame_id == ROOT
+        if seq:
+            assert odom.twist.twist.angular.z == pytest.approx(0.5, rel=1e-6)
+            assert odom.twist.twist.linear.x == pytest.approx(0.2, rel=1e-2)
+
+
+def test_a_wrong_robot_or_an_existing_directory_is_one_line(session, tmp_path, capsys):
+    path, _ = session
+    bag = tmp_path / "bag"
+    code, _, err = export(
+        ["export", str(path), "--ros2", "-o", str(bag), "--robot", "ur5e_fixed"], capsys
+    )
+    assert code == 2 and "arm joints" in err and "Traceback" not in err
+    assert not bag.exists()
+    bag.mkdir()
+    code, _, err = export(["export", str(path), "--ros2", "-o", str(bag)], capsys)
+    assert code == 2 and "exists" in err
+    code, _, err = export(
+        ["export", str(tmp_path / "none.mcap"), "--ros2", "-o", str(tmp_path / "b")], capsys
+    )
+    assert code == 2 and err.startswith("export:") and len(err.strip().splitlines()) == 1
