@@ -19,6 +19,7 @@ from profiles.deploy_files import ROBOT_FILE
 from record.sessions import load_session
 from studies.reproduce.loop import folder
 from studies.reproduce.runs import laws_of
+from tests.parsimony.in_process import refused
 from wbc.robot import MobileManipulator
 
 pytestmark = pytest.mark.heavy  # the whole loop, twice
@@ -93,13 +94,10 @@ def test_the_loop_prints_the_rows_of_its_recordings_beside_the_kinematic_ones(
     assert loop["wall_s"] > 0.0 and loop["sim_s"] == pytest.approx(4.0, abs=0.1)
 
 
-def test_the_laws_of_the_loop_need_the_loop(tmp_path: Path) -> None:
-    done = subprocess.run(
-        [sys.executable, "-m", "parsimony.cli", "reproduce", "--law", "LP", "--out", str(tmp_path)],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert done.returncode == 2 and done.stdout == "", done.stderr
-    assert "--law chooses the laws of the loop: add --loop" in done.stderr
-    assert "Traceback" not in done.stderr and not any(tmp_path.iterdir())
+def test_the_laws_of_the_loop_need_the_loop(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, out, err = refused(["reproduce", "--law", "LP", "--out", str(tmp_path)], capsys)
+    assert code == 2 and out == "", err
+    assert "--law chooses the laws of the loop: add --loop" in err
+    assert not any(tmp_path.iterdir())
