@@ -5,6 +5,7 @@ import json
 
 import numpy as np
 import pytest
+from mcap.reader import make_reader
 from rosbags.rosbag2 import Reader
 
 from messages.header import Header
@@ -74,6 +75,12 @@ def test_bag_read_back_message_for_message(session, tmp_path, capsys):
     assert result["start_ns"] == START_NS + DT_NS
     assert result["duration_s"] == pytest.approx((STEPS - 1) * DT_NS * 1e-9)
     assert (bag / "metadata.yaml").is_file() and result["size_bytes"] > 0
+    (storage,) = bag.glob("*.mcap")
+    with storage.open("rb") as stream:
+        reader = make_reader(stream)
+        assert reader.get_header().profile == "ros2"
+        schemas = reader.get_summary().schemas.values()
+        assert {s.encoding for s in schemas} == {"ros2msg"}
     store, tree = typestore(), joints(ROBOT)
     read: dict[str, list] = {}
     with Reader(bag) as reader:
