@@ -1,6 +1,7 @@
 """`parsimony export SESSION.mcap --ros2 -o DIR`: a recorded session as a ROS 2 Jazzy bag
 (ros2.bag): /joint_states, /tf and /odom from the robot's recorded states, which
-``ros2 bag info`` and ``ros2 bag play`` read; its size and time span printed."""
+``ros2 bag info`` and ``ros2 bag play`` read; its size and time span printed.
+`parsimony export --urdf -o FILE`: the robot's URDF (ros2.urdf), for rviz2's RobotModel."""
 
 from __future__ import annotations
 
@@ -19,19 +20,25 @@ from parsimony.commands.robot_option import robot_file
 from profiles.deploy_files import ROBOT_FILE
 from record.session_reader import read_session
 from ros2.bag import write_bag
+from ros2.urdf import urdf
 from wbc.robot import MobileManipulator, RobotDescriptionError
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
         "export",
-        help="a recording as a ROS 2 bag (--ros2)",
+        help="a recording as a ROS 2 bag (--ros2), the robot's URDF (--urdf)",
         description="Write the robot's recorded states as a ROS 2 Jazzy bag (MCAP storage, "
-        "ros2msg schemas, metadata.yaml): /joint_states, /tf and /odom, one message per state.",
+        "ros2msg schemas, metadata.yaml): /joint_states, /tf and /odom, one message per state; "
+        "or the robot's URDF, whose frames the bag's /tf names.",
     )
-    parser.add_argument("file", type=Path, metavar="SESSION", help="MCAP session")
-    parser.add_argument("--ros2", action="store_true", required=True, help="a ROS 2 bag")
-    parser.add_argument("-o", "--out", type=Path, required=True, help="the bag's directory (new)")
+    parser.add_argument("file", type=Path, nargs="?", metavar="SESSION", help="MCAP session")
+    kind = parser.add_mutually_exclusive_group(required=True)
+    kind.add_argument("--ros2", action="store_true", help="a ROS 2 bag of SESSION")
+    kind.add_argument("--urdf", action="store_true", help="the robot's URDF")
+    parser.add_argument(
+        "-o", "--out", type=Path, required=True, help="the bag's directory or the URDF's file (new)"
+    )
     parser.add_argument(
         "--robot",
         type=robot_file,
@@ -52,8 +59,28 @@ def states(path: Path) -> Iterator[RobotState]:
 
 def run(args: argparse.Namespace) -> int:
     if args.out.exists():
-        print(f"export: {args.out} exists: give a new directory", file=sys.stderr)
+        print(f"export: {args.out} exists: give a new path", file=sys.stderr)
         return 2
+    if (args.file is None) == bool(args.ros2):
+        wanted = "--ros2 exports a SESSION" if args.ros2 else "--urdf takes no SESSION"
+        print(f"export: {wanted}", file=sys.stderr)
+        return 2
+    return export_bag(args) if args.ros2 else export_urdf(args)
+
+
+def export_urdf(args: argparse.Namespace) -> int:
+    try:
+        text = urdf(MobileManipulator.from_yaml(args.robot))
+        args.out.write_text(text)
+    except (OSError, RobotDescriptionError) as error:
+        print(f"export: {error}", file=sys.stderr)
+        return 2
+    result = {"urdf": str(args.out), "size_bytes": len(text.encode())}
+    emit(json_text(result, indent=2) if args.json else f"{args.out}: {result['size_bytes']} bytes")
+    return 0
+
+
+def export_bag(args: argparse.Namespace) -> int:
     try:
         robot = MobileManipulator.from_yaml(args.robot)
         if not args.file.is_file():

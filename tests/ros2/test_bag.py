@@ -14,7 +14,7 @@ from messages.topics import ROBOT_STATE
 from parsimony.cli import main
 from profiles.deploy_files import ROBOT_FILE
 from record.session_file import SessionWriter
-from ros2.urdf import ROOT, joints, link_name, matrix, planar
+from ros2.urdf import ROOT, joints, link_name, matrix, planar, urdf
 from ros2.wire import typestore
 from wbc.robot import BASE_DOF, MobileManipulator
 
@@ -134,3 +134,13 @@ def test_a_wrong_robot_or_an_existing_directory_is_one_line(session, tmp_path, c
         ["export", str(tmp_path / "none.mcap"), "--ros2", "-o", str(tmp_path / "b")], capsys
     )
     assert code == 2 and err.startswith("export:") and len(err.strip().splitlines()) == 1
+
+
+def test_the_urdf_the_bags_frames_come_from(tmp_path, capsys):
+    out = tmp_path / "robot.urdf"
+    code, printed, err = export(["export", "--urdf", "--robot", "youbot", "-o", str(out)], capsys)
+    assert code == 0, err
+    assert printed == f"{out}: {out.stat().st_size} bytes\n"
+    assert out.read_text() == urdf(MobileManipulator.from_yaml("deploy/robots/youbot.yaml"))
+    code, _, err = export(["export", "x.mcap", "--urdf", "-o", str(tmp_path / "u")], capsys)
+    assert code == 2 and "no SESSION" in err
