@@ -151,14 +151,22 @@ class WarmStartedLP:
         """Minimise the sum of ``costs`` over u subject to ``rows`` (5.29)."""
         residuals: list[ResidualCost] = []
         velocity_costs: list[VelocityCost] = []
-        for cost in costs:
-            (residuals if type(cost) is ResidualCost else velocity_costs).append(cost)
         linear: list[LinearRows] = []
         norms: list[OneNormBound] = []
         bounds: list[VelocityBounds] = []
-        kinds = {LinearRows: linear, OneNormBound: norms, VelocityBounds: bounds}
-        for rows_ in rows:
-            kinds[type(rows_)].append(rows_)  # type: ignore[attr-defined]
+        for item in (*costs, *rows):
+            if isinstance(item, ResidualCost):
+                residuals.append(item)
+            elif isinstance(item, VelocityCost):
+                velocity_costs.append(item)
+            elif isinstance(item, LinearRows):
+                linear.append(item)
+            elif isinstance(item, VelocityBounds):
+                bounds.append(item)
+            elif isinstance(item, OneNormBound):
+                norms.append(item)
+            else:
+                raise TypeError(f"not a cost or rows of the LP: {type(item).__name__}")
         n = residuals[0].matrix.shape[1]
         stacked = [cost.matrix for cost in residuals] + [rows_.matrix for rows_ in linear]
         layout = self._layout_for(n, stacked, len(residuals), len(norms))
