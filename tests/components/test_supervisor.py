@@ -233,35 +233,41 @@ def test_a_goal_inside_an_obstacle_is_refused_for_that_reason(
     assert "lies inside obstacle 1" in status.reason, status.reason
 
 
-@pytest.mark.parametrize(
-    ("fields", "blamed"),
-    [
-        ({"pose": (math.nan, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)}, "pose"),
-        ({"pose": (2.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)}, "pose"),
-        ({"pose": (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)}, "pose"),
-        ({"pose": (1.0, 0.0, 0.0, 0.0, 0.3, 0.0, 0.0, 0.0)}, "pose"),
-        ({"pose": (0.0,) * 8}, "pose"),
-        ({"pose": (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), "eta": -1.0}, "eta"),
-    ],
-)
+REFUSED_REQUESTS = [
+    ({"pose": (math.nan, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)}, "pose"),
+    ({"pose": (2.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)}, "pose"),
+    ({"pose": (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)}, "pose"),
+    ({"pose": (1.0, 0.0, 0.0, 0.0, 0.3, 0.0, 0.0, 0.0)}, "pose"),
+    ({"pose": (0.0,) * 8}, "pose"),
+    ({"pose": (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), "eta": -1.0}, "eta"),
+]
+"""Requests the supervisor refuses (a NaN, a pose of norm 2, of 7 numbers, not unit, zero, a
+negative gain), and the field each refusal names."""
+
+
 def test_a_refused_request_is_on_the_status_with_its_reason_and_the_goal_stays(
-    deployed: Callable[[str], System], fields: dict, blamed: str
+    deployed: Callable[[str], System],
 ) -> None:
+    """Each request in turn, to one supervisor whose goal is under way: each is refused, the
+    status names its field, and the goal goes on (its phase kept, status after status)."""
     operator = supervised(deployed)
     goal = operator.robot.fkm(REACH_GOAL)
     operator.ask(goal)
     operator.send_state(REACH_GOAL)
     operator.statuses.wait_for(lambda s: s.phase not in ("idle", "planning"), "the goal taken")
-    operator.ask_raw(fields)
-    refused = operator.statuses.wait_for(lambda s: s.refusals == 1, "the refusal")
-    assert f"Goal.{blamed}" in refused.last_refusal, refused.last_refusal
-    assert refused.phase not in ("idle", "planning", "unreachable"), refused
-    count = len(operator.statuses.messages)
-    operator.send_state(REACH_GOAL)
-    after = operator.statuses.wait_for(
-        lambda s: operator.statuses.messages.index(s) >= count, "a status after the refusal"
-    )
-    assert after.phase == refused.phase and after.refusals == 1
+    for refusals, (fields, blamed) in enumerate(REFUSED_REQUESTS, start=1):
+        operator.ask_raw(fields)
+        refused = refusal(operator, refusals)
+        assert f"Goal.{blamed}" in refused.last_refusal, (fields, refused.last_refusal)
+        assert refused.phase not in ("idle", "planning", "unreachable"), refused
+        count = len(operator.statuses.messages)
+        after = operator.statuses_after(count, REACH_GOAL, "a status after the refusal")
+        assert after.phase == refused.phase and after.refusals == refusals
+
+
+def refusal(operator: Operator, refusals: int) -> SupervisorStatus:
+    """The first status that counts ``refusals`` refused requests."""
+    return operator.statuses.wait_for(lambda s: s.refusals == refusals, f"refusal {refusals}")
 
 
 @pytest.mark.parametrize(
