@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 import zenoh
 
 from launch import query
@@ -58,11 +59,21 @@ class Station:
         return f"{self.profile.namespace}/{suffix}"
 
 
+def paced(path: Path) -> None:
+    """The simulator of the profile at ``path`` paced at the wall clock's rate, still in
+    lockstep: the loop does not run flat out (two cores) while a test waits on the client."""
+    data = yaml.safe_load(path.read_text())
+    simulator = next(c for c in data["components"] if c["name"] == "simulator")
+    simulator["params"]["real_time_factor"] = 1.0
+    path.write_text(yaml.safe_dump(data))
+
+
 @pytest.fixture(scope="module")
 def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Station]:
     assert not missing(), missing()
     directory = tmp_path_factory.mktemp("station")
     path = lockstep_profile(directory, DEPLOY / "sim_station.yaml", "station")
+    paced(path)
     profile = load_profile(path)
     with (
         (directory / "launch.log").open("w") as log,
