@@ -10,6 +10,7 @@ from pathlib import Path
 
 from rosbags.rosbag2 import StoragePlugin, Writer
 
+from messages.base import default_joint_names
 from messages.state import RobotState
 from ros2.state_messages import JOINT_STATES, ODOM, TF, joint_state, odometry, tf_message
 from ros2.urdf import joints
@@ -18,6 +19,22 @@ from wbc.robot import MobileManipulator
 
 BAG_VERSION = 9
 """rosbag2's metadata version of Jazzy's bags."""
+
+
+def check_joints(state: RobotState, robot: MobileManipulator) -> None:
+    """``ValueError`` unless the state's joints are the robot's: as many, and named as it names
+    them (or unnamed, ``q1 .. qn``, as recordings made before messages named them)."""
+    names = state.joint_names
+    if len(names) != robot.arm_dof:
+        raise ValueError(
+            f"a state has {len(names)} arm joints, robot {robot.name} {robot.arm_dof}: "
+            "give the recorded robot (--robot)"
+        )
+    if names not in (robot.joint_names, default_joint_names(len(names))):
+        raise ValueError(
+            f"a state's joints {list(names)} are not robot {robot.name}'s "
+            f"{list(robot.joint_names)}: give the recorded robot (--robot)"
+        )
 
 
 def write_bag(directory: Path, robot: MobileManipulator, states: Iterable[RobotState]) -> dict:
@@ -34,11 +51,7 @@ def write_bag(directory: Path, robot: MobileManipulator, states: Iterable[RobotS
             for topic, msgtype in (JOINT_STATES, TF, ODOM)
         }
         for state in states:
-            if len(state.arm_joints) != robot.arm_dof:
-                raise ValueError(
-                    f"a state has {len(state.arm_joints)} arm joints, robot {robot.name} "
-                    f"{robot.arm_dof}: give the recorded robot (--robot)"
-                )
+            check_joints(state, robot)
             if not state.valid:
                 invalid += 1
                 continue

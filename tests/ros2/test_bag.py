@@ -14,6 +14,7 @@ from messages.topics import ROBOT_STATE
 from parsimony.cli import main
 from profiles.deploy_files import ROBOT_FILE
 from record.session_file import SessionWriter
+from ros2.bag import check_joints
 from ros2.urdf import ROOT, joints, link_name, matrix, planar, urdf
 from ros2.wire import typestore
 from wbc.robot import BASE_DOF, MobileManipulator
@@ -144,3 +145,11 @@ def test_the_urdf_the_bags_frames_come_from(tmp_path, capsys):
     assert out.read_text() == urdf(MobileManipulator.from_yaml("deploy/robots/youbot.yaml"))
     code, _, err = export(["export", "x.mcap", "--urdf", "-o", str(tmp_path / "u")], capsys)
     assert code == 2 and "no SESSION" in err
+
+
+def test_a_state_naming_other_joints_is_refused():
+    q = configurations()[0]
+    named = state(0, q).model_copy(update={"joint_names": ("a", "b", "c", "d", "e")})
+    with pytest.raises(ValueError, match="not robot little_john's"):
+        check_joints(named, ROBOT)
+    check_joints(state(0, q), ROBOT)  # unnamed: q1 .. qn
