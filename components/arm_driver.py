@@ -54,6 +54,8 @@ READ_BYTES = 4
 """Present Position and Present Speed, from address 36."""
 HOLD_SPEED = 1
 """The Moving Speed of a held joint: the slowest there is (0 would mean full speed)."""
+READ_WAIT_S = 0.001
+"""How long one read of the serial port waits for bytes before the SDK looks again (s)."""
 
 
 def check_ids(ids: tuple[int, ...]) -> None:
@@ -178,6 +180,10 @@ class ArmDriver(Component):
         if not opened:
             self.node.state = "no port"
             return
+        # The SDK opens the port non-blocking and spins on empty reads while a servo answers
+        # (a third of a core at 50 Hz x 5 servos); a read that waits up to READ_WAIT_S for
+        # bytes gives the core back and notices a silent servo at most that much later.
+        self.port.ser.timeout = READ_WAIT_S
         self.connected = True
         self.node.state = "running"
         self._enable_torque()
