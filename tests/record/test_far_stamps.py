@@ -168,7 +168,7 @@ def test_the_recorder_says_once_which_topic_was_stamped_far_outside_the_session(
             text=True,
         )
         while "recorder" not in live_components(session, "rec", 0.5):
-            assert command.poll() is None
+            assert command.poll() is None and launcher.poll() is None, "record or launch ended"
         clock = session.declare_publisher(topics.SIM_CLOCK.key("rec"))
         goals = session.declare_publisher(topics.GOAL_REQUEST.key("rec"))
         for tick in range(1, 101):  # a simulated second
