@@ -136,8 +136,7 @@ def test_a_killed_controller_leaves_the_robot_stopped_by_its_drivers(tmp_path: P
     )
     profile = load_profile(path)
     truth: list = []
-    with launched(path) as launcher:
-        session = connect(profile, launcher)
+    with launched(path) as launcher, connect(profile, launcher) as session:
         key = topics.SIM_TRUTH.key(profile.namespace)
         session.declare_subscriber(
             key, lambda s: truth.append(codec.decode(s.payload.to_bytes(), topics.SIM_TRUTH.type))
@@ -161,7 +160,6 @@ def test_a_killed_controller_leaves_the_robot_stopped_by_its_drivers(tmp_path: P
         assert max(abs(a - b) for a, b in zip(arm[0], arm[-1], strict=True)) < 0.01
         counters = query.statuses(session, profile.namespace)["base_driver"].counters
         assert counters["stops"] >= 1
-        session.close()
 
 
 def moving(truth: list) -> bool:
