@@ -152,15 +152,14 @@ EDGE = 0.01
 
 
 def at_joint_box_edge(law: Law, robot: MobileManipulator, q: Array) -> list[str]:
-    """The arm joints of ``q`` (q1..q5) within EDGE of the joint box of ``law``: b_l [q-, q+]
-    for the LP and the QP (their safety factor b_l), the joint limits for a law without one."""
+    """The arm joints of ``q`` (by the robot's names) within EDGE of the joint box of ``law``:
+    b_l [q-, q+] for the LP and the QP (their safety factor b_l), the joint limits for a law
+    without one (``MobileManipulator.joint_box``)."""
     factor = law.params.safety_factor if isinstance(law, LPLaw | QPLaw) else 1.0
     arm = q[BASE_DOF:]
-    near = (
-        np.minimum(arm - factor * robot.q_min[BASE_DOF:], factor * robot.q_max[BASE_DOF:] - arm)
-        < EDGE
-    )
-    return [f"q{index + 1}" for index in np.flatnonzero(near)]
+    low, high = robot.joint_box(factor)
+    near = np.minimum(arm - low[BASE_DOF:], high[BASE_DOF:] - arm) < EDGE
+    return [robot.joint_names[index] for index in np.flatnonzero(near)]
 
 
 def _logged(supervisor: StagingSupervisor, tasks: list[object]) -> StagingSupervisor:

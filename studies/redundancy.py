@@ -89,11 +89,9 @@ TASKS = {"pose": PoseTask.dof, "position": PositionTask.dof}
 
 
 def arm_box(robot: MobileManipulator) -> tuple[Array, Array]:
-    """The arm's joint box inside both its limits and the LP's b_l [q-, q+] (``JointLimits``
-    shrinks the range about zero: where it does not straddle zero, one side lies beyond)."""
-    factor = LPParams().safety_factor
-    low, high = robot.q_min[BASE_DOF:], robot.q_max[BASE_DOF:]
-    return np.maximum(low, factor * low), np.minimum(high, factor * high)
+    """The arm's part of the LP's joint box b_l [q-, q+] (``MobileManipulator.joint_box``)."""
+    low, high = robot.joint_box(LPParams().safety_factor)
+    return low[BASE_DOF:], high[BASE_DOF:]
 
 
 def above_floor(robot: MobileManipulator, q: Array) -> bool:

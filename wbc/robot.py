@@ -145,6 +145,18 @@ class MobileManipulator:
         self.collision = collision
         """The parts that obstacles in 3-D must clear (``wbc.collision_model``)."""
 
+    def joint_box(self, safety_factor: float) -> tuple[Array, Array]:
+        """b_l [q-, q+] of 5.14 for every entry of q: each range shrunk by ``safety_factor``
+        about zero where it holds zero (the dissertation's), about its centre where it does
+        not (scaled about zero, one end of such a range would lie beyond its limit); the
+        base's infinite ranges stay infinite."""
+        straddles = (self.q_min <= 0.0) & (self.q_max >= 0.0)
+        with np.errstate(invalid="ignore"):  # the base's -inf + inf, where the range holds 0
+            centre = np.where(straddles, 0.0, 0.5 * (self.q_min + self.q_max))
+        low = centre + safety_factor * (self.q_min - centre)
+        high = centre + safety_factor * (self.q_max - centre)
+        return low, high
+
     def with_velocity_max(self, velocity_max: Array) -> MobileManipulator:
         """The same robot with other bounds on u (section 6.3's tests impose none); a fixed
         base's stay 0."""

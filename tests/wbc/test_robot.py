@@ -443,3 +443,18 @@ def test_other_velocity_bounds_keep_the_description(robot: MobileManipulator) ->
     np.testing.assert_array_equal(free.velocity_max, 9.0)
     q = random_configurations(robot, 1, seed=13)[0]
     np.testing.assert_array_equal(free.kinematics(q)[1], robot.kinematics(q)[1])
+
+
+def test_the_joint_box_shrinks_a_range_about_zero_or_else_about_its_centre() -> None:
+    """b_l [q-, q+] (5.14) for Little John, whose every range holds zero; a range that does not
+    hold zero (the Panda's q4, -3.07 to -0.07 rad) shrinks about its centre, inside its limits
+    (about zero, its upper end -0.063 would lie beyond -0.070)."""
+    little_john = MobileManipulator.from_yaml(ROBOT_FILE)
+    low, high = little_john.joint_box(0.9)
+    np.testing.assert_array_equal(low, 0.9 * little_john.q_min)
+    np.testing.assert_array_equal(high, 0.9 * little_john.q_max)
+    panda = MobileManipulator.from_yaml(ROBOT_FILE.parent / "arm7_differential.yaml")
+    low, high = panda.joint_box(0.9)
+    assert np.all(low[3:] >= panda.q_min[3:]) and np.all(high[3:] <= panda.q_max[3:])
+    centre = 0.5 * (panda.q_min[6] + panda.q_max[6])
+    np.testing.assert_allclose(high[6] - centre, 0.9 * (panda.q_max[6] - centre))

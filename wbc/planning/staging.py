@@ -163,9 +163,8 @@ def staging_point(base: Array, final_leg: float) -> Array:
 
 def arm_box(robot: MobileManipulator, safety_factor: float, margin: float) -> tuple[Array, Array]:
     """The arm joints' search bounds: b_l [q-, q+] shrunk by ``margin`` on each side."""
-    low = safety_factor * robot.q_min[BASE_DOF:] + margin
-    high = safety_factor * robot.q_max[BASE_DOF:] - margin
-    return low, high
+    low, high = robot.joint_box(safety_factor)
+    return low[BASE_DOF:] + margin, high[BASE_DOF:] - margin
 
 
 def solve_ik(

@@ -25,9 +25,10 @@ class JointLimits:
     """max(q'-, k (b_l q- - q)) <= u <= min(q'+, k (b_l q+ - q)) (5.15).
 
     k > 0 (``gain``, 1/s) scales how fast a joint may approach its limit; 0 << b_l <= 1
-    (``safety_factor``) shrinks the range [q-, q+] about zero. Entries with infinite position
-    limits (the base's x, y, phi) keep their velocity bounds only. Where a joint already lies
-    outside b_l [q-, q+], the bounds leave it only the way back, at most at its speed limit.
+    (``safety_factor``) shrinks the range [q-, q+] (``MobileManipulator.joint_box``). Entries
+    with infinite position limits (the base's x, y, phi) keep their velocity bounds only.
+    Where a joint already lies outside b_l [q-, q+], the bounds leave it only the way back, at
+    most at its speed limit.
     """
 
     name = "joint_limits"
@@ -51,8 +52,8 @@ class JointLimits:
     def _scaled(self, robot: MobileManipulator) -> tuple[Array, Array, Array]:
         """k b_l q-, k b_l q+ and -q'+ of ``robot``, kept for the robot last seen."""
         if robot is not self._robot:
-            scale = self.gain * self.safety_factor
-            self._limits = (scale * robot.q_min, scale * robot.q_max, -robot.velocity_max)
+            low, high = robot.joint_box(self.safety_factor)
+            self._limits = (self.gain * low, self.gain * high, -robot.velocity_max)
             self._robot = robot
         return self._limits
 
