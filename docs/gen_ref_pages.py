@@ -11,8 +11,8 @@ import mkdocs_gen_files
 ROOT = Path(__file__).resolve().parent.parent
 NOT_PACKAGES = {"tests", "docs", "site", "build"}
 LAYERS = (
-    "wbc protocols messages sim2d vision profiles scenes record analysis ros2 components launch view "
-    "studies parsimony deploy bench"
+    "wbc protocols messages sim2d vision profiles scenes record analysis ros2 components launch "
+    "view studies parsimony deploy bench"
 ).split()
 """The packages in layering order (lowest first); any other package follows, by name."""
 
