@@ -28,7 +28,6 @@ from pathlib import Path
 
 import numpy as np
 
-from profiles.deploy_files import DEPLOY
 from studies.goal_families import FAMILIES
 from studies.goal_sets import LIMIT_TOLERANCE, MOVING_ERROR, TOLERANCE
 from wbc import dq
@@ -55,25 +54,15 @@ TIME_LIMIT_S = 20.0
 goals the laws reach here, they reach in 10 to 15 s)."""
 
 
-def zoo() -> list[Path]:
-    """Every robot description of deploy/robots, sorted by name."""
-    return sorted((DEPLOY / "robots").glob("*.yaml"))
-
-
-def base_kind(robot: MobileManipulator) -> str:
-    """The base's kind: differential (5.12 holds), omnidirectional or fixed."""
-    return getattr(robot.base, "kind", "differential")
-
-
 def mobility(robot: MobileManipulator) -> int:
     """How many velocities the robot can set independently: the arm's joints and the base's
     forward speed and yaw (differential), its three velocities (omnidirectional) or none."""
-    extra = {"differential": 2, "omnidirectional": 3, "fixed": 0}[base_kind(robot)]
+    extra = {"differential": 2, "omnidirectional": 3, "fixed": 0}[robot.base.kind]
     return robot.arm_dof + extra
 
 
 def _lp_gains(robot: MobileManipulator) -> dict[str, bool]:
-    return {"nonholonomic": base_kind(robot) == "differential"}
+    return {"nonholonomic": robot.base.kind == "differential"}
 
 
 LAWS: dict[str, Callable[[MobileManipulator], Law]] = {
@@ -103,7 +92,7 @@ def draw(robot: MobileManipulator, count: int, seed: int = SEED) -> list[tuple[A
     """``count`` (start, goal configuration) pairs: the start base at the origin facing x."""
     rng = np.random.default_rng(seed)
     low, high = arm_box(robot)
-    fixed = base_kind(robot) == "fixed"
+    fixed = robot.base.kind == "fixed"
     pairs: list[tuple[Array, Array]] = []
     while len(pairs) < count:
         start = np.concatenate((np.zeros(BASE_DOF), rng.uniform(low, high)))
@@ -247,7 +236,7 @@ def study(
                     rows[family][law] = summary(list(mapped(run_one, jobs)), TASKS[family])
             report[robot.name] = {
                 "description": path.name,
-                "base": base_kind(robot),
+                "base": robot.base.kind,
                 "dof": robot.dof,
                 "arm_dof": robot.arm_dof,
                 "mobility": mobility(robot),

@@ -66,11 +66,6 @@ def blocks(
         position = (position + len(block)) % len(trajectory)
 
 
-def base_kind(robot: MobileManipulator) -> str:
-    """The base's kind (wbc.robot.BASE_KINDS); a description that names none: differential."""
-    return str(getattr(robot.base, "kind", "differential"))
-
-
 def laws_for(robot: MobileManipulator) -> dict[str, Law]:
     """The laws timed on ``robot``: the LP, the QP, the classic law (the pseudoinverse) and,
     where the base is differential, the cascade of appendix B."""
@@ -79,7 +74,7 @@ def laws_for(robot: MobileManipulator) -> dict[str, Law]:
         "qp": QPLaw(robot),
         "classic": PseudoinverseLaw(robot),
     }
-    if base_kind(robot) == "differential":
+    if robot.base.kind == "differential":
         laws["cascade"] = CascadeLaw(robot)
     return laws
 
@@ -95,7 +90,7 @@ def scenario(robot: MobileManipulator) -> tuple[Array, Array]:
     arm = middle + 0.1 * span * signs
     moved = arm + 0.2 * span * np.random.default_rng(0).uniform(-1.0, 1.0, robot.arm_dof)
     moved = np.clip(moved, low + 0.1 * span, high - 0.1 * span)
-    base = np.zeros(BASE_DOF) if base_kind(robot) == "fixed" else np.array([0.4, 0.1, 0.2])
+    base = np.zeros(BASE_DOF) if robot.base.kind == "fixed" else np.array([0.4, 0.1, 0.2])
     return np.concatenate((np.zeros(BASE_DOF), arm)), np.concatenate((base, moved))
 
 
@@ -193,7 +188,7 @@ def zoo_step_times(robot_files: Iterable[Path], repeats: int) -> dict[str, dict]
         results[robot.name] = {
             "dof": robot.dof,
             "arm_dof": robot.arm_dof,
-            "base": base_kind(robot),
+            "base": robot.base.kind,
             "step": steps,
             "lp_over_classic": steps["lp"]["median_us"] / steps["classic"]["median_us"],
             "lp_breakdown_us": lp_breakdown(robot, repeats, start, goal),

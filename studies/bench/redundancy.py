@@ -19,6 +19,7 @@ from pathlib import Path
 from matplotlib.figure import Figure
 
 from outputs.stdout import emit, json_text, result_only_stdout, table
+from profiles.deploy_files import zoo
 from studies import redundancy
 from studies.redundancy import TASKS
 
@@ -124,7 +125,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--figure", type=Path, help="write the figure (PNG) here")
     parser.add_argument("--from", dest="reports", type=Path, nargs="+", help="reports to merge")
     args = parser.parse_args(argv)
-    known = {path.stem: path for path in redundancy.zoo()}
+    known = {path.stem: path for path in zoo()}
     names = args.robots.split(",") if args.robots else list(known)
     unknown = [name for name in names if name not in known]
     families = tuple(args.families.split(","))

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from profiles.deploy_files import DEPLOY
+from profiles.deploy_files import DEPLOY, zoo
 from studies import redundancy
 from studies.bench.redundancy import main
 from studies.redundancy import BASE_MOVE, TASKS, arm_box, draw, engaged_count, task_of
@@ -27,7 +27,7 @@ LITTLE_JOHN, SNAKE, SEVEN = (
 
 
 def test_the_zoo_is_every_description_and_the_study_runs_them_all() -> None:
-    assert {LITTLE_JOHN, SNAKE, SEVEN} <= set(redundancy.zoo())
+    assert {LITTLE_JOHN, SNAKE, SEVEN} <= set(zoo())
 
 
 def test_goals_are_configurations_inside_every_limit_drawn_from_a_fixed_seed() -> None:
