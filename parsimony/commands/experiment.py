@@ -12,7 +12,7 @@ import yaml
 
 from launch.query import QueryError
 from outputs.stdout import emit, json_text
-from parsimony.commands.robot_option import robot_file
+from parsimony.commands.robot_option import add_robot_option
 from profiles.profile import ProfileError
 from sim2d.scenarios import NAMES, SEED_MAX
 from studies.experiment import PROFILES, TIME_LIMIT_S, Options, run_experiment
@@ -80,12 +80,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("--force", action="store_true", help="replace what --out holds")
     parser.add_argument("--seed", type=seed, help="draw the start and the bin from the ranges")
     parser.add_argument("--profile", type=Path, help="simulation profile to extend")
-    parser.add_argument(
-        "--robot",
-        type=robot_file,
-        metavar="NAME|PATH",
-        help="run another robot: a zoo name (deploy/robots/NAME.yaml) or a description's "
-        "file, in place of the profile's; its goal is derived from it",
+    add_robot_option(
+        parser,
+        "run another robot: a zoo name (deploy/robots/NAME.yaml) or a description's file, in "
+        "place of the profile's; its goal is derived from it",
+        default=None,
     )
     parser.add_argument(
         "--realtime",

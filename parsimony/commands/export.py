@@ -16,8 +16,7 @@ from rosbags.rosbag2 import WriterError
 from messages.state import RobotState
 from messages.topics import ROBOT_STATE
 from outputs.stdout import emit, json_text
-from parsimony.commands.robot_option import robot_file
-from profiles.deploy_files import ROBOT_FILE
+from parsimony.commands.robot_option import add_robot_option
 from record.session_reader import read_session
 from ros2.bag import write_bag
 from ros2.urdf import urdf
@@ -39,13 +38,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument(
         "-o", "--out", type=Path, required=True, help="the bag's directory or the URDF's file (new)"
     )
-    parser.add_argument(
-        "--robot",
-        type=robot_file,
-        default=ROBOT_FILE,
-        metavar="NAME|PATH",
-        help="the recorded robot's description: a zoo name or a file",
-    )
+    add_robot_option(parser, "the recorded robot's description: a zoo name or a file")
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
     return parser
 

@@ -13,8 +13,7 @@ from analysis.judge import JUDGED, judge, open_loop, the_run
 from analysis.report import write_report
 from outputs.stdout import emit, json_text
 from parsimony.commands.launch import positive_seconds
-from parsimony.commands.robot_option import robot_file
-from profiles.deploy_files import ROBOT_FILE
+from parsimony.commands.robot_option import add_robot_option
 from profiles.profile import ProfileError, load_profile
 from record.session_span import parted
 from record.sessions import load_session
@@ -33,13 +32,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("files", type=Path, nargs="+", metavar="FILE", help="MCAP sessions")
     parser.add_argument("--labels", help="comma-separated labels (default: the law's name)")
     parser.add_argument("--out", type=Path, required=True, help="directory of the figures")
-    parser.add_argument(
-        "--robot",
-        type=robot_file,
-        default=ROBOT_FILE,
-        metavar="NAME|PATH",
-        help="robot description: a zoo name or a file",
-    )
+    add_robot_option(parser)
     parser.add_argument(
         "--profile", type=Path, help="the recorded profile: truth drawn in F0's frame"
     )

@@ -29,8 +29,7 @@ from messages.header import Header
 from messages.obstacles import obstacles_of
 from outputs.files import writable_output, written_whole
 from outputs.stdout import emit
-from parsimony.commands.robot_option import robot_file
-from profiles.deploy_files import ROBOT_FILE
+from parsimony.commands.robot_option import add_robot_option
 from record.session_file import Recorded, SessionWriter
 from record.session_reader import read_groups
 from wbc.robot import MobileManipulator, RobotDescriptionError
@@ -59,13 +58,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument("file", type=Path, help="MCAP session")
     parser.add_argument("--controller", choices=tuple(LAWS), required=True)
     parser.add_argument("-o", "--output", type=Path, required=True, help="the MCAP to write")
-    parser.add_argument(
-        "--robot",
-        type=robot_file,
-        default=ROBOT_FILE,
-        metavar="NAME|PATH",
-        help="robot description: a zoo name or a file",
-    )
+    add_robot_option(parser)
     parser.add_argument("--force", action="store_true", help="replace an existing output")
     return parser
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from profiles.deploy_files import ROBOTS_DIR, zoo
+from profiles.deploy_files import ROBOT_FILE, ROBOTS_DIR, zoo
 
 
 def robot_file(text: str) -> Path:
@@ -23,3 +23,14 @@ def robot_file(text: str) -> Path:
             f"no robot {text!r} in the zoo ({names}); or give a description's path"
         )
     return found
+
+
+def add_robot_option(
+    parser: argparse.ArgumentParser,
+    help_text: str = "robot description: a zoo name or a file",
+    default: Path | None = ROBOT_FILE,
+) -> None:
+    """``--robot NAME|PATH`` on ``parser`` (``robot_file``), Little John's by default."""
+    parser.add_argument(
+        "--robot", type=robot_file, default=default, metavar="NAME|PATH", help=help_text
+    )
