@@ -13,6 +13,7 @@ import yaml
 
 from launch import query
 from profiles.deploy_files import ROBOT_FILE
+from profiles.profile import Profile
 from tests.launch.conftest import DEADLINE_S, free_port
 from tests.processes import process_gone
 
@@ -88,7 +89,10 @@ def test_every_line_of_the_launch_says_when_and_what_it_waits_for(
     """The launcher's lines and its components' alike; it says what it waits for."""
     controller = {"name": "ctl", "module": "lp_controller", "role": "controller"}
     launched = launch(write_profile([publisher("pub"), controller], robot=str(ROBOT_FILE)))
-    launched.wait_for(r"\[launch\] waiting for 2 component\(s\) to come alive \(at most 10 s\)")
+    timeout = Profile.model_fields["startup_timeout_s"].default
+    launched.wait_for(
+        rf"\[launch\] waiting for 2 component\(s\) to come alive \(at most {timeout:g} s\)"
+    )
     launched.wait_for(r"\[launch\] all 2 components alive; running until Ctrl-C")
     assert launched.stop() == 0
     lines = launched.text().splitlines()
