@@ -13,7 +13,6 @@ from messages.commands import ArmCommand, BaseCommand
 from messages.diagnostics import ControllerDiagnostics
 from messages.goal import Goal
 from messages.header import Header
-from messages.state import RobotState
 from messages.topics import (
     ARM_COMMAND,
     BASE_COMMAND,
@@ -24,6 +23,7 @@ from messages.topics import (
 )
 from profiles.deploy_files import ROBOT_FILE
 from record.session_file import SessionWriter
+from tests.robot_states import state_at
 from wbc.base_motion import unicycle, wheel_speeds
 from wbc.geometry import scenarios
 from wbc.laws.cascade_law import CascadeLaw
@@ -63,16 +63,7 @@ def session_of(run: Run, law: str, task: PoseTask) -> dict[str, list]:
     for seq, (q, out) in enumerate(zip(run.configurations, run.outputs, strict=True)):
         stamp = START_NS + seq * DT_NS
         base = wheel_speeds(*unicycle(out.u[0], out.u[1], out.u[2], q[2]), ROBOT.base)
-        session[ROBOT_STATE.name].append(
-            RobotState(
-                header=header(stamp, "world", seq),
-                base_pose=tuple(q[:3]),
-                arm_joints=tuple(q[3:]),
-                end_effector=tuple(ROBOT.fkm(q)),
-                valid=True,
-                age_s=0.0,
-            )
-        )
+        session[ROBOT_STATE.name].append(state_at(ROBOT, q, header(stamp, "world", seq)))
         session[BASE_COMMAND.name].append(
             BaseCommand(
                 header=header(stamp, "base", seq),

@@ -12,8 +12,8 @@ import pytest
 from components.control_step import ControlStep, base_command
 from messages.goal import Goal
 from messages.header import Header
-from messages.state import RobotState
 from profiles.deploy_files import ROBOT_FILE, ROBOTS_DIR
+from tests.robot_states import state_at
 from wbc.laws.lp_law import LPLaw, LPParams
 from wbc.robot import MobileManipulator
 
@@ -55,15 +55,7 @@ def test_the_step_commands_every_joint_of_the_robot(name: str) -> None:
     goal[3:] += 0.1 * (arm.q_max[3:] - arm.q_min[3:]) / 2  # a reachable pose nearby
     control = ControlStep("lp", LPLaw, arm, LPParams())
     control.take_goal(Goal(header=HEADER, task="pose", pose=tuple(arm.fkm(goal))))
-    state = RobotState(
-        header=HEADER,
-        base_pose=tuple(q[:3]),
-        arm_joints=tuple(q[3:]),
-        joint_names=arm.joint_names,
-        end_effector=tuple(arm.fkm(q)),
-        valid=True,
-        age_s=0.0,
-    )
+    state = state_at(arm, q, HEADER)
     step = control.step(state, HEADER.stamp_ns, 0.5)
     assert step.status == "optimal", step.reason
     assert len(step.joints) == arm.arm_dof and any(v != 0.0 for v in step.joints)

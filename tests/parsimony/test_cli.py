@@ -11,7 +11,7 @@ import pytest
 
 from parsimony.cli import COMMANDS
 from studies.goal_sets import LAWS, POSITION_LAWS
-from tests.parsimony.in_process import refused
+from tests.parsimony.in_process import run_in_process
 
 
 def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
@@ -138,7 +138,9 @@ def test_demo_reports_every_experiment_and_exits_zero(demo: subprocess.Completed
 
 @pytest.mark.parametrize("duration", ["nan", "inf", "-1", "0", "soon"])
 def test_launch_refuses_a_duration_that_is_not_a_positive_number_of_seconds(duration, capsys):
-    code, _, err = refused(["launch", "deploy/controllers.yaml", "--duration", duration], capsys)
+    code, _, err = run_in_process(
+        ["launch", "deploy/controllers.yaml", "--duration", duration], capsys
+    )
     assert code == 2
     assert "--duration" in err and repr(duration) in err
 
@@ -172,5 +174,5 @@ def test_goal_refuses_input_it_cannot_use_with_exit_2(
     argv: tuple[str, ...], error: str, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """Before anything is sent, and with no running system to ask."""
-    code, _, err = refused(["goal", *argv], capsys)
+    code, _, err = run_in_process(["goal", *argv], capsys)
     assert code == 2 and error in err, err

@@ -11,12 +11,13 @@ from rosbags.rosbag2 import Reader
 from messages.header import Header
 from messages.state import RobotState
 from messages.topics import ROBOT_STATE
-from parsimony.cli import main
 from profiles.deploy_files import ROBOT_FILE
 from record.session_file import SessionWriter
 from ros2.bag import check_joints
 from ros2.urdf import ROOT, joints, link_name, matrix, planar, urdf
 from ros2.wire import typestore
+from tests.parsimony.in_process import run_in_process
+from tests.robot_states import state_at
 from wbc.robot import BASE_DOF, MobileManipulator
 
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
@@ -35,14 +36,8 @@ def configurations() -> np.ndarray:
 
 
 def state(seq: int, q: np.ndarray, valid: bool = True) -> RobotState:
-    return RobotState(
-        header=Header(stamp_ns=START_NS + seq * DT_NS, frame="world", seq=seq, source="test"),
-        base_pose=tuple(q[:BASE_DOF]),
-        arm_joints=tuple(q[BASE_DOF:]),
-        end_effector=tuple(ROBOT.fkm(q)),
-        valid=valid,
-        age_s=0.0,
-    )
+    header = Header(stamp_ns=START_NS + seq * DT_NS, frame="world", seq=seq, source="test")
+    return state_at(ROBOT, q, header, valid)
 
 
 @pytest.fixture(scope="module")
@@ -56,19 +51,12 @@ def session(tmp_path_factory) -> tuple:
     return path, qs
 
 
-def export(argv: list[str], capsys) -> tuple[int, str, str]:
-    try:
-        code = main(argv)
-    except SystemExit as exit:
-        code = int(exit.code or 0)
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
 def test_bag_read_back_message_for_message(session, tmp_path, capsys):
     path, qs = session
     bag = tmp_path / "bag"
-    code, out, err = export(["export", str(path), "--ros2", "-o", str(bag), "--json"], capsys)
+    code, out, err = run_in_process(
+        ["export", str(path), "--ros2", "-o", str(bag), "--json"], capsys
+    )
     assert code == 0, err
     result = json.loads(out)
     assert result["topics"] == {"/joint_states": STEPS, "/tf": STEPS, "/odom": STEPS}
@@ -123,15 +111,15 @@ def test_bag_read_back_message_for_message(session, tmp_path, capsys):
 def test_a_wrong_robot_or_an_existing_directory_is_one_line(session, tmp_path, capsys):
     path, _ = session
     bag = tmp_path / "bag"
-    code, _, err = export(
+    code, _, err = run_in_process(
         ["export", str(path), "--ros2", "-o", str(bag), "--robot", "ur5e_fixed"], capsys
     )
     assert code == 2 and "arm joints" in err and "Traceback" not in err
     assert not bag.exists()
     bag.mkdir()
-    code, _, err = export(["export", str(path), "--ros2", "-o", str(bag)], capsys)
+    code, _, err = run_in_process(["export", str(path), "--ros2", "-o", str(bag)], capsys)
     assert code == 2 and "exists" in err
-    code, _, err = export(
+    code, _, err = run_in_process(
         ["export", str(tmp_path / "none.mcap"), "--ros2", "-o", str(tmp_path / "b")], capsys
     )
     assert code == 2 and err.startswith("export:") and len(err.strip().splitlines()) == 1
@@ -139,11 +127,13 @@ def test_a_wrong_robot_or_an_existing_directory_is_one_line(session, tmp_path, c
 
 def test_the_urdf_the_bags_frames_come_from(tmp_path, capsys):
     out = tmp_path / "robot.urdf"
-    code, printed, err = export(["export", "--urdf", "--robot", "youbot", "-o", str(out)], capsys)
+    code, printed, err = run_in_process(
+        ["export", "--urdf", "--robot", "youbot", "-o", str(out)], capsys
+    )
     assert code == 0, err
     assert printed == f"{out}: {out.stat().st_size} bytes\n"
     assert out.read_text() == urdf(MobileManipulator.from_yaml("deploy/robots/youbot.yaml"))
-    code, _, err = export(["export", "x.mcap", "--urdf", "-o", str(tmp_path / "u")], capsys)
+    code, _, err = run_in_process(["export", "x.mcap", "--urdf", "-o", str(tmp_path / "u")], capsys)
     assert code == 2 and "no SESSION" in err
 
 

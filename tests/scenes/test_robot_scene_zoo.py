@@ -16,6 +16,7 @@ from messages.state import RobotState
 from profiles.deploy_files import ROBOT_FILE, zoo
 from scenes.foxglove_views import ESTIMATE_COLOR, Viewer
 from scenes.robot_scene import RobotDrawing
+from tests.robot_states import state_at
 from tests.scenes.views_read import KEY, STAMP_NS, chain, decode, transforms_of, vector
 from wbc import dq
 from wbc.robot import MobileManipulator
@@ -25,15 +26,7 @@ WHEELS = {"differential": 2, "omnidirectional": 4, "fixed": 0}
 
 
 def state_of(robot: MobileManipulator, q: np.ndarray) -> RobotState:
-    return RobotState(
-        header=Header(stamp_ns=STAMP_NS, frame="world", seq=0, source="test"),
-        base_pose=tuple(q[:3]),
-        arm_joints=tuple(q[3:]),
-        joint_names=robot.joint_names,
-        end_effector=tuple(robot.fkm(q)),
-        valid=True,
-        age_s=0.0,
-    )
+    return state_at(robot, q, Header(stamp_ns=STAMP_NS, frame="world", seq=0, source="test"))
 
 
 def inside(robot: MobileManipulator, seed: int = 0) -> np.ndarray:

@@ -29,7 +29,7 @@ from studies.experiment import (
     Options,
     experiment_profile,
 )
-from tests.parsimony.in_process import refused
+from tests.parsimony.in_process import run_in_process
 from tests.scenes.views_read import decode, vector
 from tests.studies.experiments import assert_sound, experiment, run_here
 from wbc.planar import inverse
@@ -282,7 +282,7 @@ def test_usage_errors_exit_2_and_say_why(
 ) -> None:
     """The command's own entry point, in this process (a traceback would fail the test)."""
     extra = [] if bad == ["pose"] else ["--out", str(tmp_path)]
-    code, out, err = refused(["experiment", *bad, *extra], capsys)
+    code, out, err = run_in_process(["experiment", *bad, *extra], capsys)
     assert code == 2 and why in err and out == "", err
     assert not any(tmp_path.iterdir())  # refused before anything was written
 
@@ -318,6 +318,6 @@ def test_an_experiment_does_not_write_over_a_directory_that_holds_files(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     (tmp_path / "report.json").write_text("{}")
-    code, _, err = refused(["experiment", "pose", "--out", str(tmp_path)], capsys)
+    code, _, err = run_in_process(["experiment", "pose", "--out", str(tmp_path)], capsys)
     assert code == 2 and "give --force" in err, err
     assert (tmp_path / "report.json").read_text() == "{}"

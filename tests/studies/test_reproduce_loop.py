@@ -19,7 +19,7 @@ from profiles.deploy_files import ROBOT_FILE
 from record.sessions import load_session
 from studies.reproduce.loop import folder
 from studies.reproduce.runs import laws_of
-from tests.parsimony.in_process import refused
+from tests.parsimony.in_process import run_in_process
 from wbc.robot import MobileManipulator
 
 pytestmark = pytest.mark.heavy  # the whole loop, twice
@@ -97,7 +97,7 @@ def test_the_loop_prints_the_rows_of_its_recordings_beside_the_kinematic_ones(
 def test_the_laws_of_the_loop_need_the_loop(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    code, out, err = refused(["reproduce", "--law", "LP", "--out", str(tmp_path)], capsys)
+    code, out, err = run_in_process(["reproduce", "--law", "LP", "--out", str(tmp_path)], capsys)
     assert code == 2 and out == "", err
     assert "--law chooses the laws of the loop: add --loop" in err
     assert not any(tmp_path.iterdir())

@@ -52,6 +52,7 @@ from record.session_reader import info
 from record.sessions import load_session
 from scenes.foxglove_views import MODEL_SUFFIX, View, Viewer
 from sim2d.scenarios import scenario
+from tests.robot_states import state_at
 from tests.scenes.views_read import decode
 from tests.studies.experiments import run_here
 from tests.view.live_view_client import DEADLINE_S, StderrLines, watch
@@ -89,15 +90,7 @@ def record_loop(robot: MobileManipulator, path: Path) -> None:
         out.write(topics.CONTROL_GOAL.key(NAMESPACE), goal)
         for k in range(STEPS):
             head = Header(stamp_ns=(k + 1) * DT_NS, frame="world", seq=k, source="test")
-            state = RobotState(
-                header=head,
-                base_pose=tuple(q[:3]),
-                arm_joints=tuple(q[3:]),
-                joint_names=robot.joint_names,
-                end_effector=tuple(robot.fkm(q)),
-                valid=True,
-                age_s=0.0,
-            )
+            state = state_at(robot, q, head)
             out.write(topics.ROBOT_STATE.key(NAMESPACE), state, views=True)
             step = stepper.step(state, head.stamp_ns, math.inf)
             write_step(out, NAMESPACE, "lp", step, stepper.gains, robot.joint_names)
