@@ -34,6 +34,7 @@ COMMANDS = (
     "view",
     "layout",
     "reproduce",
+    "calibrate",
 )
 
 
