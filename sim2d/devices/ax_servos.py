@@ -32,11 +32,10 @@ import math
 import time
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Protocol
 
 from protocols import dynamixel_v1 as dxl
 from protocols.dynamixel_v1 import Address, Instruction, StatusError
-from sim2d.devices.pty_link import SerialDevice
+from sim2d.devices.servo_chain import ServoBackend, ServoChain, spoiled
 
 MODEL_NUMBER = 18
 MAX_SPEED_RAD_S = 97.0 * 2.0 * math.pi / 60.0
@@ -72,32 +71,6 @@ punch 32; present voltage 12.0 V and temperature 25 C stand for a cool servo on 
 _READ_ONLY = frozenset((0, 1, 2, *range(36, 47)))
 """Model number, firmware version and the present values 36..46 (position, speed, load,
 voltage, temperature, Registered, Moving): a write leaves them as they are."""
-
-
-class ServoBackend(Protocol):
-    def joint_positions(self) -> Sequence[float]:
-        """Joint angles (rad), one per servo in id order."""
-
-    def set_joint_velocities(self, velocities: Sequence[float]) -> None:
-        """Joint velocity commands (rad/s), one per servo in id order."""
-
-
-class IntegratingJoints:
-    """The plainest world for the servos: joints that move at the velocities they command,
-    ``step(dt)`` at a time (tests and benchmarks without the simulator)."""
-
-    def __init__(self, angles: Sequence[float]) -> None:
-        self.angles = list(angles)
-        self.velocities = [0.0] * len(self.angles)
-
-    def joint_positions(self) -> Sequence[float]:
-        return tuple(self.angles)
-
-    def set_joint_velocities(self, velocities: Sequence[float]) -> None:
-        self.velocities = list(velocities)
-
-    def step(self, dt: float) -> None:
-        self.angles = [q + v * dt for q, v in zip(self.angles, self.velocities, strict=True)]
 
 
 def default_table(servo_id: int) -> bytearray:
@@ -267,7 +240,7 @@ class AXServo:
         return StatusError(0)
 
 
-class AXChainEmulator(SerialDevice):
+class AXChainEmulator(ServoChain):
     """A servo per joint of ``backend``, answering to ``ids`` in the joints' order (1..n when
     None)."""
 
@@ -278,93 +251,13 @@ class AXChainEmulator(SerialDevice):
         link: Path | None = None,
         return_delay_us: float = 500.0,
     ) -> None:
-        self._backend = backend
         positions = backend.joint_positions()
         ids = range(1, len(positions) + 1) if ids is None else ids
-        self.servos = [
+        servos = [
             AXServo(servo_id, return_delay_us, position)
             for servo_id, position in zip(ids, positions, strict=True)
         ]
-        self._previous_positions: list[float] = list(positions)
-        super().__init__(
-            link,
-            (
-                "packets",
-                "bad_checksums",
-                "skipped_bytes",
-                "unanswered",
-                "status_sent",
-                "sync_writes",
-                "handler_errors",
-            ),
-        )
-        self._parser = dxl.PacketParser()
-
-    def fail(self, servo_id: int, silent: bool = True) -> None:
-        """Fault injection (see ``AXServo.fail``)."""
-        with self._lock:
-            self._named(servo_id).fail(silent)
-
-    def recover(self, servo_id: int) -> None:
-        """A silent servo answers again, its torque off as after a brown-out."""
-        with self._lock:
-            self._named(servo_id).silent = False
-
-    def corrupt(self, servo_id: int, fault: dxl.StatusFault | None) -> None:
-        """Spoil every status packet of ``servo_id`` as ``fault`` says (TRUNCATED: its first
-        five bytes; CHECKSUM: the checksum inverted; WRONG_ID: the next id's; WRONG_LENGTH:
-        one parameter short); None sends them whole again."""
-        if fault is dxl.StatusFault.SILENT:
-            raise ValueError("a silent servo is fail(id), not a corrupt answer")
-        with self._lock:
-            self._named(servo_id).corruption = fault
-
-    def words(self, address: int) -> list[int]:
-        """Every servo's word at ``address``, read at one moment (no Sync Write half done)."""
-        with self._lock:
-            return [servo.word(address) for servo in self.servos]
-
-    def _named(self, servo_id: int) -> AXServo:
-        servo = self._servo(servo_id)
-        if servo is None:
-            raise KeyError(f"no servo {servo_id} on the chain, ids {self._ids()}")
-        return servo
-
-    def update(self, dt: float) -> None:
-        """One simulator step of dt seconds: measure each joint's motion since the last step,
-        then command every joint's velocity towards its goal."""
-        if dt <= 0.0:
-            raise ValueError(f"update needs a positive step, got dt = {dt} s")
-        with self._lock:
-            positions = list(self._backend.joint_positions())
-            velocities = []
-            for servo, position, previous in zip(
-                self.servos, positions, self._previous_positions, strict=True
-            ):
-                servo.sense_position(position)
-                servo.sense_speed((position - previous) / dt)
-                velocities.append(servo.velocity_command(position, dt))
-            self._previous_positions = positions
-            self._backend.set_joint_velocities(velocities)
-
-    def _ids(self) -> list[int]:
-        return [servo.id for servo in self.servos]
-
-    def _servo(self, servo_id: int) -> AXServo | None:
-        return next((servo for servo in self.servos if servo.id == servo_id), None)
-
-    def receive(self, data: bytes) -> None:
-        for packet in self._parser.feed(data):
-            self._handle_guarded(packet)
-        self.counters["bad_checksums"] = self._parser.bad_checksums
-        self.counters["skipped_bytes"] = self._parser.skipped_bytes
-
-    def _handle_guarded(self, packet: dxl.Packet) -> None:
-        """A fault in handling one packet is counted, not fatal: a bus keeps going."""
-        try:
-            self._handle(packet)
-        except Exception:
-            self.counters["handler_errors"] += 1
+        super().__init__(backend, servos, dxl.PacketParser(), link)
 
     def _handle(self, packet: dxl.Packet) -> None:
         self.counters["packets"] += 1
@@ -380,9 +273,7 @@ class AXChainEmulator(SerialDevice):
                 self.counters["unanswered"] += 1
                 return
             if packet.instruction == Instruction.READ:
-                index = self.servos.index(servo)
-                position = self._backend.joint_positions()[index]
-                servo.sense_position(position)
+                self._sense(servo)
             answer_id = servo.id
             answer = servo.execute(packet)
             delay = servo.return_delay_s
@@ -391,17 +282,4 @@ class AXChainEmulator(SerialDevice):
             self.counters["unanswered"] += 1
             return
         time.sleep(delay)
-        self.send(spoiled(dxl.status_packet(answer_id, *answer), corruption), "status_sent")
-
-
-def spoiled(packet: bytes, fault: dxl.StatusFault | None) -> bytes:
-    """A status packet as ``fault`` spoils it (see ``AXChainEmulator.corrupt``)."""
-    if fault is dxl.StatusFault.TRUNCATED:
-        return packet[:5]
-    if fault is dxl.StatusFault.CHECKSUM:
-        return packet[:-1] + bytes([packet[-1] ^ 0xFF])
-    if fault is dxl.StatusFault.WRONG_ID:
-        return dxl.status_packet((packet[2] + 1) % dxl.BROADCAST_ID, packet[4], packet[5:-1])
-    if fault is dxl.StatusFault.WRONG_LENGTH:
-        return dxl.status_packet(packet[2], packet[4], packet[5:-2])
-    return packet
+        self.send(spoiled(dxl.status_packet, answer_id, *answer, corruption, 2), "status_sent")

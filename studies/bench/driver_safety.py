@@ -43,8 +43,9 @@ from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from profiles.profile_files import read_profile_data
 from protocols import create_oi
-from sim2d.devices.ax_servos import AXChainEmulator, IntegratingJoints
+from sim2d.devices.ax_servos import AXChainEmulator
 from sim2d.devices.create2 import Create2Emulator
+from sim2d.devices.servo_chain import IntegratingJoints
 from studies.bench.figures import run_bench, spread
 from studies.experiment import connect, launched
 

@@ -18,7 +18,8 @@ from messages.header import Header
 from profiles.deploy_files import ROBOT_FILE
 from protocols import dynamixel_v1 as dxl
 from protocols.dynamixel_v1 import Address, StatusFault
-from sim2d.devices.ax_servos import AXChainEmulator, IntegratingJoints
+from sim2d.devices.ax_servos import AXChainEmulator
+from sim2d.devices.servo_chain import IntegratingJoints
 from tests.components.conftest import System
 from tests.components.driver_harness import driver_system, status
 from wbc.robot import MobileManipulator

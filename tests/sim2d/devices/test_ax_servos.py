@@ -20,7 +20,8 @@ from dynamixel_sdk import (
 
 from protocols import dynamixel_v1 as dxl
 from protocols.dynamixel_v1 import Address, Instruction, StatusError
-from sim2d.devices.ax_servos import MODEL_NUMBER, AXChainEmulator, IntegratingJoints
+from sim2d.devices.ax_servos import MODEL_NUMBER, AXChainEmulator
+from sim2d.devices.servo_chain import IntegratingJoints
 
 IDS = (1, 2, 3, 4, 5)
 START_ANGLES = (0.0, 0.4, -0.6, 1.2, -1.0)

@@ -1,0 +1,163 @@
+"""What every emulated chain of Dynamixel servos shares, whatever its protocol: the world the
+servos move (``ServoBackend``), the chain on a pseudo-terminal with its fault injection
+(``ServoChain``), and status packets spoiled on their way out (``spoiled``).
+
+A servo of a chain (``AXServo``, ``XServo``) has an ``id``, ``silent``, ``corruption``,
+``fail(silent)``, ``word(address)``, ``sense_position(rad)``, ``sense_speed(rad_s)`` and
+``velocity_command(position_rad, dt)``; the chain's ``_handle`` answers a packet.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any, Protocol
+
+from protocols.dynamixel_v1 import StatusFault
+from sim2d.devices.pty_link import SerialDevice
+
+
+class ServoBackend(Protocol):
+    def joint_positions(self) -> Sequence[float]:
+        """Joint angles (rad), one per servo in id order."""
+
+    def set_joint_velocities(self, velocities: Sequence[float]) -> None:
+        """Joint velocity commands (rad/s), one per servo in id order."""
+
+
+class IntegratingJoints:
+    """The plainest world for the servos: joints that move at the velocities they command,
+    ``step(dt)`` at a time (tests and benchmarks without the simulator)."""
+
+    def __init__(self, angles: Sequence[float]) -> None:
+        self.angles = list(angles)
+        self.velocities = [0.0] * len(self.angles)
+
+    def joint_positions(self) -> Sequence[float]:
+        return tuple(self.angles)
+
+    def set_joint_velocities(self, velocities: Sequence[float]) -> None:
+        self.velocities = list(velocities)
+
+    def step(self, dt: float) -> None:
+        self.angles = [q + v * dt for q, v in zip(self.angles, self.velocities, strict=True)]
+
+
+COUNTERS = (
+    "packets",
+    "bad_checksums",
+    "skipped_bytes",
+    "unanswered",
+    "status_sent",
+    "sync_writes",
+    "handler_errors",
+)
+
+
+class ServoChain(SerialDevice):
+    """Servos on one pseudo-terminal, one per joint of ``backend``; ``parser`` frames the
+    driver's packets (``feed``, ``bad_checksums``, ``skipped_bytes``)."""
+
+    def __init__(
+        self, backend: ServoBackend, servos: Sequence[Any], parser: Any, link: Path | None
+    ) -> None:
+        self._backend = backend
+        self.servos = list(servos)
+        self._previous_positions: list[float] = list(backend.joint_positions())
+        super().__init__(link, COUNTERS)
+        self._parser = parser
+
+    def fail(self, servo_id: int, silent: bool = True) -> None:
+        """Fault injection (see the servo's ``fail``)."""
+        with self._lock:
+            self._named(servo_id).fail(silent)
+
+    def recover(self, servo_id: int) -> None:
+        """A silent servo answers again, its torque off as after a brown-out."""
+        with self._lock:
+            self._named(servo_id).silent = False
+
+    def corrupt(self, servo_id: int, fault: StatusFault | None) -> None:
+        """Spoil every status packet of ``servo_id`` as ``fault`` says (TRUNCATED: cut after
+        its id; CHECKSUM: the checksum's last byte inverted; WRONG_ID: the next id's;
+        WRONG_LENGTH: one parameter short); None sends them whole again."""
+        if fault is StatusFault.SILENT:
+            raise ValueError("a silent servo is fail(id), not a corrupt answer")
+        with self._lock:
+            self._named(servo_id).corruption = fault
+
+    def words(self, address: int) -> list[int]:
+        """Every servo's value at ``address``, read at one moment (no Sync Write half done)."""
+        with self._lock:
+            return [servo.word(address) for servo in self.servos]
+
+    def _named(self, servo_id: int) -> Any:
+        servo = self._servo(servo_id)
+        if servo is None:
+            raise KeyError(f"no servo {servo_id} on the chain, ids {self._ids()}")
+        return servo
+
+    def update(self, dt: float) -> None:
+        """One simulator step of dt seconds: measure each joint's motion since the last step,
+        then command every joint's velocity towards its goal."""
+        if dt <= 0.0:
+            raise ValueError(f"update needs a positive step, got dt = {dt} s")
+        with self._lock:
+            positions = list(self._backend.joint_positions())
+            velocities = []
+            for servo, position, previous in zip(
+                self.servos, positions, self._previous_positions, strict=True
+            ):
+                servo.sense_position(position)
+                servo.sense_speed((position - previous) / dt)
+                velocities.append(servo.velocity_command(position, dt))
+            self._previous_positions = positions
+            self._backend.set_joint_velocities(velocities)
+
+    def _sense(self, servo: Any) -> None:
+        """The servo's Present Position read from the backend now (a read asks for it)."""
+        servo.sense_position(self._backend.joint_positions()[self.servos.index(servo)])
+
+    def _ids(self) -> list[int]:
+        return [servo.id for servo in self.servos]
+
+    def _servo(self, servo_id: int) -> Any:
+        return next((servo for servo in self.servos if servo.id == servo_id), None)
+
+    def receive(self, data: bytes) -> None:
+        for packet in self._parser.feed(data):
+            self._handle_guarded(packet)
+        self.counters["bad_checksums"] = self._parser.bad_checksums
+        self.counters["skipped_bytes"] = self._parser.skipped_bytes
+
+    def _handle_guarded(self, packet: Any) -> None:
+        """A fault in handling one packet is counted, not fatal: a bus keeps going."""
+        try:
+            self._handle(packet)
+        except Exception:
+            self.counters["handler_errors"] += 1
+
+    def _handle(self, packet: Any) -> None:
+        raise NotImplementedError
+
+
+def spoiled(
+    status: Callable[[int, int, bytes], bytes],
+    servo_id: int,
+    error: int,
+    params: bytes,
+    fault: StatusFault | None,
+    id_at: int,
+) -> bytes:
+    """The status packet ``status(servo_id, error, params)`` as ``fault`` spoils it (see
+    ``ServoChain.corrupt``); ``id_at`` is the id's offset in the packet."""
+    if fault is StatusFault.WRONG_ID:
+        return status((servo_id + 1) % 0xFE, error, params)
+    if fault is StatusFault.WRONG_LENGTH:
+        return status(servo_id, error, params[:-1])
+    packet = status(servo_id, error, params)
+    if fault is StatusFault.TRUNCATED:
+        return packet[: id_at + 3]
+    if fault is StatusFault.CHECKSUM:
+        return packet[:-1] + bytes([packet[-1] ^ 0xFF])
+    return packet
