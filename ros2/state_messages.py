@@ -56,24 +56,39 @@ def joint_state(state: RobotState, names: tuple[str, ...]):
     )
 
 
+def transform_stamped(stamp_ns: int, parent: str, child: str, pose: Array):
+    """geometry_msgs/TransformStamped of ``child`` at ``pose`` (4x4) in ``parent``."""
+    types = _types()
+    return types["geometry_msgs/msg/TransformStamped"](
+        header=header(stamp_ns, parent),
+        child_frame_id=child,
+        transform=types["geometry_msgs/msg/Transform"](
+            translation=_vector("Vector3", pose[:3, 3]), rotation=_quaternion(pose[:3, :3])
+        ),
+    )
+
+
+def _pairs(state: RobotState, tree: list[Joint]) -> list[tuple[str, str, Array]]:
+    """(parent, child, pose in parent) of the base in the world, then of every joint."""
+    q_arm = np.array(state.arm_joints)
+    pairs = [(WORLD, ROOT, planar(*state.base_pose))]
+    return pairs + [(joint.parent, joint.child, joint.transform(q_arm)) for joint in tree]
+
+
 def tf_message(state: RobotState, tree: list[Joint]):
     """tf2_msgs/TFMessage: the base on the floor in the world, then every joint's transform
     at the state's joint values."""
-    types = _types()
-    q_arm = np.array(state.arm_joints)
-    pairs = [(WORLD, ROOT, planar(*state.base_pose))]
-    pairs += [(joint.parent, joint.child, joint.transform(q_arm)) for joint in tree]
-    transforms = [
-        types["geometry_msgs/msg/TransformStamped"](
-            header=header(state.header.stamp_ns, parent),
-            child_frame_id=child,
-            transform=types["geometry_msgs/msg/Transform"](
-                translation=_vector("Vector3", pose[:3, 3]), rotation=_quaternion(pose[:3, :3])
-            ),
-        )
-        for parent, child, pose in pairs
-    ]
-    return types["tf2_msgs/msg/TFMessage"](transforms=transforms)
+    stamp = state.header.stamp_ns
+    transforms = [transform_stamped(stamp, *pair) for pair in _pairs(state, tree)]
+    return _types()["tf2_msgs/msg/TFMessage"](transforms=transforms)
+
+
+def frames(state: RobotState, tree: list[Joint]) -> dict[str, Array]:
+    """Every frame of the tree (the world, the base, every link) as its 4x4 pose in the world."""
+    found = {WORLD: np.eye(4)}
+    for parent, child, pose in _pairs(state, tree):
+        found[child] = found[parent] @ pose
+    return found
 
 
 def odometry(state: RobotState, before: RobotState | None):

@@ -1,0 +1,274 @@
+"""The ROS 2 face of a profile: the robot's topics on the wire as rmw_zenoh writes them
+(``ros2.participant``; ROS 2 Jazzy, rmw_zenoh_cpp 0.2.5), and goals from ROS 2 nodes.
+
+A ROS 2 node ``parsimony`` in domain ``domain_id`` publishes, from each robot state (at most
+``max_rate_hz`` a host second), /joint_states, /tf (the base in the world, every link, the end
+effector, and the goal's frame ``goal``) and /odom; /clock on simulated time; the ceiling
+camera's frames (at most ``camera_rate_hz``) as /camera/image/compressed with
+/camera/camera_info; /tf_static (the camera in the world) and /robot_description (the URDF),
+both latched (TRANSIENT_LOCAL: a late joiner gets them); and /diagnostics: the controller's, the
+supervisor's and the bridge's own status, every host second and at once when a goal is refused.
+
+It subscribes to /goal_pose (geometry_msgs/PoseStamped of the end effector, in a frame of the
+TF tree) and passes each goal on goal/request, where the supervisor checks it as any goal
+(``ros2.goal_in``; the access rules see the bridge as the Zenoh user ``ros2_bridge``). A goal
+is refused, counted as ``refused.<kind>``, logged (rate-limited) and said on /diagnostics,
+and nothing moves, when its key's type hash is not PoseStamped's (``type_hash``), it comes
+faster than ``goal_rate_hz`` allows (``flood``), its bytes are not a PoseStamped's CDR
+(``malformed_cdr``), its frame is not in the tree (``frame``) or its pose is not one
+(``goal``). ``domain_id`` is read at start.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from functools import partial
+
+import numpy as np
+import zenoh
+
+from components.clock import SimClock
+from components.joint_check import joints_match
+from components.params import Param, ParamError, load_robot
+from components.process_entry import run_component
+from components.pubsub import Input
+from components.runtime import Component, Node
+from messages import topics
+from messages.camera import CameraFrame
+from messages.diagnostics import ControllerDiagnostics
+from messages.goal import Goal
+from messages.state import RobotState
+from messages.supervisor import SupervisorStatus
+from ros2 import bridge_messages as made
+from ros2.goal_in import Refused, goal_of
+from ros2.participant import SENSOR_QOS, TRANSIENT_LOCAL_QOS, Participant, hash_of
+from ros2.state_messages import (
+    JOINT_STATES,
+    ODOM,
+    TF,
+    WORLD,
+    frames,
+    joint_state,
+    odometry,
+    tf_message,
+    transform_stamped,
+)
+from ros2.urdf import joints, matrix, urdf
+from ros2.wire import type_hash
+from sim2d.camera import ceiling_pose
+from vision.images import jpeg
+from wbc import dq
+
+log = logging.getLogger("components.ros2_bridge")
+
+NODE_NAME = "parsimony"
+REFUSALS = ("type_hash", "flood", "malformed_cdr", "frame", "goal")
+DIAGNOSTICS_EVERY_S = 1.0
+"""/diagnostics goes out at least this often (host seconds) while states come."""
+GOAL_BURST = 3
+"""Goals that may come at once before ``goal_rate_hz`` holds them back."""
+JPEG_QUALITY = 80
+
+
+class Ros2Bridge(Component):
+    """robot/state, camera/image, supervisor/status, control/diagnostics -> ROS 2;
+    /goal_pose -> goal/request."""
+
+    reads = (
+        Input(topics.ROBOT_STATE),
+        Input(topics.CAMERA_IMAGE),
+        Input(topics.SUPERVISOR_STATUS),
+        Input(topics.CONTROL_DIAGNOSTICS),
+        Input(topics.GOAL_REQUEST),
+    )
+    writes = (topics.GOAL_REQUEST,)
+    params = (
+        Param("domain_id", int, 0, low=0, high=232, doc="the ROS 2 graph's ROS_DOMAIN_ID"),
+        Param("max_rate_hz", float, 50.0, low=0.1, high=1000.0, doc="most states a host s"),
+        Param("camera_rate_hz", float, 10.0, low=0.0, high=100.0, doc="most images a host s"),
+        Param("goal_rate_hz", float, 2.0, low=0.01, high=100.0, doc="most goals a host s"),
+    )
+
+    def __init__(self, node: Node) -> None:
+        super().__init__(node)
+        if node.profile.robot is None:
+            raise ParamError("the ROS 2 bridge needs the profile's robot (robot:)")
+        self.robot = load_robot(node.profile.robot)
+        self.tree = joints(self.robot)
+        scene = node.profile.scene
+        camera = scene.camera if scene is not None else None
+        self.camera_pose = ceiling_pose(*camera.position) if camera is not None else None
+        for kind in REFUSALS:
+            node.counters[f"refused.{kind}"] = 0
+        node.counters |= {"refused_states": 0, "goals_passed": 0}
+        self.last_refusal = ""
+        self.frames: dict[str, np.ndarray] = {WORLD: np.eye(4)}
+        self.state: RobotState | None = None
+        self.goal: Goal | None = None
+        self.controller: ControllerDiagnostics | None = None
+        self.supervisor: SupervisorStatus | None = None
+        self._next_state_ns = self._next_image_ns = self._next_diagnostics_ns = 0
+        self._lock = threading.Lock()
+        self._tokens, self._filled_ns, self._flooded = float(GOAL_BURST), time.monotonic_ns(), 0
+        self.goal_request = node.publisher(topics.GOAL_REQUEST)
+        self._declare(int(node.params["domain_id"]), camera is not None)
+        node.subscribe(topics.ROBOT_STATE, self.on_state)
+        node.subscribe(topics.CAMERA_IMAGE, self.on_frame)
+        node.subscribe(topics.SUPERVISOR_STATUS, self.on_supervisor)
+        node.subscribe(topics.CONTROL_DIAGNOSTICS, self.on_controller)
+        node.subscribe(topics.GOAL_REQUEST, self.on_goal)
+
+    def _declare(self, domain_id: int, camera: bool) -> None:
+        """The ROS 2 node, its publishers (the latched ones put once) and its subscription."""
+        ros = self.participant = Participant(self.node.session, NODE_NAME, domain_id)
+        self.out = {
+            topic: ros.publisher(*topic)
+            for topic in (JOINT_STATES, TF, ODOM, made.DIAGNOSTICS)
+            + ((made.CLOCK,) if isinstance(self.node.clock, SimClock) else ())
+        }
+        if camera:
+            self.out[made.COMPRESSED_IMAGE] = ros.publisher(*made.COMPRESSED_IMAGE, SENSOR_QOS)
+            self.out[made.CAMERA_INFO] = ros.publisher(*made.CAMERA_INFO, SENSOR_QOS)
+        stamp = self.node.clock.now_ns()
+        latched = {
+            made.ROBOT_DESCRIPTION: made.string(urdf(self.robot)),
+            made.TF_STATIC: made.static_transforms(self.camera_pose, stamp),
+        }
+        for topic, message in latched.items():
+            self.out[topic] = ros.publisher(*topic, TRANSIENT_LOCAL_QOS)
+            self.out[topic].put(message)
+        self.goal_hash = type_hash(made.GOAL_POSE[1])
+        ros.subscription(*made.GOAL_POSE, self._on_ros_goal)
+
+    def _due(self, attribute: str, rate_hz: float) -> bool:
+        """Whether the host time has come for what ``attribute`` schedules (at ``rate_hz``)."""
+        now = time.monotonic_ns()
+        if rate_hz <= 0.0 or now < getattr(self, attribute):
+            return False
+        setattr(self, attribute, now + round(1e9 / rate_hz))
+        return True
+
+    def on_state(self, state: RobotState) -> None:
+        """Keep the tree's frames; publish the state's topics when due."""
+        names = self.robot.joint_names
+        if not joints_match(self.node, "refused_states", "robot/state", state.joint_names, names):
+            return
+        if not state.valid:
+            return
+        self.frames = frames(state, self.tree)
+        if self.camera_pose is not None:
+            self.frames[made.CAMERA_FRAME] = matrix(self.camera_pose)
+        if self.goal is not None:
+            self.frames[made.GOAL_FRAME] = self._goal_matrix(self.goal)
+        if self._due("_next_state_ns", float(self.node.params["max_rate_hz"])):
+            stamp = state.header.stamp_ns
+            tf = tf_message(state, self.tree)
+            if made.GOAL_FRAME in self.frames:
+                goal = self.frames[made.GOAL_FRAME]
+                tf.transforms.append(transform_stamped(stamp, WORLD, made.GOAL_FRAME, goal))
+            self.out[JOINT_STATES].put(joint_state(state, names))
+            self.out[TF].put(tf)
+            self.out[ODOM].put(odometry(state, self.state))
+            if made.CLOCK in self.out:
+                self.out[made.CLOCK].put(made.clock(stamp))
+            self.state = state
+        if self._due("_next_diagnostics_ns", 1.0 / DIAGNOSTICS_EVERY_S):
+            self.publish_diagnostics()
+
+    @staticmethod
+    def _goal_matrix(goal: Goal) -> np.ndarray:
+        if goal.pose is not None:
+            return matrix(np.array(goal.pose))
+        where = np.eye(4)
+        if goal.position is not None:
+            where[:3, 3] = goal.position
+        return where
+
+    def on_frame(self, frame: CameraFrame) -> None:
+        """The camera's frame and its intrinsics, when due."""
+        if made.COMPRESSED_IMAGE not in self.out:
+            return
+        if not self._due("_next_image_ns", float(self.node.params["camera_rate_hz"])):
+            return
+        if frame.encoding == "jpeg":
+            data = frame.data
+        else:
+            pixels = np.frombuffer(frame.data, np.uint8).reshape(frame.height, frame.width, -1)
+            data = jpeg(pixels[:, :, ::-1] if frame.encoding == "rgb8" else pixels, JPEG_QUALITY)
+        self.out[made.COMPRESSED_IMAGE].put(made.compressed_image(frame, data))
+        self.out[made.CAMERA_INFO].put(made.camera_info(frame))
+
+    def on_supervisor(self, status: SupervisorStatus) -> None:
+        """Keep the status; say a change of phase at once."""
+        changed = self.supervisor is None or self.supervisor.phase != status.phase
+        self.supervisor = status
+        if changed:
+            self.publish_diagnostics()
+
+    def on_controller(self, diagnostics: ControllerDiagnostics) -> None:
+        self.controller = diagnostics
+
+    def on_goal(self, goal: Goal) -> None:
+        """The goal the supervisor is given (by the bridge or anyone): its frame on /tf."""
+        self.goal = goal
+
+    def publish_diagnostics(self) -> None:
+        """/diagnostics: the controller's, the supervisor's and the bridge's status."""
+        statuses = [made.bridge_status(self.node.counters, self.last_refusal)]
+        if self.supervisor is not None:
+            statuses.insert(0, made.supervisor_status(self.supervisor))
+        if self.controller is not None:
+            statuses.insert(0, made.controller_status(self.controller))
+        self.out[made.DIAGNOSTICS].put(made.diagnostic_array(self.node.clock.now_ns(), statuses))
+
+    def _on_ros_goal(self, sample: zenoh.Sample) -> None:
+        """On Zenoh's thread: take the goal if the rate allows, else count a flood."""
+        with self._lock:
+            now = time.monotonic_ns()
+            rate = float(self.node.params["goal_rate_hz"])
+            self._tokens = min(GOAL_BURST, self._tokens + (now - self._filled_ns) * 1e-9 * rate)
+            self._filled_ns = now
+            if self._tokens < 1.0:
+                self._flooded += 1
+                if self._flooded == 1:
+                    self.node.post(self._count_flood)
+                return
+            self._tokens -= 1.0
+        key = str(sample.key_expr)
+        self.node.post(partial(self.on_ros_goal, key, sample.payload.to_bytes()))
+
+    def _count_flood(self) -> None:
+        with self._lock:
+            flooded, self._flooded = self._flooded, 0
+        rate = float(self.node.params["goal_rate_hz"])
+        self.refuse("flood", f"{flooded} goals faster than goal_rate_hz {rate:g}", flooded)
+
+    def on_ros_goal(self, key: str, data: bytes) -> None:
+        """A PoseStamped from ROS 2: on goal/request, or refused."""
+        try:
+            if hash_of(key) != self.goal_hash:
+                raise Refused("type_hash", f"type hash {hash_of(key)[:80]} is not PoseStamped's")
+            goal = goal_of(data, self.frames, self.node.header("world"))
+        except Refused as refused:
+            self.refuse(refused.kind, str(refused))
+            return
+        self.goal_request.put(goal)
+        self.node.count("goals_passed")
+        x, y, z = dq.translation(np.array(goal.pose))[1:]
+        log.info("a ROS 2 goal passed on: the end effector to (%.3f, %.3f, %.3f)", x, y, z)
+
+    def refuse(self, kind: str, reason: str, amount: int = 1) -> None:
+        """Count, log and say a refused ROS 2 goal; nothing is passed on."""
+        self.node.count(f"refused.{kind}", amount)
+        self.last_refusal = f"goal refused ({kind}): {reason}"
+        self.node.warn(f"refused.{kind}", f"/goal_pose: {self.last_refusal}")
+        self.publish_diagnostics()
+
+    def shutdown(self) -> None:
+        self.participant.close()
+
+
+if __name__ == "__main__":
+    run_component(Ros2Bridge)
