@@ -22,6 +22,7 @@ from protocols import dynamixel_v1 as dxl
 from protocols.dynamixel_v1 import Address, Instruction, StatusError
 from sim2d.devices.ax_servos import MODEL_NUMBER, AXChainEmulator
 from sim2d.devices.servo_chain import IntegratingJoints
+from tests.sim2d.devices.patient_port import PatientPort
 
 IDS = (1, 2, 3, 4, 5)
 START_ANGLES = (0.0, 0.4, -0.6, 1.2, -1.0)
@@ -39,15 +40,6 @@ def emulator(arm: IntegratingJoints) -> Iterator[AXChainEmulator]:
     with AXChainEmulator(arm, IDS) as chain:
         yield chain
     assert chain.counters["handler_errors"] == 0
-
-
-class PatientPort(PortHandler):
-    """The SDK's own port, waiting up to a second for a status packet instead of the few
-    milliseconds it sets per packet: the emulator's thread may be starved on a busy machine, and
-    a test's verdict must not depend on that."""
-
-    def setPacketTimeout(self, packet_length: int) -> None:  # noqa: N802 (the SDK's name)
-        self.setPacketTimeoutMillis(1000.0)
 
 
 @pytest.fixture
