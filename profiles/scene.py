@@ -34,6 +34,29 @@ Finite = Annotated[float, Field(allow_inf_nan=False)]
 Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
 
+ARUCO_DICTIONARIES: dict[str, tuple[int, int]] = {
+    **{
+        f"DICT_{bits}X{bits}_{count}": (4 * (bits - 4) + index, count)
+        for bits in (4, 5, 6, 7)
+        for index, count in enumerate((50, 100, 250, 1000))
+    },
+    "DICT_ARUCO_ORIGINAL": (16, 1024),
+    **{
+        f"DICT_{family}{code}": (dictionary_id, count)
+        for family, name, dictionary_id, count in (
+            ("APRILTAG_", "16h5", 17, 30),
+            ("APRILTAG_", "25h9", 18, 35),
+            ("APRILTAG_", "36h10", 19, 2320),
+            ("APRILTAG_", "36h11", 20, 587),
+            ("ARUCO_MIP_", "36h12", 21, 250),
+        )
+        for code in (name, name.upper())
+    },
+}
+"""OpenCV's predefined ArUco dictionaries (``cv2.aruco.DICT_*``, both spellings it has): name
+-> (id, how many markers). Written out so that loading a profile does not import OpenCV (about
+0.15 s of CPU in every process); tests/profiles/test_scene.py holds it to OpenCV's own."""
+
 
 class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
@@ -105,9 +128,7 @@ class Scene(_Strict):
 
     @model_validator(mode="after")
     def _known_dictionary(self) -> Scene:
-        import cv2  # only profiles with a scene pay for it
-
-        if not self.dictionary.startswith("DICT_") or not hasattr(cv2.aruco, self.dictionary):
+        if self.dictionary not in ARUCO_DICTIONARIES:
             raise ValueError(
                 f"dictionary: not an OpenCV ArUco dictionary: {self.dictionary!r} "
                 "(e.g. 'DICT_4X4_50')"
@@ -118,9 +139,7 @@ class Scene(_Strict):
     def _ids_unique(self) -> Scene:
         """Each marker id once and in the dictionary; the error names the marker (the later of
         two that share an id)."""
-        import cv2
-
-        size = cv2.aruco.getPredefinedDictionary(self.dictionary_id).bytesList.shape[0]
+        size = ARUCO_DICTIONARIES[self.dictionary][1]
         fields = [
             ("reference.id", self.reference.id),
             ("base.id", self.base.id),
@@ -166,9 +185,7 @@ class Scene(_Strict):
     @property
     def dictionary_id(self) -> int:
         """The OpenCV predefined dictionary id."""
-        import cv2
-
-        return int(getattr(cv2.aruco, self.dictionary))
+        return ARUCO_DICTIONARIES[self.dictionary][0]
 
     def markers(self) -> dict[int, Marker]:
         """Every marker of the scene by id."""

@@ -9,7 +9,7 @@ import pytest
 import yaml
 
 from profiles.profile import ProfileError, load_profile
-from profiles.scene import BaseMarker, GoalMarker, Marker, Scene
+from profiles.scene import ARUCO_DICTIONARIES, BaseMarker, GoalMarker, Marker, Scene
 
 REPO = Path(__file__).resolve().parents[2]
 PUB = {"name": "pub", "module": "scripted_publisher", "role": "tool"}
@@ -76,6 +76,16 @@ def test_the_dictionary_id_is_opencvs() -> None:
     assert scene.dictionary_id == cv2.aruco.DICT_4X4_50
     other = Scene.model_validate({**SCENE, "dictionary": "DICT_5X5_100"})
     assert other.dictionary_id == cv2.aruco.DICT_5X5_100 != cv2.aruco.DICT_4X4_50
+
+
+def test_the_dictionaries_are_opencvs() -> None:
+    """A profile is checked without OpenCV, against a table that is OpenCV's own."""
+    opencv = {}
+    for name in (n for n in dir(cv2.aruco) if n.startswith("DICT_")):
+        dictionary_id = getattr(cv2.aruco, name)
+        count = cv2.aruco.getPredefinedDictionary(dictionary_id).bytesList.shape[0]
+        opencv[name] = (dictionary_id, count)
+    assert opencv == ARUCO_DICTIONARIES
 
 
 @pytest.mark.parametrize(
