@@ -6,7 +6,9 @@ list`` and rviz2 build the graph (``ros2.wire``).
 A publisher with ``TRANSIENT_LOCAL`` durability (``/robot_description``, ``/tf_static``) is a
 Zenoh advanced publisher with a cache of its depth and publisher detection, as rmw_zenoh
 declares it since 0.2.2 (ros2/rmw_zenoh#469): a late joiner's advanced subscriber with history
-gets the latest message from that cache."""
+gets the latest message from that cache. It numbers its samples for miss detection (a sporadic
+heartbeat every ``HEARTBEAT_S``, as a reliable publisher of rmw_zenoh's), so that it needs no
+timestamping in the session's configuration."""
 
 from __future__ import annotations
 
@@ -26,6 +28,9 @@ DEFAULT_QOS = "::,10:,:,:,,"
 """The default profile's: reliable, volatile, keep last 10."""
 SENSOR_QOS = "2::,5:,:,:,,"
 """sensor data's: best effort (2), volatile, keep last 5 (the camera)."""
+
+HEARTBEAT_S = 0.5
+MISS_DETECTION = zenoh.ext.MissDetectionConfig(heartbeat=None, sporadic_heartbeat=HEARTBEAT_S)
 
 
 def gid(session_id: str, entity_id: int) -> bytes:
@@ -79,7 +84,11 @@ class Participant:
         entity_id = self._entity("MP", topic, msgtype, qos)
         if qos == TRANSIENT_LOCAL_QOS:
             declared = zenoh.ext.declare_advanced_publisher(
-                self.session, key, cache=zenoh.ext.CacheConfig(1), publisher_detection=True
+                self.session,
+                key,
+                cache=zenoh.ext.CacheConfig(1),
+                publisher_detection=True,
+                sample_miss_detection=MISS_DETECTION,
             )
         else:
             declared = self.session.declare_publisher(key)

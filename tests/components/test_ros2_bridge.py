@@ -1,0 +1,315 @@
+"""The ROS 2 bridge, in-process on a real Zenoh router (loopback), seen by a ROS 2 subscriber
+written against rmw_zenoh's design document (0.2.5, Jazzy) alone: its keys
+``<domain>/<topic>/<DDS type>/<RIHS01 hash>``, the 33-byte attachment, CDR decoded by rosbags
+(not by ``ros2``'s code), the liveliness tokens ``@ros2_lv/...``; goals from ROS 2 reach the
+supervisor's goal/request, and bad ones are refused, counted and never passed on."""
+
+from __future__ import annotations
+
+import math
+import struct
+import threading
+import time
+from collections.abc import Callable, Iterator
+
+import numpy as np
+import pytest
+import yaml
+import zenoh
+import zenoh.ext
+
+from components.ros2_bridge import Ros2Bridge
+from components.runtime import Node
+from launch import query
+from messages import codec, topics
+from messages.camera import CameraFrame, CameraIntrinsics
+from messages.header import Header
+from messages.supervisor import SupervisorStatus
+from profiles.deploy_files import DEPLOY, ROBOT_FILE
+from profiles.profile_files import read_profile_data
+from ros2.urdf import urdf
+from tests.components.conftest import DEADLINE_S, System
+from tests.robot_states import state_at
+from wbc import dq
+from wbc.robot import MobileManipulator
+
+ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
+DOMAIN = 7
+Q = np.array([1.0, 0.5, 0.3, 0.1, -0.4, 0.6, 0.2, 0.0])[: 3 + ROBOT.arm_dof]
+JPEG = b"\xff\xd8\xff\xe0" + bytes(60) + b"\xff\xd9"
+
+
+def store():
+    """rosbags' Jazzy types (the independent serialiser)."""
+    from rosbags.typesys import Stores, get_typestore
+
+    return get_typestore(Stores.ROS2_JAZZY)
+
+
+def design_key(topic: str, msgtype: str) -> str:
+    """The data key as the design document writes it, from rosbags' hash."""
+    package, _, name = msgtype.split("/")
+    return f"{DOMAIN}/{topic}/{package}::msg::dds_::{name}_/{store().hash_rihs01(msgtype)}"
+
+
+class RosSide:
+    """Everything put under the domain's keys, with its attachment."""
+
+    def __init__(self, session: zenoh.Session) -> None:
+        self.samples: dict[str, list[tuple[bytes, bytes]]] = {}
+        self._changed = threading.Condition()
+        self._subscriber = session.declare_subscriber(f"{DOMAIN}/**", self._on_sample)
+
+    def _on_sample(self, sample: zenoh.Sample) -> None:
+        attachment = sample.attachment.to_bytes() if sample.attachment is not None else b""
+        with self._changed:
+            self.samples.setdefault(str(sample.key_expr), []).append(
+                (sample.payload.to_bytes(), attachment)
+            )
+            self._changed.notify_all()
+
+    def wait(self, key: str, count: int = 1) -> list[tuple[bytes, bytes]]:
+        with self._changed:
+            if not self._changed.wait_for(
+                lambda: len(self.samples.get(key, ())) >= count, DEADLINE_S
+            ):
+                pytest.fail(f"nothing on {key}; saw {sorted(self.samples)}")
+            return list(self.samples[key])
+
+    def message(self, topic: str, msgtype: str, count: int = 1):
+        data, _ = self.wait(design_key(topic, msgtype), count)[-1]
+        return store().deserialize_cdr(data, msgtype)
+
+
+class Bridge:
+    """The bridge node in this process, the router, the ROS 2 side and Parsimony's side."""
+
+    def __init__(self, system: System, node: Node) -> None:
+        self.system, self.node = system, node
+        namespace = system.profile.namespace
+        self.ros = RosSide(system.router)
+        self.requests = system.inbox(topics.GOAL_REQUEST)
+        self.state = system.router.declare_publisher(topics.ROBOT_STATE.key(namespace))
+        self.goal_out = system.router.declare_publisher(
+            design_key("goal_pose", "geometry_msgs/msg/PoseStamped")
+        )
+
+    def put(self, topic: topics.Topic, message) -> None:
+        key = topics.key(self.system.profile.namespace, topic)
+        self.system.router.put(key, codec.encode(message))
+
+    def send_state(self) -> None:
+        header = Header(stamp_ns=time.time_ns(), frame="world", seq=0, source="test")
+        self.state.put(codec.encode(state_at(ROBOT, Q, header)))
+
+    def counters(self) -> dict[str, int]:
+        status = query.status_of(self.system.router, self.system.profile.namespace, "ros2_bridge")
+        return status.counters
+
+    def wait_counter(self, name: str, at_least: int) -> dict[str, int]:
+        deadline = time.monotonic() + DEADLINE_S
+        while (counters := self.counters()).get(name, 0) < at_least:
+            assert time.monotonic() < deadline, f"{name} stayed {counters.get(name)}"
+            time.sleep(0.01)
+        return counters
+
+
+def pose_stamped(frame: str, position, orientation=(1.0, 0.0, 0.0, 0.0)) -> bytes:
+    types = store().types
+    w, x, y, z = orientation
+    message = types["geometry_msgs/msg/PoseStamped"](
+        header=types["std_msgs/msg/Header"](
+            stamp=types["builtin_interfaces/msg/Time"](sec=0, nanosec=0), frame_id=frame
+        ),
+        pose=types["geometry_msgs/msg/Pose"](
+            position=types["geometry_msgs/msg/Point"](x=position[0], y=position[1], z=position[2]),
+            orientation=types["geometry_msgs/msg/Quaternion"](x=x, y=y, z=z, w=w),
+        ),
+    )
+    return bytes(store().serialize_cdr(message, "geometry_msgs/msg/PoseStamped"))
+
+
+ATTACHMENT = struct.pack("<qqB16s", 1, time.time_ns(), 16, bytes(16))
+
+
+@pytest.fixture(scope="module")
+def bridge(deployed_for_module) -> Iterator[Bridge]:
+    scene = read_profile_data(DEPLOY / "sim.yaml")["scene"]
+    profile = {
+        "namespace": "rosbridge",
+        "zenoh": {"router": ["tcp/127.0.0.1:7447"]},
+        "robot": "robots/little_john.yaml",
+        "scene": scene,
+        "components": [
+            {
+                "name": "ros2_bridge",
+                "module": "ros2_bridge",
+                "role": "tool",
+                "enabled": False,
+                "params": {"domain_id": DOMAIN, "goal_rate_hz": 100.0},
+            }
+        ],
+    }
+    system = deployed_for_module(yaml.safe_dump(profile))
+    with Node(
+        system.profile, "ros2_bridge", Ros2Bridge.params, Ros2Bridge.reads, Ros2Bridge.writes
+    ) as node:
+        component = Ros2Bridge(node)
+        node.start(component.shutdown)
+        yield Bridge(system, node)
+
+
+def test_each_topic_is_on_its_design_key_with_the_attachment_and_rosbags_cdr(bridge):
+    bridge.send_state()
+    intrinsics = CameraIntrinsics(fx=600.0, fy=600.0, cx=319.5, cy=239.5)
+    header = Header(stamp_ns=time.time_ns(), frame="camera", seq=0, source="test")
+    frame = CameraFrame(
+        header=header, encoding="jpeg", width=640, height=480, data=JPEG, intrinsics=intrinsics
+    )
+    bridge.put(topics.CAMERA_IMAGE, frame)
+    status = SupervisorStatus(
+        header=header, phase="idle", candidate=0, plans=0, replans=0, stalls=0
+    )
+    bridge.put(topics.SUPERVISOR_STATUS, status)
+
+    joints = bridge.ros.message("joint_states", "sensor_msgs/msg/JointState")
+    assert list(joints.name) == list(ROBOT.joint_names)
+    assert np.allclose(joints.position, Q[3:])
+    tf = bridge.ros.message("tf", "tf2_msgs/msg/TFMessage")
+    pairs = {(t.header.frame_id, t.child_frame_id): t.transform for t in tf.transforms}
+    base = pairs[("world", "base_footprint")].translation
+    assert (base.x, base.y) == pytest.approx((Q[0], Q[1]))
+    children = {child for _, child in pairs}
+    assert {"base_link", "end_effector"} | {f"link_{i}" for i in range(1, 6)} <= children
+    odom = bridge.ros.message("odom", "nav_msgs/msg/Odometry")
+    assert (odom.pose.pose.position.x, odom.child_frame_id) == (
+        pytest.approx(Q[0]),
+        "base_footprint",
+    )
+    image = bridge.ros.message("camera/image/compressed", "sensor_msgs/msg/CompressedImage")
+    assert (image.format, bytes(image.data)) == ("jpeg", JPEG)
+    info = bridge.ros.message("camera/camera_info", "sensor_msgs/msg/CameraInfo")
+    assert (info.width, info.height, info.k[0], info.header.frame_id) == (
+        640,
+        480,
+        600.0,
+        image.header.frame_id,
+    )
+    static = latched(bridge, "tf_static", "tf2_msgs/msg/TFMessage")
+    assert [t.child_frame_id for t in static.transforms] == [image.header.frame_id]
+    diagnostics = bridge.ros.message("diagnostics", "diagnostic_msgs/msg/DiagnosticArray")
+    assert "parsimony/ros2_bridge" in [s.name for s in diagnostics.status]
+
+    key = design_key("joint_states", "sensor_msgs/msg/JointState")
+    attachments = [a for _, a in bridge.ros.wait(key)]
+    sequence, stamp, length, gid = struct.unpack("<qqB16s", attachments[-1])
+    assert (len(attachments[-1]), length, sequence) == (33, 16, len(attachments))
+    assert abs(stamp - time.time_ns()) < DEADLINE_S * 1e9 and gid != bytes(16)
+
+
+def test_liveliness_tokens_are_the_golden_forms(bridge):
+    zid = str(bridge.node.session.zid())
+    tokens = {str(r.ok.key_expr) for r in bridge.system.router.liveliness().get("@ros2_lv/**")}
+    prefix = f"@ros2_lv/{DOMAIN}/{zid}/0"
+    assert f"{prefix}/0/NN/%/%/parsimony" in tokens
+
+    def entity(kind: str, topic: str, msgtype: str, qos: str) -> bool:
+        key = design_key(topic, msgtype).split("/", 2)[2]  # the DDS type and hash
+        tail = f"{kind}/%/%/parsimony/%{topic.replace('/', '%')}/{key}/{qos}"
+        return any(t.startswith(prefix + "/") and t.endswith(tail) for t in tokens)
+
+    assert entity("MP", "joint_states", "sensor_msgs/msg/JointState", "::,10:,:,:,,")
+    assert entity("MP", "robot_description", "std_msgs/msg/String", ":1:,1:,:,:,,")
+    assert entity("MS", "goal_pose", "geometry_msgs/msg/PoseStamped", "::,10:,:,:,,")
+    ids = [int(t.split("/")[4]) for t in tokens if t.startswith(prefix)]
+    assert len(ids) == len(set(ids))  # one entity id each
+
+
+def latched(bridge: Bridge, topic: str, msgtype: str):
+    """The message a late joiner gets on a TRANSIENT_LOCAL topic, as rmw_zenoh's subscription
+    asks for it: an advanced subscriber with history, detecting late publishers."""
+    got: list[bytes] = []
+    arrived = threading.Event()
+
+    def on_sample(sample: zenoh.Sample) -> None:
+        got.append(sample.payload.to_bytes())
+        arrived.set()
+
+    history = zenoh.ext.HistoryConfig(detect_late_publishers=True)
+    key = design_key(topic, msgtype)
+    with zenoh.ext.declare_advanced_subscriber(
+        bridge.system.router, key, on_sample, history=history
+    ):
+        assert arrived.wait(DEADLINE_S), f"no /{topic} for a late joiner"
+    return store().deserialize_cdr(got[0], msgtype)
+
+
+def test_a_late_joiner_gets_the_robot_description(bridge):
+    assert latched(bridge, "robot_description", "std_msgs/msg/String").data == urdf(ROBOT)
+
+
+def test_a_pose_stamped_goal_reaches_the_supervisor_in_the_world(bridge):
+    bridge.send_state()
+    bridge.ros.message("tf", "tf2_msgs/msg/TFMessage")
+    before = len(bridge.requests.messages)
+    bridge.goal_out.put(pose_stamped("base_footprint", (0.5, 0.0, 0.4)), attachment=ATTACHMENT)
+    goal = bridge.requests.wait_for(lambda _: len(bridge.requests.messages) > before, "goal")
+    x, y, z = dq.translation(np.array(goal.pose))[1:]
+    c, s = math.cos(Q[2]), math.sin(Q[2])
+    assert (x, y, z) == pytest.approx((Q[0] + 0.5 * c, Q[1] + 0.5 * s, 0.4))
+    assert goal.task == "pose" and bridge.wait_counter("goals_passed", 1)["goals_passed"] >= 1
+
+
+def said(bridge: Bridge, name: str, match: Callable[[int, str], bool]) -> None:
+    """Wait for /diagnostics to say of ``name`` what ``match`` (level, message) accepts."""
+    key = design_key("diagnostics", "diagnostic_msgs/msg/DiagnosticArray")
+    deadline, seen = time.monotonic() + DEADLINE_S, 0
+    while True:
+        arrays = bridge.ros.wait(key, seen + 1)
+        for data, _ in arrays[seen:]:
+            array = store().deserialize_cdr(data, "diagnostic_msgs/msg/DiagnosticArray")
+            if any(s.name == name and match(s.level, s.message) for s in array.status):
+                return
+        seen = len(arrays)
+        assert time.monotonic() < deadline, f"/diagnostics never said it of {name}"
+
+
+BAD = [
+    ("malformed_cdr", None, b"\x00\x01\x00\x00\xff"),
+    ("frame", None, pose_stamped("nowhere", (1.0, 0.0, 0.5))),
+    ("goal", None, pose_stamped("world", (math.nan, 0.0, 0.5))),
+    ("goal", None, pose_stamped("world", (1.0, 0.0, 0.5), (2.0, 0.0, 0.0, 0.0))),
+    ("type_hash", "RIHS01_" + "0" * 64, pose_stamped("world", (1.0, 0.0, 0.5))),
+]
+
+
+@pytest.mark.parametrize(("kind", "hash_", "data"), BAD, ids=[b[0] for b in BAD])
+def test_a_bad_goal_is_refused_counted_said_and_nothing_moves(bridge, kind, hash_, data):
+    before = bridge.counters()[f"refused.{kind}"]
+    requests = len(bridge.requests.messages)
+    key = design_key("goal_pose", "geometry_msgs/msg/PoseStamped")
+    if hash_ is not None:
+        key = key.rsplit("/", 1)[0] + "/" + hash_
+    bridge.system.router.put(key, data, attachment=ATTACHMENT)
+    bridge.wait_counter(f"refused.{kind}", before + 1)
+    said(bridge, "parsimony/ros2_bridge", lambda level, message: f"({kind})" in message)
+    assert len(bridge.requests.messages) == requests  # a goal is refused or passed on, not both
+
+
+def test_a_supervisors_refusal_is_said_on_diagnostics_with_its_reason(bridge):
+    header = Header(stamp_ns=time.time_ns(), frame="", seq=0, source="test")
+    status = SupervisorStatus(
+        header=header, phase="refused", reason="too far", candidate=0, plans=0, replans=0, stalls=0
+    )
+    bridge.put(topics.SUPERVISOR_STATUS, status)
+    said(bridge, "parsimony/supervisor", lambda *said: said == (2, "refused: too far"))
+
+
+def test_a_flood_of_goals_is_refused_past_the_rate(bridge):
+    query.set_param(bridge.system.router, "rosbridge", "ros2_bridge", "goal_rate_hz", "0.01")
+    before = bridge.counters()["refused.flood"]
+    requests = len(bridge.requests.messages)
+    for _ in range(20):
+        bridge.goal_out.put(b"\x00", attachment=ATTACHMENT)
+    bridge.wait_counter("refused.flood", before + 15)
+    assert len(bridge.requests.messages) == requests
