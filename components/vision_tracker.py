@@ -24,7 +24,6 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-import yaml
 
 from components.params import Param, ParamError
 from components.process_entry import run_component
@@ -34,6 +33,7 @@ from messages import topics
 from messages.camera import CameraFrame
 from messages.markers import MarkerDetection, MarkerDetections
 from profiles.scene import Scene
+from vision.camera_file import CameraFile, read_camera_file
 from vision.images import grey
 from vision.markers import (
     THRESHOLD_WINDOW_PX,
@@ -190,11 +190,17 @@ class VisionTracker(Component):
     # -- a real camera ---------------------------------------------------------------------
 
     def _open_device(self):
+        """The capture, asked for the calibration's image size when the file gives one, and
+        the calibration's intrinsics."""
         source = str(self.node.params["device"])
         capture = cv2.VideoCapture(int(source) if source.isdigit() else source)
         if not capture.isOpened():
             raise ParamError(f"device: cannot open {source!r}")
-        return capture, load_calibration(Path(str(self.node.params["calibration"])))
+        self.calibration = load_calibration(Path(str(self.node.params["calibration"])))
+        if self.calibration.size is not None and source.isdigit():
+            capture.set(cv2.CAP_PROP_FRAME_WIDTH, self.calibration.size[0])
+            capture.set(cv2.CAP_PROP_FRAME_HEIGHT, self.calibration.size[1])
+        return capture, self.calibration.intrinsics
 
     def _read_device(self) -> None:
         ok, image = self.capture.read()
@@ -204,6 +210,9 @@ class VisionTracker(Component):
             return
         if image.ndim == 3:
             image = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
+        mismatch = self.calibration.size_mismatch(image.shape[1], image.shape[0])
+        if mismatch:
+            self.node.warn("calibration_size", mismatch)
         self.track(image, self.intrinsics, self.node.clock.now_ns())
 
     def shutdown(self) -> None:
@@ -211,15 +220,12 @@ class VisionTracker(Component):
             self.capture.release()
 
 
-def load_calibration(path: Path) -> Intrinsics:
-    """``fx fy cx cy`` (px) and optional ``distortion`` from a YAML file, or ``ParamError``."""
+def load_calibration(path: Path) -> CameraFile:
+    """The intrinsics file (``vision.camera_file``): ``fx fy cx cy`` (px), optional
+    ``distortion`` and image ``width`` and ``height``; or ``ParamError``."""
     try:
-        data = yaml.safe_load(path.read_text())
-        distortion = tuple(float(v) for v in data.get("distortion", ()))
-        return Intrinsics(
-            float(data["fx"]), float(data["fy"]), float(data["cx"]), float(data["cy"]), distortion
-        )
-    except (OSError, yaml.YAMLError, KeyError, TypeError, ValueError, AttributeError) as error:
+        return read_camera_file(path)
+    except (OSError, ValueError) as error:
         raise ParamError(f"calibration: cannot read intrinsics from {path}: {error}") from error
 
 

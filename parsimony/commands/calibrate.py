@@ -1,18 +1,164 @@
-"""`parsimony calibrate camera`: the ceiling camera's intrinsics from views of a ChArUco board."""
+"""`parsimony calibrate camera SOURCE -o FILE`: the ceiling camera's intrinsics from views of a
+ChArUco board (vision.calibration), written as the vision tracker's intrinsics file
+(vision.camera_file). `parsimony calibrate ceiling PROFILE`: where that camera hangs over the
+floor, from the profile's reference marker (vision.camera_pose).
+
+SOURCE is a camera device index (``0``), a video file or a folder of images. Exit 1 when the
+views cannot determine the intrinsics (the reason names the rule), 2 when the source or the
+board cannot be read."""
 
 from __future__ import annotations
 
 import argparse
 import sys
+from datetime import UTC, datetime
+from pathlib import Path
+
+from outputs.files import writable_output, written_whole
+from outputs.stdout import emit, json_text
+from vision.calibration import (
+    Board,
+    BoardDetector,
+    Calibration,
+    CalibrationRefused,
+    View,
+    calibrate,
+    evenly,
+)
+from vision.camera_file import CameraFile, camera_file_text
+from vision.frame_source import FrameSourceError, frames
+
+DEVICE_FRAMES = 300
+"""Frames read from a device unless ``--frames`` says otherwise (10 s at 30 Hz)."""
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    parser = subparsers.add_parser("calibrate", help="calibrate the ceiling camera")
-    steps = parser.add_subparsers(dest="step", required=True)
-    steps.add_parser("camera", help="intrinsics from views of a ChArUco board")
+    parser = subparsers.add_parser(
+        "calibrate", help="calibrate the ceiling camera", description=__doc__
+    )
+    steps = parser.add_subparsers(dest="what", required=True)
+    camera = steps.add_parser(
+        "camera",
+        help="intrinsics from views of a ChArUco board",
+        description="Show the board flat and tilted 20 to 45 degrees each way, near the middle "
+        "and near every edge and corner of the image; 20 to 40 views are plenty.",
+    )
+    camera.add_argument("source", help="device index (0), video file or folder of images")
+    camera.add_argument("-o", "--output", type=Path, required=True, help="intrinsics file")
+    camera.add_argument("--force", action="store_true", help="write over an existing file")
+    board = Board()
+    across, down = board.squares
+    camera.add_argument(
+        "--squares",
+        type=int,
+        nargs=2,
+        default=board.squares,
+        metavar=("X", "Y"),
+        help=f"the board's squares across and down (default {across} {down})",
+    )
+    camera.add_argument(
+        "--square", type=float, default=board.square_m, help="a square's side, m (default 0.04)"
+    )
+    camera.add_argument(
+        "--marker", type=float, default=board.marker_m, help="a marker's side, m (default 0.03)"
+    )
+    camera.add_argument(
+        "--dictionary", default=board.dictionary, help=f"ArUco dictionary ({board.dictionary})"
+    )
+    camera.add_argument(
+        "--frames", type=int, help=f"read at most this many (a device: {DEVICE_FRAMES})"
+    )
+    camera.add_argument("--step", type=int, default=1, help="use every STEP-th frame")
+    camera.add_argument(
+        "--max-views", type=int, default=40, help="calibrate on at most this many, evenly spread"
+    )
+    camera.add_argument("--k3", action="store_true", help="fit k3 too (wide-angle lenses)")
+    camera.add_argument("--json", action="store_true", help="print the result as JSON")
     return parser
 
 
+def _views(args: argparse.Namespace, board: Board) -> tuple[list[View], int, tuple[int, int]]:
+    """The views with a board, the frames read and the image size (width, height)."""
+    detector = BoardDetector(board)
+    limit = args.frames or (DEVICE_FRAMES if args.source.isdigit() else sys.maxsize)
+    views, read, size = [], 0, None
+    for name, image in frames(args.source, limit, args.step):
+        read += 1
+        shape = (image.shape[1], image.shape[0])
+        if size is None:
+            size = shape
+        elif shape != size:
+            raise FrameSourceError(
+                f"{name} is {shape[0]}x{shape[1]}, the first frame {size[0]}x{size[1]}"
+            )
+        view = detector.detect(name, image)
+        if view is not None:
+            views.append(view)
+            print(f"calibrate: {name}: {len(view.image_points)} corners", file=sys.stderr)
+    if not views:
+        raise CalibrationRefused(f"no board ({board.describe()}) in the {read} frames read")
+    return views, read, size
+
+
+def _summary(result: Calibration, frames_read: int, output: Path) -> dict:
+    i = result.intrinsics
+    return {
+        "fx": i.fx,
+        "fy": i.fy,
+        "cx": i.cx,
+        "cy": i.cy,
+        "distortion": list(i.distortion),
+        "width": result.size[0],
+        "height": result.size[1],
+        "rms_px": result.rms_px,
+        "views": result.views,
+        "frames": frames_read,
+        "std_px": dict(zip(("fx", "fy", "cx", "cy"), result.std_px, strict=True)),
+        "span": list(result.span),
+        "tilt_spread_deg": result.tilt_spread_deg,
+        "output": str(output),
+    }
+
+
+def calibrate_camera(args: argparse.Namespace) -> int:
+    why = writable_output(args.output, [], args.force)
+    if why is not None:
+        print(f"calibrate: {why}", file=sys.stderr)
+        return 2
+    try:
+        board = Board(tuple(args.squares), args.square, args.marker, args.dictionary)
+        views, read, size = _views(args, board)
+        result = calibrate(evenly(views, args.max_views), size, k3=args.k3)
+    except CalibrationRefused as error:
+        print(f"calibrate: refused: {error}", file=sys.stderr)
+        return 1
+    except ValueError as error:  # the board's arguments, the source (FrameSourceError)
+        print(f"calibrate: {error}", file=sys.stderr)
+        return 2
+    stamp = datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
+    comment = (
+        f"Intrinsics of the ceiling camera (pixels) at {size[0]}x{size[1]}, from `parsimony "
+        f"calibrate camera` on {stamp}:\n{result.views} views of a ChArUco board, RMS "
+        f"reprojection error {result.rms_px:.3f} px;\nboard: {board.describe()}."
+    )
+    with written_whole(args.output) as partial:
+        partial.write_text(camera_file_text(CameraFile(result.intrinsics, size), comment))
+    summary = _summary(result, read, args.output)
+    if args.json:
+        emit(json_text(summary, indent=2))
+        return 0
+    i, s = result.intrinsics, result.std_px
+    emit(
+        f"fx {i.fx:.2f} fy {i.fy:.2f} cx {i.cx:.2f} cy {i.cy:.2f} px "
+        f"(standard deviations {' '.join(f'{v:.2f}' for v in s)})\n"
+        f"distortion k1 k2 p1 p2 k3: {' '.join(f'{k:.5f}' for k in i.distortion)}\n"
+        f"RMS reprojection error {result.rms_px:.3f} px over {result.views} views "
+        f"({read} frames, {size[0]}x{size[1]}); written to {args.output}"
+    )
+    return 0
+
+
 def run(args: argparse.Namespace) -> int:
-    print("calibrate: not built yet", file=sys.stderr)
-    return 2
+    if args.what == "camera":
+        return calibrate_camera(args)
+    raise AssertionError(args.what)
