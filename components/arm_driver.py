@@ -1,22 +1,25 @@
-"""The arm driver: AX-18A servos, one per joint of the robot's arm, Dynamixel protocol 1.0,
-through ROBOTIS's dynamixel-sdk. Which servo drives which joint, from which zero and which way,
-is the robot description's ``servos:`` section (``wbc.servo_map``: servo angle = offset +
+"""The arm driver: Dynamixel servos, one per joint of the robot's arm, through ROBOTIS's
+dynamixel-sdk: AX-18A on protocol 1.0 (``protocol: 1``, the default) or X-series (XM430,
+XL430) on protocol 2.0 (``protocol: 2``; ``components.servo_bus`` holds what differs). Which
+servo drives which joint, from which zero and which way, is the robot description's
+``servos:`` section (``wbc.servo_map``: servo angle = offset +
 direction * q); the ``ids`` parameter, when set, overrides its ids.
 
-Every 1/``rate_hz`` s it reads each servo's present position, speed and load on its own (bulk
-and sync read do not exist for AX servos in protocol 1.0) and publishes ``arm/joint_states``.
+Every 1/``rate_hz`` s it reads each servo's present position and speed on its own (so that a
+fault is named for its servo) and publishes ``arm/joint_states``.
 
 A velocity command is checked (every entry finite, else the arm holds) and each joint's speed
 clamped to the robot's velocity limit. It becomes, per joint, a goal position ahead of the
 present one in the direction of motion (``lookahead_s`` of the commanded speed, at least
-``min_step`` units) with the moving speed of the commanded speed (about 0.111 rpm per unit).
-A joint whose speed rounds to Moving Speed 0 (which would mean full speed) holds: its goal is
+``min_step`` units) at the commanded speed (Moving Speed, 0.111 rpm per unit, or Profile
+Velocity, 0.229 rpm per unit). A joint whose speed rounds to 0 (which would mean full speed)
+holds: its goal is
 its position read when it stops (not a reading from before: a joint still moving would move
 back to it after the stop), kept while it stays stopped, so it does not creep. All
 the goals and speeds go in one Sync Write, and every goal written lies inside the robot
 description's joint limits. With no command for ``command_timeout_s`` the arm holds.
 
-Each answer is checked (``protocols.dynamixel_v1.status_fault``): a servo that is silent (for
+Each answer is checked (the protocol's ``status_fault``): a servo that is silent (for
 ``answer_timeout_s``, by default the SDK's packet timeout), or answers a truncated packet, a
 bad checksum, another servo's id or the wrong length, is counted by that name
 (``servo_faults.<name>``); a reading outside the joint limits (by more than ``limit_margin``)
@@ -24,8 +27,9 @@ is counted (``out_of_limits``) and never published. Either way no joint state is
 the arm holds (each joint where it is read then, a faulty one at its last good reading) and
 refuses commands until every servo answers again with a reading inside its limits, and the
 component's state says why (``holding: servo 3 silent``); then every goal is set where its
-joint is and torque is enabled again on every servo. Status-packet error bits are counted by
-name (``servo_error.<bit>``) and logged.
+joint is and torque is enabled again on every servo. Status-packet errors are counted by name
+(``servo_error.<name>``: protocol 1.0's error bits; protocol 2.0's error number and, with the
+alert bit, the bits of Hardware Error Status) and logged.
 """
 
 from __future__ import annotations
@@ -33,7 +37,7 @@ from __future__ import annotations
 import math
 from collections.abc import Collection, Sequence
 
-from dynamixel_sdk import COMM_SUCCESS, GroupSyncWrite, PacketHandler, PortHandler
+from dynamixel_sdk import COMM_SUCCESS, PortHandler
 
 from components.joint_check import joints_match
 from components.params import Param, ParamError
@@ -41,21 +45,13 @@ from components.process_entry import run_component
 from components.pubsub import Input
 from components.robot_vector import RobotVector, of_robot
 from components.runtime import Component, Node
+from components.servo_bus import BUSES, HOLD_SPEED, open_port
 from messages import topics
 from messages.commands import ArmCommand
 from messages.joints import JointStates
-from protocols import dynamixel_v1 as dxl
+from protocols.dynamixel_v1 import StatusFault
 from wbc.robot import BASE_DOF, MobileManipulator
 from wbc.servo_map import ServoMap
-
-ERROR_BITS = {int(bit): bit.name.lower() for bit in dxl.StatusError}
-"""The status-packet error bits of protocol 1.0, by the name they are counted under."""
-READ_BYTES = 4
-"""Present Position and Present Speed, from address 36."""
-HOLD_SPEED = 1
-"""The Moving Speed of a held joint: the slowest there is (0 would mean full speed)."""
-READ_WAIT_S = 0.001
-"""How long one read of the serial port waits for bytes before the SDK looks again (s)."""
 
 
 def check_ids(ids: tuple[int, ...]) -> None:
@@ -72,6 +68,14 @@ class ArmDriver(Component):
     params = (
         Param("port", str, "/dev/ttyUSB1", doc="serial port of the servo bus"),
         Param("baud", int, 1_000_000, low=9600, high=3_000_000, doc="bus speed, bit/s"),
+        Param(
+            "protocol",
+            int,
+            1,
+            low=1,
+            high=2,
+            doc="Dynamixel protocol: 1 (AX-series) or 2 (X-series in position mode)",
+        ),
         RobotVector(
             "ids",
             tuple,
@@ -135,13 +139,13 @@ class ArmDriver(Component):
             sorted((servos.servo_angle(i, self.low[i]), servos.servo_angle(i, self.high[i])))
             for i in range(joints)
         ]
-        self.goal_low = [max(0, math.ceil(dxl.position_of_angle(low))) for low, _ in ends]
+        self.port = PortHandler(str(node.params["port"]))
+        bus = self.bus = BUSES[node.params["protocol"]](self.port, node.params["answer_timeout_s"])
+        self.goal_low = [max(0, math.ceil(bus.position_of_angle(low))) for low, _ in ends]
         self.goal_high = [
-            min(dxl.POSITION_MAX, math.floor(dxl.position_of_angle(high))) for _, high in ends
+            min(bus.position_max, math.floor(bus.position_of_angle(high))) for _, high in ends
         ]
         """The Goal Positions inside the joint limits (every goal written lies in them)."""
-        self.port = PortHandler(str(node.params["port"]))
-        self.packet = PacketHandler(1.0)
         self.connected = False
         for name in (
             "sync_writes",
@@ -154,9 +158,9 @@ class ArmDriver(Component):
             "port_errors",
         ):
             node.counters[name] = 0
-        for fault in dxl.StatusFault:
+        for fault in StatusFault:
             node.counters[f"servo_faults.{fault}"] = 0
-        for name in ERROR_BITS.values():
+        for name in bus.error_names:
             node.counters[f"servo_error.{name}"] = 0
         self.present: list[float | None] = [None] * joints
         """The last good reading of each joint (inside its limits)."""
@@ -173,17 +177,9 @@ class ArmDriver(Component):
 
     def _connect(self) -> None:
         """Open the bus and enable every servo's torque; ``no port`` until it opens."""
-        try:
-            opened = self.port.openPort() and self.port.setBaudRate(self.node.params["baud"])
-        except OSError:  # pyserial's SerialException is one
-            opened = False
-        if not opened:
+        if not open_port(self.port, self.node.params["baud"]):
             self.node.state = "no port"
             return
-        # The SDK opens the port non-blocking and spins on empty reads while a servo answers
-        # (a third of a core at 50 Hz x 5 servos); a read that waits up to READ_WAIT_S for
-        # bytes gives the core back and notices a silent servo at most that much later.
-        self.port.ser.timeout = READ_WAIT_S
         self.connected = True
         self.node.state = "running"
         self._enable_torque()
@@ -191,11 +187,9 @@ class ArmDriver(Component):
     def _enable_torque(self) -> None:
         """Torque on for every servo (a servo that browned out comes back with it off)."""
         for servo in self.ids:
-            result, error = self.packet.write1ByteTxRx(
-                self.port, servo, dxl.Address.TORQUE_ENABLE, 1
-            )
-            if result == COMM_SUCCESS:
-                self._count_error_bits(servo, error)
+            error = self.bus.enable_torque(servo)
+            if error is not None:
+                self._count_errors(servo, error)
 
     def _lost(self, error: Exception) -> None:
         self.node.count("port_errors")
@@ -207,28 +201,23 @@ class ArmDriver(Component):
         except OSError:
             pass
 
-    def _read(self, servo: int) -> tuple[bytes, dxl.StatusFault | None]:
-        """One servo's Present Position and Speed: the answer's parameters, or what is wrong."""
-        result = self.packet.readTx(self.port, servo, dxl.Address.PRESENT_POSITION, READ_BYTES)
-        answer = b""
-        if result == COMM_SUCCESS:
-            if self.node.params["answer_timeout_s"] > 0.0:
-                self.port.setPacketTimeoutMillis(self.node.params["answer_timeout_s"] * 1e3)
-            rx, _ = self.packet.rxPacket(self.port)
-            answer = bytes(rx)
-        fault = dxl.status_fault(answer, servo, READ_BYTES)
+    def _read(self, servo: int) -> tuple[int, float] | StatusFault:
+        """One servo's Present Position (units) and speed (rad/s), or what is wrong."""
+        reading, fault, error = self.bus.read(servo)
         if fault is not None:
             self.node.count(f"servo_faults.{fault}")
             self.node.warn(f"servo_faults.{fault}.{servo}", f"servo {servo}: {fault} answer")
-            return b"", fault
-        self._count_error_bits(servo, answer[4])
-        return answer[5 : 5 + READ_BYTES], None
+            return fault
+        self._count_errors(servo, error)
+        assert reading is not None
+        return reading
 
-    def _count_error_bits(self, servo: int, error: int) -> None:
-        for bit, name in ERROR_BITS.items():
-            if error & bit:
-                self.node.count(f"servo_error.{name}")
-                self.node.warn(f"servo_error.{name}", f"servo {servo} reports {name}")
+    def _count_errors(self, servo: int, error: int) -> None:
+        if not error:
+            return
+        for name in self.bus.errors(servo, error):
+            self.node.count(f"servo_error.{name}")
+            self.node.warn(f"servo_error.{name}", f"servo {servo} reports {name}")
 
     def read_joints(self) -> None:
         """Timer: each servo's present position and speed; publish when all answered well,
@@ -266,10 +255,11 @@ class ArmDriver(Component):
         """Joint ``index``'s position (kept as ``present``) and speed, read now; or what is
         wrong: a fault, or a position outside the joint's limits."""
         servo = self.ids[index]
-        data, fault = self._read(servo)
-        if fault is not None:
-            return f"servo {servo} {fault}"
-        position = self.servos.joint_position(index, dxl.angle_of_units(data[0] | data[1] << 8))
+        reading = self._read(servo)
+        if isinstance(reading, StatusFault):
+            return f"servo {servo} {reading}"
+        units, speed = reading
+        position = self.servos.joint_position(index, self.bus.angle_of_units(units))
         low, high = self.low[index], self.high[index]
         margin = self.node.params["limit_margin"]
         if not low - margin <= position <= high + margin:
@@ -279,7 +269,6 @@ class ArmDriver(Component):
                 f"[{low:.3f}, {high:.3f}]"
             )
         self.present[index] = position
-        speed = dxl.rad_s_of_speed_units(data[2] | data[3] << 8)
         return position, self.servos.directions[index] * speed
 
     def _recover(self) -> None:
@@ -324,7 +313,7 @@ class ArmDriver(Component):
                 self.node.count("speed_limited")
                 velocity = math.copysign(limit, velocity)
             limited.append(velocity)
-        self._read_stopping([i for i, v in enumerate(limited) if dxl.moving_speed(v) is None])
+        self._read_stopping([i for i, v in enumerate(limited) if self.bus.speed_units(v) is None])
         goals, speeds = zip(*(self._goal(i, v) for i, v in enumerate(limited)), strict=True)
         self.holding = False
         self._sync_write(goals, speeds)
@@ -332,7 +321,7 @@ class ArmDriver(Component):
 
     def _goal(self, index: int, velocity: float) -> tuple[int, int]:
         """Joint ``index``'s goal (units) and Moving Speed for a finite ``velocity`` (rad/s)."""
-        speed = dxl.moving_speed(velocity)
+        speed = self.bus.speed_units(velocity)
         if speed is None:
             return self._held(index), HOLD_SPEED
         self.held[index] = None
@@ -340,7 +329,7 @@ class ArmDriver(Component):
         assert present is not None
         step = max(
             abs(velocity) * self.node.params["lookahead_s"],
-            self.node.params["min_step"] / dxl.POSITION_UNITS_PER_RAD,
+            self.node.params["min_step"] / self.bus.units_per_rad,
         )
         return self._inside_limits(index, present + math.copysign(step, velocity)), speed
 
@@ -372,7 +361,7 @@ class ArmDriver(Component):
     def _inside_limits(self, index: int, q: float) -> int:
         """The Goal Position of joint position ``q`` (finite), clamped to the joint's limits in
         units."""
-        units = dxl.position_units(self.servos.servo_angle(index, q))
+        units = self.bus.position_units(self.servos.servo_angle(index, q))
         return min(max(units, self.goal_low[index]), self.goal_high[index])
 
     def hold(self, failed: Collection[int] = ()) -> None:
@@ -393,21 +382,19 @@ class ArmDriver(Component):
     def _sync_write(self, goals: Sequence[int], speeds: Sequence[int]) -> None:
         if not self.connected:  # a read on the way found the port gone
             return
-        group = GroupSyncWrite(self.port, self.packet, dxl.Address.GOAL_POSITION, 4)
         for index, (servo, goal, speed) in enumerate(zip(self.ids, goals, speeds, strict=True)):
             if not (
                 self.goal_low[index] <= goal <= self.goal_high[index]
-                and 1 <= speed <= dxl.SPEED_MAX
+                and 1 <= speed <= self.bus.speed_max
             ):
                 raise ValueError(f"servo {servo}: goal {goal} or speed {speed} out of range")
-            group.addParam(servo, [goal & 0xFF, goal >> 8, speed & 0xFF, speed >> 8])
         try:
-            result = group.txPacket()
+            result = self.bus.write_goals(self.ids, goals, speeds)
         except (OSError, TypeError) as error:
             self._lost(error)
             return
         if result != COMM_SUCCESS:
-            self.node.warn("sync_write", f"sync write: {self.packet.getTxRxResult(result)}")
+            self.node.warn("sync_write", f"sync write: {self.bus.result_text(result)}")
         self.node.count("sync_writes")
 
     def shutdown(self) -> None:

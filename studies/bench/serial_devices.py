@@ -19,6 +19,7 @@ import numpy as np
 import serial
 from dynamixel_sdk import COMM_SUCCESS, GroupSyncWrite, PacketHandler, PortHandler
 
+from components.servo_bus import open_port
 from outputs.stdout import emit, json_text, result_only_stdout
 from profiles.deploy_files import ROBOT_FILE
 from protocols import create_oi
@@ -63,8 +64,7 @@ def figures(values_us: list[float]) -> dict[str, float]:
 def servo_bus() -> dict:
     with AXChainEmulator(StillArm(), SERVOS) as chain:
         port, packet = PortHandler(chain.port), PacketHandler(1.0)
-        port.openPort()
-        port.setBaudRate(1_000_000)
+        open_port(port, 1_000_000)  # as the driver does: see open_port
         reads, writes = [], []
         for index in range(SAMPLES):
             servo = SERVOS[index % len(SERVOS)]
