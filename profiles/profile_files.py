@@ -19,9 +19,11 @@ MAX_YAML_VALUES = 100_000
 """A profile expands to at most this many YAML values, aliases counted where they point."""
 
 
-class _ProfileLoader(yaml.SafeLoader):
-    """Safe YAML whose document, aliases expanded, holds at most ``MAX_YAML_VALUES`` values:
-    a few hundred bytes of aliases inside aliases expand into gigabytes (an alias bomb)."""
+class _Bounded:
+    """A safe YAML loader whose document, aliases expanded, holds at most ``MAX_YAML_VALUES``
+    values: a few hundred bytes of aliases inside aliases expand into gigabytes (an alias bomb)."""
+
+    name: str
 
     def get_single_node(self):  # noqa: ANN201 - PyYAML's own signature
         node = super().get_single_node()
@@ -31,6 +33,15 @@ class _ProfileLoader(yaml.SafeLoader):
                 "(aliases inside aliases?)"
             )
         return node
+
+
+class _ProfileLoader(_Bounded, yaml.SafeLoader):
+    """PyYAML's own parser: the one whose words a syntax error is told in."""
+
+
+class _FastProfileLoader(_Bounded, getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
+    """libyaml's parser where PyYAML has it: several times faster, and every process reads its
+    profile at start; the values are built by the same constructor."""
 
 
 def _expanded(node: yaml.Node, sizes: dict[int, int]) -> int:
@@ -55,17 +66,25 @@ def _read_yaml(path: Path) -> object:
     except UnicodeDecodeError as error:
         raise ProfileError(f"{path}: not UTF-8 text (byte {error.start})") from None
     try:
-        loader = _ProfileLoader(text)
-        loader.name = str(path)
-        try:
-            return loader.get_single_data()
-        finally:
-            loader.dispose()
+        return _load(_FastProfileLoader, text, path)
+    except yaml.YAMLError:
+        pass  # libyaml says it in other words: read again for PyYAML's, as it always said
+    try:
+        return _load(_ProfileLoader, text, path)
     except yaml.YAMLError as error:
         mark = getattr(error, "problem_mark", None)
         where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else str(path)
         problem = getattr(error, "problem", None) or str(error)
         raise ProfileError(f"{where}: YAML syntax error: {problem}") from error
+
+
+def _load(loader_class: type, text: str, path: Path) -> object:
+    loader = loader_class(text)
+    loader.name = str(path)
+    try:
+        return loader.get_single_data()
+    finally:
+        loader.dispose()
 
 
 def merge(base: object, override: object) -> object:

@@ -8,6 +8,8 @@ from pathlib import Path
 import pytest
 import yaml
 
+from profiles import profile_files
+from profiles.deploy_files import DEPLOY
 from profiles.profile import ProfileError, load_profile
 from tests.profiles.profile_yaml import PUB, refusal
 
@@ -17,6 +19,12 @@ def test_yaml_syntax_errors_give_the_line(tmp_path: Path) -> None:
     path.write_text("namespace: sim\ncomponents:\n  - {name: pub, module: x\n  - other\n")
     with pytest.raises(ProfileError, match=r"broken\.yaml:5:1: YAML syntax error: expected ','"):
         load_profile(path)
+
+
+@pytest.mark.parametrize("path", sorted(DEPLOY.glob("**/*.yaml")), ids=lambda path: path.name)
+def test_a_profile_is_read_as_pyyaml_reads_it(path: Path) -> None:
+    """libyaml's parser, which reads profiles (several times faster), builds what PyYAML's does."""
+    assert profile_files._read_yaml(path) == yaml.safe_load(path.read_text())
 
 
 def test_an_alias_bomb_and_a_file_that_is_not_utf8_are_refused_at_once(tmp_path: Path) -> None:
