@@ -16,8 +16,6 @@ import sys
 from collections.abc import Iterator, Sequence
 from typing import Any, TextIO
 
-from tabulate import tabulate
-
 _result: TextIO | None = None
 
 
@@ -25,6 +23,8 @@ def table(rows: Sequence, headers: Sequence[str] | str = "keys", **style: Any) -
     """Rows (dicts, with ``headers="keys"``, or sequences under ``headers``) as a plain text
     table, numbers right-aligned: the one table style of every command and benchmark
     (``tabulate``; ``style`` passes ``floatfmt`` and the like on)."""
+    from tabulate import tabulate  # tens of ms of CPU: only a command that prints a table pays
+
     return tabulate(rows, headers=headers, tablefmt="plain", missingval="-", **style)
 
 
