@@ -191,3 +191,13 @@ def urdf(robot: MobileManipulator, camera: tuple[str, int, Array] | None = None)
             ET.SubElement(element, "limit", limit)
     ET.indent(root)
     return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+URDF_URI = "package://parsimony/urdf/robot.urdf"
+"""Where Foxglove's URDF panel finds the robot (its URL setting): the live view serves it."""
+
+
+def assets(robot: MobileManipulator) -> dict[str, bytes]:
+    """What the live view serves Foxglove's clients (``view.live_view``): the robot's URDF at
+    ``URDF_URI``, the file /robot_description carries."""
+    return {URDF_URI: urdf(robot).encode()}

@@ -20,7 +20,9 @@ of all its views, so clients see them), a message of it whose channels no client
 is dropped undecoded (``unwatched``), and of one that is read only the channels read are made.
 
 What clients may do beyond watching (publish, parameters) is the ``listener``'s, with the
-``capabilities`` it needs; this module only serves.
+``capabilities`` it needs; this module only serves, and the ``assets`` it is given (URI ->
+bytes: the robot's URDF for Foxglove's URDF panel, ``ros2.urdf.assets``) to clients that fetch
+them.
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ import collections
 import logging
 import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from functools import partial
 
 import foxglove
@@ -62,7 +64,8 @@ class LiveView:
     ``warn(key, text)`` says why (default: a log warning each time).
     ``viewer`` makes the views (give it the robot description to draw the robot);
     ``listener`` (a ``foxglove.ServerListener``) answers what clients send, with
-    ``capabilities`` and the ``encodings`` clients may publish in."""
+    ``capabilities`` and the ``encodings`` clients may publish in; ``assets`` what clients may
+    fetch, by URI."""
 
     def __init__(
         self,
@@ -75,6 +78,7 @@ class LiveView:
         listener: foxglove.ServerListener | None = None,
         capabilities: Sequence[Capability] = (),
         encodings: Sequence[str] = (),
+        assets: Mapping[str, bytes] | None = None,
     ) -> None:
         self._context = foxglove.Context()
         try:
@@ -87,6 +91,7 @@ class LiveView:
                 capabilities=list(capabilities),
                 supported_encodings=list(encodings),
                 message_backlog_size=BACKLOG,
+                asset_handler=dict(assets).get if assets else None,
             )
         except RuntimeError as error:
             raise OSError(f"port: cannot listen on {HOST}:{port}: {error}") from error

@@ -2,13 +2,18 @@
 kinematics are the model's on random configurations, for every robot of deploy/robots."""
 
 import io
+import json
+import struct
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yourdfpy
+import zenoh
+from websockets.sync.client import connect
 
-from ros2.urdf import END_EFFECTOR, joints, link_name, matrix, planar, urdf
+from ros2.urdf import END_EFFECTOR, URDF_URI, assets, joints, link_name, matrix, planar, urdf
+from view.live_view import LiveView
 from wbc.robot import BASE_DOF, BaseDescription, MobileManipulator
 
 ROBOTS = sorted(Path("deploy/robots").glob("*.yaml"))
@@ -77,3 +82,24 @@ def test_joint_transforms_are_yourdfpys():
     for joint in joints(robot):
         found = model.get_transform(joint.child, joint.parent)
         np.testing.assert_allclose(joint.transform(q_arm), found, rtol=0.0, atol=1e-12)
+
+
+def test_foxglove_fetches_the_urdf_the_live_view_serves():
+    """A WebSocket client asks the live view for ``URDF_URI`` as Foxglove's URDF panel does
+    (the ``assets`` capability, op ``fetchAsset``, a binary fetch-asset response) and gets the
+    file /robot_description carries."""
+    robot = MobileManipulator.from_yaml(ROBOTS[0])
+    config = zenoh.Config()
+    config.insert_json5("scouting/multicast/enabled", "false")
+    with (
+        zenoh.open(config) as session,
+        LiveView(session, "urdf", [], port=0, assets=assets(robot)) as view,
+        connect(view.address, subprotocols=["foxglove.sdk.v1"]) as client,
+    ):
+        info = json.loads(client.recv(timeout=30))
+        assert "assets" in info["capabilities"]
+        client.send(json.dumps({"op": "fetchAsset", "uri": URDF_URI, "requestId": 7}))
+        reply = client.recv(timeout=30)
+        opcode, request, status, error_length = struct.unpack_from("<BIBI", reply)
+        assert (opcode, request, status, error_length) == (4, 7, 0, 0)
+        assert reply[10:].decode() == urdf(robot)
