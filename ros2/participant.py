@@ -97,9 +97,9 @@ class Participant:
 
     def subscription(self, topic: str, msgtype: str, on_sample, qos: str = DEFAULT_QOS) -> str:
         """Subscribe ``on_sample`` (a Zenoh callback, on Zenoh's thread) to ``topic`` of any type
-        hash (the callback checks it: ``hash_of``); the key it matches."""
+        and hash (the callback checks them against ``key``); the key it matches."""
         self._entity("MS", topic, msgtype, qos)
-        key = self.key(topic, msgtype).rsplit("/", 1)[0] + "/*"
+        key = self.key(topic, msgtype).rsplit("/", 2)[0] + "/*/*"
         self._declared.append(self.session.declare_subscriber(key, on_sample))
         return key
 
@@ -108,8 +108,3 @@ class Participant:
         for entity in reversed(self._declared):
             entity.undeclare()
         self._declared.clear()
-
-
-def hash_of(key: str) -> str:
-    """The type hash chunk of a data key (its last)."""
-    return key.rsplit("/", 1)[-1]

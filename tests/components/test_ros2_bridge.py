@@ -274,22 +274,24 @@ def said(bridge: Bridge, name: str, match: Callable[[int, str], bool]) -> None:
         assert time.monotonic() < deadline, f"/diagnostics never said it of {name}"
 
 
-BAD = [
-    ("malformed_cdr", None, b"\x00\x01\x00\x00\xff"),
-    ("frame", None, pose_stamped("nowhere", (1.0, 0.0, 0.5))),
-    ("goal", None, pose_stamped("world", (math.nan, 0.0, 0.5))),
-    ("goal", None, pose_stamped("world", (1.0, 0.0, 0.5), (2.0, 0.0, 0.0, 0.0))),
-    ("type_hash", "RIHS01_" + "0" * 64, pose_stamped("world", (1.0, 0.0, 0.5))),
-]
+POSE_KEY = design_key("goal_pose", "geometry_msgs/msg/PoseStamped")
+STRING_KEY = design_key("goal_pose", "std_msgs/msg/String")
+GOOD = pose_stamped("world", (1.0, 0.0, 0.5))
+BAD = {
+    "cdr": ("malformed_cdr", POSE_KEY, b"\x00\x01\x00\x00\xff"),
+    "too_many_bytes": ("malformed_cdr", POSE_KEY, GOOD + bytes(4096)),
+    "frame": ("frame", POSE_KEY, pose_stamped("nowhere", (1.0, 0.0, 0.5))),
+    "nan": ("goal", POSE_KEY, pose_stamped("world", (math.nan, 0.0, 0.5))),
+    "quaternion": ("goal", POSE_KEY, pose_stamped("world", (1.0, 0.0, 0.5), (2.0, 0, 0, 0))),
+    "hash": ("type_hash", POSE_KEY.rsplit("/", 1)[0] + "/RIHS01_" + "0" * 64, GOOD),
+    "type": ("type_hash", STRING_KEY, GOOD),
+}
 
 
-@pytest.mark.parametrize(("kind", "hash_", "data"), BAD, ids=[b[0] for b in BAD])
-def test_a_bad_goal_is_refused_counted_said_and_nothing_moves(bridge, kind, hash_, data):
+@pytest.mark.parametrize(("kind", "key", "data"), BAD.values(), ids=BAD)
+def test_a_bad_goal_is_refused_counted_said_and_nothing_moves(bridge, kind, key, data):
     before = bridge.counters()[f"refused.{kind}"]
     requests = len(bridge.requests.messages)
-    key = design_key("goal_pose", "geometry_msgs/msg/PoseStamped")
-    if hash_ is not None:
-        key = key.rsplit("/", 1)[0] + "/" + hash_
     bridge.system.router.put(key, data, attachment=ATTACHMENT)
     bridge.wait_counter(f"refused.{kind}", before + 1)
     said(bridge, "parsimony/ros2_bridge", lambda level, message: f"({kind})" in message)
