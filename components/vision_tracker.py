@@ -20,6 +20,7 @@ Before F0 is seen, every marker gets the square fit.
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 
 import cv2
@@ -34,6 +35,7 @@ from messages.camera import CameraFrame
 from messages.markers import MarkerDetection, MarkerDetections
 from profiles.scene import Scene
 from vision.camera_file import CameraFile, read_camera_file
+from vision.camera_pose import placement_of
 from vision.images import grey
 from vision.markers import (
     THRESHOLD_WINDOW_PX,
@@ -50,6 +52,8 @@ FLIP_DEG = 3.0
 """A square fit of F0 tilted this far from the filtered one is IPPE's wrong solution."""
 FLIP_MIN_SAMPLES = 10
 """Fits filtered before the tilt check applies."""
+
+log = logging.getLogger("components.vision_tracker")
 
 
 class VisionTracker(Component):
@@ -102,6 +106,7 @@ class VisionTracker(Component):
         node.counters["unknown_markers"] = 0
         node.counters["reference_flips"] = 0
         node.counters["undecodable_frames"] = 0
+        self._placed = False
         self.capture = None
         if node.params["device"]:
             self.capture, self.intrinsics = self._open_device()
@@ -133,6 +138,7 @@ class VisionTracker(Component):
             pose, error = square_pose(reference, self.scene.reference.size_m, intrinsics)
             if self._consistent(pose):
                 self.reference.update(pose)
+                self._say_where_the_camera_is()
             reference_pose = self.reference.pose
             if self.node.params["plane_fit"]:
                 # The floor plane from the filtered fits; F0's position and yaw on it.
@@ -186,6 +192,16 @@ class VisionTracker(Component):
             return True
         self.node.count("reference_flips")
         return False
+
+    def _say_where_the_camera_is(self) -> None:
+        """Log, once F0's filter holds ``FLIP_MIN_SAMPLES`` fits, the camera's height and tilt
+        over the floor (``vision.camera_pose``; `parsimony calibrate ceiling` compares them with
+        the profile's camera)."""
+        if self._placed or self.reference.count < FLIP_MIN_SAMPLES:
+            return
+        self._placed = True
+        found = placement_of(self.reference.pose, self.scene.reference.height_m)
+        log.info("%s", found.describe())
 
     # -- a real camera ---------------------------------------------------------------------
 

@@ -12,13 +12,13 @@ The views are refused, with the rule they break, when they cannot determine the 
 - their corners together span less than ``MIN_SPAN`` of the image's width or height (the
   distortion, largest at the edges, is then extrapolated);
 - the board's orientations (its normal in each view) differ by less than
-  ``MIN_TILT_SPREAD_DEG``: views of parallel planes leave the focal length undetermined.
+  ``MIN_TILT_SPREAD_DEG``: views of parallel planes leave the focal length undetermined;
+- the fit leaves over ``MAX_RMS_PX`` between the corners and their images.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
 from dataclasses import dataclass
 
 import cv2
@@ -34,6 +34,8 @@ MIN_SPAN = 0.5
 """The fraction of the image's width and of its height the corners of all views must span."""
 MIN_TILT_SPREAD_DEG = 20.0
 """The least angle between the board's normals in two of the views."""
+MAX_RMS_PX = 2.0
+"""A fit that leaves more between the corners and their images is not of this board."""
 CRITERIA = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-12)
 SUBPIX_GAP_FRACTION = 0.4
 """``cornerSubPix``'s half window, as a fraction of the white gap between a square's corner and
@@ -146,10 +148,20 @@ def spread(views: list[View], size: tuple[int, int]) -> tuple[float, float]:
     return float(extent[0] / size[0]), float(extent[1] / size[1])
 
 
-def tilt_spread_deg(rotations: Iterable[np.ndarray]) -> float:
-    """The largest angle between the board's normals (R z) of two views, deg."""
-    normals = np.array([cv2.Rodrigues(r)[0][:, 2] for r in rotations])
-    cosines = np.clip(normals @ normals.T, -1.0, 1.0)
+def tilt_spread_deg(views: list[View], size: tuple[int, int]) -> float:
+    """The largest angle between the board's normals in two views, deg, each view's pose fitted
+    (``SOLVEPNP_IPPE``) through a guessed camera (f = the image's larger side, the centre in
+    the middle, no distortion): a board parallel to the image is so with any focal length, so
+    the guess tells parallel views from tilted ones without the fit they would spoil."""
+    f = float(max(size))
+    guess = np.array([[f, 0.0, 0.5 * size[0]], [0.0, f, 0.5 * size[1]], [0.0, 0.0, 1.0]])
+    normals = []
+    for view in views:
+        _, rotation, _ = cv2.solvePnP(
+            view.board_points, view.image_points, guess, None, flags=cv2.SOLVEPNP_IPPE
+        )
+        normals.append(cv2.Rodrigues(rotation)[0][:, 2])
+    cosines = np.clip(np.array(normals) @ np.array(normals).T, -1.0, 1.0)
     return float(np.degrees(np.arccos(cosines.min())))
 
 
@@ -175,9 +187,16 @@ def calibrate(views: list[View], size: tuple[int, int], k3: bool = False) -> Cal
             f"and {100 * span[1]:.0f} % of its height, {100 * MIN_SPAN:.0f} % of each is "
             "needed: show the board near the image's edges and corners too"
         )
+    tilt = tilt_spread_deg(views, size)
+    if tilt < MIN_TILT_SPREAD_DEG:
+        raise CalibrationRefused(
+            f"views too alike: the board's orientations differ by {tilt:.1f} degrees at most, "
+            f"{MIN_TILT_SPREAD_DEG:g} are needed: tilt the board 20 to 45 degrees towards the "
+            "camera in some views, each way"
+        )
     flags = 0 if k3 else cv2.CALIB_FIX_K3
     try:
-        rms, matrix, distortion, rotations, _, std, _, _ = cv2.calibrateCameraExtended(
+        rms, matrix, distortion, _, _, std, _, _ = cv2.calibrateCameraExtended(
             [v.board_points.astype(np.float32) for v in views],
             [v.image_points.astype(np.float32) for v in views],
             size,
@@ -188,12 +207,10 @@ def calibrate(views: list[View], size: tuple[int, int], k3: bool = False) -> Cal
         )
     except cv2.error as error:
         raise CalibrationRefused(f"OpenCV could not calibrate: {error.err}") from error
-    tilt = tilt_spread_deg(rotations)
-    if tilt < MIN_TILT_SPREAD_DEG:
+    if rms > MAX_RMS_PX:
         raise CalibrationRefused(
-            f"views too alike: the board's orientations differ by {tilt:.1f} degrees at most, "
-            f"{MIN_TILT_SPREAD_DEG:g} are needed: tilt the board 20 to 45 degrees towards the "
-            "camera in some views, each way"
+            f"the fit leaves {rms:.2f} px RMS between the corners and their images (over "
+            f"{MAX_RMS_PX:g}): a board other than the one described, or a blurred one"
         )
     k = matrix
     intrinsics = Intrinsics(

@@ -10,12 +10,16 @@ board cannot be read."""
 from __future__ import annotations
 
 import argparse
+import math
 import sys
+from dataclasses import asdict
 from datetime import UTC, datetime
 from pathlib import Path
 
 from outputs.files import writable_output, written_whole
 from outputs.stdout import emit, json_text
+from profiles.profile import Profile, ProfileError, load_profile
+from sim2d.camera import ceiling_camera
 from vision.calibration import (
     Board,
     BoardDetector,
@@ -25,11 +29,20 @@ from vision.calibration import (
     calibrate,
     evenly,
 )
-from vision.camera_file import CameraFile, camera_file_text
+from vision.camera_file import CameraFile, camera_file_text, read_camera_file
+from vision.camera_pose import measured_camera, placement, shift_of_seen_floor
 from vision.frame_source import FrameSourceError, frames
+from vision.markers import Intrinsics, MarkerDetector
+from wbc import dq
 
 DEVICE_FRAMES = 300
 """Frames read from a device unless ``--frames`` says otherwise (10 s at 30 Hz)."""
+SEEN_FLOOR_TOLERANCE_M = 0.05
+"""How far the floor the profile's level camera sees may lie from the one the real camera sees
+before a warning: the supervisor keeps the base's axle a margin inside it (0.17 m on Little
+John: the marker's offset and half diagonal), and 5 cm spends under a third of that."""
+LEVEL_DEG = 1.0
+"""A tilt the warning asks to level the camera from (the profile's camera can only be level)."""
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -74,6 +87,21 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     )
     camera.add_argument("--k3", action="store_true", help="fit k3 too (wide-angle lenses)")
     camera.add_argument("--json", action="store_true", help="print the result as JSON")
+    ceiling = steps.add_parser(
+        "ceiling",
+        help="the camera's height and tilt over the floor, from the reference marker",
+        description="The camera over the floor as the profile's reference marker F0 shows it, "
+        "against the profile's scene.camera (level, at its position).",
+    )
+    ceiling.add_argument("profile", type=Path, help="deploy profile (its scene and tracker)")
+    ceiling.add_argument(
+        "--source", help="device, video or folder of images (default: the tracker's device)"
+    )
+    ceiling.add_argument(
+        "--calibration", type=Path, help="intrinsics file (default: the tracker's)"
+    )
+    ceiling.add_argument("--frames", type=int, default=30, help="frames to read (default 30)")
+    ceiling.add_argument("--json", action="store_true", help="print the result as JSON")
     return parser
 
 
@@ -161,4 +189,80 @@ def calibrate_camera(args: argparse.Namespace) -> int:
 def run(args: argparse.Namespace) -> int:
     if args.what == "camera":
         return calibrate_camera(args)
-    raise AssertionError(args.what)
+    try:
+        return calibrate_ceiling(args)
+    except (ProfileError, ValueError) as error:  # FrameSourceError, the intrinsics file
+        print(f"calibrate: {error}", file=sys.stderr)
+        return 2
+
+
+def _camera_of(args: argparse.Namespace, profile: Profile) -> tuple[str, CameraFile]:
+    """The frames' source and the intrinsics: the arguments', else the tracker's, else (no
+    intrinsics file: synthetic frames) the scene's camera."""
+    params = next((c.params for c in profile.components if c.module == "vision_tracker"), {})
+    source = args.source or str(params.get("device", ""))
+    if not source:
+        raise ValueError("no source: give --source (the profile's tracker reads camera/image)")
+    calibration = args.calibration or params.get("calibration")
+    if calibration:
+        return source, read_camera_file(Path(str(calibration)))
+    c = profile.scene.camera
+    print("calibrate: no intrinsics file: the scene's camera intrinsics", file=sys.stderr)
+    return source, CameraFile(Intrinsics(c.fx, c.fy, c.cx, c.cy), (c.width, c.height))
+
+
+def calibrate_ceiling(args: argparse.Namespace) -> int:
+    profile = load_profile(args.profile)
+    scene = profile.scene
+    if scene is None:
+        raise ValueError(f"{args.profile} has no scene (markers and camera)")
+    source, camera = _camera_of(args, profile)
+    detector = MarkerDetector(scene.dictionary_id)
+    seen, read, size = [], 0, None
+    for _, image in frames(source, args.frames):
+        read, size = read + 1, (image.shape[1], image.shape[0])
+        seen += [d for d in detector.detect(image) if d.id == scene.reference.id]
+    mismatch = camera.size_mismatch(*size)
+    if mismatch:
+        print(f"calibrate: {mismatch}", file=sys.stderr)
+    if not seen:
+        print(
+            f"calibrate: refused: the reference marker (id {scene.reference.id}, "
+            f"{scene.dictionary}) is in none of the {read} frames read",
+            file=sys.stderr,
+        )
+        return 1
+    ref = scene.reference
+    found, pose_c = placement(seen, ref.size_m, ref.height_m, camera.intrinsics)
+    x0, y0, yaw0 = scene.reference_pose
+    measured = measured_camera(pose_c, (x0, y0, ref.height_m, yaw0), camera.intrinsics, size)
+    try:
+        shift = shift_of_seen_floor(ceiling_camera(scene.camera), measured, scene.base.height_m)
+    except ValueError:
+        shift = math.inf
+    position = dq.translation(measured.pose)[1:]
+    suggested = [round(float(v), 3) for v in (position[0], position[1], found.height_m)]
+    warnings = []
+    if shift > SEEN_FLOOR_TOLERANCE_M:
+        warnings.append(
+            f"the profile's camera (scene.camera.position {list(scene.camera.position)}, "
+            f"level) sees the floor at the base marker's height up to {shift:.3f} m from where "
+            f"this one does (over {SEEN_FLOOR_TOLERANCE_M} m): the sight region the supervisor "
+            f"keeps the base in is off; set scene.camera.position to "
+            f"{suggested}" + (" and level the camera" if found.tilt_deg > LEVEL_DEG else "")
+        )
+    summary = {
+        **asdict(found),
+        "frames": read,
+        "reference_seen": len(seen),
+        "seen_floor_shift_m": shift,
+        "suggested_position": suggested,
+        "warnings": warnings,
+    }
+    for warning in warnings:
+        print(f"calibrate: warning: {warning}", file=sys.stderr)
+    if args.json:
+        emit(json_text(summary, indent=2))
+    else:
+        emit(f"{found.describe()} (F0 in {len(seen)} of {read} frames)")
+    return 0

@@ -150,7 +150,7 @@ def distance(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.linalg.norm(dq.translation(a) - dq.translation(b)))
 
 
-def test_markers_of_a_video_device_are_found(deployed, tmp_path: Path) -> None:
+def test_markers_of_a_video_device_are_found(deployed, tmp_path: Path, wait_until) -> None:
     system = tracker_system(deployed, tmp_path, {})
     video = tmp_path / "ceiling.avi"
     c = system.profile.scene.camera
@@ -161,7 +161,9 @@ def test_markers_of_a_video_device_are_found(deployed, tmp_path: Path) -> None:
         writer.write(scene_image(system, seed)[0])
     writer.release()
     calibration = tmp_path / "calibration.yaml"
-    calibration.write_text(yaml.safe_dump({"fx": c.fx, "fy": c.fy, "cx": c.cx, "cy": c.cy}))
+    # Calibrated at another size than the video's: the tracker says so, and runs on.
+    intrinsics = {"fx": c.fx, "fy": c.fy, "cx": c.cx, "cy": c.cy, "width": 320, "height": 240}
+    calibration.write_text(yaml.safe_dump(intrinsics))
     system = tracker_system(
         deployed, tmp_path, {"device": str(video), "calibration": str(calibration)}
     )
@@ -169,6 +171,8 @@ def test_markers_of_a_video_device_are_found(deployed, tmp_path: Path) -> None:
     system.start("vision_tracker")
     found = inbox.wait_for(lambda m: len(m.markers) == 3, "with the three markers", 20.0)
     assert [m.id for m in found.markers] == [0, 1, 2]
+    wait_until(lambda: "m over the floor, tilted" in system.log("vision_tracker"), "its height")
+    assert "its calibration is for 320x240" in system.log("vision_tracker")
 
 
 def test_a_device_that_does_not_open_is_a_configuration_error(deployed, tmp_path: Path) -> None:

@@ -23,7 +23,7 @@ DISTORTION_TRUE = np.array([-0.12, 0.06, 0.0015, -0.001, 0.0])
 BOARD = Board()
 BOARD_PX_PER_M = 1500.0
 """The board's image: about as fine as it is seen (a 40 mm square is some 60 px at 0.4 m)."""
-PAD_PX = 160
+PAD_PX = 32
 """The ideal image is drawn this far beyond each edge: barrel distortion pulls it in."""
 SUPERSAMPLE = 2
 BLUR_SIGMA_PX = 0.6

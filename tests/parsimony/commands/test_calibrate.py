@@ -1,11 +1,13 @@
 """`parsimony calibrate camera` on folders of rendered views of a ChArUco board seen through a
 camera of known intrinsics and distortion (tests/vision/board_views.py): it recovers them and
 writes the file the vision tracker reads; it refuses too few views, views too alike, frames
-without the board and a source it cannot read, each with its reason."""
+without the board and a source it cannot read, each with its reason. `parsimony calibrate
+ceiling` on frames of the synthetic ceiling camera, level and tilted."""
 
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import cv2
@@ -13,10 +15,17 @@ import numpy as np
 import pytest
 
 from components.vision_tracker import load_calibration
+from profiles.deploy_files import DEPLOY
+from profiles.profile import load_profile
+from sim2d.camera import ImageNoise, PinholeCamera, PlacedMarker, ceiling_pose, render
 from tests.parsimony.in_process import run_in_process
 from tests.vision.board_views import DISTORTION_TRUE, K_TRUE, SIZE, varied_poses, write_views
+from wbc import dq
+from wbc.planar import planar_pose
 
 VIEWS = 24
+SIM_PROFILE = DEPLOY / "sim.yaml"
+CEILING_FRAMES = 8
 INTRINSICS_TOLERANCE = 0.005
 """fx, fy, cx, cy within 0.5 % of the truth."""
 DISTORTION_TOLERANCE_PX = (1.0, 0.5)
@@ -150,3 +159,57 @@ def test_a_board_that_cannot_be_is_refused_before_reading(tmp_path: Path, capsys
     argv = [str(tmp_path), "-o", str(tmp_path / "c.yaml"), "--marker", "0.05"]
     code, _, err = calibrate(argv, capsys)
     assert code == 2 and "must be smaller than the square" in err
+
+
+def ceiling_frames(folder: Path, tilt_deg: float) -> Path:
+    """Frames of deploy/sim.yaml's reference marker from its ceiling camera, turned by
+    ``tilt_deg`` about the camera's x axis."""
+    scene = load_profile(SIM_PROFILE).scene
+    x0, y0, yaw0 = scene.reference_pose
+    reference = PlacedMarker(
+        scene.reference.id, scene.reference.size_m, planar_pose(x0, y0, yaw0, 0.0)
+    )
+    tilt = dq.pose(dq.rotation_quaternion(math.radians(tilt_deg), [1.0, 0.0, 0.0]), [0, 0, 0])
+    camera = PinholeCamera(dq.mul(ceiling_pose(*scene.camera.position), tilt))
+    folder.mkdir()
+    for seed in range(CEILING_FRAMES):
+        rng = np.random.default_rng(seed)
+        image = render(camera, [reference], scene.dictionary_id, ImageNoise(), rng)
+        cv2.imwrite(str(folder / f"{seed}.png"), image)
+    return folder
+
+
+@pytest.mark.parametrize("tilt_deg", [0.0, 4.0])
+def test_the_ceiling_camera_s_height_and_tilt_over_the_floor(
+    tmp_path: Path, capsys, tilt_deg: float
+) -> None:
+    """deploy/sim.yaml's camera, 2.5 m over the floor, level or tilted: its height within 2 cm
+    and its tilt within half a degree; tilted, the floor it sees is off from the profile's
+    level camera's, which is said, with the position to declare."""
+    folder = ceiling_frames(tmp_path / "frames", tilt_deg)
+    argv = ["calibrate", "ceiling", str(SIM_PROFILE), "--source", str(folder), "--json"]
+    code, out, err = run_in_process(argv, capsys)
+    assert code == 0, err
+    found = json.loads(out)
+    print(
+        f"tilt {tilt_deg}: height {found['height_m']:.4f} m, tilt {found['tilt_deg']:.2f} deg, "
+        f"seen floor off by {found['seen_floor_shift_m']:.3f} m"
+    )
+    assert found["height_m"] == pytest.approx(2.5, abs=0.02)
+    assert found["tilt_deg"] == pytest.approx(tilt_deg, abs=0.5)
+    assert found["reference_seen"] == CEILING_FRAMES
+    if tilt_deg == 0.0:
+        assert found["warnings"] == []
+    else:
+        assert "sight region the supervisor keeps the base in is off" in err
+        assert found["warnings"] and "and level the camera" in found["warnings"][0]
+
+
+def test_a_ceiling_without_the_reference_marker_is_refused(tmp_path: Path, capsys) -> None:
+    folder = tmp_path / "blank"
+    folder.mkdir()
+    cv2.imwrite(str(folder / "0.png"), np.full((480, 640), 128, np.uint8))
+    argv = ["calibrate", "ceiling", str(SIM_PROFILE), "--source", str(folder)]
+    code, _, err = run_in_process(argv, capsys)
+    assert code == 1
+    assert "refused: the reference marker (id 0, DICT_4X4_50) is in none of the 1 frames" in err
