@@ -35,6 +35,7 @@ COMMANDS = (
     "layout",
     "reproduce",
     "calibrate",
+    "study",
 )
 
 

@@ -1,0 +1,178 @@
+"""The figures a study's tables compute over a group of runs, by name, each from the
+functions that compute it for the benchmarks (``studies.goal_sets``' shares, parsimony,
+failures and planning; an experiment's summary): none is computed anew here."""
+
+from __future__ import annotations
+
+import json
+import statistics
+from collections import Counter
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from studies.goal_sets import failures, parsimony, planning, shares
+from studies.study.execute import OK
+from studies.study.runs import attempt_of
+from wbc import dq
+from wbc.planar import wrap
+from wbc.robot import MobileManipulator
+
+Rows = list[dict[str, Any]]
+Figure = Callable[[Rows, MobileManipulator], dict[str, Any]]
+
+FOLDED = 0.2
+"""A goal's gripper this near its base, horizontally (m), has the arm bent back over it."""
+HEADING_OFF = 0.5
+"""How far (rad) a missed run's base heading may end from the goal configuration's unremarked."""
+
+
+def ok(rows: Rows) -> Rows:
+    return [row for row in rows if row["status"] == OK]
+
+
+def _attempts(rows: Rows) -> list:
+    return [attempt_of(row) for row in ok(rows)]
+
+
+def _share(name: str, key: str) -> Figure:
+    return lambda rows, robot: {name: shares(_attempts(rows))[key]}
+
+
+def _parsimony(name: str, key: str) -> Figure:
+    return lambda rows, robot: {name: parsimony(_attempts(rows), robot.dof)[key]}
+
+
+def _sets(rows: Rows, robot: MobileManipulator) -> dict[str, Any]:
+    """The worst and the best seed's share reached inside every limit."""
+    seeds = sorted({row["seed"] for row in rows})
+    each = [
+        shares(_attempts([r for r in rows if r["seed"] == s]))["within_joint_and_speed_limits"]
+        for s in seeds
+    ]
+    return {"worst set": min(each), "best set": max(each)}
+
+
+def misses(rows: Rows, robot: MobileManipulator) -> dict[str, int]:
+    """The goals not reached inside every limit, by kind (a goal may be of several)."""
+    kinds: Counter[str] = Counter()
+    for row in ok(rows):
+        a, goal = attempt_of(row), np.asarray(row["goal_q"])
+        if a.within_all_limits:
+            continue
+        kinds["missed"] += 1
+        gripper = dq.translation(robot.fkm(goal))[1:3]
+        kinds["gripper over its base"] += bool(np.hypot(*(gripper - goal[:2])) < FOLDED)
+        edge = a.reason.partition(", ")[2].removesuffix(" at the joint box's edge")
+        kinds[f"{edge} at its box's edge"] += edge.startswith("q")
+        turned = a.last is not None and abs(wrap(float(a.last[2] - goal[2]))) > HEADING_OFF
+        kinds["base heading off"] += turned
+    return {"missed": 0} | {kind: n for kind, n in kinds.items() if n}
+
+
+def _effort(rows: Rows, robot: MobileManipulator) -> dict[str, float]:
+    """Table 6.1's metrics, from rest, the median over the runs."""
+    efforts = [a.effort_from_rest for a in _attempts(rows) if a.effort_from_rest is not None]
+    names = ("velocity_l1", "velocity_l2", "acceleration_l1", "acceleration_l2")
+    return {n: float(np.median([getattr(e, n) for e in efforts])) for n in names if efforts}
+
+
+KINEMATIC: dict[str, Figure] = {
+    "runs": lambda rows, robot: {"runs": len(rows)},
+    "failed": lambda rows, robot: {"failed": len(rows) - len(ok(rows))},
+    "seeds": lambda rows, robot: {"seeds": ",".join(map(str, sorted({r["seed"] for r in rows})))},
+    "reached": _share("reached", "reached"),
+    "reached inside the joint limits": _share(
+        "reached inside the joint limits", "within_joint_limits"
+    ),
+    "reached inside every limit": _share(
+        "reached inside every limit", "within_joint_and_speed_limits"
+    ),
+    "time to converge": _share("time to converge (s)", "median_time_to_converge_s"),
+    "every step optimal": _share("every step optimal", "every_step_optimal"),
+    "sets": _sets,
+    "nonzero moving": _parsimony("nonzero moving", "median_nonzero_moving"),
+    "nonzero near the goal": _parsimony("nonzero near the goal", "median_nonzero_settling"),
+    "contacts": lambda rows, robot: {"contacts": failures(_attempts(rows))["contacts"]},
+    "clearance": lambda rows, robot: {
+        "least clearance (m)": failures(_attempts(rows))["least_clearance_m"]
+    },
+    "planning": lambda rows, robot: planning(_attempts(rows)),
+    "effort": _effort,
+    "misses": misses,
+}
+"""A kinematic study's figures: each gives one or more columns."""
+
+
+def median_of(reports: list[dict], component: str, counter: str) -> int:
+    return round(
+        statistics.median(r["durations_us"].get(component, {}).get(counter, 0) for r in reports)
+    )
+
+
+def summary(name: str, controller: str, found: list[dict | None]) -> dict:
+    """Every seed of one experiment and law, summarised (those that could not run counted)."""
+    reports = [r for r in found if r is not None]
+    estimator = [r["estimator_error"] for r in reports if r["estimator_error"]["samples"]]
+    # The recorder's CPU per simulated second: its share of one core in real time (30 Hz).
+    recorder = [r["cpu_s"].get("recorder", 0.0) / r["sim_time_s"] for r in reports]
+    return {
+        "experiment": name,
+        "law": controller,
+        "runs": len(reports),
+        "did_not_run": len(found) - len(reports),
+        "converged": sum(r["converged"] for r in reports),
+        "with_contact": sum(r["contacts"] > 0 for r in reports),
+        "at_joint_stops": sum(r["joint_limit_violations"] > 0 for r in reports),
+        "estimator_position_mm": round(max(e["position_m"] for e in estimator) * 1e3, 2),
+        "estimator_angle_deg": round(float(np.degrees(max(e["angle_rad"] for e in estimator))), 2),
+        "real_time_factor": round(statistics.median(r["real_time_factor"] for r in reports), 2),
+        "rtf_min": round(min(r["real_time_factor"] for r in reports), 2),
+        "tracker_frame_us": median_of(reports, "vision_tracker", "handler.camera/image_us_median"),
+        "estimator_odometry_us": median_of(
+            reports, "state_estimator", "handler.base/odometry_us_median"
+        ),
+        "controller_state_us": median_of(reports, "controller", "handler.robot/state_us_median"),
+        "frame_answer_us": median_of(reports, "simulator", "frame_us_median"),
+        "loop_us": median_of(reports, "simulator", "loop_us_median"),
+        "recorder_cpu_pct_rt": round(100 * statistics.median(recorder), 1),
+        "bytes_per_sim_s": round(
+            statistics.median(r["recording"]["bytes_per_sim_s"] for r in reports)
+        ),
+        "recordings_whole": sum(r["recording"]["whole"] for r in reports),
+    }
+
+
+def _summary(key: str) -> Figure:
+    def figure(rows: Rows, robot: MobileManipulator) -> dict[str, Any]:
+        reports = [json.loads(r["report"]) if r["status"] == OK else None for r in rows]
+        if not any(reports):
+            return {key: None}
+        return {key: summary(rows[0]["experiment"], rows[0]["law_name"], reports)[key]}
+
+    return figure
+
+
+SIMULATED_COLUMNS = (
+    "runs",
+    "did_not_run",
+    "converged",
+    "with_contact",
+    "at_joint_stops",
+    "estimator_position_mm",
+    "estimator_angle_deg",
+    "real_time_factor",
+    "rtf_min",
+    "tracker_frame_us",
+    "estimator_odometry_us",
+    "controller_state_us",
+    "frame_answer_us",
+    "loop_us",
+    "recorder_cpu_pct_rt",
+    "bytes_per_sim_s",
+    "recordings_whole",
+)
+"""The columns of ``summary`` a simulated study's table may name."""
+SIMULATED: dict[str, Figure] = {key: _summary(key) for key in SIMULATED_COLUMNS}
+"""A simulated study's figures."""

@@ -1,0 +1,146 @@
+"""`parsimony study`: a tiny kinematic study on the local pool and on a real Dask cluster on
+loopback (a scheduler and two workers, separate processes) gives the same rows; a second
+invocation runs only the rows missing; a hung run is recorded with its reason, retried once,
+and the study goes on; the report's table; a bad study file is one line."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+
+from parsimony.cli import main
+from studies.study import results
+
+ROOT = Path(__file__).resolve().parents[3]
+DASK = Path(sys.executable).parent / "dask"
+TINY = {
+    "name": "tiny",
+    "families": ["ahead"],
+    "goals": 2,
+    "seeds": [2],
+    "laws": [{"law": "lp"}, {"law": "lp", "label": "lp eta", "gains": {"eta": [0.5]}}],
+    "tables": [
+        {
+            "title": "reach",
+            "by": ["family", "law"],
+            "figures": ["runs", "failed", "reached inside every limit", "nonzero moving"],
+        }
+    ],
+}
+
+
+def study_file(directory: Path, **changes: object) -> Path:
+    path = directory / "tiny.yaml"
+    path.write_text(yaml.safe_dump(TINY | changes))
+    return path
+
+
+def study(capsys, *args: object) -> dict:
+    """``parsimony study ARGS`` in this process: its JSON line."""
+    code = main(["study", *map(str, args)])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    return json.loads(out)
+
+
+def findings(path: Path) -> str:
+    """The rows without how long they took, as text (a NaN equal to a NaN)."""
+    return json.dumps([results.findings(row) for row in results.read(path)], default=str)
+
+
+@pytest.fixture(scope="module")
+def local(tmp_path_factory) -> Path:
+    """The tiny study run on the local pool: its results file."""
+    directory = tmp_path_factory.mktemp("local")
+    path = directory / "tiny.parquet"
+    code = main(["study", str(study_file(directory)), "--workers", "2", "--results", str(path)])
+    assert code == 0
+    return path
+
+
+@pytest.fixture(scope="module")
+def scheduler(tmp_path_factory):
+    """A Dask scheduler and two workers on 127.0.0.1, each its own process: the address."""
+    directory = tmp_path_factory.mktemp("dask")
+    file = directory / "scheduler.json"
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    quiet = {"cwd": ROOT, "env": env, "stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
+    common = ["--host", "127.0.0.1", "--no-dashboard"]
+    processes = [
+        subprocess.Popen(
+            [DASK, "scheduler", *common, "--port", "0", "--scheduler-file", file], **quiet
+        )
+    ]
+    try:
+        deadline = time.monotonic() + 120
+        while not file.exists() and time.monotonic() < deadline:
+            assert processes[0].poll() is None, "the scheduler ended"
+            time.sleep(0.1)
+        address = json.loads(file.read_text())["address"]
+        assert address.startswith("tcp://127.0.0.1:")
+        worker = [DASK, "worker", address, *common, "--nthreads", "1", "--no-nanny"]
+        processes += [subprocess.Popen(worker, **quiet) for _ in range(2)]
+        from distributed import Client
+
+        with Client(address, timeout="60s") as client:
+            client.wait_for_workers(2, timeout=120)
+        yield address
+    finally:
+        for process in reversed(processes):
+            process.terminate()
+        for process in processes:
+            process.wait(timeout=30)
+
+
+def test_a_dask_cluster_gives_the_local_pools_rows(local, scheduler, tmp_path, capsys) -> None:
+    path = tmp_path / "tiny.parquet"
+    counts = study(capsys, study_file(tmp_path), "--address", scheduler, "--results", path)
+    assert counts["ran"] == counts["runs"] == 4 and counts["workers"] == 2
+    assert findings(path) == findings(local)
+    assert {row["status"] for row in results.read(path)} == {"ok"}
+
+
+def test_a_second_invocation_runs_only_the_missing_rows(local, tmp_path, capsys) -> None:
+    path = tmp_path / "tiny.parquet"
+    rows = results.read(local)
+    results.write(path, rows[1:3])  # two rows lost, as by an interrupted study
+    counts = study(capsys, study_file(tmp_path), "--results", path)
+    assert (counts["already_there"], counts["ran"]) == (2, 2)
+    assert findings(path) == findings(local)
+    again = study(capsys, study_file(tmp_path), "--results", path)
+    assert again["ran"] == 0
+
+
+def test_a_hung_run_is_recorded_retried_once_and_the_study_goes_on(tmp_path, capsys) -> None:
+    file = study_file(tmp_path, time_limit_s=0.001, laws=[{"law": "lp"}])
+    path = tmp_path / "hung.parquet"
+    counts = study(capsys, file, "--results", path)
+    assert counts["failed"] == counts["runs"] == 2
+    for row in results.read(path):
+        assert row["status"] == "failed" and row["tries"] == 2
+        assert row["reason"] == "hung: no answer within its time limit of 0.001 s"
+
+
+def test_the_report_is_a_markdown_table_naming_the_study(local, tmp_path, capsys) -> None:
+    file = study_file(tmp_path)
+    study_text = main(["study", str(file), "--results", str(local), "--report"])
+    out = capsys.readouterr().out
+    assert study_text == 0
+    assert f"parsimony study {file} --report" in out and "4 of 4 runs" in out
+    lines = [line for line in out.splitlines() if line.startswith("| ahead")]
+    assert [line.split("|")[2].strip() for line in lines] == ["lp", "lp eta, eta=0.5"]
+    assert all(line.split("|")[3].strip() == "2" for line in lines)  # runs per law
+
+
+def test_a_study_naming_an_unknown_law_is_one_line(tmp_path, capsys) -> None:
+    file = study_file(tmp_path, laws=[{"law": "lq"}])
+    assert main(["study", str(file)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("parsimony study: no kinematic law 'lq'") and "\n" not in err
