@@ -19,7 +19,8 @@ import zenoh
 import zenoh.ext
 
 from components.ros2_bridge import Ros2Bridge
-from components.runtime import Node
+from components.runtime import Component, Node
+from components.supervisor import Supervisor
 from launch import query
 from messages import codec, topics
 from messages.camera import CameraFrame, CameraIntrinsics
@@ -82,7 +83,7 @@ class RosSide:
 
 
 class Bridge:
-    """The bridge node in this process, the router, the ROS 2 side and Parsimony's side."""
+    """The bridge and the supervisor in this process, the router, and both sides of it."""
 
     def __init__(self, system: System, node: Node) -> None:
         self.system, self.node = system, node
@@ -132,6 +133,10 @@ def pose_stamped(frame: str, position, orientation=(1.0, 0.0, 0.0, 0.0)) -> byte
 ATTACHMENT = struct.pack("<qqB16s", 1, time.time_ns(), 16, bytes(16))
 
 
+def declared(component: type[Component]) -> tuple:
+    return component.params, component.reads, component.writes
+
+
 @pytest.fixture(scope="module")
 def bridge(deployed_for_module) -> Iterator[Bridge]:
     scene = read_profile_data(DEPLOY / "sim.yaml")["scene"]
@@ -142,18 +147,28 @@ def bridge(deployed_for_module) -> Iterator[Bridge]:
         "scene": scene,
         "components": [
             {
+                "name": "supervisor",
+                "module": "supervisor",
+                "role": "controller",
+                "enabled": False,
+                "params": {"planning_budget_s": 0.05},
+            },
+            {
                 "name": "ros2_bridge",
                 "module": "ros2_bridge",
                 "role": "tool",
                 "enabled": False,
                 "params": {"domain_id": DOMAIN, "goal_rate_hz": 100.0},
-            }
+            },
         ],
     }
     system = deployed_for_module(yaml.safe_dump(profile))
-    with Node(
-        system.profile, "ros2_bridge", Ros2Bridge.params, Ros2Bridge.reads, Ros2Bridge.writes
-    ) as node:
+    with (
+        Node(system.profile, "supervisor", *declared(Supervisor)) as supervisor_node,
+        Node(system.profile, "ros2_bridge", *declared(Ros2Bridge)) as node,
+    ):
+        supervisor = Supervisor(supervisor_node)
+        supervisor_node.start(supervisor.shutdown, supervisor.clock_stalled)
         component = Ros2Bridge(node)
         node.start(component.shutdown)
         yield Bridge(system, node)
@@ -298,13 +313,16 @@ def test_a_bad_goal_is_refused_counted_said_and_nothing_moves(bridge, kind, key,
     assert len(bridge.requests.messages) == requests  # a goal is refused or passed on, not both
 
 
-def test_a_supervisors_refusal_is_said_on_diagnostics_with_its_reason(bridge):
-    header = Header(stamp_ns=time.time_ns(), frame="", seq=0, source="test")
-    status = SupervisorStatus(
-        header=header, phase="refused", reason="too far", candidate=0, plans=0, replans=0, stalls=0
-    )
-    bridge.put(topics.SUPERVISOR_STATUS, status)
-    said(bridge, "parsimony/supervisor", lambda *said: said == (2, "refused: too far"))
+def test_a_goal_the_supervisor_refuses_is_said_on_diagnostics_with_its_reason(bridge):
+    far = pose_stamped("world", (40.0, 0.0, 0.5))
+    bridge.goal_out.put(far, attachment=ATTACHMENT)
+    bridge.send_state()  # the supervisor takes a goal on the state after it
+
+    def refused(level: int, message: str) -> bool:
+        bridge.send_state()
+        return level == 2 and message.startswith("refused: ") and len(message) > len("refused: ")
+
+    said(bridge, "parsimony/supervisor", refused)
 
 
 def test_a_flood_of_goals_is_refused_past_the_rate(bridge):
