@@ -2,8 +2,9 @@
 
 ``terminal_keys()`` puts standard input in cbreak mode (no line editing, no echo; Ctrl-C
 still interrupts) for the duration of a ``with`` block and yields a ``KeyReader``; the
-terminal's settings come back on every way out of the block: its end, an exception, Ctrl-C
-or SIGTERM. When standard input is not a terminal it yields ``None`` and changes nothing.
+terminal's settings come back on every way out of the block: its end or an exception (Ctrl-C,
+and SIGTERM where the command raises one for it: ``parsimony.stop_signals``). When standard
+input is not a terminal it yields ``None`` and changes nothing.
 """
 
 from __future__ import annotations
@@ -11,7 +12,6 @@ from __future__ import annotations
 import os
 import re
 import select
-import signal
 import sys
 import termios
 import tty
@@ -67,24 +67,17 @@ def split_keys(text: str) -> list[str]:
     return keys
 
 
-def _exit_on_sigterm(signum: int, _frame: object) -> None:
-    raise SystemExit(128 + signum)
-
-
 @contextmanager
 def terminal_keys() -> Iterator[KeyReader | None]:
     """Standard input in cbreak mode and a ``KeyReader`` of it, or ``None`` if it is no
-    terminal. SIGTERM raises ``SystemExit`` inside the block, so the settings come back then
-    too."""
+    terminal."""
     if sys.stdin is None or not sys.stdin.isatty():
         yield None
         return
     fd = sys.stdin.fileno()
     saved = termios.tcgetattr(fd)
-    previous = signal.signal(signal.SIGTERM, _exit_on_sigterm)
     try:
         tty.setcbreak(fd, termios.TCSANOW)
         yield KeyReader(fd)
     finally:
         termios.tcsetattr(fd, termios.TCSADRAIN, saved)
-        signal.signal(signal.SIGTERM, previous)

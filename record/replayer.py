@@ -259,6 +259,8 @@ class Player:
         self.first_ns, self.last_ns = recording.window(playing.start_offset_s, playing.duration_s)
         self.progress = Progress(self.first_ns, self.last_ns - self.first_ns)
         self.pace = Pace(playing.rate, self.first_ns, time.monotonic(), paused=playing.start_paused)
+        self.sent = 0
+        """The messages sent in this pass."""
         self.answers = Answers(session, namespace) if playing.lockstep else None
         names = recording.names | ({"sim/clock"} if playing.clock else set())
         block = zenoh.CongestionControl.BLOCK  # a replay waits rather than drop a sample
@@ -277,7 +279,11 @@ class Player:
             sys.stdin.readline()
             self.pace.paused = False
         while True:
-            sent, quit_asked = self.replay_once()
+            try:
+                sent, quit_asked = self.replay_once()
+            except KeyboardInterrupt:
+                self.progress.say(f"{self.sent} messages sent (interrupted)")
+                raise
             if self.answers is not None and self.answers.timeouts:
                 self.progress.say(
                     f"{self.answers.timeouts} messages not answered within {ANSWER_TIMEOUT_S:g} s"
@@ -290,6 +296,7 @@ class Player:
         """One pass over the records at the recorded pace; the number of messages sent and
         whether ``q`` was pressed."""
         pace, clock_ns, sent = self.pace, None, 0
+        self.sent = 0
         pace.anchor(self.first_ns, time.monotonic())
         self.progress.show(pace, self.first_ns, sent, changed=True)
         for group in self.recording.groups(self.first_ns, self.last_ns):
@@ -302,6 +309,7 @@ class Player:
                     self.publish("sim/clock", Clock(stamp_ns=clock_ns))
                 self.send(record)
                 sent += 1
+                self.sent = sent
                 if pace.paused:
                     pace.anchor(record.log_time_ns, time.monotonic())
                 self.progress.show(pace, record.log_time_ns, sent, changed=pace.paused)

@@ -39,7 +39,14 @@ from launch.query import NoRouter, QueryError, Target, live_components
 from launch.zenoh_error import zenoh_error_text
 from messages import topics
 from parsimony.commands.launch import positive, positive_seconds
-from parsimony.commands.view import namespace_argument, port_number, serving, watched_profile
+from parsimony.commands.view import (
+    namespace_argument,
+    port_number,
+    serving,
+    stopped,
+    watched_profile,
+)
+from parsimony.stop_signals import Interrupted, stop_signals
 from parsimony.target_options import fail, target_options
 from profiles.endpoints import endpoint_problem
 from profiles.profile import Profile, ProfileError, load_profile
@@ -124,6 +131,18 @@ def wanted(args: argparse.Namespace, name: str) -> bool:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Replay as asked until the end, ``q``, or a stop signal (SIGINT or SIGTERM, whatever the
+    process inherited: ``parsimony.stop_signals``), which ends it with 128 plus its number."""
+    with stop_signals(raising=True):
+        try:
+            return replay(args)
+        except Interrupted as stop:
+            print(f"\n[replay] interrupted by {stop.signal}", file=sys.stderr, flush=True)
+            return stop.exit_code
+
+
+def replay(args: argparse.Namespace) -> int:
+    """The replay ``args`` ask for, and what it did said on stderr (the view's too)."""
     try:  # what was asked is checked before the router is reached
         recorded = recording(args)
         profile = load_profile(args.profile) if args.profile is not None else None
@@ -142,43 +161,56 @@ def run(args: argparse.Namespace) -> int:
         return fail(error)
     if recorded.outside is not None:
         print(f"[replay] not sent, {recorded.outside}", file=sys.stderr)
-    conflicts = (
-        []
-        if args.into_live or own_router
-        else live_conflicts(session, profile, namespace, recorded.names)
-    )
-    if conflicts:
-        session.close()
-        print(
-            f"replay: refused: {'; '.join(conflicts)}. Replay into a namespace of its own "
-            "(--namespace), leave those topics out (--exclude, --sensors), or say "
-            "--into-live",
-            file=sys.stderr,
+    with session:
+        conflicts = (
+            []
+            if args.into_live or own_router
+            else live_conflicts(session, profile, namespace, recorded.names)
         )
-        return 2
-    try:
+        if conflicts:
+            print(
+                f"replay: refused: {'; '.join(conflicts)}. Replay into a namespace of its own "
+                "(--namespace), leave those topics out (--exclude, --sensors), or say "
+                "--into-live",
+                file=sys.stderr,
+            )
+            return 2
         view = (
             serving(session, watched, topics.topics_matching(["*"]), args.port, robot)
             if watched and args.view
             else contextlib.nullcontext()
         )
-        with session, view, terminal_keys() as keys:
-            playing = Playing(
-                args.rate,
-                args.start_offset,
-                args.duration,
-                args.loop,
-                args.clock,
-                args.lockstep,
-                args.start_paused,
-            )
-            return Player(playing, session, namespace, recorded, keys).run()
+        return played(args, session, namespace, recorded, view)
+
+
+def played(
+    args: argparse.Namespace,
+    session: zenoh.Session,
+    namespace: str,
+    recorded: Recording,
+    view: contextlib.AbstractContextManager,
+) -> int:
+    """The replay on ``session`` (``view``: its live view, or nothing); the view says what it
+    did when the replay ends, whatever ends it."""
+    playing = Playing(
+        args.rate,
+        args.start_offset,
+        args.duration,
+        args.loop,
+        args.clock,
+        args.lockstep,
+        args.start_paused,
+    )
+    try:
+        with view as served, terminal_keys() as keys:
+            try:
+                return Player(playing, session, namespace, recorded, keys).run()
+            finally:
+                if served is not None:
+                    stopped(*served, as_json=False)
     except OSError as error:  # the view's port
         print(f"replay: {error}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("\n[replay] interrupted", file=sys.stderr, flush=True)
-        return 130
 
 
 def recording(args: argparse.Namespace) -> Recording:

@@ -29,6 +29,7 @@ from messages.topics import Topic, check_namespace, topics_matching
 from outputs.stdout import emit, json_text
 from parsimony.commands.launch import positive_seconds
 from parsimony.commands.layout import write_layout
+from parsimony.stop_signals import STOP_SIGNALS, stop_signals
 from parsimony.target_options import exit_code
 from profiles.profile import Profile, ProfileError, load_profile
 from scenes.foxglove_views import Viewer
@@ -97,10 +98,6 @@ NICE = 10
 take the CPU first, and the view falls behind and sheds rather than slow them."""
 
 
-def _interrupt(signum: int, frame: object) -> None:
-    raise KeyboardInterrupt
-
-
 def run(args: argparse.Namespace) -> int:
     try:
         profile = watched_profile(load_profile(args.profile), args.namespace)
@@ -114,25 +111,21 @@ def run(args: argparse.Namespace) -> int:
         return 2
     target = Target(profile.namespace, profile.zenoh)
     os.nice(args.nice)
-    previous = signal.signal(signal.SIGTERM, _interrupt)
-    if args.duration is not None:
-        signal.signal(signal.SIGALRM, _interrupt)
-        signal.setitimer(signal.ITIMER_REAL, args.duration)
-    try:
-        with (
-            target.open() as session,
-            serving(session, profile, chosen, args.port, robot) as (view, station),
-        ):
-            return _serve(view, station, args.json)
-    except (QueryError, OSError) as error:
-        print(f"view: {error}", file=sys.stderr)
-        return exit_code(error)
-    except KeyboardInterrupt:
-        pass  # before the server was up
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGTERM, previous)
-    return 0
+    with stop_signals((*STOP_SIGNALS, signal.SIGALRM)) as stop:
+        if args.duration is not None:
+            signal.setitimer(signal.ITIMER_REAL, args.duration)
+        try:
+            with (
+                target.open() as session,
+                serving(session, profile, chosen, args.port, robot) as (view, station),
+            ):
+                stop.wait()
+                return stopped(view, station, args.json)
+        except (QueryError, OSError) as error:
+            print(f"view: {error}", file=sys.stderr)
+            return exit_code(error)
+        finally:
+            signal.setitimer(signal.ITIMER_REAL, 0)
 
 
 def watched_profile(profile: Profile, namespace: str | None) -> Profile:
@@ -180,16 +173,6 @@ def serving(
             yield view, station
     finally:
         station.close()
-
-
-def _serve(view: LiveView, station: ControlStation, as_json: bool) -> int:
-    """Serve until interrupted, then say what the view did (``stopped``)."""
-    try:
-        while True:
-            signal.pause()
-    except KeyboardInterrupt:
-        pass
-    return stopped(view, station, as_json)
 
 
 def stopped(view: LiveView, station: ControlStation, as_json: bool) -> int:
