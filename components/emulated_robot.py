@@ -1,6 +1,7 @@
 """The simulator with its robot behind serial devices: an emulated Create 2 and an emulated
-chain of AX-18A servos, one per joint of the robot's arm (placed as its description's
-``servos:`` say), each on a pseudo-terminal, moving the simulated world.
+chain of Dynamixel servos, one per joint of the robot's arm (placed as its description's
+``servos:`` say; AX-18A on protocol 1.0, or X-series on protocol 2.0 with ``servo_protocol:
+2``), each on a pseudo-terminal, moving the simulated world.
 
 Everything of ``components.simulator`` but the sensor topics: the world, the ceiling camera,
 ``sim/clock`` and ``sim/truth``. The base and arm drivers open the emulators' ports (at the
@@ -25,6 +26,7 @@ from components.simulator import Simulator
 from messages import topics
 from sim2d.devices.ax_servos import AXChainEmulator
 from sim2d.devices.create2 import Create2Emulator
+from sim2d.devices.x_servos import XChainEmulator
 from sim2d.world import World
 from wbc.servo_map import ServoMap
 
@@ -70,6 +72,14 @@ class EmulatedRobot(Simulator):
         *(p for p in Simulator.params if p.name != "command_timeout_s"),
         Param("create_link", str, "/tmp/parsimony/create2", doc="link to the Create's port"),
         Param("servo_link", str, "/tmp/parsimony/servos", doc="link to the servos' port"),
+        Param(
+            "servo_protocol",
+            int,
+            1,
+            low=1,
+            high=2,
+            doc="the servos' Dynamixel protocol: 1 (AX-18A) or 2 (X-series)",
+        ),
     )
 
     def __init__(self, node: Node) -> None:
@@ -93,7 +103,8 @@ class EmulatedRobot(Simulator):
         for link in links:
             link.parent.mkdir(parents=True, exist_ok=True)
         self.create = Create2Emulator(self.devices, links[0])
-        self.servos = AXChainEmulator(self.devices, servos.ids, link=links[1])
+        chain = XChainEmulator if node.params["servo_protocol"] == 2 else AXChainEmulator
+        self.servos = chain(self.devices, servos.ids, link=links[1])
         self.create.start()
         self.servos.start()
         for name in ("create_bad_bytes", "servo_bad_checksums"):

@@ -169,6 +169,18 @@ class XBus(ServoBus):
             if self.port.isPacketTimeout():
                 return bytes(buffer)
 
+    def _answer(self, servo: int) -> bytes:
+        """``servo``'s answer. A whole status packet of another servo (a late answer to an
+        earlier read) is passed over, as the SDK's txRxPacket does; it is the answer only when
+        nothing follows it before the timeout (``WRONG_ID``)."""
+        answer = self._receive()
+        while dxl2.status_fault(answer, servo, self.read_bytes) is StatusFault.WRONG_ID:
+            following = self._receive()
+            if not following:
+                return answer
+            answer = following
+        return answer
+
     def read(self, servo: int) -> tuple[tuple[int, float] | None, StatusFault | None, int]:
         """One servo's Present Position (units) and Present Velocity (rad/s), or what is wrong
         with its answer; and the answer's error byte."""
@@ -178,7 +190,7 @@ class XBus(ServoBus):
         answer = b""
         if result == COMM_SUCCESS:
             self._await()
-            answer = self._receive()
+            answer = self._answer(servo)
             self.port.is_using = False
         fault = dxl2.status_fault(answer, servo, self.read_bytes)
         if fault is not None:
