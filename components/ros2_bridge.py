@@ -103,8 +103,10 @@ class Ros2Bridge(Component):
             node.counters[f"refused.{kind}"] = 0
         node.counters |= {"refused_states": 0, "goals_passed": 0}
         self.last_refusal = ""
-        self.frames: dict[str, np.ndarray] = {WORLD: np.eye(4)}
+        self.latest: RobotState | None = None
+        """The latest valid state: the TF tree's frames are its (``tree``)."""
         self.state: RobotState | None = None
+        """The latest state published (/odom's twist is from it)."""
         self.goal: Goal | None = None
         self.controller: ControllerDiagnostics | None = None
         self.supervisor: SupervisorStatus | None = None
@@ -149,23 +151,29 @@ class Ros2Bridge(Component):
         setattr(self, attribute, now + round(1e9 / rate_hz))
         return True
 
+    def tf_frames(self) -> dict[str, np.ndarray]:
+        """Every frame of the TF tree as its 4x4 pose in the world: the robot's at the latest
+        state (the world alone without one), the camera's, the goal's."""
+        found = frames(self.latest, self.tree) if self.latest else {WORLD: np.eye(4)}
+        if self.camera_pose is not None:
+            found[made.CAMERA_FRAME] = matrix(self.camera_pose)
+        if self.goal is not None:
+            found[made.GOAL_FRAME] = self._goal_matrix(self.goal)
+        return found
+
     def on_state(self, state: RobotState) -> None:
-        """Keep the tree's frames; publish the state's topics when due."""
+        """Keep the state; publish its topics when due."""
         names = self.robot.joint_names
         if not joints_match(self.node, "refused_states", "robot/state", state.joint_names, names):
             return
         if not state.valid:
             return
-        self.frames = frames(state, self.tree)
-        if self.camera_pose is not None:
-            self.frames[made.CAMERA_FRAME] = matrix(self.camera_pose)
-        if self.goal is not None:
-            self.frames[made.GOAL_FRAME] = self._goal_matrix(self.goal)
+        self.latest = state
         if self._due("_next_state_ns", float(self.node.params["max_rate_hz"])):
             stamp = state.header.stamp_ns
             tf = tf_message(state, self.tree)
-            if made.GOAL_FRAME in self.frames:
-                goal = self.frames[made.GOAL_FRAME]
+            if self.goal is not None:
+                goal = self._goal_matrix(self.goal)
                 tf.transforms.append(transform_stamped(stamp, WORLD, made.GOAL_FRAME, goal))
             self.out[JOINT_STATES].put(joint_state(state, names))
             self.out[TF].put(tf)
@@ -252,7 +260,7 @@ class Ros2Bridge(Component):
             if key != self.goal_key:
                 got = "/".join(key.split("/")[-2:])[:160]
                 raise Refused("type_hash", f"{got} is not {self.goal_key.split('/', 2)[2]}")
-            goal = goal_of(data, self.frames, self.node.header("world"))
+            goal = goal_of(data, self.tf_frames(), self.node.header("world"))
         except Refused as refused:
             self.refuse(refused.kind, str(refused))
             return

@@ -6,6 +6,7 @@ world, its twist in base_footprint from the state before)."""
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 
@@ -35,8 +36,14 @@ def header(stamp_ns: int, frame: str):
     return types["std_msgs/msg/Header"](stamp=stamp, frame_id=frame)
 
 
+@lru_cache(maxsize=1024)
+def _unit_quaternion(rotation: bytes) -> tuple[float, ...]:
+    """(w, x, y, z) of a rotation matrix's bytes (a fixed joint's come again with every state)."""
+    return tuple(float(v) for v in dq.quaternion_of_matrix(np.frombuffer(rotation).reshape(3, 3)))
+
+
 def _quaternion(rotation: Array):
-    w, x, y, z = dq.quaternion_of_matrix(rotation)
+    w, x, y, z = _unit_quaternion(np.ascontiguousarray(rotation, dtype=np.float64).tobytes())
     return _types()["geometry_msgs/msg/Quaternion"](x=x, y=y, z=z, w=w)
 
 
