@@ -4,8 +4,10 @@ Run as ``python -m studies.bench.serial_devices [--json]``. On the AX-18A chain 
 (return delay 500 us, the servos' default), with ROBOTIS's dynamixel-sdk: one servo's
 present position and speed (a 4-byte read), the Sync Write of a goal and speed per servo of
 Little John's five (its description's ``servos``), and the joint-state rate one read per servo
-allows. On the Create 2 emulator, with pyserial: a Drive
-Direct written until the wheels take it, and the mean period of the encoder stream.
+allows. On the X-series chain emulator (protocol 2.0), the same for the OpenManipulator-X's
+four servos (Present Velocity and Position, 8 bytes; Profile Velocity and Goal Position), and
+one Sync Read of all four. On the Create 2 emulator, with pyserial: a Drive Direct written
+until the wheels take it, and the mean period of the encoder stream.
 """
 
 from __future__ import annotations
@@ -17,15 +19,17 @@ from collections.abc import Sequence
 
 import numpy as np
 import serial
-from dynamixel_sdk import COMM_SUCCESS, GroupSyncWrite, PacketHandler, PortHandler
+from dynamixel_sdk import COMM_SUCCESS, GroupSyncRead, GroupSyncWrite, PacketHandler, PortHandler
 
 from components.servo_bus import open_port
 from outputs.stdout import emit, json_text, result_only_stdout
 from profiles.deploy_files import ROBOT_FILE
 from protocols import create_oi
 from protocols import dynamixel_v1 as dxl
+from protocols import dynamixel_v2 as dxl2
 from sim2d.devices.ax_servos import AXChainEmulator
 from sim2d.devices.create2 import Create2Emulator
+from sim2d.devices.x_servos import XChainEmulator
 from wbc.servo_map import ServoMap
 
 SAMPLES = 300
@@ -36,6 +40,14 @@ SERVOS = ServoMap.of(ROBOT_FILE, 5).ids
 class StillArm:
     def joint_positions(self) -> Sequence[float]:
         return (0.0, -0.2, 0.2, 0.0, 0.5)
+
+    def set_joint_velocities(self, velocities: Sequence[float]) -> None:
+        pass
+
+
+class StillOMX:
+    def joint_positions(self) -> Sequence[float]:
+        return (0.0, -0.2, 0.2, 0.5)
 
     def set_joint_velocities(self, velocities: Sequence[float]) -> None:
         pass
@@ -88,6 +100,44 @@ def servo_bus() -> dict:
     }
 
 
+def x_servo_bus() -> dict:
+    """The X-series chain of four, protocol 2.0: one read, one Sync Read of all, one Sync
+    Write of all, per sample."""
+    ids = (1, 2, 3, 4)
+    with XChainEmulator(StillOMX(), ids) as chain:
+        port, packet = PortHandler(chain.port), PacketHandler(2.0)
+        open_port(port, 1_000_000)
+        reads, sync_reads, writes = [], [], []
+        group = GroupSyncRead(port, packet, dxl2.Address.PRESENT_VELOCITY, 8)
+        for servo_id in ids:
+            group.addParam(servo_id)
+        for index in range(SAMPLES):
+            start = time.perf_counter()
+            _, result, _ = packet.readTxRx(
+                port, ids[index % len(ids)], dxl2.Address.PRESENT_VELOCITY, 8
+            )
+            reads.append((time.perf_counter() - start) * 1e6)
+            start = time.perf_counter()
+            result = result or group.txRxPacket()
+            sync_reads.append((time.perf_counter() - start) * 1e6)
+            if result != COMM_SUCCESS:
+                raise RuntimeError(packet.getTxRxResult(result))
+            writer = GroupSyncWrite(port, packet, dxl2.Address.PROFILE_VELOCITY, 8)
+            for servo_id in ids:
+                writer.addParam(servo_id, [*dxl2.value(100, 4), *dxl2.value(2048, 4)])
+            start = time.perf_counter()
+            writer.txPacket()
+            writes.append((time.perf_counter() - start) * 1e6)
+        port.closePort()
+    cycle_us = len(ids) * float(np.median(reads)) + float(np.median(writes))
+    return {
+        "read_one_servo": figures(reads),
+        "sync_read_four": figures(sync_reads),
+        "sync_write_four": figures(writes),
+        "joint_state_rate_hz": round(1e6 / cycle_us, 1),
+    }
+
+
 def create_link() -> dict:
     wheels = Wheels()
     with Create2Emulator(wheels) as create:
@@ -117,13 +167,18 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--json", action="store_true", help="print JSON instead of lines")
     args = parser.parse_args(argv)
-    report = {"bench": "serial_devices", "servos": servo_bus(), "create": create_link()}
+    report = {
+        "bench": "serial_devices",
+        "servos": servo_bus(),
+        "x_servos": x_servo_bus(),
+        "create": create_link(),
+    }
     if args.json:
         emit(json_text(report))
     else:
-        for device in ("servos", "create"):
+        for device in ("servos", "x_servos", "create"):
             for name, value in report[device].items():
-                emit(f"{device:7} {name:24} {value}")
+                emit(f"{device:8} {name:24} {value}")
     return 0
 
 
