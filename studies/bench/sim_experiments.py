@@ -1,67 +1,37 @@
-"""The chapter 6 experiments on the whole simulated loop, over many seeds, and the loop's speed.
+"""The speed of the simulated loop's camera stages per frame, in this process.
 
-Run as ``python -m studies.bench.sim_experiments [--seeds N] [--workers W] [--json]``. For each
-experiment and law it runs ``parsimony experiment`` in lockstep, recorder on, for seeds
-0..N-1, W at a time (each system in its own process, namespace and router port), and prints the
-share that converged, contacts, the worst estimator error in steady state, the real-time factor
-(simulated over wall seconds, on this machine, with the other workers running), the cost of
-each stage (the handlers' median times, the simulator's frame answer and state-to-command
-times), the recorder's CPU per simulated second (its share of one core in real time) and the
-recording's bytes per simulated second; then experiments per minute over the whole study.
-Last, the speed of the camera's parts per frame in this process, on the scene of
-``deploy/sim.yaml``: render, JPEG encode and decode, marker detection and pose fits.
+Run as ``python -m studies.bench.sim_experiments [--json]``: on the scene of ``deploy/sim.yaml``,
+render, JPEG encode and decode, marker detection and pose fits, median and p99 over FRAMES
+frames. The chapter 6 experiments over many seeds on the whole simulated loop (the share that
+converged, contacts, estimator errors, real-time factors, each stage's handler times, the
+recorder's cost) are a study: ``parsimony study studies/files/sim-experiments.yaml``, whose
+progress says the experiments per minute.
 """
 
 from __future__ import annotations
 
 import argparse
-import os
-import statistics
 import sys
-import tempfile
 import time
-from concurrent.futures import ProcessPoolExecutor
-from pathlib import Path
 
 import numpy as np
 
 from launch.query import QueryError
-from outputs.stdout import emit, json_text, result_only_stdout, table
+from outputs.stdout import emit, json_text, result_only_stdout
 from profiles.profile import ProfileError, load_profile
 from sim2d.camera import ImageNoise, PlacedMarker, Renderer, ceiling_camera
-from sim2d.scenarios import NAMES, scenario
-from studies.experiment import PROFILES, SUPERVISED, Options, run_experiment
+from sim2d.scenarios import scenario
+from studies.experiment import PROFILES, Options, run_experiment
 from vision.images import grey, jpeg
 from vision.markers import Intrinsics, MarkerDetector, plane_of, plane_pose, square_pose
 from wbc.planar import planar_pose
 from wbc.robot import MobileManipulator
 
-RUNS = [(name, "lp") for name in NAMES] + [
-    (name, "cascade") for name in NAMES if name not in SUPERVISED
-]
-"""Every experiment with each law; the cascade cannot follow the supervisor's drive tasks."""
 FRAMES = 200
 
 
 def percentile(values: list[float], q: float) -> float:
     return round(float(np.percentile(values, q)), 1)
-
-
-def run_one(name: str, controller: str, seed: int, directory: Path) -> dict | None:
-    """One lockstep run (in a worker process: its pid names the system's namespace); None
-    when it could not run (said, with why)."""
-    options = Options(
-        name=name, controller=controller, seed=seed, out=directory / f"{name}-{controller}-{seed}"
-    )
-    report = experiment_or_none(options, f"{name} {controller} seed {seed}")
-    if report is not None:
-        print(
-            f"[bench] {name} {controller} seed {seed}: converged={report['converged']} "
-            f"rtf={report['real_time_factor']}",
-            file=sys.stderr,
-            flush=True,
-        )
-    return report
 
 
 def experiment_or_none(options: Options, label: str) -> dict | None:
@@ -72,45 +42,6 @@ def experiment_or_none(options: Options, label: str) -> dict | None:
     except (OSError, RuntimeError, QueryError, ProfileError) as error:
         print(f"[bench] {label}: did not run: {error}", file=sys.stderr, flush=True)
         return None
-
-
-def median_of(reports: list[dict], component: str, counter: str) -> int:
-    return round(
-        statistics.median(r["durations_us"].get(component, {}).get(counter, 0) for r in reports)
-    )
-
-
-def summary(name: str, controller: str, found: list[dict | None]) -> dict:
-    """Every seed of one experiment and law, summarised (those that could not run counted)."""
-    reports = [r for r in found if r is not None]
-    estimator = [r["estimator_error"] for r in reports if r["estimator_error"]["samples"]]
-    # The recorder's CPU per simulated second: its share of one core in real time (30 Hz).
-    recorder = [r["cpu_s"].get("recorder", 0.0) / r["sim_time_s"] for r in reports]
-    return {
-        "experiment": name,
-        "law": controller,
-        "runs": len(reports),
-        "did_not_run": len(found) - len(reports),
-        "converged": sum(r["converged"] for r in reports),
-        "with_contact": sum(r["contacts"] > 0 for r in reports),
-        "at_joint_stops": sum(r["joint_limit_violations"] > 0 for r in reports),
-        "estimator_position_mm": round(max(e["position_m"] for e in estimator) * 1e3, 2),
-        "estimator_angle_deg": round(float(np.degrees(max(e["angle_rad"] for e in estimator))), 2),
-        "real_time_factor": round(statistics.median(r["real_time_factor"] for r in reports), 2),
-        "rtf_min": round(min(r["real_time_factor"] for r in reports), 2),
-        "tracker_frame_us": median_of(reports, "vision_tracker", "handler.camera/image_us_median"),
-        "estimator_odometry_us": median_of(
-            reports, "state_estimator", "handler.base/odometry_us_median"
-        ),
-        "controller_state_us": median_of(reports, "controller", "handler.robot/state_us_median"),
-        "frame_answer_us": median_of(reports, "simulator", "frame_us_median"),
-        "loop_us": median_of(reports, "simulator", "loop_us_median"),
-        "recorder_cpu_pct_rt": round(100 * statistics.median(recorder), 1),
-        "bytes_per_sim_s": round(
-            statistics.median(r["recording"]["bytes_per_sim_s"] for r in reports)
-        ),
-        "recordings_whole": sum(r["recording"]["whole"] for r in reports),
-    }
 
 
 def vision_speed() -> dict:
@@ -165,49 +96,12 @@ def vision_speed() -> dict:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--seeds", type=int, default=20, help="seeds per experiment and law")
-    parser.add_argument(
-        "--workers",
-        type=int,
-        default=max(1, (os.cpu_count() or 2) // 2),
-        help="experiments run at once (default: one per two cores)",
-    )
-    parser.add_argument("--only", help="comma-separated experiments to run (default: all)")
-    parser.add_argument("--laws", default="lp,cascade", help="comma-separated laws to run")
-    parser.add_argument("--json", action="store_true", help="print JSON instead of tables")
+    parser.add_argument("--json", action="store_true", help="print JSON instead of a line")
     args = parser.parse_args(argv)
-    runs = [
-        (n, law)
-        for n, law in RUNS
-        if (not args.only or n in args.only.split(",")) and law in args.laws.split(",")
-    ]
-    started = time.monotonic()
-    with tempfile.TemporaryDirectory() as directory, ProcessPoolExecutor(args.workers) as pool:
-        jobs = {
-            (n, law): [
-                pool.submit(run_one, n, law, seed, Path(directory)) for seed in range(args.seeds)
-            ]
-            for n, law in runs
-        }
-        rows = [
-            summary(n, law, [job.result() for job in found]) for (n, law), found in jobs.items()
-        ]
-    minutes = (time.monotonic() - started) / 60.0
-    study = {
-        "experiments": len(runs) * args.seeds,
-        "workers": args.workers,
-        "experiments_per_minute": round(len(runs) * args.seeds / minutes, 1),
-    }
     speed = vision_speed()
     if args.json:
-        emit(
-            json_text(
-                {"bench": "sim_experiments", "study": study, "experiments": rows, "vision": speed}
-            )
-        )
+        emit(json_text({"bench": "sim_experiments", "vision": speed}))
     else:
-        emit(table(rows))
-        emit(" ".join(f"{k}={v}" for k, v in study.items()))
         emit(
             "per camera frame: "
             + "  ".join(f"{k} median {v['median']} p99 {v['p99']}" for k, v in speed.items())

@@ -31,6 +31,8 @@ class LawSpec(_Strict):
     label: str | None = None
     """Its name in the tables (the law's by default)."""
     gains: dict[str, Gain | list[Gain]] = Field(default_factory=dict)
+    only: list[str] = []
+    """The families or experiments it runs on (all by default)."""
 
 
 class Table(_Strict):

@@ -60,6 +60,8 @@ def expand(study: Study, directory: Path = Path("."), runs_dir: Path = Path("run
         path = _robot(robot, directory)
         check_place(study.loop, place)
         for seed, spec in itertools.product(study.seeds, study.laws):
+            if spec.only and place not in spec.only:
+                continue
             for label, gains in laws(spec):
                 check_law(study.loop, spec.law, gains, place, path)
                 goals = range(study.goals) if study.loop == "kinematic" else [None]
