@@ -6,7 +6,8 @@ drivers, estimators, controllers, tools; one that waits for others, ``after``, o
 alive), prefixes every line they print with the time and ``[name]``, restarts the ones that
 exit according to their restart policy, reports liveliness changes and each change of a
 component's ``state`` (its status), and on SIGINT, SIGTERM or the end of the duration
-stops them in the reverse order: SIGTERM, then SIGKILL after each one's ``stop_timeout_s``
+(counted from the moment every component is alive, so that a slow start-up does not eat into
+it) stops them in the reverse order: SIGTERM, then SIGKILL after each one's ``stop_timeout_s``
 (for a recorder, which stops last, ``stop_timeout_s`` without progress: it drains its backlog
 however long that takes, and is killed only when it has spent no CPU time for that long).
 
@@ -141,9 +142,12 @@ class Launcher:
         """Components whose liveliness token the router has seen at least once."""
         self._starting_until: float | None = None
         self._duration_s: float | None = None
+        self._deadline: float | None = None
+        """When the duration ends: set once every component is alive."""
 
     def run(self, duration_s: float | None = None) -> int:
-        """Run until a stop signal, the duration, or no component is left; return 0 or 1.
+        """Run until a stop signal, the duration (from the moment every component is alive),
+        or no component is left; return 0 or 1.
 
         Must be called from the main thread (it installs SIGINT and SIGTERM handlers).
         """
@@ -177,7 +181,7 @@ class Launcher:
                     f"(at most {self.profile.startup_timeout_s:g} s)"
                 )
                 threading.Thread(target=self._watch, args=(router,), daemon=True).start()
-                self._supervise(None if duration_s is None else time.monotonic() + duration_s)
+                self._supervise()
             finally:
                 for stop_signal in (signal.SIGINT, signal.SIGTERM):
                     signal.signal(stop_signal, signal.SIG_IGN)
@@ -208,12 +212,12 @@ class Launcher:
                     return  # no loss: the stop's own lines say what becomes of it
         self.output.say(f"{name} {'alive' if alive else 'lost'}")
 
-    def _supervise(self, deadline: float | None) -> None:
-        """Poll the children until a stop is asked, the deadline passes or none is left."""
+    def _supervise(self) -> None:
+        """Poll the children until a stop is asked, the duration ends or none is left."""
         while self._stop_reason is None:
             self._start_ready()
             now = time.monotonic()
-            if deadline is not None and now >= deadline:
+            if self._deadline is not None and now >= self._deadline:
                 self._stop_reason = "end of duration"
                 break
             for child in self.children:
@@ -286,11 +290,10 @@ class Launcher:
             self._fail_startup(f"{', '.join(refused)} failed during start-up", refused)
         elif not waiting:
             self._starting_until = None
-            until = (
-                "Ctrl-C"
-                if self._duration_s is None
-                else f"the end of the {self._duration_s:g} s duration"
-            )
+            until = "Ctrl-C"
+            if self._duration_s is not None:
+                self._deadline = now + self._duration_s
+                until = f"the end of the {self._duration_s:g} s duration"
             self.output.say(f"all {len(self.children)} components alive; running until {until}")
         elif now >= self._starting_until:
             timeout = self.profile.startup_timeout_s
