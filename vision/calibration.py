@@ -51,11 +51,12 @@ class CalibrationRefused(ValueError):
 @dataclass(frozen=True)
 class Board:
     """A ChArUco board: ``squares`` (x, y) chessboard squares of side ``square_m`` with an
-    ArUco marker of side ``marker_m`` from OpenCV's ``dictionary`` in each white one."""
+    ArUco marker of side ``marker_m`` from OpenCV's ``dictionary`` in each white one. The
+    default's squares cover 245 x 175 mm: an A4 or US Letter sheet, landscape."""
 
     squares: tuple[int, int] = (7, 5)
-    square_m: float = 0.04
-    marker_m: float = 0.03
+    square_m: float = 0.035
+    marker_m: float = 0.026
     dictionary: str = "DICT_5X5_100"
 
     def __post_init__(self) -> None:

@@ -1,7 +1,8 @@
-"""`parsimony calibrate camera SOURCE -o FILE`: the ceiling camera's intrinsics from views of a
-ChArUco board (vision.calibration), written as the vision tracker's intrinsics file
-(vision.camera_file). `parsimony calibrate ceiling PROFILE`: where that camera hangs over the
-floor, from the profile's reference marker (vision.camera_pose).
+"""`parsimony calibrate board -o PNG`: a ChArUco board to print. `parsimony calibrate camera
+SOURCE -o FILE`: the ceiling camera's intrinsics from views of it (vision.calibration), written
+as the vision tracker's intrinsics file (vision.camera_file). `parsimony calibrate ceiling
+PROFILE`: where that camera hangs over the floor, from the profile's reference marker
+(vision.camera_pose).
 
 SOURCE is a camera device index (``0``), a video file or a folder of images. Exit 1 when the
 views cannot determine the intrinsics (the reason names the rule), 2 when the source or the
@@ -15,6 +16,8 @@ import sys
 from dataclasses import asdict
 from datetime import UTC, datetime
 from pathlib import Path
+
+import cv2
 
 from outputs.files import writable_output, written_whole
 from outputs.stdout import emit, json_text
@@ -41,6 +44,8 @@ SEEN_FLOOR_TOLERANCE_M = 0.05
 """How far the floor the profile's level camera sees may lie from the one the real camera sees
 before a warning: the supervisor keeps the base's axle a margin inside it (0.17 m on Little
 John: the marker's offset and half diagonal), and 5 cm spends under a third of that."""
+PRINT_MARGIN_M = 0.01
+"""White around the printed board's squares."""
 LEVEL_DEG = 1.0
 """A tilt the warning asks to level the camera from (the profile's camera can only be level)."""
 
@@ -59,34 +64,29 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     camera.add_argument("source", help="device index (0), video file or folder of images")
     camera.add_argument("-o", "--output", type=Path, required=True, help="intrinsics file")
     camera.add_argument("--force", action="store_true", help="write over an existing file")
-    board = Board()
-    across, down = board.squares
+    _board_arguments(camera)
     camera.add_argument(
-        "--squares",
-        type=int,
-        nargs=2,
-        default=board.squares,
-        metavar=("X", "Y"),
-        help=f"the board's squares across and down (default {across} {down})",
+        "--frames", type=_positive, help=f"read at most this many (a device: {DEVICE_FRAMES})"
     )
+    camera.add_argument("--step", type=_positive, default=1, help="use every STEP-th frame")
     camera.add_argument(
-        "--square", type=float, default=board.square_m, help="a square's side, m (default 0.04)"
-    )
-    camera.add_argument(
-        "--marker", type=float, default=board.marker_m, help="a marker's side, m (default 0.03)"
-    )
-    camera.add_argument(
-        "--dictionary", default=board.dictionary, help=f"ArUco dictionary ({board.dictionary})"
-    )
-    camera.add_argument(
-        "--frames", type=int, help=f"read at most this many (a device: {DEVICE_FRAMES})"
-    )
-    camera.add_argument("--step", type=int, default=1, help="use every STEP-th frame")
-    camera.add_argument(
-        "--max-views", type=int, default=40, help="calibrate on at most this many, evenly spread"
+        "--max-views",
+        type=_positive,
+        default=40,
+        help="calibrate on at most this many, evenly spread",
     )
     camera.add_argument("--k3", action="store_true", help="fit k3 too (wide-angle lenses)")
     camera.add_argument("--json", action="store_true", help="print the result as JSON")
+    printed = steps.add_parser(
+        "board",
+        help="the ChArUco board as an image to print",
+        description="Print it at 100 %% scale (no fitting to the page), glue it flat on "
+        "something stiff, and measure a square: give that side with --square.",
+    )
+    printed.add_argument("-o", "--output", type=Path, required=True, help="PNG file")
+    printed.add_argument("--force", action="store_true", help="write over an existing file")
+    printed.add_argument("--dpi", type=_positive, default=300, help="printer dots per inch")
+    _board_arguments(printed)
     ceiling = steps.add_parser(
         "ceiling",
         help="the camera's height and tilt over the floor, from the reference marker",
@@ -100,9 +100,75 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     ceiling.add_argument(
         "--calibration", type=Path, help="intrinsics file (default: the tracker's)"
     )
-    ceiling.add_argument("--frames", type=int, default=30, help="frames to read (default 30)")
+    ceiling.add_argument("--frames", type=_positive, default=30, help="frames to read (default 30)")
     ceiling.add_argument("--json", action="store_true", help="print the result as JSON")
     return parser
+
+
+def _positive(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be 1 or more, got {value}")
+    return value
+
+
+def _board_arguments(parser: argparse.ArgumentParser) -> None:
+    board = Board()
+    across, down = board.squares
+    parser.add_argument(
+        "--squares",
+        type=int,
+        nargs=2,
+        default=board.squares,
+        metavar=("X", "Y"),
+        help=f"the board's squares across and down (default {across} {down})",
+    )
+    parser.add_argument(
+        "--square",
+        type=float,
+        default=board.square_m,
+        help=f"a square's side, m (default {board.square_m})",
+    )
+    parser.add_argument(
+        "--marker",
+        type=float,
+        default=board.marker_m,
+        help=f"a marker's side, m (default {board.marker_m})",
+    )
+    parser.add_argument(
+        "--dictionary", default=board.dictionary, help=f"ArUco dictionary ({board.dictionary})"
+    )
+
+
+def _board(args: argparse.Namespace) -> Board:
+    return Board(tuple(args.squares), args.square, args.marker, args.dictionary)
+
+
+def print_board(args: argparse.Namespace) -> int:
+    """The board's image at ``--dpi``, ``PRINT_MARGIN_M`` of white around it, as a PNG."""
+    why = writable_output(args.output, [], args.force)
+    if why is not None:
+        print(f"calibrate: {why}", file=sys.stderr)
+        return 2
+    try:
+        board = _board(args)
+    except ValueError as error:
+        print(f"calibrate: {error}", file=sys.stderr)
+        return 2
+    dots_per_m = args.dpi / 0.0254
+    square, margin = round(board.square_m * dots_per_m), round(PRINT_MARGIN_M * dots_per_m)
+    x, y = (n * square for n in board.squares)
+    image = board.charuco().generateImage((x + 2 * margin, y + 2 * margin), marginSize=margin)
+    _, png = cv2.imencode(".png", image)
+    with written_whole(args.output) as partial:
+        partial.write_bytes(png.tobytes())
+    width, height = (1e3 * n * square / dots_per_m for n in board.squares)
+    print(
+        f"calibrate: {args.output}: {board.describe()}; printed at {args.dpi} dpi its squares "
+        f"cover {width:.0f} x {height:.0f} mm",
+        file=sys.stderr,
+    )
+    return 0
 
 
 def _views(args: argparse.Namespace, board: Board) -> tuple[list[View], int, tuple[int, int]]:
@@ -154,7 +220,7 @@ def calibrate_camera(args: argparse.Namespace) -> int:
         print(f"calibrate: {why}", file=sys.stderr)
         return 2
     try:
-        board = Board(tuple(args.squares), args.square, args.marker, args.dictionary)
+        board = _board(args)
         views, read, size = _views(args, board)
         result = calibrate(evenly(views, args.max_views), size, k3=args.k3)
     except CalibrationRefused as error:
@@ -189,6 +255,8 @@ def calibrate_camera(args: argparse.Namespace) -> int:
 def run(args: argparse.Namespace) -> int:
     if args.what == "camera":
         return calibrate_camera(args)
+    if args.what == "board":
+        return print_board(args)
     try:
         return calibrate_ceiling(args)
     except (ProfileError, ValueError) as error:  # FrameSourceError, the intrinsics file

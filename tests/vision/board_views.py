@@ -22,7 +22,7 @@ DISTORTION_TRUE = np.array([-0.12, 0.06, 0.0015, -0.001, 0.0])
 """Barrel distortion of a small wide lens: 19 px at the image's corners."""
 BOARD = Board()
 BOARD_PX_PER_M = 1500.0
-"""The board's image: about as fine as it is seen (a 40 mm square is some 60 px at 0.4 m)."""
+"""The board's image: about as fine as it is seen (a 35 mm square is some 53 px at 0.4 m)."""
 PAD_PX = 32
 """The ideal image is drawn this far beyond each edge: barrel distortion pulls it in."""
 SUPERSAMPLE = 2
@@ -37,11 +37,12 @@ class BoardCamera:
 
     def __init__(self, board: Board = BOARD, matrix=K_TRUE, distortion=DISTORTION_TRUE) -> None:
         self.board, self.matrix = board, np.asarray(matrix, float)
-        margin = round(0.25 * board.square_m * BOARD_PX_PER_M)
-        x, y = (round(n * board.square_m * BOARD_PX_PER_M) for n in board.squares)
+        square = round(board.square_m * BOARD_PX_PER_M)  # whole pixels: squares all alike
+        margin = square // 4
+        x, y = (n * square for n in board.squares)
         image = board.charuco().generateImage((x + 2 * margin, y + 2 * margin), marginSize=margin)
         self.image = np.where(image > 127, 235.0, 20.0).astype(np.float32)
-        step = 1.0 / BOARD_PX_PER_M
+        step = board.square_m / square
         self.board_to_plane = np.array(
             [[step, 0.0, (0.5 - margin) * step], [0.0, step, (0.5 - margin) * step], [0, 0, 1]]
         )

@@ -20,6 +20,7 @@ from profiles.profile import load_profile
 from sim2d.camera import ImageNoise, PinholeCamera, PlacedMarker, ceiling_pose, render
 from tests.parsimony.in_process import run_in_process
 from tests.vision.board_views import DISTORTION_TRUE, K_TRUE, SIZE, varied_poses, write_views
+from vision.calibration import Board, BoardDetector
 from wbc import dq
 from wbc.planar import planar_pose
 
@@ -131,7 +132,7 @@ def test_frames_without_the_board_are_refused(tmp_path: Path, capsys) -> None:
         cv2.imwrite(str(folder / f"{i}.png"), np.full((SIZE[1], SIZE[0]), 128, np.uint8))
     code, _, err = calibrate([str(folder), "-o", str(tmp_path / "c.yaml")], capsys)
     assert code == 1
-    assert "refused: no board (7x5 squares of 40 mm" in err and "in the 3 frames read" in err
+    assert "refused: no board (7x5 squares of 35 mm" in err and "in the 3 frames read" in err
 
 
 @pytest.mark.parametrize(
@@ -213,3 +214,15 @@ def test_a_ceiling_without_the_reference_marker_is_refused(tmp_path: Path, capsy
     code, _, err = run_in_process(argv, capsys)
     assert code == 1
     assert "refused: the reference marker (id 0, DICT_4X4_50) is in none of the 1 frames" in err
+
+
+def test_the_board_to_print_is_the_board_calibration_looks_for(tmp_path: Path, capsys) -> None:
+    output = tmp_path / "board.png"
+    code, _, err = run_in_process(["calibrate", "board", "-o", str(output), "--dpi", "100"], capsys)
+    assert code == 0, err
+    assert "its squares cover 245 x 175 mm" in err
+    image = cv2.imread(str(output), cv2.IMREAD_GRAYSCALE)
+    # 245 x 175 mm and 10 mm of white each side, at 100 dots per inch, to a dot or two.
+    assert np.allclose(image.shape, np.array([195, 265]) / 25.4 * 100, atol=2)
+    view = BoardDetector(Board()).detect("printed", image)
+    assert view is not None and len(view.image_points) == 6 * 4
