@@ -142,7 +142,7 @@ class XBus(ServoBus):
         names = []
         if error & ~dxl2.ALERT:
             number = error & ~dxl2.ALERT
-            known = number in dxl2.StatusError._value2member_map_
+            known = number <= max(dxl2.StatusError)
             names.append(dxl2.StatusError(number).name.lower() if known else "result_fail")
         if error & dxl2.ALERT:
             status, result, _ = self.packet.read1ByteTxRx(
@@ -159,7 +159,7 @@ class XBus(ServoBus):
         header = len(dxl2.HEADER)
         while True:
             end = dxl2.packet_end(buffer) if buffer[:header] == dxl2.HEADER else None
-            wanted = (end or 11) - len(buffer)
+            wanted = (end or dxl2.MIN_STATUS_BYTES) - len(buffer)
             if wanted <= 0:
                 return bytes(buffer[:end])
             buffer += self.port.readPort(wanted)

@@ -40,6 +40,8 @@ MAX_PACKET_BYTES = 1024
 _PREFIX = 7
 """Header, id and length: the bytes before the instruction."""
 _MIN_LENGTH = 3
+MIN_STATUS_BYTES = _PREFIX + 4
+"""The shortest status packet: header, id, length, 55, error and CRC."""
 
 
 class Instruction(enum.IntEnum):
@@ -94,6 +96,7 @@ class Address(enum.IntEnum):
     RETURN_DELAY = 9
     """2 us per unit."""
     OPERATING_MODE = 11
+    MOVING_THRESHOLD = 24
     VELOCITY_LIMIT = 44
     MAX_POSITION_LIMIT = 48
     MIN_POSITION_LIMIT = 52
@@ -112,6 +115,7 @@ class Address(enum.IntEnum):
 
 SIZES: dict[Address, int] = {
     Address.MODEL_NUMBER: 2,
+    Address.MOVING_THRESHOLD: 4,
     Address.VELOCITY_LIMIT: 4,
     Address.MAX_POSITION_LIMIT: 4,
     Address.MIN_POSITION_LIMIT: 4,
@@ -305,7 +309,7 @@ def status_fault(answer: bytes, servo_id: int, params: int) -> StatusFault | Non
     servo's whole status packet with a good CRC."""
     if not answer:
         return StatusFault.SILENT
-    if len(answer) < _PREFIX + 4 or answer[:4] != HEADER:
+    if len(answer) < MIN_STATUS_BYTES or answer[:4] != HEADER:
         return StatusFault.TRUNCATED
     end = _PREFIX + int.from_bytes(answer[5:7], "little")
     if len(answer) < end:

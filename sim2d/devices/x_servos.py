@@ -51,7 +51,7 @@ _DEFAULTS: dict[Address | int, tuple[int, int]] = {
     Address.BAUD_RATE: (1, 1),
     Address.RETURN_DELAY: (250, 1),
     Address.OPERATING_MODE: (OperatingMode.POSITION, 1),
-    24: (10, 4),
+    Address.MOVING_THRESHOLD: (10, 4),
     31: (80, 1),
     32: (160, 2),
     34: (95, 2),
@@ -124,10 +124,10 @@ class XServo:
         self._set(Address.PRESENT_POSITION, round(dxl.position_of_angle(position_rad)))
 
     def sense_speed(self, velocity_rad_s: float) -> None:
-        """Present Velocity, and Moving: faster than the Moving Threshold (24)."""
+        """Present Velocity, and Moving: faster than the Moving Threshold."""
         units = dxl.velocity_units(velocity_rad_s)
         self._set(Address.PRESENT_VELOCITY, units)
-        self.table[Address.MOVING] = abs(units) > int.from_bytes(self.table[24:28], "little")
+        self.table[Address.MOVING] = abs(units) > self.word(Address.MOVING_THRESHOLD)
 
     def velocity_command(self, position_rad: float, dt: float) -> float:
         """Towards Goal Position at Profile Velocity (0: the limit), landing on it, or at Goal
@@ -209,7 +209,8 @@ class XServo:
             data = table[address : address + 4]
             return int.from_bytes(data, "little", signed=address in dxl.SIGNED)
 
-        if Address.GOAL_POSITION in span and table[Address.OPERATING_MODE] == 3:
+        position_mode = table[Address.OPERATING_MODE] == OperatingMode.POSITION
+        if Address.GOAL_POSITION in span and position_mode:
             goal = entry(Address.GOAL_POSITION)
             if not entry(Address.MIN_POSITION_LIMIT) <= goal <= entry(Address.MAX_POSITION_LIMIT):
                 return True
