@@ -73,12 +73,18 @@ def summarise(
     active: tuple[str, ...],
     error: Array,
     start: float,
+    owned: bool = False,
 ) -> LawOutput:
-    """Freeze u and count its nonzero entries (section 5.7) and practical ones (6.2.1)."""
-    u = np.array(u, dtype=float)
+    """Freeze u and count its nonzero entries (section 5.7) and practical ones (6.2.1).
+
+    ``owned``: u is a new float array no one else holds (the LP's), frozen in place, not copied.
+    """
+    if not owned:
+        u = np.array(u, dtype=float)
     u.flags.writeable = False
     magnitude = np.abs(u)
-    return LawOutput(
+    output = object.__new__(LawOutput)  # the frozen dataclass, its fields set at once
+    output.__dict__.update(
         u=u,
         status=status,
         objective=objective,
@@ -88,3 +94,4 @@ def summarise(
         solve_time_s=time.perf_counter() - start,
         error_norm=math.sqrt(float(error @ error)),
     )
+    return output

@@ -33,7 +33,9 @@ optimal basis, so the dual simplex starts from the previous vertex (usually 0 to
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import operator
+from collections.abc import Callable, Sequence
+from typing import NamedTuple
 
 import highspy
 import numpy as np
@@ -58,10 +60,10 @@ the default and 208 us with threads 1, the two laws stepping in turn on one traj
 loaded 2-core machine."""
 
 
-@dataclass(frozen=True)
-class LPSolution:
+class LPSolution(NamedTuple):
     """What one solve gives: u (zeros unless optimal), the split u = u_P - u_N, the status,
-    the objective and the names of the active constraints."""
+    the objective and the names of the active constraints (a named tuple: built at every
+    step in a fraction of the time of a frozen dataclass)."""
 
     u: Array
     status: str
@@ -112,10 +114,20 @@ class _Layout:
         starts = np.cumsum([0, *residual_rows]).tolist()
         self._slices = [slice(a, b) for a, b in zip(starts, starts[1:], strict=False)]
         self._weights: list[float] = []
-        self.stacked = np.zeros((self.varying_rows, n))
-        """A_b and A of the varying rows, stacked."""
         self.col_lower = np.zeros(self.columns)
         self.col_upper = np.full(self.columns, INF)
+        # Views of the buffers each step writes, made once for the shape.
+        static = self.static_rows
+        self.u_lower, self.u_upper = self.lower[:n], self.upper[:n]
+        self.plus, self.minus = self.varying[:, :n], self.varying[:, n : 2 * n]
+        self.residual_plus = self.plus[:residual_total]
+        """A_b of every residual cost, stacked (rows of ``plus``)."""
+        self.residual_upper = self.upper[static : static + residual_total]
+        self.linear_lower = self.lower[static + residual_total :]
+        self.linear_upper = self.upper[static + residual_total :]
+        self.cost_positive, self.cost_negative = self.cost[:n], self.cost[n : 2 * n]
+        self.filled = [i for i, count in enumerate(counts[residual_count:]) if count]
+        """The linear row sets that hold rows (by their place among the linear ones)."""
 
     def weigh(self, weights: list[float]) -> None:
         """Set ``row_weight`` from the weight of each residual cost (kept while they hold)."""
@@ -142,6 +154,7 @@ class WarmStartedLP:
         self._costs: list[VelocityCost] = []
         self._cost_key: tuple[int, ...] = ()
         self._cost_sums: tuple[Array, Array] = (np.zeros(0), np.zeros(0))
+        self._kinds = _Kinds(())
 
     def reset(self) -> None:
         """Forget the previous basis: the next solve starts cold."""
@@ -149,28 +162,15 @@ class WarmStartedLP:
 
     def solve(self, costs: list[Cost], rows: list[Rows]) -> LPSolution:
         """Minimise the sum of ``costs`` over u subject to ``rows`` (5.29)."""
-        residuals: list[ResidualCost] = []
-        velocity_costs: list[VelocityCost] = []
-        linear: list[LinearRows] = []
-        norms: list[OneNormBound] = []
-        bounds: list[VelocityBounds] = []
-        for item in (*costs, *rows):
-            if isinstance(item, ResidualCost):
-                residuals.append(item)
-            elif isinstance(item, VelocityCost):
-                velocity_costs.append(item)
-            elif isinstance(item, LinearRows):
-                linear.append(item)
-            elif isinstance(item, VelocityBounds):
-                bounds.append(item)
-            elif isinstance(item, OneNormBound):
-                norms.append(item)
-            else:
-                raise TypeError(f"not a cost or rows of the LP: {type(item).__name__}")
-        n = residuals[0].matrix.shape[1]
-        stacked = [cost.matrix for cost in residuals] + [rows_.matrix for rows_ in linear]
-        layout = self._layout_for(n, stacked, len(residuals), len(norms))
-        u_lower, u_upper = layout.lower[:n], layout.upper[:n]
+        items = (*costs, *rows)
+        kinds = tuple(map(type, items))
+        if kinds != self._kinds.types:
+            self._kinds = _Kinds(kinds)
+        residuals, velocity_costs, linear, bounds, norms, with_matrix = self._kinds.pick(items)
+        matrices = list(map(_MATRIX, with_matrix))
+        n = matrices[0].shape[1]
+        layout = self._layout_for(n, matrices, len(residuals), len(norms))
+        u_lower, u_upper = layout.u_lower, layout.u_upper
         if len(bounds) == 1:
             u_lower[:], u_upper[:] = bounds[0].lower, bounds[0].upper
         else:
@@ -181,20 +181,21 @@ class WarmStartedLP:
                 np.minimum(u_upper, bound.upper, out=u_upper)
         if np.count_nonzero(u_lower > u_upper):
             return _failed(n, "infeasible")
-        layout.upper[n : layout.static_rows] = [bound.limit for bound in norms]
+        for row, bound in enumerate(norms, n):
+            layout.upper[row] = bound.limit
 
         # The varying rows: [A_b -A_b -I_b] of every residual cost, then [A -A 0] of the rows.
-        residual_rows, static = layout.residual_rows, layout.static_rows
-        matrix = layout.varying
-        np.concatenate(stacked, out=layout.stacked)
-        matrix[:, :n] = layout.stacked
-        matrix[:, n : 2 * n] = -layout.stacked
-        lower, upper = layout.lower[static:], layout.upper[static:]
-        np.concatenate([cost.offset for cost in residuals], out=upper[:residual_rows])
-        np.negative(upper[:residual_rows], out=upper[:residual_rows])
-        _stack([rows_.lower for rows_ in linear], lower[residual_rows:])
-        _stack([rows_.upper for rows_ in linear], upper[residual_rows:])
-        layout.weigh([cost.weight for cost in residuals])
+        np.concatenate(matrices, out=layout.plus)
+        np.negative(layout.plus, out=layout.minus)
+        np.concatenate(list(map(_OFFSET, residuals)), out=layout.residual_upper)
+        np.negative(layout.residual_upper, out=layout.residual_upper)
+        if len(layout.filled) == 1:
+            only = linear[layout.filled[0]]
+            layout.linear_lower[:], layout.linear_upper[:] = only.lower, only.upper
+        elif layout.filled:
+            np.concatenate([linear[i].lower for i in layout.filled], out=layout.linear_lower)
+            np.concatenate([linear[i].upper for i in layout.filled], out=layout.linear_upper)
+        layout.weigh(list(map(_WEIGHT, residuals)))
         positive, negative = self._velocity_costs(velocity_costs, n)
         _fill_costs(layout, positive, negative)
         status, values = self._vertex(layout)
@@ -203,19 +204,19 @@ class WarmStartedLP:
         # With no cost on u_P + u_N (c = 0) a vertex may hold both halves of one u_i positive,
         # the one-norm row tight only through that waste (its dual 0). One degenerate pivot away
         # lies the same u with the halves split canonically; report that one.
-        common = np.minimum(values[:n], values[n : 2 * n])
-        u_positive, u_negative = values[:n] - common, values[n : 2 * n] - common
-        u = u_positive - u_negative
+        halves = values[: 2 * n].reshape(2, n)
+        halves = halves - np.minimum(halves[0], halves[1])
+        u = halves[0] - halves[1]
         # The constant -sum_b w_b 1'b_b; the residual rows' upper bounds hold -b.
-        offsets = -float(layout.row_weight @ upper[:residual_rows])
+        offsets = -float(layout.row_weight @ layout.residual_upper)
         objective = float(layout.cost @ values) - offsets
-        active = _active(u, sum(np.abs(u).tolist()), linear, norms, bounds)
-        return LPSolution(u, status, objective, active, u_positive, u_negative)
+        active = _active(u, linear, norms, bounds)
+        return LPSolution(u, status, objective, active, halves[0], halves[1])
 
     def _velocity_costs(self, costs: list[VelocityCost], n: int) -> tuple[Array, Array]:
         """c_P and c_N, the sums of the velocity costs' weights, kept while the terms return the
         same costs (the same objects, held here so that no other takes their ids) for u of n."""
-        key = (n, *[id(cost) for cost in costs])
+        key = (n, *map(id, costs))
         if key != self._cost_key:
             self._costs, self._cost_key = costs, key
             self._cost_sums = (
@@ -228,7 +229,7 @@ class WarmStartedLP:
         self, n: int, stacked: list[Array], residual_count: int, norm_rows: int
     ) -> _Layout:
         """The layout of this step's shape: the last one while the shape holds."""
-        key = (n, residual_count, [matrix.shape[0] for matrix in stacked], norm_rows)
+        key = (n, residual_count, list(map(len, stacked)), norm_rows)
         if self._layout is None or self._layout.key != key:
             self._build(_Layout(*key))
         assert self._layout is not None
@@ -317,19 +318,47 @@ def _fill_costs(layout: _Layout, positive: Array, negative: Array) -> None:
     """u_P: c_P - sum_b w_b 1'A_b, u_N: c_N + sum_b w_b 1'A_b (rows weighted by w), with c_P
     and c_N the velocity costs of each entry's two directions; y_b's 2 w_b are set with the
     weights (``_Layout.weigh``)."""
-    n, cost = layout.n, layout.cost
-    column_sums = layout.row_weight @ layout.stacked[: layout.residual_rows]
-    np.subtract(positive, column_sums, out=cost[:n])
-    np.add(negative, column_sums, out=cost[n : 2 * n])
+    column_sums = layout.row_weight @ layout.residual_plus
+    np.subtract(positive, column_sums, out=layout.cost_positive)
+    np.add(negative, column_sums, out=layout.cost_negative)
 
 
-def _stack(parts: list[Array], out: Array) -> None:
-    """``parts`` end to end into ``out`` (a single part or none copied without concatenate)."""
-    filled = [part for part in parts if part.size]
-    if len(filled) == 1:
-        out[:] = filled[0]
-    elif filled:
-        np.concatenate(filled, out=out)
+_MATRIX, _OFFSET, _WEIGHT = (operator.attrgetter(name) for name in ("matrix", "offset", "weight"))
+KINDS = (ResidualCost, VelocityCost, LinearRows, VelocityBounds, OneNormBound)
+"""What ``WarmStartedLP.solve`` takes, in the order ``_Kinds.pick`` gives them."""
+
+
+class _Kinds:
+    """Where each kind of cost or rows sits among one step's items, found once for a sequence
+    of types: a step whose terms return the kinds of the last picks them by place.
+
+    ``pick`` gives the residual costs, velocity costs, linear rows, velocity bounds and
+    one-norm bounds, then the residual costs and linear rows together (those with a matrix).
+    """
+
+    def __init__(self, types: tuple[type, ...]) -> None:
+        self.types = types
+        places: list[list[int]] = [[] for _ in KINDS]
+        for place, kind in enumerate(types):
+            group = next((i for i, base in enumerate(KINDS) if issubclass(kind, base)), None)
+            if group is None:
+                raise TypeError(f"not a cost or rows of the LP: {kind.__name__}")
+            places[group].append(place)
+        places.append(places[0] + places[2])
+        self._pickers = [_picker(group) for group in places]
+
+    def pick(self, items: tuple) -> list[tuple]:
+        return [picker(items) for picker in self._pickers]
+
+
+def _picker(places: list[int]) -> Callable[[tuple], tuple]:
+    """The items at ``places``, as a tuple (``operator.itemgetter`` gives one item bare)."""
+    if len(places) > 1:
+        return operator.itemgetter(*places)
+    if places:
+        place = places[0]
+        return lambda items: (items[place],)
+    return lambda items: ()
 
 
 def _failed(n: int, status: str) -> LPSolution:
@@ -339,10 +368,9 @@ def _failed(n: int, status: str) -> LPSolution:
 
 def _active(
     u: Array,
-    split_sum: float,
-    linear: list[LinearRows],
-    norms: list[OneNormBound],
-    bounds: list[VelocityBounds],
+    linear: Sequence[LinearRows],
+    norms: Sequence[OneNormBound],
+    bounds: Sequence[VelocityBounds],
 ) -> tuple[str, ...]:
     """Names of the constraints that hold with equality at the solution.
 
@@ -351,8 +379,10 @@ def _active(
     (named ``name[i]``) when u_i sits on a finite, non-degenerate bound.
     """
     active = [rows.name for rows in linear if rows.engaged and _tight(rows, u)]
-    active += [bound.name for bound in norms if split_sum >= bound.limit - ACTIVE_TOLERANCE]
     values = u.tolist()
+    if norms:
+        split_sum = sum(map(abs, values))  # 1'(u_P + u_N), the halves split canonically
+        active += [bound.name for bound in norms if split_sum >= bound.limit - ACTIVE_TOLERANCE]
     for bound in bounds:
         # An infinite bound is never within the tolerance of u; a degenerate one never counts.
         # On Python floats: the same IEEE arithmetic, and at 8 to 40 entries faster than NumPy.

@@ -101,15 +101,12 @@ def program(
     (``wbc.geometry.obstacles.split``). ``previous_u`` is the u the law gave at its previous step,
     for the terms and rows that read it (``StepContext.previous_u``). The LP and the QP
     (``wbc.laws.qp_law``) solve the same one."""
-    q = require_finite("configuration q", q)
-    dt = float(dt)
-    if not math.isfinite(dt):
-        raise NonFiniteInputError(f"dt must be finite, got {dt}")
-    if dt <= 0.0:
-        raise ValueError(f"dt must be > 0, got {dt}")
-    circles, solids = split(obstacles)  # a solid checked its numbers when it was made
-    for index, obstacle in enumerate(circles):
-        require_finite(f"obstacle {index}", (obstacle.x, obstacle.y, obstacle.radius))
+    q, dt = np.asarray(q, dtype=float), float(dt)
+    # One test for a good q and dt (q'q is finite only if every q_i is, or overflows: then
+    # ``_check`` looks entry by entry); ``_check`` names what is wrong.
+    if q.ndim != 1 or not math.isfinite(q @ q) or not 0.0 < dt < math.inf:
+        _check(q, dt)
+    circles, solids = _obstacles(obstacles) if obstacles else ((), ())
     chain = robot.forward(q)  # one pass for the task and the collision parts' rows
     error, task_jacobian = task.error(chain.pose, chain.jacobian, q)
     if last is not None and same_task(last[0], task):
@@ -127,13 +124,31 @@ def program(
         goal_pose,
         dt,
         solids,
-        previous_u=previous_u,
-        chain=chain,
+        previous_u,
+        chain,
     )
     rows = [constraint.rows(context) for constraint in constraints]  # first: a term may read
     costs = [ResidualCost("task", task_jacobian, eta * error)]  # what a row engaged
     costs += [term.cost(context) for term in objectives]
     return costs, rows, error, (task, error)
+
+
+def _check(q: Array, dt: float) -> None:
+    """``NonFiniteInputError`` for a q or dt not finite, ValueError for dt <= 0."""
+    require_finite("configuration q", q)
+    if not math.isfinite(dt):
+        raise NonFiniteInputError(f"dt must be finite, got {dt}")
+    if dt <= 0.0:
+        raise ValueError(f"dt must be > 0, got {dt}")
+
+
+def _obstacles(obstacles: Sequence[Obstacle]) -> tuple[tuple, tuple]:
+    """The circles and the solids among ``obstacles``, each circle's numbers checked (a solid
+    checked its own when it was made)."""
+    circles, solids = split(obstacles)
+    for index, obstacle in enumerate(circles):
+        require_finite(f"obstacle {index}", (obstacle.x, obstacle.y, obstacle.radius))
+    return circles, solids
 
 
 @dataclass
@@ -206,7 +221,7 @@ class LPLaw:
         )
         solution = self._lp.solve(costs, rows)
         output = summarise(
-            solution.u, solution.status, solution.objective, solution.active, error, start
+            solution.u, solution.status, solution.objective, solution.active, error, start, True
         )
         self._previous_u = output.u
         return output
