@@ -40,6 +40,7 @@ from launch.zenoh_error import zenoh_error_text
 from messages import topics
 from parsimony.commands.launch import positive, positive_seconds
 from parsimony.commands.view import (
+    live,
     namespace_argument,
     port_number,
     serving,
@@ -190,8 +191,8 @@ def played(
     recorded: Recording,
     view: contextlib.AbstractContextManager,
 ) -> int:
-    """The replay on ``session`` (``view``: its live view, or nothing); the view says what it
-    did when the replay ends, whatever ends it."""
+    """The replay on ``session`` (``view``: its live view, or nothing); once the view has said
+    it is live, it says what it did when the replay ends, whatever ends it."""
     playing = Playing(
         args.rate,
         args.start_offset,
@@ -202,9 +203,12 @@ def played(
         args.start_paused,
     )
     try:
-        with view as served, terminal_keys() as keys:
+        with view as served:
             try:
-                return Player(playing, session, namespace, recorded, keys).run()
+                if served is not None:
+                    live(*served)
+                with terminal_keys() as keys:
+                    return Player(playing, session, namespace, recorded, keys).run()
             finally:
                 if served is not None:
                     stopped(*served, as_json=False)

@@ -119,6 +119,7 @@ def run(args: argparse.Namespace) -> int:
                 target.open() as session,
                 serving(session, profile, chosen, args.port, robot) as (view, station),
             ):
+                live(view, station)
                 stop.wait()
                 return stopped(view, station, args.json)
         except (QueryError, OSError) as error:
@@ -142,7 +143,7 @@ def serving(
     robot: MobileManipulator | None,
 ) -> Iterator[tuple[LiveView, ControlStation]]:
     """The live view and control station of ``profile``'s namespace on ``session``, served on
-    127.0.0.1:``port``, said on stderr once live (``parsimony view``'s, ``replay --view``'s)."""
+    127.0.0.1:``port`` (``parsimony view``'s, ``replay --view``'s); ``live`` says so."""
     warnings = RateLimitedLog(logging.getLogger("parsimony.view"))
     station = ControlStation(session, profile)
     try:
@@ -158,21 +159,25 @@ def serving(
             station.encodings,
         ) as view:
             station.attach(view.server)
-            publishing = (
-                "goals from clients on goal/request"
-                if station.may_publish
-                else (f"no publishing: {station.user} may not write goal/request")
-            )
-            setting = "" if station.may_set_any else f", read-only: {station.user} may set none"
-            print(
-                f"view: {profile.namespace} live at {view.address} ({publishing}; the "
-                f"parameters of every running component{setting})",
-                file=sys.stderr,
-                flush=True,
-            )
             yield view, station
     finally:
         station.close()
+
+
+def live(view: LiveView, station: ControlStation) -> None:
+    """Say on stderr where the view is live and what its clients may do."""
+    publishing = (
+        "goals from clients on goal/request"
+        if station.may_publish
+        else (f"no publishing: {station.user} may not write goal/request")
+    )
+    setting = "" if station.may_set_any else f", read-only: {station.user} may set none"
+    print(
+        f"view: {station.namespace} live at {view.address} ({publishing}; the "
+        f"parameters of every running component{setting})",
+        file=sys.stderr,
+        flush=True,
+    )
 
 
 def stopped(view: LiveView, station: ControlStation, as_json: bool) -> int:

@@ -17,7 +17,15 @@ from parsimony.target_options import PROFILE_ENV
 from profiles.endpoints import free_port
 from record.replayer import Recording
 from record.session_file import SessionWriter, from_json
-from tests.view.live_view_client import DEADLINE_S, StderrLines, state, watch, write_profile
+from tests.view.live_view_client import (
+    DEADLINE_S,
+    StderrLines,
+    background_job,
+    state,
+    stopped_by,
+    watch,
+    write_profile,
+)
 
 RECORDED = "rec"
 INTO = "other"
@@ -39,28 +47,22 @@ def watched(address: str, channel: str) -> tuple[int, bytes]:
 
 
 def test_a_replay_with_no_system_serves_its_own_router_and_is_watched_live(tmp_path: Path) -> None:
+    """Both started as a shell's background job (SIGINT ignored), they stop on SIGINT and
+    SIGTERM, and say what they did."""
     profile = write_profile(tmp_path)  # its router's port is free: nothing is running
     states = recording(tmp_path / "k.mcap")
     port = free_port()
-    replay = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "parsimony.cli",
-            "replay",
-            str(tmp_path / "k.mcap"),
-            "--profile",
-            str(profile),
-            "--loop",
-            "--namespace",
-            INTO,
-            "--view",
-            "--port",
-            str(port),
-        ],
-        stdin=subprocess.DEVNULL,
-        stderr=subprocess.PIPE,
-        text=True,
+    replay = background_job(
+        "replay",
+        str(tmp_path / "k.mcap"),
+        "--profile",
+        str(profile),
+        "--loop",
+        "--namespace",
+        INTO,
+        "--view",
+        "--port",
+        str(port),
     )
     said = StderrLines(replay)
     view = None
@@ -72,31 +74,22 @@ def test_a_replay_with_no_system_serves_its_own_router_and_is_watched_live(tmp_p
         log_time, payload = watched(address, channel)
         assert from_json(payload, RobotState) == states[log_time]
         # `parsimony view` of the profile reaches the replay's router, and watches it too.
-        view = subprocess.Popen(
-            [
-                sys.executable,
-                "-m",
-                "parsimony.cli",
-                "view",
-                str(profile),
-                "--namespace",
-                INTO,
-                "--port",
-                "0",
-            ],
-            stderr=subprocess.PIPE,
-            text=True,
-        )
-        line = StderrLines(view).wait_for(" live at ")
+        view = background_job("view", str(profile), "--namespace", INTO, "--port", "0")
+        view_said = StderrLines(view)
+        line = view_said.wait_for(" live at ")
         log_time, payload = watched(line.split(" live at ")[1].split()[0], channel)
         assert from_json(payload, RobotState) == states[log_time]
+        assert stopped_by(view, signal.SIGINT) == 0
+        assert " messages shown, " in view_said.all(), view_said.all()
+        assert stopped_by(replay, signal.SIGTERM) == 143
     finally:
         for process in (view, replay):
-            if process is not None:
-                process.send_signal(signal.SIGINT)
-                process.wait(DEADLINE_S)
-    assert replay.returncode == 130 and "Traceback" not in said.all(), said.all()
-    assert view.returncode == 0
+            if process is not None and process.poll() is None:
+                process.kill()
+    assert "Traceback" not in said.all(), said.all()
+    assert " messages sent (interrupted)\n" in said.all()
+    assert " messages shown, " in said.all()  # what its view did
+    assert said.all().endswith("[replay] interrupted by SIGTERM\n")
 
 
 def test_without_a_profile_a_replay_goes_into_its_recorded_namespace(tmp_path: Path) -> None:

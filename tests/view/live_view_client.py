@@ -1,13 +1,16 @@
 """What the live view's tests and the replay's share: a robot state of a given sequence number, a
-profile on a free loopback port, a process's stderr read as it comes, and a WebSocket client
-that watches channels as the Foxglove app does (subprotocol ``foxglove.sdk.v1``)."""
+profile on a free loopback port, a command run as a shell's background job, a process's stderr
+read as it comes, and a WebSocket client that watches channels as the Foxglove app does
+(subprotocol ``foxglove.sdk.v1``)."""
 
 from __future__ import annotations
 
 import asyncio
 import json
+import signal
 import struct
 import subprocess
+import sys
 import threading
 from pathlib import Path
 from typing import Any
@@ -62,6 +65,32 @@ def write_profile(directory: Path) -> Path:
         )
     )
     return profile
+
+
+def background_job(*words: str) -> subprocess.Popen[str]:
+    """``parsimony WORDS`` started as a shell without job control starts ``cmd &`` (a suite run
+    in the background, ``nohup``): SIGINT and SIGQUIT ignored, which the command inherits; its
+    stderr piped."""
+    return subprocess.Popen(
+        ["sh", "-c", 'trap "" INT QUIT; exec "$@"', "sh"]
+        + [sys.executable, "-m", "parsimony.cli", *words],
+        stdin=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
+def stopped_by(process: subprocess.Popen[str], signum: signal.Signals) -> int:
+    """``process``'s exit code once ``signum`` stopped it; killed, and the test failed, if it
+    did not within ``DEADLINE_S``."""
+    process.send_signal(signum)
+    try:
+        return process.wait(DEADLINE_S)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.wait()
+        stuck = f"{process.args} did not stop within {DEADLINE_S} s of {signum.name}"
+        raise AssertionError(stuck) from None
 
 
 class StderrLines:
