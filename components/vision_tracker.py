@@ -36,6 +36,7 @@ from messages.markers import MarkerDetection, MarkerDetections
 from profiles.scene import Scene
 from vision.camera_file import CameraFile, read_camera_file
 from vision.camera_pose import placement_of
+from vision.frame_source import FrameSourceError, ask_size, open_capture
 from vision.images import grey
 from vision.markers import (
     THRESHOLD_WINDOW_PX,
@@ -209,13 +210,12 @@ class VisionTracker(Component):
         """The capture, asked for the calibration's image size when the file gives one, and
         the calibration's intrinsics."""
         source = str(self.node.params["device"])
-        capture = cv2.VideoCapture(int(source) if source.isdigit() else source)
-        if not capture.isOpened():
-            raise ParamError(f"device: cannot open {source!r}")
+        try:
+            capture = open_capture(source)
+        except FrameSourceError as error:
+            raise ParamError(f"device: cannot open {source!r}") from error
         self.calibration = load_calibration(Path(str(self.node.params["calibration"])))
-        if self.calibration.size is not None and source.isdigit():
-            capture.set(cv2.CAP_PROP_FRAME_WIDTH, self.calibration.size[0])
-            capture.set(cv2.CAP_PROP_FRAME_HEIGHT, self.calibration.size[1])
+        ask_size(capture, source, self.calibration.size)
         return capture, self.calibration.intrinsics
 
     def _read_device(self) -> None:

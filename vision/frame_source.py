@@ -20,10 +20,30 @@ def _grey(image: np.ndarray) -> np.ndarray:
     return cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image
 
 
-def frames(source: str, limit: int, step: int = 1) -> Iterator[tuple[str, np.ndarray]]:
+def open_capture(source: str) -> cv2.VideoCapture:
+    """``cv2.VideoCapture`` of a device index (``0``) or of anything it opens (a video file, a
+    URL); ``FrameSourceError`` when it does not open."""
+    capture = cv2.VideoCapture(int(source) if source.isdigit() else source)
+    if not capture.isOpened():
+        capture.release()
+        raise FrameSourceError(f"{source}: cannot open it as a camera or a video")
+    return capture
+
+
+def ask_size(capture: cv2.VideoCapture, source: str, size: tuple[int, int] | None) -> None:
+    """Ask a device for images of ``size`` (width, height); a file's size is its own."""
+    if size is not None and source.isdigit():
+        capture.set(cv2.CAP_PROP_FRAME_WIDTH, size[0])
+        capture.set(cv2.CAP_PROP_FRAME_HEIGHT, size[1])
+
+
+def frames(
+    source: str, limit: int, step: int = 1, size: tuple[int, int] | None = None
+) -> Iterator[tuple[str, np.ndarray]]:
     """(name, grey image) of every ``step``-th frame, at most ``limit`` of them: ``source`` is a
-    device index (``0``), a folder of images (read in name order; one that does not decode is
-    ``FrameSourceError``) or anything ``cv2.VideoCapture`` opens (a video file, a URL)."""
+    device index (``0``, asked for images of ``size`` (width, height) when given), a folder of
+    images (read in name order; one that does not decode is ``FrameSourceError``) or anything
+    ``cv2.VideoCapture`` opens (a video file, a URL)."""
     path = Path(source)
     if path.is_dir():
         files = sorted(p for p in path.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES)
@@ -37,10 +57,9 @@ def frames(source: str, limit: int, step: int = 1) -> Iterator[tuple[str, np.nda
         return
     if not source.isdigit() and not path.exists() and "://" not in source:
         raise FrameSourceError(f"{source}: no such device, file or folder")
-    capture = cv2.VideoCapture(int(source) if source.isdigit() else source)
+    capture = open_capture(source)
     try:
-        if not capture.isOpened():
-            raise FrameSourceError(f"{source}: cannot open it as a camera or a video")
+        ask_size(capture, source, size)
         taken = read = 0
         while taken < limit:
             ok, image = capture.read()

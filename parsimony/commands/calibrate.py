@@ -70,6 +70,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     )
     camera.add_argument("--step", type=_positive, default=1, help="use every STEP-th frame")
     camera.add_argument(
+        "--size",
+        type=_positive,
+        nargs=2,
+        metavar=("WIDTH", "HEIGHT"),
+        help="ask a device for images of this size (calibrate at the size the tracker will use)",
+    )
+    camera.add_argument(
         "--max-views",
         type=_positive,
         default=40,
@@ -176,7 +183,7 @@ def _views(args: argparse.Namespace, board: Board) -> tuple[list[View], int, tup
     detector = BoardDetector(board)
     limit = args.frames or (DEVICE_FRAMES if args.source.isdigit() else sys.maxsize)
     views, read, size = [], 0, None
-    for name, image in frames(args.source, limit, args.step):
+    for name, image in frames(args.source, limit, args.step, args.size):
         read += 1
         shape = (image.shape[1], image.shape[0])
         if size is None:
@@ -287,7 +294,7 @@ def calibrate_ceiling(args: argparse.Namespace) -> int:
     source, camera = _camera_of(args, profile)
     detector = MarkerDetector(scene.dictionary_id)
     seen, read, size = [], 0, None
-    for _, image in frames(source, args.frames):
+    for _, image in frames(source, args.frames, size=camera.size):
         read, size = read + 1, (image.shape[1], image.shape[0])
         seen += [d for d in detector.detect(image) if d.id == scene.reference.id]
     mismatch = camera.size_mismatch(*size)
