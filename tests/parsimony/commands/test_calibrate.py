@@ -226,3 +226,22 @@ def test_the_board_to_print_is_the_board_calibration_looks_for(tmp_path: Path, c
     assert np.allclose(image.shape, np.array([195, 265]) / 25.4 * 100, atol=2)
     view = BoardDetector(Board()).detect("printed", image)
     assert view is not None and len(view.image_points) == 6 * 4
+
+
+def test_a_video_of_the_board_calibrates_as_its_frames_do(
+    views: Path, tmp_path: Path, capsys
+) -> None:
+    """The same views as an MJPG video, read through ``cv2.VideoCapture``, every frame."""
+    video = tmp_path / "board.avi"
+    fourcc = cv2.VideoWriter_fourcc(*"MJPG")
+    writer = cv2.VideoWriter(str(video), fourcc, 30.0, SIZE, isColor=False)
+    for image in sorted(views.iterdir()):
+        writer.write(cv2.imread(str(image), cv2.IMREAD_GRAYSCALE))
+    writer.release()
+    argv = [str(video), "-o", str(tmp_path / "camera.yaml"), "--json"]
+    code, out, err = calibrate(argv, capsys)
+    assert code == 0, err
+    found = json.loads(out)
+    assert found["frames"] == found["views"] == VIEWS
+    assert found["fx"] == pytest.approx(K_TRUE[0, 0], rel=INTRINSICS_TOLERANCE)
+    assert found["cy"] == pytest.approx(K_TRUE[1, 2], rel=INTRINSICS_TOLERANCE)
