@@ -58,21 +58,28 @@ def test_a_killed_component_comes_back_at_once_then_after_a_backoff_until_restar
     assert "[launch] failed: pub" in launched.text()
 
 
-def test_sigint_stops_in_reverse_role_order(
+def test_sigint_stops_in_reverse_role_order_and_every_line_says_when_and_what(
     write_profile: ProfileWriter, launch: LaunchFixture
 ) -> None:
     """Started drivers first, stopped tools first; a clean stop exits 0. (A failure's exit
-    code is checked by the restart and start-up tests.)"""
+    code is checked by the restart and start-up tests.) The launcher's lines and its
+    components' alike say when and who, and it says what it waits for. (One launch for both:
+    each stamped line was the same of a launch of its own.)"""
     profile = write_profile(
         [
             publisher("arm", role="tool"),
-            publisher("lp", role="controller"),
+            {"name": "lp", "module": "lp_controller", "role": "controller"},
             publisher("est", role="estimator"),
             publisher("base", role="driver"),
-        ]
+        ],
+        robot=str(ROBOT_FILE),
     )
     launched = launch(profile)
-    launched.wait_for(r"\[launch\] all 4 components alive")
+    timeout = Profile.model_fields["startup_timeout_s"].default
+    launched.wait_for(
+        rf"\[launch\] waiting for 4 component\(s\) to come alive \(at most {timeout:g} s\)"
+    )
+    launched.wait_for(r"\[launch\] all 4 components alive; running until Ctrl-C")
 
     assert launched.stop(signal.SIGINT) == 0
     text = launched.text()
@@ -81,24 +88,9 @@ def test_sigint_stops_in_reverse_role_order(
     assert starts == sorted(starts) and stops == sorted(stops)
     assert "INFO arm stopping on SIGTERM" in text
     assert " lost" not in text  # a clean stop says "stopped", not "lost" (it did both)
-
-
-def test_every_line_of_the_launch_says_when_and_what_it_waits_for(
-    write_profile: ProfileWriter, launch: LaunchFixture
-) -> None:
-    """The launcher's lines and its components' alike; it says what it waits for."""
-    controller = {"name": "ctl", "module": "lp_controller", "role": "controller"}
-    launched = launch(write_profile([publisher("pub"), controller], robot=str(ROBOT_FILE)))
-    timeout = Profile.model_fields["startup_timeout_s"].default
-    launched.wait_for(
-        rf"\[launch\] waiting for 2 component\(s\) to come alive \(at most {timeout:g} s\)"
-    )
-    launched.wait_for(r"\[launch\] all 2 components alive; running until Ctrl-C")
-    assert launched.stop() == 0
-    lines = launched.text().splitlines()
-    stamped = re.compile(r"^\d\d:\d\d:\d\d\.\d{3} \[(launch|pub|ctl)\] ")
-    assert [line for line in lines if not stamped.match(line)] == []
-    assert any(" [pub] INFO pub running" in line for line in lines)
+    stamped = re.compile(r"^\d\d:\d\d:\d\d\.\d{3} \[(launch|arm|lp|est|base)\] ")
+    assert [line for line in text.splitlines() if not stamped.match(line)] == []
+    assert " [arm] INFO arm running" in text
 
 
 def test_a_component_starts_once_those_it_waits_for_are_alive_and_stops_before_them(
@@ -204,9 +196,11 @@ def test_a_configuration_error_at_start_up_fails_the_whole_launch(
     launched.wait_for(r"\[launch\] good stopped")
 
 
-def test_a_parameter_set_at_run_time_survives_a_restart(
+def test_a_parameter_set_at_run_time_survives_a_restart_and_components_stop_with_the_launcher(
     write_profile: ProfileWriter, launch: LaunchFixture
 ) -> None:
+    """A parameter set, the component killed: its restart has it. Then the launcher is
+    killed: the component stops by itself. (One launch for both.)"""
     profile = write_profile([publisher("pub")])
     launched = launch(profile)
     started, _, match = launched.wait_for(r"\[launch\] started pub \(.*pid (\d+)\)")
@@ -215,11 +209,19 @@ def test_a_parameter_set_at_run_time_survives_a_restart(
     with target.open() as session:
         assert query.set_param(session, "test", "pub", "rate_hz", "7.5") == 7.5
         os.kill(int(match.group(1)), signal.SIGKILL)
-        restarted, _, _ = launched.wait_for(r"\[launch\] started pub", after=started + 1)
+        restarted, _, match = launched.wait_for(
+            r"\[launch\] started pub \(.*pid (\d+)\)", after=started + 1
+        )
         launched.wait_for(r"\[launch\] pub alive", after=restarted)
         assert query.get_param(session, "test", "pub", "rate_hz") == 7.5
         assert query.get_param(session, "test", "pub", "goal_task") == "position"  # untouched
-    launched.stop()
+    launched.process.kill()
+    launched.process.wait()
+    pid = int(match.group(1))
+    deadline = time.monotonic() + DEADLINE_S
+    while not process_gone(pid):
+        assert time.monotonic() < deadline, "component outlived its launcher by 60 s"
+        time.sleep(0.02)
 
 
 def test_a_hung_component_is_killed_and_restarted_by_the_watchdog(
@@ -238,21 +240,6 @@ def test_a_hung_component_is_killed_and_restarted_by_the_watchdog(
     restarted, _, _ = launched.wait_for(r"\[launch\] started pub", after=hung)
     launched.wait_for(r"\[launch\] pub alive", after=restarted)
     assert launched.stop() == 0
-
-
-def test_components_stop_when_the_launcher_is_killed(
-    write_profile: ProfileWriter, launch: LaunchFixture
-) -> None:
-    launched = launch(write_profile([publisher("pub")]))
-    started, _, match = launched.wait_for(r"\[launch\] started pub \(.*pid (\d+)\)")
-    launched.wait_for(r"\[launch\] pub alive", after=started)
-    launched.process.kill()
-    launched.process.wait()
-    pid = int(match.group(1))
-    deadline = time.monotonic() + DEADLINE_S
-    while not process_gone(pid):
-        assert time.monotonic() < deadline, "component outlived its launcher by 10 s"
-        time.sleep(0.02)
 
 
 def test_an_invalid_profile_is_refused_before_anything_starts(
