@@ -21,7 +21,7 @@ from profiles.deploy_files import DEPLOY
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from profiles.profile_files import read_profile_data
-from studies.experiment import connect, launched, wait_alive
+from studies.experiment import connect, launched
 
 
 def components(path: Path) -> dict[str, dict]:
@@ -61,7 +61,12 @@ def test_emulated_differs_from_hardware_by_device_paths_and_camera_source_only()
 
 def test_the_pose_experiment_converges_through_the_emulated_devices(tmp_path: Path) -> None:
     """In real time (the emulated devices keep the wall clock), on one seed's set-up: a second
-    seed drew a like drive forward to a like bin and proved nothing more, for 24 s."""
+    seed drew a like drive forward to a like bin and proved nothing more, for 24 s.
+
+    Its launch of the emulated profile starts and stops without a word of failure. Before, the
+    base driver started before its emulated device existed and logged `cannot open
+    .../create2: No such file` at every start, and a clean stop logged `controller lost` before
+    `controller stopped (0)`. (A launch of its own for that proved it again, for 40 s.)"""
     command = [
         sys.executable,
         "-m",
@@ -84,6 +89,12 @@ def test_the_pose_experiment_converges_through_the_emulated_devices(tmp_path: Pa
     assert report["joint_limit_violations"] == 0
     assert report["final_error"] < 0.02
     assert report["estimator_error"]["position_m"] < 0.02
+    text = (tmp_path / "launch.log").read_text()
+    assert "cannot open" not in text and "No such file" not in text, text
+    assert re.search(r"\[launch\] \w+ lost", text) is None, text
+    for name in ("simulator", "base_driver", "arm_driver", "controller"):
+        assert f"[launch] {name} stopped (0)" in text
+    assert text.index("[launch] simulator alive") < text.index("[launch] started base_driver")
 
 
 def emulated_profile(tmp_path: Path, namespace: str, *components: dict) -> Path:
@@ -110,25 +121,6 @@ def emulated_profile(tmp_path: Path, namespace: str, *components: dict) -> Path:
     return path
 
 
-def test_the_emulated_profile_starts_and_stops_without_a_word_of_failure(tmp_path: Path) -> None:
-    """Before, the base driver started before its emulated device existed and logged `cannot
-    open .../create2: No such file` at every start, and a clean stop logged `controller lost`
-    before `controller stopped (0)`."""
-    path = emulated_profile(tmp_path, "quiettest")
-    profile = load_profile(path)
-    log_path = tmp_path / "launch.log"
-    with log_path.open("w") as log, launched(path, log) as launcher:
-        with connect(profile, launcher) as session:
-            wait_alive(session, profile, launcher)
-    text = log_path.read_text()
-    assert launcher.returncode == 0, text
-    assert "cannot open" not in text and "No such file" not in text, text
-    assert re.search(r"\[launch\] \w+ lost", text) is None, text
-    for name in ("simulator", "base_driver", "arm_driver", "controller"):
-        assert f"[launch] {name} stopped (0)" in text
-    assert text.index("[launch] simulator alive") < text.index("[launch] started base_driver")
-
-
 def test_a_killed_controller_leaves_the_robot_stopped_by_its_drivers(tmp_path: Path) -> None:
     """The Create keeps its last Drive command for ever; the base driver's timeout stops it."""
     path = emulated_profile(
@@ -148,11 +140,12 @@ def test_a_killed_controller_leaves_the_robot_stopped_by_its_drivers(tmp_path: P
         controller = query.statuses(session, profile.namespace)["controller"]
         os.kill(controller.pid, signal.SIGKILL)
         killed_ns = time.time_ns()  # the simulator keeps host time (host_epoch)
-        time.sleep(1.5)
-        after = [t for t in truth if t.header.stamp_ns > killed_ns]
-        # Command timeout 0.2 s, then the wheels decelerate at 1 m/s^2 from under 0.25 m/s.
-        settled = [t for t in after if t.header.stamp_ns > killed_ns + 600_000_000]
-        assert len(settled) > 25  # 0.9 s of the simulator's 50 Hz truth
+        # Command timeout 0.2 s, then the wheels decelerate at 1 m/s^2 from under 0.25 m/s:
+        # the truth stamped from 0.6 s after the kill on, 0.9 s of it at 50 Hz however late.
+        deadline = time.monotonic() + 60
+        while len(settled := [t for t in truth if t.header.stamp_ns > killed_ns + 6e8]) <= 45:
+            assert time.monotonic() < deadline and launcher.poll() is None, "no truth"
+            time.sleep(0.1)
         xs = [t.base_pose[0] for t in settled]
         ys = [t.base_pose[1] for t in settled]
         assert max(xs) - min(xs) < 1e-4 and max(ys) - min(ys) < 1e-4, (xs[0], xs[-1])
