@@ -5,8 +5,9 @@ servo drives which joint, from which zero and which way, is the robot descriptio
 ``servos:`` section (``wbc.servo_map``: servo angle = offset +
 direction * q); the ``ids`` parameter, when set, overrides its ids.
 
-Every 1/``rate_hz`` s it reads each servo's present position and speed on its own (so that a
-fault is named for its servo) and publishes ``arm/joint_states``.
+Every 1/``rate_hz`` s it reads each servo's present position and speed (on protocol 2.0 all in
+one Sync Read; on its own when that is not whole, and always on protocol 1.0, so that a fault
+is named for its servo) and publishes ``arm/joint_states``.
 
 A velocity command is checked (every entry finite, else the arm holds) and each joint's speed
 clamped to the robot's velocity limit. It becomes, per joint, a goal position ahead of the
@@ -45,7 +46,7 @@ from components.process_entry import run_component
 from components.pubsub import Input
 from components.robot_vector import RobotVector, of_robot
 from components.runtime import Component, Node
-from components.servo_bus import BUSES, HOLD_SPEED, open_port
+from components.servo_bus import BUSES, HOLD_SPEED, Reading, open_port
 from messages import topics
 from messages.commands import ArmCommand
 from messages.joints import JointStates
@@ -201,9 +202,10 @@ class ArmDriver(Component):
         except OSError:
             pass
 
-    def _read(self, servo: int) -> tuple[int, float] | StatusFault:
-        """One servo's Present Position (units) and speed (rad/s), or what is wrong."""
-        reading, fault, error = self.bus.read(servo)
+    def _read(self, servo: int, read: Reading | None = None) -> tuple[int, float] | StatusFault:
+        """One servo's Present Position (units) and speed (rad/s), or what is wrong: ``read``
+        when a read of all the servos gave it, else read now."""
+        reading, fault, error = self.bus.read(servo) if read is None else read
         if fault is not None:
             self.node.count(f"servo_faults.{fault}")
             self.node.warn(f"servo_faults.{fault}.{servo}", f"servo {servo}: {fault} answer")
@@ -227,8 +229,9 @@ class ArmDriver(Component):
             return
         readings, faults = [], {}
         try:
+            batch = self.bus.read_all(self.ids)
             for index in range(len(self.ids)):
-                reading = self._reading(index)
+                reading = self._reading(index, None if batch is None else batch[index])
                 if isinstance(reading, str):
                     faults[index] = reading
                 else:
@@ -251,11 +254,12 @@ class ArmDriver(Component):
             )
         )
 
-    def _reading(self, index: int) -> tuple[float, float] | str:
-        """Joint ``index``'s position (kept as ``present``) and speed, read now; or what is
-        wrong: a fault, or a position outside the joint's limits."""
+    def _reading(self, index: int, read: Reading | None = None) -> tuple[float, float] | str:
+        """Joint ``index``'s position (kept as ``present``) and speed, read now (or ``read``
+        by a read of all); or what is wrong: a fault, or a position outside the joint's
+        limits."""
         servo = self.ids[index]
-        reading = self._read(servo)
+        reading = self._read(servo, read)
         if isinstance(reading, StatusFault):
             return f"servo {servo} {reading}"
         units, speed = reading

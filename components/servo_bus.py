@@ -8,8 +8,11 @@ Velocity and Goal Position, 0 meaning no limit); torque is enabled only after th
 mode is position and the goal is where the servo is, and an answer with the alert bit is
 followed by a read of Hardware Error Status, its bits counted by name.
 
-Both read one servo at a time (each answer checked by the protocol's ``status_fault``, so a
-fault is named for its servo) and write every goal in one Sync Write.
+Each answer is checked by the protocol's ``status_fault``, so that a fault is named for its
+servo. ``AXBus`` reads one servo at a time; ``XBus`` reads them all in one Sync Read, and one at
+a time only when an answer of the Sync Read did not come whole, in time and from its servo (one
+instruction packet a cycle instead of one per servo: one USB round trip instead of one per
+servo on a U2D2). Both write every goal in one Sync Write.
 """
 
 from __future__ import annotations
@@ -24,6 +27,9 @@ from protocols.dynamixel_v1 import StatusFault
 
 HOLD_SPEED = 1
 """The speed of a held joint, units: the slowest there is (0 would mean full speed)."""
+Reading = tuple[tuple[int, float] | None, StatusFault | None, int]
+"""A servo's Present Position (units) and speed (rad/s), or what is wrong with its answer (then
+None); and the answer's error byte."""
 READ_WAIT_S = 0.001
 """How long one read of the serial port waits for bytes before the SDK looks again (s)."""
 
@@ -65,6 +71,11 @@ class ServoBus:
     def result_text(self, result: int) -> str:
         return self.packet.getTxRxResult(result)
 
+    def read_all(self, ids: Sequence[int]) -> list[Reading] | None:
+        """Every servo's reading (as ``read`` gives it) at once; None when they are to be read
+        one at a time."""
+        return None
+
 
 class AXBus(ServoBus):
     """AX-18A servos, protocol 1.0."""
@@ -86,9 +97,8 @@ class AXBus(ServoBus):
         """The names of the bits set in a status packet's error byte."""
         return [bit.name.lower() for bit in dxl1.StatusError if error & bit]
 
-    def read(self, servo: int) -> tuple[tuple[int, float] | None, StatusFault | None, int]:
-        """One servo's Present Position (units) and speed (rad/s), or what is wrong with its
-        answer; and the answer's error byte."""
+    def read(self, servo: int) -> Reading:
+        """One servo's reading."""
         result = self.packet.readTx(
             self.port, servo, dxl1.Address.PRESENT_POSITION, self.read_bytes
         )
@@ -181,9 +191,8 @@ class XBus(ServoBus):
             answer = following
         return answer
 
-    def read(self, servo: int) -> tuple[tuple[int, float] | None, StatusFault | None, int]:
-        """One servo's Present Position (units) and Present Velocity (rad/s), or what is wrong
-        with its answer; and the answer's error byte."""
+    def read(self, servo: int) -> Reading:
+        """One servo's reading (Present Position and Present Velocity)."""
         result = self.packet.readTx(
             self.port, servo, dxl2.Address.PRESENT_VELOCITY, self.read_bytes
         )
@@ -192,12 +201,33 @@ class XBus(ServoBus):
             self._await()
             answer = self._answer(servo)
             self.port.is_using = False
+        return self._reading(answer, servo)
+
+    def _reading(self, answer: bytes, servo: int) -> Reading:
         fault = dxl2.status_fault(answer, servo, self.read_bytes)
         if fault is not None:
             return None, fault, 0
         error, data = dxl2.status_data(answer)
         velocity = dxl2.rad_s_of_velocity_units(dxl2.signed(data[:4]))
         return (dxl2.signed(data[4:8]), velocity), None, error
+
+    def read_all(self, ids: Sequence[int]) -> list[Reading] | None:
+        """Every servo's reading from one Sync Read; None unless every answer came whole, in
+        time and from its servo (then each servo is read on its own, which names the fault)."""
+        self.port.clearPort()
+        packet = dxl2.sync_read(dxl2.Address.PRESENT_VELOCITY, self.read_bytes, ids)
+        if self.port.writePort(packet) != len(packet):
+            return None
+        self.port.setPacketTimeout((dxl2.MIN_STATUS_BYTES + self.read_bytes) * len(ids))
+        self._await()
+        answers = {}
+        for _ in ids:
+            answer = self._receive()
+            if len(answer) < dxl2.MIN_STATUS_BYTES:
+                return None
+            answers[answer[4]] = answer
+        readings = [self._reading(answers.get(servo, b""), servo) for servo in ids]
+        return None if any(fault for _, fault, _ in readings) else readings
 
     def enable_torque(self, servo: int) -> int | None:
         """Torque on in position mode, the goal where the servo is: with torque off, the

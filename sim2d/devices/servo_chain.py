@@ -50,6 +50,7 @@ COUNTERS = (
     "unanswered",
     "status_sent",
     "sync_writes",
+    "sync_reads",
     "handler_errors",
 )
 

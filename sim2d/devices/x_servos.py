@@ -282,6 +282,7 @@ class XChainEmulator(ServoChain):
         if instruction in (Instruction.SYNC_READ, Instruction.SYNC_WRITE) and len(params) > 4:
             address, length = (int.from_bytes(params[i : i + 2], "little") for i in (0, 2))
             if instruction == Instruction.SYNC_READ:
+                self.counters["sync_reads"] += 1
                 listed = [(i, address, length) for i in params[4:]]
                 return self._reads(listed)
             self.counters["sync_writes"] += 1

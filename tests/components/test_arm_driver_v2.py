@@ -124,6 +124,7 @@ def test_the_arm_moves_as_commanded_and_a_joint_commanded_to_stop_holds(bench: B
     first = bench.joints.messages[0]
     assert max(abs(p - s) for p, s in zip(first.positions, START, strict=True)) <= UNIT
     assert bench.servos.words(Address.TORQUE_ENABLE) == [1] * 4
+    assert bench.servos.counters["sync_reads"] > 0  # every servo read by one instruction
     q1, q4, q2 = bench.arm.angles[0], bench.arm.angles[3], bench.arm.angles[1]
 
     def command_and_step() -> bool:
