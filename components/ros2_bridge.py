@@ -1,13 +1,19 @@
 """The ROS 2 face of a profile: the robot's topics on the wire as rmw_zenoh writes them
 (``ros2.participant``; ROS 2 Jazzy, rmw_zenoh_cpp 0.2.5), and goals from ROS 2 nodes.
 
-A ROS 2 node ``parsimony`` in domain ``domain_id`` publishes, from each robot state (at most
-``max_rate_hz`` a host second), /joint_states, /tf (the base in the world, every link, the end
+A ROS 2 node ``parsimony`` in domain ``domain_id`` publishes, from the newest robot state
+``max_rate_hz`` times a second, /joint_states, /tf (the base in the world, every link, the end
 effector, and the goal's frame ``goal``) and /odom; /clock on simulated time; the ceiling
 camera's frames (at most ``camera_rate_hz``) as /camera/image/compressed with
 /camera/camera_info; /tf_static (the camera in the world) and /robot_description (the URDF),
 both latched (TRANSIENT_LOCAL: a late joiner gets them); and /diagnostics: the controller's, the
-supervisor's and the bridge's own status, every host second and at once when a goal is refused.
+supervisor's and the bridge's own status, every second and at once when a goal is refused.
+The robot state, the camera's frames and the controller's diagnostics are kept as they come,
+undecoded, and decoded only when published (``Newest``): the bridge costs the loop it watches
+little, whatever the rate of its topics. Its timers run on its clock: with ``clock: wall`` in
+its profile entry (``deploy/ros2.yaml``), host time, and it reads no sim/clock; the messages
+keep the stamps of the states they come from (and ``/clock`` carries them when the profile
+runs on simulated time).
 
 It subscribes to /goal_pose (geometry_msgs/PoseStamped of the end effector, in a frame of the
 TF tree) and passes each goal on goal/request, where the supervisor checks it as any goal
@@ -25,19 +31,18 @@ import logging
 import threading
 import time
 from functools import partial
+from typing import Generic, TypeVar
 
 import numpy as np
 import zenoh
+from pydantic import BaseModel
 
-from components.clock import SimClock
 from components.joint_check import joints_match
 from components.params import Param, ParamError, load_robot
 from components.process_entry import run_component
 from components.pubsub import Input
 from components.runtime import Component, Node
-from messages import topics
-from messages.camera import CameraFrame
-from messages.diagnostics import ControllerDiagnostics
+from messages import codec, topics
 from messages.goal import Goal
 from messages.state import RobotState
 from messages.supervisor import SupervisorStatus
@@ -61,6 +66,7 @@ from vision.images import jpeg
 from wbc import dq
 
 log = logging.getLogger("components.ros2_bridge")
+M = TypeVar("M", bound=BaseModel)
 
 NODE_NAME = "parsimony"
 REFUSALS = ("type_hash", "flood", "malformed_cdr", "frame", "goal")
@@ -69,6 +75,38 @@ DIAGNOSTICS_EVERY_S = 1.0
 GOAL_BURST = 3
 """Goals that may come at once before ``goal_rate_hz`` holds them back."""
 JPEG_QUALITY = 80
+
+
+class Newest(Generic[M]):
+    """The newest payload of a topic the component reads (its remap followed), kept undecoded
+    on Zenoh's thread and decoded when taken; one that does not decode is dropped, counted
+    (``rejected.<topic>``) and logged, rate-limited, as a subscription's."""
+
+    def __init__(self, node: Node, topic: topics.Topic[M]) -> None:
+        self.node, self.topic = node, node.spec.topic(topic)
+        self.key = self.topic.key(node.namespace)
+        self._payload: zenoh.ZBytes | None = None
+        self._kept: M | None = None
+        node.counters[f"rejected.{self.topic.name}"] = 0
+        self._subscriber = node.session.declare_subscriber(self.key, self._on_sample)
+
+    def _on_sample(self, sample: zenoh.Sample) -> None:
+        if sample.kind == zenoh.SampleKind.PUT and len(sample.payload) <= self.topic.max_bytes:
+            self._payload = sample.payload
+
+    def take(self, keep: bool = False) -> M | None:
+        """The newest message not taken yet (None if none came since); with ``keep``, the
+        newest taken so far when none came since."""
+        payload, self._payload = self._payload, None
+        if payload is None:
+            return self._kept if keep else None
+        try:
+            self._kept = codec.decode(payload.to_bytes(), self.topic.type, self.key)
+        except codec.DecodeError as error:
+            self.node.count(f"rejected.{self.topic.name}")
+            self.node.warn(f"rejected.{self.topic.name}", f"dropped a malformed message: {error}")
+            return self._kept if keep else None
+        return self._kept
 
 
 class Ros2Bridge(Component):
@@ -85,8 +123,8 @@ class Ros2Bridge(Component):
     writes = (topics.GOAL_REQUEST,)
     params = (
         Param("domain_id", int, 0, low=0, high=232, doc="the ROS 2 graph's ROS_DOMAIN_ID"),
-        Param("max_rate_hz", float, 50.0, low=0.1, high=1000.0, doc="most states a host s"),
-        Param("camera_rate_hz", float, 10.0, low=0.0, high=100.0, doc="most images a host s"),
+        Param("max_rate_hz", float, 50.0, low=1.0, high=1000.0, doc="states published a s"),
+        Param("camera_rate_hz", float, 10.0, low=0.0, high=100.0, doc="images a s; 0: none"),
         Param("goal_rate_hz", float, 2.0, low=0.01, high=100.0, doc="most goals a host s"),
     )
 
@@ -104,22 +142,21 @@ class Ros2Bridge(Component):
         node.counters |= {"refused_states": 0, "goals_passed": 0}
         self.last_refusal = ""
         self.latest: RobotState | None = None
-        """The latest valid state: the TF tree's frames are its (``tree``)."""
-        self.state: RobotState | None = None
-        """The latest state published (/odom's twist is from it)."""
+        """The newest valid state published: the TF tree's frames are its (``tf_frames``)."""
         self.goal: Goal | None = None
-        self.controller: ControllerDiagnostics | None = None
         self.supervisor: SupervisorStatus | None = None
-        self._next_state_ns = self._next_image_ns = self._next_diagnostics_ns = 0
         self._lock = threading.Lock()
         self._tokens, self._filled_ns, self._flooded = float(GOAL_BURST), time.monotonic_ns(), 0
         self.goal_request = node.publisher(topics.GOAL_REQUEST)
         self._declare(int(node.params["domain_id"]), camera is not None)
-        node.subscribe(topics.ROBOT_STATE, self.on_state)
-        node.subscribe(topics.CAMERA_IMAGE, self.on_frame)
+        self.states = Newest(node, topics.ROBOT_STATE)
+        self.frames_in = Newest(node, topics.CAMERA_IMAGE)
+        self.controller = Newest(node, topics.CONTROL_DIAGNOSTICS)
         node.subscribe(topics.SUPERVISOR_STATUS, self.on_supervisor)
-        node.subscribe(topics.CONTROL_DIAGNOSTICS, self.on_controller)
         node.subscribe(topics.GOAL_REQUEST, self.on_goal)
+        self.state_timer = node.timer(self._period("max_rate_hz"), self.publish_state)
+        self.image_timer = node.timer(self._period("camera_rate_hz"), self.publish_image)
+        node.timer(DIAGNOSTICS_EVERY_S, self.publish_diagnostics)
 
     def _declare(self, domain_id: int, camera: bool) -> None:
         """The ROS 2 node, its publishers (the latched ones put once) and its subscription."""
@@ -127,15 +164,14 @@ class Ros2Bridge(Component):
         self.out = {
             topic: ros.publisher(*topic)
             for topic in (JOINT_STATES, TF, ODOM, made.DIAGNOSTICS)
-            + ((made.CLOCK,) if isinstance(self.node.clock, SimClock) else ())
+            + ((made.CLOCK,) if self.node.profile.clock == "sim" else ())
         }
         if camera:
             self.out[made.COMPRESSED_IMAGE] = ros.publisher(*made.COMPRESSED_IMAGE, SENSOR_QOS)
             self.out[made.CAMERA_INFO] = ros.publisher(*made.CAMERA_INFO, SENSOR_QOS)
-        stamp = self.node.clock.now_ns()
         latched = {
             made.ROBOT_DESCRIPTION: made.string(urdf(self.robot)),
-            made.TF_STATIC: made.static_transforms(self.camera_pose, stamp),
+            made.TF_STATIC: made.static_transforms(self.camera_pose, self.stamp_ns()),
         }
         for topic, message in latched.items():
             self.out[topic] = ros.publisher(*topic, TRANSIENT_LOCAL_QOS)
@@ -143,13 +179,15 @@ class Ros2Bridge(Component):
         self.goal_key = ros.key(*made.GOAL_POSE)
         ros.subscription(*made.GOAL_POSE, self._on_ros_goal)
 
-    def _due(self, attribute: str, rate_hz: float) -> bool:
-        """Whether the host time has come for what ``attribute`` schedules (at ``rate_hz``)."""
-        now = time.monotonic_ns()
-        if rate_hz <= 0.0 or now < getattr(self, attribute):
-            return False
-        setattr(self, attribute, now + round(1e9 / rate_hz))
-        return True
+    def _period(self, name: str) -> float:
+        """The period of a timer at the rate parameter ``name`` (at most 1 s: a rate of 0, no
+        publishing, is looked at again every second)."""
+        return 1.0 / max(1.0, float(self.node.params[name]))
+
+    def stamp_ns(self) -> int:
+        """The time of what the bridge says: the newest state's stamp (the system's time,
+        simulated or the host's), else its clock's."""
+        return self.latest.header.stamp_ns if self.latest else self.node.clock.now_ns()
 
     def tf_frames(self) -> dict[str, np.ndarray]:
         """Every frame of the TF tree as its 4x4 pose in the world: the robot's at the latest
@@ -161,28 +199,26 @@ class Ros2Bridge(Component):
             found[made.GOAL_FRAME] = self._goal_matrix(self.goal)
         return found
 
-    def on_state(self, state: RobotState) -> None:
-        """Keep the state; publish its topics when due."""
+    def publish_state(self) -> None:
+        """/joint_states, /tf, /odom (and /clock) of the newest state, if a new one came."""
+        self.state_timer.period_ns = round(1e9 * self._period("max_rate_hz"))
+        state = self.states.take()
         names = self.robot.joint_names
+        if state is None or not state.valid:
+            return
         if not joints_match(self.node, "refused_states", "robot/state", state.joint_names, names):
             return
-        if not state.valid:
-            return
+        stamp = state.header.stamp_ns
+        tf = tf_message(state, self.tree)
+        if self.goal is not None:
+            goal = self._goal_matrix(self.goal)
+            tf.transforms.append(transform_stamped(stamp, WORLD, made.GOAL_FRAME, goal))
+        self.out[JOINT_STATES].put(joint_state(state, names))
+        self.out[TF].put(tf)
+        self.out[ODOM].put(odometry(state, self.latest))
+        if made.CLOCK in self.out:
+            self.out[made.CLOCK].put(made.clock(stamp))
         self.latest = state
-        if self._due("_next_state_ns", float(self.node.params["max_rate_hz"])):
-            stamp = state.header.stamp_ns
-            tf = tf_message(state, self.tree)
-            if self.goal is not None:
-                goal = self._goal_matrix(self.goal)
-                tf.transforms.append(transform_stamped(stamp, WORLD, made.GOAL_FRAME, goal))
-            self.out[JOINT_STATES].put(joint_state(state, names))
-            self.out[TF].put(tf)
-            self.out[ODOM].put(odometry(state, self.state))
-            if made.CLOCK in self.out:
-                self.out[made.CLOCK].put(made.clock(stamp))
-            self.state = state
-        if self._due("_next_diagnostics_ns", 1.0 / DIAGNOSTICS_EVERY_S):
-            self.publish_diagnostics()
 
     @staticmethod
     def _goal_matrix(goal: Goal) -> np.ndarray:
@@ -193,11 +229,13 @@ class Ros2Bridge(Component):
             where[:3, 3] = goal.position
         return where
 
-    def on_frame(self, frame: CameraFrame) -> None:
-        """The camera's frame and its intrinsics, when due."""
-        if made.COMPRESSED_IMAGE not in self.out:
+    def publish_image(self) -> None:
+        """The newest camera frame and its intrinsics, if a new one came."""
+        self.image_timer.period_ns = round(1e9 * self._period("camera_rate_hz"))
+        frame = self.frames_in.take()
+        if frame is None or made.COMPRESSED_IMAGE not in self.out:
             return
-        if not self._due("_next_image_ns", float(self.node.params["camera_rate_hz"])):
+        if float(self.node.params["camera_rate_hz"]) <= 0.0:
             return
         if frame.encoding == "jpeg":
             data = frame.data
@@ -214,21 +252,19 @@ class Ros2Bridge(Component):
         if changed:
             self.publish_diagnostics()
 
-    def on_controller(self, diagnostics: ControllerDiagnostics) -> None:
-        self.controller = diagnostics
-
     def on_goal(self, goal: Goal) -> None:
         """The goal the supervisor is given (by the bridge or anyone): its frame on /tf."""
         self.goal = goal
 
     def publish_diagnostics(self) -> None:
         """/diagnostics: the controller's, the supervisor's and the bridge's status."""
+        controller = self.controller.take(keep=True)
         statuses = [made.bridge_status(self.node.counters, self.last_refusal)]
         if self.supervisor is not None:
             statuses.insert(0, made.supervisor_status(self.supervisor))
-        if self.controller is not None:
-            statuses.insert(0, made.controller_status(self.controller))
-        self.out[made.DIAGNOSTICS].put(made.diagnostic_array(self.node.clock.now_ns(), statuses))
+        if controller is not None:
+            statuses.insert(0, made.controller_status(controller))
+        self.out[made.DIAGNOSTICS].put(made.diagnostic_array(self.stamp_ns(), statuses))
 
     def _on_ros_goal(self, sample: zenoh.Sample) -> None:
         """On Zenoh's thread: take the goal if the rate allows, else count a flood."""
@@ -260,7 +296,7 @@ class Ros2Bridge(Component):
             if key != self.goal_key:
                 got = "/".join(key.split("/")[-2:])[:160]
                 raise Refused("type_hash", f"{got} is not {self.goal_key.split('/', 2)[2]}")
-            goal = goal_of(data, self.tf_frames(), self.node.header("world"))
+            goal = goal_of(data, self.tf_frames(), self.node.header("world", self.stamp_ns()))
         except Refused as refused:
             self.refuse(refused.kind, str(refused))
             return
