@@ -5,9 +5,10 @@ Run as ``python -m studies.bench.serial_devices [--json]``. On the AX-18A chain 
 present position and speed (a 4-byte read), the Sync Write of a goal and speed per servo of
 Little John's five (its description's ``servos``), and the joint-state rate one read per servo
 allows. On the X-series chain emulator (protocol 2.0), the same for the OpenManipulator-X's
-four servos (Present Velocity and Position, 8 bytes; Profile Velocity and Goal Position), and
-one Sync Read of all four. On the Create 2 emulator, with pyserial: a Drive Direct written
-until the wheels take it, and the mean period of the encoder stream.
+four servos (Present Velocity and Position, 8 bytes; Profile Velocity and Goal Position), one
+Sync Read of all four, and the joint-state rate a Sync Read and a Sync Write a cycle allow.
+On the Create 2 emulator, with pyserial: a Drive Direct written until the wheels take it, and
+the mean period of the encoder stream.
 """
 
 from __future__ import annotations
@@ -129,7 +130,7 @@ def x_servo_bus() -> dict:
             writer.txPacket()
             writes.append((time.perf_counter() - start) * 1e6)
         port.closePort()
-    cycle_us = len(ids) * float(np.median(reads)) + float(np.median(writes))
+    cycle_us = float(np.median(sync_reads)) + float(np.median(writes))  # as the driver reads
     return {
         "read_one_servo": figures(reads),
         "sync_read_four": figures(sync_reads),
