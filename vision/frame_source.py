@@ -22,8 +22,15 @@ def _grey(image: np.ndarray) -> np.ndarray:
 
 def open_capture(source: str) -> cv2.VideoCapture:
     """``cv2.VideoCapture`` of a device index (``0``) or of anything it opens (a video file, a
-    URL); ``FrameSourceError`` when it does not open."""
-    capture = cv2.VideoCapture(int(source) if source.isdigit() else source)
+    URL); ``FrameSourceError`` when it does not open (OpenCV's own warnings about each backend
+    it tried are kept back: the error says it)."""
+    logging = cv2.utils.logging
+    level = logging.getLogLevel()
+    logging.setLogLevel(logging.LOG_LEVEL_ERROR)
+    try:
+        capture = cv2.VideoCapture(int(source) if source.isdigit() else source)
+    finally:
+        logging.setLogLevel(level)
     if not capture.isOpened():
         capture.release()
         raise FrameSourceError(f"{source}: cannot open it as a camera or a video")

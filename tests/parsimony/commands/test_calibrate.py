@@ -142,6 +142,7 @@ def test_frames_without_the_board_are_refused(tmp_path: Path, capsys) -> None:
         ("empty", "no images"),
         ("broken", "not an image OpenCV can read"),
         ("text.avi", "cannot open it as a camera or a video"),
+        ("99", "99: cannot open it as a camera or a video"),  # no device 99
     ],
 )
 def test_a_source_that_cannot_be_read_is_one_line(
@@ -151,7 +152,8 @@ def test_a_source_that_cannot_be_read_is_one_line(
     (tmp_path / "broken").mkdir()
     (tmp_path / "broken" / "0.png").write_bytes(b"not a png")
     (tmp_path / "text.avi").write_text("not a video")
-    code, _, err = calibrate([str(tmp_path / source), "-o", str(tmp_path / "c.yaml")], capsys)
+    given = source if source.isdigit() else str(tmp_path / source)
+    code, _, err = calibrate([given, "-o", str(tmp_path / "c.yaml")], capsys)
     assert code == 2
     assert says in err and len(err.strip().splitlines()) == 1
 
