@@ -11,6 +11,7 @@ from dynamixel_sdk import (
     COMM_RX_TIMEOUT,
     COMM_SUCCESS,
     GroupBulkRead,
+    GroupBulkWrite,
     GroupSyncRead,
     GroupSyncWrite,
     PacketHandler,
@@ -102,6 +103,18 @@ def test_sync_write_moves_every_joint_to_its_goal_at_its_profile_velocity(
     for servo_id in IDS:
         position = bulk.getData(servo_id, Address.PRESENT_POSITION, 4)
         assert abs(position - goals[servo_id]) <= 1, servo_id
+
+
+def test_bulk_write_writes_each_servo_its_own_entry(
+    port: PortHandler, packet: PacketHandler, emulator: XChainEmulator
+) -> None:
+    group = GroupBulkWrite(port, packet)
+    assert group.addParam(11, Address.GOAL_POSITION, 4, list(dxl.value(3000, 4)))
+    assert group.addParam(13, Address.PROFILE_VELOCITY, 4, list(dxl.value(40, 4)))
+    assert group.txPacket() == COMM_SUCCESS
+    assert packet.read4ByteTxRx(port, 11, Address.GOAL_POSITION)[:2] == (3000, COMM_SUCCESS)
+    assert packet.read4ByteTxRx(port, 13, Address.PROFILE_VELOCITY)[:2] == (40, COMM_SUCCESS)
+    assert emulator.words(Address.PROFILE_VELOCITY) == [0, 0, 40, 0]
 
 
 def test_writes_the_servo_refuses(
