@@ -5,14 +5,15 @@ and the LP builder only adds them up:
 ``ResidualCost`` (w ||A u + b||_1: the task itself, with A = J and b = eta e, or a secondary
 goal such as keeping the waist centred) or ``VelocityCost`` (sum_i w_i |u_i|, a cost on the
 split columns u_P + u_N, which may differ between the two directions of an entry). Weights
-are >= 0, so the sum stays convex and its minimiser a vertex.
+are >= 0, so the sum stays convex and its minimiser a vertex. Both are named tuples, built at
+every step in a fraction of the time of a frozen dataclass.
 """
 
 from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
-from typing import Protocol
+from typing import NamedTuple, Protocol
 
 import numpy as np
 
@@ -21,8 +22,7 @@ from wbc.laws.step_context import StepContext
 Array = np.ndarray
 
 
-@dataclass(frozen=True)
-class ResidualCost:
+class ResidualCost(NamedTuple):
     """weight * ||matrix u + offset||_1, one residual per row of ``matrix``."""
 
     name: str
@@ -49,8 +49,7 @@ def no_cost(name: str, dof: int) -> ResidualCost:
     return ResidualCost(name, matrix, offset, 0.0)
 
 
-@dataclass(frozen=True)
-class VelocityCost:
+class VelocityCost(NamedTuple):
     """sum_i weights_i max(u_i, 0) + negative_i max(-u_i, 0): a cost on the split columns u_P
     and u_N, the same both ways (sum_i weights_i |u_i|) unless ``negative`` is given."""
 
