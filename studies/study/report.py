@@ -9,6 +9,7 @@ from typing import Any
 
 from tabulate import tabulate
 
+from outputs.stdout import finite
 from studies.study.figures import KINEMATIC, SIMULATED
 from studies.study.schema import Study, StudyError
 from studies.study.sweep import PARAMETERS, Run
@@ -52,7 +53,7 @@ def markdown(study: Study, file: str, runs: list[Run], rows: list[dict[str, Any]
             line: dict[str, Any] = dict(zip(table.by, values, strict=True))
             for name in table.figures:
                 line |= figures[name](group, loaded[group[0]["robot"]])
-            lines.append(line)
+            lines.append(finite(line))  # a median of no step is blank, not nan
         text = tabulate(lines, headers="keys", tablefmt="pipe", floatfmt=".3g", missingval="")
         parts.append(f"**{table.title}**\n\n{text}")
     return "\n\n".join(parts) + "\n"
