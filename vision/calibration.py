@@ -34,6 +34,8 @@ MIN_SPAN = 0.5
 """The fraction of the image's width and of its height the corners of all views must span."""
 MIN_TILT_SPREAD_DEG = 20.0
 """The least angle between the board's normals in two of the views."""
+WORST_VIEWS = 3
+"""Views named in the result for the error the fit leaves in them."""
 MAX_RMS_PX = 2.0
 """A fit that leaves more between the corners and their images is not of this board."""
 CRITERIA = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-12)
@@ -131,7 +133,9 @@ class BoardDetector:
 class Calibration:
     """The fit: intrinsics, image size (width, height), RMS reprojection error (px), the views
     used, the standard deviation of fx fy cx cy (px), the span of the corners (fraction of
-    width, height) and the largest angle between two views' board normals (deg)."""
+    width, height), the largest angle between two views' board normals (deg) and the
+    ``WORST_VIEWS`` views the fit leaves the largest RMS error in (name, px), worst first: a
+    blurred or misdetected frame shows there."""
 
     intrinsics: Intrinsics
     size: tuple[int, int]
@@ -140,6 +144,7 @@ class Calibration:
     std_px: tuple[float, float, float, float]
     span: tuple[float, float]
     tilt_spread_deg: float
+    worst_views: tuple[tuple[str, float], ...] = ()
 
 
 def spread(views: list[View], size: tuple[int, int]) -> tuple[float, float]:
@@ -197,7 +202,7 @@ def calibrate(views: list[View], size: tuple[int, int], k3: bool = False) -> Cal
         )
     flags = 0 if k3 else cv2.CALIB_FIX_K3
     try:
-        rms, matrix, distortion, _, _, std, _, _ = cv2.calibrateCameraExtended(
+        rms, matrix, distortion, _, _, std, _, per_view = cv2.calibrateCameraExtended(
             [v.board_points.astype(np.float32) for v in views],
             [v.image_points.astype(np.float32) for v in views],
             size,
@@ -231,4 +236,8 @@ def calibrate(views: list[View], size: tuple[int, int], k3: bool = False) -> Cal
         tuple(float(s) for s in std.ravel()[:4]),
         span,
         tilt,
+        tuple(
+            (views[i].name, float(per_view[i, 0]))
+            for i in np.argsort(-per_view.ravel())[:WORST_VIEWS]
+        ),
     )

@@ -217,6 +217,7 @@ def _summary(result: Calibration, frames_read: int, output: Path) -> dict:
         "std_px": dict(zip(("fx", "fy", "cx", "cy"), result.std_px, strict=True)),
         "span": list(result.span),
         "tilt_spread_deg": result.tilt_spread_deg,
+        "worst_views": [{"view": name, "rms_px": rms} for name, rms in result.worst_views],
         "output": str(output),
     }
 
@@ -254,7 +255,9 @@ def calibrate_camera(args: argparse.Namespace) -> int:
         f"(standard deviations {' '.join(f'{v:.2f}' for v in s)})\n"
         f"distortion k1 k2 p1 p2 k3: {' '.join(f'{k:.5f}' for k in i.distortion)}\n"
         f"RMS reprojection error {result.rms_px:.3f} px over {result.views} views "
-        f"({read} frames, {size[0]}x{size[1]}); written to {args.output}"
+        f"({read} frames, {size[0]}x{size[1]}); the worst: "
+        + ", ".join(f"{name} {rms:.3f} px" for name, rms in result.worst_views)
+        + f"\nwritten to {args.output}"
     )
     return 0
 

@@ -84,6 +84,8 @@ def test_the_intrinsics_and_distortion_are_recovered_and_written(
     assert whole < DISTORTION_TOLERANCE_PX[0] and inner < DISTORTION_TOLERANCE_PX[1]
     assert found["distortion"][0] == pytest.approx(DISTORTION_TRUE[0], abs=0.01)
     assert found["views"] == VIEWS and found["rms_px"] < 0.2
+    worst = [view["rms_px"] for view in found["worst_views"]]
+    assert len(worst) == 3 and worst == sorted(worst, reverse=True) and worst[0] >= found["rms_px"]
     assert (found["width"], found["height"]) == SIZE
     written = load_calibration(output)
     assert written.size == SIZE
