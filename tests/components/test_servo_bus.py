@@ -1,0 +1,57 @@
+"""The arm driver's protocol 2.0 bus (components/servo_bus.py) on the emulated X-series chain
+through a real pty: torque comes on in position mode with the goal where the servo is, and a
+Sync Read gives every servo's reading or none."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import pytest
+from dynamixel_sdk import PortHandler
+
+from components.servo_bus import XBus, open_port
+from protocols import dynamixel_v2 as dxl
+from protocols.dynamixel_v2 import Address, OperatingMode
+from sim2d.devices.servo_chain import IntegratingJoints
+from sim2d.devices.x_servos import XChainEmulator
+
+START = (0.0, 0.4, -0.6)
+ANSWER_TIMEOUT_S = 1.0
+"""A busy machine's emulator may answer late; only a silent servo reaches this."""
+
+
+@pytest.fixture
+def chain() -> Iterator[tuple[XChainEmulator, IntegratingJoints, XBus]]:
+    arm = IntegratingJoints(START)
+    with XChainEmulator(arm) as emulator:
+        port = PortHandler(emulator.port)
+        assert open_port(port, 1_000_000)
+        yield emulator, arm, XBus(port, ANSWER_TIMEOUT_S)
+        port.closePort()
+
+
+def test_torque_comes_on_in_position_mode_with_the_goal_where_the_servo_is(chain) -> None:
+    """A servo left in velocity mode with a stale goal far away: the goal would have thrown
+    the joint there the moment torque came on."""
+    emulator, arm, bus = chain
+    servo = emulator.servos[1]
+    servo.table[Address.OPERATING_MODE] = OperatingMode.VELOCITY
+    servo.table[Address.GOAL_POSITION : Address.GOAL_POSITION + 4] = dxl.value(4000, 4)
+    assert bus.enable_torque(2) == 0
+    assert servo.table[Address.OPERATING_MODE] == OperatingMode.POSITION
+    assert servo.table[Address.TORQUE_ENABLE] == 1
+    assert servo.word(Address.GOAL_POSITION) == dxl.position_units(START[1])
+    for _ in range(50):
+        emulator.update(0.01)
+        arm.step(0.01)
+    assert abs(arm.angles[1] - START[1]) <= 1.0 / dxl.POSITION_UNITS_PER_RAD
+
+
+def test_a_sync_read_gives_every_reading_or_none(chain) -> None:
+    emulator, arm, bus = chain
+    readings = bus.read_all((1, 2, 3))
+    assert readings is not None
+    assert [units for (units, _), _, _ in readings] == [dxl.position_units(a) for a in START]
+    emulator.fail(2)
+    assert bus.read_all((1, 2, 3)) is None  # read one at a time, to name servo 2's fault
+    assert bus.read(3)[1] is None
