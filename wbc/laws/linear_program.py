@@ -40,7 +40,7 @@ from typing import NamedTuple
 import highspy
 import numpy as np
 
-from wbc.laws.basis_reuse import KeptBasis
+from wbc.laws.basis_reuse import KeptBasis, lapack
 from wbc.laws.constraints.base import LinearRows, OneNormBound, Rows, VelocityBounds
 from wbc.laws.objectives.base import Cost, ResidualCost, VelocityCost
 
@@ -147,6 +147,7 @@ class WarmStartedLP:
 
     def __init__(self) -> None:
         self._highs = highspy.Highs()
+        lapack()  # SciPy's LAPACK loaded with the LP, not in its first step
         for option, value in SOLVER_OPTIONS.items():
             self._highs.setOptionValue(option, value)
         self._layout: _Layout | None = None
