@@ -88,7 +88,10 @@ class Newest(Generic[M]):
         self._payload: zenoh.ZBytes | None = None
         self._kept: M | None = None
         node.counters[f"rejected.{self.topic.name}"] = 0
-        self._subscriber = node.session.declare_subscriber(self.key, self._on_sample)
+        # On the Zenoh thread that received it (no hand-over to a thread of its own): keeping
+        # a reference is all it does.
+        on_sample = zenoh.handlers.Callback(self._on_sample, indirect=False)
+        self._subscriber = node.session.declare_subscriber(self.key, on_sample)
 
     def _on_sample(self, sample: zenoh.Sample) -> None:
         if sample.kind == zenoh.SampleKind.PUT and len(sample.payload) <= self.topic.max_bytes:
@@ -123,7 +126,7 @@ class Ros2Bridge(Component):
     writes = (topics.GOAL_REQUEST,)
     params = (
         Param("domain_id", int, 0, low=0, high=232, doc="the ROS 2 graph's ROS_DOMAIN_ID"),
-        Param("max_rate_hz", float, 50.0, low=1.0, high=1000.0, doc="states published a s"),
+        Param("max_rate_hz", float, 30.0, low=1.0, high=1000.0, doc="states published a s"),
         Param("camera_rate_hz", float, 10.0, low=0.0, high=100.0, doc="images a s; 0: none"),
         Param("goal_rate_hz", float, 2.0, low=0.01, high=100.0, doc="most goals a host s"),
     )

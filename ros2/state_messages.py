@@ -42,9 +42,23 @@ def _unit_quaternion(rotation: bytes) -> tuple[float, ...]:
     return tuple(float(v) for v in dq.quaternion_of_matrix(np.frombuffer(rotation).reshape(3, 3)))
 
 
-def _quaternion(rotation: Array):
-    w, x, y, z = _unit_quaternion(np.ascontiguousarray(rotation, dtype=np.float64).tobytes())
+def _wxyz(rotation: Array) -> tuple[float, ...]:
+    return _unit_quaternion(np.ascontiguousarray(rotation, dtype=np.float64).tobytes())
+
+
+def _quaternion(rotation: Array, wxyz: tuple[float, ...] | None = None):
+    w, x, y, z = _wxyz(rotation) if wxyz is None else wxyz
     return _types()["geometry_msgs/msg/Quaternion"](x=x, y=y, z=z, w=w)
+
+
+def _turn(joint: Joint, q_arm: Array) -> tuple[float, ...]:
+    """(w, x, y, z) of a joint's rotation at ``q_arm``: its origin's (the same with every
+    state), then its own turn about its axis, as quaternions (no matrix to convert)."""
+    origin = _wxyz(joint.origin[:3, :3])
+    if joint.index is None or joint.kind == "prismatic":
+        return origin
+    turn = dq.rotation_quaternion(float(q_arm[joint.index]), joint.axis)
+    return tuple(float(v) for v in dq.qmul(np.array(origin), turn))
 
 
 def _vector(kind: str, values) -> object:
@@ -63,23 +77,33 @@ def joint_state(state: RobotState, names: tuple[str, ...]):
     )
 
 
-def transform_stamped(stamp_ns: int, parent: str, child: str, pose: Array):
-    """geometry_msgs/TransformStamped of ``child`` at ``pose`` (4x4) in ``parent``."""
+def transform_stamped(
+    stamp_ns: int, parent: str, child: str, pose: Array, wxyz: tuple[float, ...] | None = None
+):
+    """geometry_msgs/TransformStamped of ``child`` at ``pose`` (4x4) in ``parent``; ``wxyz``
+    its rotation's quaternion when known (else taken from the matrix)."""
     types = _types()
     return types["geometry_msgs/msg/TransformStamped"](
         header=header(stamp_ns, parent),
         child_frame_id=child,
         transform=types["geometry_msgs/msg/Transform"](
-            translation=_vector("Vector3", pose[:3, 3]), rotation=_quaternion(pose[:3, :3])
+            translation=_vector("Vector3", pose[:3, 3]),
+            rotation=_quaternion(pose[:3, :3], wxyz),
         ),
     )
 
 
-def _pairs(state: RobotState, tree: list[Joint]) -> list[tuple[str, str, Array]]:
-    """(parent, child, pose in parent) of the base in the world, then of every joint."""
+def _pairs(state: RobotState, tree: list[Joint]) -> list[tuple[str, str, Array, tuple]]:
+    """(parent, child, pose in parent, its rotation's quaternion) of the base in the world,
+    then of every joint."""
     q_arm = np.array(state.arm_joints)
-    pairs = [(WORLD, ROOT, planar(*state.base_pose))]
-    return pairs + [(joint.parent, joint.child, joint.transform(q_arm)) for joint in tree]
+    phi = state.base_pose[2]
+    pairs = [
+        (WORLD, ROOT, planar(*state.base_pose), (math.cos(phi / 2), 0.0, 0.0, math.sin(phi / 2)))
+    ]
+    return pairs + [
+        (joint.parent, joint.child, joint.transform(q_arm), _turn(joint, q_arm)) for joint in tree
+    ]
 
 
 def tf_message(state: RobotState, tree: list[Joint]):
@@ -93,7 +117,7 @@ def tf_message(state: RobotState, tree: list[Joint]):
 def frames(state: RobotState, tree: list[Joint]) -> dict[str, Array]:
     """Every frame of the tree (the world, the base, every link) as its 4x4 pose in the world."""
     found = {WORLD: np.eye(4)}
-    for parent, child, pose in _pairs(state, tree):
+    for parent, child, pose, _ in _pairs(state, tree):
         found[child] = found[parent] @ pose
     return found
 
