@@ -3,7 +3,8 @@ sensor stream frames an emulator writes and a driver reads. Pure: bytes in, byte
 
 Commands (115200 baud, 8N1): Start 128, Safe 131, Full 132, Drive Direct
 ``145 Rhi Rlo Lhi Llo`` (signed 16-bit big-endian mm/s, right wheel first, -500..500),
-Stream ``148 n id_1 .. id_n``, Pause/Resume Stream ``150 0|1``.
+Stream ``148 n id_1 .. id_n``, Pause/Resume Stream ``150 0|1``, Sensors ``142 id`` (the robot
+answers the packet's data bytes once; a read, which moves nothing).
 
 Stream frame, sent every 15 ms once requested::
 
@@ -28,6 +29,7 @@ START = 128
 SAFE = 131
 FULL = 132
 DRIVE_DIRECT = 145
+SENSORS = 142
 STREAM = 148
 PAUSE_RESUME_STREAM = 150
 
@@ -37,6 +39,13 @@ VIRTUAL_WALL = 13
 CLIFF_FRONT_LEFT_SIGNAL = 29
 LEFT_ENCODER = 43
 RIGHT_ENCODER = 44
+BATTERY_CHARGE = 25
+"""mAh."""
+BATTERY_CAPACITY = 26
+"""mAh."""
+OI_MODE = 35
+OI_MODES = ("off", "passive", "safe", "full")
+"""The names of packet 35's values 0..3."""
 
 PACKET_LENGTHS: dict[int, int] = {
     BUMPS_AND_WHEEL_DROPS: 1,
@@ -44,6 +53,9 @@ PACKET_LENGTHS: dict[int, int] = {
     CLIFF_FRONT_LEFT_SIGNAL: 2,
     LEFT_ENCODER: 2,
     RIGHT_ENCODER: 2,
+    BATTERY_CHARGE: 2,
+    BATTERY_CAPACITY: 2,
+    OI_MODE: 1,
 }
 """Data bytes of each sensor packet this module decodes; every one is unsigned, big-endian."""
 
@@ -80,6 +92,12 @@ def stream_request(packet_ids: Iterable[int]) -> bytes:
     """Stream: ``148 n id_1 .. id_n``."""
     ids = list(packet_ids)
     return bytes([STREAM, len(ids), *ids])
+
+
+def sensors(packet_id: int) -> bytes:
+    """Sensors: ``142 id``, answered by the packet's data bytes (``packet_data``)."""
+    _packet_length(packet_id)
+    return bytes([SENSORS, packet_id])
 
 
 def pause_resume(on: bool) -> bytes:

@@ -5,8 +5,10 @@ The OI modes: Off until Start (128), which sets Passive (and stops the wheels); 
 Full (132) from any started mode. Drive Direct (145) acts in Safe and Full only, clamps each
 wheel to +-500 mm/s and sets the backend's wheel speeds (m/s) until the next command: the real
 robot has no command timeout. Stream (148 n ids) sends a frame of the requested packets every
-15 ms, encoders (43, 44) as counts mod 2^16; Pause/Resume Stream (150 0|1). Commands other than
-Start are ignored while Off. Bytes that start no known command are counted and skipped; packets
+15 ms, encoders (43, 44) as counts mod 2^16; Pause/Resume Stream (150 0|1); Sensors (142 id)
+answers the OI mode (35) and the battery's charge and capacity (25, 26: ``battery_mah``) once.
+Commands other than Start are ignored while Off; ``opcodes`` counts the commands received by
+opcode. Bytes that start no known command are counted and skipped; packets
 other than the encoders are counted and left out of the frames. Safe mode's cliff and wheel-drop
 reflexes are not emulated.
 
@@ -19,6 +21,7 @@ from __future__ import annotations
 import enum
 import threading
 import time
+from collections import Counter
 from pathlib import Path
 from typing import Protocol
 
@@ -49,6 +52,7 @@ _FIXED_DATA_LENGTHS: dict[int, int] = {
     oi.FULL: 0,
     oi.DRIVE_DIRECT: 4,
     oi.PAUSE_RESUME_STREAM: 1,
+    oi.SENSORS: 1,
 }
 """Data bytes after each opcode the emulator knows, but Stream's, which carries 1 + n."""
 _DRIVING_MODES = (Mode.SAFE, Mode.FULL)
@@ -66,8 +70,16 @@ class Create2Emulator(SerialDevice):
     OI mode; ``counters`` counts commands executed and ignored, bad bytes (no known opcode),
     unsupported stream packets, frames sent and output bytes dropped while nobody read."""
 
-    def __init__(self, backend: WheelBackend, link: Path | None = None) -> None:
+    def __init__(
+        self,
+        backend: WheelBackend,
+        link: Path | None = None,
+        battery_mah: tuple[int, int] = (2400, 3000),
+    ) -> None:
         self._backend = backend
+        self.battery_mah = battery_mah
+        """The battery's charge and capacity (mAh)."""
+        self.opcodes: Counter[int] = Counter()
         super().__init__(
             link,
             (
@@ -102,6 +114,7 @@ class Create2Emulator(SerialDevice):
             return
         command = bytes(self._pending)
         self._pending.clear()
+        self.opcodes[command[0]] += 1
         self._execute(command[0], command[1:])
 
     def _execute(self, opcode: int, data: bytes) -> None:
@@ -123,6 +136,19 @@ class Create2Emulator(SerialDevice):
             self._request_stream(data[1:])
         elif opcode == oi.PAUSE_RESUME_STREAM:
             self._streaming = data[0] != 0 and bool(self._stream_ids)
+        elif opcode == oi.SENSORS:
+            self._answer_sensor(data[0])
+
+    def _answer_sensor(self, packet_id: int) -> None:
+        values = {
+            oi.OI_MODE: list(Mode).index(self.mode),
+            oi.BATTERY_CHARGE: self.battery_mah[0],
+            oi.BATTERY_CAPACITY: self.battery_mah[1],
+        }
+        if packet_id not in values:
+            self.counters["unsupported_packets"] += 1
+            return
+        self.send(oi.packet_data(packet_id, values[packet_id]))
 
     def _accepts(self, opcode: int) -> bool:
         """Off accepts only Start; Drive Direct needs Safe or Full."""

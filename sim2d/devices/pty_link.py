@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import select
+import termios
 import threading
 import tty
 from pathlib import Path
@@ -16,6 +17,13 @@ from typing import Self
 
 READ_TIMEOUT_S = 0.02
 """How long a reader waits for bytes before it looks whether it should stop."""
+_RATES = {
+    getattr(termios, f"B{rate}"): rate
+    for rate in (9600, 19200, 38400, 57600, 115200, 230400, 460800, 500000, 576000, 921600)
+    + (1000000, 2000000, 3000000)
+    if hasattr(termios, f"B{rate}")
+}
+"""termios's speed constants by bit rate (those a Dynamixel or a Create runs at)."""
 
 
 class PtyLink:
@@ -31,6 +39,10 @@ class PtyLink:
             if link.is_symlink() or link.exists():
                 link.unlink()
             link.symlink_to(self.port)
+
+    def baud(self) -> int | None:
+        """The bit rate the driver set on the port (None: one not in ``_RATES``)."""
+        return _RATES.get(termios.tcgetattr(self.master)[5])
 
     def close(self) -> None:
         """Close both ends; remove the link if it still names this port."""

@@ -9,6 +9,7 @@ A servo of a chain (``AXServo``, ``XServo``) has an ``id``, ``silent``, ``corrup
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, Protocol
@@ -57,16 +58,26 @@ COUNTERS = (
 
 class ServoChain(SerialDevice):
     """Servos on one pseudo-terminal, one per joint of ``backend``; ``parser`` frames the
-    driver's packets (``feed``, ``bad_checksums``, ``skipped_bytes``)."""
+    driver's packets (``feed``, ``bad_checksums``, ``skipped_bytes``). ``instructions`` counts
+    the packets received by instruction. With ``baud`` (bit/s) the servos listen at that rate
+    only: bytes written while the port is set to another are garbled for them and dropped
+    (``wrong_baud_bytes``), as on a real bus."""
 
     def __init__(
-        self, backend: ServoBackend, servos: Sequence[Any], parser: Any, link: Path | None
+        self,
+        backend: ServoBackend,
+        servos: Sequence[Any],
+        parser: Any,
+        link: Path | None,
+        baud: int | None = None,
     ) -> None:
         self._backend = backend
         self.servos = list(servos)
         self._previous_positions: list[float] = list(backend.joint_positions())
-        super().__init__(link, COUNTERS)
+        super().__init__(link, (*COUNTERS, "wrong_baud_bytes"))
         self._parser = parser
+        self._baud = baud
+        self.instructions: Counter[int] = Counter()
 
     def fail(self, servo_id: int, silent: bool = True) -> None:
         """Fault injection (see the servo's ``fail``)."""
@@ -126,7 +137,11 @@ class ServoChain(SerialDevice):
         return next((servo for servo in self.servos if servo.id == servo_id), None)
 
     def receive(self, data: bytes) -> None:
+        if self._baud is not None and self._pty.baud() != self._baud:
+            self.counters["wrong_baud_bytes"] += len(data)
+            return
         for packet in self._parser.feed(data):
+            self.instructions[packet.instruction] += 1
             self._handle_guarded(packet)
         self.counters["bad_checksums"] = self._parser.bad_checksums
         self.counters["skipped_bytes"] = self._parser.skipped_bytes

@@ -229,6 +229,7 @@ class XChainEmulator(ServoChain):
         ids: Sequence[int] | None = None,
         link: Path | None = None,
         return_delay_us: float = 500.0,
+        baud: int | None = None,
     ) -> None:
         positions = backend.joint_positions()
         ids = range(1, len(positions) + 1) if ids is None else ids
@@ -236,7 +237,7 @@ class XChainEmulator(ServoChain):
             XServo(servo_id, return_delay_us, position)
             for servo_id, position in zip(ids, positions, strict=True)
         ]
-        super().__init__(backend, servos, dxl.PacketParser(), link)
+        super().__init__(backend, servos, dxl.PacketParser(), link, baud)
 
     def _handle(self, packet: dxl.Packet) -> None:
         self.counters["packets"] += 1
