@@ -19,6 +19,7 @@ from launch.query import QueryError, live_writers, overwritten_by
 from launch.tool_clock import ToolClock
 from messages import codec, topics
 from outputs.stdout import emit, json_text
+from parsimony.stop_signals import stop_signals
 from parsimony.target_options import fail, profile_and_target, target_options
 from profiles.profile import Profile, ProfileError
 
@@ -166,7 +167,7 @@ def echo(args: argparse.Namespace, session: zenoh.Session, profile: Profile) -> 
                 done.set()
             changed.notify_all()
 
-    with listen(session, key, topic, done, on_message), changed:
+    with stop_signals(raising=True), listen(session, key, topic, done, on_message), changed:
         seen, since, noted = 0, time.monotonic(), False
         try:
             while not done.is_set():

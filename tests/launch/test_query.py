@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import signal
 import subprocess
 import sys
 import threading
@@ -21,6 +22,7 @@ from messages import codec
 from messages.goal import Goal
 from parsimony.commands import param, status
 from parsimony.target_options import PROFILE_ENV
+from tests.view.live_view_client import StderrLines, background_job, stopped_by
 from wbc import dq
 
 
@@ -289,3 +291,13 @@ def test_node_info_shows_what_a_component_reads_writes_and_counts(running_pub: P
     assert info["reads"] == [] and info["writes"] == ["robot/state", "control/goal"]
     assert info["counters"]["published.robot/state"] > 0
     assert info["parameters"]["rate_hz"] > 0
+
+
+def test_topic_echo_started_in_the_background_stops_on_sigint(running_pub: Path) -> None:
+    """Started as a shell's background job (SIGINT ignored, inherited), echo on a silent topic
+    still stops at Ctrl-C's signal, and exits 0 with nothing on stdout."""
+    echo = background_job("topic", "echo", "world/obstacles", "--profile", str(running_pub))
+    said = StderrLines(echo)
+    said.wait_for("waiting for messages on test/world/obstacles")
+    assert stopped_by(echo, signal.SIGINT) == 0, said.all()
+    assert echo.stdout is None or echo.stdout.read() == ""
