@@ -7,6 +7,7 @@ from pydantic import Field
 from messages.base import Count, Message
 from messages.header import Header
 from messages.process import ParamValue
+from messages.stop import StopState
 
 
 class ComponentStatus(Message):
@@ -15,7 +16,8 @@ class ComponentStatus(Message):
     ``name`` is the instance name from the profile, ``module`` the Python module
     it runs, ``state`` its life-cycle state, ``pid`` its process id,
     ``counters`` monotonic event counts (messages in, out, dropped...) and
-    ``parameters`` its current tunable parameters.
+    ``parameters`` its current tunable parameters; ``stop`` the emergency stop it holds (a
+    component that obeys the stop: ``components.stop_latch``), else None.
     """
 
     header: Header
@@ -25,3 +27,4 @@ class ComponentStatus(Message):
     pid: Count
     counters: dict[str, Count] = Field(default_factory=dict)
     parameters: dict[str, ParamValue] = Field(default_factory=dict)
+    stop: StopState | None = None

@@ -33,6 +33,7 @@ from messages.obstacles import Obstacles
 from messages.odometry import BaseOdometry
 from messages.state import RobotState
 from messages.status import ComponentStatus
+from messages.stop import StopState
 from messages.supervisor import SupervisorStatus
 from messages.truth import SimTruth
 
@@ -86,6 +87,8 @@ ARM_COMMAND = Topic("arm/command", "arm/command", ArmCommand)
 CONTROL_DIAGNOSTICS = Topic("control/diagnostics", "control/diagnostics", ControllerDiagnostics)
 SIM_CLOCK = Topic("sim/clock", "sim/clock", Clock)
 SIM_TRUTH = Topic("sim/truth", "sim/truth", SimTruth, ground_truth=True)
+CONTROL_STOP = Topic("control/stop", "control/stop", StopState)
+"""The latched emergency stop and its release (``components.stop_latch``)."""
 
 TOPICS: Mapping[str, Topic] = MappingProxyType(
     {
@@ -107,6 +110,7 @@ TOPICS: Mapping[str, Topic] = MappingProxyType(
             CONTROL_DIAGNOSTICS,
             SIM_CLOCK,
             SIM_TRUTH,
+            CONTROL_STOP,
         )
     }
 )

@@ -24,6 +24,7 @@ from messages import (
 )
 from messages.base import Message
 from messages.obstacles import Cylinder, Plane, Solids
+from messages.stop import StopState
 from messages.supervisor import SupervisorStatus
 from messages.truth import SimTruth
 
@@ -138,7 +139,9 @@ EXAMPLES: tuple[Message, ...] = (
         pid=4242,
         counters={"received": 10, "published": 9},
         parameters={"eta": 5.0, "steps": 3, "law": "lp", "warm_start": True},
+        stop=StopState(header=HEADER, stopped=True, reason="a hand in the way"),
     ),
+    StopState(header=HEADER, stopped=False),
     Clock(stamp_ns=123_000_000),
     SimTruth(
         header=HEADER,

@@ -66,6 +66,7 @@ def test_the_table_holds_every_topic_of_the_design() -> None:
         "control/diagnostics": "ControllerDiagnostics",
         "sim/clock": "Clock",
         "sim/truth": "SimTruth",
+        "control/stop": "StopState",
     }
 
 
