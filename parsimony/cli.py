@@ -36,6 +36,7 @@ COMMANDS = (
     "reproduce",
     "calibrate",
     "study",
+    "doctor",
 )
 
 
