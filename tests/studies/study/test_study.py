@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -96,7 +97,11 @@ def scheduler(tmp_path_factory):
         for process in reversed(processes):
             process.terminate()
         for process in processes:
-            process.wait(timeout=30)
+            try:
+                process.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait()
 
 
 def test_a_dask_cluster_gives_the_local_pools_rows(local, scheduler, tmp_path, capsys) -> None:
@@ -144,3 +149,26 @@ def test_a_study_naming_an_unknown_law_is_one_line(tmp_path, capsys) -> None:
     assert main(["study", str(file)]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("parsimony study: no kinematic law 'lq'") and "\n" not in err
+
+
+def test_a_worker_killed_mid_study_loses_no_run(local, scheduler, tmp_path) -> None:
+    """Last of the cluster's tests: one of its two workers is killed while it holds a run;
+    the study ends with every row, each run to the end."""
+    from distributed import Client
+
+    path = tmp_path / "tiny.parquet"
+    command = [sys.executable, "-m", "parsimony.cli", "study", str(study_file(tmp_path))]
+    command += ["--address", scheduler, "--results", str(path)]
+    study = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
+    with Client(scheduler, timeout="60s") as client:
+        deadline = time.monotonic() + 300
+        busy: list[str] = []
+        while not busy and time.monotonic() < deadline and study.poll() is None:
+            busy = [worker for worker, held in client.processing().items() if held]
+            time.sleep(0.05)
+        assert busy, "no worker was seen holding a run"
+        os.kill(client.run(os.getpid, workers=busy[:1])[busy[0]], signal.SIGKILL)
+    out, _ = study.communicate(timeout=600)
+    assert study.returncode == 0
+    assert json.loads(out)["runs"] == 4
+    assert findings(path) == findings(local)
