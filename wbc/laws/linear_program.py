@@ -209,8 +209,9 @@ class WarmStartedLP:
         halves = halves - np.minimum(halves[0], halves[1])
         u = halves[0] - halves[1]
         # The constant -sum_b w_b 1'b_b; the residual rows' upper bounds hold -b.
-        offsets = -float(layout.row_weight @ layout.residual_upper)
-        objective = float(layout.cost @ values) - offsets
+        # ndarray.dot: the same BLAS sums as @, in about half the time for vectors this short.
+        offsets = -float(layout.row_weight.dot(layout.residual_upper))
+        objective = float(layout.cost.dot(values)) - offsets
         active = _active(u, linear, norms, bounds)
         return LPSolution(u, status, objective, active, halves[0], halves[1])
 
@@ -319,7 +320,7 @@ def _fill_costs(layout: _Layout, positive: Array, negative: Array) -> None:
     """u_P: c_P - sum_b w_b 1'A_b, u_N: c_N + sum_b w_b 1'A_b (rows weighted by w), with c_P
     and c_N the velocity costs of each entry's two directions; y_b's 2 w_b are set with the
     weights (``_Layout.weigh``)."""
-    column_sums = layout.row_weight @ layout.residual_plus
+    column_sums = layout.row_weight.dot(layout.residual_plus)
     np.subtract(positive, column_sums, out=layout.cost_positive)
     np.add(negative, column_sums, out=layout.cost_negative)
 

@@ -104,7 +104,7 @@ def program(
     q, dt = np.asarray(q, dtype=float), float(dt)
     # One test for a good q and dt (q'q is finite only if every q_i is, or overflows: then
     # ``_check`` looks entry by entry); ``_check`` names what is wrong.
-    if q.ndim != 1 or not math.isfinite(q @ q) or not 0.0 < dt < math.inf:
+    if q.ndim != 1 or not math.isfinite(q.dot(q)) or not 0.0 < dt < math.inf:
         _check(q, dt)
     circles, solids = _obstacles(obstacles) if obstacles else ((), ())
     chain = robot.forward(q)  # one pass for the task and the collision parts' rows
