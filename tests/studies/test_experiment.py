@@ -34,9 +34,10 @@ from wbc.planar import inverse
 from wbc.robot import MobileManipulator
 
 ROBOT = MobileManipulator.from_yaml(load_profile(PROFILES["lp"]).robot)
-SHORT_RUN = {"time_limit_s": 3.0}
-"""A run cut at 3 simulated seconds, for a test whose point comes in its first second (the
-estimator's fix, the law's first rows engaged), not at its convergence."""
+SHORT_RUN_S = 3.0
+SHORT_RUN = {"time_limit_s": SHORT_RUN_S}
+"""A run cut at 3 simulated seconds, for a test whose point comes in its first seconds (the
+estimator's fix, the law's first rows engaged, the error falling), not at its convergence."""
 
 
 @pytest.fixture(scope="module")
@@ -126,13 +127,20 @@ def test_two_lockstep_runs_of_one_seed_send_bit_identical_commands(
 
 
 def test_the_qp_controller_runs_the_pose_experiment_as_the_lp_does(tmp_path: Path) -> None:
-    """deploy/sim_qp.yaml: the QP of the LP's rows and terms, a process like the others, reaches
-    the goal seen by the camera; it spreads u over every entry (not parsimonious)."""
-    report = run_here(tmp_path, "pose", controller="qp")
-    assert_sound(report)
-    assert set(report["controller_statuses"]) <= {"optimal", "invalid state"}  # before a fix
+    """deploy/sim_qp.yaml: the QP of the LP's rows and terms, a process like the others, takes
+    the robot towards the goal seen by the camera; it spreads u over every entry (not
+    parsimonious). The run is cut at SHORT_RUN_S (the error falls from 0.64 to under 0.1 by
+    then); that the QP reaches the goal of 6.2.1 is tests/wbc/laws/test_qp_law.py's."""
+    report = run_here(tmp_path, "pose", controller="qp", **SHORT_RUN)
+    assert report["contacts"] == 0 and report["joint_limit_violations"] == 0
+    statuses = report["controller_statuses"]
+    assert set(statuses) <= {"optimal", "invalid state"}  # before a fix
+    assert statuses["optimal"] > 0.9 * report["iterations"], statuses
     histogram = {int(k): v for k, v in report["nonzero_entries"].items()}
     assert max(histogram, key=histogram.get) == 8, histogram
+    steps = load_session(tmp_path / "session.mcap", {"control/diagnostics"})["control/diagnostics"]
+    errors = [d.error_norm for d in steps if d.error_norm is not None]
+    assert errors[-1] < 0.5 * errors[0], (errors[0], errors[-1])  # on its way to the goal
 
 
 def obstacle_rows(out: Path) -> tuple[set[str], set[str]]:
