@@ -16,9 +16,7 @@ from __future__ import annotations
 
 import argparse
 import math
-import multiprocessing
 import sys
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -26,8 +24,10 @@ import numpy as np
 from outputs.stdout import emit, json_text, result_only_stdout, table
 from profiles.deploy_files import ROBOT_FILE
 from studies.gain_sets import input_change_gains
-from studies.goal_sets import FAMILIES, Attempt, attempt, goals, parsimony, shares
-from wbc.laws.lp_law import LPLaw, LPParams
+from studies.goal_families import GOAL_SEED
+from studies.goal_sets import Attempt, parsimony, shares
+from studies.study.attempts import sweep_attempts
+from studies.study.schema import Study
 from wbc.robot import MobileManipulator
 
 VARIANTS: dict[str, dict[str, Any]] = {
@@ -42,28 +42,17 @@ form, w ||u - u_prev||_1, at two weights."""
 TASKS = ("pose", "position")
 
 
-def _attempt_one(job: tuple[dict[str, Any], Path, np.ndarray, np.ndarray, bool]) -> Attempt:
-    gains, robot_file, start, goal, position = job
-    robot = MobileManipulator.from_yaml(robot_file)
-    return attempt(LPLaw(robot, LPParams(**gains)), robot, start, goal, position=position)
-
-
-def measure(
-    names: list[str], count: int, workers: int, robot_file: Path = ROBOT_FILE
-) -> dict[str, dict[str, list[Attempt]]]:
-    """Every variant's attempts at the 'ahead' goals, per task."""
-    robot = MobileManipulator.from_yaml(robot_file)
-    pairs = goals(FAMILIES["ahead"], count, robot)
-    found: dict[str, dict[str, list[Attempt]]] = {task: {} for task in TASKS}
-    with multiprocessing.get_context("spawn").Pool(workers) as pool:
-        for task in TASKS:
-            for name in names:
-                print(f"bench: {name}, {task} task, {count} goals", file=sys.stderr, flush=True)
-                jobs = [
-                    (VARIANTS[name], robot_file, start, goal, task == "position")
-                    for start, goal in pairs
-                ]
-                found[task][name] = pool.map(_attempt_one, jobs, chunksize=1)
+def measure(names: list[str], count: int, workers: int) -> dict[str, dict[str, list[Attempt]]]:
+    """Every variant's attempts at the 'ahead' goals, per task (a study on the local pool)."""
+    laws = [{"law": "lp", "label": name, "gains": VARIANTS[name]} for name in names]
+    found: dict[str, dict[str, list[Attempt]]] = {}
+    for task in TASKS:
+        study = Study.model_validate(
+            {"name": f"input-change-{task}", "families": ["ahead"], "task": task}
+            | {"goals": count, "seeds": [GOAL_SEED], "laws": laws}
+        )
+        ran = sweep_attempts(study, workers)
+        found[task] = {name: ran[("ahead", task, GOAL_SEED, name)] for name in names}
     return found
 
 
