@@ -231,19 +231,22 @@ def servo_checks(port: str, baud: int, protocol: int, joints: Sequence[Joint]) -
 
 
 def _silent_lines(bus: Bus, silent: list[Joint], ids: list[int], baud: int) -> list[Check]:
-    """Where the servos that did not answer are: at another id, another baud rate, or none."""
-    elsewhere = bus.find_elsewhere([j.id for j in silent], ids)
-    other_baud = None if elsewhere else bus.find_baud([j.id for j in silent], baud)
+    """Where the servos that did not answer are: when none did, at another baud rate; else at
+    another id; or nowhere."""
+    missing = [j.id for j in silent]
+    other_baud = bus.find_baud(missing, baud) if len(silent) == len(ids) else None
+    elsewhere = [] if other_baud else bus.find_elsewhere(missing, ids)
     lines = []
     for joint in silent:
         name, expected = f"servo {joint.id} ({joint.name})", f"id {joint.id} at {baud} baud"
         if elsewhere:
             found = ", ".join(map(str, elsewhere))
+            answer = f"id {found} answers" if len(elsewhere) == 1 else f"ids {found} answer"
             lines.append(
                 Check(
                     name,
                     "fail",
-                    f"no answer at {expected}; id {found} answers instead",
+                    f"no answer at {expected}; {answer} instead",
                     f"set that servo's id to {joint.id} (Dynamixel Wizard), or the robot's "
                     "servos.ids (or arm_driver's ids) to the ids the servos have",
                 )
