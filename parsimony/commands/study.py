@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 from outputs.stdout import emit, json_text
+from parsimony.stop_signals import Interrupted, stop_signals
 from studies.study import results
 from studies.study.drive import drive
 from studies.study.report import check_tables, markdown, update_page
@@ -75,7 +76,16 @@ def run(args: argparse.Namespace) -> int:
         from studies.study.local import LocalPool
 
         runner = LocalPool(args.workers)
-    with runner:
-        counts = drive(runs, runner, path, study.name)
+    with stop_signals(raising=True):
+        try:
+            with runner:
+                counts = drive(runs, runner, path, study.name)
+        except Interrupted as stop:
+            print(
+                f"parsimony study: stopped by {stop.signal}; the rows done are in {path}, "
+                "and running it again runs the others",
+                file=sys.stderr,
+            )
+            return stop.exit_code
     emit(json_text({"study": study.name, "results": str(path), **counts}))
     return 0

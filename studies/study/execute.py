@@ -72,6 +72,8 @@ def _child(run: Run, write: int) -> None:
     """Run ``run`` and write its answer to ``write``; never returns."""
     code = 0
     try:
+        for stop in (signal.SIGINT, signal.SIGTERM):  # the study's handlers are not the run's
+            signal.signal(stop, signal.SIG_DFL)
         log = os.path.join(run.out, "run.log") if run.out else os.devnull
         if run.out:
             os.makedirs(run.out, exist_ok=True)

@@ -22,8 +22,10 @@ class LocalPool:
         self._threads = ThreadPoolExecutor(self.workers, thread_name_prefix="study")
         return self
 
-    def __exit__(self, *exc: object) -> None:
-        self._threads.shutdown(wait=True, cancel_futures=True)
+    def __exit__(self, kind: type | None, *exc: object) -> None:
+        """Waits for the runs under way, unless the study was stopped (they end on their own,
+        their answers unread)."""
+        self._threads.shutdown(wait=kind is None, cancel_futures=True)
 
     def outcomes(self, runs: list[Run]) -> Iterator[tuple[Run, dict[str, Any]]]:
         """Each run with its outcome (``execute``), in the order they finish."""

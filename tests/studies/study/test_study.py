@@ -172,3 +172,27 @@ def test_a_worker_killed_mid_study_loses_no_run(local, scheduler, tmp_path) -> N
     assert study.returncode == 0
     assert json.loads(out)["runs"] == 4
     assert findings(path) == findings(local)
+
+
+def test_a_study_stopped_keeps_its_rows_and_the_next_runs_the_others(
+    local, tmp_path, capsys
+) -> None:
+    """SIGTERM once a run is done: exit 143, the rows done saved; run again, the others ran."""
+    path = tmp_path / "tiny.parquet"
+    file = study_file(tmp_path)
+    command = [sys.executable, "-m", "parsimony.cli", "study", str(file), "--workers", "1"]
+    study_run = subprocess.Popen(
+        [*command, "--results", str(path)], cwd=ROOT, stderr=subprocess.PIPE, stdout=subprocess.PIPE
+    )
+    said = b""
+    while b" 1/4 " not in said and study_run.poll() is None:  # the progress bar's first run
+        said += os.read(study_run.stderr.fileno(), 4096)
+    study_run.send_signal(signal.SIGTERM)
+    _, err = study_run.communicate(timeout=300)
+    assert study_run.returncode == 143, (said + err).decode()[-2000:]
+    assert b"stopped by SIGTERM" in err
+    kept = len(results.read(path))
+    assert 1 <= kept < 4
+    counts = study(capsys, file, "--results", path)
+    assert (counts["already_there"], counts["ran"]) == (kept, 4 - kept)
+    assert findings(path) == findings(local)
