@@ -173,7 +173,7 @@ def _servo_line(bus: Bus, joint: Joint, baud: int) -> Check:
         model, torque = int.from_bytes(table[0:2], "little"), table[dxl1.Address.TORQUE_ENABLE]
         low = int.from_bytes(table[6:8], "little")
         high = int.from_bytes(table[8:10], "little")
-        hardware_error = 0
+        hardware_error, operating = 0, ""
     else:
         table = bus.read(joint.id, 0, 71)
         if table is None:
@@ -182,6 +182,9 @@ def _servo_line(bus: Bus, joint: Joint, baud: int) -> Check:
         high = dxl2.signed(table[48:52])
         low = dxl2.signed(table[52:56])
         hardware_error = table[dxl2.Address.HARDWARE_ERROR_STATUS]
+        mode = table[dxl2.Address.OPERATING_MODE]
+        modes = {m.value: m.name.lower() for m in dxl2.OperatingMode}
+        operating = f", {modes.get(mode, f'operating mode {mode}')} mode"
     what = f"{model_name(model)} at {baud} baud, protocol {bus.protocol}.0"
     if model not in DRIVEN[bus.protocol]:
         driven = ", ".join(model_name(m) for m in DRIVEN[bus.protocol][:3])
@@ -193,7 +196,7 @@ def _servo_line(bus: Bus, joint: Joint, baud: int) -> Check:
         )
     limits = f"angle limits {low}..{high}"
     torque_text = "torque on (holding)" if torque else "torque off"
-    detail = f"{what}, {limits}, {torque_text}"
+    detail = f"{what}, {limits}{operating}, {torque_text}"
     if hardware_error:
         bits = [bit.name.lower() for bit in dxl2.HardwareError if hardware_error & bit]
         return Check(
