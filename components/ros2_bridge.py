@@ -43,6 +43,7 @@ from components.process_entry import run_component
 from components.pubsub import Input
 from components.runtime import Component, Node
 from messages import codec, topics
+from messages.camera import CameraFrame
 from messages.goal import Goal
 from messages.state import RobotState
 from messages.supervisor import SupervisorStatus
@@ -69,6 +70,8 @@ log = logging.getLogger("components.ros2_bridge")
 M = TypeVar("M", bound=BaseModel)
 
 NODE_NAME = "parsimony"
+STATE_TOPICS = (JOINT_STATES, TF, ODOM, made.CLOCK)
+"""What a state is published on (/clock on simulated time only)."""
 REFUSALS = ("type_hash", "flood", "malformed_cdr", "frame", "goal")
 DIAGNOSTICS_EVERY_S = 1.0
 """/diagnostics goes out at least this often (host seconds) while states come."""
@@ -87,7 +90,7 @@ class Newest(Generic[M]):
         self.key = self.topic.key(node.namespace)
         self._payload: zenoh.ZBytes | None = None
         self._kept: M | None = None
-        node.counters[f"rejected.{self.topic.name}"] = 0
+        node.counters.setdefault(f"rejected.{self.topic.name}", 0)
         # On the Zenoh thread that received it (no hand-over to a thread of its own): keeping
         # a reference is all it does.
         on_sample = zenoh.handlers.Callback(self._on_sample, indirect=False)
@@ -110,6 +113,10 @@ class Newest(Generic[M]):
             self.node.warn(f"rejected.{self.topic.name}", f"dropped a malformed message: {error}")
             return self._kept if keep else None
         return self._kept
+
+    def close(self) -> None:
+        """Stop reading the topic."""
+        self._subscriber.undeclare()
 
 
 class Ros2Bridge(Component):
@@ -153,7 +160,8 @@ class Ros2Bridge(Component):
         self.goal_request = node.publisher(topics.GOAL_REQUEST)
         self._declare(int(node.params["domain_id"]), camera is not None)
         self.states = Newest(node, topics.ROBOT_STATE)
-        self.frames_in = Newest(node, topics.CAMERA_IMAGE)
+        self.frames_in: Newest[CameraFrame] | None = None
+        """The camera's frames, read while a ROS 2 node reads /camera (``publish_image``)."""
         self.controller = Newest(node, topics.CONTROL_DIAGNOSTICS)
         node.subscribe(topics.SUPERVISOR_STATUS, self.on_supervisor)
         node.subscribe(topics.GOAL_REQUEST, self.on_goal)
@@ -203,13 +211,17 @@ class Ros2Bridge(Component):
         return found
 
     def publish_state(self) -> None:
-        """/joint_states, /tf, /odom (and /clock) of the newest state, if a new one came."""
+        """/joint_states, /tf, /odom (and /clock) of the newest state, if a new one came and a
+        ROS 2 node reads one of them (the state is kept for goals either way)."""
         self.state_timer.period_ns = round(1e9 * self._period("max_rate_hz"))
         state = self.states.take()
         names = self.robot.joint_names
         if state is None or not state.valid:
             return
         if not joints_match(self.node, "refused_states", "robot/state", state.joint_names, names):
+            return
+        before, self.latest = self.latest, state
+        if not any(self.out[topic].listened() for topic in STATE_TOPICS if topic in self.out):
             return
         stamp = state.header.stamp_ns
         tf = tf_message(state, self.tree)
@@ -218,10 +230,9 @@ class Ros2Bridge(Component):
             tf.transforms.append(transform_stamped(stamp, WORLD, made.GOAL_FRAME, goal))
         self.out[JOINT_STATES].put(joint_state(state, names))
         self.out[TF].put(tf)
-        self.out[ODOM].put(odometry(state, self.latest))
+        self.out[ODOM].put(odometry(state, before))
         if made.CLOCK in self.out:
             self.out[made.CLOCK].put(made.clock(stamp))
-        self.latest = state
 
     @staticmethod
     def _goal_matrix(goal: Goal) -> np.ndarray:
@@ -233,12 +244,22 @@ class Ros2Bridge(Component):
         return where
 
     def publish_image(self) -> None:
-        """The newest camera frame and its intrinsics, if a new one came."""
+        """The newest camera frame and its intrinsics, if a new one came. The frames are read
+        only while a ROS 2 node subscribes to the camera's topics: an image costs the camera
+        a copy to each reader."""
         self.image_timer.period_ns = round(1e9 * self._period("camera_rate_hz"))
-        frame = self.frames_in.take()
-        if frame is None or made.COMPRESSED_IMAGE not in self.out:
+        if made.COMPRESSED_IMAGE not in self.out:
             return
-        if float(self.node.params["camera_rate_hz"]) <= 0.0:
+        wanted = float(self.node.params["camera_rate_hz"]) > 0.0 and (
+            self.out[made.COMPRESSED_IMAGE].listened() or self.out[made.CAMERA_INFO].listened()
+        )
+        if wanted and self.frames_in is None:
+            self.frames_in = Newest(self.node, topics.CAMERA_IMAGE)
+        elif not wanted and self.frames_in is not None:
+            self.frames_in.close()
+            self.frames_in = None
+        frame = self.frames_in.take() if self.frames_in is not None else None
+        if frame is None:
             return
         if frame.encoding == "jpeg":
             data = frame.data

@@ -48,6 +48,10 @@ class Publisher:
     zenoh_publisher: zenoh.Publisher | zenoh.ext.AdvancedPublisher
     sequence: int = 0
 
+    def listened(self) -> bool:
+        """Whether a subscriber matches this publisher's key (a ROS 2 node reads the topic)."""
+        return self.zenoh_publisher.matching_status.matching
+
     def put(self, message: object) -> bytes:
         """Serialise ``message`` to CDR and put it with its attachment; the CDR bytes."""
         data = bytes(wire.typestore().serialize_cdr(message, self.msgtype))

@@ -25,7 +25,6 @@ from launch import query
 from messages import codec, topics
 from messages.camera import CameraFrame, CameraIntrinsics
 from messages.header import Header
-from messages.supervisor import SupervisorStatus
 from profiles.deploy_files import DEPLOY, ROBOT_FILE
 from profiles.profile_files import read_profile_data
 from ros2.urdf import urdf
@@ -107,6 +106,14 @@ class Bridge:
         status = query.status_of(self.system.router, self.system.profile.namespace, "ros2_bridge")
         return status.counters
 
+    def until(self, key: str, action: Callable[[], None]) -> None:
+        """Do ``action`` again every 50 ms until something arrives on ``key``."""
+        deadline = time.monotonic() + DEADLINE_S
+        while not self.ros.samples.get(key):
+            assert time.monotonic() < deadline, f"nothing on {key}"
+            action()
+            time.sleep(0.05)
+
     def wait_counter(self, name: str, at_least: int) -> dict[str, int]:
         deadline = time.monotonic() + DEADLINE_S
         while (counters := self.counters()).get(name, 0) < at_least:
@@ -181,11 +188,12 @@ def test_each_topic_is_on_its_design_key_with_the_attachment_and_rosbags_cdr(bri
     frame = CameraFrame(
         header=header, encoding="jpeg", width=640, height=480, data=JPEG, intrinsics=intrinsics
     )
-    bridge.put(topics.CAMERA_IMAGE, frame)
-    status = SupervisorStatus(
-        header=header, phase="idle", candidate=0, plans=0, replans=0, stalls=0
+    # the bridge reads the camera, and publishes a state, once it sees a ROS 2 reader
+    bridge.until(
+        design_key("camera/camera_info", "sensor_msgs/msg/CameraInfo"),
+        lambda: bridge.put(topics.CAMERA_IMAGE, frame),
     )
-    bridge.put(topics.SUPERVISOR_STATUS, status)
+    bridge.until(design_key("tf", "tf2_msgs/msg/TFMessage"), bridge.send_state)
 
     joints = bridge.ros.message("joint_states", "sensor_msgs/msg/JointState")
     assert list(joints.name) == list(ROBOT.joint_names)
