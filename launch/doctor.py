@@ -59,6 +59,14 @@ def port_check(name: str, path: str) -> Check:
             "profile's port (or device) to it",
         )
     if os.access(device, os.R_OK | os.W_OK):
+        holders = holding(device)
+        if holders:
+            return Check(
+                name,
+                "fail",
+                f"{path} is open in {'; '.join(holders)}",
+                "stop it first (a running profile: doctor checks before the profile runs)",
+            )
         return Check(name, "ok", f"{path} is there and open to this user")
     group = grp.getgrgid(device.stat().st_gid).gr_name
     user = os.environ.get("USER", "")
@@ -67,6 +75,23 @@ def port_check(name: str, path: str) -> Check:
     else:
         fix = f"join its group: sudo usermod -aG {group} $USER, then log out and in"
     return Check(name, "fail", f"{path}: no read and write permission (group {group})", fix)
+
+
+def holding(device: Path) -> list[str]:
+    """The other processes that hold ``device`` open ("pid N (command)"), as far as this
+    user may see them in /proc."""
+    target, holders = str(device.resolve()), []
+    for fd_dir in Path("/proc").glob("[0-9]*/fd"):
+        pid = int(fd_dir.parent.name)
+        if pid == os.getpid():
+            continue
+        try:
+            if any(os.readlink(fd) == target for fd in fd_dir.iterdir()):
+                command = (fd_dir.parent / "cmdline").read_bytes().replace(b"\0", b" ")
+                holders.append(f"pid {pid} ({command.decode(errors='replace').strip()[:60]})")
+        except OSError:
+            continue
+    return holders
 
 
 def _joints(profile: Profile, params: Parameters) -> list[Joint]:

@@ -4,6 +4,8 @@ fix; never a packet that moves anything."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -12,6 +14,7 @@ from launch.doctor import checklist, port_check
 from launch.doctor_devices import Check
 from profiles.profile import load_profile
 from protocols import create_oi as oi
+from sim2d.devices.pty_link import PtyLink
 from tests.launch.doctor_bench import READS, Bench, Setup, bench
 
 
@@ -93,3 +96,25 @@ def test_a_port_this_user_may_not_open_says_the_group_to_join(tmp_path: Path) ->
         pytest.skip("this user reads every file (root)")
     assert line.status == "fail" and "no read and write permission" in line.detail
     assert "usermod -aG" in line.fix or "log out and in" in line.fix
+
+
+def test_a_port_another_process_holds_open_is_a_fault_naming_it(tmp_path: Path) -> None:
+    link = PtyLink(tmp_path / "servos")
+    holder = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import sys; f = open(sys.argv[1], 'rb'); print(1, flush=True); sys.stdin.read()",
+            str(link.link),
+        ],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+    )
+    try:
+        assert holder.stdout.readline().strip() == b"1"  # the port is open
+        line = port_check("arm port", str(link.link))
+    finally:
+        holder.communicate(b"")
+        link.close()
+    assert line.status == "fail" and f"pid {holder.pid}" in line.detail, line
+    assert "stop it first" in line.fix
