@@ -206,14 +206,14 @@ class WarmStartedLP:
         # the one-norm row tight only through that waste (its dual 0). One degenerate pivot away
         # lies the same u with the halves split canonically; report that one.
         halves = values[: 2 * n].reshape(2, n)
-        halves = halves - np.minimum(halves[0], halves[1])
-        u = halves[0] - halves[1]
+        u_positive, u_negative = halves - np.minimum(*halves)
+        u = u_positive - u_negative
         # The constant -sum_b w_b 1'b_b; the residual rows' upper bounds hold -b.
         # ndarray.dot: the same BLAS sums as @, in about half the time for vectors this short.
         offsets = -float(layout.row_weight.dot(layout.residual_upper))
         objective = float(layout.cost.dot(values)) - offsets
         active = _active(u, linear, norms, bounds)
-        return LPSolution(u, status, objective, active, halves[0], halves[1])
+        return LPSolution(u, status, objective, active, u_positive, u_negative)
 
     def _velocity_costs(self, costs: list[VelocityCost], n: int) -> tuple[Array, Array]:
         """c_P and c_N, the sums of the velocity costs' weights, kept while the terms return the
