@@ -47,6 +47,7 @@ from components.pubsub import Input
 from components.robot_vector import RobotVector, of_robot
 from components.runtime import Component, Node
 from components.servo_bus import BUSES, HOLD_SPEED, Reading, open_port
+from components.stop_latch import StopLatch
 from messages import topics
 from messages.commands import ArmCommand
 from messages.joints import JointStates
@@ -173,6 +174,7 @@ class ArmDriver(Component):
         self.output = node.publisher(topics.ARM_JOINT_STATES)
         self.timeout = node.alarm(self.hold)
         self._connect()  # a port that is not there yet is opened by the timer when it is
+        self.latch = StopLatch(node, lambda state: self.hold() if state.stopped else None)
         node.subscribe(topics.ARM_COMMAND, self.on_command)
         node.timer(1.0 / node.params["rate_hz"], self.read_joints)
 
@@ -307,6 +309,8 @@ class ArmDriver(Component):
             )
             self.hold()
             return
+        if self.latch.refuses():
+            return  # the arm held where it was when the stop came
         if self.fault or not self.connected or any(p is None for p in self.present):
             self.node.count("refused_commands")
             return  # holding, or no position read yet to aim from

@@ -33,9 +33,11 @@ from components.params import Param, ParamError
 from components.process_entry import run_component
 from components.pubsub import Input
 from components.runtime import Component, Node
+from components.stop_latch import StopLatch
 from messages import topics
 from messages.commands import BaseCommand
 from messages.odometry import BaseOdometry
+from messages.stop import StopState
 from protocols import create_oi
 from wbc.base_motion import dead_reckoning
 from wbc.robot import MobileManipulator
@@ -103,6 +105,7 @@ class BaseDriver(Component):
         self._tried_ns = 0
         self._open()  # a port that is not there yet is opened by the watch timer when it is
         self.timeout = node.alarm(self.on_timeout)
+        self.latch = StopLatch(node, self.on_stop)
         node.subscribe(topics.BASE_COMMAND, self.on_command)
         node.timer(WATCH_PERIOD_S, self.watch)
         self.reader = threading.Thread(target=self._read, name="create-reader", daemon=True)
@@ -191,12 +194,20 @@ class BaseDriver(Component):
             self.node.warn("non_finite_commands", f"non-finite wheel speeds {left}, {right}")
             self.stop_wheels()
             return
+        if self.latch.refuses():
+            return  # the wheels were stopped when the stop came
         limit = self.base.wheel_speed_max
         left, right = max(-limit, min(limit, left)), max(-limit, min(limit, right))
         self.commanded = (left, right)
         self.moving = left != 0.0 or right != 0.0
         self._write(create_oi.drive_direct(round(right * 1000), round(left * 1000)))
         self.timeout.set(self.node.params["command_timeout_s"])
+
+    def on_stop(self, state: StopState) -> None:
+        """The emergency stop (``components.stop_latch``): the wheels stopped at once."""
+        if state.stopped:
+            self.timeout.cancel()
+            self.stop_wheels()
 
     def on_timeout(self) -> None:
         """Alarm: no command for ``command_timeout_s``."""

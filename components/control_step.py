@@ -46,6 +46,8 @@ GOAL_OVERRIDES = ("eta", "beta")
 ZERO_WHEELS = (0.0, 0.0, 0.0, 0.0)
 REFUSED_STATE = "refused state"
 """The status of a step on a state whose joints are not the robot's (zero sent)."""
+STOPPED = "stopped"
+"""The status of a step while the namespace is stopped (``components.stop_latch``; zero sent)."""
 
 
 def base_command(

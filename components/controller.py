@@ -30,6 +30,7 @@ from typing import Any, ClassVar
 
 from components.control_step import (
     REFUSED_STATE,
+    STOPPED,
     ControlStep,
     Step,
     gain_values,
@@ -38,6 +39,7 @@ from components.control_step import (
 from components.params import Param, ParamError, load_robot
 from components.pubsub import Input
 from components.runtime import Component, Node
+from components.stop_latch import StopLatch, stop_text
 from messages import topics
 from messages.commands import ArmCommand, BaseCommand
 from messages.diagnostics import ControllerDiagnostics
@@ -134,6 +136,7 @@ class Controller(Component):
         node.counters["refused_goals"] = 0
         node.counters["refused_obstacles"] = 0
         node.counters["refused_states"] = 0
+        self.latch = StopLatch(node)
         self.state_input = node.subscribe(topics.ROBOT_STATE, self.on_state)
         node.subscribe(topics.CONTROL_GOAL, self.on_goal)
         node.subscribe(topics.WORLD_OBSTACLES, self.on_obstacles)
@@ -172,7 +175,13 @@ class Controller(Component):
         self.stepper.take_obstacles(obstacles)
 
     def on_state(self, state: RobotState) -> None:
-        """One control step: publish its commands and diagnostics."""
+        """One control step: publish its commands and diagnostics; zero while the namespace is
+        stopped (``components.stop_latch``), the goal kept for after the release."""
+        if self.latch.stopped:
+            self.stepper.last_stamp_ns = state.header.stamp_ns
+            stamp = state.header.stamp_ns
+            self.publish(self.stepper.zero(stamp, STOPPED, stop_text(self.latch.state)))
+            return
         try:
             self.update_law()
         except ParamError as error:

@@ -40,6 +40,7 @@ from messages import codec, topics
 from messages.header import Header
 from messages.process import encode_value
 from messages.status import ComponentStatus
+from messages.stop import StopState
 from profiles.profile import Profile
 
 M = TypeVar("M", bound=BaseModel)
@@ -94,6 +95,8 @@ class Node:
         self.clock: Clock = SimClock() if source == "sim" else WallClock()
         self.counters: dict[str, int] = {"clock_stalls": 0}
         self.state = "starting"
+        self.stop: StopState | None = None
+        """The emergency stop this component holds (``components.stop_latch``), if it does."""
         self.failure: str | None = None
         """Why this component stopped for good (``fail``); the process exits non-zero."""
         self.stop_requested = threading.Event()
@@ -197,10 +200,13 @@ class Node:
             header=self.header(),
             name=self.name,
             module=self.spec.module,
-            state=self.state,
+            state=self.state
+            if self.stop is None or not self.stop.stopped
+            else f"{self.state}, stopped by {self.stop.header.source}",
             pid=os.getpid(),
             counters={**self.counters, "cpu_ms": round(time.process_time() * 1e3)},
             parameters=dict(self.params),
+            stop=self.stop,
         )
 
     def fail(self, reason: str) -> None:

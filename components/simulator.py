@@ -54,11 +54,13 @@ from components.robot_vector import RobotVector, of_robot
 from components.runtime import Component, Node
 from components.sim_camera import FrameFormat, SimCamera
 from components.sim_sensors import SimSensors
+from components.stop_latch import StopLatch
 from messages import topics
 from messages.clock import Clock
 from messages.commands import ArmCommand, BaseCommand
 from messages.obstacles import Circle as TruthCircle
 from messages.obstacles import Solids
+from messages.stop import StopState
 from profiles.scene import Scene
 from sim2d.camera import ImageNoise
 from sim2d.scenarios import SEED_MAX
@@ -240,6 +242,7 @@ class Simulator(Component):
         node.counters["contacts"] = 0
         node.counters["arm_penetrations"] = 0
         node.counters["refused_arm_commands"] = 0
+        self.latch = StopLatch(node, self.on_stop)
         for topic in self.reads:
             node.subscribe(topic.topic, self._answer_handler(topic.topic.name))
         self.base_command = self.arm_command = None
@@ -366,7 +369,10 @@ class Simulator(Component):
 
     def _take_command(self, name: str, message: BaseCommand | ArmCommand) -> None:
         """Hold a command until the next; an arm command whose joints are not the robot's is
-        refused (``refused_arm_commands``): the last one holds, until its timeout."""
+        refused (``refused_arm_commands``): the last one holds, until its timeout. While stopped
+        every command is refused (``refused_while_stopped``)."""
+        if self.latch.refuses():
+            return
         if name == COMMANDS[0]:
             self.base_command = message
         elif joints_match(
@@ -381,9 +387,19 @@ class Simulator(Component):
             return
         self.last_command_ns = self.now_ns
 
+    def on_stop(self, state: StopState) -> None:
+        """The emergency stop (``components.stop_latch``): the commands held are dropped, the
+        robot stopped from the next step on."""
+        if state.stopped:
+            self.base_command = self.arm_command = self.last_command_ns = None
+
     def _apply_commands(self) -> None:
         timeout_ns = self.node.params["command_timeout_s"] * 1e9
-        if self.last_command_ns is None or self.now_ns - self.last_command_ns > timeout_ns:
+        if (
+            self.latch.stopped
+            or self.last_command_ns is None
+            or self.now_ns - self.last_command_ns > timeout_ns
+        ):
             self.world.stop()
             return
         base, arm = self.base_command, self.arm_command

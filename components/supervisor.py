@@ -47,6 +47,7 @@ from components.process_entry import run_component
 from components.pubsub import Input
 from components.robot_sight import RobotSight
 from components.runtime import Component, Node
+from components.stop_latch import StopLatch
 from messages import topics
 from messages.goal import Goal
 from messages.obstacles import Obstacles, circles_of
@@ -158,6 +159,7 @@ class Supervisor(Component):
         self.last_refusal = ""
         for name in (*COUNTED.values(), "refusals", "aborted", "refused_states"):
             node.counters[name] = 0
+        self.latch = StopLatch(node)
         node.subscribe(topics.GOAL_REQUEST, self.on_request, on_reject=self.on_refused)
         node.subscribe(topics.WORLD_OBSTACLES, self.on_obstacles)
         node.subscribe(topics.ROBOT_STATE, self.on_state)
@@ -187,6 +189,9 @@ class Supervisor(Component):
     def on_state(self, state: RobotState) -> None:
         """Take a new goal, advance the phases, publish the controller's goal and the status.
         A state whose joints are not the robot's is refused (``refused_states``)."""
+        if self.latch.stopped:
+            self._publish(state.header.stamp_ns)
+            return  # the emergency stop: no phase advances, no goal goes out until the release
         names = self.robot.joint_names
         if not joints_match(self.node, "refused_states", "robot/state", state.joint_names, names):
             return

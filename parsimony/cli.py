@@ -37,6 +37,8 @@ COMMANDS = (
     "calibrate",
     "study",
     "doctor",
+    "stop",
+    "release",
 )
 
 
