@@ -96,6 +96,8 @@ def holding(device: Path) -> list[str]:
 
 def _joints(profile: Profile, params: Parameters) -> list[Joint]:
     """Each arm joint's servo id and the Goal Positions the driver may write to it."""
+    if profile.robot is None:
+        raise ValueError("the arm driver needs the profile's `robot`")
     robot = MobileManipulator.from_yaml(profile.robot)
     servos = ServoMap.of(profile.robot, robot.arm_dof)
     if params["ids"]:
@@ -253,11 +255,17 @@ def checklist(profile: Profile, say: Callable[[Check], None] = lambda check: Non
             lines.append(check)
             say(check)
 
-    for spec in _enabled(profile, "arm_driver"):
-        add(arm_checks(profile, spec))
-    for spec in _enabled(profile, "base_driver"):
-        add(base_checks(spec))
-    for spec in _enabled(profile, "vision_tracker"):
-        add(camera_checks(profile, spec))
+    checks = {
+        "arm_driver": lambda spec: arm_checks(profile, spec),
+        "base_driver": base_checks,
+        "vision_tracker": lambda spec: camera_checks(profile, spec),
+    }
+    for module, check in checks.items():
+        for spec in _enabled(profile, module):
+            try:
+                add(check(spec))
+            except ValueError as error:  # ParamError, RobotDescriptionError: the profile's
+                fix = "correct the profile (parsimony launch refuses it too)"
+                add([Check(spec.name, "fail", str(error).splitlines()[0], fix)])
     add(clock_checks(profile))
     return lines

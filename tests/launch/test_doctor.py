@@ -118,3 +118,13 @@ def test_a_port_another_process_holds_open_is_a_fault_naming_it(tmp_path: Path) 
         link.close()
     assert line.status == "fail" and f"pid {holder.pid}" in line.detail, line
     assert "stop it first" in line.fix
+
+
+def test_a_parameter_the_driver_refuses_is_a_fault_not_a_traceback(tmp_path: Path) -> None:
+    with bench(tmp_path, Setup()) as devices:
+        profile = load_profile(devices.profile)
+        arm = next(spec for spec in profile.components if spec.name == "arm_driver")
+        arm.params["baud"] = 12
+        lines = checklist(profile)
+    line = by_name(lines)["arm_driver"]
+    assert line.status == "fail" and "baud" in line.detail, line
