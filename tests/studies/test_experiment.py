@@ -134,11 +134,15 @@ def test_the_qp_controller_runs_the_pose_experiment_as_the_lp_does(tmp_path: Pat
     report = run_here(tmp_path, "pose", controller="qp", **SHORT_RUN)
     assert report["contacts"] == 0 and report["joint_limit_violations"] == 0
     statuses = report["controller_statuses"]
-    assert set(statuses) <= {"optimal", "invalid state"}  # before a fix
     assert statuses["optimal"] > 0.9 * report["iterations"], statuses
+    steps = load_session(tmp_path / "session.mcap", {"control/diagnostics"})["control/diagnostics"]
+    first = next(i for i, d in enumerate(steps) if d.status == "optimal")
+    # Before the camera's first fix the state is invalid (on a loaded machine the very first
+    # step may find it stale); from the first solve on, every step is solved.
+    assert {d.status for d in steps[first:]} == {"optimal"}, statuses
+    assert first < 10, [d.status for d in steps[:first]]
     histogram = {int(k): v for k, v in report["nonzero_entries"].items()}
     assert max(histogram, key=histogram.get) == 8, histogram
-    steps = load_session(tmp_path / "session.mcap", {"control/diagnostics"})["control/diagnostics"]
     errors = [d.error_norm for d in steps if d.error_norm is not None]
     assert errors[-1] < 0.5 * errors[0], (errors[0], errors[-1])  # on its way to the goal
 
