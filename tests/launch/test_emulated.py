@@ -17,6 +17,7 @@ import yaml
 
 from launch import query
 from messages import codec, topics
+from parsimony import cli
 from profiles.deploy_files import DEPLOY
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
@@ -122,7 +123,9 @@ def emulated_profile(tmp_path: Path, namespace: str, *components: dict) -> Path:
 
 
 def test_a_killed_controller_leaves_the_robot_stopped_by_its_drivers(tmp_path: Path) -> None:
-    """The Create keeps its last Drive command for ever; the base driver's timeout stops it."""
+    """The Create keeps its last Drive command for ever; the base driver's timeout stops it.
+    Before, on the same launch, the emergency stop holds the robot still until its release
+    (``stop_until_released``)."""
     path = emulated_profile(
         tmp_path, "killtest", {"name": "controller", "restart": {"policy": "never"}}
     )
@@ -137,6 +140,7 @@ def test_a_killed_controller_leaves_the_robot_stopped_by_its_drivers(tmp_path: P
         while not moving(truth):
             assert time.monotonic() < deadline and launcher.poll() is None, "never moved"
             time.sleep(0.1)
+        stop_until_released(path, profile.namespace, session, truth, launcher)
         controller = query.statuses(session, profile.namespace)["controller"]
         os.kill(controller.pid, signal.SIGKILL)
         killed_ns = time.time_ns()  # the simulator keeps host time (host_epoch)
@@ -153,6 +157,33 @@ def test_a_killed_controller_leaves_the_robot_stopped_by_its_drivers(tmp_path: P
         assert max(abs(a - b) for a, b in zip(arm[0], arm[-1], strict=True)) < 0.01
         counters = query.statuses(session, profile.namespace)["base_driver"].counters
         assert counters["stops"] >= 1
+
+
+def stop_until_released(path: Path, namespace: str, session, truth: list, launcher) -> None:
+    """`parsimony stop`: the robot still (0.9 s of truth from 0.6 s after the stop on, the
+    wheels decelerating first), the controller still sending, every holder saying who stopped
+    it; `parsimony release`: it moves again."""
+    assert cli.main(["stop", "--profile", str(path), "--reason", "test"]) == 0
+    stopped_ns = time.time_ns()
+    deadline = time.monotonic() + 60
+    while len(still := [t for t in truth if t.header.stamp_ns > stopped_ns + 6e8]) <= 45:
+        assert time.monotonic() < deadline and launcher.poll() is None, "no truth"
+        time.sleep(0.1)
+    xs, ys = [t.base_pose[0] for t in still], [t.base_pose[1] for t in still]
+    assert max(xs) - min(xs) < 1e-4 and max(ys) - min(ys) < 1e-4, (xs[0], xs[-1])
+    arm = [t.arm_joints for t in still]
+    assert max(abs(a - b) for a, b in zip(arm[0], arm[-1], strict=True)) < 0.01
+    found = query.statuses(session, namespace)
+    for name in ("simulator", "base_driver", "arm_driver", "controller"):
+        assert found[name].stop is not None and found[name].stop.stopped, name
+        assert found[name].state.endswith("stopped by operator"), found[name].state
+    assert found["base_driver"].counters["refused_while_stopped"] > 0  # the controller sends
+    assert cli.main(["release", "--profile", str(path)]) == 0
+    released = len(truth)
+    deadline = time.monotonic() + 60
+    while not moving(truth[released:]):
+        assert time.monotonic() < deadline and launcher.poll() is None, "never moved again"
+        time.sleep(0.1)
 
 
 def moving(truth: list) -> bool:
