@@ -14,6 +14,8 @@ The listener of the live view's server (``view.live_view``):
   ``parsimony param set``, when the view's user may set that component's parameters
   (``zenoh.access.parameters``). Foxglove's protocol has no read-only parameters: a view whose
   user may set none still lists them, and refuses every set.
+- The emergency stop, a boolean among the parameters (``view.station_stop``): true stops the
+  namespace as ``parsimony stop`` does, false releases it as ``parsimony release`` does.
 
 What becomes of each goal and set is said in a status message naming the client it answers
 (foxglove-sdk 0.30's Python server sends a status to every client, not to one), and logged.
@@ -44,6 +46,7 @@ from foxglove.websocket import (
     WebSocketServer,
 )
 
+from components.stop_latch import stop_text
 from launch.tool_clock import ToolClock
 from launch.zenoh_error import is_session_error, zenoh_error_text
 from messages import codec, topics
@@ -54,6 +57,7 @@ from profiles.profile import Profile
 from view.client_goals import ENCODING, SCHEMAS, GoalRefused, client_goal
 from view.client_limits import ECHO_CHARS, GOAL_RATE, STATUS_CHARS, Bucket, cut, echo
 from view.foxglove_params import running_parameters, set_parameters
+from view.station_stop import STOP_PARAMETER, stop_given, stop_parameters
 from wbc import dq
 from wbc.geometry.obstacles import Circle
 from wbc.planar import offset_pose
@@ -335,15 +339,36 @@ class ControlStation(ServerListener):
         wanted = set(param_names)
         try:
             found = self._on_session(lambda s: running_parameters(s, self.namespace))
+            found += self._on_session(lambda s: stop_parameters(s, self.namespace))
         except SessionFailed as error:
             self._status(client, "parameters", str(error), StatusLevel.Error)
             return []
         return [p for p in found if not wanted or p.name in wanted]
 
+    def _give_stop(self, client: Client, value: Any) -> list[Parameter]:
+        """Stop (``value`` true) or release (false) the namespace for ``client``."""
+        given = stop_given(self._profile, self.user, client.id, value)
+        if isinstance(given, str):
+            self._status(client, "stop", given, StatusLevel.Error)
+            return []
+        key = topics.CONTROL_STOP.key(self.namespace)
+        try:
+            self._on_session(lambda s: s.put(key, codec.encode(given)))
+        except SessionFailed as error:
+            self._status(client, "stop", f"not sent: {error}", StatusLevel.Error)
+            return []
+        self._status(client, "stop", f"{STOP_PARAMETER}: {stop_text(given)}", StatusLevel.Info)
+        return [Parameter(STOP_PARAMETER, value=given.stopped)]
+
     @_answering("parameters", [])
     def on_set_parameters(
         self, client: Client, parameters: list[Parameter], request_id: str | None = None
     ) -> list[Parameter]:
+        stops = [p for p in parameters if p.name == STOP_PARAMETER]
+        if stops:
+            given = self._give_stop(client, stops[-1].get_value())
+            rest = [p for p in parameters if p.name != STOP_PARAMETER]
+            return given + (self.on_set_parameters(client, rest, request_id) if rest else [])
         if not self.may_set_any:
             self._status(
                 client,
