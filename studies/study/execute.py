@@ -1,10 +1,12 @@
 """One run in a child process of its own, on whichever machine executes it: forked from the
-worker (its modules already imported, so a fork costs milliseconds), killed past the run's time
-limit, and its crash (a signal, an exit) or its error told apart from its figures. A simulated
-run's namespace is named after that child's process id: two runs never share one."""
+worker (its modules already imported, so a fork costs tens of milliseconds, not an
+interpreter's start), killed past the run's time limit with every process it started (its
+process group), and its crash (a signal, an exit) or its error told apart from its figures. A
+simulated run's namespace is named after that child's process id: two runs never share one."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import pickle
 import select
@@ -18,6 +20,8 @@ from studies.study import runs
 from studies.study.sweep import Run
 
 OK, FAILED = "ok", "failed"
+RUNNING: set[int] = set()
+"""The process groups of the runs under way in this process (``stop_all``)."""
 
 
 def execute(run: Run) -> dict[str, Any]:
@@ -29,12 +33,16 @@ def execute(run: Run) -> dict[str, Any]:
     if pid == 0:  # the child: its output to /dev/null (or the run's log), its answer to the pipe
         os.close(read)
         _child(run, write)
+    with contextlib.suppress(OSError):  # its own process group, with all it starts
+        os.setpgid(pid, pid)
+    RUNNING.add(pid)
     os.close(write)
     payload, timed_out = _read(read, started + run.time_limit_s)
     os.close(read)
     if timed_out:
-        os.kill(pid, signal.SIGKILL)
+        _kill(pid)
     _, status = os.waitpid(pid, 0)
+    RUNNING.discard(pid)
     wall_s = round(time.monotonic() - started, 3)
     if timed_out:
         return failed(f"hung: no answer within its time limit of {run.time_limit_s:g} s", wall_s)
@@ -49,6 +57,17 @@ def execute(run: Run) -> dict[str, Any]:
     if kind == "error":
         return failed(value, wall_s)
     return {"status": OK, "reason": "", "wall_s": wall_s, "figures": value}
+
+
+def stop_all() -> None:
+    """Kill the runs under way and every process they started (a study stopped)."""
+    for pid in list(RUNNING):
+        _kill(pid)
+
+
+def _kill(pid: int) -> None:
+    with contextlib.suppress(ProcessLookupError, PermissionError):
+        os.killpg(pid, signal.SIGKILL)
 
 
 def failed(reason: str, wall_s: float) -> dict[str, Any]:
@@ -72,6 +91,7 @@ def _child(run: Run, write: int) -> None:
     """Run ``run`` and write its answer to ``write``; never returns."""
     code = 0
     try:
+        os.setpgid(0, 0)
         for stop in (signal.SIGINT, signal.SIGTERM):  # the study's handlers are not the run's
             signal.signal(stop, signal.SIG_DFL)
         log = os.path.join(run.out, "run.log") if run.out else os.devnull

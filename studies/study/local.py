@@ -8,7 +8,7 @@ from collections.abc import Iterator
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from typing import Any
 
-from studies.study.execute import execute
+from studies.study.execute import execute, stop_all
 from studies.study.sweep import Run
 
 
@@ -23,9 +23,10 @@ class LocalPool:
         return self
 
     def __exit__(self, kind: type | None, *exc: object) -> None:
-        """Waits for the runs under way, unless the study was stopped (they end on their own,
-        their answers unread)."""
-        self._threads.shutdown(wait=kind is None, cancel_futures=True)
+        """Waits for the runs under way, or, when the study was stopped, kills them."""
+        if kind is not None:
+            stop_all()
+        self._threads.shutdown(wait=True, cancel_futures=True)
 
     def outcomes(self, runs: list[Run]) -> Iterator[tuple[Run, dict[str, Any]]]:
         """Each run with its outcome (``execute``), in the order they finish."""
