@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import resource
+import signal
 import subprocess
 import sys
 import tempfile
@@ -100,12 +101,7 @@ def alive_cost(path: Path, module: str, name: str, tokens: Tokens) -> tuple[floa
     try:
         alive = (tokens.wait(name, started) - started) / 1e6
     finally:
-        child.terminate()
-        try:
-            child.wait(30)
-        except subprocess.TimeoutExpired:  # slow to stop on a loaded machine: its start counts
-            child.kill()
-            child.wait()
+        process.stop(child, signal.SIGTERM, 30.0)  # then killed: a loaded machine is slow
     return alive, children_cpu_ms() - cpu_before
 
 
