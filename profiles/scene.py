@@ -54,8 +54,9 @@ ARUCO_DICTIONARIES: dict[str, tuple[int, int]] = {
     },
 }
 """OpenCV's predefined ArUco dictionaries (``cv2.aruco.DICT_*``, both spellings it has): name
--> (id, how many markers). Written out so that loading a profile does not import OpenCV (about
-0.15 s of CPU in every process); tests/profiles/test_scene.py holds it to OpenCV's own."""
+-> (id, how many markers). Written out so that loading a profile does not import OpenCV (some
+30 ms of CPU in every process that loads one); tests/profiles/test_scene.py holds it to OpenCV's
+own."""
 
 
 class _Strict(BaseModel):
