@@ -242,7 +242,10 @@ class Simulator(Component):
         node.counters["contacts"] = 0
         node.counters["arm_penetrations"] = 0
         node.counters["refused_arm_commands"] = 0
-        self.latch = StopLatch(node, self.on_stop)
+        commanded = {i.topic.name for i in self.reads} & set(COMMANDS)
+        self.latch = StopLatch(node, self.on_stop) if commanded else None
+        """The emergency stop, when it reads commands (an emulated robot takes them from its
+        drivers, which hold it, as the real robot does)."""
         for topic in self.reads:
             node.subscribe(topic.topic, self._answer_handler(topic.topic.name))
         self.base_command = self.arm_command = None
@@ -371,7 +374,7 @@ class Simulator(Component):
         """Hold a command until the next; an arm command whose joints are not the robot's is
         refused (``refused_arm_commands``): the last one holds, until its timeout. While stopped
         every command is refused (``refused_while_stopped``)."""
-        if self.latch.refuses():
+        if self.latch is not None and self.latch.refuses():
             return
         if name == COMMANDS[0]:
             self.base_command = message
@@ -396,7 +399,7 @@ class Simulator(Component):
     def _apply_commands(self) -> None:
         timeout_ns = self.node.params["command_timeout_s"] * 1e9
         if (
-            self.latch.stopped
+            (self.latch is not None and self.latch.stopped)
             or self.last_command_ns is None
             or self.now_ns - self.last_command_ns > timeout_ns
         ):

@@ -174,7 +174,8 @@ def stop_until_released(path: Path, namespace: str, session, truth: list, launch
     arm = [t.arm_joints for t in still]
     assert max(abs(a - b) for a, b in zip(arm[0], arm[-1], strict=True)) < 0.01
     found = query.statuses(session, namespace)
-    for name in ("simulator", "base_driver", "arm_driver", "controller"):
+    assert found["simulator"].stop is None  # the emulated robot obeys its drivers alone
+    for name in ("base_driver", "arm_driver", "controller"):
         assert found[name].stop is not None and found[name].stop.stopped, name
         assert found[name].state.endswith("stopped by operator"), found[name].state
     assert found["base_driver"].counters["refused_while_stopped"] > 0  # the controller sends
