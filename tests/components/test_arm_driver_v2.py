@@ -24,9 +24,12 @@ from sim2d.devices.x_servos import XChainEmulator
 from tests.components.conftest import System, _wait_until
 from tests.components.driver_harness import status
 from wbc.robot import MobileManipulator
+from wbc.servo_map import ServoMap
 
 ROBOT_FILE = DEPLOY / "robots" / "open_manipulator_x.yaml"
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
+IDS = ServoMap.of(ROBOT_FILE, ROBOT.arm_dof).ids
+"""The servos' bus ids, joint by joint, as the robot's description gives them."""
 LOW, HIGH = ROBOT.q_min[3:], ROBOT.q_max[3:]
 START = (0.0, -0.2, 0.2, 0.5)
 STEP_S = 0.01
@@ -98,7 +101,7 @@ class Bench:
 def shared(deployed_for_module, tmp_path_factory: pytest.TempPathFactory) -> Iterator[Bench]:
     arm = IntegratingJoints(list(START))
     link = tmp_path_factory.mktemp("x_chain") / "servos"
-    with XChainEmulator(arm, link=link) as servos:
+    with XChainEmulator(arm, IDS, link=link) as servos:
         profile = link.parent / "profile.yaml"
         profile.write_text(
             f"extends: {DEPLOY / 'hardware.yaml'}\nrobot: {ROBOT_FILE}\ncomponents:\n"
@@ -152,10 +155,10 @@ def test_a_silent_servo_holds_the_whole_arm_until_it_answers_again(bench: Bench)
     moving = (0.4, 0.3, -0.3, 0.4)
     bench.written(moving)
     asked = bench.servos.counters["unanswered"]
-    bench.servos.fail(3)
+    bench.servos.fail(IDS[2])
     _wait_until(lambda: bench.servos.counters["unanswered"] > asked, "the driver asking servo 3")
     bench.run(0.1)  # while the driver waits for its answer
-    _wait_until(lambda: bench.state() == "holding: servo 3 silent", "the arm holding")
+    _wait_until(lambda: bench.state() == f"holding: servo {IDS[2]} silent", "the arm holding")
     _wait_until(
         lambda: [bench.speeds()[i] for i in (0, 1, 3)] == [HOLD_SPEED] * 3,
         "the hold written to every servo that answers",
@@ -168,7 +171,7 @@ def test_a_silent_servo_holds_the_whole_arm_until_it_answers_again(bench: Bench)
     assert max(abs(a - b) for a, b in zip(bench.arm.angles, held, strict=True)) <= UNIT
     counters = bench.counters()
     assert counters["servo_faults.silent"] >= 1 and counters["refused_commands"] >= 1
-    bench.servos.recover(3)  # torque off, as after a brown-out: the driver enables it again
+    bench.servos.recover(IDS[2])  # torque off, as after a brown-out: the driver enables it again
     _wait_until(lambda: bench.state() == "running", "every servo answering again")
     q1, q3 = bench.arm.angles[0], bench.arm.angles[2]
 
@@ -187,7 +190,9 @@ def test_a_reading_outside_the_limits_is_refused_and_no_goal_leaves_them(bench: 
     assert bench.servos.words(Address.GOAL_POSITION)[2] <= high_units
     inside = bench.arm.angles[2]
     bench.arm.angles[2] = HIGH[2] + 0.3
-    _wait_until(lambda: bench.state().startswith("holding: servo 3 reads 1.7"), "the refusal")
+    _wait_until(
+        lambda: bench.state().startswith(f"holding: servo {IDS[2]} reads 1.7"), "the refusal"
+    )
     for _ in range(20):
         bench.send((0.0, 0.0, 0.8, 0.0))
         time.sleep(0.02)
@@ -219,16 +224,16 @@ def test_speeds_over_the_limit_go_out_at_the_limit(bench: Bench) -> None:
     [StatusFault.TRUNCATED, StatusFault.CHECKSUM, StatusFault.WRONG_ID, StatusFault.WRONG_LENGTH],
 )
 def test_a_spoiled_status_packet_is_reported_by_its_name(bench: Bench, fault: StatusFault) -> None:
-    bench.servos.corrupt(2, fault)
-    _wait_until(lambda: bench.state() == f"holding: servo 2 {fault}", f"servo 2 {fault}")
+    bench.servos.corrupt(IDS[1], fault)
+    _wait_until(lambda: bench.state() == f"holding: servo {IDS[1]} {fault}", f"servo 2 {fault}")
     assert bench.counters()[f"servo_faults.{fault}"] >= 1
-    bench.servos.corrupt(2, None)
+    bench.servos.corrupt(IDS[1], None)
     _wait_until(lambda: bench.state() == "running", "servo 2 answering whole again")
 
 
 def test_a_hardware_error_is_counted_by_name(bench: Bench) -> None:
     """An overload: the alert bit in every answer, Hardware Error Status read and counted."""
-    bench.servos.fail(4, silent=False)
+    bench.servos.fail(IDS[3], silent=False)
     _wait_until(lambda: bench.counters()["servo_error.overload"] >= 1, "the overload counted")
     assert bench.counters()["servo_error.input_voltage"] == 0
     bench.servos.servos[3].table[Address.HARDWARE_ERROR_STATUS] = 0  # a reboot, by hand
