@@ -28,7 +28,7 @@ steers towards a target behind the base. Both are off by default: on the held-ou
 of 'ahead, wide arm' they raise the share reached from 0.72 to 0.82 (7 entries while moving),
 short of the 0.9 sought, while 'ahead, any arm start' goes from 0.947 to 0.937 on the same
 seeds and the 'ahead' goals of `parsimony bench` (seed 2) from 0.94 to 0.92
-(``studies.bench.goal_reach``).
+(the study ``studies/files/goal-reach.yaml``).
 """
 
 from __future__ import annotations
