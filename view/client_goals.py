@@ -31,7 +31,6 @@ from messages.header import Header
 from view.client_limits import ECHO_CHARS, GOAL_BYTES, cut, echo
 from wbc import dq
 from wbc.geometry.obstacles import Circle
-from wbc.planning.staging import StagingParams, refusal
 
 IN_FRAME = ("foxglove.PoseInFrame",)
 STAMPED = ("geometry_msgs/PoseStamped", "geometry_msgs/msg/PoseStamped")
@@ -128,6 +127,10 @@ def client_goal(
     if height < 0.0:
         raise GoalRefused(f"the goal is {-height:.3f} m below the floor")
     if q_now is not None:
+        # The planner (and its LP, SciPy) is imported by the first goal checked against a robot,
+        # not by every command that imports this module.
+        from wbc.planning.staging import StagingParams, refusal
+
         reason = refusal(q_now, pose, obstacles, StagingParams())
         if reason:
             raise GoalRefused(reason)

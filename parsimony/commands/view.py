@@ -27,8 +27,7 @@ from components.rate_limited_log import RateLimitedLog
 from launch.query import QueryError, Target
 from messages.topics import Topic, check_namespace, topics_matching
 from outputs.stdout import emit, json_text
-from parsimony.commands.launch import positive_seconds
-from parsimony.commands.layout import write_layout
+from parsimony.argument_types import positive_seconds
 from parsimony.stop_signals import STOP_SIGNALS, stop_signals
 from parsimony.target_options import exit_code
 from profiles.profile import Profile, ProfileError, load_profile
@@ -104,6 +103,9 @@ def run(args: argparse.Namespace) -> int:
         chosen = topics_matching(args.keys)
         robot = MobileManipulator.from_yaml(profile.robot) if profile.robot else None
         if args.layout is not None:
+            # Foxglove's layouts library is imported only by a view that writes one.
+            from parsimony.commands.layout import write_layout
+
             names = robot.joint_names if robot else ()
             write_layout(profile.namespace, args.layout, args.force, names)
     except (ProfileError, ValueError, OSError) as error:
