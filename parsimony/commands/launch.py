@@ -4,9 +4,7 @@
 from __future__ import annotations
 
 import argparse
-import math
 import sys
-from collections.abc import Callable
 from pathlib import Path
 
 import zenoh
@@ -15,34 +13,12 @@ from launch.graph import dataflow
 from launch.launcher import Launcher
 from launch.zenoh_error import zenoh_error_text
 from outputs.files import writable_output
-from parsimony.commands.record import memory_file
+from parsimony.argument_types import positive_seconds
+from parsimony.memory_file import memory_file
 from profiles.profile import Profile, ProfileError, load_profile
 from profiles.recorder import RECORDER, with_recorder
 
 EXIT_INVALID_PROFILE = 2
-
-
-def positive(what: str) -> Callable[[str], float]:
-    """An argument type: a finite number > 0 of ``what`` (``nan``, ``inf`` and ``-1`` are
-    refused, saying what was expected)."""
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}") from None
-        if not math.isfinite(value) or value <= 0.0:
-            raise argparse.ArgumentTypeError(
-                f"expected a finite number of {what} > 0, got {text!r}"
-            )
-        return value
-
-    parse.__name__ = what  # argparse names the type in its own messages
-    return parse
-
-
-positive_seconds = positive("seconds")
-"""A duration in seconds."""
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:

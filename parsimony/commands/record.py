@@ -18,6 +18,7 @@ from messages.process import PARENT_PID_ENV
 from messages.topics import topics_matching
 from outputs.files import writable_output, written_whole
 from outputs.stdout import emit
+from parsimony.memory_file import memory_file
 from profiles.profile import ProfileError
 from profiles.recorder import RECORDER, with_recorder
 from record.session_reader import recover
@@ -63,15 +64,6 @@ def run(args: argparse.Namespace) -> int:
         print(f"record: {error}", file=sys.stderr)
         return 2
     return record(with_recorder(args.profile, args.output, args.keys))
-
-
-def memory_file(name: str, text: str) -> tuple[int, Path]:
-    """A file in memory (``memfd_create``) holding ``text``, and the path a child that
-    inherits its descriptor (``pass_fds``) reads it at: nothing is left behind, whatever kills
-    this process."""
-    descriptor = os.memfd_create(name)
-    os.write(descriptor, text.encode())
-    return descriptor, Path(f"/proc/self/fd/{descriptor}")
 
 
 def record(profile: str) -> int:

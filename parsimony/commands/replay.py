@@ -38,7 +38,7 @@ from launch.graph import component_class
 from launch.query import NoRouter, QueryError, Target, live_components
 from launch.zenoh_error import zenoh_error_text
 from messages import topics
-from parsimony.commands.launch import positive, positive_seconds
+from parsimony.argument_types import positive, positive_seconds
 from parsimony.commands.view import (
     live,
     namespace_argument,

@@ -12,7 +12,7 @@ from pathlib import Path
 from analysis.judge import JUDGED, judge, open_loop, the_run
 from analysis.report import write_report
 from outputs.stdout import emit, json_text
-from parsimony.commands.launch import positive_seconds
+from parsimony.argument_types import positive_seconds
 from parsimony.commands.robot_option import add_robot_option
 from profiles.profile import ProfileError, load_profile
 from record.session_span import parted

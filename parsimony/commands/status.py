@@ -19,7 +19,7 @@ from launch.query import (
 )
 from messages.status import ComponentStatus
 from outputs.stdout import emit, json_text, table
-from parsimony.commands.launch import positive_seconds
+from parsimony.argument_types import positive_seconds
 from parsimony.target_options import fail
 from profiles.profile import ProfileError, load_profile
 
