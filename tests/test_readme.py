@@ -49,9 +49,20 @@ def test_the_first_hour_of_the_readme_runs_as_written(tmp_path: Path) -> None:
     assert re.search(r"^sim/goal/request\s+Goal\s+\d+\s+2\s", result.stdout, re.M), result.stdout
     assert (tmp_path / "first_report" / "judged.json").is_file()
     assert (tmp_path / "first_report" / "base_path.png").is_file()
-    # the cascade re-run on the recording's states, beside the LP in one report
+    # the cascade re-run on the recording's states, beside the LP in one report, which says
+    # the rerun's commands were not in a closed loop (on stderr, in the table, in the verdict)
     assert (tmp_path / "cascade.mcap").is_file()
-    assert "cascade (rerun)" in (tmp_path / "compare" / "effort.md").read_text()
+    note = (
+        "cascade (rerun): its commands were computed by `parsimony rerun` on the "
+        "recording's states, not in a closed loop"
+    )
+    assert note in result.stderr, result.stderr[-3000:]
+    assert f"Note: {note}" in (tmp_path / "compare" / "effort.md").read_text()
+    judged = json.loads((tmp_path / "compare" / "judged.json").read_text())
+    assert {label: run["open_loop"] for label, run in judged.items()} == {
+        "lp": False,
+        "cascade (rerun)": True,
+    }, judged.keys()
     # the live view served on the profile's port, and stopped after its duration
     assert "view: sim live at ws://127.0.0.1:8765" in result.stderr, result.stderr[-3000:]
     assert "messages shown" in result.stderr

@@ -20,11 +20,9 @@ from messages.topics import (
     CONTROL_GOAL,
     ROBOT_STATE,
     SIM_TRUTH,
-    TOPICS,
     WORLD_OBSTACLES,
 )
 from messages.truth import SimTruth
-from record.session_file import SessionWriter
 from tests.analysis.conftest import DT, FIGURES, ROBOT, START_NS, header
 from tests.processes import parsimony
 from wbc import dq
@@ -256,23 +254,3 @@ def test_labels_that_do_not_match_the_files_are_said_in_one_line(tmp_path):
     assert (
         done.stderr == "report: --labels: expected 2 non-empty comma-separated labels, got 'one'\n"
     )
-
-
-def test_a_report_beside_a_rerun_says_its_commands_were_not_in_a_closed_loop(runs, tmp_path):
-    recording, rerun, out = tmp_path / "lp.mcap", tmp_path / "rerun.mcap", tmp_path / "out"
-    with SessionWriter(recording) as writer:
-        for topic, found in runs["LP"][1].items():
-            for message in found:
-                writer.write(TOPICS[topic].key("t"), message)
-    done = parsimony("rerun", str(recording), "--controller", "cascade", "-o", str(rerun))
-    assert done.returncode == 0, done.stderr
-    done = parsimony("report", str(recording), str(rerun), "--out", str(out))
-    assert done.returncode == 0, done.stderr
-    note = (
-        "cascade (rerun): its commands were computed by `parsimony rerun` on the "
-        "recording's states, not in a closed loop"
-    )
-    assert [line for line in done.stderr.splitlines() if note in line], done.stderr
-    assert f"Note: {note}" in (out / "effort.md").read_text()
-    judged = json.loads((out / "judged.json").read_text())
-    assert judged["cascade (rerun)"]["open_loop"] and not judged["LP"]["open_loop"]
