@@ -35,14 +35,10 @@ import json
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from matplotlib.axes import Axes
-from matplotlib.figure import Figure
-from matplotlib.patches import Circle
 
-from analysis.floor_plan import draw_obstacles
 from analysis.judge import (
     Array,
     Session,
@@ -66,6 +62,10 @@ from record.session_span import parted
 from wbc import dq
 from wbc.planar import in_frame, planar_pose
 from wbc.robot import MobileManipulator
+
+if TYPE_CHECKING:  # matplotlib is imported by the first figure drawn, not by every command
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 FORMULAS: Mapping[str, str] = {
     "metric1": r"$\int \lVert\dot{q}\rVert_1\,dt$",
@@ -241,6 +241,8 @@ def _effort_table(efforts: Mapping[str, Mapping[str, float]], notes: Sequence[st
 
 def _panels(recordings: Sequence[_Recording], rows: int, height: float, **share: Any) -> tuple:
     """A figure with ``rows`` panels per session, sessions side by side, labels as titles."""
+    from matplotlib.figure import Figure
+
     figure = Figure(figsize=(6.0 * len(recordings), height), layout="constrained")
     axes = figure.subplots(rows, len(recordings), squeeze=False, **share)
     for ax, rec in zip(axes[0], recordings, strict=True):
@@ -380,6 +382,10 @@ def _end_effector_path_figure(recordings: Sequence[_Recording], _: MobileManipul
 
 
 def _base_path_figure(recordings: Sequence[_Recording], robot: MobileManipulator) -> Figure:
+    from matplotlib.patches import Circle
+
+    from analysis.floor_plan import draw_obstacles
+
     figure, axes = _panels(recordings, 1, 5.0)
     for ax, rec in zip(axes[0], recordings, strict=True):
         if estimated := _estimated(rec.states):
