@@ -29,6 +29,7 @@ import numpy as np
 from components.joint_check import mismatch
 from messages.goal import Goal
 from messages.state import RobotState
+from messages.teleop import TeleopCommand
 from wbc.base_motion import unicycle, wheel_speeds
 from wbc.geometry.obstacles import Obstacle
 from wbc.laws.gains import gain_specs
@@ -46,6 +47,10 @@ GOAL_OVERRIDES = ("eta", "beta")
 ZERO_WHEELS = (0.0, 0.0, 0.0, 0.0)
 REFUSED_STATE = "refused state"
 """The status of a step on a state whose joints are not the robot's (zero sent)."""
+TELEOP = "teleop"
+"""The status of a step commanded by hand (``teleop_step``), or of its zero (why said)."""
+TELEOP_TIMEOUT_S = 0.5
+"""The dead-man timeout: a hand's command older than this commands zero."""
 STOPPED = "stopped"
 """The status of a step while the namespace is stopped (``components.stop_latch``; zero sent)."""
 
@@ -68,6 +73,40 @@ def base_command(
         velocity = wheel_speeds(*speeds, base)
         wheels = (velocity.forward, velocity.angular, velocity.left_wheel, velocity.right_wheel)
     return wheels, 0.0
+
+
+def teleop_step(robot: MobileManipulator, state: RobotState, hand: TeleopCommand) -> Step:
+    """The commands of a hand's ``hand`` at ``state`` (stamped with its stamp): the base's
+    forward speed and turn as u_b in F0, scaled down as a whole into the base's velocity
+    limits; the joint it names at its velocity clamped to its limit, still where it would
+    leave its joint limits; every other joint still."""
+    stamp, dof = state.header.stamp_ns, robot.arm_dof
+    why = mismatch(state.joint_names, robot.joint_names)
+    if why:
+        return Step.zero(stamp, dof, REFUSED_STATE, f"robot/state refused: it has {why}")
+    if hand.joint and hand.joint not in robot.joint_names:
+        names = ", ".join(robot.joint_names)
+        return Step.zero(stamp, dof, TELEOP, f"no joint {hand.joint!r}: the robot's are {names}")
+    phi = state.base_pose[2]
+    u_b = np.array([hand.forward * math.cos(phi), hand.forward * math.sin(phi), hand.turn])
+    limits = robot.velocity_max[:3]
+    over = max(
+        (abs(u) / m if m > 0 else math.inf for u, m in zip(u_b, limits, strict=True) if u),
+        default=0.0,
+    )
+    u_b = u_b / max(1.0, over) if over < math.inf else np.zeros(3)
+    wheels, lateral = base_command(u_b, phi, robot.base)
+    joints = [0.0] * dof
+    if hand.joint:
+        index = robot.joint_names.index(hand.joint)
+        limit = robot.velocity_max[3 + index]
+        velocity = max(-limit, min(limit, hand.joint_velocity))
+        q = state.arm_joints[index]
+        leaving = (velocity > 0 and q >= robot.q_max[3 + index]) or (
+            velocity < 0 and q <= robot.q_min[3 + index]
+        )
+        joints[index] = 0.0 if leaving else float(velocity)
+    return Step(stamp, wheels, tuple(joints), TELEOP, "", None, lateral)
 
 
 def task_of(goal: Goal) -> Task:

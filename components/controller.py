@@ -31,13 +31,17 @@ from typing import Any, ClassVar
 from components.control_step import (
     REFUSED_STATE,
     STOPPED,
+    TELEOP,
+    TELEOP_TIMEOUT_S,
     ControlStep,
     Step,
     gain_values,
     gains_of,
+    task_of,
+    teleop_step,
 )
 from components.params import Param, ParamError, load_robot
-from components.pubsub import Input
+from components.pubsub import Input, Subscription
 from components.runtime import Component, Node
 from components.stop_latch import StopLatch, stop_text
 from messages import topics
@@ -47,11 +51,12 @@ from messages.goal import Goal
 from messages.header import Header
 from messages.obstacles import Obstacles, obstacles_of
 from messages.state import RobotState
+from messages.teleop import TeleopCommand
 from wbc.laws.gains import gain_specs
 from wbc.laws.law_output import Law
 from wbc.planning.drive_tasks import HeadingTask, PointTask
 from wbc.robot import MobileManipulator
-from wbc.task import PoseTask, PositionTask, Task
+from wbc.task import MEASUREMENT_TOLERANCE, PoseTask, PositionTask, Task, same_task
 
 STALE_CHECK_PERIOD_S = 0.1
 """How often the controller checks that states still arrive."""
@@ -140,6 +145,11 @@ class Controller(Component):
         self.state_input = node.subscribe(topics.ROBOT_STATE, self.on_state)
         node.subscribe(topics.CONTROL_GOAL, self.on_goal)
         node.subscribe(topics.WORLD_OBSTACLES, self.on_obstacles)
+        # A tool's input (`parsimony teleop`), not the graph's: no launch warns that no
+        # component writes it.
+        self.teleop = Subscription(node, topics.TELEOP_COMMAND, self.on_teleop)
+        self.teleoperated = False
+        """A hand commands the robot: the goal yields until a new one."""
         node.timer(STALE_CHECK_PERIOD_S, self.check_inputs_arrive)
 
     @property
@@ -151,7 +161,11 @@ class Controller(Component):
         ``refused_goals``, one line logged) drops the current one: zero commands, and the
         diagnostics say why (``goal refused``) until the next goal. The goal's ``eta`` and
         ``beta`` must lie in the bounds of the gains they override, the bounds of their
-        parameters too (``parsimony param set``)."""
+        parameters too (``parsimony param set``). While teleoperated, the goal held is ignored
+        (measured again or passed on again); another ends the teleoperation."""
+        if self.teleoperated and self._holds(goal):
+            return
+        self.teleoperated = False
         try:
             self.stepper.take_goal(goal)
         except ValueError:
@@ -159,6 +173,21 @@ class Controller(Component):
             self.node.warn(
                 "refused_goals", f"{self.stepper.refusal}; zero sent until the next goal"
             )
+
+    def _holds(self, goal: Goal) -> bool:
+        """Whether ``goal`` asks what the goal held asks."""
+        try:
+            task = task_of(goal)
+        except ValueError:
+            return False
+        held = self.stepper.task
+        return held is not None and same_task(held, task, MEASUREMENT_TOLERANCE)
+
+    def on_teleop(self, _hand: TeleopCommand) -> None:
+        """A hand takes the robot: the goal yields (``hand_step`` on each state)."""
+        if not self.teleoperated:
+            self.teleoperated = True
+            self.node.warn("teleop", f"{self.node.name}: teleoperated; the goal yields")
 
     def on_obstacles(self, message: Obstacles) -> None:
         """Take the obstacles every following step avoids; a message with a solid the law
@@ -182,6 +211,10 @@ class Controller(Component):
             stamp = state.header.stamp_ns
             self.publish(self.stepper.zero(stamp, STOPPED, stop_text(self.latch.state)))
             return
+        if self.teleoperated:
+            self.stepper.last_stamp_ns = state.header.stamp_ns
+            self.publish(self.hand_step(state))
+            return
         try:
             self.update_law()
         except ParamError as error:
@@ -196,6 +229,16 @@ class Controller(Component):
             self.node.count(counter)
             self.node.warn(counter, f"{step.reason}; zero sent")
         self.publish(step)
+
+    def hand_step(self, state: RobotState) -> Step:
+        """The teleoperated step: the hand's command, zero once it is older than the dead-man
+        timeout (``TELEOP_TIMEOUT_S``)."""
+        hand, age_s = self.teleop.latest, self.teleop.age_s()
+        if hand is None or age_s > TELEOP_TIMEOUT_S:
+            reason = f"no teleop/command for {age_s:.2f} s (dead-man {TELEOP_TIMEOUT_S} s)"
+            return self.stepper.zero(state.header.stamp_ns, TELEOP, reason)
+        self.stepper.law.stopped()
+        return teleop_step(self.robot, state, hand)
 
     def check_inputs_arrive(self) -> None:
         """Timer: command zero while no state has arrived for ``stale_timeout_s``."""

@@ -153,16 +153,17 @@ def stop_state(stopped: bool, source: str, reason: str = "") -> StopState:
     return StopState(header=header, stopped=stopped, reason=reason)
 
 
-def release_refusal(profile: Profile, user: str) -> str | None:
+def release_refusal(profile: Profile, user: str, doing: str = "release the stop") -> str | None:
     """Why ``user`` may not release the stop, or None. A stop is anyone's who may open a
     session (who may see the robot: a profile should list no ``writers`` for ``control/stop``);
     a release lets the robot move again, so it is only for who may command it: who may put on
     ``control/goal`` and ``goal/request``. The router cannot tell a release from a stop (one
-    key), so the tools that release obey this, as they obey the parameters' rules."""
+    key), so the tools that release obey this, as they obey the parameters' rules; so do the
+    tools that teleoperate (``doing`` says what is refused)."""
     access = profile.zenoh.access
     if access is None:
         return None
     for topic in COMMAND_TOPICS:
         if not access.may_write(topic, user):
-            return f"{user} may not release the stop: not a writer of {topic} (zenoh.access)"
+            return f"{user} may not {doing}: not a writer of {topic} (zenoh.access)"
     return None

@@ -44,7 +44,7 @@ from components.controller import goal_of
 from components.joint_check import joints_match
 from components.params import Param, ParamError, load_robot
 from components.process_entry import run_component
-from components.pubsub import Input
+from components.pubsub import Input, Subscription
 from components.robot_sight import RobotSight
 from components.runtime import Component, Node
 from components.stop_latch import StopLatch
@@ -53,6 +53,7 @@ from messages.goal import Goal
 from messages.obstacles import Obstacles, circles_of
 from messages.state import RobotState
 from messages.supervisor import ENDED, IDLE, SupervisorStatus
+from messages.teleop import TeleopCommand
 from wbc.geometry.obstacles import Circle
 from wbc.planning.drive_tasks import PointTask, offset_point
 from wbc.planning.staging import Plan, StagingParams, within
@@ -160,6 +161,9 @@ class Supervisor(Component):
         for name in (*COUNTED.values(), "refusals", "aborted", "refused_states"):
             node.counters[name] = 0
         self.latch = StopLatch(node)
+        self.teleoperated = False
+        """A hand commands the robot (``teleop/command``): no goal goes out until a new one."""
+        self.teleop = Subscription(node, topics.TELEOP_COMMAND, self.on_teleop)  # a tool's
         node.subscribe(topics.GOAL_REQUEST, self.on_request, on_reject=self.on_refused)
         node.subscribe(topics.WORLD_OBSTACLES, self.on_obstacles)
         node.subscribe(topics.ROBOT_STATE, self.on_state)
@@ -175,10 +179,14 @@ class Supervisor(Component):
         if request is not None and self.ended is None and goal.task == request.task:
             if same_task(task_of(request), task_of(goal), MEASUREMENT_TOLERANCE):
                 return
-        self.request, self.fresh, self.ended = goal, True, None
+        self.request, self.fresh, self.ended, self.teleoperated = goal, True, None, False
         self.supervisor, self._events_reported, self.reached = None, 0, False
         self._hold = self._planning = None
         self.error_norm = None
+
+    def on_teleop(self, _hand: TeleopCommand) -> None:
+        """A hand takes the robot: the supervisor yields until a new goal."""
+        self.teleoperated = True
 
     def on_refused(self, reason: str) -> None:
         """A malformed request: counted, and said on the status at once."""
@@ -189,7 +197,7 @@ class Supervisor(Component):
     def on_state(self, state: RobotState) -> None:
         """Take a new goal, advance the phases, publish the controller's goal and the status.
         A state whose joints are not the robot's is refused (``refused_states``)."""
-        if self.latch.stopped:
+        if self.latch.stopped or self.teleoperated:
             self._publish(state.header.stamp_ns)
             return  # the emergency stop: no phase advances, no goal goes out until the release
         names = self.robot.joint_names

@@ -35,6 +35,7 @@ from messages.state import RobotState
 from messages.status import ComponentStatus
 from messages.stop import StopState
 from messages.supervisor import SupervisorStatus
+from messages.teleop import TeleopCommand
 from messages.truth import SimTruth
 
 M = TypeVar("M", bound=BaseModel)
@@ -89,6 +90,7 @@ SIM_CLOCK = Topic("sim/clock", "sim/clock", Clock)
 SIM_TRUTH = Topic("sim/truth", "sim/truth", SimTruth, ground_truth=True)
 CONTROL_STOP = Topic("control/stop", "control/stop", StopState)
 """The latched emergency stop and its release (``components.stop_latch``)."""
+TELEOP_COMMAND = Topic("teleop/command", "teleop/command", TeleopCommand)
 
 TOPICS: Mapping[str, Topic] = MappingProxyType(
     {
@@ -111,6 +113,7 @@ TOPICS: Mapping[str, Topic] = MappingProxyType(
             SIM_CLOCK,
             SIM_TRUTH,
             CONTROL_STOP,
+            TELEOP_COMMAND,
         )
     }
 )

@@ -39,6 +39,7 @@ COMMANDS = (
     "doctor",
     "stop",
     "release",
+    "teleop",
 )
 
 

@@ -26,6 +26,7 @@ from messages.base import Message
 from messages.obstacles import Cylinder, Plane, Solids
 from messages.stop import StopState
 from messages.supervisor import SupervisorStatus
+from messages.teleop import TeleopCommand
 from messages.truth import SimTruth
 
 HEADER = Header(stamp_ns=1_700_000_000_123_456_789, frame="world", seq=7, source="test")
@@ -142,6 +143,7 @@ EXAMPLES: tuple[Message, ...] = (
         stop=StopState(header=HEADER, stopped=True, reason="a hand in the way"),
     ),
     StopState(header=HEADER, stopped=False),
+    TeleopCommand(header=HEADER, forward=0.1, turn=-0.2, joint="q2", joint_velocity=0.3),
     Clock(stamp_ns=123_000_000),
     SimTruth(
         header=HEADER,

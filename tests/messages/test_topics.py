@@ -67,6 +67,7 @@ def test_the_table_holds_every_topic_of_the_design() -> None:
         "sim/clock": "Clock",
         "sim/truth": "SimTruth",
         "control/stop": "StopState",
+        "teleop/command": "TeleopCommand",
     }
 
 

@@ -1,0 +1,127 @@
+"""Teleoperation: a hand's command under the robot's limits (``control_step.teleop_step``) and
+the keys of `parsimony teleop` (``parsimony.commands.teleop.press``)."""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from components.control_step import REFUSED_STATE, TELEOP, teleop_step
+from components.lp_controller import LPController
+from components.runtime import Node
+from messages import codec, topics
+from messages.diagnostics import ControllerDiagnostics
+from messages.goal import Goal
+from messages.header import Header
+from messages.state import RobotState
+from messages.teleop import TeleopCommand
+from parsimony.commands.teleop import Hand, press
+from profiles.deploy_files import DEPLOY, ROBOT_FILE
+from wbc.robot import MobileManipulator
+
+ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
+HEADER = Header(stamp_ns=7, frame="world", seq=0, source="test")
+IDENTITY = (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+def state(arm: tuple[float, ...] = (0.0,) * 5, phi: float = 0.7) -> RobotState:
+    return RobotState(
+        header=HEADER,
+        base_pose=(1.0, 2.0, phi),
+        arm_joints=arm,
+        joint_names=ROBOT.joint_names,
+        end_effector=IDENTITY,
+        valid=True,
+        age_s=0.0,
+    )
+
+
+def hand(**fields: object) -> TeleopCommand:
+    return TeleopCommand(header=HEADER, **fields)
+
+
+def test_the_base_goes_as_asked_inside_its_limits() -> None:
+    slow = teleop_step(ROBOT, state(), hand(forward=0.05, turn=0.1))
+    forward, angular, left, right = slow.wheels
+    assert slow.status == TELEOP and slow.stamp_ns == 7
+    assert math.isclose(forward, 0.05) and math.isclose(angular, 0.1)
+    assert slow.joints == (0.0,) * 5
+    fast = teleop_step(ROBOT, state(), hand(forward=100.0, turn=0.0))
+    limits = ROBOT.velocity_max[:2]
+    assert 0 < fast.wheels[0] <= float(np.hypot(*limits)) + 1e-9
+    assert max(abs(fast.wheels[2]), abs(fast.wheels[3])) <= ROBOT.base.wheel_speed_max + 1e-9
+
+
+def test_one_joint_moves_inside_its_velocity_and_joint_limits() -> None:
+    name, limit = ROBOT.joint_names[1], ROBOT.velocity_max[4]
+    step = teleop_step(ROBOT, state(), hand(joint=name, joint_velocity=100.0))
+    assert step.joints == (0.0, limit, 0.0, 0.0, 0.0)
+    top = (0.0, float(ROBOT.q_max[4]), 0.0, 0.0, 0.0)
+    assert teleop_step(ROBOT, state(top), hand(joint=name, joint_velocity=0.2)).joints[1] == 0
+    assert teleop_step(ROBOT, state(top), hand(joint=name, joint_velocity=-0.2)).joints[1] == -0.2
+    unknown = teleop_step(ROBOT, state(), hand(joint="elbow", joint_velocity=0.2))
+    assert unknown.joints == (0.0,) * 5 and unknown.wheels == (0.0,) * 4
+    assert "no joint 'elbow'" in unknown.reason
+    other = state().model_copy(update={"joint_names": ("a", "b", "c", "d", "e")})
+    assert teleop_step(ROBOT, other, hand(forward=0.1)).status == REFUSED_STATE
+
+
+def test_the_keys() -> None:
+    speeds = (0.1, 0.5, 0.3)
+    held = press("w", Hand(), speeds, 5)
+    assert held == Hand(forward=0.1)
+    assert press("d", held, speeds, 5) == Hand(forward=0.1, turn=-0.5)
+    assert press("3", held, speeds, 5) == Hand(joint=2)
+    assert press("k", Hand(joint=2), speeds, 5) == Hand(joint=2, joint_velocity=-0.3)
+    assert press(" ", Hand(forward=0.1, joint=2, joint_velocity=0.3), speeds, 5) == Hand(joint=2)
+    assert press("9", held, speeds, 5) == held and press("x", held, speeds, 5) == held
+    assert press("q", held, speeds, 5) is None
+
+
+def test_the_controller_yields_to_a_hand_and_resumes_only_on_a_new_goal(deployed) -> None:
+    """The LP controller in process on deploy/hardware.yaml's settings (wall clock)."""
+    system = deployed(DEPLOY / "hardware.yaml")
+    namespace = system.profile.namespace
+    diagnostics = system.inbox(topics.CONTROL_DIAGNOSTICS)
+    put = {
+        topic: system.router.declare_publisher(topic.key(namespace))
+        for topic in (topics.ROBOT_STATE, topics.CONTROL_GOAL, topics.TELEOP_COMMAND)
+    }
+
+    def send(topic: topics.Topic, message: object) -> None:
+        put[topic].put(codec.encode(message))
+
+    def step(**hand_fields: object) -> ControllerDiagnostics:
+        """A hand's command (when given), then a state; the diagnostics answering it."""
+        stamp = time.time_ns()
+        if hand_fields:
+            send(topics.TELEOP_COMMAND, hand(**hand_fields))
+        header = Header(stamp_ns=stamp, frame="world", seq=0, source="test")
+        send(topics.ROBOT_STATE, state().model_copy(update={"header": header}))
+        return diagnostics.wait_for(lambda d: d.header.stamp_ns == stamp, "of the state")
+
+    def goal(x: float) -> Goal:
+        header = Header(stamp_ns=time.time_ns(), frame="world", seq=0, source="test")
+        return Goal(header=header, task="position", position=(x, 2.0, 0.4))
+
+    spec = LPController
+    with Node(system.profile, "controller", spec.params, spec.reads, spec.writes) as node:
+        controller = LPController(node)
+        node.start()
+        held = goal(2.0)
+        send(topics.CONTROL_GOAL, held)
+        while step().status == "no goal":
+            pass  # the goal on its way
+        assert step(forward=0.05).status == TELEOP
+        send(topics.CONTROL_GOAL, held.model_copy(update={"header": goal(2.0).header}))
+        answer = step(forward=0.05)
+        assert answer.status == TELEOP and controller.teleoperated  # the same goal: still yields
+        while (answer := step()).reason == "":
+            pass  # no command: the dead-man timeout
+        assert answer.status == TELEOP and "dead-man" in answer.reason
+        send(topics.CONTROL_GOAL, goal(2.5))
+        while step().status == TELEOP:
+            pass  # a new goal: the law again
+        assert not controller.teleoperated
