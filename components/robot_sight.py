@@ -16,6 +16,7 @@ from typing import Any
 from messages.state import RobotState
 from profiles.scene import Scene
 from sim2d.floor_view import Region, camera_region
+from sim2d.pinhole import ceiling_camera
 
 
 def sight_region(scene: Scene | None) -> Region:
@@ -23,8 +24,6 @@ def sight_region(scene: Scene | None) -> Region:
     without a scene."""
     if scene is None:
         return ()
-    from sim2d.camera import ceiling_camera  # cv2: only profiles with a scene pay for it
-
     base = scene.base
     margin = math.hypot(*base.offset) + base.size_m / math.sqrt(2.0)
     return camera_region(ceiling_camera(scene.camera), scene.reference_pose, base.height_m, margin)

@@ -62,7 +62,7 @@ from ros2.state_messages import (
     transform_stamped,
 )
 from ros2.urdf import joints, matrix, urdf
-from sim2d.camera import ceiling_pose
+from sim2d.pinhole import ceiling_pose
 from vision.images import jpeg
 from wbc import dq
 

@@ -19,7 +19,8 @@ import numpy as np
 from messages.camera import CameraFrame, CameraIntrinsics
 from messages.header import Header
 from profiles.scene import Scene
-from sim2d.camera import ImageNoise, PlacedMarker, Renderer, ceiling_camera
+from sim2d.camera import ImageNoise, PlacedMarker, Renderer
+from sim2d.pinhole import ceiling_camera
 from vision.images import jpeg
 from wbc.geometry.obstacles import Circle
 from wbc.planar import compose, planar_pose

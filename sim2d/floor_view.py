@@ -12,7 +12,7 @@ from wbc import dq
 from wbc.planar import in_frame
 
 if TYPE_CHECKING:
-    from sim2d.camera import PinholeCamera
+    from sim2d.pinhole import PinholeCamera
 
 Region = tuple[tuple[float, float, float], ...]
 """Half-planes (a, b, c), (a, b) a unit vector: a point (x, y) is inside where a x + b y <= c

@@ -23,8 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim2d.camera import PinholeCamera
 from sim2d.floor_view import seen_floor
+from sim2d.pinhole import PinholeCamera
 from vision.markers import Detection, Intrinsics, square_pose
 from wbc import dq
 from wbc.planar import planar_pose

@@ -22,7 +22,7 @@ import cv2
 from outputs.files import writable_output, written_whole
 from outputs.stdout import emit, json_text
 from profiles.profile import Profile, ProfileError, load_profile
-from sim2d.camera import ceiling_camera
+from sim2d.pinhole import ceiling_camera
 from vision.calibration import (
     Board,
     BoardDetector,

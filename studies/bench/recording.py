@@ -62,7 +62,8 @@ from profiles.profile import Profile, ZenohSettings, load_profile
 from record.session_file import MESSAGE_ENCODING
 from record.session_reader import info, read_session
 from record.sessions import load_session
-from sim2d.camera import ImageNoise, PlacedMarker, ceiling_camera, render
+from sim2d.camera import ImageNoise, PlacedMarker, render
+from sim2d.pinhole import ceiling_camera
 from studies.bench.long_sessions import memory_use, repeated_session
 from studies.bench.pubsub_workers import NAMESPACE, WAIT_S, message
 from studies.bench.sim_experiments import percentile

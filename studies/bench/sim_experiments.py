@@ -19,7 +19,8 @@ import numpy as np
 from launch.query import QueryError
 from outputs.stdout import emit, json_text, result_only_stdout
 from profiles.profile import ProfileError, load_profile
-from sim2d.camera import ImageNoise, PlacedMarker, Renderer, ceiling_camera
+from sim2d.camera import ImageNoise, PlacedMarker, Renderer
+from sim2d.pinhole import ceiling_camera
 from sim2d.scenarios import scenario
 from studies.experiment import PROFILES, Options, run_experiment
 from vision.images import grey, jpeg

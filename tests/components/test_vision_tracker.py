@@ -19,13 +19,8 @@ from messages.camera import CameraFrame, CameraIntrinsics
 from messages.header import Header
 from profiles.deploy_files import DEPLOY
 from profiles.profile_files import read_profile_data
-from sim2d.camera import (
-    ImageNoise,
-    PinholeCamera,
-    PlacedMarker,
-    ceiling_camera,
-    render,
-)
+from sim2d.camera import ImageNoise, PlacedMarker, render
+from sim2d.pinhole import PinholeCamera, ceiling_camera
 from vision.images import jpeg
 from wbc import dq
 from wbc.planar import planar_pose

@@ -16,11 +16,12 @@ import yaml
 from profiles.profile import load_profile
 from protocols import dynamixel_v1 as dxl1
 from protocols import dynamixel_v2 as dxl2
-from sim2d.camera import ImageNoise, PlacedMarker, ceiling_camera, render
+from sim2d.camera import ImageNoise, PlacedMarker, render
 from sim2d.devices.ax_servos import AXChainEmulator
 from sim2d.devices.create2 import Create2Emulator
 from sim2d.devices.servo_chain import IntegratingJoints
 from sim2d.devices.x_servos import XChainEmulator
+from sim2d.pinhole import ceiling_camera
 from wbc.planar import planar_pose
 from wbc.servo_map import ServoMap
 

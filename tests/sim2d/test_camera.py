@@ -7,16 +7,8 @@ import math
 import cv2
 import numpy as np
 
-from sim2d.camera import (
-    BLACK,
-    FLOOR_GREY,
-    WHITE,
-    ImageNoise,
-    PinholeCamera,
-    PlacedMarker,
-    ceiling_pose,
-    render,
-)
+from sim2d.camera import BLACK, FLOOR_GREY, WHITE, ImageNoise, PlacedMarker, render
+from sim2d.pinhole import PinholeCamera, ceiling_pose
 from wbc import dq
 
 DICTIONARY = cv2.aruco.DICT_4X4_50

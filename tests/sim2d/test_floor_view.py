@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from sim2d.camera import PinholeCamera, ceiling_pose
 from sim2d.floor_view import camera_region, region_of, seen_floor
+from sim2d.pinhole import PinholeCamera, ceiling_pose
 from wbc import dq
 from wbc.planning.staging import within
 

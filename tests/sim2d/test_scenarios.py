@@ -12,7 +12,7 @@ from components.simulator import Simulator
 from profiles.deploy_files import ROBOT_FILE
 from profiles.profile import load_profile
 from profiles.scene import Scene
-from sim2d.camera import PinholeCamera, ceiling_camera
+from sim2d.pinhole import PinholeCamera, ceiling_camera
 from sim2d.scenarios import (
     ANYWHERE_OBSTACLE,
     ANYWHERE_START,

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from profiles.deploy_files import DEPLOY
-from sim2d.camera import PinholeCamera, ceiling_pose
+from sim2d.pinhole import PinholeCamera, ceiling_pose
 from vision.calibration import (
     MIN_TILT_SPREAD_DEG,
     Board,

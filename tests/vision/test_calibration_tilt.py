@@ -13,7 +13,8 @@ import pytest
 
 from profiles.deploy_files import DEPLOY
 from profiles.profile import load_profile
-from sim2d.camera import ImageNoise, PinholeCamera, PlacedMarker, ceiling_pose, render
+from sim2d.camera import ImageNoise, PlacedMarker, render
+from sim2d.pinhole import PinholeCamera, ceiling_pose
 from vision.markers import Intrinsics, MarkerDetector, plane_of, plane_pose, square_pose
 from wbc import dq
 from wbc.planar import planar_pose

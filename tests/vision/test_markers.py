@@ -10,7 +10,8 @@ from functools import cache
 import cv2
 import numpy as np
 
-from sim2d.camera import ImageNoise, PinholeCamera, PlacedMarker, ceiling_pose, render
+from sim2d.camera import ImageNoise, PlacedMarker, render
+from sim2d.pinhole import PinholeCamera, ceiling_pose
 from vision.markers import (
     Detection,
     Intrinsics,

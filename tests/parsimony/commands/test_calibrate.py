@@ -17,7 +17,8 @@ import pytest
 from components.vision_tracker import load_calibration
 from profiles.deploy_files import DEPLOY
 from profiles.profile import load_profile
-from sim2d.camera import ImageNoise, PinholeCamera, PlacedMarker, ceiling_pose, render
+from sim2d.camera import ImageNoise, PlacedMarker, render
+from sim2d.pinhole import PinholeCamera, ceiling_pose
 from tests.parsimony.in_process import run_in_process
 from tests.vision.board_views import DISTORTION_TRUE, K_TRUE, SIZE, varied_poses, write_views
 from vision.calibration import Board, BoardDetector
