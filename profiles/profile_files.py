@@ -7,6 +7,8 @@ from pathlib import Path
 
 import yaml
 
+from wbc.yaml_text import FAST_LOADER, error_place, parse_yaml
+
 TLS_FILES = ("root_ca_certificate", "listen_certificate", "listen_private_key")
 """The files of a profile's ``zenoh.tls``: made absolute against the file that names them."""
 
@@ -39,9 +41,8 @@ class _ProfileLoader(_Bounded, yaml.SafeLoader):
     """PyYAML's own parser: the one whose words a syntax error is told in."""
 
 
-class _FastProfileLoader(_Bounded, getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
-    """libyaml's parser where PyYAML has it: several times faster, and every process reads its
-    profile at start; the values are built by the same constructor."""
+class _FastProfileLoader(_Bounded, FAST_LOADER):
+    """libyaml's parser where PyYAML has it (``wbc.yaml_text``)."""
 
 
 def _expanded(node: yaml.Node, sizes: dict[int, int]) -> int:
@@ -66,25 +67,12 @@ def _read_yaml(path: Path) -> object:
     except UnicodeDecodeError as error:
         raise ProfileError(f"{path}: not UTF-8 text (byte {error.start})") from None
     try:
-        return _load(_FastProfileLoader, text, path)
-    except yaml.YAMLError:
-        pass  # libyaml says it in other words: read again for PyYAML's, as it always said
-    try:
-        return _load(_ProfileLoader, text, path)
+        return parse_yaml(text, str(path), _FastProfileLoader, _ProfileLoader)
     except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else str(path)
         problem = getattr(error, "problem", None) or str(error)
-        raise ProfileError(f"{where}: YAML syntax error: {problem}") from error
-
-
-def _load(loader_class: type, text: str, path: Path) -> object:
-    loader = loader_class(text)
-    loader.name = str(path)
-    try:
-        return loader.get_single_data()
-    finally:
-        loader.dispose()
+        raise ProfileError(
+            f"{error_place(error, str(path))}: YAML syntax error: {problem}"
+        ) from error
 
 
 def merge(base: object, override: object) -> object:

@@ -23,6 +23,7 @@ import yaml
 
 from wbc.serial_chain import JOINT_TYPES, RobotDescriptionError, SerialChain, from_dh, readonly
 from wbc.urdf_chain import read_urdf_arm
+from wbc.yaml_text import error_place, parse_yaml
 
 Array = np.ndarray
 
@@ -60,14 +61,14 @@ def read_mapping(path: Path) -> dict:
     """The YAML mapping in the file at ``path``; ``RobotDescriptionError`` naming the file if it
     is not text, not YAML or not a mapping (``OSError`` if it cannot be read)."""
     try:
-        data = yaml.safe_load(path.read_bytes().decode("utf-8"))
+        data = parse_yaml(path.read_bytes().decode("utf-8"), str(path))
     except UnicodeDecodeError as error:
         raise RobotDescriptionError(f"{path}: not UTF-8 text (byte {error.start})") from None
     except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else str(path)
         problem = getattr(error, "problem", None) or str(error).splitlines()[0]
-        raise RobotDescriptionError(f"{where}: not YAML: {problem}") from None
+        raise RobotDescriptionError(
+            f"{error_place(error, str(path))}: not YAML: {problem}"
+        ) from None
     if not isinstance(data, dict):
         found = "nothing" if data is None else f"a {type(data).__name__}"
         raise RobotDescriptionError(

@@ -17,6 +17,7 @@ from wbc.laws.lp_law import LPLaw
 from wbc.laws.pinv_law import PinvParams, PseudoinverseLaw
 from wbc.laws.qp_law import QPLaw
 from wbc.robot import BASE_KINDS, JOINT_TYPES, MobileManipulator, RobotDescriptionError
+from wbc.robot_description import read_mapping
 from wbc.serial_chain import from_dh
 
 DT = 0.02
@@ -255,3 +256,10 @@ def test_the_kinds_a_description_may_give_load(tmp_path: Path) -> None:
     path = tmp_path / "urdf.yaml"
     path.write_text(yaml.safe_dump(_urdf_arm(_little_john())))
     assert MobileManipulator.from_yaml(path).velocity_max[3:].tolist() == [4.8] * 4
+
+
+@pytest.mark.parametrize("path", sorted(ROBOTS_DIR.glob("*.yaml")), ids=lambda path: path.name)
+def test_a_description_is_read_as_pyyaml_reads_it(path: Path) -> None:
+    """libyaml's parser, which reads descriptions (several times faster), builds what PyYAML's
+    does."""
+    assert read_mapping(path) == yaml.safe_load(path.read_text())
