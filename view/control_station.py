@@ -16,6 +16,8 @@ The listener of the live view's server (``view.live_view``):
   user may set none still lists them, and refuses every set.
 - The emergency stop, a boolean among the parameters (``view.station_stop``): true stops the
   namespace as ``parsimony stop`` does, false releases it as ``parsimony release`` does.
+- Teleoperation (``view.station_teleop``): Foxglove's Teleop panel on a channel on
+  teleop/command, when the view's user may command the robot.
 
 What becomes of each goal and set is said in a status message naming the client it answers
 (foxglove-sdk 0.30's Python server sends a status to every client, not to one), and logged.
@@ -46,7 +48,7 @@ from foxglove.websocket import (
     WebSocketServer,
 )
 
-from components.stop_latch import stop_text
+from components.stop_latch import release_refusal, stop_text
 from launch.tool_clock import ToolClock
 from launch.zenoh_error import is_session_error, zenoh_error_text
 from messages import codec, topics
@@ -58,6 +60,7 @@ from view.client_goals import ENCODING, SCHEMAS, GoalRefused, client_goal
 from view.client_limits import ECHO_CHARS, GOAL_RATE, STATUS_CHARS, Bucket, cut, echo
 from view.foxglove_params import running_parameters, set_parameters
 from view.station_stop import STOP_PARAMETER, stop_given, stop_parameters
+from view.station_teleop import TWIST_SCHEMAS, teleop_of, teleop_topic
 from wbc import dq
 from wbc.geometry.obstacles import Circle
 from wbc.planar import offset_pose
@@ -123,6 +126,7 @@ class ControlStation(ServerListener):
         self._server: WebSocketServer | None = None
         self._lock = threading.Lock()
         self._goal_channels: dict[tuple[int, int], ClientChannel] = {}
+        self._teleop_channels: set[tuple[int, int]] = set()
         self._buckets: dict[int, Bucket] = {}
         self._q: np.ndarray | None = None
         self._obstacles: tuple[Circle, ...] = ()
@@ -243,6 +247,16 @@ class ControlStation(ServerListener):
     @_answering("publish")
     def on_client_advertise(self, client: Client, channel: ClientChannel) -> None:
         key = (client.id, channel.id)
+        if teleop_topic(channel.topic, self.namespace):
+            refusal = release_refusal(self._profile, self.user, "teleoperate the robot")
+            if channel.encoding != ENCODING or channel.schema_name not in TWIST_SCHEMAS:
+                refusal = f"teleop/command takes {ENCODING} {' or '.join(TWIST_SCHEMAS)}"
+            if refusal is not None:
+                self._status(client, "teleop", refusal, StatusLevel.Error)
+            else:
+                with self._lock:
+                    self._teleop_channels.add(key)
+            return
         if channel.topic not in (topics.GOAL_REQUEST.name, topics.GOAL_REQUEST.key(self.namespace)):
             self._status(
                 client,
@@ -269,11 +283,15 @@ class ControlStation(ServerListener):
     def on_client_unadvertise(self, client: Client, client_channel_id: int) -> None:
         with self._lock:
             self._goal_channels.pop((client.id, client_channel_id), None)
+            self._teleop_channels.discard((client.id, client_channel_id))
             if not any(id_ == client.id for id_, _ in self._goal_channels):
                 self._buckets.pop(client.id, None)
 
     @_answering("goal")
     def on_message_data(self, client: Client, client_channel_id: int, data: bytes) -> None:
+        if (client.id, client_channel_id) in self._teleop_channels:
+            self._teleoperate(client, data)
+            return
         now_s = time.monotonic()
         with self._lock:
             channel = self._goal_channels.get((client.id, client_channel_id))
@@ -320,6 +338,15 @@ class ControlStation(ServerListener):
             f"goal/request sent: the gripper to ({x:.3f}, {y:.3f}, {z:.3f}) in world",
             StatusLevel.Info,
         )
+
+    def _teleoperate(self, client: Client, data: bytes) -> None:
+        """A twist of the Teleop panel onto teleop/command (what is wrong said, nothing sent)."""
+        try:
+            command = teleop_of(data, self.user)
+            key = topics.TELEOP_COMMAND.key(self.namespace)
+            self._on_session(lambda s: s.put(key, codec.encode(command)))
+        except (ValueError, SessionFailed) as error:
+            self._status(client, "teleop", f"teleop/command: {error}", StatusLevel.Error)
 
     def _put(self, payload: bytes) -> None:
         assert self._goal_out is not None

@@ -1,12 +1,16 @@
-"""The control station's stop control (``view.station_stop``), with Foxglove's own client on a
+"""The control station's stop control (``view.station_stop``) and Teleop channel
+(``view.station_teleop``), with Foxglove's own client on a
 view in this process (``tests.view.test_station_limits``'s), a holder of the latch on its node:
 set true, the namespace stops; false, it is released; anything else is refused saying why."""
 
 from __future__ import annotations
 
+import json
 import time
 
 from components.stop_latch import StopLatch
+from messages import codec, topics
+from messages.teleop import TeleopCommand
 from tests.foxglove_client.client import DEADLINE_S, FoxgloveClient
 from tests.view.test_station_limits import View, answer, view  # noqa: F401 - the fixture
 
@@ -15,20 +19,59 @@ def test_the_station_stops_and_releases_the_namespace(view: View) -> None:  # no
     latch = StopLatch(view.node)
     with FoxgloveClient(view.address) as client:
         client.server_info()
-        values, said = answer(client, [{"name": "control/stop", "value": True}], "stop")
+        start = len(client.events)
+        values, _ = answer(client, [{"name": "control/stop", "value": True}], "stop")
         assert [(v["name"], v["value"]) for v in values] == [("control/stop", True)]
-        assert any("control/stop: stopped by" in s for s in said), said
+        client.wait_for(
+            lambda e: e["event"] == "status" and "control/stop: stopped by" in e["message"],
+            "the stop said",
+            start,
+        )
         client.send("getParameters", names=["control/stop"], id="read")
         listed = client.wait_for(
             lambda e: e["event"] == "parameterValues" and e.get("id") == "read", "the stop"
         )
         assert [(p["name"], p["value"]) for p in listed["parameters"]] == [("control/stop", True)]
         assert latch.stopped and latch.state.header.source == view.station.user
-        _, said = answer(client, [{"name": "control/stop", "value": "yes"}], "bad")
-        assert any("control/stop = 'yes' refused: true or false" in s for s in said), said
+        start = len(client.events)
+        answer(client, [{"name": "control/stop", "value": "yes"}], "bad")
+        client.wait_for(
+            lambda e: e["event"] == "status" and "'yes' refused: true or false" in e["message"],
+            "the refusal",
+            start,
+        )
         values, _ = answer(client, [{"name": "control/stop", "value": False}], "release")
         assert [(v["name"], v["value"]) for v in values] == [("control/stop", False)]
     deadline = time.monotonic() + DEADLINE_S
     while latch.stopped:  # the release on its way through the router
         assert time.monotonic() < deadline, "the release never came"
         time.sleep(0.01)
+
+
+def test_the_teleop_panel_drives_through_the_station(view: View) -> None:  # noqa: F811
+    heard: list[TeleopCommand] = []
+    watcher = view.router.declare_subscriber(
+        topics.TELEOP_COMMAND.key(view.profile.namespace),
+        lambda sample: heard.append(codec.decode(sample.payload.to_bytes(), TeleopCommand)),
+    )
+    with FoxgloveClient(view.address) as client:
+        client.server_info()
+        client.send(
+            "advertise", topic="teleop/command", encoding="json", schemaName="geometry_msgs/Twist"
+        )
+        channel = client.wait_for(lambda e: e["event"] == "advertised", "the channel")["channel"]
+        twist = {"linear": {"x": 0.1, "y": 0, "z": 0}, "angular": {"x": 0, "y": 0, "z": -0.2}}
+        client.send("publish", channel=channel, text=json.dumps(twist))
+        start = len(client.events)
+        client.send("publish", channel=channel, text='{"linear": 1}')
+        client.wait_for(
+            lambda e: e["event"] == "status" and "not a geometry_msgs/Twist" in e["message"],
+            "the refusal",
+            start,
+        )
+    deadline = time.monotonic() + DEADLINE_S
+    while not heard:
+        assert time.monotonic() < deadline, "no teleop/command"
+        time.sleep(0.01)
+    watcher.undeclare()
+    assert [(c.forward, c.turn, c.joint) for c in heard] == [(0.1, -0.2, "")]
