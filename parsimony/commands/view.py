@@ -31,6 +31,7 @@ from parsimony.argument_types import positive_seconds
 from parsimony.stop_signals import STOP_SIGNALS, stop_signals
 from parsimony.target_options import exit_code
 from profiles.profile import Profile, ProfileError, load_profile
+from ros2.urdf import assets as urdf_assets
 from scenes.foxglove_views import Viewer
 from view.control_station import ControlStation
 from view.live_view import DEFAULT_PORT, LiveView
@@ -159,6 +160,7 @@ def serving(
             station,
             station.capabilities,
             station.encodings,
+            assets=None if robot is None else urdf_assets(robot),
         ) as view:
             station.attach(view.server)
             yield view, station

@@ -12,8 +12,9 @@ import yourdfpy
 import zenoh
 from websockets.sync.client import connect
 
-from ros2.urdf import END_EFFECTOR, URDF_URI, assets, joints, link_name, matrix, planar, urdf
-from view.live_view import LiveView
+from parsimony.commands.view import serving
+from profiles.profile import load_profile
+from ros2.urdf import END_EFFECTOR, URDF_URI, joints, link_name, matrix, planar, urdf
 from wbc.robot import BASE_DOF, BaseDescription, MobileManipulator
 
 ROBOTS = sorted(Path("deploy/robots").glob("*.yaml"))
@@ -85,15 +86,17 @@ def test_joint_transforms_are_yourdfpys():
 
 
 def test_foxglove_fetches_the_urdf_the_live_view_serves():
-    """A WebSocket client asks the live view for ``URDF_URI`` as Foxglove's URDF panel does
-    (the ``assets`` capability, op ``fetchAsset``, a binary fetch-asset response) and gets the
-    file /robot_description carries."""
-    robot = MobileManipulator.from_yaml(ROBOTS[0])
+    """A WebSocket client asks `parsimony view`'s live view (``serving``) for ``URDF_URI`` as
+    Foxglove's URDF panel does (the ``assets`` capability, op ``fetchAsset``, a binary
+    fetch-asset response) and gets the file /robot_description carries: the profile's robot's."""
+    profile = load_profile(Path("deploy/sim.yaml"))
+    robot = MobileManipulator.from_yaml(profile.robot)
     config = zenoh.Config()
     config.insert_json5("scouting/multicast/enabled", "false")
+    config.insert_json5("listen/endpoints", '["tcp/127.0.0.1:0"]')
     with (
         zenoh.open(config) as session,
-        LiveView(session, "urdf", [], port=0, assets=assets(robot)) as view,
+        serving(session, profile, [], 0, robot) as (view, _),
         connect(view.address, subprotocols=["foxglove.sdk.v1"]) as client,
     ):
         info = json.loads(client.recv(timeout=30))
