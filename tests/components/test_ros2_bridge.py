@@ -181,7 +181,8 @@ def bridge(deployed_for_module) -> Iterator[Bridge]:
         yield Bridge(system, node)
 
 
-def test_each_topic_is_on_its_design_key_with_the_attachment_and_rosbags_cdr(bridge):
+def every_topic_out(bridge: Bridge) -> None:
+    """A state and a camera frame put until the bridge has published its topics of both."""
     bridge.send_state()
     intrinsics = CameraIntrinsics(fx=600.0, fy=600.0, cx=319.5, cy=239.5)
     header = Header(stamp_ns=time.time_ns(), frame="camera", seq=0, source="test")
@@ -194,6 +195,10 @@ def test_each_topic_is_on_its_design_key_with_the_attachment_and_rosbags_cdr(bri
         lambda: bridge.put(topics.CAMERA_IMAGE, frame),
     )
     bridge.until(design_key("tf", "tf2_msgs/msg/TFMessage"), bridge.send_state)
+
+
+def test_each_topic_is_on_its_design_key_with_the_attachment_and_rosbags_cdr(bridge):
+    every_topic_out(bridge)
 
     joints = bridge.ros.message("joint_states", "sensor_msgs/msg/JointState")
     assert list(joints.name) == list(ROBOT.joint_names)
@@ -230,6 +235,45 @@ def test_each_topic_is_on_its_design_key_with_the_attachment_and_rosbags_cdr(bri
     assert abs(stamp - time.time_ns()) < DEADLINE_S * 1e9 and gid != bytes(16)
 
 
+def test_every_payload_is_what_a_second_cdr_serialiser_writes(bridge):
+    """Each message the bridge put, of every type, decoded by Foxglove's CDR serialiser
+    (mcap-ros2-support, from the type's ros2msg text) and written again by it: the same bytes."""
+    from mcap_ros2._dynamic import generate_dynamic, serialize_dynamic
+
+    every_topic_out(bridge)
+    bridge.ros.wait(design_key("diagnostics", "diagnostic_msgs/msg/DiagnosticArray"))
+    payloads = {  # the bridge's own publications (the goals the tests put are not)
+        key: [data for data, _ in samples]
+        for key, samples in bridge.ros.samples.items()
+        if "/goal_pose/" not in key
+    }
+    for topic, msgtype in (
+        ("robot_description", "std_msgs/msg/String"),
+        ("tf_static", "tf2_msgs/msg/TFMessage"),
+    ):
+        payloads[design_key(topic, msgtype)] = [latched_bytes(bridge, topic, msgtype)]
+    checked = set()
+    for key, samples in payloads.items():
+        dds_type, type_hash = key.split("/")[-2:]
+        package, _, _, name = dds_type.split("::")
+        msgtype = f"{package}/msg/{name.removesuffix('_')}"
+        assert type_hash == store().hash_rihs01(msgtype), key
+        text, _ = store().generate_msgdef(msgtype, ros_version=2)
+        decode, encode = generate_dynamic(msgtype, text)[msgtype], serialize_dynamic(msgtype, text)
+        for data in samples[-3:]:
+            assert encode[msgtype](decode(data)) == data, key
+        checked.add(msgtype)
+    assert {
+        "sensor_msgs/msg/JointState",
+        "tf2_msgs/msg/TFMessage",
+        "nav_msgs/msg/Odometry",
+        "sensor_msgs/msg/CompressedImage",
+        "sensor_msgs/msg/CameraInfo",
+        "std_msgs/msg/String",
+        "diagnostic_msgs/msg/DiagnosticArray",
+    } <= checked
+
+
 def test_liveliness_tokens_are_the_golden_forms(bridge):
     zid = str(bridge.node.session.zid())
     tokens = {str(r.ok.key_expr) for r in bridge.system.router.liveliness().get("@ros2_lv/**")}
@@ -249,7 +293,12 @@ def test_liveliness_tokens_are_the_golden_forms(bridge):
 
 
 def latched(bridge: Bridge, topic: str, msgtype: str):
-    """The message a late joiner gets on a TRANSIENT_LOCAL topic, as rmw_zenoh's subscription
+    """The message a late joiner gets on a TRANSIENT_LOCAL topic (``latched_bytes``)."""
+    return store().deserialize_cdr(latched_bytes(bridge, topic, msgtype), msgtype)
+
+
+def latched_bytes(bridge: Bridge, topic: str, msgtype: str) -> bytes:
+    """The payload a late joiner gets on a TRANSIENT_LOCAL topic, as rmw_zenoh's subscription
     asks for it: an advanced subscriber with history, detecting late publishers."""
     got: list[bytes] = []
     arrived = threading.Event()
@@ -264,7 +313,7 @@ def latched(bridge: Bridge, topic: str, msgtype: str):
         bridge.system.router, key, on_sample, history=history
     ):
         assert arrived.wait(DEADLINE_S), f"no /{topic} for a late joiner"
-    return store().deserialize_cdr(got[0], msgtype)
+    return got[0]
 
 
 def test_a_late_joiner_gets_the_robot_description(bridge):
