@@ -65,12 +65,13 @@ def test_sigint_stops_in_reverse_role_order_and_every_line_says_when_and_what(
     code is checked by the restart and start-up tests.) The launcher's lines and its
     components' alike say when and who, and it says what it waits for. (One launch for both:
     each stamped line was the same of a launch of its own.)"""
+    slow = {"params": {"rate_hz": 1.0}}  # states and goals the controller need not solve for
     profile = write_profile(
         [
-            publisher("arm", role="tool"),
+            publisher("arm", role="tool", **slow),
             {"name": "lp", "module": "lp_controller", "role": "controller"},
-            publisher("est", role="estimator"),
-            publisher("base", role="driver"),
+            publisher("est", role="estimator", **slow),
+            publisher("base", role="driver", **slow),
         ],
         robot=str(ROBOT_FILE),
     )
