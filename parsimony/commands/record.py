@@ -21,7 +21,6 @@ from outputs.stdout import emit
 from parsimony.memory_file import memory_file
 from profiles.profile import ProfileError
 from profiles.recorder import RECORDER, with_recorder
-from record.session_reader import recover
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -42,6 +41,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"record: {problem}", file=sys.stderr)
         return 2
     if args.recover is not None:
+        # The MCAP reader (and Foxglove's schemas) only for a recovery, not for every recording.
+        from record.session_reader import recover
+
         try:
             with written_whole(args.output) as partial:
                 saved = recover(args.recover, partial)
