@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+import zenoh
 
 from components.base_driver import BaseDriver
 from components.runtime import Node
@@ -142,3 +143,23 @@ def test_the_base_driver_stops_at_once_and_refuses_motion_until_the_release(
         del heard[:]
         wait_until(lambda: drive() or hears(moving), "the wheels driven again")
     link.close()
+
+
+def test_the_stop_outlives_its_router(
+    system: System, capsys: pytest.CaptureFixture[str], wait_until
+) -> None:
+    """The router goes away and comes back (its port the same): the holder kept the stop, and
+    a holder started after hears it (asked, or put again every second)."""
+    with Node(system.profile, "talker") as talker:
+        first = StopLatch(talker)
+        talker.start()
+        give(system, capsys, "stop")
+        system.router.close()
+        assert first.stopped and talker.status().stop == first.state
+        with zenoh.open(system.profile.zenoh.router_config()) as router:
+            system.router = router  # the fixture's, closed once more at its end: no harm
+            with Node(system.profile, "listener") as listener:
+                second = StopLatch(listener)
+                listener.start()
+                wait_until(lambda: second.stopped, "the stop heard after the router's return")
+                assert second.state == first.state
