@@ -11,6 +11,7 @@ import numpy as np
 from components.control_step import REFUSED_STATE, TELEOP, teleop_step
 from components.lp_controller import LPController
 from components.runtime import Node
+from components.stop_latch import stop_state
 from messages import codec, topics
 from messages.diagnostics import ControllerDiagnostics
 from messages.goal import Goal
@@ -19,6 +20,9 @@ from messages.state import RobotState
 from messages.teleop import TeleopCommand
 from parsimony.commands.teleop import Hand, press
 from profiles.deploy_files import DEPLOY, ROBOT_FILE
+from tests.components.conftest import DEADLINE_S
+from tests.components.test_supervisor import header, met_at, supervised
+from wbc.geometry.scenarios import HOME, REACH_GOAL
 from wbc.robot import MobileManipulator
 
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
@@ -125,3 +129,45 @@ def test_the_controller_yields_to_a_hand_and_resumes_only_on_a_new_goal(deployed
         while step().status == TELEOP:
             pass  # a new goal: the law again
         assert not controller.teleoperated
+
+
+def test_the_supervisor_holds_while_stopped_and_yields_to_a_hand_until_a_new_goal(
+    deployed,
+) -> None:
+    """The supervisor process (``tests.components.test_supervisor``'s): while the namespace is
+    stopped, and while a hand teleoperates, no goal goes out; a release, and a new goal, bring
+    them back (the same goal again does not end the teleoperation)."""
+    operator = supervised(deployed)
+    namespace = operator.system.profile.namespace
+    router = operator.system.router
+    goals = met_at(REACH_GOAL)
+    first, second = goals["PositionTask"], goals["PointTask"]
+
+    def goals_after_a_state() -> int:
+        """Goals out between two statuses answering a state each."""
+        before = len(operator.goals.messages)
+        count = len(operator.statuses.messages)
+        operator.statuses_after(count, HOME, "a status")
+        operator.statuses_after(count + 1, HOME, "another status")
+        return len(operator.goals.messages) - before
+
+    operator.send_goal(first)
+    operator.send_state(HOME)
+    operator.goals.wait_for(lambda g: g.task == "position", "the goal passed on")
+    stop = router.declare_publisher(topics.CONTROL_STOP.key(namespace))
+    stop.put(codec.encode(stop_state(True, "test")))
+    deadline = time.monotonic() + DEADLINE_S
+    while goals_after_a_state():
+        assert time.monotonic() < deadline, "goals went on while stopped"
+    stop.put(codec.encode(stop_state(False, "test")))
+    while not goals_after_a_state():
+        assert time.monotonic() < deadline, "no goal after the release"
+    hand_out = router.declare_publisher(topics.TELEOP_COMMAND.key(namespace))
+    hand_out.put(codec.encode(hand(forward=0.05)))
+    while goals_after_a_state():
+        assert time.monotonic() < deadline, "goals went on while teleoperated"
+    operator.send_goal(first.model_copy(update={"header": header()}))
+    assert goals_after_a_state() == 0  # the same goal: still yielding
+    operator.send_goal(second)
+    operator.send_state(HOME)
+    operator.goals.wait_for(lambda g: g.task == "point", "the new goal passed on")
