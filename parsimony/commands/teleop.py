@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import select
 import sys
 import termios
@@ -114,25 +115,29 @@ def run(args: argparse.Namespace) -> int:
 
 
 def drive(args: argparse.Namespace, names: tuple[str, ...], put) -> None:
-    """Read keys until ``q``, putting the command at ``args.rate``; zero on the way out."""
+    """Read keys until ``q``, putting the command at ``args.rate``; zero on the way out. The
+    keys are read from the descriptor as they come (a buffered read would keep the second of
+    two keys typed at once until a third)."""
     speeds = (args.speed, args.turn, args.joint_speed)
     hand, pressed = Hand(), 0.0
-    saved = termios.tcgetattr(sys.stdin)
+    terminal = sys.stdin.fileno()
+    saved = termios.tcgetattr(terminal)
     print(f"teleop: {KEYS}", file=sys.stderr)
     try:
-        tty.setcbreak(sys.stdin)
+        tty.setcbreak(terminal)
         while True:
-            if select.select([sys.stdin], [], [], 1.0 / args.rate)[0]:
-                after = press(sys.stdin.read(1), hand, speeds, len(names))
-                if after is None:
-                    break
-                hand, pressed = after, time.monotonic()
+            if select.select([terminal], [], [], 1.0 / args.rate)[0]:
+                for key in os.read(terminal, 64).decode(errors="replace"):
+                    after = press(key, hand, speeds, len(names))
+                    if after is None:
+                        return
+                    hand, pressed = after, time.monotonic()
             if time.monotonic() - pressed > HOLD_S:
                 hand = replace(Hand(), joint=hand.joint)
             put(command_of(hand, names))
     finally:
         put(command_of(replace(Hand(), joint=hand.joint), names))
-        termios.tcsetattr(sys.stdin, termios.TCSADRAIN, saved)
+        termios.tcsetattr(terminal, termios.TCSADRAIN, saved)
 
 
 def command_of(hand: Hand, names: tuple[str, ...]) -> TeleopCommand:

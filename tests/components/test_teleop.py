@@ -4,6 +4,9 @@ the keys of `parsimony teleop` (``parsimony.commands.teleop.press``)."""
 from __future__ import annotations
 
 import math
+import os
+import subprocess
+import sys
 import time
 
 import numpy as np
@@ -171,3 +174,26 @@ def test_the_supervisor_holds_while_stopped_and_yields_to_a_hand_until_a_new_goa
     operator.send_goal(second)
     operator.send_state(HOME)
     operator.goals.wait_for(lambda g: g.task == "point", "the new goal passed on")
+
+
+def test_parsimony_teleop_puts_what_the_keys_ask_and_zero_on_its_way_out(deployed) -> None:
+    """`parsimony teleop` on a terminal (a pseudo-terminal the test types into)."""
+    system = deployed(DEPLOY / "hardware.yaml")
+    heard = system.inbox(topics.TELEOP_COMMAND)
+    leader, follower = os.openpty()
+    command = [sys.executable, "-m", "parsimony.cli", "teleop", "--profile", str(system.path)]
+    process = subprocess.Popen(command, stdin=follower, stderr=subprocess.PIPE, text=True)
+    try:
+        heard.wait_for(lambda c: c.forward == 0.0, "a still command")  # the tool is reading
+        os.write(leader, b"w")
+        heard.wait_for(lambda c: c.forward == 0.1, "forward")
+        os.write(leader, b"2i")
+        heard.wait_for(lambda c: c.joint == ROBOT.joint_names[1] and c.joint_velocity == 0.3, "j")
+        os.write(leader, b"q")
+        assert process.wait(DEADLINE_S) == 0, process.stderr.read() if process.stderr else ""
+    finally:
+        process.kill()
+        os.close(leader)
+        os.close(follower)
+    last = heard.messages[-1]
+    assert (last.forward, last.turn, last.joint_velocity) == (0.0, 0.0, 0.0)
