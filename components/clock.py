@@ -46,15 +46,16 @@ class SimClock:
     def advance(self, stamp_ns: int, paused: bool = False, lockstep: bool = False) -> None:
         """Set the time to ``stamp_ns`` (it may go back when a replay restarts). A paused
         simulator holds its time on purpose, and a lockstep one waits for the loop's answers
-        (its own timeout bounds that wait): neither clock counts as stalled."""
-        self.started = True
-        if stamp_ns != self._stamp_ns or paused:
+        (its own timeout bounds that wait): neither clock counts as stalled. Its first tick
+        starts it: the time before counts as no stall."""
+        if stamp_ns != self._stamp_ns or paused or not self.started:
             self._moved_at_ns = time.monotonic_ns()
+        self.started = True
         self._stamp_ns = stamp_ns
         self._lockstep = lockstep
 
     def stalled_s(self) -> float:
-        """Host seconds since the simulated time last moved (or since the clock was made); 0
+        """Host seconds since the simulated time last moved (or since its first tick); 0
         in lockstep, where a component's command on a stall would be taken as the step's."""
         if self._lockstep:
             return 0.0

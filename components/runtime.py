@@ -290,12 +290,14 @@ class Node:
 
     def _check_clock(self) -> None:
         """On simulated time: say so, once, when the clock stops moving, and when it moves again.
-        A recorder, which starts before the simulator, is ``WAITING_FOR_CLOCK`` until its first
-        tick: a clock that has not started has not stalled."""
+        A component is ``WAITING_FOR_CLOCK`` until the clock's first tick: a clock that has not
+        started has not stalled (nothing simulated moves before it starts, and a zero command
+        stamped 0 from a component that started before the simulator would make a lockstep
+        run's commands depend on the order the processes came up)."""
         clock = self.clock
         if not isinstance(clock, SimClock):
             return
-        if not clock.started and self.spec.role == "recorder":
+        if not clock.started:
             if self.state == "running":
                 self.state = WAITING_FOR_CLOCK
             return

@@ -14,7 +14,7 @@ from components import rate_limited_log
 from components.params import Param
 from components.pubsub import Input
 from components.rate_limited_log import RateLimitedLog
-from components.runtime import Node
+from components.runtime import WAITING_FOR_CLOCK, Node
 from launch import query
 from messages import codec, topics
 from messages.base import IDENTITY_POSE
@@ -184,7 +184,10 @@ def test_a_stopped_sim_clock_is_reported_once_and_its_return_too(
     stalls: list[float] = []
     with Node(profile, "listener") as node:
         node.start(on_clock_stall=stalls.append)
+        wait_until(lambda: node.state == WAITING_FOR_CLOCK, "the wait for the first tick")
         clock = system.router.declare_publisher(topics.SIM_CLOCK.key("test"))
+        wait_until(lambda: clock.matching_status.matching, "the clock subscription")
+        clock.put(codec.encode(topics.SIM_CLOCK.type(stamp_ns=0)))
         wait_until(lambda: node.state == "clock stalled", "the stall to be noticed")
         wait_until(lambda: len(stalls) == 1, "the stall hook")
         assert stalls[0] >= 0.2 and node.counters["clock_stalls"] == 1

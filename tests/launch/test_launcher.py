@@ -116,11 +116,12 @@ def test_a_component_starts_once_those_it_waits_for_are_alive_and_stops_before_t
 def test_a_change_of_a_components_state_is_said(
     write_profile: ProfileWriter, launch: LaunchFixture
 ) -> None:
-    """On simulated time with no simulator, its clock stalls: the launcher says so."""
+    """On simulated time with no simulator, a component waits for the clock's first tick: the
+    launcher says so (and not that a clock stalled which never started)."""
     profile = write_profile([publisher("pub")], clock="sim", clock_timeout_s=0.2)
     launched = launch(profile)
     alive, _, _ = launched.wait_for(r"\[launch\] pub alive")
-    launched.wait_for(r"\[launch\] pub clock stalled \(was running\)", after=alive)
+    launched.wait_for(r"\[launch\] pub waiting for the clock \(was running\)", after=alive)
     assert launched.stop() == 0
 
 
