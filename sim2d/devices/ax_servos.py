@@ -30,12 +30,10 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
-from pathlib import Path
 
 from protocols import dynamixel_v1 as dxl
 from protocols.dynamixel_v1 import Address, Instruction, StatusError
-from sim2d.devices.servo_chain import ServoBackend, ServoChain, spoiled
+from sim2d.devices.servo_chain import ServoChain, spoiled
 
 MODEL_NUMBER = 18
 MAX_SPEED_RAD_S = 97.0 * 2.0 * math.pi / 60.0
@@ -244,21 +242,8 @@ class AXChainEmulator(ServoChain):
     """A servo per joint of ``backend``, answering to ``ids`` in the joints' order (1..n when
     None)."""
 
-    def __init__(
-        self,
-        backend: ServoBackend,
-        ids: Sequence[int] | None = None,
-        link: Path | None = None,
-        return_delay_us: float = 500.0,
-        baud: int | None = None,
-    ) -> None:
-        positions = backend.joint_positions()
-        ids = range(1, len(positions) + 1) if ids is None else ids
-        servos = [
-            AXServo(servo_id, return_delay_us, position)
-            for servo_id, position in zip(ids, positions, strict=True)
-        ]
-        super().__init__(backend, servos, dxl.PacketParser(), link, baud)
+    servo_type = AXServo
+    parser_type = dxl.PacketParser
 
     def _handle(self, packet: dxl.Packet) -> None:
         self.counters["packets"] += 1

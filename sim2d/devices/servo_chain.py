@@ -57,25 +57,34 @@ COUNTERS = (
 
 
 class ServoChain(SerialDevice):
-    """Servos on one pseudo-terminal, one per joint of ``backend``; ``parser`` frames the
-    driver's packets (``feed``, ``bad_checksums``, ``skipped_bytes``). ``instructions`` counts
-    the packets received by instruction. With ``baud`` (bit/s) the servos listen at that rate
-    only: bytes written while the port is set to another are garbled for them and dropped
-    (``wrong_baud_bytes``), as on a real bus."""
+    """Servos on one pseudo-terminal, a ``servo_type(id, return_delay_us, position)`` per
+    joint of ``backend``, answering to ``ids`` in the joints' order (1..n when None); a
+    ``parser_type()`` frames the driver's packets (``feed``, ``bad_checksums``,
+    ``skipped_bytes``). ``instructions`` counts the packets received by instruction. With
+    ``baud`` (bit/s) the servos listen at that rate only: bytes written while the port is set
+    to another are garbled for them and dropped (``wrong_baud_bytes``), as on a real bus."""
+
+    servo_type: Callable[[int, float, float], Any]
+    parser_type: Callable[[], Any]
 
     def __init__(
         self,
         backend: ServoBackend,
-        servos: Sequence[Any],
-        parser: Any,
-        link: Path | None,
+        ids: Sequence[int] | None = None,
+        link: Path | None = None,
+        return_delay_us: float = 500.0,
         baud: int | None = None,
     ) -> None:
+        positions = backend.joint_positions()
+        ids = range(1, len(positions) + 1) if ids is None else ids
         self._backend = backend
-        self.servos = list(servos)
+        self.servos = [
+            self.servo_type(servo_id, return_delay_us, position)
+            for servo_id, position in zip(ids, positions, strict=True)
+        ]
         self._previous_positions: list[float] = list(backend.joint_positions())
         super().__init__(link, (*COUNTERS, "wrong_baud_bytes"))
-        self._parser = parser
+        self._parser = self.parser_type()
         self._baud = baud
         self.instructions: Counter[int] = Counter()
 

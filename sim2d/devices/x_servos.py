@@ -26,8 +26,6 @@ the backend's motion over the last step.
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
-from pathlib import Path
 
 from protocols import dynamixel_v2 as dxl
 from protocols.dynamixel_v2 import (
@@ -39,7 +37,7 @@ from protocols.dynamixel_v2 import (
     OperatingMode,
     StatusError,
 )
-from sim2d.devices.servo_chain import ServoBackend, ServoChain, spoiled
+from sim2d.devices.servo_chain import ServoChain, spoiled
 
 MODEL_NUMBER = 1020
 """XM430-W350."""
@@ -223,21 +221,8 @@ class XChainEmulator(ServoChain):
     """An X-series servo per joint of ``backend``, answering to ``ids`` in the joints' order
     (1..n when None)."""
 
-    def __init__(
-        self,
-        backend: ServoBackend,
-        ids: Sequence[int] | None = None,
-        link: Path | None = None,
-        return_delay_us: float = 500.0,
-        baud: int | None = None,
-    ) -> None:
-        positions = backend.joint_positions()
-        ids = range(1, len(positions) + 1) if ids is None else ids
-        servos = [
-            XServo(servo_id, return_delay_us, position)
-            for servo_id, position in zip(ids, positions, strict=True)
-        ]
-        super().__init__(backend, servos, dxl.PacketParser(), link, baud)
+    servo_type = XServo
+    parser_type = dxl.PacketParser
 
     def _handle(self, packet: dxl.Packet) -> None:
         self.counters["packets"] += 1
