@@ -25,6 +25,8 @@ import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
+from protocols.dynamixel_common import FrameParser
+
 HEADER = b"\xff\xff"
 BROADCAST_ID = 0xFE
 MAX_PACKET_BYTES = 250
@@ -193,7 +195,7 @@ def word(value: int) -> bytes:
     return (value & 0xFFFF).to_bytes(2, "little")
 
 
-class PacketParser:
+class PacketParser(FrameParser[Packet]):
     """Frames packets from a byte stream fed in pieces of any size; never raises.
 
     A frame starts at ``FF FF`` followed by an id other than 0xFF and a length 2..246. Bytes
@@ -203,21 +205,7 @@ class PacketParser:
     a packet that a corrupt length had swallowed is still found.
     """
 
-    def __init__(self) -> None:
-        self._buffer = bytearray()
-        self.skipped_bytes = 0
-        self.bad_checksums = 0
-
-    def feed(self, data: bytes) -> list[Packet]:
-        self._buffer += data
-        packets: list[Packet] = []
-        while (packet := self._next_packet()) is not None:
-            packets.append(packet)
-        return packets
-
-    def _skip(self, count: int) -> None:
-        del self._buffer[:count]
-        self.skipped_bytes += count
+    header = HEADER
 
     def _next_packet(self) -> Packet | None:
         """The first whole frame in the buffer, consuming it; None until one is complete."""
@@ -225,7 +213,7 @@ class PacketParser:
         while True:
             start = buffer.find(HEADER)
             if start < 0:
-                self._skip(len(buffer) - 1 if buffer.endswith(HEADER[:1]) else len(buffer))
+                self._skip_all_but_header_start()
                 return None
             self._skip(start)
             if len(buffer) < 4:

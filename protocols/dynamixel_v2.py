@@ -29,6 +29,7 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
+from protocols.dynamixel_common import FrameParser
 from protocols.dynamixel_v1 import StatusFault
 
 HEADER = b"\xff\xff\xfd\x00"
@@ -339,7 +340,7 @@ def packet_end(buffer: bytes) -> int | None:
     return _PREFIX + int.from_bytes(buffer[5:7], "little")
 
 
-class PacketParser:
+class PacketParser(FrameParser[Packet]):
     """Frames packets from a byte stream fed in pieces of any size; never raises.
 
     A frame starts at ``FF FF FD 00`` followed by an id other than 0xFD and 0xFF and a length
@@ -349,29 +350,14 @@ class PacketParser:
     consumed: the rest is scanned again.
     """
 
-    def __init__(self) -> None:
-        self._buffer = bytearray()
-        self.skipped_bytes = 0
-        self.bad_checksums = 0
-
-    def feed(self, data: bytes) -> list[Packet]:
-        self._buffer += data
-        packets: list[Packet] = []
-        while (packet := self._next_packet()) is not None:
-            packets.append(packet)
-        return packets
-
-    def _skip(self, count: int) -> None:
-        del self._buffer[:count]
-        self.skipped_bytes += count
+    header = HEADER
 
     def _next_packet(self) -> Packet | None:
         buffer = self._buffer
         while True:
             start = buffer.find(HEADER)
             if start < 0:
-                keep = next((n for n in (3, 2, 1) if buffer.endswith(HEADER[:n])), 0)
-                self._skip(len(buffer) - keep)
+                self._skip_all_but_header_start()
                 return None
             self._skip(start)
             end = packet_end(buffer)
