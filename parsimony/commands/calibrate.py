@@ -148,15 +148,15 @@ def _board_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _board(args: argparse.Namespace) -> Board:
+    """The arguments' board, once ``--output`` is known writable; ValueError says why not."""
+    why = writable_output(args.output, [], args.force)
+    if why is not None:
+        raise ValueError(why)
     return Board(tuple(args.squares), args.square, args.marker, args.dictionary)
 
 
 def print_board(args: argparse.Namespace) -> int:
     """The board's image at ``--dpi``, ``PRINT_MARGIN_M`` of white around it, as a PNG."""
-    why = writable_output(args.output, [], args.force)
-    if why is not None:
-        print(f"calibrate: {why}", file=sys.stderr)
-        return 2
     try:
         board = _board(args)
     except ValueError as error:
@@ -223,10 +223,6 @@ def _summary(result: Calibration, frames_read: int, output: Path) -> dict:
 
 
 def calibrate_camera(args: argparse.Namespace) -> int:
-    why = writable_output(args.output, [], args.force)
-    if why is not None:
-        print(f"calibrate: {why}", file=sys.stderr)
-        return 2
     try:
         board = _board(args)
         views, read, size = _views(args, board)
