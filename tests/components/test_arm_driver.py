@@ -6,76 +6,36 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
 from components.arm_driver import HOLD_SPEED
-from messages import codec, topics
-from messages.commands import ArmCommand
-from messages.header import Header
 from profiles.deploy_files import ROBOT_FILE
 from protocols import dynamixel_v1 as dxl
 from protocols.dynamixel_v1 import Address, StatusFault
 from sim2d.devices.ax_servos import AXChainEmulator
 from sim2d.devices.servo_chain import IntegratingJoints
-from tests.components.conftest import System
+from tests.components.arm_bench import ArmBench
 from tests.components.driver_harness import driver_system, status
 from wbc.robot import MobileManipulator
 
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 LOW, HIGH = ROBOT.q_min[3:], ROBOT.q_max[3:]
-STEP_S = 0.01
 ANSWER_TIMEOUT_S = 1.0
 """The driver's wait for an answer: the SDK's 34 ms is less than a loaded machine may take to
 answer (every Moving Speed read 1, a hold, after such a timeout), so only a servo made silent
 is."""
 
 
-class Bench:
-    """The emulated chain, the driver's process, and the test as the controller."""
+class Bench(ArmBench):
+    """The AX-18A chain: commands without joint names, Moving Speed left by a Sync Write."""
 
-    def __init__(self, system: System, arm: IntegratingJoints, servos: AXChainEmulator) -> None:
-        self.system, self.arm, self.servos = system, arm, servos
-        self.joints = system.inbox(topics.ARM_JOINT_STATES)
-        self.command = system.router.declare_publisher(
-            topics.ARM_COMMAND.key(system.profile.namespace)
-        )
-
-    def send(self, velocities: Sequence[float]) -> None:
-        header = Header(stamp_ns=time.time_ns(), frame="arm", seq=0, source="test")
-        self.command.put(
-            codec.encode(ArmCommand(header=header, joint_velocities=tuple(velocities)))
-        )
-
-    def run(self, seconds: float) -> None:
-        """The world and the servos for ``seconds`` of their own time."""
-        for _ in range(round(seconds / STEP_S)):
-            self.servos.update(STEP_S)
-            self.arm.step(STEP_S)
-
-    def written(self, velocities: Sequence[float], wait_until) -> None:
-        """Send ``velocities`` until the driver has written a Sync Write for one of them."""
-        before = self.servos.counters["sync_writes"]
-
-        def sent() -> bool:
-            self.send(velocities)
-            time.sleep(0.005)
-            return self.servos.counters["sync_writes"] > before
-
-        wait_until(sent, f"a Sync Write for {velocities}")
+    speed_address = Address.MOVING_SPEED
 
     def word(self, servo_index: int, address: int) -> int:
         return self.servos.servos[servo_index].word(address)
-
-    def speeds(self) -> list[int]:
-        """Every servo's Moving Speed, as one Sync Write left them."""
-        return self.servos.words(Address.MOVING_SPEED)
-
-    def state(self) -> str:
-        answer = status(self.system, "arm_driver")
-        return "" if answer is None else answer.state
 
 
 @pytest.fixture

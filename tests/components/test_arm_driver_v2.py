@@ -7,21 +7,19 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator
 
 import pytest
 
 from components.servo_bus import HOLD_SPEED
-from messages import codec, topics
-from messages.commands import ArmCommand
-from messages.header import Header
 from profiles.deploy_files import DEPLOY
 from protocols import dynamixel_v2 as dxl
 from protocols.dynamixel_v1 import StatusFault
 from protocols.dynamixel_v2 import Address
 from sim2d.devices.servo_chain import IntegratingJoints
 from sim2d.devices.x_servos import XChainEmulator
-from tests.components.conftest import System, _wait_until
+from tests.components.arm_bench import ArmBench
+from tests.components.conftest import _wait_until
 from tests.components.driver_harness import status
 from wbc.robot import MobileManipulator
 from wbc.servo_map import ServoMap
@@ -32,57 +30,17 @@ IDS = ServoMap.of(ROBOT_FILE, ROBOT.arm_dof).ids
 """The servos' bus ids, joint by joint, as the robot's description gives them."""
 LOW, HIGH = ROBOT.q_min[3:], ROBOT.q_max[3:]
 START = (0.0, -0.2, 0.2, 0.5)
-STEP_S = 0.01
 ANSWER_TIMEOUT_S = 1.0
 """As the AX tests': only a servo made silent is."""
 UNIT = 1.0 / dxl.POSITION_UNITS_PER_RAD
 
 
-class Bench:
-    """The emulated chain, the driver's process, and the test as the controller."""
+class Bench(ArmBench):
+    """The X-series chain: commands naming their joints, Profile Velocity left by a Sync
+    Write."""
 
-    def __init__(self, system: System, arm: IntegratingJoints, servos: XChainEmulator) -> None:
-        self.system, self.arm, self.servos = system, arm, servos
-        self.joints = system.inbox(topics.ARM_JOINT_STATES)
-        self.command = system.router.declare_publisher(
-            topics.ARM_COMMAND.key(system.profile.namespace)
-        )
-
-    def send(self, velocities: Sequence[float]) -> None:
-        header = Header(stamp_ns=time.time_ns(), frame="arm", seq=0, source="test")
-        self.command.put(
-            codec.encode(
-                ArmCommand(
-                    header=header,
-                    joint_velocities=tuple(velocities),
-                    joint_names=ROBOT.joint_names,
-                )
-            )
-        )
-
-    def run(self, seconds: float) -> None:
-        for _ in range(round(seconds / STEP_S)):
-            self.servos.update(STEP_S)
-            self.arm.step(STEP_S)
-
-    def written(self, velocities: Sequence[float]) -> None:
-        """Send ``velocities`` until the driver has written a Sync Write for one of them."""
-        before = self.servos.counters["sync_writes"]
-
-        def sent() -> bool:
-            self.send(velocities)
-            time.sleep(0.005)
-            return self.servos.counters["sync_writes"] > before
-
-        _wait_until(sent, f"a Sync Write for {velocities}")
-
-    def speeds(self) -> list[int]:
-        """Every servo's Profile Velocity, as one Sync Write left them."""
-        return self.servos.words(Address.PROFILE_VELOCITY)
-
-    def state(self) -> str:
-        answer = status(self.system, "arm_driver")
-        return "" if answer is None else answer.state
+    speed_address = Address.PROFILE_VELOCITY
+    joint_names = ROBOT.joint_names
 
     def counters(self) -> dict[str, int]:
         return status(self.system, "arm_driver").counters
