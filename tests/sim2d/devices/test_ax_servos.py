@@ -22,44 +22,14 @@ from protocols import dynamixel_v1 as dxl
 from protocols.dynamixel_v1 import Address, Instruction, StatusError
 from sim2d.devices.ax_servos import MODEL_NUMBER, AXChainEmulator
 from sim2d.devices.servo_chain import IntegratingJoints
-from tests.sim2d.devices.patient_port import PatientPort
+from tests.sim2d.devices.conftest import simulate
 
 IDS = (1, 2, 3, 4, 5)
 START_ANGLES = (0.0, 0.4, -0.6, 1.2, -1.0)
-DT = 0.01
+CHAIN = AXChainEmulator
+PROTOCOL = 1.0
+BAUD = 1_000_000
 QUIET_S = 0.03
-
-
-@pytest.fixture
-def arm() -> IntegratingJoints:
-    return IntegratingJoints(START_ANGLES)
-
-
-@pytest.fixture
-def emulator(arm: IntegratingJoints) -> Iterator[AXChainEmulator]:
-    with AXChainEmulator(arm, IDS) as chain:
-        yield chain
-    assert chain.counters["handler_errors"] == 0
-
-
-@pytest.fixture
-def port(emulator: AXChainEmulator) -> Iterator[PortHandler]:
-    handler = PatientPort(emulator.port)
-    assert handler.openPort()
-    assert handler.setBaudRate(1_000_000)
-    yield handler
-    handler.closePort()
-
-
-@pytest.fixture
-def packet() -> PacketHandler:
-    return PacketHandler(1.0)
-
-
-def simulate(emulator: AXChainEmulator, arm: IntegratingJoints, steps: int) -> None:
-    for _ in range(steps):
-        emulator.update(DT)
-        arm.step(DT)
 
 
 def test_every_servo_answers_a_ping_with_the_ax18a_model(

@@ -3,9 +3,6 @@ dynamixel-sdk at protocol 2.0, and by pyserial for the bytes the SDK never sends
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
-import pytest
 import serial
 from dynamixel_sdk import (
     COMM_RX_TIMEOUT,
@@ -22,43 +19,13 @@ from protocols import dynamixel_v2 as dxl
 from protocols.dynamixel_v2 import ALERT, Address, HardwareError, Instruction, StatusError
 from sim2d.devices.servo_chain import IntegratingJoints
 from sim2d.devices.x_servos import MODEL_NUMBER, XChainEmulator
-from tests.sim2d.devices.patient_port import PatientPort
+from tests.sim2d.devices.conftest import simulate
 
 IDS = (11, 12, 13, 14)
 START_ANGLES = (0.0, 0.4, -0.6, 1.2)
-DT = 0.01
+CHAIN = XChainEmulator
+PROTOCOL = 2.0
 QUIET_S = 0.03
-
-
-@pytest.fixture
-def arm() -> IntegratingJoints:
-    return IntegratingJoints(START_ANGLES)
-
-
-@pytest.fixture
-def emulator(arm: IntegratingJoints) -> Iterator[XChainEmulator]:
-    with XChainEmulator(arm, IDS) as chain:
-        yield chain
-    assert chain.counters["handler_errors"] == 0
-
-
-@pytest.fixture
-def port(emulator: XChainEmulator) -> Iterator[PortHandler]:
-    handler = PatientPort(emulator.port)
-    assert handler.openPort()
-    yield handler
-    handler.closePort()
-
-
-@pytest.fixture
-def packet() -> PacketHandler:
-    return PacketHandler(2.0)
-
-
-def simulate(emulator: XChainEmulator, arm: IntegratingJoints, steps: int) -> None:
-    for _ in range(steps):
-        emulator.update(DT)
-        arm.step(DT)
 
 
 def test_a_ping_answers_the_model_and_a_sync_read_every_servo_in_order(
