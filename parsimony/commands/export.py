@@ -1,5 +1,7 @@
 """`parsimony export SESSION.mcap --ros2 -o DIR`: a recorded session as a ROS 2 Jazzy bag
-(ros2.bag): /joint_states, /tf and /odom from the robot's recorded states, which
+(ros2.bag) of the live bridge's topics: /joint_states, /tf, /odom and /robot_description from
+the robot's recorded states, /camera/image/compressed and /camera/camera_info from its JPEG
+camera frames, /diagnostics from its controller diagnostics and supervisor statuses; which
 ``ros2 bag info`` and ``ros2 bag play`` read; its size and time span printed.
 `parsimony export --urdf -o FILE`: the robot's URDF (ros2.urdf), for rviz2's RobotModel."""
 
@@ -11,10 +13,10 @@ import sys
 from collections.abc import Iterator
 from pathlib import Path
 
+from pydantic import BaseModel
 from rosbags.rosbag2 import WriterError
 
-from messages.state import RobotState
-from messages.topics import ROBOT_STATE
+from messages.topics import CAMERA_IMAGE, CONTROL_DIAGNOSTICS, ROBOT_STATE, SUPERVISOR_STATUS
 from outputs.stdout import emit, json_text
 from parsimony.commands.robot_option import add_robot_option
 from record.session_reader import read_session
@@ -27,9 +29,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser = subparsers.add_parser(
         "export",
         help="a recording as a ROS 2 bag (--ros2), the robot's URDF (--urdf)",
-        description="Write the robot's recorded states as a ROS 2 Jazzy bag (MCAP storage, "
-        "ros2msg schemas, metadata.yaml): /joint_states, /tf and /odom, one message per state; "
-        "or the robot's URDF, whose frames the bag's /tf names.",
+        description="Write a recording as a ROS 2 Jazzy bag (MCAP storage, ros2msg schemas, "
+        "metadata.yaml) of the live bridge's topics: /joint_states, /tf and /odom, one message "
+        "per robot state; /robot_description (the URDF, latched); /camera/image/compressed and "
+        "/camera/camera_info per JPEG camera frame; /diagnostics per controller diagnostics or "
+        "supervisor status. Or the robot's URDF, whose frames the bag's /tf names.",
     )
     parser.add_argument("file", type=Path, nargs="?", metavar="SESSION", help="MCAP session")
     kind = parser.add_mutually_exclusive_group(required=True)
@@ -43,11 +47,15 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     return parser
 
 
-def states(path: Path) -> Iterator[RobotState]:
-    """The robot's states recorded in ``path``, in log-time order."""
-    for recorded in read_session(path, {ROBOT_STATE.name}):
-        if isinstance(recorded.message, RobotState):
-            yield recorded.message
+BAG_TOPICS = (ROBOT_STATE, CAMERA_IMAGE, CONTROL_DIAGNOSTICS, SUPERVISOR_STATUS)
+"""The recorded topics a bag is made from (``ros2.bag``)."""
+
+
+def recorded(path: Path) -> Iterator[BaseModel]:
+    """The messages of ``BAG_TOPICS`` recorded in ``path``, in log-time order (one pass)."""
+    for found in read_session(path, {topic.name for topic in BAG_TOPICS}):
+        if found.message is not None:
+            yield found.message
 
 
 def run(args: argparse.Namespace) -> int:
@@ -79,7 +87,7 @@ def export_bag(args: argparse.Namespace) -> int:
         if not args.file.is_file():
             raise FileNotFoundError(f"no such file: {args.file}")
         print(f"export: {args.file} -> {args.out} (ROS 2 jazzy, mcap)", file=sys.stderr)
-        result = write_bag(args.out, robot, states(args.file))
+        result = write_bag(args.out, robot, recorded(args.file))
     except (OSError, ValueError, WriterError, RobotDescriptionError) as error:
         if args.out.is_dir():
             shutil.rmtree(args.out)  # made by this run alone: it did not exist before
@@ -90,6 +98,9 @@ def export_bag(args: argparse.Namespace) -> int:
     if result["invalid_states_left_out"]:
         left = result["invalid_states_left_out"]
         print(f"export: {left} states without a fix (valid false) left out", file=sys.stderr)
+    if result["frames_not_jpeg_left_out"]:
+        left = result["frames_not_jpeg_left_out"]
+        print(f"export: {left} camera frames not JPEG left out", file=sys.stderr)
     if args.json:
         emit(json_text(result, indent=2))
     else:
