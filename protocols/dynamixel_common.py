@@ -1,8 +1,11 @@
-"""What the framing of both Dynamixel protocols shares: a parser fed a byte stream in pieces of
-any size, skipping (and counting) the bytes before a header."""
+"""What both Dynamixel protocols share: a parser fed a byte stream in pieces of any size,
+skipping (and counting) the bytes before a header; a servo model's position scale; a speed
+limit's value."""
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
 from typing import Generic, TypeVar
 
 P = TypeVar("P")
@@ -40,3 +43,39 @@ class FrameParser(Generic[P]):
 
     def _next_packet(self) -> P | None:
         raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class PositionScale:
+    """A servo model's position values: ``center`` at 0 rad, ``units_per_rad``, 0..``max_units``;
+    a goal angle is clamped to +-``clamp_rad`` before it is rounded."""
+
+    center: int
+    units_per_rad: float
+    max_units: int
+    clamp_rad: float
+
+    def of_angle(self, angle_rad: float) -> float:
+        """The Goal Position of an angle, before rounding."""
+        return self.center + angle_rad * self.units_per_rad
+
+    def units(self, angle_rad: float) -> int:
+        """Goal Position of a joint angle (rad, 0 at the centre), clamped to 0..``max_units``;
+        ValueError for a non-finite angle."""
+        if not math.isfinite(angle_rad):
+            raise ValueError(f"no position for a non-finite angle {angle_rad}")
+        units = round(self.of_angle(min(max(angle_rad, -self.clamp_rad), self.clamp_rad)))
+        return min(max(units, 0), self.max_units)
+
+    def angle(self, units: int) -> float:
+        """Joint angle (rad) of a Present or Goal Position."""
+        return (units - self.center) / self.units_per_rad
+
+
+def speed_limit(rad_s: float, rad_s_per_unit: float, max_units: int, name: str) -> int | None:
+    """The speed limit value (``name``) of a speed magnitude, at most ``max_units``; None when
+    it rounds to 0 (which means no limit, not stop: a joint that slow must hold). ValueError
+    for a non-finite speed."""
+    if not math.isfinite(rad_s):
+        raise ValueError(f"no {name} for a non-finite speed {rad_s}")
+    return round(min(abs(rad_s), max_units * rad_s_per_unit) / rad_s_per_unit) or None

@@ -25,7 +25,7 @@ import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
-from protocols.dynamixel_common import FrameParser
+from protocols.dynamixel_common import FrameParser, PositionScale, speed_limit
 
 HEADER = b"\xff\xff"
 BROADCAST_ID = 0xFE
@@ -89,7 +89,6 @@ SPEED_RAD_S_PER_UNIT = 0.111 * 2.0 * math.pi / 60.0
 """0.111 rpm per unit."""
 _HALF_SPAN = POSITION_MAX / POSITION_UNITS_PER_RAD
 """An angle bound wider than the servo's travel, so that rounding never meets a huge float."""
-_SPEED_SPAN = SPEED_MAX * SPEED_RAD_S_PER_UNIT
 DIRECTION_BIT = 0x400
 """Bit 10 of Present Speed and Present Load: set for clockwise (negative)."""
 
@@ -237,32 +236,19 @@ class PacketParser(FrameParser[Packet]):
             return Packet(packet.id, packet.code, packet.params, checksum_ok=False)
 
 
-def position_units(angle_rad: float) -> int:
-    """Goal Position of a joint angle (rad, 0 at the centre), clamped to 0..1023; ValueError
-    for a non-finite angle."""
-    if not math.isfinite(angle_rad):
-        raise ValueError(f"no position for a non-finite angle {angle_rad}")
-    units = round(position_of_angle(min(max(angle_rad, -_HALF_SPAN), _HALF_SPAN)))
-    return min(max(units, 0), POSITION_MAX)
-
-
-def position_of_angle(angle_rad: float) -> float:
-    """512 + angle * 1024 / 300 degrees: the Goal Position of an angle, before rounding."""
-    return POSITION_CENTER + angle_rad * POSITION_UNITS_PER_RAD
-
-
-def angle_of_units(units: int) -> float:
-    """Joint angle (rad) of a Present or Goal Position."""
-    return (units - POSITION_CENTER) / POSITION_UNITS_PER_RAD
+_POSITIONS = PositionScale(POSITION_CENTER, POSITION_UNITS_PER_RAD, POSITION_MAX, _HALF_SPAN)
+position_units = _POSITIONS.units
+"""Goal Position of a joint angle (rad, 0 at the centre), clamped to 0..1023."""
+position_of_angle = _POSITIONS.of_angle
+"""512 + angle * 1024 / 300 degrees: the Goal Position of an angle, before rounding."""
+angle_of_units = _POSITIONS.angle
 
 
 def moving_speed(rad_s: float) -> int | None:
     """Moving Speed of a speed magnitude: round(|rad_s| / 0.0116), at most 1023; None when
     that is 0, for Moving Speed 0 means full speed: a joint that slow must hold. ValueError
     for a non-finite speed."""
-    if not math.isfinite(rad_s):
-        raise ValueError(f"no moving speed for a non-finite speed {rad_s}")
-    return round(min(abs(rad_s), _SPEED_SPAN) / SPEED_RAD_S_PER_UNIT) or None
+    return speed_limit(rad_s, SPEED_RAD_S_PER_UNIT, SPEED_MAX, "moving speed")
 
 
 def signed_speed_units(rad_s: float) -> int:

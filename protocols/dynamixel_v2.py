@@ -29,7 +29,7 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
-from protocols.dynamixel_common import FrameParser
+from protocols.dynamixel_common import FrameParser, PositionScale, speed_limit
 from protocols.dynamixel_v1 import StatusFault
 
 HEADER = b"\xff\xff\xfd\x00"
@@ -381,34 +381,19 @@ class PacketParser(FrameParser[Packet]):
             return packet
 
 
-def position_of_angle(angle_rad: float) -> float:
-    """2048 + angle * 4096 / 2 pi: the Goal Position of an angle, before rounding."""
-    return POSITION_CENTER + angle_rad * POSITION_UNITS_PER_RAD
-
-
-def position_units(angle_rad: float) -> int:
-    """Goal Position of a joint angle (rad, 0 at the centre), clamped to 0..4095; ValueError
-    for a non-finite angle."""
-    if not math.isfinite(angle_rad):
-        raise ValueError(f"no position for a non-finite angle {angle_rad}")
-    half_turn = math.pi + 1.0
-    units = round(position_of_angle(min(max(angle_rad, -half_turn), half_turn)))
-    return min(max(units, 0), POSITION_MAX)
-
-
-def angle_of_units(units: int) -> float:
-    """Joint angle (rad) of a Present or Goal Position."""
-    return (units - POSITION_CENTER) / POSITION_UNITS_PER_RAD
+_POSITIONS = PositionScale(POSITION_CENTER, POSITION_UNITS_PER_RAD, POSITION_MAX, math.pi + 1.0)
+position_of_angle = _POSITIONS.of_angle
+"""2048 + angle * 4096 / 2 pi: the Goal Position of an angle, before rounding."""
+position_units = _POSITIONS.units
+"""Goal Position of a joint angle (rad, 0 at the centre), clamped to 0..4095."""
+angle_of_units = _POSITIONS.angle
 
 
 def profile_velocity(rad_s: float) -> int | None:
     """Profile Velocity of a speed magnitude: round(|rad_s| / 0.024), at most 32767; None when
     that is 0, for Profile Velocity 0 means no limit: a joint that slow must hold. ValueError
     for a non-finite speed."""
-    if not math.isfinite(rad_s):
-        raise ValueError(f"no profile velocity for a non-finite speed {rad_s}")
-    span = PROFILE_VELOCITY_MAX * VELOCITY_RAD_S_PER_UNIT
-    return round(min(abs(rad_s), span) / VELOCITY_RAD_S_PER_UNIT) or None
+    return speed_limit(rad_s, VELOCITY_RAD_S_PER_UNIT, PROFILE_VELOCITY_MAX, "profile velocity")
 
 
 def velocity_units(rad_s: float) -> int:
