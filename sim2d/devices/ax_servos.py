@@ -33,7 +33,7 @@ import time
 
 from protocols import dynamixel_v1 as dxl
 from protocols.dynamixel_v1 import Address, Instruction, StatusError
-from sim2d.devices.servo_chain import ServoChain, spoiled
+from sim2d.devices.servo_chain import ChainServo, ServoChain, spoiled
 
 MODEL_NUMBER = 18
 MAX_SPEED_RAD_S = 97.0 * 2.0 * math.pi / 60.0
@@ -79,30 +79,20 @@ def default_table(servo_id: int) -> bytearray:
     return table
 
 
-class AXServo:
+class AXServo(ChainServo):
     """One AX-18A: its control table and its answers to instruction packets. No I/O."""
 
+    id_address = Address.ID
+    delay_address = Address.RETURN_DELAY
+    delay_us_per_unit = dxl.RETURN_DELAY_US_PER_UNIT
+
     def __init__(self, servo_id: int, return_delay_us: float, position_rad: float) -> None:
-        self.table = default_table(servo_id)
-        self.table[Address.RETURN_DELAY] = min(
-            max(round(return_delay_us / dxl.RETURN_DELAY_US_PER_UNIT), 0), 254
-        )
-        self.silent = False
+        super().__init__(default_table(servo_id), return_delay_us)
         self.overloaded = False
-        self.corruption: dxl.StatusFault | None = None
-        """How this servo's status packets are spoiled on their way out (fault injection)."""
         self._registered: tuple[int, bytes] | None = None
         self._set_word(Address.GOAL_POSITION, dxl.position_units(position_rad))
         self.sense_position(position_rad)
         self.sense_speed(0.0)
-
-    @property
-    def id(self) -> int:
-        return self.table[Address.ID]
-
-    @property
-    def return_delay_s(self) -> float:
-        return self.table[Address.RETURN_DELAY] * dxl.RETURN_DELAY_US_PER_UNIT * 1e-6
 
     def word(self, address: int) -> int:
         """The control table's word at ``address`` (low byte first)."""

@@ -1,6 +1,7 @@
 """What every emulated chain of Dynamixel servos shares, whatever its protocol: the world the
 servos move (``ServoBackend``), the chain on a pseudo-terminal with its fault injection
-(``ServoChain``), and status packets spoiled on their way out (``spoiled``).
+(``ServoChain``), what each of its servos keeps (``ChainServo``), and status packets spoiled
+on their way out (``spoiled``).
 
 A servo of a chain (``AXServo``, ``XServo``) has an ``id``, ``silent``, ``corruption``,
 ``fail(silent)``, ``word(address)``, ``sense_position(rad)``, ``sense_speed(rad_s)`` and
@@ -42,6 +43,33 @@ class IntegratingJoints:
 
     def step(self, dt: float) -> None:
         self.angles = [q + v * dt for q, v in zip(self.angles, self.velocities, strict=True)]
+
+
+class ChainServo:
+    """What every emulated servo keeps: its control table, its Return Delay Time (at
+    ``delay_address``, ``delay_us_per_unit`` a unit), its id (at ``id_address``), whether it
+    is silent, and how its status packets are spoiled."""
+
+    id_address: int
+    delay_address: int
+    delay_us_per_unit: float
+
+    def __init__(self, table: bytearray, return_delay_us: float) -> None:
+        self.table = table
+        self.table[self.delay_address] = min(
+            max(round(return_delay_us / self.delay_us_per_unit), 0), 254
+        )
+        self.silent = False
+        self.corruption: StatusFault | None = None
+        """How this servo's status packets are spoiled on their way out (fault injection)."""
+
+    @property
+    def id(self) -> int:
+        return self.table[self.id_address]
+
+    @property
+    def return_delay_s(self) -> float:
+        return self.table[self.delay_address] * self.delay_us_per_unit * 1e-6
 
 
 COUNTERS = (

@@ -37,7 +37,7 @@ from protocols.dynamixel_v2 import (
     OperatingMode,
     StatusError,
 )
-from sim2d.devices.servo_chain import ServoChain, spoiled
+from sim2d.devices.servo_chain import ChainServo, ServoChain, spoiled
 
 MODEL_NUMBER = 1020
 """XM430-W350."""
@@ -80,27 +80,17 @@ def default_table(servo_id: int) -> bytearray:
     return table
 
 
-class XServo:
+class XServo(ChainServo):
     """One X-series servo: its control table and its answers to instruction packets. No I/O."""
 
+    id_address = Address.ID
+    delay_address = Address.RETURN_DELAY
+    delay_us_per_unit = dxl.RETURN_DELAY_US_PER_UNIT
+
     def __init__(self, servo_id: int, return_delay_us: float, position_rad: float) -> None:
-        self.table = default_table(servo_id)
-        self.table[Address.RETURN_DELAY] = min(
-            max(round(return_delay_us / dxl.RETURN_DELAY_US_PER_UNIT), 0), 254
-        )
-        self.silent = False
-        self.corruption = None
-        """How this servo's status packets are spoiled on their way out (fault injection)."""
+        super().__init__(default_table(servo_id), return_delay_us)
         self._set(Address.GOAL_POSITION, dxl.position_units(position_rad))
         self.sense_position(position_rad)
-
-    @property
-    def id(self) -> int:
-        return self.table[Address.ID]
-
-    @property
-    def return_delay_s(self) -> float:
-        return self.table[Address.RETURN_DELAY] * dxl.RETURN_DELAY_US_PER_UNIT * 1e-6
 
     def word(self, address: int) -> int:
         """The table's entry at ``address`` (its size, signed where it is)."""
