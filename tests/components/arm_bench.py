@@ -45,6 +45,13 @@ class ArmBench:
             self.servos.update(STEP_S)
             self.arm.step(STEP_S)
 
+    def command_step(self, velocities: Sequence[float]) -> None:
+        """Send ``velocities``, step the world and the servos 20 ms of their time, and let
+        20 ms of the driver's pass."""
+        self.send(velocities)
+        self.run(0.02)
+        time.sleep(0.02)
+
     def written(
         self,
         velocities: Sequence[float],

@@ -103,9 +103,7 @@ def test_a_silent_servo_holds_the_whole_arm_until_it_answers_again(
     )
     held = list(bench.arm.angles)
     for _ in range(50):  # a second of commands that must not move it
-        bench.send(moving)
-        bench.run(0.02)
-        time.sleep(0.02)
+        bench.command_step(moving)
     assert max(abs(a - b) for a, b in zip(bench.arm.angles, held, strict=True)) < 0.006  # 1 unit
     counters = status(bench.system, "arm_driver").counters
     assert counters["servo_faults.silent"] >= 1 and counters["refused_commands"] >= 1
@@ -118,9 +116,7 @@ def test_a_silent_servo_holds_the_whole_arm_until_it_answers_again(
     q1 = bench.arm.angles[0]
 
     def moves_again() -> bool:
-        bench.send(moving)
-        bench.run(0.02)
-        time.sleep(0.02)
+        bench.command_step(moving)
         return bench.arm.angles[0] > q1 + 0.05 and bench.arm.angles[2] < held[2] - 0.05
 
     wait_until(moves_again, "the arm, servo 3 included, moving again")

@@ -123,9 +123,7 @@ def test_a_silent_servo_holds_the_whole_arm_until_it_answers_again(bench: Bench)
     )
     held = list(bench.arm.angles)
     for _ in range(50):  # a second of commands that must not move it
-        bench.send(moving)
-        bench.run(0.02)
-        time.sleep(0.02)
+        bench.command_step(moving)
     assert max(abs(a - b) for a, b in zip(bench.arm.angles, held, strict=True)) <= UNIT
     counters = bench.counters()
     assert counters["servo_faults.silent"] >= 1 and counters["refused_commands"] >= 1
@@ -134,9 +132,7 @@ def test_a_silent_servo_holds_the_whole_arm_until_it_answers_again(bench: Bench)
     q1, q3 = bench.arm.angles[0], bench.arm.angles[2]
 
     def moves_again() -> bool:
-        bench.send(moving)
-        bench.run(0.02)
-        time.sleep(0.02)
+        bench.command_step(moving)
         return bench.arm.angles[0] > q1 + 0.05 and bench.arm.angles[2] < q3 - 0.05
 
     _wait_until(moves_again, "the arm, servo 3 included, moving again")
