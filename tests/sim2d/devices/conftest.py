@@ -7,6 +7,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 
 import pytest
+import serial
 from dynamixel_sdk import PacketHandler, PortHandler
 
 from sim2d.devices.servo_chain import IntegratingJoints, ServoChain
@@ -14,6 +15,8 @@ from tests.sim2d.devices.patient_port import PatientPort
 
 DT = 0.01
 """The world's and the servos' step, s."""
+QUIET_S = 0.03
+"""How long the line stays quiet before an exchange is taken as answered, s."""
 
 
 @pytest.fixture
@@ -48,3 +51,19 @@ def simulate(emulator: ServoChain, arm: IntegratingJoints, steps: int) -> None:
     for _ in range(steps):
         emulator.update(DT)
         arm.step(DT)
+
+
+@pytest.fixture
+def raw(emulator: ServoChain) -> Iterator[serial.Serial]:
+    """The chain's line as pyserial opens it, for the bytes the SDK never sends."""
+    with serial.Serial(emulator.port, 1_000_000, timeout=QUIET_S) as connection:
+        yield connection
+
+
+def answered(raw: serial.Serial, request: bytes) -> bytes:
+    """Write ``request``; every byte answered until the line is quiet for QUIET_S."""
+    raw.write(request)
+    answer = bytearray()
+    while chunk := raw.read(max(raw.in_waiting, 1)):
+        answer += chunk
+    return bytes(answer)

@@ -4,10 +4,8 @@ dynamixel-sdk, and by pyserial for the bytes the SDK never sends."""
 from __future__ import annotations
 
 import random
-from collections.abc import Iterator
 from pathlib import Path
 
-import pytest
 import serial
 from dynamixel_sdk import (
     COMM_RX_TIMEOUT,
@@ -22,14 +20,13 @@ from protocols import dynamixel_v1 as dxl
 from protocols.dynamixel_v1 import Address, Instruction, StatusError
 from sim2d.devices.ax_servos import MODEL_NUMBER, AXChainEmulator
 from sim2d.devices.servo_chain import IntegratingJoints
-from tests.sim2d.devices.conftest import simulate
+from tests.sim2d.devices.conftest import answered, simulate
 
 IDS = (1, 2, 3, 4, 5)
 START_ANGLES = (0.0, 0.4, -0.6, 1.2, -1.0)
 CHAIN = AXChainEmulator
 PROTOCOL = 1.0
 BAUD = 1_000_000
-QUIET_S = 0.03
 
 
 def test_every_servo_answers_a_ping_with_the_ax18a_model(
@@ -121,19 +118,9 @@ def test_a_goal_beyond_the_angle_limit_is_clamped_with_the_angle_limit_bit(
     assert packet.read2ByteTxRx(port, 4, Address.GOAL_POSITION) == (200, COMM_SUCCESS, 0)
 
 
-@pytest.fixture
-def raw(emulator: AXChainEmulator) -> Iterator[serial.Serial]:
-    with serial.Serial(emulator.port, 1_000_000, timeout=QUIET_S) as connection:
-        yield connection
-
-
 def exchange(raw: serial.Serial, request: bytes) -> list[dxl.Packet]:
-    """Write ``request``; every packet answered until the line is quiet for QUIET_S."""
-    raw.write(request)
-    answer = bytearray()
-    while chunk := raw.read(max(raw.in_waiting, 1)):
-        answer += chunk
-    return dxl.PacketParser().feed(bytes(answer))
+    """Write ``request``; every packet answered until the line is quiet."""
+    return dxl.PacketParser().feed(answered(raw, request))
 
 
 def test_a_bad_checksum_is_answered_with_the_checksum_bit(

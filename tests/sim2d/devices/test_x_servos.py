@@ -19,13 +19,12 @@ from protocols import dynamixel_v2 as dxl
 from protocols.dynamixel_v2 import ALERT, Address, HardwareError, Instruction, StatusError
 from sim2d.devices.servo_chain import IntegratingJoints
 from sim2d.devices.x_servos import MODEL_NUMBER, XChainEmulator
-from tests.sim2d.devices.conftest import simulate
+from tests.sim2d.devices.conftest import answered, simulate
 
 IDS = (11, 12, 13, 14)
 START_ANGLES = (0.0, 0.4, -0.6, 1.2)
 CHAIN = XChainEmulator
 PROTOCOL = 2.0
-QUIET_S = 0.03
 
 
 def test_a_ping_answers_the_model_and_a_sync_read_every_servo_in_order(
@@ -123,28 +122,23 @@ def test_a_silent_servo_times_out_and_an_overloaded_one_raises_the_alert(
 
 
 def exchange(raw: serial.Serial, request: bytes) -> list[dxl.Packet]:
-    """Write ``request``; every packet answered until the line is quiet for QUIET_S."""
-    raw.write(request)
-    answer = bytearray()
-    while chunk := raw.read(max(raw.in_waiting, 1)):
-        answer += chunk
-    return dxl.PacketParser().feed(bytes(answer))
+    """Write ``request``; every packet answered until the line is quiet."""
+    return dxl.PacketParser().feed(answered(raw, request))
 
 
 def test_a_bad_crc_an_unknown_instruction_and_a_stuffed_answer(
-    emulator: XChainEmulator,
+    raw: serial.Serial, emulator: XChainEmulator
 ) -> None:
     """A goal whose bytes hold FF FF FD goes in stuffed and comes back unstuffed."""
-    with serial.Serial(emulator.port, 1_000_000, timeout=QUIET_S) as raw:
-        ping = dxl.instruction_packet(12, Instruction.PING)
-        (status,) = exchange(raw, ping[:-1] + bytes(((ping[-1] + 1) & 0xFF,)))
-        assert (status.id, status.error) == (12, StatusError.CRC)
-        (unknown,) = exchange(raw, dxl.instruction_packet(12, 0x42))
-        assert unknown.error == StatusError.INSTRUCTION
-        address = dxl.value(Address.VELOCITY_LIMIT, 2)
-        limit = b"\xff\xff\xfd\x00"  # too fast for a real XM430, fine for the bytes
-        assert exchange(raw, dxl.write(12, Address.VELOCITY_LIMIT, limit))[0].error == 0
-        (read,) = exchange(raw, dxl.instruction_packet(12, Instruction.READ, address + b"\4\0"))
-        assert read.data == limit
-        assert exchange(raw, dxl.instruction_packet(9, Instruction.PING)) == []
+    ping = dxl.instruction_packet(12, Instruction.PING)
+    (status,) = exchange(raw, ping[:-1] + bytes(((ping[-1] + 1) & 0xFF,)))
+    assert (status.id, status.error) == (12, StatusError.CRC)
+    (unknown,) = exchange(raw, dxl.instruction_packet(12, 0x42))
+    assert unknown.error == StatusError.INSTRUCTION
+    address = dxl.value(Address.VELOCITY_LIMIT, 2)
+    limit = b"\xff\xff\xfd\x00"  # too fast for a real XM430, fine for the bytes
+    assert exchange(raw, dxl.write(12, Address.VELOCITY_LIMIT, limit))[0].error == 0
+    (read,) = exchange(raw, dxl.instruction_packet(12, Instruction.READ, address + b"\4\0"))
+    assert read.data == limit
+    assert exchange(raw, dxl.instruction_packet(9, Instruction.PING)) == []
     assert emulator.counters["bad_checksums"] == 1
