@@ -35,11 +35,18 @@ class FrameParser(Generic[P]):
         del self._buffer[:count]
         self.skipped_bytes += count
 
-    def _skip_all_but_header_start(self) -> None:
-        """No header in the buffer: skip all of it but a header's beginning at its end."""
+    def _to_header(self) -> bool:
+        """Skip to the buffer's first header; False when there is none (then all of it is
+        skipped but a header's beginning at its end)."""
         header, buffer = self.header, self._buffer
-        keep = next((n for n in range(len(header) - 1, 0, -1) if buffer.endswith(header[:n])), 0)
-        self._skip(len(buffer) - keep)
+        start = buffer.find(header)
+        if start < 0:
+            prefixes = range(len(header) - 1, 0, -1)
+            keep = next((n for n in prefixes if buffer.endswith(header[:n])), 0)
+            self._skip(len(buffer) - keep)
+            return False
+        self._skip(start)
+        return True
 
     def _next_packet(self) -> P | None:
         raise NotImplementedError

@@ -210,11 +210,8 @@ class PacketParser(FrameParser[Packet]):
         """The first whole frame in the buffer, consuming it; None until one is complete."""
         buffer = self._buffer
         while True:
-            start = buffer.find(HEADER)
-            if start < 0:
-                self._skip_all_but_header_start()
+            if not self._to_header():
                 return None
-            self._skip(start)
             if len(buffer) < 4:
                 return None
             if buffer[2] == 0xFF:

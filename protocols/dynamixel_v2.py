@@ -355,11 +355,8 @@ class PacketParser(FrameParser[Packet]):
     def _next_packet(self) -> Packet | None:
         buffer = self._buffer
         while True:
-            start = buffer.find(HEADER)
-            if start < 0:
-                self._skip_all_but_header_start()
+            if not self._to_header():
                 return None
-            self._skip(start)
             end = packet_end(buffer)
             if end is None:
                 return None
