@@ -4,7 +4,8 @@ its joints move in, the driver's process, and the test as the controller."""
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from typing import Self
 
 from messages import codec, topics
 from messages.commands import ArmCommand
@@ -31,6 +32,15 @@ class ArmBench:
         self.command = system.router.declare_publisher(
             topics.ARM_COMMAND.key(system.profile.namespace)
         )
+
+    def serve(self) -> Iterator[Self]:
+        """A fixture's body: the driver started and its first joint state in, this bench
+        yielded; then the driver must still run and the chain have handled every packet."""
+        self.system.start("arm_driver")
+        self.joints.wait_for(lambda m: True, "a joint state")
+        yield self
+        assert self.system.processes[0].poll() is None, "the driver died"
+        assert self.servos.counters["handler_errors"] == 0
 
     def send(self, velocities: Sequence[float]) -> None:
         header = Header(stamp_ns=time.time_ns(), frame="arm", seq=0, source="test")

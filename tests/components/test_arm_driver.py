@@ -46,12 +46,7 @@ def bench(deployed, tmp_path: Path) -> Iterator[Bench]:
         system = driver_system(
             deployed, tmp_path, "arm_driver", link, answer_timeout_s=ANSWER_TIMEOUT_S
         )
-        bench = Bench(system, arm, servos)
-        system.start("arm_driver")
-        bench.joints.wait_for(lambda m: True, "a joint state")
-        yield bench
-        assert system.processes[0].poll() is None, "the driver died"
-        assert servos.counters["handler_errors"] == 0
+        yield from Bench(system, arm, servos).serve()
 
 
 def test_the_arm_moves_as_commanded_and_a_joint_commanded_to_stop_holds(

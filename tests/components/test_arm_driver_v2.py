@@ -67,12 +67,7 @@ def shared(deployed_for_module, tmp_path_factory: pytest.TempPathFactory) -> Ite
             f"answer_timeout_s: {ANSWER_TIMEOUT_S}}}\n"
         )
         system = deployed_for_module(profile)
-        bench = Bench(system, arm, servos)
-        system.start("arm_driver")
-        bench.joints.wait_for(lambda m: True, "a joint state")
-        yield bench
-        assert system.processes[0].poll() is None, "the driver died"
-        assert servos.counters["handler_errors"] == 0
+        yield from Bench(system, arm, servos).serve()
 
 
 @pytest.fixture
