@@ -134,7 +134,8 @@ def test_the_robot_links_arrive_and_match_the_kinematics(
     model_key = station.key("robot/state/model")
     client.send("subscribe", topics=[state_key, frames_key, model_key])
     robot = MobileManipulator.from_yaml(station.profile.robot)
-    state, frames = same_time(client, state_key, frames_key)
+    # a state with the estimator's fix: before its first, the end effector is not known
+    state, frames = same_time(client, state_key, frames_key, lambda state, _: state["valid"])
     by_child = {t["child_frame_id"]: t for t in frames["transforms"]}
     # world -> base -> link_0 -> ... -> link_5, each in the one before, as the DH chain.
     links = [f"estimate/link_{i}" for i in range(robot.arm_dof + 1)]
