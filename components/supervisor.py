@@ -158,6 +158,8 @@ class Supervisor(Component):
         self._published = 0
         """Statuses published since the last tick of the status timer."""
         self.last_refusal = ""
+        self.request_stamp_ns = 0
+        """The header stamp of the latest goal request taken (``SupervisorStatus``)."""
         for name in (*COUNTED.values(), "refusals", "aborted", "refused_states"):
             node.counters[name] = 0
         self.latch = StopLatch(node)
@@ -176,6 +178,7 @@ class Supervisor(Component):
         """A new goal replaces the current one, to be taken on the next state; the same goal
         measured again keeps it (unless it was given up)."""
         request = self.request
+        self.request_stamp_ns = goal.header.stamp_ns
         if request is not None and self.ended is None and goal.task == request.task:
             if same_task(task_of(request), task_of(goal), MEASUREMENT_TOLERANCE):
                 return
@@ -388,6 +391,7 @@ class Supervisor(Component):
             error_norm=self.error_norm,
             refusals=self.node.counters["refusals"],
             last_refusal=self.last_refusal,
+            request_stamp_ns=self.request_stamp_ns,
             **self.sight.fields(stamp_ns),
         )
         if supervisor is None:

@@ -86,10 +86,11 @@ class GoalFollower:
         while not self._statuses.empty():
             self._statuses.get_nowait()
 
-    def follow(self, progress: Callable[[SupervisorStatus], None]) -> Outcome:
-        """Hand each status to ``progress`` until the goal is reached, found unreachable or
-        refused (malformed: the status says why in ``last_refusal``); ``QueryError`` when
-        ``timeout_s`` pass with no status."""
+    def follow(self, progress: Callable[[SupervisorStatus], None], stamp_ns: int = 0) -> Outcome:
+        """Hand each status to ``progress`` until the goal stamped ``stamp_ns`` is reached,
+        found unreachable or refused (malformed: the status says why in ``last_refusal``);
+        ``QueryError`` when ``timeout_s`` pass with no status. A status of a request taken
+        before it (published before the goal was taken, and delivered after) is passed over."""
         while True:
             try:
                 status = self._statuses.get(timeout=self.timeout_s)
@@ -100,7 +101,7 @@ class GoalFollower:
                 ) from None
             if self._refused:
                 return Outcome("refused", status.last_refusal, status)
-            if status.phase == IDLE:
+            if status.phase == IDLE or status.request_stamp_ns < stamp_ns:
                 continue  # published before the goal was taken, and delivered after
             progress(status)
             if status.phase in DONE:

@@ -55,7 +55,9 @@ class SupervisorStatus(Message):
     time of the last plan and ``planning_cpu_ms`` its planning thread's CPU time (the plan's
     budget is CPU time); ``refusals`` counts the requests refused since the supervisor
     started (malformed ones, which leave the current goal as it is, and goals refused),
-    ``last_refusal`` says why the latest was;
+    ``last_refusal`` says why the latest was; ``request_stamp_ns`` is the header stamp of the
+    latest goal request taken (the one worked, or one that asked the same again; 0 before any),
+    so that who sent a goal tells its statuses from those published before it was taken;
     ``state`` is a ``StateName``, since ``state_since_s`` (the stamp of the first state so, s);
     ``no_fix_s`` how long the camera has not fixed the base, s, when the state is degraded or
     invalid; ``warning`` what the operator should know that the phase does not say (the base
@@ -78,6 +80,7 @@ class SupervisorStatus(Message):
     planning_cpu_ms: NonNegative | None = None
     refusals: int = Field(default=0, ge=0)
     last_refusal: str = ""
+    request_stamp_ns: int = Field(default=0, ge=0)
     state: StateName = "valid"
     state_since_s: NonNegative | None = None
     no_fix_s: NonNegative | None = None

@@ -206,7 +206,7 @@ def send(
             return 0
         print(f"goal: {sent}", file=sys.stderr)
         follower.sent()
-        outcome = follower.follow(Progress(header.stamp_ns))
+        outcome = follower.follow(Progress(header.stamp_ns), goal.header.stamp_ns)
     finally:
         if follower is not None:
             follower.close()
