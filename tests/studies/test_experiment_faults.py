@@ -125,9 +125,10 @@ def test_a_killed_estimator_stops_the_robot_is_restarted_and_the_run_converges(
     assert "state_estimator exited with -9; restart 1/" in log, log[-3000:]
     assert log.count("started state_estimator") == 2
     # No command on an old state: the simulator held its time for the step the dead estimator
-    # never answered, as for the frame the dead tracker never answered (a controller on a held
-    # lockstep clock no longer commands zero, so no 'stale' status is the sign of it).
-    assert report["lockstep_timeouts"] >= 2, report["lockstep_timeouts"]
+    # never answered (a controller on a held lockstep clock no longer commands zero, so no
+    # 'stale' status is the sign of it). The dead tracker leaves a frame unanswered only when it
+    # was killed with one in flight, which depends on the moment: it is not counted on.
+    assert report["lockstep_timeouts"] >= 1, report["lockstep_timeouts"]
     assert report["contacts"] == 0
 
 
