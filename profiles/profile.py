@@ -270,9 +270,13 @@ class Profile(StrictModel):
     by the router) before it fails the launch, naming those that are not. A component starts
     in about a second on an idle machine (its imports) and took over 10 s on a shared one;
     one that exits before it is alive fails the launch at once, whatever this is."""
-    watchdog_s: float = Field(default=3.0, gt=0.0)
+    watchdog_s: float = Field(default=10.0, gt=0.0)
     """A component alive but answering no status query for this long (a stopped process, a
-    handler that never returns) is hung: the launcher kills it and restarts it by its policy."""
+    handler that never returns) is hung: the launcher kills it and restarts it by its policy.
+    It answers on its handler thread, behind the work queued there: at 3 s, a sound recorder
+    starved of CPU on a shared machine (one core busy, two test systems) was killed and its
+    recording lost. The robot does not wait for it: the drivers stop on their own command
+    timeout (0.2 s) whatever the launcher does."""
     clock_timeout_s: float = Field(default=1.0, gt=0.0)
     """Host seconds after which a component on ``sim`` time whose clock has not moved says its
     clock stalled (a controller then commands zero)."""

@@ -88,7 +88,7 @@ STARTUP_S = 60.0
 """Host seconds the components may take to come up."""
 LOCKSTEP_WATCHDOG_S = 30.0
 """Host seconds a component of a lockstep run may answer no status query before the launcher
-takes it for hung (the profile's default is 3 s): the loop waits for its slowest member, and on a
+takes it for hung (the profile's default is 10 s): the loop waits for its slowest member, and on a
 machine shared with other work a sound controller was seen silent for 3 s, killed and restarted
 mid-run, which cut its recording's diagnostics in two."""
 SESSION_FILE = "session.mcap"
