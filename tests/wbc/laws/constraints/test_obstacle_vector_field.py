@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import example, given
 from hypothesis import strategies as st
 
 from tests.wbc.laws.constraints.constraint_steps import (
@@ -36,6 +36,7 @@ def point_distance(q: np.ndarray, obstacle: Circle, margin: float, lookahead: fl
     st.floats(0.0, 0.2),
     st.lists(st.floats(-1.0, 1.0), min_size=8, max_size=8),
 )
+@example(-0.703125, 0.0, 0.0, 0.1953125, [0.0] * 8)  # the point inside the margin: found once
 def test_the_vector_field_row_is_minus_the_rate_of_the_distance(
     x: float, y: float, phi: float, lookahead: float, u: list[float]
 ) -> None:
@@ -50,7 +51,9 @@ def test_the_vector_field_row_is_minus_the_rate_of_the_distance(
         - point_distance(q - step * direction, obstacle, 0.05, lookahead)
     ) / (2 * step)
     assert (rows.matrix @ direction)[0] == pytest.approx(-rate, abs=1e-6)
-    assert rows.upper[0] == pytest.approx(2.0 * point_distance(q, obstacle, 0.05, lookahead))
+    # eta_d d, and 0 once the point is inside the margin (d < 0): it may not come nearer
+    distance = point_distance(q, obstacle, 0.05, lookahead)
+    assert rows.upper[0] == pytest.approx(2.0 * max(distance, 0.0))
     assert rows.lower[0] == -np.inf and rows.engaged  # an inequality: u = 0 always meets it
 
 
