@@ -13,16 +13,14 @@ import sys
 import time
 from pathlib import Path
 
-import yaml
-
 from launch import query
 from messages import codec, topics
 from parsimony import cli
 from profiles.deploy_files import DEPLOY
-from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from profiles.profile_files import read_profile_data
 from studies.experiment import connect, launched
+from tests.launch.emulated_profiles import emulated_profile
 
 
 def components(path: Path) -> dict[str, dict]:
@@ -96,30 +94,6 @@ def test_the_pose_experiment_converges_through_the_emulated_devices(tmp_path: Pa
     for name in ("simulator", "base_driver", "arm_driver", "controller"):
         assert f"[launch] {name} stopped (0)" in text
     assert text.index("[launch] simulator alive") < text.index("[launch] started base_driver")
-
-
-def emulated_profile(tmp_path: Path, namespace: str, *components: dict) -> Path:
-    """deploy/emulated.yaml on a free port, its devices in ``tmp_path``."""
-    data = {
-        "extends": str(DEPLOY / "emulated.yaml"),
-        "namespace": namespace,
-        "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
-        "components": [
-            {
-                "name": "simulator",
-                "params": {
-                    "create_link": str(tmp_path / "create2"),
-                    "servo_link": str(tmp_path / "servos"),
-                },
-            },
-            {"name": "base_driver", "params": {"port": str(tmp_path / "create2")}},
-            {"name": "arm_driver", "params": {"port": str(tmp_path / "servos")}},
-            *components,
-        ],
-    }
-    path = tmp_path / "profile.yaml"
-    path.write_text(yaml.safe_dump(data))
-    return path
 
 
 def test_a_killed_controller_leaves_the_robot_stopped_by_its_drivers(tmp_path: Path) -> None:

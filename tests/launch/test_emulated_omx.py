@@ -7,15 +7,13 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-import yaml
-
 from launch import query
 from messages import codec, topics
 from profiles.deploy_files import DEPLOY
-from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from profiles.profile_files import read_profile_data
 from studies.experiment import connect, launched, wait_alive
+from tests.launch.emulated_profiles import emulated_profile
 from wbc.robot import MobileManipulator
 
 DEADLINE_S = 60.0
@@ -37,24 +35,7 @@ def test_the_omx_profile_is_emulated_yaml_on_protocol_2_with_its_robot() -> None
 def test_the_omx_arm_moves_through_its_emulated_x_series_servos(tmp_path: Path) -> None:
     """The controller drives the pose set-up; the arm's joints move in the world as the driver
     reads them back, with no fault of any servo's answers."""
-    data = {
-        "extends": str(DEPLOY / "emulated_omx.yaml"),
-        "namespace": "omxtest",
-        "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
-        "components": [
-            {
-                "name": "simulator",
-                "params": {
-                    "create_link": str(tmp_path / "create2"),
-                    "servo_link": str(tmp_path / "servos"),
-                },
-            },
-            {"name": "base_driver", "params": {"port": str(tmp_path / "create2")}},
-            {"name": "arm_driver", "params": {"port": str(tmp_path / "servos")}},
-        ],
-    }
-    path = tmp_path / "profile.yaml"
-    path.write_text(yaml.safe_dump(data))
+    path = emulated_profile(tmp_path, "omxtest", base="emulated_omx.yaml")
     profile = load_profile(path)
     log_path = tmp_path / "launch.log"
     states: list = []
