@@ -4,10 +4,12 @@
 ``control/stop``; ``parsimony release`` publishes the release. Each holder takes a state newer
 than the one it holds (the giver's wall clock) and keeps it until a newer one: a lost router
 changes nothing, each holder stays as it was. A holder that starts (a restarted driver) first
-asks every running component's status for the stop it holds and takes the newest, so it
-starts stopped when the namespace is; its subscription is declared before it asks, so a stop
-given meanwhile is not missed. A stopped holder puts its stop again every ``REMIND_S``, so
-that a holder that missed it (its question unanswered, a partition) takes it then.
+takes the newest stop kept on disk by the holders of its launch (``kept_dir``), then asks
+every running component's status for the stop it holds and takes the newest, so it starts
+stopped when the namespace is, even with the router away and nobody to answer; its
+subscription is declared before it asks, so a stop given meanwhile is not missed. A stopped
+holder puts its stop again every ``REMIND_S``, so that a holder that missed it (its question
+unanswered, a partition) takes it then.
 
 The state is set on the Zenoh thread the moment it arrives, so a command the handler thread
 takes after it is refused (``refuses``); ``on_change`` then runs on the handler thread (a
@@ -17,16 +19,19 @@ driver commands zero there). The holder's status carries the state (``ComponentS
 from __future__ import annotations
 
 import logging
+import os
 import threading
 import time
 from collections.abc import Callable
 from functools import partial
+from pathlib import Path
 
 import zenoh
 
 from components.runtime import Node
 from messages import codec, topics
 from messages.header import Header
+from messages.process import PARAMS_FILE_ENV
 from messages.stop import StopState
 from profiles.profile import Profile
 
@@ -41,6 +46,9 @@ REMIND_S = 1.0
 NEVER_STOPPED = StopState(header=Header(stamp_ns=0, frame="", seq=0, source=""), stopped=False)
 """What a holder holds before any stop: released, older than any state given."""
 
+UNREADABLE_SOURCE = "stop_latch"
+"""Who gave the stop a holder starts with when a kept stop cannot be read (``_recall``)."""
+
 REFUSED = "refused_while_stopped"
 """The counter of the commands (and goals) a holder refused while stopped."""
 
@@ -54,6 +62,15 @@ def stop_text(state: StopState) -> str:
     """``stopped by alice (a hand in the way)`` or ``released by bob``."""
     verb = "stopped" if state.stopped else "released"
     return f"{verb} by {state.header.source}" + (f" ({state.reason})" if state.reason else "")
+
+
+def kept_dir() -> Path | None:
+    """Where the holders of this launch keep the stop each holds, one ``NAME.json`` each:
+    ``stop/`` in the launcher's runtime directory (the one of the parameters' files,
+    ``PARAMS_FILE_ENV``, removed when the launch ends); None for a component that no launcher
+    started."""
+    params = os.environ.get(PARAMS_FILE_ENV)
+    return Path(params).parent / "stop" if params else None
 
 
 class StopLatch:
@@ -73,6 +90,8 @@ class StopLatch:
         )
         self._publisher = node.session.declare_publisher(topics.CONTROL_STOP.key(node.namespace))
         node.timer(REMIND_S, self._remind)
+        self._kept = kept_dir()
+        self._recall()
         self._ask()
 
     @property
@@ -101,10 +120,42 @@ class StopLatch:
         return True
 
     def _changed(self, state: StopState) -> None:
-        """Handler thread: say it, and tell the component."""
+        """Handler thread: say it, tell the component, and keep it on disk."""
         log.warning("%s: %s", self.node.name, stop_text(state))
         if self._on_change is not None:
             self._on_change(state)
+        self._keep(state)
+
+    def _keep(self, state: StopState) -> None:
+        """Write the state held to this holder's file in ``kept_dir`` (whole, or not at all),
+        for the holder started after it on this computer (``_recall``)."""
+        if self._kept is None:
+            return
+        path = self._kept / f"{self.node.name}.json"
+        part = path.with_name(f".{path.name}.part")
+        try:
+            self._kept.mkdir(exist_ok=True)
+            part.write_text(state.model_dump_json())
+            os.replace(part, path)
+        except OSError as error:
+            self.node.count("stop_file_errors")
+            self.node.warn("stop_file_errors", f"cannot keep the stop in {path}: {error}")
+
+    def _recall(self) -> None:
+        """Take the newest stop kept by this launch's holders (a holder restarted while the
+        router is away starts stopped). A kept file that cannot be read may have held a stop:
+        the holder starts stopped (fail safe), older than any stop or release given, so that
+        the first one heard, or a running holder's answer, replaces it."""
+        if self._kept is None or not self._kept.is_dir():
+            return
+        for path in sorted(self._kept.glob("*.json")):
+            try:
+                self.take(StopState.model_validate_json(path.read_text()))
+            except (OSError, ValueError) as error:  # pydantic's ValidationError is a ValueError
+                header = Header(stamp_ns=1, frame="", seq=0, source=UNREADABLE_SOURCE)
+                why = str(error).splitlines()[0]
+                reason = f"the stop kept in {path} unreadable ({why})"
+                self.take(StopState(header=header, stopped=True, reason=reason))
 
     def _on_sample(self, sample: zenoh.Sample) -> None:
         """Zenoh thread: a stop or release given."""

@@ -20,6 +20,7 @@ from launch import query
 from messages import codec, topics
 from messages.commands import BaseCommand
 from messages.header import Header
+from messages.process import PARAMS_FILE_ENV
 from parsimony import cli
 from protocols import create_oi
 from tests.components.conftest import System
@@ -163,3 +164,70 @@ def test_the_stop_outlives_its_router(
                 listener.start()
                 wait_until(lambda: second.stopped, "the stop heard after the router's return")
                 assert second.state == first.state
+
+
+def test_a_driver_restarted_while_the_router_is_away_starts_stopped(
+    deployed, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, wait_until
+) -> None:
+    """The stop kept on disk by the holders of a launch (``kept_dir``): the base driver took a
+    stop, died, and starts again with no router to ask: it starts stopped and stops the wheels;
+    the router back, the release releases it."""
+    launch = tmp_path / "launch"  # the launcher's runtime directory
+    launch.mkdir()
+    monkeypatch.setenv(PARAMS_FILE_ENV, str(launch / "base_driver.json"))
+    link = FakeLink(tmp_path / "create2")
+    system = driver_system(deployed, tmp_path, "base_driver", link.link)
+    namespace = system.profile.namespace
+    spec = (system.profile, "base_driver", BaseDriver.params, BaseDriver.reads, BaseDriver.writes)
+    with Node(*spec) as node:
+        driver = BaseDriver(node)
+        node.start(driver.shutdown)
+        stop = system.router.declare_publisher(topics.CONTROL_STOP.key(namespace))
+        stop.put(codec.encode(stop_state(True, USER, "a hand in the way")))
+        kept = launch / "stop" / "base_driver.json"
+        wait_until(kept.exists, "the stop kept on disk")
+        given = driver.latch.state
+    system.router.close()  # the router away: nobody to ask
+    link.read()
+    with Node(*spec) as node:
+        driver = BaseDriver(node)
+        assert driver.latch.stopped and driver.latch.state == given
+        node.start(driver.shutdown)
+        assert node.status().stop == given
+        heard = bytearray()
+        wait_until(
+            lambda: heard.extend(link.read()) or node.counters["stops"] >= 1, "the wheels stopped"
+        )
+        heard.extend(link.read())
+        assert heard.endswith(create_oi.drive_direct(0, 0))
+        with zenoh.open(system.profile.zenoh.router_config()) as router:
+            system.router = router  # the fixture's, closed once more at its end: no harm
+            release = router.declare_publisher(topics.CONTROL_STOP.key(namespace))
+            wait_until(
+                lambda: (
+                    release.put(codec.encode(stop_state(False, USER))) or not driver.latch.stopped
+                ),
+                "the release heard after the router's return",
+            )
+    link.close()
+
+
+def test_a_kept_stop_that_cannot_be_read_starts_the_holder_stopped(
+    system: System, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, wait_until
+) -> None:
+    """Fail safe: what a holder cannot read may have been a stop; the first release given
+    replaces it."""
+    launch = tmp_path / "launch"
+    (launch / "stop").mkdir(parents=True)
+    (launch / "stop" / "talker.json").write_text('{"stopped": tr')
+    monkeypatch.setenv(PARAMS_FILE_ENV, str(launch / "talker.json"))
+    with Node(system.profile, "talker") as talker:
+        latch = StopLatch(talker)
+        talker.start()
+        assert latch.stopped and latch.state.header.source == "stop_latch"
+        assert "talker.json unreadable" in latch.state.reason
+        release = system.router.declare_publisher(topics.CONTROL_STOP.key("test"))
+        release.put(codec.encode(stop_state(False, USER)))
+        wait_until(lambda: not latch.stopped, "the release taken")
+        kept = launch / "stop" / "talker.json"
+        wait_until(lambda: '"stopped":false' in kept.read_text(), "the release kept")
