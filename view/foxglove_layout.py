@@ -11,12 +11,15 @@ foxglove-sdk's layout support (``foxglove.layouts``): it opens ready on the chan
     |                           | task error | nonzero|
     |                           +---------------------+
     |                           | arm joints          |
-    +-------------+-------------+------------+--------+
-    | controller's diagnostics | supervisor | parameters |
-    +-------------+-------------+------------+--------+
+    +-------------+------------+-------------+--------+
+    | controller's| supervisor | parameters  | teleop |
+    | diagnostics |            |             |        |
+    +-------------+------------+-------------+--------+
 
 The arm joints' plot has a series per joint of the robot's description, by its name (none
-without a description).
+without a description). The Teleop panel drives the base through the control station
+(``view.station_teleop``) on teleop/command: up and down forward and back, left and right a
+turn, the base stopped when a button is released.
 
 Foxglove imports it as a file (Layouts, Import from file); its topics are keys of one
 namespace, so each profile has its own (``parsimony layout PROFILE``).
@@ -38,6 +41,7 @@ from scenes.foxglove_views import (
     SOLIDS_SUFFIX,
     view_channel,
 )
+from view.station_teleop import PANEL_FORWARD_M_S, PANEL_RATE_HZ, PANEL_TURN_RAD_S
 
 FIXED_FRAME = "world"
 """F0, the estimate's world, where the 3-D panel stands."""
@@ -125,6 +129,27 @@ def messages_of(namespace: str, topic: topics.Topic, title: str) -> fl.RawMessag
     )
 
 
+def teleop(namespace: str) -> fl.TeleopPanel:
+    """Foxglove's Teleop panel on the channel the control station takes for teleop/command."""
+
+    def button(field: str, value: float) -> fl.TeleopButton:
+        return fl.TeleopButton(field=field, value=value)
+
+    return fl.TeleopPanel(
+        title="Teleop",
+        config=fl.TeleopConfig(
+            topic=channel(namespace, topics.TELEOP_COMMAND),
+            publish_rate=PANEL_RATE_HZ,
+            up_button=button("linear-x", PANEL_FORWARD_M_S),
+            down_button=button("linear-x", -PANEL_FORWARD_M_S),
+            left_button=button("angular-z", PANEL_TURN_RAD_S),
+            right_button=button("angular-z", -PANEL_TURN_RAD_S),
+            stop_button=button("linear-x", 0.0),
+            auto_send_stop_on_release=True,
+        ),
+    )
+
+
 def split(direction: str, *items: tuple[float, fl.Content]) -> fl.SplitContainer:
     return fl.SplitContainer(
         direction=direction,
@@ -158,5 +183,6 @@ def layout(namespace: str, joint_names: Sequence[str] = ()) -> fl.Layout:
         (2, messages_of(namespace, topics.CONTROL_DIAGNOSTICS, "Controller")),
         (2, messages_of(namespace, topics.SUPERVISOR_STATUS, "Supervisor")),
         (2, fl.ParametersPanel(title="Parameters")),
+        (1, teleop(namespace)),
     )
     return fl.Layout(content=split("column", (3, top), (2, bottom)))

@@ -19,6 +19,15 @@ TWIST_SCHEMAS = ("geometry_msgs/Twist", "geometry_msgs/msg/Twist")
 TWIST_BYTES = 1024
 """The largest twist taken (a twist in JSON is about 100 bytes)."""
 
+PANEL_RATE_HZ = 10.0
+"""How often the layout's Teleop panel puts its twist while a button is held: five times
+within the controller's dead-man timeout (``components.control_step.TELEOP_TIMEOUT_S``,
+0.5 s), so that a held button drives without a pause."""
+PANEL_FORWARD_M_S = 0.1
+"""The panel's forward (up) and back (down) speed, as ``parsimony teleop --speed``'s default."""
+PANEL_TURN_RAD_S = 0.5
+"""The panel's turn rate (left, right), as ``parsimony teleop --turn``'s default."""
+
 
 def teleop_topic(topic: str, namespace: str) -> bool:
     """Whether a client's channel ``topic`` is ``teleop/command``."""

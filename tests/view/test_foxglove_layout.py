@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from components.control_step import TELEOP_TIMEOUT_S
 from messages import topics
 from messages.camera import CameraFrame
 from messages.diagnostics import ControllerDiagnostics
@@ -24,6 +25,7 @@ from scenes.foxglove_views import Viewer
 from tests.processes import parsimony
 from tests.scenes.views_read import ROBOT, pose_dq, robot_state
 from view.foxglove_layout import layout
+from view.station_teleop import teleop_topic
 from vision.images import jpeg
 
 NAMESPACE = "sim"
@@ -114,7 +116,7 @@ def named_topics(node: object) -> set[str]:
         for key, value in node.items():
             if key in ("topics", "annotations") and isinstance(value, dict):
                 found |= set(value)
-            elif key in ("imageTopic", "poseTopic"):
+            elif key in ("imageTopic", "poseTopic", "topic"):
                 found.add(value)
             elif key in ("value", "topicPath") and isinstance(value, str) and value[:1] == '"':
                 found.add(value.split('"')[1])
@@ -125,6 +127,20 @@ def named_topics(node: object) -> set[str]:
     return found
 
 
+def teleop_config(node: object) -> dict | None:
+    """The config of the Teleop panel of a layout's document, None without one."""
+    if isinstance(node, dict):
+        if node.get("panelType") == "Teleop":
+            return node["config"]
+        node = list(node.values())
+    if isinstance(node, list):
+        for item in node:
+            found = teleop_config(item)
+            if found is not None:
+                return found
+    return None
+
+
 def test_every_topic_the_layout_names_is_a_channel_of_the_namespace(tmp_path: Path) -> None:
     path = tmp_path / "session.mcap"
     with SessionWriter(path, viewer=Viewer(ROBOT)) as writer:
@@ -133,9 +149,9 @@ def test_every_topic_the_layout_names_is_a_channel_of_the_namespace(tmp_path: Pa
     channels = {c["key"] for c in info(path)["channels"]}
     document = json.loads(layout(NAMESPACE, ROBOT.joint_names).to_json())
     named = named_topics(document)
-    publish = f"{NAMESPACE}/goal/request"  # the client's, not the namespace's
-    assert publish in named
-    assert named - {publish} <= channels, sorted(named - channels)
+    publish = {f"{NAMESPACE}/goal/request", f"{NAMESPACE}/teleop/command"}  # the client's
+    assert publish <= named
+    assert named - publish <= channels, sorted(named - channels)
     assert {
         f"{NAMESPACE}/{suffix}"
         for suffix in (
@@ -152,7 +168,7 @@ def test_every_topic_the_layout_names_is_a_channel_of_the_namespace(tmp_path: Pa
         )
     } <= named
     panels = json.dumps(document)
-    for panel in ("ThreeDee", "Image", "Plot", "RawMessages", "Parameters"):
+    for panel in ("ThreeDee", "Image", "Plot", "RawMessages", "Parameters", "Teleop"):
         assert f'"panelType":"{panel}"' in panels.replace(" ", "")
 
 
@@ -175,3 +191,20 @@ def test_the_joints_plot_has_a_series_per_joint_of_the_description() -> None:
     for i, name in enumerate(("shoulder", "elbow", "slide")):
         assert f'robot/state\\".arm_joints[{i}]' in text and f'"{name}"' in text
     assert '"Arm joints"' not in json.dumps(json.loads(layout(NAMESPACE).to_json()))
+
+
+def test_the_teleop_panel_drives_the_base_on_the_stations_teleop_channel() -> None:
+    """Its topic is one the control station takes as teleop/command
+    (``tests.view.test_station_stop`` drives through it); a held button puts its twist
+    several times within the controller's dead-man timeout, and a released one stops."""
+    config = teleop_config(json.loads(layout(NAMESPACE).to_json()))
+    assert config is not None
+    assert config["topic"] == f"{NAMESPACE}/teleop/command"
+    assert teleop_topic(config["topic"], NAMESPACE)
+    assert 2.0 / config["publishRate"] < TELEOP_TIMEOUT_S
+    buttons = {name: config[f"{name}Button"] for name in ("up", "down", "left", "right", "stop")}
+    assert buttons["up"]["field"] == buttons["down"]["field"] == "linear-x"
+    assert buttons["left"]["field"] == buttons["right"]["field"] == "angular-z"
+    assert buttons["up"]["value"] > 0 > buttons["down"]["value"]
+    assert buttons["left"]["value"] > 0 > buttons["right"]["value"]  # left: counterclockwise
+    assert buttons["stop"]["value"] == 0 and config["autoSendStopOnRelease"]

@@ -12,7 +12,11 @@ from components.stop_latch import StopLatch
 from messages import codec, topics
 from messages.teleop import TeleopCommand
 from tests.foxglove_client.client import DEADLINE_S, FoxgloveClient
+from tests.view.test_foxglove_layout import teleop_config
 from tests.view.test_station_limits import View, answer, view  # noqa: F401 - the fixture
+from view.foxglove_layout import layout
+
+TWIST = "geometry_msgs/Twist"
 
 
 def test_the_station_stops_and_releases_the_namespace(view: View) -> None:  # noqa: F811
@@ -54,14 +58,25 @@ def test_the_teleop_panel_drives_through_the_station(view: View) -> None:  # noq
         topics.TELEOP_COMMAND.key(view.profile.namespace),
         lambda sample: heard.append(codec.decode(sample.payload.to_bytes(), TeleopCommand)),
     )
+    panel = teleop_config(json.loads(layout(view.profile.namespace).to_json()))
+    assert panel is not None
     with FoxgloveClient(view.address) as client:
         client.server_info()
-        client.send(
-            "advertise", topic="teleop/command", encoding="json", schemaName="geometry_msgs/Twist"
-        )
-        channel = client.wait_for(lambda e: e["event"] == "advertised", "the channel")["channel"]
+        for topic in ("teleop/command", panel["topic"]):  # by hand, and the layout's panel
+            client.send("advertise", topic=topic, encoding="json", schemaName=TWIST)
+        channels = [
+            client.wait_for(lambda e, t=t: e["event"] == "advertised" and e["topic"] == t, t)
+            for t in ("teleop/command", panel["topic"])
+        ]
+        channel = channels[0]["channel"]
         twist = {"linear": {"x": 0.1, "y": 0, "z": 0}, "angular": {"x": 0, "y": 0, "z": -0.2}}
         client.send("publish", channel=channel, text=json.dumps(twist))
+        up = {"linear": {"x": panel["upButton"]["value"], "y": 0, "z": 0}}
+        client.send(
+            "publish",
+            channel=channels[1]["channel"],
+            text=json.dumps({**up, "angular": {"x": 0, "y": 0, "z": 0}}),
+        )
         start = len(client.events)
         client.send("publish", channel=channel, text='{"linear": 1}')
         client.wait_for(
@@ -70,8 +85,11 @@ def test_the_teleop_panel_drives_through_the_station(view: View) -> None:  # noq
             start,
         )
     deadline = time.monotonic() + DEADLINE_S
-    while not heard:
+    while len(heard) < 2:
         assert time.monotonic() < deadline, "no teleop/command"
         time.sleep(0.01)
     watcher.undeclare()
-    assert [(c.forward, c.turn, c.joint) for c in heard] == [(0.1, -0.2, "")]
+    assert [(c.forward, c.turn, c.joint) for c in heard] == [
+        (0.1, -0.2, ""),
+        (panel["upButton"]["value"], 0.0, ""),
+    ]
