@@ -41,6 +41,7 @@ import numpy as np
 
 from components.control_step import task_of
 from components.controller import goal_of
+from components.direct_goal import direct_refusal
 from components.joint_check import joints_match
 from components.params import Param, ParamError, load_robot
 from components.process_entry import run_component
@@ -48,6 +49,7 @@ from components.pubsub import Input, Subscription
 from components.robot_sight import RobotSight
 from components.runtime import Component, Node
 from components.stop_latch import StopLatch
+from components.supervisor_status import supervisor_status
 from messages import topics
 from messages.goal import Goal
 from messages.obstacles import Obstacles, circles_of
@@ -56,7 +58,7 @@ from messages.supervisor import ENDED, IDLE, SupervisorStatus
 from messages.teleop import TeleopCommand
 from wbc.geometry.obstacles import Circle
 from wbc.planning.drive_tasks import PointTask, offset_point
-from wbc.planning.staging import Plan, StagingParams, within
+from wbc.planning.staging import Plan, StagingParams
 from wbc.planning.staging_supervisor import PlanRequest, StagingSupervisor, SupervisorParams
 from wbc.planning.supervisor_phase import Phase
 from wbc.task import MEASUREMENT_TOLERANCE, PoseTask, Task, same_task
@@ -214,7 +216,7 @@ class Supervisor(Component):
         elif request is not None:
             q = np.array(state.configuration())
             if self.fresh:
-                self._give_up(self._refusal(request, q))
+                self._give_up(direct_refusal(request, q, self.robot, self._region()))
                 self.fresh = False
             if self.ended is not None:
                 self.goal_out.put(self._goal_of(self._held(q), request, stamp))
@@ -273,32 +275,6 @@ class Supervisor(Component):
         if self._hold is None:
             self._hold = PointTask(offset_point(q, DEFAULTS.lookahead), q[3:], DEFAULTS.lookahead)
         return self._hold
-
-    def _refusal(self, request: Goal, q: np.ndarray) -> str:
-        """Why a goal of another kind than a pose is refused at q: its target farther than a
-        plan may cover, or where the camera cannot see the base; else empty (a pose goal's
-        plan says so itself)."""
-        if request.task == "pose":
-            return ""
-        if request.arm is not None and len(request.arm) != self.robot.arm_dof:
-            return (
-                f"the {request.task} goal's arm has {len(request.arm)} joints, the robot's "
-                f"are {self.robot.arm_dof} ({', '.join(self.robot.joint_names)})"
-            )
-        x, y = request.position[:2] if request.task == "position" else request.point
-        distance, limit = math.hypot(x - q[0], y - q[1]), StagingParams.max_distance
-        if not distance <= limit:
-            return (
-                f"the {request.task} goal is {distance:.3g} m from the base, farther than "
-                f"the {limit:g} m a goal may lie"
-            )
-        region = self._region()
-        if region and not within(region, (x, y)):
-            return (
-                f"the {request.task} goal's ({x:.2f}, {y:.2f}) m lies where the camera "
-                "cannot see the base (keep_in_view)"
-            )
-        return ""
 
     def _give_up(self, reason: str) -> None:
         """Refuse the goal not taken yet, or abort the one under way, for ``reason`` (empty:
@@ -394,24 +370,7 @@ class Supervisor(Component):
             request_stamp_ns=self.request_stamp_ns,
             **self.sight.fields(stamp_ns),
         )
-        if supervisor is None:
-            return SupervisorStatus(candidate=0, plans=0, replans=0, stalls=0, **fields)
-        candidate = supervisor.candidate
-        return SupervisorStatus(
-            candidate=len(supervisor.tried),
-            candidate_base=None if candidate is None else tuple(candidate.base.tolist()),
-            candidate_arm=None if candidate is None else tuple(candidate.arm.tolist()),
-            way=tuple(tuple(point.tolist()) for point in supervisor.way()),
-            plans=len(supervisor.planning_s),
-            replans=supervisor.replans,
-            stalls=sum(e.kind == "stall" for e in supervisor.events),
-            last_event=supervisor.events[-1].detail if supervisor.events else "",
-            planning_ms=supervisor.planning_s[-1] * 1e3 if supervisor.planning_s else None,
-            planning_cpu_ms=(
-                supervisor.planning_cpu_s[-1] * 1e3 if supervisor.planning_cpu_s else None
-            ),
-            **fields,
-        )
+        return supervisor_status(supervisor, **fields)
 
     def shutdown(self) -> None:
         """Drop a plan still waiting; one running ends with its budget."""
