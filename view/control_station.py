@@ -25,7 +25,7 @@ A refusal is an error status that says why, at most ``client_limits.STATUS_CHARS
 
 A Zenoh error on the station's session (closed, or a panic in Zenoh) is logged as an error and
 counted (``session_errors``); the station opens a new session from the profile and goes on on
-it (``failed`` says why it could not).
+it (``failed`` says why it could not; ``view.station_session``).
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ import logging
 import threading
 import time
 from collections.abc import Callable
-from typing import Any, TypeVar
+from typing import Any
 
 import numpy as np
 import zenoh
@@ -50,7 +50,6 @@ from foxglove.websocket import (
 
 from components.stop_latch import release_refusal, stop_text
 from launch.tool_clock import ToolClock
-from launch.zenoh_error import is_session_error, zenoh_error_text
 from messages import codec, topics
 from messages.header import Header
 from messages.obstacles import circles_of
@@ -59,6 +58,7 @@ from profiles.profile import Profile
 from view.client_goals import ENCODING, SCHEMAS, GoalRefused, client_goal
 from view.client_limits import ECHO_CHARS, GOAL_RATE, STATUS_CHARS, Bucket, cut, echo
 from view.foxglove_params import running_parameters, set_parameters
+from view.station_session import SessionFailed, StationSession
 from view.station_stop import STOP_PARAMETER, stop_given, stop_parameters
 from view.station_teleop import TWIST_SCHEMAS, teleop_of, teleop_topic
 from wbc import dq
@@ -69,11 +69,6 @@ SOURCE = "view"
 """The source named in the header of a goal the view passes on."""
 
 log = logging.getLogger("parsimony.view")
-T = TypeVar("T")
-
-
-class SessionFailed(Exception):
-    """The station's Zenoh session failed and no new one could be opened."""
 
 
 def _answering(about: str, nothing: Any = None) -> Callable:
@@ -114,7 +109,7 @@ class ControlStation(ServerListener):
     listens to; ``close`` undeclares what it declared."""
 
     def __init__(self, session: zenoh.Session, profile: Profile, user: str | None = None) -> None:
-        self.session, self.namespace, self._profile = session, profile.namespace, profile
+        self.namespace, self._profile = profile.namespace, profile
         self.user = tool_user(user)
         access = profile.zenoh.access
         self.may_publish = access is None or access.may_write(topics.GOAL_REQUEST.name, self.user)
@@ -130,16 +125,25 @@ class ControlStation(ServerListener):
         self._buckets: dict[int, Bucket] = {}
         self._q: np.ndarray | None = None
         self._obstacles: tuple[Circle, ...] = ()
-        self.goals_sent = self.goals_refused = self.goals_dropped = 0
-        self.session_errors = self.errors = 0
-        self.failed = ""
-        """Why the station's session failed for good (a new one could not be opened)."""
-        self._declared: list = []
-        self._opened: list[zenoh.Session] = []
-        """The sessions the station opened itself (after a failure), closed with it."""
+        self.goals_sent = self.goals_refused = self.goals_dropped = self.errors = 0
         self._goal_out: zenoh.Publisher | None = None
         self._clock: ToolClock | None = None
-        self._declare()
+        self._session = StationSession(session, profile, self.user, self._declare, self._lock)
+
+    @property
+    def session(self) -> zenoh.Session:
+        """The station's Zenoh session (a new one after a failure)."""
+        return self._session.session
+
+    @property
+    def session_errors(self) -> int:
+        """How many times the station's session failed."""
+        return self._session.errors
+
+    @property
+    def failed(self) -> str:
+        """Why the station's session failed for good (a new one could not be opened)."""
+        return self._session.failed
 
     @property
     def capabilities(self) -> list[Capability]:
@@ -154,79 +158,19 @@ class ControlStation(ServerListener):
         self._server = server
 
     def close(self) -> None:
-        self._undeclare()
-        for session in self._opened:
-            session.close()
-        self._opened = []
+        self._session.close()
 
-    # -- the session ----------------------------------------------------------------------
-
-    def _declare(self) -> None:
+    def _declare(self, session: zenoh.Session) -> list:
+        """What the station declares on ``session``: the goals' publisher, the namespace's
+        clock and what a goal is checked against, when the user may send goals."""
         if not self.may_publish:
-            return
-        self._goal_out = self.session.declare_publisher(topics.GOAL_REQUEST.key(self.namespace))
-        self._clock = ToolClock(self.session, self._profile)
-        self._declared = [self._goal_out, self._clock] + [
-            self.session.declare_subscriber(topic.key(self.namespace), self._taker(topic))
+            return []
+        self._goal_out = session.declare_publisher(topics.GOAL_REQUEST.key(self.namespace))
+        self._clock = ToolClock(session, self._profile)
+        return [self._goal_out, self._clock] + [
+            session.declare_subscriber(topic.key(self.namespace), self._taker(topic))
             for topic in (topics.ROBOT_STATE, topics.WORLD_OBSTACLES)
         ]
-
-    def _undeclare(self) -> None:
-        for declared in self._declared:
-            try:
-                if isinstance(declared, ToolClock):
-                    declared.close()
-                else:
-                    declared.undeclare()
-            except BaseException as error:
-                if not is_session_error(error):
-                    raise
-        self._declared = []
-
-    def _on_session(self, operation: Callable[[zenoh.Session], T]) -> T:
-        """``operation`` on the station's session; after a Zenoh error, once more on a new
-        one (``SessionFailed`` if none can be opened, or it fails there too)."""
-        session = self.session
-        try:
-            return operation(session)
-        except BaseException as error:
-            if not is_session_error(error):
-                raise
-            self._reopen(session, error)
-        try:
-            return operation(self.session)
-        except BaseException as error:
-            if not is_session_error(error):
-                raise
-            raise SessionFailed(self._failure(zenoh_error_text(error))) from None
-
-    def _reopen(self, failed: zenoh.Session, error: BaseException) -> None:
-        """Say that ``failed`` failed, and open a new session in its place (unless another
-        thread did already)."""
-        with self._lock:
-            if self.session is not failed:
-                return
-            self.session_errors += 1
-            log.error(
-                "view: the control station's Zenoh session failed (%s); opening a new one",
-                zenoh_error_text(error),
-            )
-            self._undeclare()
-            try:
-                self.session = zenoh.open(self._profile.zenoh.client_config(self.user))
-                self._opened.append(self.session)
-                self._declare()
-            except BaseException as opening:
-                if not is_session_error(opening):
-                    raise
-                raise SessionFailed(self._failure(zenoh_error_text(opening))) from None
-            self.failed = ""
-            log.warning("view: the control station goes on on a new Zenoh session")
-
-    def _failure(self, reason: str) -> str:
-        self.failed = f"the view's Zenoh session failed: {reason}"
-        log.error("view: %s", self.failed)
-        return self.failed
 
     # -- goals ----------------------------------------------------------------------------
 
@@ -325,7 +269,7 @@ class ControlStation(ServerListener):
             self._status(client, "goal", f"goal/request refused: {error}", StatusLevel.Error)
             return
         try:
-            self._on_session(lambda _: self._put(codec.encode(goal)))
+            self._session.run(lambda _: self._put(codec.encode(goal)))
         except SessionFailed as error:
             self._status(client, "goal", f"goal/request not sent: {error}", StatusLevel.Error)
             return
@@ -344,7 +288,7 @@ class ControlStation(ServerListener):
         try:
             command = teleop_of(data, self.user)
             key = topics.TELEOP_COMMAND.key(self.namespace)
-            self._on_session(lambda s: s.put(key, codec.encode(command)))
+            self._session.run(lambda s: s.put(key, codec.encode(command)))
         except (ValueError, SessionFailed) as error:
             self._status(client, "teleop", f"teleop/command: {error}", StatusLevel.Error)
 
@@ -365,8 +309,8 @@ class ControlStation(ServerListener):
     ) -> list[Parameter]:
         wanted = set(param_names)
         try:
-            found = self._on_session(lambda s: running_parameters(s, self.namespace))
-            found += self._on_session(lambda s: stop_parameters(s, self.namespace))
+            found = self._session.run(lambda s: running_parameters(s, self.namespace))
+            found += self._session.run(lambda s: stop_parameters(s, self.namespace))
         except SessionFailed as error:
             self._status(client, "parameters", str(error), StatusLevel.Error)
             return []
@@ -380,7 +324,7 @@ class ControlStation(ServerListener):
             return []
         key = topics.CONTROL_STOP.key(self.namespace)
         try:
-            self._on_session(lambda s: s.put(key, codec.encode(given)))
+            self._session.run(lambda s: s.put(key, codec.encode(given)))
         except SessionFailed as error:
             self._status(client, "stop", f"not sent: {error}", StatusLevel.Error)
             return []
@@ -406,7 +350,7 @@ class ControlStation(ServerListener):
             )
             return self.on_get_parameters(client, [p.name for p in parameters], request_id)
         try:
-            values, refusals = self._on_session(
+            values, refusals = self._session.run(
                 lambda s: set_parameters(s, self.namespace, parameters, self._may_set)
             )
         except SessionFailed as error:
