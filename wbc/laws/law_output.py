@@ -82,14 +82,15 @@ def summarise(
     if not owned:
         u = np.array(u, dtype=float)
     u.setflags(write=False)
-    magnitude = np.abs(u)
+    # Counted on Python floats: the same comparisons, in half NumPy's time at these sizes.
+    magnitudes = list(map(abs, u.tolist()))
     output = object.__new__(LawOutput)  # the frozen dataclass, its fields set at once
     output.__dict__.update(
         u=u,
         status=status,
         objective=objective,
-        nonzero=int(np.count_nonzero(magnitude > ZERO_THRESHOLD)),
-        practical_nonzero=int(np.count_nonzero(magnitude >= PRACTICAL_THRESHOLD)),
+        nonzero=sum(m > ZERO_THRESHOLD for m in magnitudes),
+        practical_nonzero=sum(m >= PRACTICAL_THRESHOLD for m in magnitudes),
         active_constraints=active,
         solve_time_s=time.perf_counter() - start,
         error_norm=math.sqrt(float(error.dot(error))),  # ndarray.dot: @'s sum, in half the time

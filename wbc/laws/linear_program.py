@@ -86,6 +86,10 @@ class _Layout:
         """What makes two steps' problems one shape: n, the residual costs' count, the rows of
         each residual cost and linear rows, and the one-norm rows."""
         self.n, self.norm_rows = n, norm_rows
+        self.counts = (n, *counts)
+        """n and the rows of each matrix, as a step checks them."""
+        self.kinds: _Kinds | None = None
+        """The sequence of kinds of costs and rows this layout was last taken for."""
         residual_rows = counts[:residual_count]
         linear_rows = sum(counts[residual_count:])
         residual_total = self.residual_rows = sum(residual_rows)
@@ -167,10 +171,16 @@ class WarmStartedLP:
         kinds = tuple(map(type, items))
         if kinds != self._kinds.types:
             self._kinds = _Kinds(kinds)
-        residuals, velocity_costs, linear, bounds, norms, with_matrix = self._kinds.pick(items)
+        velocity_costs, residuals, linear, bounds, norms, with_matrix = self._kinds.pick(items)
         matrices = list(map(_MATRIX, with_matrix))
         n = matrices[0].shape[1]
-        layout = self._layout_for(n, matrices, len(residuals), len(norms))
+        layout = self._layout
+        if (
+            layout is None
+            or layout.kinds is not self._kinds
+            or layout.counts != (n, *map(len, matrices))
+        ):
+            layout = self._layout_for(n, matrices, len(residuals), len(norms))
         u_lower, u_upper = layout.u_lower, layout.u_upper
         if len(bounds) == 1:
             u_lower[:], u_upper[:] = bounds[0].lower, bounds[0].upper
@@ -188,8 +198,9 @@ class WarmStartedLP:
         # The varying rows: [A_b -A_b -I_b] of every residual cost, then [A -A 0] of the rows.
         np.concatenate(matrices, out=layout.plus)
         np.negative(layout.plus, out=layout.minus)
-        np.concatenate(list(map(_OFFSET, residuals)), out=layout.residual_upper)
-        np.negative(layout.residual_upper, out=layout.residual_upper)
+        residual_upper = layout.residual_upper
+        np.concatenate(list(map(_OFFSET, residuals)), out=residual_upper)
+        np.negative(residual_upper, out=residual_upper)
         if len(layout.filled) == 1:
             only = linear[layout.filled[0]]
             layout.linear_lower[:], layout.linear_upper[:] = only.lower, only.upper
@@ -197,20 +208,26 @@ class WarmStartedLP:
             np.concatenate([linear[i].lower for i in layout.filled], out=layout.linear_lower)
             np.concatenate([linear[i].upper for i in layout.filled], out=layout.linear_upper)
         layout.weigh(list(map(_WEIGHT, residuals)))
+        # The costs of u_P: c_P - sum_b w_b 1'A_b, of u_N: c_N + sum_b w_b 1'A_b (rows weighted
+        # by w), c_P and c_N the velocity costs of each entry's two directions; y_b's 2 w_b are
+        # set with the weights (``_Layout.weigh``).
         positive, negative = self._velocity_costs(velocity_costs, n)
-        _fill_costs(layout, positive, negative)
+        column_sums = layout.row_weight.dot(layout.residual_plus)
+        np.subtract(positive, column_sums, out=layout.cost_positive)
+        np.add(negative, column_sums, out=layout.cost_negative)
         status, values = self._vertex(layout)
         if values is None:
             return _failed(n, status)
         # With no cost on u_P + u_N (c = 0) a vertex may hold both halves of one u_i positive,
         # the one-norm row tight only through that waste (its dual 0). One degenerate pivot away
         # lies the same u with the halves split canonically; report that one.
-        halves = values[: 2 * n].reshape(2, n)
-        u_positive, u_negative = halves - np.minimum(*halves)
+        u_positive, u_negative = values[:n], values[n : 2 * n]
+        common = np.minimum(u_positive, u_negative)
+        u_positive, u_negative = u_positive - common, u_negative - common
         u = u_positive - u_negative
         # The constant -sum_b w_b 1'b_b; the residual rows' upper bounds hold -b.
         # ndarray.dot: the same BLAS sums as @, in about half the time for vectors this short.
-        offsets = -float(layout.row_weight.dot(layout.residual_upper))
+        offsets = -float(layout.row_weight.dot(residual_upper))
         objective = float(layout.cost.dot(values)) - offsets
         active = _active(u, linear, norms, bounds)
         return LPSolution(u, status, objective, active, u_positive, u_negative)
@@ -235,6 +252,7 @@ class WarmStartedLP:
         if self._layout is None or self._layout.key != key:
             self._build(_Layout(*key))
         assert self._layout is not None
+        self._layout.kinds = self._kinds
         return self._layout
 
     def _build(self, layout: _Layout) -> None:
@@ -316,17 +334,8 @@ class WarmStartedLP:
         return "optimal", np.asarray(highs.getSolution().col_value)
 
 
-def _fill_costs(layout: _Layout, positive: Array, negative: Array) -> None:
-    """u_P: c_P - sum_b w_b 1'A_b, u_N: c_N + sum_b w_b 1'A_b (rows weighted by w), with c_P
-    and c_N the velocity costs of each entry's two directions; y_b's 2 w_b are set with the
-    weights (``_Layout.weigh``)."""
-    column_sums = layout.row_weight.dot(layout.residual_plus)
-    np.subtract(positive, column_sums, out=layout.cost_positive)
-    np.add(negative, column_sums, out=layout.cost_negative)
-
-
 _MATRIX, _OFFSET, _WEIGHT = (operator.attrgetter(name) for name in ("matrix", "offset", "weight"))
-KINDS = (ResidualCost, VelocityCost, LinearRows, VelocityBounds, OneNormBound)
+KINDS = (VelocityCost, ResidualCost, LinearRows, VelocityBounds, OneNormBound)
 """What ``WarmStartedLP.solve`` takes, in the order ``_Kinds.pick`` gives them."""
 
 
@@ -334,8 +343,9 @@ class _Kinds:
     """Where each kind of cost or rows sits among one step's items, found once for a sequence
     of types: a step whose terms return the kinds of the last picks them by place.
 
-    ``pick`` gives the residual costs, velocity costs, linear rows, velocity bounds and
-    one-norm bounds, then the residual costs and linear rows together (those with a matrix).
+    ``pick`` gives the velocity costs, residual costs, linear rows, velocity bounds and
+    one-norm bounds, then the residual costs and linear rows together (those with a matrix):
+    one itemgetter puts the items in that order, and each group is a slice of it.
     """
 
     def __init__(self, types: tuple[type, ...]) -> None:
@@ -346,11 +356,15 @@ class _Kinds:
             if group is None:
                 raise TypeError(f"not a cost or rows of the LP: {kind.__name__}")
             places[group].append(place)
-        places.append(places[0] + places[2])
-        self._pickers = [_picker(group) for group in places]
+        order = [place for group in places for place in group]
+        self._order = _picker(order)
+        ends = np.cumsum([0, *map(len, places)]).tolist()
+        self._slices = [slice(a, b) for a, b in zip(ends, ends[1:], strict=False)]
+        self._slices.append(slice(ends[1], ends[3]))
 
     def pick(self, items: tuple) -> list[tuple]:
-        return [picker(items) for picker in self._pickers]
+        ordered = self._order(items)
+        return [ordered[group] for group in self._slices]
 
 
 def _picker(places: list[int]) -> Callable[[tuple], tuple]:

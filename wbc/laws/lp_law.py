@@ -109,7 +109,7 @@ def program(
     circles, solids = _obstacles(obstacles) if obstacles else ((), ())
     chain = robot.forward(q)  # one pass for the task and the collision parts' rows
     error, task_jacobian = task.error(chain.pose, chain.jacobian, q)
-    if last is not None and same_task(last[0], task):
+    if last is not None and (last[0] is task or same_task(last[0], task)):
         error_rate = (error - last[1]) / dt
     else:
         error_rate = -eta * error
@@ -127,10 +127,23 @@ def program(
         previous_u,
         chain,
     )
-    rows = [constraint.rows(context) for constraint in constraints]  # first: a term may read
-    costs = [ResidualCost("task", task_jacobian, eta * error)]  # what a row engaged
-    costs += [term.cost(context) for term in objectives]
+    costs, rows = terms(context, task_jacobian, eta, constraints, objectives)
     return costs, rows, error, (task, error)
+
+
+def terms(
+    context: StepContext,
+    task_jacobian: Array,
+    eta: float,
+    constraints: Sequence[Constraint],
+    objectives: Sequence[ObjectiveTerm],
+) -> tuple[list, list]:
+    """The costs of 5.29 (the task's first, ||J u + eta e||, then the objective's terms) and
+    the constraints' rows, at one step's ``context``."""
+    rows = [constraint.rows(context) for constraint in constraints]  # first: a term may read
+    costs = [ResidualCost("task", task_jacobian, eta * context.error)]  # what a row engaged
+    costs += [term.cost(context) for term in objectives]
+    return costs, rows
 
 
 def _check(q: Array, dt: float) -> None:
