@@ -5,16 +5,14 @@ robot's limits, and how parsimonious its u is on the way.
 from __future__ import annotations
 
 import math
-import multiprocessing
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
-from multiprocessing.pool import Pool
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
-from studies.gain_sets import bare_5_29, supervised_params
-from studies.goal_families import FAMILIES, OBSTACLE_FAMILIES, goals, obstacle_goals
+from studies.gain_sets import bare_5_29, input_change_gains, supervised_params
+from studies.goal_families import FAMILIES, GOAL_SEED, OBSTACLE_FAMILIES
 from wbc import dq
 from wbc.geometry.obstacles import Circle, least_clearance
 from wbc.geometry.scenarios import DT
@@ -253,20 +251,16 @@ LAWS: dict[str, Callable[[MobileManipulator], Law]] = {
     SUPERVISED: lambda robot: LPLaw(robot, supervised_params()),
     "qp": lambda robot: QPLaw(robot),
     "cascade": lambda robot: CascadeLaw(robot),
+    "lp with input change": lambda robot: LPLaw(robot, replace(LPParams(), **input_change_gains())),
 }
 """The laws compared: the default LP, LP 5.29 as written (``exact_5_29``), the LP under the
 staging supervisor (wbc.planning.staging_supervisor) with its gains, the QP of the same rows and
-terms (wbc.laws.qp_law), the cascade."""
+terms (wbc.laws.qp_law), the cascade; the LP with the input change term of
+deploy/sim_smooth.yaml (``input_change_gains``)."""
+BENCH_LAWS = ("lp", "lp 5.29 exactly", SUPERVISED, "qp", "cascade")
+"""The laws `parsimony bench` runs on the pose task of each family's goals."""
 POSITION_LAWS = ("lp", "lp 5.29 exactly", "qp", "cascade")
 """The laws run on the position task of each family's goals (6.2.2)."""
-
-
-def _attempt_one(job: tuple[str, Path, Array, Array, bool, tuple[Circle, ...]]) -> Attempt:
-    law_name, robot_file, start, goal, position, obstacles = job
-    robot = MobileManipulator.from_yaml(robot_file)
-    return attempt(
-        LAWS[law_name](robot), robot, start, goal, law_name == SUPERVISED, position, obstacles
-    )
 
 
 def not_reached(attempts: Iterable[Attempt]) -> dict[str, dict[str, int]]:
@@ -289,52 +283,42 @@ def failures(attempts: Iterable[Attempt]) -> dict:
     }
 
 
-def _obstacle_rows(pool: Pool, robot_file: Path, count: int) -> dict:
-    """For every family of OBSTACLE_FAMILIES, the LP under the staging supervisor: the shares
-    reached, the failures by reason, the contacts and the planning times."""
-    robot = MobileManipulator.from_yaml(robot_file)
-    report: dict = {}
-    for family in OBSTACLE_FAMILIES.values():
-        jobs = [
-            (SUPERVISED, robot_file, start, goal, False, (circle,))
-            for start, goal, circle in obstacle_goals(family, count, robot)
-        ]
-        attempts = pool.map(_attempt_one, jobs, chunksize=1)
-        row = {
-            **shares(attempts),
-            **parsimony(attempts, robot.dof),
-            **failures(attempts),
-            **planning(attempts),
-        }
-        report[f"{family.name} pose"] = {"goals": count, "laws": {SUPERVISED: row}}
-    return report
-
-
 def goal_report(robot_file: Path, count: int, processes: int = 2) -> dict:
-    """For every family and law: the shares reached, the parsimony of u and the goals not
-    reached by reason, for the pose task and, with the laws of POSITION_LAWS, for the position
-    task of the same goals; and the LP under the supervisor on the goals of OBSTACLE_FAMILIES
-    (``_obstacle_rows``)."""
+    """For every family and law of ``BENCH_LAWS``: the shares reached, the parsimony of u and
+    the goals not reached by reason, for the pose task and, with the laws of POSITION_LAWS,
+    for the position task of the same goals; and the LP under the supervisor on the goals of
+    OBSTACLE_FAMILIES with the contacts and planning times. The runs are studies on the local
+    pool of ``processes`` (``studies.study.attempts``)."""
+    from studies.study.attempts import sweep_attempts
+    from studies.study.schema import Study
+
     robot = MobileManipulator.from_yaml(robot_file)
+    sweeps = [
+        (task, [*FAMILIES], [GOAL_SEED], names)
+        for task, names in (("pose", BENCH_LAWS), ("position", POSITION_LAWS))
+    ]
+    sweeps += [("pose", [f.name], [f.seed], (SUPERVISED,)) for f in OBSTACLE_FAMILIES.values()]
     report: dict = {}
-    with multiprocessing.get_context("spawn").Pool(processes) as pool:
-        for family in FAMILIES.values():
-            pairs = goals(family, count, robot)
-            for task, law_names in (("pose", tuple(LAWS)), ("position", POSITION_LAWS)):
-                rows = {}
-                for law_name in law_names:
-                    jobs = [
-                        (law_name, robot_file, start, goal, task == "position", ())
-                        for start, goal in pairs
-                    ]
-                    attempts = pool.map(_attempt_one, jobs, chunksize=1)
-                    rows[law_name] = {
-                        **shares(attempts),
-                        **parsimony(attempts, robot.dof),
-                        **not_reached(attempts),
-                    }
-                    if law_name == SUPERVISED:
-                        rows[law_name].update(planning(attempts))
-                report[f"{family.name} {task}"] = {"goals": count, "laws": rows}
-        report.update(_obstacle_rows(pool, robot_file, count))
-    return report
+    for task, families, seeds, names in sweeps:
+        study = Study.model_validate(
+            {"name": f"bench-{task}", "robots": [str(robot_file)], "families": families}
+            | {"task": task, "goals": count, "seeds": seeds}
+            | {"laws": [{"law": name} for name in names]}
+        )
+        found = sweep_attempts(study, processes)
+        for family in families:
+            rows = {}
+            for name in names:
+                attempts = found[(family, task, seeds[0], name)]
+                rows[name] = {
+                    **shares(attempts),
+                    **parsimony(attempts, robot.dof),
+                    **not_reached(attempts),
+                }
+                if name == SUPERVISED:
+                    rows[name].update(planning(attempts))
+                if family in OBSTACLE_FAMILIES:
+                    rows[name].update(failures(attempts))
+            report[f"{family} {task}"] = {"goals": count, "laws": rows}
+    order = [f"{family} {task}" for family in FAMILIES for task in ("pose", "position")]
+    return {key: report[key] for key in order} | report

@@ -17,14 +17,10 @@ runs in kinematic closed loop (``wbc.laws.kinematic_run.integrate``) for at most
 
 from __future__ import annotations
 
-import functools
 import math
-import multiprocessing
 import re
-import sys
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -139,23 +135,18 @@ def engaged_count(out: LawOutput) -> int:
     return count
 
 
-@functools.cache
-def _robot(path: Path) -> MobileManipulator:
-    return MobileManipulator.from_yaml(path)
-
-
-def run_one(job: tuple[Path, str, str, Array, Array, float]) -> Outcome:
-    """Law ``job[1]`` of robot ``job[0]`` from start ``job[3]`` to family ``job[2]``'s goal
-    of configuration ``job[4]``, for at most ``job[5]`` s."""
-    path, law_name, family, start, goal, time_limit_s = job
-    robot = _robot(path)
-    law, task = LAWS[law_name](robot), task_of(robot, goal, family)
+def run_one(
+    law: Law, robot: MobileManipulator, task: str, start: Array, goal: Array, time_limit_s: float
+) -> Outcome:
+    """``law`` from ``start`` to the pose (``task`` pose) or the position of ``goal``'s end
+    effector, for at most ``time_limit_s``."""
+    target = task_of(robot, goal, task)
     q = np.array(start, dtype=float)
     nonzero, engaged, error = [], [], []
     joint_over = speed_over = 0.0
     reached = False
     for _ in range(round(time_limit_s / DT)):
-        out = law.step(q, task, DT)
+        out = law.step(q, target, DT)
         nonzero.append(out.nonzero)
         engaged.append(engaged_count(out))
         error.append(out.error_norm)
@@ -209,46 +200,7 @@ def summary(outcomes: list[Outcome], task_dof: int) -> dict[str, float]:
     return row
 
 
-def study(
-    paths: list[Path],
-    count: int = GOALS,
-    workers: int = 2,
-    seed: int = SEED,
-    time_limit_s: float = TIME_LIMIT_S,
-    families: tuple[str, ...] = tuple(TASKS),
-) -> dict[str, dict]:
-    """For every robot of ``paths``: its DOF, and per family (of ``families``) and law the
-    ``summary`` of its ``count`` goals. ``workers`` > 1 runs the goals in that many
-    processes."""
-    report: dict[str, dict] = {}
-    pool = multiprocessing.get_context("spawn").Pool(workers) if workers > 1 else None
-    mapped = pool.map if pool else map
-    try:
-        for path in paths:
-            robot = _robot(path)
-            pairs = draw(robot, count, seed)
-            rows: dict[str, dict] = {}
-            for family in families:
-                rows[family] = {}
-                for law in LAWS:
-                    progress(f"{robot.name}: {family} goals, {law}")
-                    jobs = [(path, law, family, *pair, time_limit_s) for pair in pairs]
-                    rows[family][law] = summary(list(mapped(run_one, jobs)), TASKS[family])
-            report[robot.name] = {
-                "description": path.name,
-                "base": robot.base.kind,
-                "dof": robot.dof,
-                "arm_dof": robot.arm_dof,
-                "mobility": mobility(robot),
-                "goals": count,
-                "families": rows,
-            }
-    finally:
-        if pool:
-            pool.close()
-            pool.join()
-    return report
-
-
-def progress(what: str) -> None:
-    print(f"redundancy: {what}", file=sys.stderr, flush=True)
+def entries(robot: MobileManipulator) -> int:
+    """The entries of u a robot can move: all of them, but the base's three on a fixed base (a
+    differential base's x' and y' are two entries of one velocity)."""
+    return robot.arm_dof if robot.base.kind == "fixed" else robot.dof

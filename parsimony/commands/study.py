@@ -44,7 +44,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument(
         "--page",
         action="store_true",
-        help="with --report, also write them into the study's docs page (its marked block)",
+        help="with --report, also write them into the study's docs page (its marked block), "
+        "and its plots into their files",
     )
     return parser
 
@@ -62,10 +63,16 @@ def run(args: argparse.Namespace) -> int:
         print("parsimony study: --workers must be 1 or more", file=sys.stderr)
         return 2
     if args.report:
-        text = markdown(study, str(args.file), runs, results.read(path))
+        rows = results.read(path)
+        text = markdown(study, str(args.file), runs, rows)
         if args.page and (study.page is None or not update_page(study.page, study, text)):
             print(f"parsimony study: {study.name} names no page with its markers", file=sys.stderr)
             return 2
+        if args.page:
+            from studies.study.plots import draw
+
+            for plot in study.plots:
+                print(f"parsimony study: {draw(study, plot, runs, rows)}", file=sys.stderr)
         emit(text.rstrip("\n"))
         return 0
     if args.address:

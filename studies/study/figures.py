@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from studies import redundancy
 from studies.goal_sets import failures, parsimony, planning, shares
 from studies.study.execute import OK
 from studies.study.runs import attempt_of
@@ -78,10 +79,13 @@ def _effort(rows: Rows, robot: MobileManipulator) -> dict[str, float]:
     return {n: float(np.median([getattr(e, n) for e in efforts])) for n in names if efforts}
 
 
-KINEMATIC: dict[str, Figure] = {
+COMMON: dict[str, Figure] = {
     "runs": lambda rows, robot: {"runs": len(rows)},
     "failed": lambda rows, robot: {"failed": len(rows) - len(ok(rows))},
     "seeds": lambda rows, robot: {"seeds": ",".join(map(str, sorted({r["seed"] for r in rows})))},
+}
+"""Figures of every study."""
+KINEMATIC: dict[str, Figure] = COMMON | {
     "reached": _share("reached", "reached"),
     "reached inside the joint limits": _share(
         "reached inside the joint limits", "within_joint_limits"
@@ -102,7 +106,7 @@ KINEMATIC: dict[str, Figure] = {
     "effort": _effort,
     "misses": misses,
 }
-"""A kinematic study's figures: each gives one or more columns."""
+"""A kinematic study's figures on goal families: each gives one or more columns."""
 
 
 def median_of(reports: list[dict], component: str, counter: str) -> int:
@@ -175,4 +179,131 @@ SIMULATED_COLUMNS = (
 )
 """The columns of ``summary`` a simulated study's table may name."""
 SIMULATED: dict[str, Figure] = {key: _summary(key) for key in SIMULATED_COLUMNS}
-"""A simulated study's figures."""
+"""A simulated study's figures (``SETUP``'s too)."""
+
+
+def _converge_times(rows: Rows, robot: MobileManipulator) -> dict[str, float | None]:
+    """The median and p99 time to converge of the runs that converged, s."""
+    times = [r["converge_s"] for r in ok(rows) if r["converged"]]
+    if not times:
+        return {"time to converge, median (s)": None, "p99 (s)": None}
+    return {
+        "time to converge, median (s)": round(float(np.median(times)), 1),
+        "p99 (s)": round(float(np.percentile(times, 99)), 1),
+    }
+
+
+def _not_converged(rows: Rows, robot: MobileManipulator) -> dict[str, str]:
+    """The seeds that did not converge, each with its final error ('every seed' and their
+    range when none did)."""
+    runs = ok(rows)
+    missed = [r for r in runs if not r["converged"]]
+    if runs and len(missed) == len(runs) and len(runs) > 1:
+        errors = [r["final_error"] for r in missed]
+        return {"not converged (final error)": f"every seed ({min(errors):.2f}-{max(errors):.2f})"}
+    text = ", ".join(f"{r['seed']} ({r['final_error']:.2f})" for r in missed)
+    return {"not converged (final error)": text}
+
+
+def _nonzero_moving(rows: Rows, robot: MobileManipulator) -> dict[str, float | None]:
+    """The median nonzero entries of u over every step of every run with ``||e||`` above
+    ``MOVING_ERROR`` (pooled, as ``studies.goal_sets.parsimony`` counts them)."""
+    counts = [n for r in ok(rows) for n in r["nonzero_moving"]]
+    return {"nonzero moving": float(np.median(counts)) if counts else None}
+
+
+SETUP: dict[str, Figure] = COMMON | {
+    "converged": lambda rows, robot: {
+        "converged": round(sum(r["converged"] for r in ok(rows)) / max(len(ok(rows)), 1), 3)
+    },
+    "with a contact": lambda rows, robot: {
+        "with a contact": sum(r["contacts"] > 0 for r in ok(rows))
+    },
+    "least clearance": lambda rows, robot: {
+        "least clearance (m)": min((r["min_obstacle_clearance_m"] for r in ok(rows)), default=None)
+    },
+    "nonzero moving": _nonzero_moving,
+    "time to converge": _converge_times,
+    "not converged": _not_converged,
+}
+"""The figures of runs of an experiment's set-up, on either loop (``runs.SETUP_COLUMNS``):
+the share converged, the runs with a contact, the least clearance, the nonzero entries while
+moving, the time to converge of those that converged and the seeds that did not."""
+
+
+def _zoo(name: str, key: str) -> Figure:
+    def figure(rows: Rows, robot: MobileManipulator) -> dict[str, Any]:
+        outcomes = [
+            redundancy.Outcome(
+                r["reached"],
+                r["within_limits"],
+                r["seconds"],
+                np.asarray(r["nonzero"], np.int16),
+                np.asarray(r["engaged"], np.int16),
+                np.asarray(r["error"]),
+            )
+            for r in ok(rows)
+        ]
+        return {name: redundancy.summary(outcomes, redundancy.TASKS[rows[0]["task"]])[key]}
+
+    return figure
+
+
+ZOO: dict[str, Figure] = COMMON | {
+    "base": lambda rows, robot: {"base": robot.base.kind},
+    "dof": lambda rows, robot: {"dof": robot.dof},
+    "entries": lambda rows, robot: {"entries": redundancy.entries(robot)},
+    **{
+        name: _zoo(name, key)
+        for name, key in (
+            ("reached in limits", "reached_within_limits"),
+            ("reached", "reached"),
+            ("nonzero moving", "nonzero_moving"),
+            ("nonzero near", "nonzero_near"),
+            ("engaged moving", "engaged_moving"),
+            ("engaged near", "engaged_near"),
+            ("<= task + engaged", "within_bound"),
+        )
+    },
+}
+"""The zoo's figures (``studies.redundancy.summary``), and the robot's base, DOF and entries
+of u it can move (``studies.redundancy.entries``)."""
+
+METRICS = {
+    "metric 3": ("acceleration_l1", "effort"),
+    "metric 4": ("acceleration_l2", "effort"),
+    "metric 3 from rest": ("acceleration_l1", "effort_from_rest"),
+    "metric 4 from rest": ("acceleration_l2", "effort_from_rest"),
+}
+"""Table 6.1's metrics compared goal by goal: a ``ControlEffort`` field, from the first
+command (``effort``, as table 6.1 takes them) or from rest."""
+GOAL = ("robot", "family", "task", "seed", "goal")
+"""What names one goal of a kinematic study."""
+
+
+def _effort_against(rows: Rows, reference: Rows, robot: MobileManipulator) -> dict[str, Any]:
+    """On the goals both these runs and ``reference`` reached inside every limit: how many,
+    and each metric's median and the median of its ratio to the reference's, goal by goal."""
+    theirs = {tuple(r[n] for n in GOAL): attempt_of(r) for r in ok(reference)}
+    pairs = [
+        (a, theirs[key])
+        for r in ok(rows)
+        if (key := tuple(r[n] for n in GOAL)) in theirs
+        and (a := attempt_of(r)).within_all_limits
+        and theirs[key].within_all_limits
+    ]
+    found: dict[str, Any] = {"goals compared": len(pairs)}
+    for label, (field, part) in METRICS.items():
+        mine = [getattr(getattr(a, part), field) for a, _ in pairs]
+        ratios = [
+            m / getattr(getattr(b, part), field) for m, (_, b) in zip(mine, pairs, strict=True)
+        ]
+        found[label] = float(np.median(mine)) if mine else None
+        found[f"{label}, ratio"] = float(np.median(ratios)) if ratios else None
+    return found
+
+
+Compared = Callable[[Rows, Rows, MobileManipulator], dict[str, Any]]
+COMPARED: dict[str, Compared] = {"effort against": _effort_against}
+"""Figures of a kinematic table with ``against``: each group's runs beside that law's runs of
+the same goals."""

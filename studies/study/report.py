@@ -1,6 +1,6 @@
 """A study's report: its tables (Markdown) from its results file, each naming the study and
-the command that made it; and the block of its docs page (``page``) between the study's
-markers, replaced by them."""
+the command that made it, and its plots (``plots``); and the block of its docs page (``page``)
+between the study's markers, replaced by the tables."""
 
 from __future__ import annotations
 
@@ -10,50 +10,97 @@ from typing import Any
 from tabulate import tabulate
 
 from outputs.stdout import finite
-from studies.study.figures import KINEMATIC, SIMULATED
-from studies.study.schema import Study, StudyError
+from studies.study import places
+from studies.study.figures import COMPARED, KINEMATIC, SETUP, SIMULATED, ZOO, Figure
+from studies.study.schema import Study, StudyError, Table
 from studies.study.sweep import PARAMETERS, Run
 from wbc.robot import MobileManipulator
 
+FIGURES: dict[str, dict[str, Figure]] = {
+    places.GOALS: KINEMATIC,
+    places.ZOO: ZOO,
+    places.SETUP: SETUP,
+    places.SIMULATED: SETUP | SIMULATED,
+}
+"""The figures a table may name, by the kind of the study's places."""
 
-def figures_of(study: Study) -> dict:
-    return KINEMATIC if study.loop == "kinematic" else SIMULATED
+
+def figures_of(study: Study) -> dict[str, Figure]:
+    """The figures every loop of ``study`` has, for the kind of its places."""
+    place = (study.families or study.experiments)[0]
+    each = [FIGURES[places.kind(loop, place)] for loop in study.loops]
+    return {name: figure for name, figure in each[0].items() if all(name in f for f in each)}
 
 
 def check_tables(study: Study) -> None:
-    """``StudyError`` naming a table's unknown parameter or figure."""
+    """``StudyError`` naming a table's or a plot's unknown parameter or figure."""
     known = figures_of(study)
     for table in study.tables:
         for name in table.by:
             if name not in PARAMETERS:
                 raise StudyError(f"table {table.title!r}: no parameter {name!r}; {PARAMETERS}")
         for name in table.figures:
-            if name not in known:
+            if name in COMPARED and table.against is None:
+                raise StudyError(f"table {table.title!r}: {name!r} needs 'against: LAW'")
+            if name not in known and name not in COMPARED:
                 raise StudyError(
                     f"table {table.title!r}: no figure {name!r}; known: {'; '.join(known)}"
                 )
+    for plot in study.plots:
+        for name in (plot.lines, plot.panels, *plot.by):
+            if name not in PARAMETERS:
+                raise StudyError(f"plot {plot.file}: no parameter {name!r}; {PARAMETERS}")
+        for name in (plot.x, *plot.y):
+            if name not in known:
+                raise StudyError(f"plot {plot.file}: no figure {name!r}; known: {'; '.join(known)}")
+
+
+def robots(runs: list[Run]) -> dict[str, MobileManipulator]:
+    """The runs' robots by name."""
+    files = {run.parameters["robot"]: run.robot_file for run in runs}
+    return {name: MobileManipulator.from_yaml(path) for name, path in files.items()}
+
+
+def groups(rows: list[dict[str, Any]], by: list[str], seeds: list[int] = ()) -> dict[tuple, list]:
+    """``rows`` (of ``seeds``, or every seed) grouped by the values of ``by``, in the runs'
+    order."""
+    found: dict[tuple, list[dict[str, Any]]] = {}
+    for row in sorted(rows, key=lambda r: r["index"]):
+        if not seeds or row["seed"] in seeds:
+            found.setdefault(tuple(row[name] for name in by), []).append(row)
+    return found
+
+
+def table_lines(
+    study: Study, table: Table, rows: list[dict[str, Any]], loaded: dict[str, MobileManipulator]
+) -> list[dict[str, Any]]:
+    """A line per group of ``table``: its parameters and figures."""
+    figures = figures_of(study)
+    found = groups(rows, table.by, table.seeds)
+    lines = []
+    for values, group in found.items():
+        robot = loaded[group[0]["robot"]]
+        line: dict[str, Any] = dict(zip(table.by, values, strict=True))
+        for name in table.figures:
+            if name in COMPARED:
+                reference = [r for r in rows if r["law"] == table.against]
+                line |= COMPARED[name](group, reference, robot)
+            else:
+                line |= figures[name](group, robot)
+        lines.append(finite(line))  # a median of no step is blank, not nan
+    return lines
 
 
 def markdown(study: Study, file: str, runs: list[Run], rows: list[dict[str, Any]]) -> str:
     """Every table of ``study`` over ``rows`` (the runs' robots from ``runs``)."""
-    robots = {run.parameters["robot"]: run.robot_file for run in runs}
-    loaded = {name: MobileManipulator.from_yaml(path) for name, path in robots.items()}
-    figures = figures_of(study)
+    loaded = robots(runs)
     done = sum(row["status"] == "ok" for row in rows)
     parts = [
         f"Made by `parsimony study {file} --report` from its results: {len(rows)} of "
         f"{len(runs)} runs, {done} of them run to the end."
     ]
     for table in study.tables:
-        groups: dict[tuple, list[dict[str, Any]]] = {}
-        for row in sorted(rows, key=lambda r: r["index"]):
-            groups.setdefault(tuple(row[name] for name in table.by), []).append(row)
-        lines = []
-        for values, group in groups.items():
-            line: dict[str, Any] = dict(zip(table.by, values, strict=True))
-            for name in table.figures:
-                line |= figures[name](group, loaded[group[0]["robot"]])
-            lines.append(finite(line))  # a median of no step is blank, not nan
+        lines = table_lines(study, table, rows, loaded)
         text = tabulate(lines, headers="keys", tablefmt="pipe", floatfmt=".3g", missingval="")
         parts.append(f"**{table.title}**\n\n{text}")
     return "\n\n".join(parts) + "\n"

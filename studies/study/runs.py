@@ -1,7 +1,9 @@
-"""What one run of a sweep does, in the process it is given: a kinematic attempt at one goal
-(``studies.goal_sets.attempt``) or one experiment on the whole simulated loop
-(``studies.experiment.run_experiment``), as a row of figures; and the checks that refuse a
-sweep naming a family, an experiment, a law or a gain nobody has, before anything runs."""
+"""What one run of a sweep does, in the process it is given, as a row of figures: a kinematic
+attempt at one goal of a family (``studies.goal_sets.attempt``) or of the zoo
+(``studies.redundancy.run_one``), an experiment's set-up run kinematically, or one experiment
+on the whole simulated loop (``studies.experiment.run_experiment``). A set-up's run and an
+experiment's give the same columns (``SETUP_COLUMNS``), so one loop's table compares with the
+other's."""
 
 from __future__ import annotations
 
@@ -12,17 +14,23 @@ from typing import Any
 
 import numpy as np
 
+from analysis.judge import CONVERGED_ERROR, JUDGED, converged_at, messages, origin_s, the_run
+from messages.topics import CONTROL_DIAGNOSTICS, SUPERVISOR_STATUS
 from outputs.stdout import json_text
-from profiles.profile import ProfileError
-from sim2d.scenarios import NAMES
-from studies.experiment import PROFILES, Options, law_overrides, run_experiment
+from profiles.profile import load_profile
+from record.sessions import load_session
+from sim2d.scenarios import scenario
+from studies import redundancy
+from studies.experiment import PROFILES, SESSION_FILE, TIME_LIMIT_S, Options, run_experiment
 from studies.goal_families import FAMILIES, OBSTACLE_FAMILIES, goals, obstacle_goals
-from studies.goal_sets import LAWS, SUPERVISED, Attempt, attempt
-from studies.study.schema import StudyError
+from studies.goal_sets import MOVING_ERROR, SUPERVISED, Attempt, attempt
+from studies.study.places import GOALS, SETUP, ZOO, ZOO_FAMILY, kind, law
 from studies.study.sweep import Run
-from wbc.laws.kinematic_run import ControlEffort
-from wbc.laws.law_output import Law
+from wbc.geometry.obstacles import least_clearance
+from wbc.geometry.scenarios import DT
+from wbc.laws.kinematic_run import ControlEffort, integrate
 from wbc.robot import MobileManipulator
+from wbc.task import PoseTask
 
 EXPERIMENT_FIGURES = (
     "converged",
@@ -31,46 +39,27 @@ EXPERIMENT_FIGURES = (
     "real_time_factor",
     "wall_time_s",
     "sim_time_s",
+    "final_error",
+    "min_obstacle_clearance_m",
 )
 """The scalars of an experiment's report that its row keeps as columns (all of it in
 ``report``)."""
-
-
-def law(name: str, gains: dict[str, Any], robot: MobileManipulator) -> Law:
-    """Law ``name`` of ``LAWS`` with ``gains`` changed (TypeError or ValueError naming a gain
-    it has not, or a value it refuses)."""
-    made = LAWS[name](robot)
-    if not gains:
-        return made
-    return type(made)(robot, dataclasses.replace(made.params, **gains))  # type: ignore[attr-defined]
-
-
-def check_place(loop: str, place: str) -> None:
-    """``StudyError`` unless ``place`` is a goal family (kinematic) or an experiment."""
-    known = [*FAMILIES, *OBSTACLE_FAMILIES] if loop == "kinematic" else list(NAMES)
-    if place not in known:
-        what = "goal family" if loop == "kinematic" else "experiment"
-        raise StudyError(f"no {what} {place!r}; known: {'; '.join(known)}")
-
-
-def check_law(loop: str, name: str, gains: dict[str, Any], place: str, robot_file: Path) -> None:
-    """``StudyError`` unless law ``name`` exists for ``loop`` and takes ``gains``."""
-    known = list(LAWS) if loop == "kinematic" else list(PROFILES)
-    if name not in known:
-        raise StudyError(f"no {loop} law {name!r}; known: {'; '.join(known)}")
-    try:
-        if loop == "kinematic":
-            law(name, gains, MobileManipulator.from_yaml(robot_file))
-        else:
-            law_overrides(Options(name=place, controller=name, gains=gains))
-    except (TypeError, ValueError, ProfileError) as error:
-        raise StudyError(f"law {name!r} with gains {gains}: {error}") from None
+SETUP_COLUMNS = ("converged", "contacts", "min_obstacle_clearance_m", "final_error")
+"""What a run of an experiment's set-up gives, on either loop, beside ``converge_s`` (the
+simulated time to ``||e||`` under ``CONVERGED_ERROR`` for good, the time limit when never) and
+``nonzero_moving`` (the nonzero entries of u at each step with ``||e|| > MOVING_ERROR``)."""
 
 
 def perform(run: Run) -> dict[str, Any]:
     """The figures of ``run`` (its columns beside its parameters)."""
-    if run.loop == "kinematic":
+    place = run.parameters.get("family") or run.parameters["experiment"]
+    found = kind(run.loop, place)
+    if found == GOALS:
         return kinematic(run)
+    if found == ZOO:
+        return zoo(run)
+    if found == SETUP:
+        return setup(run)
     return simulated(run)
 
 
@@ -87,7 +76,7 @@ def kinematic(run: Run) -> dict[str, Any]:
     else:
         start, goal = goals(FAMILIES[p["family"]], p["goal"] + 1, robot, p["seed"])[p["goal"]]
     found = attempt(
-        law(p["law_name"], json.loads(p["gains"]), robot),
+        law(GOALS, p["family"], p["law_name"], json.loads(p["gains"]), robot),
         robot,
         start,
         goal,
@@ -132,4 +121,65 @@ def simulated(run: Run) -> dict[str, Any]:
         gains=json.loads(p["gains"]),
     )
     report = run_experiment(options)
-    return {name: report.get(name) for name in EXPERIMENT_FIGURES} | {"report": json_text(report)}
+    session, _ = the_run(load_session(Path(run.out) / SESSION_FILE, JUDGED), TIME_LIMIT_S)
+    diagnostics = messages(session, CONTROL_DIAGNOSTICS)
+    since = converged_at(diagnostics, messages(session, SUPERVISOR_STATUS))
+    moving = [
+        d.nonzero
+        for d in diagnostics
+        if d.status == "optimal" and d.error_norm is not None and d.error_norm > MOVING_ERROR
+    ]
+    return {name: report.get(name) for name in EXPERIMENT_FIGURES} | {
+        "converge_s": TIME_LIMIT_S if since is None else since - origin_s(session),
+        "nonzero_moving": moving,
+        "report": json_text(report),
+    }
+
+
+def setup(run: Run) -> dict[str, Any]:
+    """The experiment's set-up of the run's seed, kinematically: its law (``places.law``) from
+    the set-up's start to the goal above its bin, ``q += u dt`` at 50 Hz for at most the
+    experiment's ``TIME_LIMIT_S``, converged at ``||e||`` under ``CONVERGED_ERROR``."""
+    p = run.parameters
+    robot = MobileManipulator.from_yaml(run.robot_file)
+    scene = load_profile(PROFILES["lp"]).scene
+    drawn = scenario(p["experiment"], robot, p["seed"])
+    height = scene.goal.height_m if drawn.goal_height is None else drawn.goal_height
+    offset = scene.goal.offset if drawn.goal_offset is None else drawn.goal_offset
+    found = integrate(
+        law(SETUP, p["experiment"], p["law_name"], json.loads(p["gains"]), robot),
+        np.array(drawn.start),
+        PoseTask(drawn.goal(height, offset)),
+        DT,
+        round(TIME_LIMIT_S / DT),
+        CONVERGED_ERROR,
+        drawn.obstacles,
+    )
+    bases = np.array(found.configurations)[:, :2]
+    clearance = least_clearance(bases, drawn.obstacles, robot.base.body_radius)
+    return {
+        "converged": found.converged,
+        "contacts": int(clearance < 0.0),
+        "min_obstacle_clearance_m": clearance,
+        "final_error": found.final_error,
+        "converge_s": len(found.outputs) * DT,
+        "nonzero_moving": [o.nonzero for o in found.outputs if o.error_norm > MOVING_ERROR],
+    }
+
+
+def zoo(run: Run) -> dict[str, Any]:
+    """One goal of the zoo (``studies.redundancy``): the goal drawn ``goal``-th from the run's
+    seed on the run's robot, its pose or its position, for at most its ``TIME_LIMIT_S``."""
+    p = run.parameters
+    robot = MobileManipulator.from_yaml(run.robot_file)
+    start, goal = redundancy.draw(robot, p["goal"] + 1, p["seed"])[p["goal"]]
+    made = law(ZOO, ZOO_FAMILY, p["law_name"], json.loads(p["gains"]), robot)
+    found = redundancy.run_one(made, robot, p["task"], start, goal, redundancy.TIME_LIMIT_S)
+    return {
+        "reached": found.reached,
+        "within_limits": found.within_limits,
+        "seconds": found.seconds,
+        "nonzero": found.nonzero.tolist(),
+        "engaged": found.engaged.tolist(),
+        "error": found.error.tolist(),
+    }

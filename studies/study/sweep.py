@@ -1,6 +1,6 @@
-"""A study's sweep, run by run: every robot x family (or experiment) x seed x law x goal, in
-that order, each run seeded by its place in it (the seed, and the goal's index among that
-seed's draws), so that it gives the same row wherever and whenever it runs."""
+"""A study's sweep, run by run: every loop x robot x family (or experiment) x task x seed x
+law x goal, in that order, each run seeded by its place in it (the seed, and the goal's index
+among that seed's draws), so that it gives the same row wherever and whenever it runs."""
 
 from __future__ import annotations
 
@@ -14,8 +14,9 @@ from typing import Any
 from profiles.deploy_files import ROBOTS_DIR
 from studies.study.schema import Gain, LawSpec, Study, StudyError
 
-PARAMETERS = ("robot", "family", "experiment", "task", "seed", "goal", "law")
-"""A run's parameters a table may group by (``law`` is the law's label)."""
+PARAMETERS = ("loop", "robot", "family", "experiment", "task", "seed", "goal", "law")
+"""A run's parameters a table may group by (``law`` is the law's label; ``loop`` only in a
+study of both loops)."""
 
 
 @dataclass(frozen=True)
@@ -51,44 +52,54 @@ def expand(study: Study, directory: Path = Path("."), runs_dir: Path = Path("run
     """Every run of ``study`` (robot paths from ``directory``, a directory of its own in
     ``runs_dir`` for each simulated run); ``StudyError`` naming the first
     robot, family, experiment, law or gain it does not know, before anything runs."""
-    from studies.study.runs import check_law, check_place
+    from studies.study.places import check_law, kind
 
     runs: list[Run] = []
-    places = study.families if study.loop == "kinematic" else study.experiments
-    place_name = "family" if study.loop == "kinematic" else "experiment"
-    for robot, place in itertools.product(study.robots, places):
-        path = _robot(robot, directory)
-        check_place(study.loop, place)
-        for seed, spec in itertools.product(study.seeds, study.laws):
-            if spec.only and place not in spec.only:
-                continue
-            for label, gains in laws(spec):
-                check_law(study.loop, spec.law, gains, place, path)
-                goals = range(study.goals) if study.loop == "kinematic" else [None]
-                for goal in goals:
-                    parameters = {
-                        "robot": Path(robot).stem,
-                        place_name: place,
-                        "task": study.task if study.loop == "kinematic" else None,
-                        "seed": seed,
-                        "goal": goal,
-                        "law": label,
-                        "law_name": spec.law,
-                        "gains": json.dumps(gains, sort_keys=True),
-                    }
-                    key = json.dumps([parameters[n] for n in PARAMETERS if n in parameters])
-                    out = runs_dir / hashlib.sha1(key.encode()).hexdigest()[:12]
-                    runs.append(
-                        Run(
-                            len(runs),
-                            key,
-                            study.loop,
-                            str(path),
-                            parameters,
-                            study.time_limit_s,
-                            str(out) if study.loop == "simulated" else "",
+    checked: set[tuple] = set()
+    places = study.families or study.experiments
+    place_name = "family" if study.families else "experiment"
+    tasks = study.tasks if study.families else [None]
+    for loop in study.loops:
+        kinds = {kind(loop, place) for place in places}
+        if len(kinds) > 1:
+            raise StudyError(f"{', '.join(places)}: places of one kind only ({', '.join(kinds)})")
+        for robot, place, task in itertools.product(study.robots, places, tasks):
+            path = _robot(robot, directory)
+            for seed, spec in itertools.product(study.seeds_of(loop), study.laws):
+                if spec.only and place not in spec.only:
+                    continue
+                for label, gains in laws(spec):
+                    law_key = (loop, place, spec.law, json.dumps(gains, sort_keys=True), path)
+                    if law_key not in checked:  # once per law, not per run
+                        check_law(kind(loop, place), spec.law, gains, place, path)
+                        checked.add(law_key)
+                    goals = range(study.goals) if study.families else [None]
+                    for goal in goals:
+                        parameters = {
+                            **({"loop": loop} if len(study.loops) > 1 else {}),
+                            "robot": Path(robot).stem,
+                            place_name: place,
+                            "task": task,
+                            "seed": seed,
+                            "goal": goal,
+                            "law": label,
+                            "law_name": spec.law,
+                            "gains": json.dumps(gains, sort_keys=True),
+                        }
+                        key = json.dumps([parameters[n] for n in PARAMETERS if n in parameters])
+                        out = runs_dir / hashlib.sha1(key.encode()).hexdigest()[:12]
+                        simulated = loop == "simulated"
+                        runs.append(
+                            Run(
+                                len(runs),
+                                key,
+                                loop,
+                                str(path),
+                                parameters,
+                                study.time_limit_s,
+                                str(out) if simulated else "",
+                            )
                         )
-                    )
     keys = [run.key for run in runs]
     if len(set(keys)) != len(keys):
         raise StudyError(

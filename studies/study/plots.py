@@ -1,0 +1,52 @@
+"""A study's plots (PNG), from its results: a point per group of runs, one figure against
+others, a line per law (or another parameter) and a panel per task (or another)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from matplotlib.figure import Figure
+
+from studies.study.report import figures_of, groups, robots
+from studies.study.schema import Plot, Study
+from studies.study.sweep import Run
+
+STYLES = ("-", ":", "--", "-.")
+"""The line of each figure of ``y``."""
+
+
+def draw(study: Study, plot: Plot, runs: list[Run], rows: list[dict[str, Any]]) -> Path:
+    """``plot`` of ``study`` over ``rows``, written to its file."""
+    figures, loaded = figures_of(study), robots(runs)
+    points: dict[Any, dict[Any, list[tuple[float, list[float]]]]] = {}
+    for group in groups(rows, [plot.panels, plot.lines, *plot.by]).values():
+        robot = loaded[group[0]["robot"]]
+        values: dict[str, Any] = {}
+        for name in (plot.x, *plot.y):
+            values |= figures[name](group, robot)
+        x, *ys = values.values()
+        line = points.setdefault(group[0][plot.panels], {}).setdefault(group[0][plot.lines], [])
+        line.append((x, ys))
+    fig = Figure(figsize=(4.5 * len(points) + 1.5, 3.4), layout="constrained")
+    axes = None
+    for index, (panel, lines) in enumerate(points.items()):
+        axes = fig.add_subplot(1, len(points), index + 1)
+        xs = sorted({x for line in lines.values() for x, _ in line})
+        if plot.diagonal:
+            axes.plot(xs, xs, color="0.7", linewidth=3, label=plot.diagonal)
+        for label, line in lines.items():
+            line.sort(key=lambda point: point[0])
+            for part, style in zip(plot.y, STYLES, strict=False):
+                ys = [y[plot.y.index(part)] for _, y in line]
+                axes.plot([x for x, _ in line], ys, style, marker="o", label=f"{label}, {part}")
+        axes.set_title(f"{plot.panels} {panel}")
+        axes.set_xlabel(plot.x)
+        axes.set_ylabel(", ".join(plot.y))
+        axes.set_xticks(xs)
+        axes.grid(alpha=0.3)
+    if axes is not None:
+        fig.legend(*axes.get_legend_handles_labels(), fontsize=7, loc="outside right center")
+    Path(plot.file).parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(plot.file, dpi=72)
+    return Path(plot.file)
