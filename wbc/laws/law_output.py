@@ -89,8 +89,8 @@ def summarise(
         u=u,
         status=status,
         objective=objective,
-        nonzero=sum(m > ZERO_THRESHOLD for m in magnitudes),
-        practical_nonzero=sum(m >= PRACTICAL_THRESHOLD for m in magnitudes),
+        nonzero=sum(map(ZERO_THRESHOLD.__lt__, magnitudes)),  # |u_i| > ZERO_THRESHOLD
+        practical_nonzero=sum(map(PRACTICAL_THRESHOLD.__le__, magnitudes)),
         active_constraints=active,
         solve_time_s=time.perf_counter() - start,
         error_norm=math.sqrt(float(error.dot(error))),  # ndarray.dot: @'s sum, in half the time
