@@ -18,9 +18,9 @@ import yaml
 
 from parsimony.cli import main
 from studies.study import results
+from studies.study.cluster import local_cluster
 
 ROOT = Path(__file__).resolve().parents[3]
-DASK = Path(sys.executable).parent / "dask"
 TINY = {
     "name": "tiny",
     "families": ["ahead"],
@@ -69,39 +69,9 @@ def local(tmp_path_factory) -> Path:
 @pytest.fixture(scope="module")
 def scheduler(tmp_path_factory):
     """A Dask scheduler and two workers on 127.0.0.1, each its own process: the address."""
-    directory = tmp_path_factory.mktemp("dask")
-    file = directory / "scheduler.json"
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    quiet = {"cwd": ROOT, "env": env, "stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
-    common = ["--host", "127.0.0.1", "--no-dashboard"]
-    processes = [
-        subprocess.Popen(
-            [DASK, "scheduler", *common, "--port", "0", "--scheduler-file", file], **quiet
-        )
-    ]
-    try:
-        deadline = time.monotonic() + 120
-        while not file.exists() and time.monotonic() < deadline:
-            assert processes[0].poll() is None, "the scheduler ended"
-            time.sleep(0.1)
-        address = json.loads(file.read_text())["address"]
+    with local_cluster(2, tmp_path_factory.mktemp("dask")) as address:
         assert address.startswith("tcp://127.0.0.1:")
-        worker = [DASK, "worker", address, *common, "--nthreads", "1", "--no-nanny"]
-        processes += [subprocess.Popen(worker, **quiet) for _ in range(2)]
-        from distributed import Client
-
-        with Client(address, timeout="60s") as client:
-            client.wait_for_workers(2, timeout=120)
         yield address
-    finally:
-        for process in reversed(processes):
-            process.terminate()
-        for process in processes:
-            try:
-                process.wait(timeout=5)
-            except subprocess.TimeoutExpired:
-                process.kill()
-                process.wait()
 
 
 def test_a_dask_cluster_gives_the_local_pools_rows(local, scheduler, tmp_path, capsys) -> None:
