@@ -9,6 +9,7 @@ component and runs until SIGINT, SIGTERM or the end of its launcher.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import os
 import signal
@@ -43,10 +44,13 @@ def _on_stop_signal(signum: int, _frame: object) -> None:
     raise _StopRequested(signal.Signals(signum).name)
 
 
-def _wait_for_stop(node: Node) -> None:
-    """Sleep until a stop signal, the node's ``fail``, or the end of the launcher that
-    started us."""
-    while not node.stop_requested.wait(1.0):
+def _wait_for_stop(nodes: Sequence[Node]) -> None:
+    """Sleep until a stop signal, the ``fail`` of one of ``nodes``, or the end of the launcher
+    that started us."""
+    first, poll_s = nodes[0], 1.0 if len(nodes) == 1 else 0.1
+    while not first.stop_requested.wait(poll_s):
+        if any(node.stop_requested.is_set() for node in nodes):
+            return
         if parent_gone():
             log.warning("launcher (pid %s) is gone; stopping", os.environ[PARENT_PID_ENV])
             return
@@ -60,59 +64,76 @@ def _parse_args(component_class: type[Component], argv: Sequence[str] | None) ->
     return parser.parse_args(argv)
 
 
-def _configure(component_class: type[Component], args: argparse.Namespace) -> Node | None:
+def _configure(
+    component_class: type[Component], profile_path: str, name: str, params_file: Path | None
+) -> Node | None:
     """The component's node, or ``None`` after logging why the configuration is refused."""
     try:
-        profile = load_profile(args.profile)
+        profile = load_profile(profile_path)
     except ProfileError as error:
         log.error("%s", error)
         return None
     names = [spec.name for spec in profile.components]
-    if args.name not in names:
-        log.error("%s: no component named %r (have %s)", args.profile, args.name, names)
+    if name not in names:
+        log.error("%s: no component named %r (have %s)", profile_path, name, names)
         return None
     try:
-        kept = os.environ.get(PARAMS_FILE_ENV)
         return Node(
             profile,
-            args.name,
+            name,
             component_class.params,
             component_class.reads,
             component_class.writes,
-            Path(kept) if kept else None,
+            params_file,
         )
     except ParamError as error:
-        log.error("%s: components[%d].params.%s", args.profile, names.index(args.name), error)
+        log.error("%s: components[%d].params.%s", profile_path, names.index(name), error)
         return None
+
+
+def start_logging(level: str) -> None:
+    """Log to stderr at ``level``, and stop on SIGINT and SIGTERM (``_StopRequested``)."""
+    logging.basicConfig(level=level.upper(), stream=sys.stderr, format="%(levelname)s %(message)s")
+    for stop_signal in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(stop_signal, _on_stop_signal)
+
+
+def serve(profile_path: str, members: Sequence[tuple[type[Component], str, Path | None]]) -> int:
+    """Run each ``(component class, name, kept parameters file)`` of ``members`` in this
+    process, started in order and closed in the reverse order, until a stop signal or one's
+    ``fail``; the exit code (``start_logging`` first)."""
+    nodes: list[Node] = []
+    name = ""
+    try:
+        with contextlib.ExitStack() as stack:
+            for component_class, name, params_file in members:
+                node = _configure(component_class, profile_path, name, params_file)
+                if node is None:
+                    return EXIT_CONFIG_ERROR
+                stack.enter_context(node)
+                nodes.append(node)
+                try:
+                    component = component_class(node)
+                except ParamError as error:
+                    log.error("%s: %s: %s", profile_path, name, error)
+                    return EXIT_CONFIG_ERROR
+                node.start(component.shutdown, component.clock_stalled)
+            _wait_for_stop(nodes)
+    except _StopRequested as stop:
+        names = ", ".join(node.name for node in nodes) or name
+        log.info("%s stopping on %s", names, stop)
+    except zenoh.ZError as error:
+        log.error("%s: Zenoh failed: %s", name, error)
+        return 1
+    return EXIT_FOR_GOOD if any(node.failure is not None for node in nodes) else 0
 
 
 def main(component_class: type[Component], argv: Sequence[str] | None = None) -> int:
     """Run ``component_class`` until SIGINT or SIGTERM; return the exit code."""
     args = _parse_args(component_class, argv)
-    logging.basicConfig(
-        level=args.log_level.upper(), stream=sys.stderr, format="%(levelname)s %(message)s"
-    )
-    for stop_signal in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(stop_signal, _on_stop_signal)
-    node = None
-    try:
-        node = _configure(component_class, args)
-        if node is None:
-            return EXIT_CONFIG_ERROR
-        with node:
-            try:
-                component = component_class(node)
-            except ParamError as error:
-                log.error("%s: %s: %s", args.profile, args.name, error)
-                return EXIT_CONFIG_ERROR
-            node.start(component.shutdown, component.clock_stalled)
-            _wait_for_stop(node)
-    except _StopRequested as stop:
-        log.info("%s stopping on %s", args.name, stop)
-    except zenoh.ZError as error:
-        log.error("%s: Zenoh failed: %s", args.name, error)
-        return 1
-    return EXIT_FOR_GOOD if node is not None and node.failure is not None else 0
+    start_logging(args.log_level)
+    kept = os.environ.get(PARAMS_FILE_ENV)
+    return serve(args.profile, [(component_class, args.name, Path(kept) if kept else None)])
 
 
 def run_component(component_class: type[Component]) -> NoReturn:

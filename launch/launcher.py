@@ -20,6 +20,11 @@ per component (``messages.process.PARAMS_FILE_ENV``) that its next start reads.
 Children run in their own session, so a Ctrl-C reaches the launcher alone and
 the stop order holds; a child whose launcher dies stops by itself
 (``messages.process.PARENT_PID_ENV``).
+
+With ``processes: shared`` the components that are not recorders and start ``after`` none run
+in one process (``components.container``), started once the recorders are alive. Each is still
+watched, reported and stopped by name, but a fault that ends that process (a kill, a component
+found hung) ends them all, and those restarted by their policy start again together.
 """
 
 from __future__ import annotations
@@ -40,6 +45,7 @@ from typing import IO
 
 import zenoh
 
+from components import container
 from launch.query import statuses
 from messages import process, topics
 from messages.process import (
@@ -134,6 +140,9 @@ class Launcher:
         self.output = Output(out, err)
         self.children = [Child(spec) for spec in profile.start_order()]
         self.recorders = [c.spec.name for c in self.children if c.spec.role == "recorder"]
+        shared = profile.shared()
+        self.shared = [c for c in self.children if c.spec in shared]
+        """The children that run in one process."""
         self._stop_reason: str | None = None
         self._kept_params = Path()
         """A directory of one JSON file per component: the parameters set while it runs, kept
@@ -269,8 +278,12 @@ class Launcher:
         for child in self.children:
             silent_s = now - child.answered_at
             if child.process is not None and child.alive and silent_s > self.profile.watchdog_s:
+                others = [c.spec.name for c in self.children if c.process is child.process]
+                others.remove(child.spec.name)
+                also = f" and {', '.join(others)}, in its process" if others else ""
                 self.output.say(
-                    f"{child.spec.name} hung: no status answer for {silent_s:.1f} s; killing it"
+                    f"{child.spec.name} hung: no status answer for {silent_s:.1f} s; "
+                    f"killing it{also}"
                 )
                 child.process.kill()
                 child.answered_at = now
@@ -329,19 +342,22 @@ class Launcher:
                 self._start(child)
 
     def _start(self, child: Child) -> None:
-        """Start a child's process and the threads that forward its output."""
+        """Start a child's process and the threads that forward its output; a shared child's
+        with the others of ``shared`` not running and not done."""
         spec = child.spec
-        child.waiting = False
-        command = process.command(spec.module_path, self.profile_path, spec.name)
-        env = dict(
-            os.environ,
-            PYTHONUNBUFFERED="1",
-            **{
-                PARENT_PID_ENV: str(os.getpid()),
-                PARAMS_FILE_ENV: str(self._kept_params / f"{spec.name}.json"),
-            },
-        )
-        child.process = subprocess.Popen(
+        group = [child]
+        if child in self.shared:
+            group = [c for c in self.shared if c.process is None and not c.done]
+        names = [c.spec.name for c in group]
+        env = dict(os.environ, PYTHONUNBUFFERED="1", **{PARENT_PID_ENV: str(os.getpid())})
+        if len(group) > 1:
+            command = container.command(self.profile_path, names, self._kept_params)
+            label, prefix = f"{', '.join(names)} in one process", "+".join(names)
+        else:
+            command = process.command(spec.module_path, self.profile_path, spec.name)
+            label, prefix = spec.name, spec.name
+            env[PARAMS_FILE_ENV] = str(self._kept_params / f"{spec.name}.json")
+        popen = subprocess.Popen(
             command,
             stdin=subprocess.DEVNULL,
             stdout=subprocess.PIPE,
@@ -352,17 +368,13 @@ class Launcher:
             start_new_session=True,
             pass_fds=self.pass_fds,
         )
-        child.started_at = time.monotonic()
-        child.restart_at = None
-        child.alive = False
-        for pipe, stream in (
-            (child.process.stdout, self.output.out),
-            (child.process.stderr, self.output.err),
-        ):
-            threading.Thread(
-                target=self._forward, args=(pipe, stream, spec.name), daemon=True
-            ).start()
-        self.output.say(f"started {spec.name} ({spec.module_path}, pid {child.process.pid})")
+        for member in group:
+            member.process, member.waiting = popen, False
+            member.started_at, member.restart_at, member.alive = time.monotonic(), None, False
+        for pipe, stream in ((popen.stdout, self.output.out), (popen.stderr, self.output.err)):
+            threading.Thread(target=self._forward, args=(pipe, stream, prefix), daemon=True).start()
+        module = container.MODULE if len(group) > 1 else spec.module_path
+        self.output.say(f"started {label} ({module}, pid {popen.pid})")
 
     def _forward(self, pipe: IO[str], stream: IO[str], name: str) -> None:
         """Copy a child's pipe to ``stream`` line by line, prefixed with its name."""
@@ -414,9 +426,10 @@ class Launcher:
         )
         for _, wave in groupby(running, key=order):
             group = list(wave)
-            for child in group:
-                child.stopping = True
-                child.process.send_signal(signal.SIGTERM)
+            for popen in {id(c.process): c.process for c in group}.values():
+                for child in self.children:
+                    child.stopping = child.stopping or child.process is popen
+                popen.send_signal(signal.SIGTERM)  # none if it has ended (shared, stopped)
             stopped_at = time.monotonic()
             for child in group:
                 self._reap(child, child.process, stopped_at + child.spec.stop_timeout_s)

@@ -280,6 +280,12 @@ class Profile(StrictModel):
     clock_timeout_s: float = Field(default=1.0, gt=0.0)
     """Host seconds after which a component on ``sim`` time whose clock has not moved says its
     clock stalled (a controller then commands zero)."""
+    processes: Literal["separate", "shared"] = "separate"
+    """``separate``: one process per component. ``shared``: the components that are not
+    recorders and start ``after`` none run in one process (``components.container``), each with
+    its own node, session and threads, so that the interpreter and its libraries load once (a
+    lockstep experiment's). A fault that ends that process ends them all together: the launcher
+    restarts each by its policy, in one new process."""
     components: list[ComponentSpec] = Field(min_length=1)
 
     @model_validator(mode="after")
@@ -361,6 +367,12 @@ class Profile(StrictModel):
         if spec.clock is not None:
             return spec.clock
         return "wall" if publishes_clock else self.clock
+
+    def shared(self) -> list[ComponentSpec]:
+        """The enabled components that run in one process (``processes``): with ``shared``, those
+        that are not recorders and start ``after`` none, when there are two or more."""
+        specs = [s for s in self.start_order() if s.role != "recorder" and not s.after]
+        return specs if self.processes == "shared" and len(specs) > 1 else []
 
     def start_order(self) -> list[ComponentSpec]:
         """The enabled components, drivers first, then estimators, controllers, tools."""

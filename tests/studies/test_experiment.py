@@ -62,7 +62,7 @@ def test_pose_experiment_with_the_lp_reaches_the_goal_seen_by_the_camera(
     # Each wait says what it waits for (before, 15-20 s of starting and stopping said nothing).
     steps = [
         "setting up the pose experiment",
-        "starting 5 processes (their log: ",
+        "starting 5 components in 2 processes (their log: ",
         "waiting for recorder, simulator, vision_tracker, state_estimator, controller to "
         "come alive",
         "waiting for every component to receive the paused simulator's clock",
@@ -113,9 +113,14 @@ def test_two_lockstep_runs_of_one_seed_send_bit_identical_commands(
 ) -> None:
     """A second run of the pose fixture's seed and hidden marker, stopped after 3 simulated
     seconds (150 steps of the whole loop, about 90 camera frames, the marker hidden for the last
-    two), sends the very commands the first sent over those seconds, bit for bit."""
+    two), sends the very commands the first sent over those seconds, bit for bit: the first with
+    its components in one process (a lockstep experiment's default), the second in one process
+    each."""
     _, first, _, folder = pose
-    again = run_here(tmp_path, "pose", seed=1, hide_base_marker=(1.0, 4.0), **SHORT_RUN)
+    marker = {"hide_base_marker": (1.0, 4.0)}
+    again = run_here(tmp_path, "pose", seed=1, processes="separate", **marker, **SHORT_RUN)
+    assert "recorder" in first["cpu_s"] and "controller" not in first["cpu_s"]  # one for four
+    assert "controller" in again["cpu_s"]
     short = (tmp_path / "commands.csv").read_text().splitlines()
     assert len(short) > 140
     assert short == (folder / "commands.csv").read_text().splitlines()[: len(short)]
@@ -312,15 +317,24 @@ def test_the_cascade_takes_its_declared_gains(tmp_path: Path) -> None:
 def test_a_lockstep_run_is_not_killed_for_being_slow_on_a_busy_machine(tmp_path: Path) -> None:
     """In lockstep the launcher's watchdog waits LOCKSTEP_WATCHDOG_S for a status answer, not the
     profile's (a controller starved 3 s was killed and restarted mid-run); a run in real time
-    keeps the profile's."""
+    keeps the profile's. A lockstep run's components share a process unless asked or its
+    profile says otherwise; a run in real time keeps the profile's (one process each)."""
     robot = MobileManipulator.from_yaml(load_profile(PROFILES["lp"]).robot)
     default_s = Profile.model_fields["watchdog_s"].default
-    for realtime, watchdog_s in ((False, LOCKSTEP_WATCHDOG_S), (True, default_s)):
-        options = Options("pose", out=tmp_path, realtime=realtime)
-        data = experiment_profile(options, PROFILES["lp"], scenario("pose", robot))
+    separate = tmp_path / "separate.yaml"
+    separate.write_text(f"extends: {PROFILES['lp']}\nprocesses: separate\n")
+    for realtime, base, asked, watchdog_s, processes in (
+        (False, PROFILES["lp"], None, LOCKSTEP_WATCHDOG_S, "shared"),
+        (False, PROFILES["lp"], "separate", LOCKSTEP_WATCHDOG_S, "separate"),
+        (False, separate, None, LOCKSTEP_WATCHDOG_S, "separate"),
+        (True, PROFILES["lp"], None, default_s, "separate"),
+    ):
+        options = Options("pose", out=tmp_path, realtime=realtime, processes=asked)
+        data = experiment_profile(options, base, scenario("pose", robot))
         written = tmp_path / "profile.yaml"
         written.write_text(yaml.safe_dump(data))
-        assert load_profile(written).watchdog_s == watchdog_s
+        profile = load_profile(written)
+        assert (profile.watchdog_s, profile.processes) == (watchdog_s, processes)
 
 
 def test_an_experiment_does_not_write_over_a_directory_that_holds_files(

@@ -20,7 +20,7 @@ import pytest
 from launch import query
 from profiles.profile import load_profile
 from record.session_reader import info
-from studies.experiment import connect
+from studies.experiment import PROFILES, SUPERVISED, connect
 from tests.processes import process_gone
 from tests.studies.experiments import assert_sound
 from wbc.planning.supervisor_phase import Phase
@@ -31,13 +31,17 @@ pytestmark = pytest.mark.heavy  # three runs of the whole loop
 def kill_during_run(
     out: Path, components: list[str], name: str = "pose", state: str | None = None
 ) -> tuple[int, dict, str]:
-    """Start experiment ``name``, SIGKILL the first of ``components`` once the controller has
-    run 200 steps (and the component's own state is ``state``, when given), each next one once
-    those before are back (answering from a new process), and return the exit status, the
-    report and the launch log."""
+    """Start experiment ``name``, its components in one process each (a kill is one
+    component's fault), SIGKILL the first of ``components`` once the controller has run 200
+    steps (and the component's own state is ``state``, when given), each next one once those
+    before are back (answering from a new process), and return the exit status, the report and
+    the launch log."""
+    separate = out.parent / f"{out.name}-separate.yaml"
+    base = SUPERVISED.get(name, PROFILES["lp"])
+    separate.write_text(f"extends: {base}\nprocesses: separate\n")
     command = [sys.executable, "-m", "parsimony.cli", "experiment", name, "--json"]
     process = subprocess.Popen(
-        [*command, "--out", str(out)],
+        [*command, "--profile", str(separate), "--out", str(out)],
         stdout=subprocess.PIPE,
         stderr=subprocess.DEVNULL,
         text=True,

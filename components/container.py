@@ -1,0 +1,82 @@
+"""Several components of one profile in one process (a profile's ``processes: shared``).
+
+    python -m components.container --profile P --names a,b,c --params-dir D
+
+runs each named component as ``python -m components.<module>`` would, with its own ``Node``,
+Zenoh session and threads, in this one process: the interpreter and the libraries they import
+(NumPy, Zenoh, OpenCV, HiGHS) load once instead of once per component. They start in the order
+given and close in the reverse order, on SIGINT, SIGTERM, the end of the launcher or the
+``fail`` of one of them; the parameters set on component N while it runs are kept in
+``D/N.json``, as the launcher keeps them for a process of its own.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from components.process_entry import serve, start_logging
+from components.runtime import Component
+from messages.process import EXIT_CONFIG_ERROR
+from profiles.profile import ProfileError, load_profile
+
+MODULE = "components.container"
+
+
+def command(profile: Path, names: Sequence[str], params_dir: Path) -> list[str]:
+    """The command line running components ``names`` of ``profile`` in one process."""
+    return [
+        sys.executable,
+        "-m",
+        MODULE,
+        "--profile",
+        str(profile),
+        "--names",
+        ",".join(names),
+        "--params-dir",
+        str(params_dir),
+    ]
+
+
+def component_class(module_path: str) -> type[Component]:
+    """The one ``Component`` class a component module defines (the one it runs)."""
+    module = importlib.import_module(module_path)
+    found = [
+        value
+        for value in vars(module).values()
+        if isinstance(value, type)
+        and issubclass(value, Component)
+        and value.__module__ == module.__name__
+    ]
+    if len(found) != 1:
+        raise ProfileError(f"{module_path} defines {len(found)} components, not one")
+    return found[0]
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--profile", required=True, help="the deploy profile (YAML)")
+    parser.add_argument("--names", required=True, help="the components to run, comma-separated")
+    parser.add_argument("--params-dir", type=Path, required=True, help="kept parameters' folder")
+    parser.add_argument("--log-level", default="INFO", help="DEBUG, INFO, WARNING or ERROR")
+    args = parser.parse_args(argv)
+    start_logging(args.log_level)
+    try:
+        profile = load_profile(args.profile)
+        specs = [profile.component(name) for name in args.names.split(",")]
+        classes = [component_class(spec.module_path) for spec in specs]
+    except (ProfileError, KeyError) as error:
+        print(f"{args.profile}: {error}", file=sys.stderr)
+        return EXIT_CONFIG_ERROR
+    members = [
+        (cls, spec.name, args.params_dir / f"{spec.name}.json")
+        for cls, spec in zip(classes, specs, strict=True)
+    ]
+    return serve(args.profile, members)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
