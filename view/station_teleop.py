@@ -24,9 +24,9 @@ PANEL_RATE_HZ = 10.0
 within the controller's dead-man timeout (``components.control_step.TELEOP_TIMEOUT_S``,
 0.5 s), so that a held button drives without a pause."""
 PANEL_FORWARD_M_S = 0.1
-"""The panel's forward (up) and back (down) speed, as ``parsimony teleop --speed``'s default."""
+"""The forward (up) and back (down) speed of the panel and of ``parsimony teleop`` by default."""
 PANEL_TURN_RAD_S = 0.5
-"""The panel's turn rate (left, right), as ``parsimony teleop --turn``'s default."""
+"""The turn rate (left, right) of the panel and of ``parsimony teleop`` by default."""
 
 
 def teleop_topic(topic: str, namespace: str) -> bool:

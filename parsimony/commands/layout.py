@@ -1,9 +1,9 @@
 """`parsimony layout PROFILE [-o FILE]`: the Foxglove layout of the profile's namespace
 (view.foxglove_layout): the 3-D panel on the robot, the annotated camera image, plots of the
 task error, of the nonzero entries of u and of the arm's joints (each by the name the profile's
-robot description gives it), the controller's diagnostics, the supervisor's
-status and a Parameters panel. Foxglove imports it from the file (Layouts, Import from file);
-without ``-o`` it is printed."""
+robot description gives it), the controller's diagnostics, the supervisor's status, a
+Parameters panel and a Teleop panel on ``teleop/command``. Foxglove imports it from the file
+(Layouts, Import from file); without ``-o`` it is printed."""
 
 from __future__ import annotations
 

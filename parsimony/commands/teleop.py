@@ -35,6 +35,7 @@ from parsimony.target_options import (
 )
 from profiles.access import tool_user
 from profiles.profile import ProfileError
+from view.station_teleop import PANEL_FORWARD_M_S, PANEL_TURN_RAD_S
 from wbc.robot import MobileManipulator
 
 HOLD_S = 0.6
@@ -80,8 +81,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         help="drive the robot from the keyboard",
         description=__doc__.split("\n\n")[0] + " Keys: " + KEYS + ".",
     )
-    parser.add_argument("--speed", type=float, default=0.1, help="forward speed, m/s")
-    parser.add_argument("--turn", type=float, default=0.5, help="turn rate, rad/s")
+    parser.add_argument("--speed", type=float, default=PANEL_FORWARD_M_S, help="forward speed, m/s")
+    parser.add_argument("--turn", type=float, default=PANEL_TURN_RAD_S, help="turn rate, rad/s")
     parser.add_argument("--joint-speed", type=float, default=0.3, help="joint speed, rad/s")
     parser.add_argument("--rate", type=float, default=20.0, help="commands a second")
     return parser
