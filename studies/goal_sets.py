@@ -315,10 +315,10 @@ def goal_report(robot_file: Path, count: int, processes: int = 2) -> dict:
                     **parsimony(attempts, robot.dof),
                     **not_reached(attempts),
                 }
-                if name == SUPERVISED:
-                    rows[name].update(planning(attempts))
                 if family in OBSTACLE_FAMILIES:
                     rows[name].update(failures(attempts))
+                if name == SUPERVISED:
+                    rows[name].update(planning(attempts))
             report[f"{family} {task}"] = {"goals": count, "laws": rows}
     order = [f"{family} {task}" for family in FAMILIES for task in ("pose", "position")]
     return {key: report[key] for key in order} | report
