@@ -251,14 +251,15 @@ LAWS: dict[str, Callable[[MobileManipulator], Law]] = {
     SUPERVISED: lambda robot: LPLaw(robot, supervised_params()),
     "qp": lambda robot: QPLaw(robot),
     "cascade": lambda robot: CascadeLaw(robot),
-    "lp with input change": lambda robot: LPLaw(robot, replace(LPParams(), **input_change_gains())),
 }
 """The laws compared: the default LP, LP 5.29 as written (``exact_5_29``), the LP under the
 staging supervisor (wbc.planning.staging_supervisor) with its gains, the QP of the same rows and
-terms (wbc.laws.qp_law), the cascade; the LP with the input change term of
+terms (wbc.laws.qp_law), the cascade."""
+STUDY_LAWS: dict[str, Callable[[MobileManipulator], Law]] = LAWS | {
+    "lp with input change": lambda robot: LPLaw(robot, replace(LPParams(), **input_change_gains())),
+}
+"""The laws a study may run on goal families: ``LAWS``, and the LP with the input change term of
 deploy/sim_smooth.yaml (``input_change_gains``)."""
-BENCH_LAWS = ("lp", "lp 5.29 exactly", SUPERVISED, "qp", "cascade")
-"""The laws `parsimony bench` runs on the pose task of each family's goals."""
 POSITION_LAWS = ("lp", "lp 5.29 exactly", "qp", "cascade")
 """The laws run on the position task of each family's goals (6.2.2)."""
 
@@ -284,7 +285,7 @@ def failures(attempts: Iterable[Attempt]) -> dict:
 
 
 def goal_report(robot_file: Path, count: int, processes: int = 2) -> dict:
-    """For every family and law of ``BENCH_LAWS``: the shares reached, the parsimony of u and
+    """For every family and law of ``LAWS``: the shares reached, the parsimony of u and
     the goals not reached by reason, for the pose task and, with the laws of POSITION_LAWS,
     for the position task of the same goals; and the LP under the supervisor on the goals of
     OBSTACLE_FAMILIES with the contacts and planning times. The runs are studies on the local
@@ -295,7 +296,7 @@ def goal_report(robot_file: Path, count: int, processes: int = 2) -> dict:
     robot = MobileManipulator.from_yaml(robot_file)
     sweeps = [
         (task, [*FAMILIES], [GOAL_SEED], names)
-        for task, names in (("pose", BENCH_LAWS), ("position", POSITION_LAWS))
+        for task, names in (("pose", tuple(LAWS)), ("position", POSITION_LAWS))
     ]
     sweeps += [("pose", [f.name], [f.seed], (SUPERVISED,)) for f in OBSTACLE_FAMILIES.values()]
     report: dict = {}

@@ -18,7 +18,7 @@ from studies import redundancy
 from studies.experiment import PROFILES, Options, law_overrides
 from studies.gain_sets import LP_PARAMS
 from studies.goal_families import FAMILIES, OBSTACLE_FAMILIES
-from studies.goal_sets import LAWS
+from studies.goal_sets import STUDY_LAWS
 from studies.study.schema import StudyError
 from wbc.laws.law_output import Law
 from wbc.laws.lp_law import LPLaw
@@ -52,7 +52,7 @@ def kind(loop: str, place: str) -> str:
 def makers(kind_: str, place: str) -> dict[str, Maker]:
     """The laws a kinematic place of ``kind_`` takes, by name."""
     if kind_ == GOALS:
-        return LAWS
+        return STUDY_LAWS
     if kind_ == ZOO:
         return redundancy.LAWS
     return {"lp": lambda robot: LPLaw(robot, LP_PARAMS[place])}
