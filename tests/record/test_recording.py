@@ -45,16 +45,13 @@ KILLED_RUN_S = 8.0
 
 
 @pytest.fixture(scope="module")
-def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
-    """The pose experiment of one seed with the LP, and with its input change term on
-    (deploy/sim_smooth.yaml), recorded (run as the command runs it, in this process: the same
-    launch, loop, recording and judgement, without two Python starts)."""
-    found = {}
-    for name, options in (("lp", {"controller": "lp"}), ("lp smooth", {"profile": SMOOTH_PROFILE})):
-        out = tmp_path_factory.mktemp(name.replace(" ", "_"))
-        assert run_here(out, "pose", seed=6, **options)["converged"], name
-        found[name] = out
-    return found
+def runs(pose_lp_run: Path, tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """The pose experiment of one seed with the LP (the suite's shared run), and with its input
+    change term on (deploy/sim_smooth.yaml), recorded (run as the command runs it, in this
+    process: the same launch, loop, recording and judgement, without a Python start)."""
+    out = tmp_path_factory.mktemp("lp_smooth")
+    assert run_here(out, "pose", seed=6, profile=SMOOTH_PROFILE)["converged"]
+    return {"lp": pose_lp_run, "lp smooth": out}
 
 
 def test_a_recorded_experiment_reads_back_with_every_channel_schema(runs) -> None:

@@ -1,9 +1,11 @@
 """A recorded lockstep experiment's sensors, replayed into a fresh vision tracker and state
 estimator, give back the robot states it recorded: real processes, real Zenoh on loopback,
-the real recording (issue 14: within 1 mm and 0.1 degree; a lockstep recording exactly)."""
+the real recording (the suite's shared pose run, its first seconds; issue 14: within 1 mm and
+0.1 degree; a lockstep recording exactly)."""
 
 from __future__ import annotations
 
+import json
 import math
 import signal
 import subprocess
@@ -20,14 +22,18 @@ from messages.state import RobotState
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.sessions import load_session
-from studies.experiment import DEPLOY, Options, connect, run_experiment, wait_alive
+from studies.experiment import DEPLOY, connect, wait_alive
 from wbc import dq
 from wbc.planar import wrap
 
 POSITION_M = 1e-3
 HEADING_RAD = math.radians(0.1)
 SIM_S = 2.0
-"""Simulated seconds of the recorded run: about 60 camera frames and 200 states."""
+"""Simulated seconds of the recorded run whose states are compared: about 60 camera frames and
+100 states."""
+SENT_S = SIM_S + 1.0
+"""Seconds of the recording replayed: those compared and a second more (what is logged after a
+state's stamp, whatever it is, is sent)."""
 RATE = 4.0
 """The replay's rate: ``--lockstep`` waits for the tracker's and estimator's answers to each
 frame and odometry message, so the rate only bounds how fast the replay may go."""
@@ -105,6 +111,8 @@ def replay_into(profile_path: Path, recording: Path, stamps: set[int]) -> dict[i
                     "--lockstep",
                     "--rate",
                     str(RATE),
+                    "--duration",
+                    str(SENT_S),
                 ],
                 capture_output=True,
                 text=True,
@@ -129,16 +137,20 @@ def differences(recorded: RobotState, replayed: RobotState) -> tuple[float, floa
     return base, heading, float(np.linalg.norm(tips[0] - tips[1]))
 
 
-def test_replayed_sensors_reproduce_the_recorded_states_exactly(tmp_path: Path) -> None:
-    report = run_experiment(Options("pose", out=tmp_path / "run", time_limit_s=SIM_S))
+def test_replayed_sensors_reproduce_the_recorded_states_exactly(
+    pose_lp_run: Path, tmp_path: Path
+) -> None:
+    report = json.loads((pose_lp_run / "report.json").read_text())
     assert report["mode"] == "lockstep" and report["lockstep_timeouts"] == 0, report
-    recording = tmp_path / "run" / "session.mcap"
+    recording = pose_lp_run / "session.mcap"
     session = load_session(recording)
+    first = session["robot/state"][0].header.stamp_ns
+    window = [s for s in session["robot/state"] if s.header.stamp_ns <= first + SIM_S * 1e9]
     end = complete_until(session)
-    recorded = [s for s in session["robot/state"] if s.header.stamp_ns < end]
+    recorded = [s for s in window if s.header.stamp_ns < end]
     lost = f"the recorder lost inputs from {end / 1e9} s (a recording fault, not the replay's)"
-    assert len(recorded) >= 0.9 * len(session["robot/state"]) > 75, lost  # 2 s of 50 Hz states
-    namespace = load_profile(tmp_path / "run" / "profile.yaml").namespace
+    assert len(recorded) >= 0.9 * len(window) > 75, lost  # 2 s of 50 Hz states
+    namespace = load_profile(pose_lp_run / "profile.yaml").namespace
     profile = estimators_profile(tmp_path / "estimators.yaml", namespace)
     replayed = replay_into(profile, recording, {s.header.stamp_ns for s in recorded})
 
