@@ -4,7 +4,7 @@ On random states (pose and position tasks, obstacles off and on, both error boun
 and the default w) the builder is given the rows and costs the law gives it. At a vertex each
 nonzero u_i is a basic column, so there are at most task DOF + secondary residual rows +
 equality rows + active inequality rows of them (section 5.7 with 6.2.1; a secondary objective
-term such as the waist centring is one more task row), and u_P, u_N are never both positive.
+term such as the waist centring is one more task row).
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from wbc.geometry.obstacles import Circle
 from wbc.laws.constraints.base import LinearRows, OneNormBound, VelocityBounds
 from wbc.laws.law_output import ZERO_THRESHOLD
 from wbc.laws.linear_program import WarmStartedLP
-from wbc.laws.lp_law import LPParams, default_constraints, default_objectives
+from wbc.laws.lp_law import LPParams, default_constraints, default_objectives, terms
 from wbc.laws.objectives.base import ResidualCost
 from wbc.laws.step_context import StepContext
 from wbc.task import PoseTask, PositionTask
@@ -82,9 +82,7 @@ def test_optimal_solutions_are_vertices(weight, kind, obstacle, bound):
     solved = 0
     for index in range(STATES_PER_CASE):
         task, task_jacobian, error, context = random_step(rng, kind, obstacle, params)
-        rows = [constraint.rows(context) for constraint in constraints]
-        costs = [ResidualCost("task", task_jacobian, params.eta * error)]
-        costs += [term.cost(context) for term in objectives]
+        costs, rows = terms(context, task_jacobian, params.eta, constraints, objectives)
         if index % 2:
             lp.reset()  # half cold starts, half warm starts from an unrelated state
         solution = lp.solve(costs, rows)
