@@ -10,9 +10,11 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import pytest
+
 from launch import query
 from profiles.deploy_files import ROBOT_FILE
-from tests.processes import parsimony
+from tests.parsimony.in_process import run_in_process
 
 if TYPE_CHECKING:
     from tests.launch.conftest import LaunchFixture, ProfileWriter
@@ -22,7 +24,10 @@ CTL = {"name": "ctl", "module": "lp_controller", "role": "controller"}
 
 
 def test_the_recording_holds_the_sessions_topics_and_is_whole_after_sigint(
-    write_profile: ProfileWriter, launch: LaunchFixture, tmp_path: Path
+    write_profile: ProfileWriter,
+    launch: LaunchFixture,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
 ) -> None:
     """The recorder starts first, the others once it is alive, and it stops last; --force
     replaces an older file."""
@@ -43,28 +48,28 @@ def test_the_recording_holds_the_sessions_topics_and_is_whole_after_sigint(
     alive, started = text.index("[launch] recorder alive"), text.index("[launch] started pub ")
     assert alive < started, "the others start once the recorder is alive"
     assert text.index("[launch] ctl stopped (0)") < text.index("[launch] recorder stopped (0)")
-    shown = parsimony("info", str(recording), "--json")
-    assert shown.returncode == 0, shown.stderr
-    found = json.loads(shown.stdout)
+    code, out, err = run_in_process(["info", str(recording), "--json"], capsys)
+    assert code == 0, err
+    found = json.loads(out)
     assert found["complete"], "the recorder wrote its footer"
     topics = {channel["topic"] for channel in found["channels"]}
     assert {"robot/state", "control/goal", "base/command", "arm/command"} <= topics
 
 
 def test_an_existing_file_is_refused_before_anything_starts(
-    write_profile: ProfileWriter, tmp_path: Path
+    write_profile: ProfileWriter, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     profile = write_profile([PUB])
     recording = tmp_path / "first.mcap"
     recording.write_text("yesterday's session")
-    done = parsimony("launch", str(profile), "--record", str(recording))
-    assert done.returncode == 2
-    assert done.stderr.splitlines() == [f"launch: {recording} exists; give --force to replace it"]
+    code, _, err = run_in_process(["launch", str(profile), "--record", str(recording)], capsys)
+    assert code == 2
+    assert err.splitlines() == [f"launch: {recording} exists; give --force to replace it"]
     assert recording.read_text() == "yesterday's session"
 
 
 def test_a_profile_that_already_records_is_refused(
-    write_profile: ProfileWriter, tmp_path: Path
+    write_profile: ProfileWriter, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """One recording, to the file the user named: not a second one beside the profile's."""
     recorder = {
@@ -74,8 +79,9 @@ def test_a_profile_that_already_records_is_refused(
         "params": {"path": str(tmp_path / "its.mcap")},
     }
     profile = write_profile([PUB, recorder])
-    done = parsimony("launch", str(profile), "--record", str(tmp_path / "mine.mcap"))
-    assert done.returncode == 2
-    (line,) = done.stderr.splitlines()
+    argv = ["launch", str(profile), "--record", str(tmp_path / "mine.mcap")]
+    code, _, err = run_in_process(argv, capsys)
+    assert code == 2
+    (line,) = err.splitlines()
     assert "already records" in line and "'rec'" in line and "without --record" in line
     assert not (tmp_path / "mine.mcap").exists() and not (tmp_path / "its.mcap").exists()

@@ -1,5 +1,7 @@
 """Broken and foreign files through the real commands: one line naming the file and exit 2,
-never a traceback; a damaged chunk skipped and named, and every other message read."""
+never a traceback; a damaged chunk skipped and named, and every other message read. (Each
+command by its entry point in the test's process, tests/parsimony/in_process.py, but where
+what it says comes from the log, which a process of its own prints on stderr.)"""
 
 from __future__ import annotations
 
@@ -15,6 +17,7 @@ from messages.state import RobotState
 from profiles.endpoints import free_port
 from record.session_file import SessionWriter, entries
 from record.session_reader import info, read_session, recover
+from tests.parsimony.in_process import run_in_process
 from tests.processes import parsimony
 
 KEY = topics.ROBOT_STATE.key("bad")
@@ -66,7 +69,7 @@ FOREIGN = {"text": b"this is not a recording\n" * 20, "zeros": bytes(4096), "sho
 
 @pytest.mark.parametrize("kind", sorted(FOREIGN))
 def test_a_file_that_is_not_mcap_is_said_in_one_line_by_every_command(
-    tmp_path: Path, kind: str
+    tmp_path: Path, kind: str, capsys: pytest.CaptureFixture[str]
 ) -> None:
     path = tmp_path / f"{kind}.mcap"
     path.write_bytes(FOREIGN[kind])
@@ -78,13 +81,15 @@ def test_a_file_that_is_not_mcap_is_said_in_one_line_by_every_command(
         ["record", "--recover", str(path), "-o", out],
     )
     for arguments in every if kind == "text" else every[:1]:  # all read through one scan
-        done = parsimony(*arguments)
-        assert done.returncode == 2, (arguments, done.stderr)
-        assert "Traceback" not in done.stderr, done.stderr
-        assert f"{path}: not an MCAP file" in done.stderr, (arguments, done.stderr)
+        code, _, err = run_in_process(arguments, capsys)
+        assert code == 2, (arguments, err)
+        assert "Traceback" not in err, err
+        assert f"{path}: not an MCAP file" in err, (arguments, err)
 
 
-def test_a_damaged_chunk_is_skipped_named_and_the_rest_read(session: Path, tmp_path: Path) -> None:
+def test_a_damaged_chunk_is_skipped_named_and_the_rest_read(
+    session: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     path, held = damaged(session, tmp_path)
     found = info(path)
     assert len(found["damaged"]) == 1 and found["complete"]
@@ -93,9 +98,9 @@ def test_a_damaged_chunk_is_skipped_named_and_the_rest_read(session: Path, tmp_p
     assert len(states) == MESSAGES - held
     assert all(s == state(s.header.seq) for s in states)  # every other message, exactly
     # `info` says so; `record --recover` keeps every message of the other chunks.
-    shown = parsimony("info", str(path))
-    assert shown.returncode == 0 and "damaged, skipped: the chunk of" in shown.stdout
-    assert "Traceback" not in shown.stderr
+    code, out, err = run_in_process(["info", str(path)], capsys)
+    assert code == 0 and "damaged, skipped: the chunk of" in out
+    assert "Traceback" not in err
     whole = tmp_path / "whole.mcap"
     done = parsimony("record", "--recover", str(path), "-o", str(whole))
     assert done.returncode == 0 and "skipped the chunk of" in done.stderr, done.stderr
@@ -138,7 +143,7 @@ BAD_ARGUMENTS = {
 
 @pytest.mark.parametrize("case", sorted(BAD_ARGUMENTS))
 def test_bad_replay_arguments_are_said_before_any_router_is_reached(
-    session: Path, tmp_path: Path, case: str
+    session: Path, tmp_path: Path, case: str, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """Each is refused, said on the last line, exit 2; the profile's router is not there, so a
     check made after connecting would say that instead."""
@@ -148,20 +153,25 @@ def test_bad_replay_arguments_are_said_before_any_router_is_reached(
         "components: [{name: pub, module: scripted_publisher, role: tool}]\n"
     )
     arguments, said = BAD_ARGUMENTS[case]
-    done = parsimony("replay", str(session), "--profile", str(profile), *arguments)
-    assert done.returncode == 2, done.stderr
-    assert said in done.stderr.strip().splitlines()[-1], done.stderr
-    assert "router" not in done.stderr and "Traceback" not in done.stderr, done.stderr
+    code, _, err = run_in_process(
+        ["replay", str(session), "--profile", str(profile), *arguments], capsys
+    )
+    assert code == 2, err
+    assert said in err.strip().splitlines()[-1], err
+    assert "router" not in err and "Traceback" not in err, err
 
 
 @pytest.mark.parametrize("keys", [[], ["robot/state", "robots/*"]])
-def test_record_refuses_keys_that_match_no_topic(tmp_path: Path, keys: list[str]) -> None:
+def test_record_refuses_keys_that_match_no_topic(
+    tmp_path: Path, keys: list[str], capsys: pytest.CaptureFixture[str]
+) -> None:
     profile = tmp_path / "p.yaml"
     profile.write_text(
         "namespace: bad\ncomponents: [{name: pub, module: scripted_publisher, role: tool}]\n"
     )
-    done = parsimony("record", str(profile), "-o", str(tmp_path / "k.mcap"), "--keys", *keys)
-    assert done.returncode == 2 and "keys: " in done.stderr, done.stderr
+    argv = ["record", str(profile), "-o", str(tmp_path / "k.mcap"), "--keys", *keys]
+    code, _, err = run_in_process(argv, capsys)
+    assert code == 2 and "keys: " in err, err
     assert not (tmp_path / "k.mcap").exists()
 
 
@@ -195,7 +205,9 @@ def foxglove_file(path: Path) -> Path:
     return path
 
 
-def test_a_file_of_another_tool_is_read_for_what_it_holds(tmp_path: Path) -> None:
+def test_a_file_of_another_tool_is_read_for_what_it_holds(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """`info` lists its channels, none of them ours; `report` and `replay` say it holds nothing
     of ours (exit 2); `record --recover` keeps every message."""
     path = foxglove_file(tmp_path / "foxglove.mcap")
@@ -206,13 +218,13 @@ def test_a_file_of_another_tool_is_read_for_what_it_holds(tmp_path: Path) -> Non
         "other/robot/state": None,
     }
     assert {r.topic_name for r in read_session(path)} == {None}
-    report = parsimony("report", str(path), "--out", str(tmp_path / "r"))
-    assert report.returncode == 2 and "the session has no messages on topic" in report.stderr
+    code, _, err = run_in_process(["report", str(path), "--out", str(tmp_path / "r")], capsys)
+    assert code == 2 and "the session has no messages on topic" in err
     profile = tmp_path / "p.yaml"
     profile.write_text(
         "namespace: bad\ncomponents: [{name: pub, module: scripted_publisher, role: tool}]\n"
     )
-    replay = parsimony("replay", str(path), "--profile", str(profile))
-    assert replay.returncode == 2 and "nothing to replay" in replay.stderr, replay.stderr
+    code, _, err = run_in_process(["replay", str(path), "--profile", str(profile)], capsys)
+    assert code == 2 and "nothing to replay" in err, err
     assert recover(path, tmp_path / "copy.mcap") == 100
     assert info(tmp_path / "copy.mcap")["channels"] == shown["channels"]

@@ -29,6 +29,7 @@ from record.session_span import FAR_NS, Span
 from record.sessions import load_session
 from studies.experiment import connect, launched
 from tests.analysis.conftest import DT, FIGURES, ROBOT, START_NS, session_of, write
+from tests.parsimony.in_process import run_in_process
 from tests.processes import parsimony
 from wbc.geometry import scenarios
 from wbc.laws.kinematic_run import integrate
@@ -78,21 +79,25 @@ def said(stderr: str, what: str) -> list[str]:
     return [line for line in stderr.splitlines() if what in line]
 
 
-def test_info_gives_the_true_span_and_names_the_far_stamp_in_one_line(files) -> None:
-    clean, poisoned = (parsimony("info", str(f), "--json") for f in files)
-    assert clean.returncode == poisoned.returncode == 0, poisoned.stderr
-    found, expected = json.loads(poisoned.stdout), json.loads(clean.stdout)
+def test_info_gives_the_true_span_and_names_the_far_stamp_in_one_line(
+    files, capsys: pytest.CaptureFixture[str]
+) -> None:
+    clean, poisoned = (run_in_process(["info", str(f), "--json"], capsys) for f in files)
+    assert clean[0] == poisoned[0] == 0, poisoned[2]
+    found, expected = json.loads(poisoned[1]), json.loads(clean[1])
     for field in ("start_ns", "end_ns", "duration_s", "messages"):
         assert found[field] == expected[field], field
     assert 10 < found["duration_s"] < 20
     assert list(found["outside"]) == [GOAL_REQUEST.key(NAMESPACE)]
-    lines = said(poisoned.stderr, "far outside the session")
-    assert len(lines) == 1 and "1 message of far/goal/request" in lines[0], poisoned.stderr
+    lines = said(poisoned[2], "far outside the session")
+    assert len(lines) == 1 and "1 message of far/goal/request" in lines[0], poisoned[2]
     assert found["warning"] in lines[0]
-    assert clean.stderr == "" and expected["warning"] is None
+    assert clean[2] == "" and expected["warning"] is None
 
 
-def test_a_replay_of_it_ends_and_says_what_it_did_not_send(files, tmp_path: Path) -> None:
+def test_a_replay_of_it_ends_and_says_what_it_did_not_send(
+    files, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     profile = tmp_path / "far.yaml"
     profile.write_text(
         yaml.safe_dump(
@@ -103,7 +108,7 @@ def test_a_replay_of_it_ends_and_says_what_it_did_not_send(files, tmp_path: Path
             }
         )
     )  # never launched: the replay has no router to reach, and serves its own
-    clean = json.loads(parsimony("info", str(files[0]), "--json").stdout)
+    clean = json.loads(run_in_process(["info", str(files[0]), "--json"], capsys)[1])
     done = parsimony("replay", str(files[1]), "--profile", str(profile), "--rate", "20")
     assert done.returncode == 0, done.stderr
     assert f"/ {clean['duration_s']:.2f} s" in done.stderr
@@ -112,13 +117,17 @@ def test_a_replay_of_it_ends_and_says_what_it_did_not_send(files, tmp_path: Path
     assert len(lines) == 1 and "not sent" in lines[0] and "goal/request" in lines[0]
 
 
-def test_a_report_of_it_is_written_whole_and_says_what_it_left_out(files, tmp_path: Path) -> None:
+def test_a_report_of_it_is_written_whole_and_says_what_it_left_out(
+    files, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "report"
-    done = parsimony("report", str(files[1]), "--out", str(out), "--json")
-    assert done.returncode == 0, done.stderr
-    assert "Traceback" not in done.stderr
-    assert {Path(f).name for f in json.loads(done.stdout)["figures"]} == set(FIGURES)
-    lines = said(done.stderr, "far outside the session")
+    code, printed, err = run_in_process(
+        ["report", str(files[1]), "--out", str(out), "--json"], capsys
+    )
+    assert code == 0, err
+    assert "Traceback" not in err
+    assert {Path(f).name for f in json.loads(printed)["figures"]} == set(FIGURES)
+    lines = said(err, "far outside the session")
     assert len(lines) == 1 and "far/goal/request" not in lines[0] and "goal/request" in lines[0]
     # The judge says so too, and judges the rest as it judges the clean recording.
     judged = json.loads((out / "judged.json").read_text())["lp"]

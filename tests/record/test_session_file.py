@@ -10,6 +10,7 @@ import struct
 from pathlib import Path
 
 import numpy as np
+import pytest
 from mcap.reader import make_reader
 from pydantic import BaseModel
 
@@ -19,7 +20,7 @@ from messages.clock import Clock
 from messages.state import RobotState
 from record.session_file import CARRIER, DROPPED, Entry, SessionWriter
 from record.session_reader import info, read_session, recover
-from tests.processes import parsimony
+from tests.parsimony.in_process import run_in_process
 from tests.record.session_messages import (
     NAMESPACE,
     header,
@@ -176,7 +177,9 @@ def test_a_writer_stopped_without_close_loses_only_what_came_after_its_flush(
     assert states_in(path) == list(range(95))
 
 
-def test_what_the_recorder_lost_is_in_the_file_and_info_shows_it(tmp_path: Path) -> None:
+def test_what_the_recorder_lost_is_in_the_file_and_info_shows_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     path = tmp_path / "lossy.mcap"
     with SessionWriter(path) as writer:
         writer.write(topics.ROBOT_STATE.key(NAMESPACE), state(5_000))
@@ -186,7 +189,5 @@ def test_what_the_recorder_lost_is_in_the_file_and_info_shows_it(tmp_path: Path)
     recovered = tmp_path / "recovered.mcap"
     recover(path, recovered)  # what was lost is still said of the recovered file
     assert info(recovered)["dropped"] == info(path)["dropped"]
-    shown = parsimony("info", str(path))
-    assert "lost by the recorder: 7 (overflowed.camera/image), 2 (overwritten.sim/clock)" in (
-        shown.stdout
-    )
+    _, shown, _ = run_in_process(["info", str(path)], capsys)
+    assert "lost by the recorder: 7 (overflowed.camera/image), 2 (overwritten.sim/clock)" in shown

@@ -8,6 +8,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from components.control_step import TELEOP_TIMEOUT_S
 from messages import topics
@@ -22,7 +23,7 @@ from profiles.deploy_files import DEPLOY
 from record.session_file import SessionWriter
 from record.session_reader import info
 from scenes.foxglove_views import Viewer
-from tests.processes import parsimony
+from tests.parsimony.in_process import run_in_process
 from tests.scenes.views_read import ROBOT, pose_dq, robot_state
 from view.foxglove_layout import layout
 from view.station_teleop import teleop_topic
@@ -172,16 +173,18 @@ def test_every_topic_the_layout_names_is_a_channel_of_the_namespace(tmp_path: Pa
         assert f'"panelType":"{panel}"' in panels.replace(" ", "")
 
 
-def test_parsimony_layout_prints_or_writes_it(tmp_path: Path) -> None:
+def test_parsimony_layout_prints_or_writes_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     profile = DEPLOY / "sim_station.yaml"
-    printed = parsimony("layout", str(profile))
-    assert printed.returncode == 0, printed.stderr
-    assert json.loads(printed.stdout) == json.loads(layout(NAMESPACE, ROBOT.joint_names).to_json())
+    code, printed, err = run_in_process(["layout", str(profile)], capsys)
+    assert code == 0, err
+    assert json.loads(printed) == json.loads(layout(NAMESPACE, ROBOT.joint_names).to_json())
     target = tmp_path / "station.json"
-    assert parsimony("layout", str(profile), "-o", str(target)).returncode == 0
-    assert json.loads(target.read_text()) == json.loads(printed.stdout)
-    again = parsimony("layout", str(profile), "-o", str(target))
-    assert again.returncode == 2 and "--force" in again.stderr
+    assert run_in_process(["layout", str(profile), "-o", str(target)], capsys)[0] == 0
+    assert json.loads(target.read_text()) == json.loads(printed)
+    code, _, err = run_in_process(["layout", str(profile), "-o", str(target)], capsys)
+    assert code == 2 and "--force" in err
 
 
 def test_the_joints_plot_has_a_series_per_joint_of_the_description() -> None:
