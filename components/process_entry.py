@@ -65,7 +65,11 @@ def _parse_args(component_class: type[Component], argv: Sequence[str] | None) ->
 
 
 def _configure(
-    component_class: type[Component], profile_path: str, name: str, params_file: Path | None
+    component_class: type[Component],
+    profile_path: str,
+    name: str,
+    params_file: Path | None,
+    session: zenoh.Session | None = None,
 ) -> Node | None:
     """The component's node, or ``None`` after logging why the configuration is refused."""
     try:
@@ -85,6 +89,7 @@ def _configure(
             component_class.reads,
             component_class.writes,
             params_file,
+            session,
         )
     except ParamError as error:
         log.error("%s: components[%d].params.%s", profile_path, names.index(name), error)
@@ -98,6 +103,19 @@ def start_logging(level: str) -> None:
         signal.signal(stop_signal, _on_stop_signal)
 
 
+def _shared_session(profile_path: str) -> zenoh.Session | None:
+    """One session for the components of this process: a sample one of them publishes reaches
+    the others in the process without a copy on the network. None (a session each) when the
+    components authenticate, each as its name (``zenoh.access``), or are clients."""
+    try:
+        zenoh_settings = load_profile(profile_path).zenoh
+    except ProfileError:
+        return None  # each component's configuration says why
+    if zenoh_settings.access is not None or zenoh_settings.mode == "client":
+        return None
+    return zenoh.open(zenoh_settings.component_config())
+
+
 def serve(profile_path: str, members: Sequence[tuple[type[Component], str, Path | None]]) -> int:
     """Run each ``(component class, name, kept parameters file)`` of ``members`` in this
     process, started in order and closed in the reverse order, until a stop signal or one's
@@ -106,8 +124,11 @@ def serve(profile_path: str, members: Sequence[tuple[type[Component], str, Path 
     name = ""
     try:
         with contextlib.ExitStack() as stack:
+            session = _shared_session(profile_path) if len(members) > 1 else None
+            if session is not None:
+                stack.callback(session.close)  # once every node has closed
             for component_class, name, params_file in members:
-                node = _configure(component_class, profile_path, name, params_file)
+                node = _configure(component_class, profile_path, name, params_file, session)
                 if node is None:
                     return EXIT_CONFIG_ERROR
                 stack.enter_context(node)

@@ -71,6 +71,7 @@ class Node:
         reads: Iterable[Input] | None = None,
         writes: Iterable[topics.Topic] | None = None,
         kept_params: Path | None = None,
+        session: zenoh.Session | None = None,
     ) -> None:
         """Raise ``KeyError`` for a name not in the profile, ``ParamError`` for bad params.
 
@@ -79,6 +80,8 @@ class Node:
         takes its mode from its declaration. ``None`` (a test's or a tool's node) allows any.
         ``kept_params`` is a JSON file of the parameters set at run time by an earlier run of
         this component: they are set again (over the profile's), and later changes written back.
+        ``session``, when given, is a session the node uses and leaves open (the one of the
+        components sharing a process, ``components.container``) instead of one of its own.
         """
         self.reads = None if reads is None else {i.topic.name: i for i in reads}
         self.writes = None if writes is None else {t.name for t in writes}
@@ -104,13 +107,14 @@ class Node:
         self._events: queue.SimpleQueue[Callable[[], None] | None] = queue.SimpleQueue()
         self._warnings = RateLimitedLog(log)
         self._session: zenoh.Session | None = None
+        self._lent = session
         self._declared: list[object] = []
         self._thread: threading.Thread | None = None
         self._on_shutdown: Callable[[], None] | None = None
         self._on_clock_stall: Callable[[float], None] | None = None
 
     def __enter__(self) -> Node:
-        self._session = zenoh.open(self.profile.zenoh.component_config(self.name))
+        self._session = self._lent or zenoh.open(self.profile.zenoh.component_config(self.name))
         clock = self.clock
         if isinstance(clock, SimClock):
             self.subscribe(
@@ -267,7 +271,7 @@ class Node:
             self._thread.join(patience_s)
             if self._thread.is_alive():
                 log.warning("handler thread busy after %.1f s; closing anyway", patience_s)
-        if self._session is not None:
+        if self._session is not None and self._lent is None:
             self._session.close()
         self._declared.clear()
 
