@@ -2,9 +2,11 @@
 
     python -m components.container --profile P --names a,b,c --params-dir D
 
-runs each named component as ``python -m components.<module>`` would, with its own ``Node``,
-Zenoh session and threads, in this one process: the interpreter and the libraries they import
-(NumPy, Zenoh, OpenCV, HiGHS) load once instead of once per component. They start in the order
+runs each named component as ``python -m components.<module>`` would, with its own ``Node``
+and threads, in this one process: the interpreter and the libraries they import (NumPy, Zenoh,
+OpenCV, HiGHS) load once instead of once per component, and they share one Zenoh session (unless
+the profile's components authenticate or are clients), so that a sample between two of them is
+handed over in the session, not copied over a socket. They start in the order
 given and close in the reverse order, on SIGINT, SIGTERM, the end of the launcher or the
 ``fail`` of one of them; the parameters set on component N while it runs are kept in
 ``D/N.json``, as the launcher keeps them for a process of its own.
