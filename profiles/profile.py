@@ -284,8 +284,9 @@ class Profile(StrictModel):
     """``separate``: one process per component. ``shared``: the components that are not
     recorders and start ``after`` none run in one process (``components.container``), each with
     its own node and threads on one Zenoh session, so that the interpreter and its libraries
-    load once and their samples to each other stay in the process (a lockstep experiment's). A fault that ends that process ends them all together: the launcher
-    restarts each by its policy, in one new process."""
+    load once and their samples to each other stay in the process (a lockstep experiment's). A
+    fault that ends that process ends them all together: the launcher restarts each by its
+    policy, in one new process."""
     components: list[ComponentSpec] = Field(min_length=1)
 
     @model_validator(mode="after")
