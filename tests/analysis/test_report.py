@@ -24,7 +24,7 @@ from messages.topics import (
 )
 from messages.truth import SimTruth
 from tests.analysis.conftest import DT, FIGURES, ROBOT, START_NS, header
-from tests.processes import parsimony
+from tests.parsimony.in_process import completed
 from wbc import dq
 from wbc.geometry import scenarios
 from wbc.laws.kinematic_run import effort_of
@@ -241,7 +241,7 @@ def test_the_base_path_starts_at_the_first_valid_state(runs):
 
 
 def test_labels_that_do_not_match_the_files_are_said_in_one_line(tmp_path):
-    done = parsimony(
+    done = completed(
         "report",
         str(tmp_path / "a.mcap"),
         str(tmp_path / "b.mcap"),

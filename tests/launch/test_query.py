@@ -1,4 +1,6 @@
-"""`parsimony status` and `parsimony param` against a launched system on loopback."""
+"""`parsimony status` and `parsimony param` against a launched system on loopback (run by the
+command's entry point in the test's process; stdout the result alone in a process of its own:
+test_status_json_is_the_whole_stdout_of_the_command)."""
 
 from __future__ import annotations
 
@@ -22,6 +24,7 @@ from messages import codec
 from messages.goal import Goal
 from parsimony.commands import param, status
 from parsimony.target_options import PROFILE_ENV
+from tests.parsimony.in_process import completed as cli  # in this process: no Python start
 from tests.view.live_view_client import StderrLines, background_job, stopped_by
 from wbc import dq
 
@@ -117,13 +120,6 @@ def test_param_errors_are_reported(
 ) -> None:
     assert command(param, "param", *argv, "--profile", str(running_pub)) == 1
     assert error in capsys.readouterr().err
-
-
-def cli(*argv: str) -> subprocess.CompletedProcess[str]:
-    """`parsimony ARGV` as a user runs it: a process, stdout its result alone."""
-    return subprocess.run(
-        [sys.executable, "-m", "parsimony.cli", *argv], capture_output=True, text=True, timeout=60
-    )
 
 
 def test_topic_echo_prints_each_decoded_message_as_a_json_line(running_pub: Path) -> None:

@@ -25,7 +25,8 @@ from profiles.profile import load_profile
 from record.session_reader import info
 from record.sessions import load_session
 from studies.experiment import connect, launched
-from tests.processes import parsimony, process_gone
+from tests.parsimony.in_process import completed
+from tests.processes import process_gone
 
 
 def system_profile(tmp_path: Path) -> Path:
@@ -99,7 +100,7 @@ def test_the_recorder_stops_with_the_record_command(
 
 
 def test_record_without_a_router_says_so_and_exits_2(tmp_path: Path) -> None:
-    done = parsimony("record", str(system_profile(tmp_path)), "-o", str(tmp_path / "k.mcap"))
+    done = completed("record", str(system_profile(tmp_path)), "-o", str(tmp_path / "k.mcap"))
     assert done.returncode == 2 and "cannot reach a router" in done.stderr, done.stderr
     assert not (tmp_path / "k.mcap").exists()
 
@@ -123,16 +124,16 @@ def test_no_command_writes_over_its_input_or_an_existing_file(
         ["record", "--recover", str(recording), "-o", str(recording)],
         ["record", str(profile), "-o", str(recording)],
     ):
-        done = parsimony(*arguments)
+        done = completed(*arguments)
         assert done.returncode == 2, (arguments, done.stderr)
         assert "Traceback" not in done.stderr and str(recording) in done.stderr, done.stderr
         assert recording.read_bytes() == kept
     other = tmp_path / "other.mcap"
     other.write_bytes(b"mine")
-    done = parsimony("record", "--recover", str(recording), "-o", str(other))
+    done = completed("record", "--recover", str(recording), "-o", str(other))
     assert done.returncode == 2 and "give --force" in done.stderr
     assert other.read_bytes() == b"mine"
-    done = parsimony("record", "--recover", str(recording), "-o", str(other), "--force")
+    done = completed("record", "--recover", str(recording), "-o", str(other), "--force")
     assert done.returncode == 0, done.stderr
     assert info(other)["messages"] == info(recording)["messages"]
 
@@ -144,7 +145,7 @@ def test_a_robot_file_that_is_no_description_is_one_line_from_report_and_rerun(
     field: list indices must be integers or slices, not str')."""
     robot = tmp_path / "robot.yaml"
     robot.write_text("- arm\n- base\n")
-    done = parsimony(
+    done = completed(
         "report", str(tmp_path / "k.mcap"), "--out", str(tmp_path / "report"), "--robot", str(robot)
     )
     assert done.returncode == 2, done.stderr
@@ -154,7 +155,7 @@ def test_a_robot_file_that_is_no_description_is_one_line_from_report_and_rerun(
     )
     recording = tmp_path / "k.mcap"
     recording.write_bytes(b"")
-    done = parsimony(
+    done = completed(
         "rerun",
         str(recording),
         "--controller",

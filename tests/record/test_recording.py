@@ -26,6 +26,7 @@ from profiles.profile import load_profile
 from record.session_reader import info, read_session, recover
 from record.sessions import load_session
 from studies.experiment import connect
+from tests.parsimony.in_process import run_in_process
 from tests.studies.experiments import run_here
 
 
@@ -54,7 +55,9 @@ def runs(pose_lp_run: Path, tmp_path_factory: pytest.TempPathFactory) -> dict[st
     return {"lp": pose_lp_run, "lp smooth": out}
 
 
-def test_a_recorded_experiment_reads_back_with_every_channel_schema(runs) -> None:
+def test_a_recorded_experiment_reads_back_with_every_channel_schema(
+    runs, capsys: pytest.CaptureFixture[str]
+) -> None:
     path = runs["lp"] / "session.mcap"
     with path.open("rb") as stream:
         reader = make_reader(stream)
@@ -70,7 +73,7 @@ def test_a_recorded_experiment_reads_back_with_every_channel_schema(runs) -> Non
         "foxglove.FrameTransforms",
         "foxglove.SceneUpdate",
     } <= names
-    shown = json.loads(parsimony("info", str(path), "--json").stdout)
+    shown = json.loads(run_in_process(["info", str(path), "--json"], capsys)[1])
     assert shown["messages"] == counted
     by_key = {c["key"]: c for c in shown["channels"]}
     # What the controller published is all there: its own count, in its recorded status.
@@ -88,7 +91,7 @@ def test_a_recorded_experiment_reads_back_with_every_channel_schema(runs) -> Non
 
 
 def test_the_report_of_two_runs_shows_the_input_change_term_lowering_metric_4(
-    runs, tmp_path: Path
+    runs, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """`parsimony report` of the same seed's runs on the whole simulated loop, the LP without
     and with its input change term: both converge, and table 6.1's metric 4 of the commands
@@ -97,9 +100,10 @@ def test_the_report_of_two_runs_shows_the_input_change_term_lowering_metric_4(
     and reproduce's table 6.1; the cascade runs the whole loop in test_experiment: a third
     run here proved neither again.)"""
     files = [str(runs[run] / "session.mcap") for run in ("lp", "lp smooth")]
-    done = parsimony("report", *files, "--labels", "lp,lp smooth", "--out", str(tmp_path), "--json")
-    assert done.returncode == 0, done.stderr
-    result = json.loads(done.stdout)
+    argv = ["report", *files, "--labels", "lp,lp smooth", "--out", str(tmp_path), "--json"]
+    code, printed, err = run_in_process(argv, capsys)
+    assert code == 0, err
+    result = json.loads(printed)
     for figure in result["figures"]:
         assert Path(figure).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     effort = result["effort"]
@@ -274,13 +278,16 @@ def test_replay_republishes_the_sensors_with_headers_as_recorded(runs, tmp_path:
 
 
 @pytest.mark.parametrize("run", ["lp", "lp smooth"])
-def test_rerun_of_the_recorded_law_reproduces_its_commands(runs, run: str, tmp_path: Path) -> None:
+def test_rerun_of_the_recorded_law_reproduces_its_commands(
+    runs, run: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """The LP run offline on a lockstep recording's states, goals and obstacles, with the
     gains its diagnostics carry, is the controller that ran: every command bit for bit; with
     the input change term on too, whose u_prev the law keeps from step to step."""
     out = tmp_path / "rerun.mcap"
-    done = parsimony("rerun", str(runs[run] / "session.mcap"), "--controller", "lp", "-o", str(out))
-    assert done.returncode == 0, done.stderr
+    argv = ["rerun", str(runs[run] / "session.mcap"), "--controller", "lp", "-o", str(out)]
+    code, _, err = run_in_process(argv, capsys)
+    assert code == 0, err
     recorded = load_session(runs[run] / "session.mcap")
     rerun = load_session(out)
     for topic, fields in (

@@ -18,7 +18,7 @@ from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.session_file import SessionWriter
 from studies.experiment import connect, launched
-from tests.processes import parsimony
+from tests.parsimony.in_process import completed
 
 
 def recording(path: Path, namespace: str) -> Path:
@@ -47,7 +47,7 @@ def recording(path: Path, namespace: str) -> Path:
 
 
 def replay(file: Path, profile: Path, *extra: str) -> subprocess.CompletedProcess:
-    return parsimony("replay", str(file), "--profile", str(profile), "--rate", "16", *extra)
+    return completed("replay", str(file), "--profile", str(profile), "--rate", "16", *extra)
 
 
 def test_a_replay_into_a_live_namespace_refuses_commands_and_live_topics(tmp_path: Path) -> None:

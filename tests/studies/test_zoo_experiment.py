@@ -52,6 +52,7 @@ from record.session_reader import info
 from record.sessions import load_session
 from scenes.foxglove_views import MODEL_SUFFIX, View, Viewer
 from sim2d.scenarios import scenario
+from tests.parsimony.in_process import run_in_process
 from tests.robot_states import state_at
 from tests.scenes.views_read import decode
 from tests.studies.experiments import run_here
@@ -182,20 +183,14 @@ def test_the_robot_runs_the_whole_loop_seen_by_the_camera(whole: tuple[str, dict
 @pytest.mark.heavy  # reads the module's whole-loop run: the omnidirectional base's lateral
 @pytest.mark.parametrize("whole", ["youbot"], indirect=True)  # speed, the rows it adds
 def test_its_recording_reruns_bit_for_bit_and_its_report_names_the_joints(
-    whole: tuple[str, dict, Path], tmp_path: Path
+    whole: tuple[str, dict, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     name, _, out = whole
     robot = MobileManipulator.from_yaml(ROBOTS_DIR / f"{name}.yaml")
     rerun = tmp_path / "rerun.mcap"
-    cli = [sys.executable, "-m", "parsimony.cli"]
-    done = subprocess.run(
-        [*cli, "rerun", str(out / "session.mcap"), "--controller", "lp", "--robot", name]
-        + ["-o", str(rerun)],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    assert done.returncode == 0, done.stderr
+    argv = ["rerun", str(out / "session.mcap"), "--controller", "lp", "--robot", name]
+    code, _, err = run_in_process([*argv, "-o", str(rerun)], capsys)
+    assert code == 0, err
     commands = {topics.ARM_COMMAND.name, topics.BASE_COMMAND.name}
     recorded, again = load_session(out / "session.mcap", commands), load_session(rerun, commands)
     for topic in commands:
