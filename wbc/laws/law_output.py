@@ -74,17 +74,21 @@ def summarise(
     error: Array,
     start: float,
     owned: bool = False,
+    magnitudes: list[float] | None = None,
 ) -> LawOutput:
     """Freeze u and count its nonzero entries (section 5.7) and practical ones (6.2.1).
 
     ``owned``: u is a new float array no one else holds (the LP's), frozen in place, not copied.
+    ``magnitudes``: |u_i| as Python floats, where the law has them (the LP's).
     """
     if not owned:
         u = np.array(u, dtype=float)
     u.setflags(write=False)
+    if magnitudes is None:
+        magnitudes = list(map(abs, u.tolist()))
     # Counted on Python floats: the same comparisons, in a fraction of NumPy's time at these
     # sizes; a practical entry is a nonzero one (PRACTICAL_THRESHOLD > ZERO_THRESHOLD).
-    nonzero = [x for x in map(abs, u.tolist()) if x > ZERO_THRESHOLD]
+    nonzero = [x for x in magnitudes if x > ZERO_THRESHOLD]
     output = object.__new__(LawOutput)  # the frozen dataclass, its fields set at once
     output.__dict__.update(
         u=u,

@@ -69,6 +69,8 @@ class LPSolution(NamedTuple):
     status: str
     objective: float | None
     active: tuple[str, ...]
+    magnitudes: list[float]
+    """|u_i| as Python floats, read for the active set and u's nonzero counts."""
 
 
 class _Layout:
@@ -229,8 +231,10 @@ class WarmStartedLP:
         # sum_b w_b 1'(-b_b), the same IEEE sum. ndarray.dot: the same BLAS sums as @, in about
         # half the time for vectors this short.
         objective = float(layout.cost.dot(values)) + float(layout.row_weight.dot(residual_upper))
-        active = _active(u, linear, norms, limits)
-        return LPSolution(u, status, objective, active)
+        values = u.tolist()
+        magnitudes = list(map(abs, values))
+        active = _active(u, values, magnitudes, linear, norms, limits)
+        return LPSolution(u, status, objective, active, magnitudes)
 
     def _velocity_costs(self, costs: list[VelocityCost], n: int) -> tuple[Array, Array]:
         """c_P and c_N, the sums of the velocity costs' weights, kept while the terms return the
@@ -378,11 +382,13 @@ def _picker(places: list[int]) -> Callable[[tuple], tuple]:
 
 
 def _failed(n: int, status: str) -> LPSolution:
-    return LPSolution(np.zeros(n), status, None, ())
+    return LPSolution(np.zeros(n), status, None, (), [0.0] * n)
 
 
 def _active(
     u: Array,
+    values: list[float],
+    magnitudes: list[float],
     linear: Sequence[LinearRows],
     norms: Sequence[OneNormBound],
     limits: Sequence[tuple[str, list[float], list[float]]],
@@ -391,12 +397,12 @@ def _active(
 
     Engaged equality rows are active, and engaged inequality rows that one of their finite
     bounds holds tight; a one-norm bound when 1'(u_P + u_N) reaches it; a velocity bound entry
-    (named ``name[i]``) when u_i sits on a finite, non-degenerate bound.
+    (named ``name[i]``) when u_i sits on a finite, non-degenerate bound. ``values`` and
+    ``magnitudes`` are u_i and |u_i| as Python floats.
     """
     active = [rows.name for rows in linear if rows.engaged and _tight(rows, u)]
-    values = u.tolist()
     if norms:
-        split_sum = sum(map(abs, values))  # 1'(u_P + u_N), the halves split canonically
+        split_sum = sum(magnitudes)  # 1'(u_P + u_N), the halves split canonically
         active += [bound.name for bound in norms if split_sum >= bound.limit - ACTIVE_TOLERANCE]
     for name, lows, highs in limits:
         # An infinite bound is never within the tolerance of u; a degenerate one never counts.

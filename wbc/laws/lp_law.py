@@ -233,8 +233,7 @@ class LPLaw:
             self._previous_u,
         )
         solution = self._lp.solve(costs, rows)
-        output = summarise(
-            solution.u, solution.status, solution.objective, solution.active, error, start, True
-        )
+        u, status, objective, active, magnitudes = solution
+        output = summarise(u, status, objective, active, error, start, True, magnitudes)
         self._previous_u = output.u
         return output
