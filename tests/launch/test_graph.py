@@ -13,6 +13,7 @@ from launch.graph import dataflow
 from profiles.deploy_files import DEPLOY
 from profiles.profile import ProfileError, load_profile
 from profiles.recorder import with_recorder
+from tests.parsimony.in_process import completed
 
 
 def test_the_controllers_profile_wires_the_publisher_to_the_controller() -> None:
@@ -146,11 +147,7 @@ def test_a_parameter_no_component_would_take_is_refused_before_anything_starts(
     ):
         dataflow(load_profile(path), path)
     for command in ("graph", "launch"):
-        done = subprocess.run(
-            [sys.executable, "-m", "parsimony.cli", command, str(path)],
-            capture_output=True,
-            text=True,
-        )
+        done = completed(command, str(path))
         assert done.returncode == 2 and f"{path}: invalid profile" in done.stderr, done.stderr
         assert "[launch]" not in done.stderr  # refused before a component was started
 

@@ -3,9 +3,7 @@
 from __future__ import annotations
 
 import json
-import os
 import subprocess
-import sys
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -21,6 +19,7 @@ from messages.header import Header
 from profiles.deploy_files import ROBOT_FILE
 from profiles.profile import ProfileError, ZenohSettings, load_profile
 from tests.launch.conftest import free_port
+from tests.parsimony.in_process import completed
 
 if TYPE_CHECKING:
     from tests.launch.conftest import LaunchFixture
@@ -90,14 +89,10 @@ def test_only_the_writers_of_a_topic_may_put_and_strangers_cannot_connect(
 
 
 def param(user: str, profile: Path, *argv: str) -> subprocess.CompletedProcess[str]:
-    """`parsimony param ARGV` run by ``user``."""
-    return subprocess.run(
-        [sys.executable, "-m", "parsimony.cli", "param", *argv, "--profile", str(profile)],
-        capture_output=True,
-        text=True,
-        timeout=60,
-        env={**os.environ, "PARSIMONY_USER": user},
-    )
+    """`parsimony param ARGV` run by ``user`` (by its entry point in the test's process)."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("PARSIMONY_USER", user)
+        return completed("param", *argv, "--profile", str(profile))
 
 
 def test_only_the_users_a_rule_names_may_set_a_components_parameters(

@@ -5,11 +5,10 @@ loopback endpoint, and the replay is watched in Foxglove as a live system is, th
 from __future__ import annotations
 
 import asyncio
-import os
 import signal
-import subprocess
-import sys
 from pathlib import Path
+
+import pytest
 
 from messages import topics
 from messages.state import RobotState
@@ -17,8 +16,8 @@ from parsimony.target_options import PROFILE_ENV
 from profiles.endpoints import free_port
 from record.replayer import Recording
 from record.session_file import SessionWriter, from_json
+from tests.parsimony.in_process import completed
 from tests.view.live_view_client import (
-    DEADLINE_S,
     StderrLines,
     background_job,
     state,
@@ -92,19 +91,16 @@ def test_a_replay_with_no_system_serves_its_own_router_and_is_watched_live(tmp_p
     assert said.all().endswith("[replay] interrupted by SIGTERM\n")
 
 
-def test_without_a_profile_a_replay_goes_into_its_recorded_namespace(tmp_path: Path) -> None:
+def test_without_a_profile_a_replay_goes_into_its_recorded_namespace(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     recording(tmp_path / "one.mcap")
     assert Recording.of(tmp_path / "one.mcap", lambda _: True).namespace() == RECORDED
     with SessionWriter(tmp_path / "two.mcap") as writer:
         for namespace in (RECORDED, INTO):
             writer.write(topics.ROBOT_STATE.key(namespace), state(0))
-    done = subprocess.run(
-        [sys.executable, "-m", "parsimony.cli", "replay", str(tmp_path / "two.mcap")],
-        capture_output=True,
-        text=True,
-        env={k: v for k, v in os.environ.items() if k != PROFILE_ENV},
-        timeout=DEADLINE_S * 6,
-    )
+    monkeypatch.delenv(PROFILE_ENV, raising=False)
+    done = completed("replay", str(tmp_path / "two.mcap"))
     assert done.returncode == 2, done.stderr
     assert done.stderr == (
         f"replay: {tmp_path / 'two.mcap'}: recorded in the namespaces "

@@ -7,8 +7,6 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
-import sys
 import threading
 from collections.abc import Iterator
 from dataclasses import dataclass, field
@@ -26,6 +24,7 @@ from messages.state import RobotState
 from profiles.endpoints import free_port
 from profiles.profile import Profile, load_profile
 from studies.experiment import DEPLOY, connect, launched, wait_alive, wait_reached
+from tests.parsimony.in_process import completed as parsimony  # in this process: no Python start
 from wbc import dq
 from wbc.planar import offset_of
 
@@ -117,15 +116,6 @@ def station(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Station]:
         yield Station(path, profile, session, watched)
         for subscriber in subscribers:
             subscriber.undeclare()
-
-
-def parsimony(*arguments: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "parsimony.cli", *arguments],
-        capture_output=True,
-        text=True,
-        timeout=COMMAND_S,
-    )
 
 
 def test_topic_pub_stamps_a_header_it_makes_on_the_simulators_clock(station: Station) -> None:
