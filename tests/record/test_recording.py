@@ -39,6 +39,8 @@ def parsimony(*arguments: str, timeout: float = 300) -> subprocess.CompletedProc
     )
 
 
+pytestmark = pytest.mark.heavy  # two whole-loop runs (one the suite's shared pose_lp_run, made
+# here first: a file that reads it later finds it made) and a recorder killed mid-run
 SMOOTH_PROFILE = DEPLOY / "sim_smooth.yaml"
 KILLED_RUN_S = 8.0
 """Simulated seconds of the run whose recorder is killed: the kill comes after 2000 messages
