@@ -55,20 +55,22 @@ def nothing(run: object) -> dict[str, Any]:
     return {}
 
 
-def doing(what: Callable[[object], dict[str, Any]]) -> Callable[[], None]:
-    """A function setting ``runs.perform`` in the process it runs in (a Dask worker's too)."""
+def doing(empty: bool) -> Callable[[], None]:
+    """A function making every run do nothing (``empty``) or its own, in the process it runs in
+    (a Dask worker's too: it keeps the runs' own ``perform`` there, as found the first time)."""
 
     def set_it() -> None:
-        runs.perform = what
+        own = runs.__dict__.setdefault("own_perform", runs.perform)
+        runs.perform = nothing if empty else own
 
     return set_it
 
 
-def use(runner: LocalPool | DaskCluster, what: Callable[[object], dict[str, Any]]) -> None:
-    """``what`` as every run of ``runner`` (and of this process) from now on."""
-    doing(what)()
+def use(runner: LocalPool | DaskCluster, empty: bool) -> None:
+    """Every run of ``runner`` (and of this process) from now on doing nothing, or its own."""
+    doing(empty)()
     if isinstance(runner, DaskCluster):
-        runner.on_each_worker(doing(what))
+        runner.on_each_worker(doing(empty))
 
 
 def timed(study: Study, runner: Any, directory: Path) -> dict[str, Any]:
@@ -94,17 +96,15 @@ def timed(study: Study, runner: Any, directory: Path) -> dict[str, Any]:
 def measure(timed_studies: dict[str, Study], workers: list[int]) -> list[dict[str, Any]]:
     """Every study on the local pool and on a local Dask cluster of each count of workers."""
     rows = []
-    original = runs.perform
     with tempfile.TemporaryDirectory() as name:
         for count in workers:
             for runner_name in RUNNERS:
                 with runner_of(runner_name, count, Path(name)) as runner:
-                    use(runner, nothing)
+                    use(runner, True)
                     warm = timed_studies["nothing"].model_copy(update={"name": "warm-up"})
                     timed(warm, runner, Path(name))  # each worker's imports, not timed
                     for study_name, study in timed_studies.items():
-                        what = nothing if study_name == "nothing" else original
-                        use(runner, what)
+                        use(runner, study_name == "nothing")
                         found = timed(study, runner, Path(name))
                         progress(f"{study_name} on {runner_name} of {count}: {found}")
                         load = round(os.getloadavg()[0], 1)
@@ -113,7 +113,7 @@ def measure(timed_studies: dict[str, Study], workers: list[int]) -> list[dict[st
                             | found
                             | {"load_average": load}
                         )
-                doing(original)()
+                doing(False)()
     return rows
 
 
