@@ -136,13 +136,18 @@ def lp_breakdown(
     terms (the task's error e and Jacobian at x, ``task.error``, then ``lp_law.terms``: the
     constraints' rows and the objective's terms, the task's ||J u + eta e|| first), the vertex
     (the kept basis tested, or the calls into HiGHS: model update, basis, run, solution) and
-    HiGHS alone; ``highs_runs`` is the share of steps that called HiGHS. A timer costs the
-    glue about half a microsecond a call: the terms are timed in one call, not term by term.
+    HiGHS alone; ``highs_runs`` is the share of steps that called HiGHS. The step (``total``)
+    is the law's own, untimed: a twin law with no timers steps the same states in turn, BLOCK
+    at a time, and a step's glue is its time less the parts the timed law spent on the same
+    state (the two in alternate order, block by block), so the timers' own cost (about half a
+    microsecond a call, some two microseconds a step) is in no part. Both laws give the same
+    outputs, so take the same path, at each state.
     """
-    task = PoseTask(robot.fkm(goal))
+    task, plain = PoseTask(robot.fkm(goal)), PoseTask(robot.fkm(goal))
     states = trajectory(robot, start, goal, repeats)
-    law = LPLaw(robot)
+    law, twin = LPLaw(robot), LPLaw(robot)
     law.step(start, task, DT)
+    twin.step(start, plain, DT)
     spent = {"kinematics": 0.0, "rows": 0.0, "vertex": 0.0, "highs": 0.0}
 
     def timed(part: str, call: Callable) -> Callable:
@@ -161,23 +166,26 @@ def lp_breakdown(
     law._lp._vertex = timed("vertex", law._lp._vertex)  # type: ignore[method-assign]
     law._lp._run = timed("highs", law._lp._run)  # type: ignore[method-assign]
     parts: dict[str, list[float]] = {name: [] for name in (*spent, "glue", "total")}
-    terms = lp_law.terms
-    lp_law.terms = timed("rows", terms)  # the program's terms, while this law steps
+    terms, timed_terms = lp_law.terms, timed("rows", lp_law.terms)
+    untimed: list[float] = []
     try:
-        while len(parts["total"]) < repeats:
-            law.reset()
-            for q in states[: repeats - len(parts["total"])]:
-                spent.update(dict.fromkeys(spent, 0.0))
-                begin = time.perf_counter()
-                law.step(q, task, DT)
-                total = time.perf_counter() - begin
-                for name, value in spent.items():
-                    parts[name].append(value)
-                named = spent["kinematics"] + spent["rows"] + spent["vertex"]
-                parts["glue"].append(total - named)
-                parts["total"].append(total)
+        for index, block in enumerate(blocks(states, repeats, (law, twin))):
+            for twin_turn in (index % 2 == 1, index % 2 == 0):  # each first every other block
+                lp_law.terms = terms if twin_turn else timed_terms
+                for q in block:
+                    spent.update(dict.fromkeys(spent, 0.0))
+                    begin = time.perf_counter()
+                    (twin if twin_turn else law).step(q, plain if twin_turn else task, DT)
+                    elapsed = time.perf_counter() - begin
+                    if twin_turn:
+                        untimed.append(elapsed)
+                    else:
+                        for name, value in spent.items():
+                            parts[name].append(value)
     finally:
         lp_law.terms = terms
+    named = np.sum([parts[name] for name in ("kinematics", "rows", "vertex")], axis=0)
+    parts["glue"], parts["total"] = list(np.array(untimed) - named), untimed
     result = {name: float(np.median(values) * 1e6) for name, values in parts.items()}
     result["highs_runs"] = float(np.mean(np.array(parts["highs"]) > 0.0))
     return result
