@@ -28,7 +28,9 @@ def write(path: Path, rows: list[dict[str, Any]]) -> None:
     """``rows`` into ``path``, sorted by the runs' places."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    table = pa.Table.from_pylist(sorted(rows, key=lambda row: row["index"]))
+    names = list(dict.fromkeys(name for row in rows for name in row))  # every row's columns
+    ordered = sorted(rows, key=lambda row: row["index"])
+    table = pa.Table.from_pylist([{name: row.get(name) for name in names} for row in ordered])
     with written_whole(path) as partial:
         pq.write_table(table, partial)
 

@@ -142,3 +142,15 @@ def test_a_range_of_seeds_that_is_none_is_one_line(tmp_path, seeds) -> None:
     with pytest.raises(StudyError, match="neither a seed nor a range") as error:
         load_study(file)
     assert "\n" not in str(error.value)
+
+
+def test_rows_of_both_loops_keep_each_its_columns(tmp_path) -> None:
+    """A kinematic row and a simulated one in one file: each keeps the columns the other has
+    not (pyarrow takes a table's columns from its first row unless told)."""
+    path = tmp_path / "both.parquet"
+    rows = [{"index": 1, "key": "b", "report": "{}"}, {"index": 0, "key": "a", "goal_q": [1.0]}]
+    results.write(path, rows)
+    assert results.read(path) == [
+        {"index": 0, "key": "a", "goal_q": [1.0], "report": None},
+        {"index": 1, "key": "b", "goal_q": None, "report": "{}"},
+    ]
