@@ -1,15 +1,17 @@
 """Several components of one profile in one process (a profile's ``processes: shared``).
 
-    python -m components.container --profile P --names a,b,c --params-dir D
+    python -m components.container --profile P --names a,b,c --params-dir D [--ahead]
 
 runs each named component as ``python -m components.<module>`` would, with its own ``Node``
 and threads, in this one process: the interpreter and the libraries they import (NumPy, Zenoh,
 OpenCV, HiGHS) load once instead of once per component, and they share one Zenoh session (unless
 the profile's components authenticate or are clients), so that a sample between two of them is
-handed over in the session, not copied over a socket. They start in the order
-given and close in the reverse order, on SIGINT, SIGTERM, the end of the launcher or the
-``fail`` of one of them; the parameters set on component N while it runs are kept in
-``D/N.json``, as the launcher keeps them for a process of its own.
+handed over in the session, not copied over a socket. They start in the order given (with
+``--ahead``, once a line on its input says so: the launcher starts the process while the
+recorders start, so that it loads its modules meanwhile) and close in the reverse order, on
+SIGINT, SIGTERM, the end of the launcher or the ``fail`` of one of them; the parameters set on
+component N while it runs are kept in ``D/N.json``, as the launcher keeps them for a process
+of its own.
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from components.process_entry import serve, start_logging
+from components.process_entry import StopRequested, serve, start_logging
 from components.runtime import Component
 from messages.process import EXIT_CONFIG_ERROR
 from profiles.profile import ProfileError, load_profile
@@ -28,8 +30,9 @@ from profiles.profile import ProfileError, load_profile
 MODULE = "components.container"
 
 
-def command(profile: Path, names: Sequence[str], params_dir: Path) -> list[str]:
-    """The command line running components ``names`` of ``profile`` in one process."""
+def command(profile: Path, names: Sequence[str], params_dir: Path, ahead: bool) -> list[str]:
+    """The command line running components ``names`` of ``profile`` in one process; ``ahead``:
+    once a line on its input says so, after loading their modules."""
     return [
         sys.executable,
         "-m",
@@ -40,6 +43,7 @@ def command(profile: Path, names: Sequence[str], params_dir: Path) -> list[str]:
         ",".join(names),
         "--params-dir",
         str(params_dir),
+        *(["--ahead"] if ahead else []),
     ]
 
 
@@ -63,6 +67,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--profile", required=True, help="the deploy profile (YAML)")
     parser.add_argument("--names", required=True, help="the components to run, comma-separated")
     parser.add_argument("--params-dir", type=Path, required=True, help="kept parameters' folder")
+    parser.add_argument("--ahead", action="store_true", help="start them on a line of input")
     parser.add_argument("--log-level", default="INFO", help="DEBUG, INFO, WARNING or ERROR")
     args = parser.parse_args(argv)
     start_logging(args.log_level)
@@ -73,6 +78,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (ProfileError, KeyError) as error:
         print(f"{args.profile}: {error}", file=sys.stderr)
         return EXIT_CONFIG_ERROR
+    try:
+        if args.ahead and not sys.stdin.readline():
+            return 0  # the launcher stopped before it said to start
+    except StopRequested:
+        return 0
     members = [
         (cls, spec.name, args.params_dir / f"{spec.name}.json")
         for cls, spec in zip(classes, specs, strict=True)

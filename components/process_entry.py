@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import json
 import logging
 import os
 import signal
@@ -34,14 +35,14 @@ from profiles.profile import ProfileError, load_profile
 log = logging.getLogger("components")
 
 
-class _StopRequested(Exception):
+class StopRequested(Exception):
     """Raised in the main thread by SIGINT or SIGTERM."""
 
 
 def _on_stop_signal(signum: int, _frame: object) -> None:
     for stop_signal in (signal.SIGINT, signal.SIGTERM):
         signal.signal(stop_signal, signal.SIG_IGN)
-    raise _StopRequested(signal.Signals(signum).name)
+    raise StopRequested(signal.Signals(signum).name)
 
 
 def _wait_for_stop(nodes: Sequence[Node]) -> None:
@@ -97,23 +98,33 @@ def _configure(
 
 
 def start_logging(level: str) -> None:
-    """Log to stderr at ``level``, and stop on SIGINT and SIGTERM (``_StopRequested``)."""
+    """Log to stderr at ``level``, and stop on SIGINT and SIGTERM (``StopRequested``)."""
     logging.basicConfig(level=level.upper(), stream=sys.stderr, format="%(levelname)s %(message)s")
     for stop_signal in (signal.SIGINT, signal.SIGTERM):
         signal.signal(stop_signal, _on_stop_signal)
 
 
-def _shared_session(profile_path: str) -> zenoh.Session | None:
-    """One session for the components of this process: a sample one of them publishes reaches
-    the others in the process without a copy on the network. None (a session each) when the
-    components authenticate, each as its name (``zenoh.access``), or are clients."""
+TX_QUEUE_KEY = "transport/link/tx/queue/size/data"
+"""A link's queue of data batches (Zenoh's default 2, at most 16): full, a sample waits a
+millisecond, then is dropped."""
+
+
+def _shared_session(profile_path: str, members: int) -> zenoh.Session | None:
+    """One session for the ``members`` components of this process: a sample one of them
+    publishes reaches the others in the process without a copy on the network; each of its
+    links queues what the links of their sessions each queued (a recorder starved of CPU
+    once lost 0.4 s of a lockstep run's commands behind the default). None (a session each)
+    when the components authenticate, each as its name (``zenoh.access``), or are clients."""
     try:
         zenoh_settings = load_profile(profile_path).zenoh
     except ProfileError:
         return None  # each component's configuration says why
     if zenoh_settings.access is not None or zenoh_settings.mode == "client":
         return None
-    return zenoh.open(zenoh_settings.component_config())
+    config = zenoh_settings.component_config()
+    queued = json.loads(config.get_json(TX_QUEUE_KEY))
+    config.insert_json5(TX_QUEUE_KEY, json.dumps(min(16, queued * members)))
+    return zenoh.open(config)
 
 
 def serve(profile_path: str, members: Sequence[tuple[type[Component], str, Path | None]]) -> int:
@@ -124,7 +135,7 @@ def serve(profile_path: str, members: Sequence[tuple[type[Component], str, Path 
     name = ""
     try:
         with contextlib.ExitStack() as stack:
-            session = _shared_session(profile_path) if len(members) > 1 else None
+            session = _shared_session(profile_path, len(members)) if len(members) > 1 else None
             if session is not None:
                 stack.callback(session.close)  # once every node has closed
             for component_class, name, params_file in members:
@@ -140,7 +151,7 @@ def serve(profile_path: str, members: Sequence[tuple[type[Component], str, Path 
                     return EXIT_CONFIG_ERROR
                 node.start(component.shutdown, component.clock_stalled)
             _wait_for_stop(nodes)
-    except _StopRequested as stop:
+    except StopRequested as stop:
         names = ", ".join(node.name for node in nodes) or name
         log.info("%s stopping on %s", names, stop)
     except zenoh.ZError as error:

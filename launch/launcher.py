@@ -153,6 +153,8 @@ class Launcher:
         self._duration_s: float | None = None
         self._deadline: float | None = None
         """When the duration ends: set once every component is alive."""
+        self._ahead: tuple[list[str], subprocess.Popen[str]] | None = None
+        """The shared children's process started ahead, waiting for the word to start them."""
 
     def run(self, duration_s: float | None = None) -> int:
         """Run until a stop signal, the duration (from the moment every component is alive),
@@ -174,6 +176,7 @@ class Launcher:
             )
             try:
                 self._start_ready()
+                self._start_ahead()
                 if self.recorders and len(self.recorders) < len(self.children):
                     self.output.say(
                         f"the others start once {' and '.join(self.recorders)} "
@@ -195,6 +198,7 @@ class Launcher:
                 for stop_signal in (signal.SIGINT, signal.SIGTERM):
                     signal.signal(stop_signal, signal.SIG_IGN)
                 self._stop_all()
+                self._end_ahead(self._ahead)
                 watcher.undeclare()
                 shutil.rmtree(self._kept_params, ignore_errors=True)
         failed = [child.spec.name for child in self.children if child.failed]
@@ -342,24 +346,57 @@ class Launcher:
                 self._start(child)
 
     def _start(self, child: Child) -> None:
-        """Start a child's process and the threads that forward its output; a shared child's
-        with the others of ``shared`` not running and not done."""
-        spec = child.spec
+        """Start a child's process; a shared child's with the others of ``shared`` not running
+        and not done (in the process started ahead for them, if it waits)."""
         group = [child]
         if child in self.shared:
             group = [c for c in self.shared if c.process is None and not c.done]
         names = [c.spec.name for c in group]
+        ahead, self._ahead = self._ahead, None
+        popen = None
+        if ahead is not None and ahead[0] == names and ahead[1].poll() is None:
+            try:
+                ahead[1].stdin.write("go\n")
+                ahead[1].stdin.close()
+                popen = ahead[1]
+            except OSError:  # it ended meanwhile
+                pass
+        if popen is None:
+            self._end_ahead(ahead)
+            popen = self._spawn(group)
+        for member in group:
+            member.process, member.waiting = popen, False
+            member.started_at, member.restart_at, member.alive = time.monotonic(), None, False
+        label = f"{', '.join(names)} in one process" if len(group) > 1 else child.spec.name
+        module = container.MODULE if len(group) > 1 else child.spec.module_path
+        self.output.say(f"started {label} ({module}, pid {popen.pid})")
+
+    def _start_ahead(self) -> None:
+        """The shared children's process, started while they wait for the recorders: it loads
+        its modules meanwhile, and starts them on the word (``_start``)."""
+        if self.shared and all(c.waiting for c in self.shared):
+            names = [c.spec.name for c in self.shared]
+            self._ahead = (names, self._spawn(self.shared, ahead=True))
+
+    def _end_ahead(self, ahead: tuple[list[str], subprocess.Popen[str]] | None) -> None:
+        if ahead is not None:
+            ahead[1].kill()
+            ahead[1].wait()
+
+    def _spawn(self, group: list[Child], ahead: bool = False) -> subprocess.Popen[str]:
+        """The process of ``group`` (one child, or shared children: ``components.container``,
+        waiting for a word on its input when ``ahead``) and the threads forwarding its output."""
+        names = [c.spec.name for c in group]
         env = dict(os.environ, PYTHONUNBUFFERED="1", **{PARENT_PID_ENV: str(os.getpid())})
         if len(group) > 1:
-            command = container.command(self.profile_path, names, self._kept_params)
-            label, prefix = f"{', '.join(names)} in one process", "+".join(names)
+            command = container.command(self.profile_path, names, self._kept_params, ahead)
         else:
+            spec = group[0].spec
             command = process.command(spec.module_path, self.profile_path, spec.name)
-            label, prefix = spec.name, spec.name
             env[PARAMS_FILE_ENV] = str(self._kept_params / f"{spec.name}.json")
         popen = subprocess.Popen(
             command,
-            stdin=subprocess.DEVNULL,
+            stdin=subprocess.PIPE if ahead else subprocess.DEVNULL,
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
             env=env,
@@ -368,13 +405,10 @@ class Launcher:
             start_new_session=True,
             pass_fds=self.pass_fds,
         )
-        for member in group:
-            member.process, member.waiting = popen, False
-            member.started_at, member.restart_at, member.alive = time.monotonic(), None, False
+        prefix = "+".join(names)
         for pipe, stream in ((popen.stdout, self.output.out), (popen.stderr, self.output.err)):
             threading.Thread(target=self._forward, args=(pipe, stream, prefix), daemon=True).start()
-        module = container.MODULE if len(group) > 1 else spec.module_path
-        self.output.say(f"started {label} ({module}, pid {popen.pid})")
+        return popen
 
     def _forward(self, pipe: IO[str], stream: IO[str], name: str) -> None:
         """Copy a child's pipe to ``stream`` line by line, prefixed with its name."""
