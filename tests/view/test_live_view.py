@@ -27,6 +27,7 @@ from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.session_file import CARRIED_FIELD, CARRIER, from_json, schema_of
 from scenes.foxglove_views import View
+from tests.parsimony.in_process import completed
 from tests.scenes.views_read import decode
 from tests.view.live_view_client import (
     DEADLINE_S,
@@ -154,19 +155,6 @@ def test_a_websocket_client_sees_live_images_and_frames(system) -> None:
 
 
 def test_keys_that_match_no_topic_are_refused(tmp_path: Path) -> None:
-    done = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "parsimony.cli",
-            "view",
-            str(write_profile(tmp_path)),
-            "--keys",
-            "camera/imag",
-        ],
-        capture_output=True,
-        text=True,
-        timeout=60,
-    )
+    done = completed("view", str(write_profile(tmp_path)), "--keys", "camera/imag")
     assert done.returncode == 2
     assert "keys: 'camera/imag' matches no topic" in done.stderr
