@@ -234,7 +234,8 @@ class WarmStartedLP:
         values = u.tolist()
         magnitudes = list(map(abs, values))
         active = _active(u, values, magnitudes, linear, norms, limits)
-        return LPSolution(u, status, objective, active, magnitudes)
+        # The named tuple built by tuple.__new__: the same value, without its __new__'s frame.
+        return tuple.__new__(LPSolution, (u, status, objective, active, magnitudes))
 
     def _velocity_costs(self, costs: list[VelocityCost], n: int) -> tuple[Array, Array]:
         """c_P and c_N, the sums of the velocity costs' weights, kept while the terms return the

@@ -114,18 +114,22 @@ def program(
     else:
         error_rate = -eta * error
     goal_pose = task.pose if isinstance(task, PoseTask) else None
-    context = StepContext(
-        robot,
-        q,
-        error,
-        error_rate,
-        task.goal_position[:2],
-        circles,
-        goal_pose,
-        dt,
-        solids,
-        previous_u,
-        chain,
+    # The named tuple built by tuple.__new__: the same value, without its own __new__'s frame.
+    context = tuple.__new__(
+        StepContext,
+        (
+            robot,
+            q,
+            error,
+            error_rate,
+            task.goal_position[:2],
+            circles,
+            goal_pose,
+            dt,
+            solids,
+            previous_u,
+            chain,
+        ),
     )
     costs, rows = terms(context, task_jacobian, eta, constraints, objectives)
     return costs, rows, error, (task, error)
