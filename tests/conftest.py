@@ -11,6 +11,7 @@ read by the others (pytest-xdist's way: a file lock in the folder the workers sh
 from __future__ import annotations
 
 import fcntl
+import shutil
 from collections.abc import Callable
 from pathlib import Path
 
@@ -32,7 +33,8 @@ def shared(factory: pytest.TempPathFactory, name: str, make: Callable[[Path], No
     with (base / "shared" / f"{name}.lock").open("w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
         if not done.exists():
-            folder.mkdir(exist_ok=True)
+            shutil.rmtree(folder, ignore_errors=True)  # what a failed make left
+            folder.mkdir()
             make(folder)
             done.touch()
     return folder
