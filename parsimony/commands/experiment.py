@@ -7,13 +7,14 @@ import argparse
 import math
 import sys
 from pathlib import Path
+from typing import get_args
 
 import yaml
 
 from launch.query import QueryError
 from outputs.stdout import emit, json_text
 from parsimony.commands.robot_option import add_robot_option
-from profiles.profile import ProfileError
+from profiles.profile import Profile, ProfileError
 from sim2d.scenarios import NAMES, SEED_MAX
 from studies.experiment import PROFILES, TIME_LIMIT_S, Options, run_experiment
 from wbc.robot import RobotDescriptionError
@@ -115,6 +116,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         "cascade's: CascadeParams), e.g. obstacle_mode=border, or saturate=true "
         "with --controller cascade",
     )
+    parser.add_argument(
+        "--processes",
+        choices=get_args(Profile.model_fields["processes"].annotation),
+        help="the components in a process each, or sharing one (by default shared in lockstep, "
+        "the profile's own otherwise)",
+    )
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
     return parser
 
@@ -138,6 +145,7 @@ def run(args: argparse.Namespace) -> int:
         hide_base_marker=args.hide_base_marker,
         robot=args.robot,
         gains=dict(args.gain),
+        processes=args.processes,
     )
     try:
         report = run_experiment(options)
