@@ -117,7 +117,8 @@ class _Layout:
         """w_b of the residual cost each residual row belongs to."""
         starts = np.cumsum([0, *residual_rows]).tolist()
         self._slices = [slice(a, b) for a, b in zip(starts, starts[1:], strict=False)]
-        self._weights: list[float] = []
+        self.weights: list[float] = []
+        """The residual costs' weights ``row_weight`` and the costs of y were set from."""
         self.col_lower = np.zeros(self.columns)
         self.col_upper = np.full(self.columns, INF)
         # Views of the buffers each step writes, made once for the shape.
@@ -134,12 +135,12 @@ class _Layout:
         """The linear row sets that hold rows (by their place among the linear ones)."""
 
     def weigh(self, weights: list[float]) -> None:
-        """Set ``row_weight`` from the weight of each residual cost (kept while they hold)."""
-        if weights != self._weights:
-            for rows, weight in zip(self._slices, weights, strict=True):
-                self.row_weight[rows] = weight
-            np.multiply(2.0, self.row_weight, out=self.cost[2 * self.n :])
-            self._weights = weights
+        """Set ``row_weight`` and the costs of y from the weight of each residual cost (a step
+        calls it when they differ from ``weights``)."""
+        for rows, weight in zip(self._slices, weights, strict=True):
+            self.row_weight[rows] = weight
+        np.multiply(2.0, self.row_weight, out=self.cost[2 * self.n :])
+        self.weights = weights
 
 
 class WarmStartedLP:
@@ -211,7 +212,9 @@ class WarmStartedLP:
         elif layout.filled:
             np.concatenate([linear[i].lower for i in layout.filled], out=layout.linear_lower)
             np.concatenate([linear[i].upper for i in layout.filled], out=layout.linear_upper)
-        layout.weigh(list(map(_WEIGHT, residuals)))
+        weights = list(map(_WEIGHT, residuals))
+        if weights != layout.weights:
+            layout.weigh(weights)
         # The costs of u_P: c_P - sum_b w_b 1'A_b, of u_N: c_N + sum_b w_b 1'A_b (rows weighted
         # by w), c_P and c_N the velocity costs of each entry's two directions; y_b's 2 w_b are
         # set with the weights (``_Layout.weigh``).
@@ -368,8 +371,7 @@ class _Kinds:
         self._slices.append(slice(ends[1], ends[3]))
 
     def pick(self, items: tuple) -> list[tuple]:
-        ordered = self._order(items)
-        return [ordered[group] for group in self._slices]
+        return list(map(self._order(items).__getitem__, self._slices))
 
 
 def _picker(places: list[int]) -> Callable[[tuple], tuple]:
@@ -401,7 +403,11 @@ def _active(
     (named ``name[i]``) when u_i sits on a finite, non-degenerate bound. ``values`` and
     ``magnitudes`` are u_i and |u_i| as Python floats.
     """
-    active = [rows.name for rows in linear if rows.engaged and _tight(rows, u)]
+    active = [
+        rows.name
+        for rows in linear
+        if rows.engaged and (rows.lower is rows.upper or _tight(rows, u))
+    ]
     if norms:
         split_sum = sum(magnitudes)  # 1'(u_P + u_N), the halves split canonically
         active += [bound.name for bound in norms if split_sum >= bound.limit - ACTIVE_TOLERANCE]
