@@ -112,6 +112,9 @@ class Options:
     """Gains of the law (``GAINS``' names) that replace the experiment's: another law on the
     same set-up, such as another obstacle constraint (``obstacle_mode``) or the cascade held
     to the robot's bounds (``saturate``)."""
+    figures: bool = True
+    """Draw the report's figures into ``out`` (``analysis.report``): a study's runs, which keep
+    their figures as numbers, skip the seconds they cost."""
     processes: str | None = None
     """The profile's ``processes``; by default ``shared`` in lockstep (its components but the
     recorder in one process: the run starts and stops faster, same commands) unless the profile
@@ -355,14 +358,14 @@ def run_experiment(options: Options) -> dict[str, Any]:
     }
     run, _ = the_run(recorded, options.time_limit_s)
     (options.out / "commands.csv").write_text(commands_csv(run, robot))
-    label = options.controller
-    say("drawing the figures")
-    if report["recording"]["missing"]:
-        label += " (RECORDING CUT SHORT: " + "; ".join(report["recording"]["missing"]) + ")"
-    figures = write_report([(label, run)], robot, options.out, profile.scene.reference_pose)[
-        "figures"
-    ]
-    report["figures"] = [str(path) for path in figures]
+    report["figures"] = []
+    if options.figures:
+        label = options.controller
+        say("drawing the figures")
+        if report["recording"]["missing"]:
+            label += " (RECORDING CUT SHORT: " + "; ".join(report["recording"]["missing"]) + ")"
+        drawn = write_report([(label, run)], robot, options.out, profile.scene.reference_pose)
+        report["figures"] = [str(path) for path in drawn["figures"]]
     (options.out / "report.json").write_text(json_text(report, indent=2))
     return report
 

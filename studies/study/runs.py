@@ -119,6 +119,7 @@ def simulated(run: Run) -> dict[str, Any]:
         out=Path(run.out),
         robot=Path(run.robot_file),
         gains=json.loads(p["gains"]),
+        figures=False,
     )
     report = run_experiment(options)
     session, _ = the_run(load_session(Path(run.out) / SESSION_FILE, JUDGED), TIME_LIMIT_S)

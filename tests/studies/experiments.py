@@ -35,7 +35,9 @@ def experiment(out: Path, *arguments: str, stderr: list[str] | None = None) -> t
 
 def run_here(out: Path, name: str, **options: Any) -> dict:
     """Experiment ``name`` with ``options`` (``studies.experiment.Options``) run by the command's
-    own function in this process: its report, as written to ``out/report.json``."""
+    own function in this process: its report, as written to ``out/report.json``. Its figures
+    are drawn only if asked (``figures=True``): a few seconds of CPU each run."""
+    options.setdefault("figures", False)
     report = json.loads(json_text(run_experiment(Options(name, out=out, **options))))
     assert report == json.loads((out / "report.json").read_text())
     return report

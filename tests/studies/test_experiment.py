@@ -150,6 +150,9 @@ def test_the_qp_controller_runs_the_pose_experiment_as_the_lp_does(tmp_path: Pat
     assert max(histogram, key=histogram.get) == 8, histogram
     errors = [d.error_norm for d in steps if d.error_norm is not None]
     assert errors[-1] < 0.5 * errors[0], (errors[0], errors[-1])  # on its way to the goal
+    # Not asked for figures (a study's runs are not): none drawn, the rest of the report whole.
+    assert report["figures"] == [] and not list(tmp_path.glob("*.png"))
+    assert (tmp_path / "commands.csv").is_file()
 
 
 def obstacle_rows(out: Path) -> tuple[set[str], set[str]]:
@@ -187,12 +190,14 @@ def test_table_experiment_reaches_over_the_edge_without_touching_the_table(tmp_p
     counts the penetrations from the true kinematics; blind to it, the LP goes through the
     table's edge within the first simulated second (the blind run cut at SHORT_RUN_S; that it
     reaches the goal so is `parsimony demo`'s, tests/parsimony/test_cli.py)."""
-    report = run_here(tmp_path / "guarded", "table")
+    report = run_here(tmp_path / "guarded", "table", figures=True)
     assert_sound(report)
     assert report["arm_penetrations"] == 0
     assert min(report["arm_clearance_m"].values()) > 0.0
     assert report["scenario"]["solids"][0]["name"] == "table"
-    blind = run_here(tmp_path / "blind", "table", gains={"arm_obstacles": False}, **SHORT_RUN)
+    blind = run_here(
+        tmp_path / "blind", "table", gains={"arm_obstacles": False}, figures=True, **SHORT_RUN
+    )
     assert blind["gains"] == {"arm_obstacles": False}
     assert blind["arm_penetrations"] > 0 and min(blind["arm_clearance_m"].values()) < -0.01
     # What a user opening the runs sees: the table in Foxglove's 3-D panel, where the scene

@@ -160,7 +160,11 @@ def whole(request: pytest.FixtureRequest, tmp_path_factory) -> tuple[str, dict, 
     """One lockstep pose experiment of the robot on the whole loop: its report and folder."""
     out = tmp_path_factory.mktemp(request.param)
     report = run_here(
-        out, "pose", robot=ROBOTS_DIR / f"{request.param}.yaml", time_limit_s=TIME_LIMIT_S
+        out,
+        "pose",
+        robot=ROBOTS_DIR / f"{request.param}.yaml",
+        time_limit_s=TIME_LIMIT_S,
+        figures=True,
     )
     return request.param, report, out
 
