@@ -12,7 +12,8 @@ camera publish on the real robot, every ``step_s`` of simulated time::
     sim/truth          the real pose, joints, end effector, contacts and the arm's penetrations
                        into the scene's solids in 3-D (tests and reports only)
 
-The readings are made by ``components.sim_sensors``, the frames by ``components.sim_camera``.
+They are published by ``components.sim_outputs`` (the readings made by
+``components.sim_sensors``, the frames by ``components.sim_camera``).
 The robot is the profile's ``robot:`` description: its joints (any number, revolute or
 prismatic, named as the description names them) and its base, driven by the wheel speeds of
 ``base/command`` when differential, by its forward, lateral and angular velocities when
@@ -52,17 +53,13 @@ from components.process_entry import run_component
 from components.pubsub import Input
 from components.robot_vector import RobotVector, of_robot
 from components.runtime import Component, Node
-from components.sim_camera import FrameFormat, SimCamera
-from components.sim_sensors import SimSensors
+from components.sim_outputs import SimOutputs
 from components.stop_latch import StopLatch
 from messages import topics
 from messages.clock import Clock
 from messages.commands import ArmCommand, BaseCommand
-from messages.obstacles import Circle as TruthCircle
-from messages.obstacles import Solids
 from messages.stop import StopState
 from profiles.scene import Scene
-from sim2d.camera import ImageNoise
 from sim2d.scenarios import SEED_MAX
 from sim2d.world import World, WorldSettings
 from wbc.geometry.obstacles import Circle
@@ -206,41 +203,24 @@ class Simulator(Component):
         )
         self.step_ns = round(p["step_s"] * 1e9)
         self.now_ns = time.time_ns() if p["host_epoch"] else 0
-        self.publishers = {t.name: node.publisher(t) for t in self.writes}
-        self.camera = (
-            SimCamera(
-                self.scene,
-                self.robot,
-                self.obstacles,
-                p["goal_marker"],
-                ImageNoise(p["image_noise"], p["image_blur_px"]),
-                np.random.default_rng(p["seed"] + 1),
-                self.publishers[topics.CAMERA_IMAGE.name].put,
-                self._camera_failed,
-            )
-            if p["camera"]
-            else None
-        )
-        self.frame_period_ns = round(1e9 / self.scene.camera.rate_hz)
-        self.next_frame_ns = self.now_ns
-        self.sensors = SimSensors(
-            self.world,
-            self.scene,
-            tuple(TruthCircle(x=c.x, y=c.y, radius=c.radius) for c in self.obstacles),
-            Solids.of(solids),
-            settings.counts_per_turn,
-        )
         self.last_command_ns: int | None = None
         self.gate = LockstepGate(
             node.counters,
             round(self.scene.camera.latency_s * 1e9),
             lambda: node.params["ack_timeout_s"],
         )
+        self.outputs = SimOutputs(
+            node,
+            self.writes,
+            self.world,
+            self.robot,
+            self.scene,
+            self.obstacles,
+            solids,
+            settings.counts_per_turn,
+            self.now_ns,
+        )
         self.frame_done = True
-        self.sensors_ns: int | None = None
-        node.counters["frames_skipped"] = 0
-        node.counters["contacts"] = 0
-        node.counters["arm_penetrations"] = 0
         node.counters["refused_arm_commands"] = 0
         commanded = {i.topic.name for i in self.reads} & set(COMMANDS)
         self.latch = StopLatch(node, self.on_stop) if commanded else None
@@ -263,7 +243,7 @@ class Simulator(Component):
         the run can see that every reader of the simulator's topics is reached before the first
         step (a reader reached only later misses the first camera frame)."""
         if self.node.params["paused"]:
-            self._put(topics.SIM_CLOCK, Clock(stamp_ns=self.now_ns, paused=True))
+            self.outputs.put(topics.SIM_CLOCK, Clock(stamp_ns=self.now_ns, paused=True))
 
     def _paced_tick(self) -> None:
         """Timer at the real-time factor's pace: step unless paused or an answer is awaited."""
@@ -293,10 +273,9 @@ class Simulator(Component):
         # On host time the stamps are the host's: the paced steps lag it under load.
         host = self.node.params["host_epoch"]
         self.now_ns = time.time_ns() if host else self.now_ns + self.step_ns
-        self._put(
-            topics.SIM_CLOCK, Clock(stamp_ns=self.now_ns, lockstep=self.node.params["lockstep"])
-        )
-        self.frame_done = self.camera is None or self.now_ns < self.next_frame_ns
+        clock = Clock(stamp_ns=self.now_ns, lockstep=self.node.params["lockstep"])
+        self.outputs.put(topics.SIM_CLOCK, clock)
+        self.frame_done = not self.outputs.frame_due(self.now_ns)
         self._go_on()
 
     def _go_on(self) -> None:
@@ -308,38 +287,20 @@ class Simulator(Component):
         if gate.frame_due(self.now_ns):
             return
         if gate.latency_ns >= self.step_ns:
-            self._publish_sensors()
+            self.outputs.sensors_of(self.now_ns)
         if not self.frame_done:
             if gate.frame_pending():
                 return
             self.frame_done = True
-            self.next_frame_ns += self.frame_period_ns
-            self._take_frame(lockstep)
+            self.outputs.frame(self.now_ns, lockstep)
             if lockstep:
                 gate.frame_taken(self.now_ns)
                 if gate.latency_ns == 0:
                     return gate.wait(FRAME_ANSWERS, self.now_ns)
-        self._publish_sensors()
+        self.outputs.sensors_of(self.now_ns)
         if lockstep:
             gate.wait(COMMANDS, self.now_ns)
             self._proceed(gate.check())  # the commands may be in already
-
-    def _publish_sensors(self) -> None:
-        """The joints, odometry and truth of the step, once."""
-        if self.sensors_ns == self.now_ns:
-            return
-        self.sensors_ns = self.now_ns
-        sensors = self.sensors
-        if topics.ARM_JOINT_STATES.name in self.publishers:  # not where drivers publish them
-            header = self._header("arm", topics.ARM_JOINT_STATES)
-            self._put(topics.ARM_JOINT_STATES, sensors.joints(header))
-        if topics.BASE_ODOMETRY.name in self.publishers:
-            header = self._header("odom", topics.BASE_ODOMETRY)
-            self._put(topics.BASE_ODOMETRY, sensors.odometry(header))
-        self.node.counters["contacts"] = self.world.contacts
-        self.node.counters["arm_penetrations"] = self.world.arm_penetrations
-        header = self._header("world", topics.SIM_TRUTH)
-        self._put(topics.SIM_TRUTH, sensors.truth(header, self.node.params["goal_marker"]))
 
     def _answer_handler(self, name: str):
         def on_answer(message) -> None:
@@ -368,7 +329,7 @@ class Simulator(Component):
             self._proceed(awaited)
         self._kick()  # also starts a run once ``paused`` is set false
 
-    # -- commands in, sensors out ---------------------------------------------------------
+    # -- commands in ----------------------------------------------------------------------
 
     def _take_command(self, name: str, message: BaseCommand | ArmCommand) -> None:
         """Hold a command until the next; an arm command whose joints are not the robot's is
@@ -416,37 +377,8 @@ class Simulator(Component):
             velocity = (base.forward_velocity, base.lateral_velocity, base.angular_velocity)
             self.world.drive(*velocity, joints)
 
-    def _header(self, frame: str, topic: topics.Topic):
-        return self.node.header(frame, self.now_ns, self.publishers[topic.name].next_seq)
-
-    def _put(self, topic: topics.Topic, message) -> None:
-        self.publishers[topic.name].put(message)
-
-    # -- the camera -----------------------------------------------------------------------
-
-    def _take_frame(self, lockstep: bool) -> None:
-        """Hand the camera the frame of now (in real time skipped, and counted, while the last
-        is being drawn)."""
-        p, now_s = self.node.params, self.now_ns / 1e9
-        hidden = any(start <= now_s < end for start, end in p["hide_base_marker"])
-        taken = self.camera.take(
-            self._header("camera", topics.CAMERA_IMAGE),
-            self.world.q,
-            hidden,
-            FrameFormat(p["image_format"], p["jpeg_quality"]),
-            wait=lockstep,
-        )
-        if not taken:
-            self.node.count("frames_skipped")
-
-    def _camera_failed(self) -> None:
-        """On the camera thread, in its ``except`` block: a frame could not be drawn."""
-        self.node.count("errors.camera")
-        self.node.warn("errors.camera", "drawing a camera frame failed", True)
-
     def shutdown(self) -> None:
-        if self.camera is not None:
-            self.camera.shutdown()
+        self.outputs.shutdown()
 
 
 if __name__ == "__main__":
