@@ -14,11 +14,11 @@ clamped to the robot's velocity limit. It becomes, per joint, a goal position ah
 present one in the direction of motion (``lookahead_s`` of the commanded speed, at least
 ``min_step`` units) at the commanded speed (Moving Speed, 0.111 rpm per unit, or Profile
 Velocity, 0.229 rpm per unit). A joint whose speed rounds to 0 (which would mean full speed)
-holds: its goal is
-its position read when it stops (not a reading from before: a joint still moving would move
-back to it after the stop), kept while it stays stopped, so it does not creep. All
-the goals and speeds go in one Sync Write, and every goal written lies inside the robot
-description's joint limits. With no command for ``command_timeout_s`` the arm holds.
+holds: its goal is its position read when it stops (not a reading from before: a joint still
+moving would move back to it after the stop), kept while it stays stopped, so it does not
+creep. All the goals and speeds go in one Sync Write, and every goal written lies inside the
+robot description's joint limits (the goals: ``components.arm_goals``). With no command for
+``command_timeout_s`` the arm holds.
 
 Each answer is checked (the protocol's ``status_fault``): a servo that is silent (for
 ``answer_timeout_s``, by default the SDK's packet timeout), or answers a truncated packet, a
@@ -40,6 +40,7 @@ from collections.abc import Collection, Sequence
 
 from dynamixel_sdk import COMM_SUCCESS, PortHandler
 
+from components.arm_goals import ArmGoals
 from components.joint_check import joints_match
 from components.params import Param, ParamError
 from components.process_entry import run_component
@@ -137,17 +138,9 @@ class ArmDriver(Component):
             servos = servos.with_ids(of_robot("ids", node.params["ids"], joints, names))
         self.servos = servos
         self.ids = servos.ids
-        ends = [
-            sorted((servos.servo_angle(i, self.low[i]), servos.servo_angle(i, self.high[i])))
-            for i in range(joints)
-        ]
         self.port = PortHandler(str(node.params["port"]))
         bus = self.bus = BUSES[node.params["protocol"]](self.port, node.params["answer_timeout_s"])
-        self.goal_low = [max(0, math.ceil(bus.position_of_angle(low))) for low, _ in ends]
-        self.goal_high = [
-            min(bus.position_max, math.floor(bus.position_of_angle(high))) for _, high in ends
-        ]
-        """The Goal Positions inside the joint limits (every goal written lies in them)."""
+        self.goals = ArmGoals(servos, bus, self.low, self.high, node.params)
         self.connected = False
         for name in (
             "sync_writes",
@@ -166,8 +159,6 @@ class ArmDriver(Component):
             node.counters[f"servo_error.{name}"] = 0
         self.present: list[float | None] = [None] * joints
         """The last good reading of each joint (inside its limits)."""
-        self.held: list[int | None] = [None] * joints
-        """The goal a stopped joint holds, units; None while it moves."""
         self.fault = ""
         """Why the arm holds whatever it is told; empty when every servo answers well."""
         self.holding = True
@@ -282,7 +273,7 @@ class ArmDriver(Component):
         self.node.warn("holding", f"every servo answers again (was: {self.fault})")
         self.fault = ""
         self.node.state = "running"
-        self.held = [None] * len(self.ids)
+        self.goals.held = [None] * len(self.ids)
         self.hold()
         self._enable_torque()
 
@@ -322,31 +313,19 @@ class ArmDriver(Component):
                 velocity = math.copysign(limit, velocity)
             limited.append(velocity)
         self._read_stopping([i for i, v in enumerate(limited) if self.bus.speed_units(v) is None])
-        goals, speeds = zip(*(self._goal(i, v) for i, v in enumerate(limited)), strict=True)
+        present = self.present
+        aims = (self.goals.ahead(i, v, present[i]) for i, v in enumerate(limited))
+        goals, speeds = zip(*aims, strict=True)
         self.holding = False
         self._sync_write(goals, speeds)
         self.timeout.set(self.node.params["command_timeout_s"])
-
-    def _goal(self, index: int, velocity: float) -> tuple[int, int]:
-        """Joint ``index``'s goal (units) and Moving Speed for a finite ``velocity`` (rad/s)."""
-        speed = self.bus.speed_units(velocity)
-        if speed is None:
-            return self._held(index), HOLD_SPEED
-        self.held[index] = None
-        present = self.present[index]
-        assert present is not None
-        step = max(
-            abs(velocity) * self.node.params["lookahead_s"],
-            self.node.params["min_step"] / self.bus.units_per_rad,
-        )
-        return self._inside_limits(index, present + math.copysign(step, velocity)), speed
 
     def _read_stopping(self, joints: Sequence[int], failed: Collection[int] = ()) -> None:
         """Read the ``joints`` that start to hold now (``present``), but those whose servo has
         just ``failed`` to answer; read again those read before a servo that failed now (its
         timeout passed since). A reading of the last cycle, or from before a timeout, lies
         behind a joint still moving: held there, it moved back after the stop."""
-        stopping = [i for i in joints if self.held[i] is None and i not in failed]
+        stopping = [i for i in joints if self.goals.held[i] is None and i not in failed]
         try:
             answered = [not isinstance(self._reading(i), str) for i in stopping]
             if False in answered:
@@ -356,21 +335,6 @@ class ArmDriver(Component):
                         self._reading(index)
         except (OSError, TypeError) as error:  # the port went away under the SDK
             self._lost(error)
-
-    def _held(self, index: int) -> int:
-        """The goal joint ``index`` holds: where it was read when it stopped (the last good
-        reading if its servo did not answer then), kept while it stays stopped."""
-        if self.held[index] is None:
-            present = self.present[index]
-            assert present is not None
-            self.held[index] = self._inside_limits(index, present)
-        return self.held[index]
-
-    def _inside_limits(self, index: int, q: float) -> int:
-        """The Goal Position of joint position ``q`` (finite), clamped to the joint's limits in
-        units."""
-        units = self.bus.position_units(self.servos.servo_angle(index, q))
-        return min(max(units, self.goal_low[index]), self.goal_high[index])
 
     def hold(self, failed: Collection[int] = ()) -> None:
         """Every joint's goal where it stopped, slowly: the arm stops where it is. Written again
@@ -385,17 +349,13 @@ class ArmDriver(Component):
         self.timeout.cancel()
         joints = range(len(self.ids))
         self._read_stopping(joints, failed)
-        self._sync_write([self._held(i) for i in joints], [HOLD_SPEED] * len(joints))
+        goals = [self.goals.holding(i, self.present[i]) for i in joints]
+        self._sync_write(goals, [HOLD_SPEED] * len(joints))
 
     def _sync_write(self, goals: Sequence[int], speeds: Sequence[int]) -> None:
         if not self.connected:  # a read on the way found the port gone
             return
-        for index, (servo, goal, speed) in enumerate(zip(self.ids, goals, speeds, strict=True)):
-            if not (
-                self.goal_low[index] <= goal <= self.goal_high[index]
-                and 1 <= speed <= self.bus.speed_max
-            ):
-                raise ValueError(f"servo {servo}: goal {goal} or speed {speed} out of range")
+        self.goals.check(self.ids, goals, speeds)
         try:
             result = self.bus.write_goals(self.ids, goals, speeds)
         except (OSError, TypeError) as error:
