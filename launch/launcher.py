@@ -25,11 +25,12 @@ With ``processes: shared`` the components that are not recorders and start ``aft
 in one process (``components.container``), started once the recorders are alive. Each is still
 watched, reported and stopped by name, but a fault that ends that process (a kill, a component
 found hung) ends them all, and those restarted by their policy start again together.
+
+A child's process is started by ``launch.spawn`` and stopped by ``launch.stop``.
 """
 
 from __future__ import annotations
 
-import os
 import shutil
 import signal
 import subprocess
@@ -37,87 +38,26 @@ import sys
 import tempfile
 import threading
 import time
-from dataclasses import dataclass
-from datetime import datetime
-from itertools import groupby
 from pathlib import Path
 from typing import IO
 
 import zenoh
 
 from components import container
+from launch.child import Child
+from launch.output import Output
 from launch.query import statuses
-from messages import process, topics
-from messages.process import (
-    EXIT_CONFIG_ERROR,
-    EXIT_FOR_GOOD,
-    PARAMS_FILE_ENV,
-    PARENT_PID_ENV,
-    parent_gone,
-)
-from profiles.profile import ROLES, ComponentSpec, Profile
+from launch.spawn import spawn
+from launch.stop import stop_all
+from messages import topics
+from messages.process import EXIT_CONFIG_ERROR, EXIT_FOR_GOOD, parent_gone
+from profiles.profile import ComponentSpec, Profile
 
 POLL_S = 0.05
 """How often the launcher looks at its children and the clock."""
 
-CLEAN_STOP_CODES = (0, -signal.SIGTERM)
-"""Exit codes that count as a clean stop after SIGTERM."""
-QUIET_WAIT_S = 1.0
-"""A stopping component slower than this is said to be waited for."""
 UNREPORTED_STATES = ("starting", "stopping")
 """States a component passes through that the launcher's own lines already say."""
-
-
-class Output:
-    """Writes whole prefixed lines from many threads to two streams."""
-
-    def __init__(self, out: IO[str], err: IO[str]) -> None:
-        self.out = out
-        self.err = err
-        self._lock = threading.Lock()
-
-    def line(self, stream: IO[str], prefix: str, text: str) -> None:
-        """Write ``HH:MM:SS.mmm [prefix] text`` as one line (the local time) and flush it."""
-        stamp = datetime.now().strftime("%H:%M:%S.%f")[:-3]
-        with self._lock:
-            stream.write(f"{stamp} [{prefix}] {text.rstrip()}\n")
-            stream.flush()
-
-    def say(self, text: str) -> None:
-        """A line of the launcher's own, on the error stream."""
-        self.line(self.err, "launch", text)
-
-
-@dataclass
-class Child:
-    """One component's process and its restart bookkeeping."""
-
-    spec: ComponentSpec
-    process: subprocess.Popen[str] | None = None
-    waiting: bool = True
-    """Not started yet: it waits for the components it starts ``after``."""
-    started_at: float = 0.0
-    restarts: int = 0
-    restart_at: float | None = None
-    done: bool = False
-    failed: bool = False
-    alive: bool = False
-    """Whether the current process's liveliness token is present."""
-    answered_at: float = 0.0
-    """When it last answered a status query, or came alive (the watchdog's reference)."""
-    state: str = "running"
-    """Its ``state`` as last reported (a component comes alive running)."""
-    stopping: bool = False
-    """Sent SIGTERM by the stop: its token going is no loss."""
-
-
-def cpu_seconds(pid: int) -> float:
-    """The user and system CPU time a process has spent (Linux /proc), 0 when it is gone."""
-    try:
-        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-    except OSError:
-        return 0.0
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 class Launcher:
@@ -197,7 +137,7 @@ class Launcher:
             finally:
                 for stop_signal in (signal.SIGINT, signal.SIGTERM):
                     signal.signal(stop_signal, signal.SIG_IGN)
-                self._stop_all()
+                stop_all(self.children, self.profile, self.output)
                 self._end_ahead(self._ahead)
                 watcher.undeclare()
                 shutil.rmtree(self._kept_params, ignore_errors=True)
@@ -384,37 +324,10 @@ class Launcher:
             ahead[1].wait()
 
     def _spawn(self, group: list[Child], ahead: bool = False) -> subprocess.Popen[str]:
-        """The process of ``group`` (one child, or shared children: ``components.container``,
-        waiting for a word on its input when ``ahead``) and the threads forwarding its output."""
-        names = [c.spec.name for c in group]
-        env = dict(os.environ, PYTHONUNBUFFERED="1", **{PARENT_PID_ENV: str(os.getpid())})
-        if len(group) > 1:
-            command = container.command(self.profile_path, names, self._kept_params, ahead)
-        else:
-            spec = group[0].spec
-            command = process.command(spec.module_path, self.profile_path, spec.name)
-            env[PARAMS_FILE_ENV] = str(self._kept_params / f"{spec.name}.json")
-        popen = subprocess.Popen(
-            command,
-            stdin=subprocess.PIPE if ahead else subprocess.DEVNULL,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            env=env,
-            text=True,
-            errors="replace",
-            start_new_session=True,
-            pass_fds=self.pass_fds,
-        )
-        prefix = "+".join(names)
-        for pipe, stream in ((popen.stdout, self.output.out), (popen.stderr, self.output.err)):
-            threading.Thread(target=self._forward, args=(pipe, stream, prefix), daemon=True).start()
-        return popen
-
-    def _forward(self, pipe: IO[str], stream: IO[str], name: str) -> None:
-        """Copy a child's pipe to ``stream`` line by line, prefixed with its name."""
-        with pipe:
-            for text in pipe:
-                self.output.line(stream, name, text)
+        """``spawn`` the process of ``group`` with this launch's profile file, kept parameters
+        and inherited descriptors."""
+        specs = [c.spec for c in group]
+        return spawn(specs, self.profile_path, self._kept_params, self.pass_fds, self.output, ahead)
 
     def _on_exit(self, child: Child, code: int, now: float) -> None:
         """Decide what a child's exit means: done, failed, or a restart after a backoff."""
@@ -443,68 +356,3 @@ class Launcher:
             f"{spec.name} exited with {code}; "
             f"restart {child.restarts}/{policy.max_restarts} in {delay:.1f} s"
         )
-
-    def _stop_all(self) -> None:
-        """Stop the running children role by role, tools first and drivers last, and in a role
-        each before the components it started ``after``."""
-        for child in self.children:
-            if child.restart_at is not None:
-                child.failed = True
-                self.output.say(f"{child.spec.name} was waiting to restart; counted as failed")
-
-        def order(child: Child) -> tuple[int, int]:
-            return ROLES.index(child.spec.role), self.profile.start_depth(child.spec)
-
-        running = sorted(
-            (c for c in self.children if c.process is not None), key=order, reverse=True
-        )
-        for _, wave in groupby(running, key=order):
-            group = list(wave)
-            for popen in {id(c.process): c.process for c in group}.values():
-                for child in self.children:
-                    child.stopping = child.stopping or child.process is popen
-                popen.send_signal(signal.SIGTERM)  # none if it has ended (shared, stopped)
-            stopped_at = time.monotonic()
-            for child in group:
-                self._reap(child, child.process, stopped_at + child.spec.stop_timeout_s)
-
-    def _reap(self, child: Child, process: subprocess.Popen[str], deadline: float) -> None:
-        """Wait for a child sent SIGTERM until ``deadline``, then kill it."""
-        code = self._wait_stopped(child, process, deadline)
-        if code is None:
-            process.kill()
-            process.wait()
-            self.output.say(
-                f"{child.spec.name} did not stop in {child.spec.stop_timeout_s:g} s; killed"
-            )
-            child.failed = True
-        else:
-            child.failed = child.failed or code not in CLEAN_STOP_CODES
-            self.output.say(f"{child.spec.name} stopped ({code})")
-        child.process = None
-
-    def _wait_stopped(
-        self, child: Child, process: subprocess.Popen[str], deadline: float
-    ) -> int | None:
-        """Its exit code, or None once ``deadline`` passed; a recorder's deadline moves on
-        while it spends CPU time. A wait longer than ``QUIET_WAIT_S`` is said."""
-        spent, said = cpu_seconds(process.pid), False
-        while True:
-            left = max(0.0, deadline - time.monotonic())
-            try:
-                return process.wait(left if said else min(left, QUIET_WAIT_S))
-            except subprocess.TimeoutExpired:
-                pass
-            if not said:
-                said = True
-                if time.monotonic() < deadline:
-                    progress = " without progress" if child.spec.role == "recorder" else ""
-                    self.output.say(
-                        f"waiting for {child.spec.name} to stop (killed after "
-                        f"{child.spec.stop_timeout_s:g} s{progress})"
-                    )
-                    continue
-            now_spent = cpu_seconds(process.pid)
-            if child.spec.role != "recorder" or now_spent <= spent:
-                return None
-            spent, deadline = now_spent, time.monotonic() + child.spec.stop_timeout_s

@@ -37,7 +37,7 @@ import yaml
 import zenoh
 
 from launch import query
-from launch.launcher import cpu_seconds
+from launch.stop import cpu_seconds
 from messages import codec, topics
 from messages.markers import MarkerDetections
 from messages.supervisor import SupervisorStatus

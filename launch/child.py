@@ -1,0 +1,31 @@
+"""One supervised component: its process and its bookkeeping."""
+
+from __future__ import annotations
+
+import subprocess
+from dataclasses import dataclass
+
+from profiles.profile import ComponentSpec
+
+
+@dataclass
+class Child:
+    """One component's process and its restart bookkeeping."""
+
+    spec: ComponentSpec
+    process: subprocess.Popen[str] | None = None
+    waiting: bool = True
+    """Not started yet: it waits for the components it starts ``after``."""
+    started_at: float = 0.0
+    restarts: int = 0
+    restart_at: float | None = None
+    done: bool = False
+    failed: bool = False
+    alive: bool = False
+    """Whether the current process's liveliness token is present."""
+    answered_at: float = 0.0
+    """When it last answered a status query, or came alive (the watchdog's reference)."""
+    state: str = "running"
+    """Its ``state`` as last reported (a component comes alive running)."""
+    stopping: bool = False
+    """Sent SIGTERM by the stop: its token going is no loss."""

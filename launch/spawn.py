@@ -1,0 +1,52 @@
+"""The start of a child's process: its command, its environment, its output forwarded."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import threading
+from pathlib import Path
+
+from components import container
+from launch.output import Output
+from messages import process
+from messages.process import PARAMS_FILE_ENV, PARENT_PID_ENV
+from profiles.profile import ComponentSpec
+
+
+def spawn(
+    group: list[ComponentSpec],
+    profile_path: Path,
+    kept_params: Path,
+    pass_fds: tuple[int, ...],
+    output: Output,
+    ahead: bool = False,
+) -> subprocess.Popen[str]:
+    """The process of ``group`` (one component, or shared ones: ``components.container``,
+    waiting for a word on its input when ``ahead``) and the threads forwarding its output.
+
+    Its parameters set at run time are kept under ``kept_params``; it inherits ``pass_fds``
+    and runs in its own session, stopping by itself when the launcher is gone."""
+    names = [spec.name for spec in group]
+    env = dict(os.environ, PYTHONUNBUFFERED="1", **{PARENT_PID_ENV: str(os.getpid())})
+    if len(group) > 1:
+        command = container.command(profile_path, names, kept_params, ahead)
+    else:
+        spec = group[0]
+        command = process.command(spec.module_path, profile_path, spec.name)
+        env[PARAMS_FILE_ENV] = str(kept_params / f"{spec.name}.json")
+    popen = subprocess.Popen(
+        command,
+        stdin=subprocess.PIPE if ahead else subprocess.DEVNULL,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env=env,
+        text=True,
+        errors="replace",
+        start_new_session=True,
+        pass_fds=pass_fds,
+    )
+    prefix = "+".join(names)
+    for pipe, stream in ((popen.stdout, output.out), (popen.stderr, output.err)):
+        threading.Thread(target=output.forward, args=(pipe, stream, prefix), daemon=True).start()
+    return popen
