@@ -1,5 +1,6 @@
 """A study's plots (PNG), from its results: a point per group of runs, one figure against
-others, a line per law (or another parameter) and a panel per task (or another)."""
+others, a line per law (or another parameter: a colour each, wider as they come, as they may
+overlap) and a panel per task (or another)."""
 
 from __future__ import annotations
 
@@ -35,11 +36,14 @@ def draw(study: Study, plot: Plot, runs: list[Run], rows: list[dict[str, Any]]) 
         xs = sorted({x for line in lines.values() for x, _ in line})
         if plot.diagonal:
             axes.plot(xs, xs, color="0.7", linewidth=3, label=plot.diagonal)
-        for label, line in lines.items():
+        for number, (label, line) in enumerate(lines.items()):
             line.sort(key=lambda point: point[0])
+            look = {"color": f"C{number}", "linewidth": 1.5 * (number + 1), "alpha": 0.8}
+            look["zorder"] = len(lines) - number  # each line over the wider ones after it
             for part, style in zip(plot.y, STYLES, strict=False):
                 ys = [y[plot.y.index(part)] for _, y in line]
-                axes.plot([x for x, _ in line], ys, style, marker="o", label=f"{label}, {part}")
+                xs_line = [x for x, _ in line]
+                axes.plot(xs_line, ys, style, marker="o", label=f"{label}, {part}", **look)
         axes.set_title(f"{plot.panels} {panel}")
         axes.set_xlabel(plot.x)
         axes.set_ylabel(", ".join(plot.y))
