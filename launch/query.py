@@ -19,7 +19,8 @@ from launch.zenoh_error import zenoh_error_text
 from messages import codec, topics
 from messages.process import ParamValue, decode_value
 from messages.status import ComponentStatus
-from profiles.profile import Profile, ZenohSettings, load_profile
+from profiles.network import ZenohSettings
+from profiles.profile import Profile, load_profile
 
 DEFAULT_ROUTER = "tcp/127.0.0.1:7447"
 """Where tools look for the router when given a namespace and no endpoint."""

@@ -25,7 +25,7 @@ from messages.header import Header
 from messages.obstacles import Circle, Obstacles
 from messages.state import RobotState
 from profiles.deploy_files import ROBOT_FILE
-from profiles.profile import ZenohSettings
+from profiles.network import ZenohSettings
 from wbc.geometry.scenarios import NEAR_START, REACH_GOAL
 from wbc.robot import MobileManipulator
 

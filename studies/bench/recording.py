@@ -58,7 +58,8 @@ from messages.joints import JointStates
 from messages.odometry import BaseOdometry
 from outputs.stdout import emit, json_text, result_only_stdout, table
 from profiles.endpoints import free_port
-from profiles.profile import Profile, ZenohSettings, load_profile
+from profiles.network import ZenohSettings
+from profiles.profile import Profile, load_profile
 from record.session_file import MESSAGE_ENCODING
 from record.session_reader import info, read_session
 from record.sessions import load_session

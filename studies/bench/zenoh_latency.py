@@ -49,7 +49,8 @@ from messages.process import stop
 from outputs.stdout import emit, json_text, result_only_stdout, table
 from profiles.deploy_files import ROBOT_FILE
 from profiles.endpoints import free_port
-from profiles.profile import ZenohSettings, load_profile
+from profiles.network import ZenohSettings
+from profiles.profile import load_profile
 from studies.bench.pubsub_workers import (
     NAMESPACE,
     WAIT_S,

@@ -17,7 +17,8 @@ from messages import codec, topics
 from messages.goal import Goal
 from messages.header import Header
 from profiles.deploy_files import ROBOT_FILE
-from profiles.profile import ProfileError, ZenohSettings, load_profile
+from profiles.network import ZenohSettings
+from profiles.profile import ProfileError, load_profile
 from tests.launch.conftest import free_port
 from tests.parsimony.in_process import completed
 

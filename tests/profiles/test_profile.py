@@ -12,7 +12,8 @@ import pytest
 import yaml
 import zenoh
 
-from profiles.profile import ProfileError, ZenohSettings, load_profile
+from profiles.network import ZenohSettings
+from profiles.profile import ProfileError, load_profile
 from tests.profiles.profile_yaml import PUB, refusal, write
 
 
