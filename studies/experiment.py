@@ -17,19 +17,15 @@ followed run, each component's CPU time and handler durations, and the set-up.
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import math
 import os
-import signal
-import subprocess
 import sys
-import threading
 import time
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Any
+from typing import Any
 
 import yaml
 import zenoh
@@ -39,7 +35,6 @@ from analysis.judge import (
     HOLD_S,
     JUDGED,
     commands_csv,
-    converged_at,
     end_of_run,
     judge,
     recording_check,
@@ -50,9 +45,8 @@ from components.cascade_controller import CascadeController
 from components.lp_controller import LPController
 from components.qp_controller import QPController
 from launch import query
-from messages import codec, process, topics
 from messages.obstacles import Solids
-from messages.topics import CONTROL_DIAGNOSTICS, ROBOT_STATE, SIM_TRUTH, SUPERVISOR_STATUS
+from messages.topics import ROBOT_STATE
 from outputs.files import written_whole
 from outputs.stdout import json_text
 from profiles.deploy_files import DEPLOY
@@ -63,6 +57,8 @@ from record.session_reader import info, make_whole
 from record.sessions import load_session
 from sim2d.scenarios import SimScenario, scenario
 from studies.gain_sets import LP_PARAMS
+from studies.launched import STARTUP_S, connect, launched, wait_alive, wait_reached
+from studies.run_follower import Follower, follow
 from wbc.laws.cascade_law import CascadeParams
 from wbc.laws.lp_law import LPParams
 from wbc.planar import inverse
@@ -84,8 +80,6 @@ MODULES = {
 
 TIME_LIMIT_S = 60.0
 """Simulated seconds after which a run that has not converged stops."""
-STARTUP_S = 60.0
-"""Host seconds the components may take to come up."""
 LOCKSTEP_WATCHDOG_S = 30.0
 """Host seconds a component of a lockstep run may answer no status query before the launcher
 takes it for hung (the profile's default is 10 s): the loop waits for its slowest member, and on a
@@ -231,54 +225,9 @@ def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict
     )
 
 
-class Follower:
-    """What the run's end is decided on, as it arrives: the controller's diagnostics, the
-    supervisor's statuses, and the stamps of the first and the latest ground truth (the
-    recording holds everything else; the run is judged from it)."""
-
-    def __init__(self, session: zenoh.Session, namespace: str) -> None:
-        self.session: dict[str, list] = {CONTROL_DIAGNOSTICS.name: [], SUPERVISOR_STATUS.name: []}
-        self.truth_ns: list[int] = []  # the first and the latest
-        self._lock = threading.Lock()
-        self._subscribers = [
-            session.declare_subscriber(topic.key(namespace), self._taker(topic))
-            for topic in (CONTROL_DIAGNOSTICS, SUPERVISOR_STATUS, SIM_TRUTH)
-        ]
-
-    def _taker(self, topic: topics.Topic):
-        def take(sample: zenoh.Sample) -> None:
-            message = codec.decode(sample.payload.to_bytes(), topic.type)
-            with self._lock:
-                if topic is SIM_TRUTH:
-                    self.truth_ns[1:] = [message.header.stamp_ns]
-                    self.truth_ns[:1] = self.truth_ns[:1] or [message.header.stamp_ns]
-                else:
-                    self.session[topic.name].append(message)
-
-        return take
-
-    def snapshot(self) -> tuple[dict[str, list], list[int]]:
-        """The diagnostics and statuses so far, and the first and latest truth stamps."""
-        with self._lock:
-            return {n: list(ms) for n, ms in self.session.items()}, list(self.truth_ns)
-
-
 def say(text: str) -> None:
     """A line of progress on stderr."""
     print(f"[experiment] {text}", file=sys.stderr, flush=True)
-
-
-def progress_line(session: dict[str, list], origin: float, wall_s: float) -> str:
-    diagnostics = session[CONTROL_DIAGNOSTICS.name]
-    if not diagnostics:
-        return f"[experiment] wall {wall_s:5.1f} s  waiting for the first control step"
-    d = diagnostics[-1]
-    t = d.header.stamp_ns / 1e9 - min(origin, d.header.stamp_ns / 1e9)
-    error = "-" if d.error_norm is None else f"{d.error_norm:.4f}"
-    return (
-        f"[experiment] sim {t:6.2f} s  wall {wall_s:5.1f} s  error {error}  "
-        f"nonzero {d.nonzero}  {d.status}"
-    )
 
 
 def run_experiment(options: Options) -> dict[str, Any]:
@@ -322,7 +271,9 @@ def run_experiment(options: Options) -> dict[str, Any]:
             f"{options.time_limit_s:g} s of simulated time"
         )
         started = time.monotonic()
-        (followed, truth_ns), wall_s = follow(follower, options, started)
+        (followed, truth_ns), wall_s = follow(
+            follower, options.time_limit_s, options.realtime, started
+        )
         counters = component_counters(session, profile.namespace)
         say("stopping the processes (the recorder writes all it holds)")
     say("judging the recording")
@@ -368,104 +319,6 @@ def run_experiment(options: Options) -> dict[str, Any]:
         report["figures"] = [str(path) for path in drawn["figures"]]
     (options.out / "report.json").write_text(json_text(report, indent=2))
     return report
-
-
-@contextlib.contextmanager
-def launched(
-    profile_path: Path, log: IO[str] | int = subprocess.DEVNULL, stop_timeout_s: float | None = 30.0
-) -> Iterator[subprocess.Popen]:
-    """``parsimony launch PROFILE`` as a child process, its output to ``log``; at the end of
-    the block it is stopped by SIGINT (its components in order), killed after
-    ``stop_timeout_s`` (None: the launcher's own limits, a recorder's progress, decide)."""
-    launcher = subprocess.Popen(
-        [sys.executable, "-m", "parsimony.cli", "launch", str(profile_path)],
-        stdout=log,
-        stderr=subprocess.STDOUT,
-        env={**os.environ, process.PARENT_PID_ENV: str(os.getpid())},  # it stops if we die
-    )
-    try:
-        yield launcher
-    finally:
-        process.stop(launcher, signal.SIGINT, stop_timeout_s)
-
-
-def connect(profile: Profile, launcher: subprocess.Popen) -> zenoh.Session:
-    """A client session to the launch's router, once the router listens."""
-    deadline = time.monotonic() + STARTUP_S
-    while True:
-        try:
-            return query.Target(profile.namespace, profile.zenoh).open()
-        except query.QueryError:
-            if launcher.poll() is not None:  # it refused the profile, or failed at once
-                raise RuntimeError(
-                    f"the launch stopped (exit {launcher.returncode}); see its log"
-                ) from None
-            if time.monotonic() > deadline:
-                raise
-
-            time.sleep(0.2)  # the launcher opens its router first thing
-
-
-def wait_alive(session: zenoh.Session, profile: Profile, launcher: subprocess.Popen) -> None:
-    """Wait until every enabled component of the profile is alive."""
-    wanted = {spec.name for spec in profile.components if spec.enabled}
-
-    def missing() -> list[str]:
-        return sorted(wanted - set(query.live_components(session, profile.namespace, 0.5)))
-
-    wait_launch(launcher, missing, "did not come up")
-
-
-def wait_reached(session: zenoh.Session, profile: Profile, launcher: subprocess.Popen) -> None:
-    """Wait until every component that reads ``sim/clock`` has received the paused simulator's
-    clock: a component's liveliness does not prove that the simulator's data reaches it yet,
-    and one reached late would miss the first steps (the recorder, the first camera frame)."""
-
-    def missing() -> list[str]:
-        found = query.statuses(session, profile.namespace, 0.5)
-        return [
-            name
-            for name, status in found.items()
-            if status.counters.get("received.sim/clock", 1) == 0
-        ]
-
-    wait_launch(launcher, missing, "never received the simulator's clock")
-
-
-def wait_launch(launcher: subprocess.Popen, missing: Callable[[], list[str]], what: str) -> None:
-    """Poll ``missing()``, the components still waited for, until it is empty; fail, naming
-    them, when the launch stops or after ``STARTUP_S``."""
-    deadline = time.monotonic() + STARTUP_S
-    while waiting := missing():
-        if launcher.poll() is not None:
-            raise RuntimeError(f"the launch stopped (exit {launcher.returncode}); see its log")
-        if time.monotonic() > deadline:
-            raise RuntimeError(f"{', '.join(waiting)} {what} in {STARTUP_S:.0f} s")
-        time.sleep(0.1)  # polling the router (liveliness tokens, the components' counters)
-
-
-def follow(
-    follower: Follower, options: Options, started: float
-) -> tuple[tuple[dict[str, list], list[int]], float]:
-    """Print progress until the run converges or its time is up; return what was followed
-    (``Follower.snapshot``), and the host seconds since ``started`` when it was."""
-    last_print = 0.0
-    wall_limit = max(120.0, options.time_limit_s * (3.0 if options.realtime else 10.0))
-    while True:
-        time.sleep(0.2)  # progress is sampled; the recording holds the run itself
-        followed, truth_ns = follower.snapshot()
-        origin = truth_ns[0] / 1e9 if truth_ns else math.inf
-        wall = time.monotonic() - started
-        if wall - last_print >= 1.0:
-            print(progress_line(followed, origin, wall), file=sys.stderr, flush=True)
-            last_print = wall
-        diagnostics = followed[CONTROL_DIAGNOSTICS.name]
-        now_s = diagnostics[-1].header.stamp_ns / 1e9 if diagnostics else 0.0
-        since = converged_at(diagnostics, followed[SUPERVISOR_STATUS.name])
-        if since is not None and now_s - since >= HOLD_S:
-            return (followed, truth_ns), wall
-        if now_s - origin >= options.time_limit_s or wall > wall_limit:
-            return (followed, truth_ns), wall
 
 
 def starting(profile: Profile) -> str:

@@ -47,7 +47,7 @@ from sim2d.devices.ax_servos import AXChainEmulator
 from sim2d.devices.create2 import Create2Emulator
 from sim2d.devices.servo_chain import IntegratingJoints
 from studies.bench.figures import run_bench, spread
-from studies.experiment import connect, launched
+from studies.launched import connect, launched
 
 METRES_PER_COUNT = create_oi.mm_per_count(0.072) / 1000.0
 RESET_AFTER_S = 1.0

@@ -42,13 +42,14 @@ from messages import codec, topics
 from messages.markers import MarkerDetections
 from messages.supervisor import SupervisorStatus
 from outputs.stdout import table
+from profiles.deploy_files import DEPLOY
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.session_file import SessionWriter, entries
 from record.session_reader import info, read_session
 from scenes.foxglove_views import ANNOTATIONS_SUFFIX, SCENE_SUFFIX, Viewer
 from studies.bench.figures import run_bench
-from studies.experiment import DEPLOY, connect, launched, wait_alive, wait_reached
+from studies.launched import connect, launched, wait_alive, wait_reached
 from tests.foxglove_client.client import FoxgloveClient, missing, running_view
 from wbc.robot import MobileManipulator
 

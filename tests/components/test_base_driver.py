@@ -19,7 +19,7 @@ from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from profiles.profile_files import read_profile_data
 from protocols import create_oi
-from studies.experiment import connect, launched
+from studies.launched import connect, launched
 from tests.components.conftest import Inbox, System
 from tests.components.driver_harness import DEPLOY, FakeLink, driver_system, frame, status
 

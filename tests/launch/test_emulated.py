@@ -19,7 +19,7 @@ from parsimony import cli
 from profiles.deploy_files import DEPLOY
 from profiles.profile import load_profile
 from profiles.profile_files import read_profile_data
-from studies.experiment import connect, launched
+from studies.launched import connect, launched
 from tests.launch.emulated_profiles import emulated_profile
 
 

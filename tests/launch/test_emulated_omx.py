@@ -12,7 +12,7 @@ from messages import codec, topics
 from profiles.deploy_files import DEPLOY
 from profiles.profile import load_profile
 from profiles.profile_files import read_profile_data
-from studies.experiment import connect, launched, wait_alive
+from studies.launched import connect, launched, wait_alive
 from tests.launch.emulated_profiles import emulated_profile
 from wbc.robot import MobileManipulator
 

@@ -27,7 +27,7 @@ from profiles.profile import load_profile
 from record.session_reader import info
 from record.session_span import FAR_NS, Span
 from record.sessions import load_session
-from studies.experiment import connect, launched
+from studies.launched import connect, launched
 from tests.analysis.conftest import DT, FIGURES, ROBOT, START_NS, session_of, write
 from tests.parsimony.in_process import run_in_process
 from tests.processes import parsimony

@@ -24,7 +24,7 @@ from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.session_reader import info
 from record.sessions import load_session
-from studies.experiment import connect, launched
+from studies.launched import connect, launched
 from tests.parsimony.in_process import completed
 from tests.processes import process_gone
 

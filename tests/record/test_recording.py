@@ -25,7 +25,7 @@ from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.session_reader import info, read_session, recover
 from record.sessions import load_session
-from studies.experiment import connect
+from studies.launched import connect
 from tests.parsimony.in_process import run_in_process
 from tests.studies.experiments import run_here
 

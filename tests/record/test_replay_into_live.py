@@ -17,7 +17,7 @@ from messages.state import RobotState
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.session_file import SessionWriter
-from studies.experiment import connect, launched
+from studies.launched import connect, launched
 from tests.parsimony.in_process import completed
 
 

@@ -19,10 +19,11 @@ import zenoh
 
 from messages import codec, topics
 from messages.state import RobotState
+from profiles.deploy_files import DEPLOY
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.sessions import load_session
-from studies.experiment import DEPLOY, connect, wait_alive
+from studies.launched import connect, wait_alive
 from wbc import dq
 from wbc.planar import wrap
 

@@ -20,7 +20,8 @@ import pytest
 from launch import query
 from profiles.profile import load_profile
 from record.session_reader import info
-from studies.experiment import PROFILES, SUPERVISED, connect
+from studies.experiment import PROFILES, SUPERVISED
+from studies.launched import connect
 from tests.processes import process_gone
 from tests.studies.experiments import assert_sound
 from wbc.planning.supervisor_phase import Phase

@@ -22,11 +22,12 @@ import zenoh
 from launch import query
 from messages import codec, topics
 from messages.goal import Goal
+from profiles.deploy_files import DEPLOY
 from profiles.profile import Profile, load_profile
 from record.session_reader import info
 from sim2d.scenarios import scenario
 from studies.bench.live_view import lockstep_profile
-from studies.experiment import DEPLOY, connect, launched, wait_alive, wait_reached
+from studies.launched import connect, launched, wait_alive, wait_reached
 from tests.foxglove_client.client import FoxgloveClient, decode, missing, running_view
 from tests.scenes.views_read import chain, pose_of
 from view.client_limits import GOAL_RATE, STATUS_CHARS

@@ -21,9 +21,10 @@ from launch import query
 from messages import codec, topics
 from messages.goal import Goal
 from messages.state import RobotState
+from profiles.deploy_files import DEPLOY
 from profiles.endpoints import free_port
 from profiles.profile import Profile, load_profile
-from studies.experiment import DEPLOY, connect, launched, wait_alive, wait_reached
+from studies.launched import connect, launched, wait_alive, wait_reached
 from tests.parsimony.in_process import completed as parsimony  # in this process: no Python start
 from wbc import dq
 from wbc.planar import offset_of

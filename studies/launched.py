@@ -1,0 +1,98 @@
+"""A launch run from a study or a test: ``parsimony launch`` as a child process, a client
+session to its router, and the waits until its components are alive and reached by the
+simulator's clock."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import IO
+
+import zenoh
+
+from launch import query
+from messages import process
+from profiles.profile import Profile
+
+STARTUP_S = 60.0
+"""Host seconds the components may take to come up."""
+
+
+@contextlib.contextmanager
+def launched(
+    profile_path: Path, log: IO[str] | int = subprocess.DEVNULL, stop_timeout_s: float | None = 30.0
+) -> Iterator[subprocess.Popen]:
+    """``parsimony launch PROFILE`` as a child process, its output to ``log``; at the end of
+    the block it is stopped by SIGINT (its components in order), killed after
+    ``stop_timeout_s`` (None: the launcher's own limits, a recorder's progress, decide)."""
+    launcher = subprocess.Popen(
+        [sys.executable, "-m", "parsimony.cli", "launch", str(profile_path)],
+        stdout=log,
+        stderr=subprocess.STDOUT,
+        env={**os.environ, process.PARENT_PID_ENV: str(os.getpid())},  # it stops if we die
+    )
+    try:
+        yield launcher
+    finally:
+        process.stop(launcher, signal.SIGINT, stop_timeout_s)
+
+
+def connect(profile: Profile, launcher: subprocess.Popen) -> zenoh.Session:
+    """A client session to the launch's router, once the router listens."""
+    deadline = time.monotonic() + STARTUP_S
+    while True:
+        try:
+            return query.Target(profile.namespace, profile.zenoh).open()
+        except query.QueryError:
+            if launcher.poll() is not None:  # it refused the profile, or failed at once
+                raise RuntimeError(
+                    f"the launch stopped (exit {launcher.returncode}); see its log"
+                ) from None
+            if time.monotonic() > deadline:
+                raise
+
+            time.sleep(0.2)  # the launcher opens its router first thing
+
+
+def wait_alive(session: zenoh.Session, profile: Profile, launcher: subprocess.Popen) -> None:
+    """Wait until every enabled component of the profile is alive."""
+    wanted = {spec.name for spec in profile.components if spec.enabled}
+
+    def missing() -> list[str]:
+        return sorted(wanted - set(query.live_components(session, profile.namespace, 0.5)))
+
+    wait_launch(launcher, missing, "did not come up")
+
+
+def wait_reached(session: zenoh.Session, profile: Profile, launcher: subprocess.Popen) -> None:
+    """Wait until every component that reads ``sim/clock`` has received the paused simulator's
+    clock: a component's liveliness does not prove that the simulator's data reaches it yet,
+    and one reached late would miss the first steps (the recorder, the first camera frame)."""
+
+    def missing() -> list[str]:
+        found = query.statuses(session, profile.namespace, 0.5)
+        return [
+            name
+            for name, status in found.items()
+            if status.counters.get("received.sim/clock", 1) == 0
+        ]
+
+    wait_launch(launcher, missing, "never received the simulator's clock")
+
+
+def wait_launch(launcher: subprocess.Popen, missing: Callable[[], list[str]], what: str) -> None:
+    """Poll ``missing()``, the components still waited for, until it is empty; fail, naming
+    them, when the launch stops or after ``STARTUP_S``."""
+    deadline = time.monotonic() + STARTUP_S
+    while waiting := missing():
+        if launcher.poll() is not None:
+            raise RuntimeError(f"the launch stopped (exit {launcher.returncode}); see its log")
+        if time.monotonic() > deadline:
+            raise RuntimeError(f"{', '.join(waiting)} {what} in {STARTUP_S:.0f} s")
+        time.sleep(0.1)  # polling the router (liveliness tokens, the components' counters)
