@@ -17,7 +17,7 @@ from outputs.stdout import table
 from profiles import deploy_files
 from profiles.deploy_files import ROBOT_FILE
 from studies.gain_sets import TABLE_PARAMS, WITHOUT_ARM_ROWS
-from studies.goal_sets import goal_report
+from studies.goal_report import goal_report
 from studies.reproduce import efficiency
 from studies.step_timing import (
     blocks,
