@@ -18,8 +18,8 @@ OBSTACLE_PARAMS = LPParams(
     base_target=0.0, waist_hold=0.0, waist_centring=0.02, error_bound="error"
 )
 """The obstacle experiment's law (6.2.3): the default obstacle constraint, the vector-field
-inequality of wbc.laws.constraints.obstacle_vector_field, in place of 5.28 (python -m
-studies.bench.obstacle_constraints compares them), the circulation term that takes the base round an
+inequality of wbc.laws.constraints.obstacle_vector_field, in place of 5.28 (the study
+studies/files/obstacles.yaml compares them), the circulation term that takes the base round an
 obstacle it stalled by, and no base target term, whose straight-line heading towards where the
 base should stand fights the detour. The waist is centred through the self-motion instead of
 held: with the base alone taking the task's yaw, the base overran the goal after its detour

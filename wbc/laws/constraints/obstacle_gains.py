@@ -5,7 +5,7 @@ lookahead point.
 The vector-field inequality is the default: it keeps u = 0 feasible, which 5.28 does not, and
 on the obstacle experiment's set-ups, with the circulation term, it converged as often as 5.28
 and kept the base 22-26 mm farther from the obstacle
-(``python -m studies.bench.obstacle_constraints``, figures in the README's "Obstacles")."""
+(the study ``studies/files/obstacles.yaml``; docs/results/obstacles.md)."""
 
 from __future__ import annotations
 
