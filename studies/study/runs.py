@@ -122,6 +122,7 @@ def simulated(run: Run) -> dict[str, Any]:
         figures=False,
     )
     report = run_experiment(options)
+    whole_recording(report)
     session, _ = the_run(load_session(Path(run.out) / SESSION_FILE, JUDGED), TIME_LIMIT_S)
     diagnostics = messages(session, CONTROL_DIAGNOSTICS)
     since = converged_at(diagnostics, messages(session, SUPERVISOR_STATUS))
@@ -135,6 +136,16 @@ def simulated(run: Run) -> dict[str, Any]:
         "nonzero_moving": moving,
         "report": json_text(report),
     }
+
+
+def whole_recording(report: dict[str, Any]) -> None:
+    """RuntimeError (the run failed, and is tried again) when the experiment's recording does
+    not hold the whole run: figures judged from a recording cut short would be wrong, such as a
+    converged run judged not converged because its last states were lost."""
+    if not report["recording"]["whole"]:
+        raise RuntimeError(
+            "its recording is not whole: " + "; ".join(report["recording"]["missing"])
+        )
 
 
 def setup(run: Run) -> dict[str, Any]:

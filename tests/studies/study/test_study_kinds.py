@@ -11,10 +11,14 @@ from pathlib import Path
 import pytest
 import yaml
 
+from analysis.judge import recording_check
+from messages.topics import ROBOT_STATE
 from parsimony.cli import main
+from record.session_reader import info
 from studies.study import results
 from studies.study.plots import draw
 from studies.study.report import markdown
+from studies.study.runs import whole_recording
 from studies.study.schema import StudyError, load_study
 from studies.study.sweep import expand
 
@@ -154,3 +158,19 @@ def test_rows_of_both_loops_keep_each_its_columns(tmp_path) -> None:
         {"index": 0, "key": "a", "goal_q": [1.0], "report": None},
         {"index": 1, "key": "b", "goal_q": None, "report": "{}"},
     ]
+
+
+def test_a_whole_loop_run_whose_recording_is_cut_short_is_a_failure_that_says_why(
+    pose_lp_run: Path,
+) -> None:
+    """A run judged from a recording that lost its last states would be judged wrongly (seen:
+    a converged run judged not converged, its recorder starved of CPU): the study records it
+    failed, with what is missing, and tries it again."""
+    report = json.loads((pose_lp_run / "report.json").read_text())
+    whole_recording(report)  # the whole run: a row of figures
+    facts = info(pose_lp_run / "session.mcap")
+    states = [c for c in facts["channels"] if c["key"].endswith("/" + ROBOT_STATE.name)]
+    start_ns, last_ns = states[0]["start_ns"], states[0]["end_ns"]
+    report["recording"] = recording_check(facts, (start_ns, last_ns + 440_000_000))
+    with pytest.raises(RuntimeError, match="not whole: its states end 0.44 s before the run's"):
+        whole_recording(report)
