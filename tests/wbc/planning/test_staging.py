@@ -9,7 +9,7 @@ import time
 import numpy as np
 import pytest
 
-from studies.goal_sets import FAMILIES, goals
+from studies.goal_families import FAMILIES, goals
 from tests.wbc.planning.crowd import CHECK_GAP_S, crowd
 from tests.wbc.wbc_scenarios import robot
 from wbc import dq
