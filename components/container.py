@@ -1,6 +1,6 @@
 """Several components of one profile in one process (a profile's ``processes: shared``).
 
-    python -m components.container --profile P --names a,b,c --params-dir D [--ahead]
+    python -m components.container --profile P --names a,b,c [--ahead]
 
 runs each named component as ``python -m components.<module>`` would, with its own ``Node``
 and threads, in this one process: the interpreter and the libraries they import (NumPy, Zenoh,
@@ -9,9 +9,9 @@ the profile's components authenticate or are clients), so that a sample between 
 handed over in the session, not copied over a socket. They start in the order given (with
 ``--ahead``, once a line on its input says so: the launcher starts the process while the
 recorders start, so that it loads its modules meanwhile) and close in the reverse order, on
-SIGINT, SIGTERM, the end of the launcher or the ``fail`` of one of them; the parameters set on
-component N while it runs are kept in ``D/N.json``, as the launcher keeps them for a process
-of its own.
+SIGINT, SIGTERM, the end of the launcher or the ``fail`` of one of them; each keeps what its
+next start takes back in the launch's runtime directory (``messages.process.runtime_dir``), as
+a component in a process of its own does.
 """
 
 from __future__ import annotations
@@ -24,13 +24,13 @@ from pathlib import Path
 
 from components.process_entry import StopRequested, serve, start_logging
 from components.runtime import Component
-from messages.process import EXIT_CONFIG_ERROR
+from messages.process import EXIT_CONFIG_ERROR, params_file
 from profiles.profile import ProfileError, load_profile
 
 MODULE = "components.container"
 
 
-def command(profile: Path, names: Sequence[str], params_dir: Path, ahead: bool) -> list[str]:
+def command(profile: Path, names: Sequence[str], ahead: bool) -> list[str]:
     """The command line running components ``names`` of ``profile`` in one process; ``ahead``:
     once a line on its input says so, after loading their modules."""
     return [
@@ -41,8 +41,6 @@ def command(profile: Path, names: Sequence[str], params_dir: Path, ahead: bool) 
         str(profile),
         "--names",
         ",".join(names),
-        "--params-dir",
-        str(params_dir),
         *(["--ahead"] if ahead else []),
     ]
 
@@ -66,7 +64,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--profile", required=True, help="the deploy profile (YAML)")
     parser.add_argument("--names", required=True, help="the components to run, comma-separated")
-    parser.add_argument("--params-dir", type=Path, required=True, help="kept parameters' folder")
     parser.add_argument("--ahead", action="store_true", help="start them on a line of input")
     parser.add_argument("--log-level", default="INFO", help="DEBUG, INFO, WARNING or ERROR")
     args = parser.parse_args(argv)
@@ -84,8 +81,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except StopRequested:
         return 0
     members = [
-        (cls, spec.name, args.params_dir / f"{spec.name}.json")
-        for cls, spec in zip(classes, specs, strict=True)
+        (cls, spec.name, params_file(spec.name)) for cls, spec in zip(classes, specs, strict=True)
     ]
     return serve(args.profile, members)
 

@@ -26,8 +26,8 @@ from components.runtime import Component, Node
 from messages.process import (
     EXIT_CONFIG_ERROR,
     EXIT_FOR_GOOD,
-    PARAMS_FILE_ENV,
     PARENT_PID_ENV,
+    params_file,
     parent_gone,
 )
 from profiles.profile import ProfileError, load_profile
@@ -164,8 +164,7 @@ def main(component_class: type[Component], argv: Sequence[str] | None = None) ->
     """Run ``component_class`` until SIGINT or SIGTERM; return the exit code."""
     args = _parse_args(component_class, argv)
     start_logging(args.log_level)
-    kept = os.environ.get(PARAMS_FILE_ENV)
-    return serve(args.profile, [(component_class, args.name, Path(kept) if kept else None)])
+    return serve(args.profile, [(component_class, args.name, params_file(args.name))])
 
 
 def run_component(component_class: type[Component]) -> NoReturn:

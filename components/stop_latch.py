@@ -31,7 +31,7 @@ import zenoh
 from components.runtime import Node
 from messages import codec, topics
 from messages.header import Header
-from messages.process import PARAMS_FILE_ENV
+from messages.process import runtime_dir
 from messages.stop import StopState
 from profiles.profile import Profile
 
@@ -66,11 +66,11 @@ def stop_text(state: StopState) -> str:
 
 def kept_dir() -> Path | None:
     """Where the holders of this launch keep the stop each holds, one ``NAME.json`` each:
-    ``stop/`` in the launcher's runtime directory (the one of the parameters' files,
-    ``PARAMS_FILE_ENV``, removed when the launch ends); None for a component that no launcher
-    started."""
-    params = os.environ.get(PARAMS_FILE_ENV)
-    return Path(params).parent / "stop" if params else None
+    ``stop/`` in the launch's runtime directory (``messages.process.runtime_dir``, removed when
+    the launch ends), whether the holder has a process of its own or shares one; None for a
+    component that no launcher started."""
+    folder = runtime_dir()
+    return folder / "stop" if folder else None
 
 
 class StopLatch:

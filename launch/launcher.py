@@ -15,7 +15,8 @@ The launch fails at start-up when a component is not alive within the profile's
 ``startup_timeout_s`` or stops for good before it ever was (a configuration error). A
 watchdog asks every component for its status; one alive but silent for ``watchdog_s`` is
 killed and restarted by its policy. Parameters set while a component runs are kept in a file
-per component (``messages.process.PARAMS_FILE_ENV``) that its next start reads.
+per component in the launch's runtime directory (``messages.process.RUNTIME_DIR_ENV``) that
+its next start reads.
 
 Children run in their own session, so a Ctrl-C reaches the launcher alone and
 the stop order holds; a child whose launcher dies stops by itself

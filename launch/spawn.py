@@ -10,7 +10,7 @@ from pathlib import Path
 from components import container
 from launch.output import Output
 from messages import process
-from messages.process import PARAMS_FILE_ENV, PARENT_PID_ENV
+from messages.process import PARENT_PID_ENV, RUNTIME_DIR_ENV
 from profiles.profile import ComponentSpec
 
 
@@ -28,13 +28,16 @@ def spawn(
     Its parameters set at run time are kept under ``kept_params``; it inherits ``pass_fds``
     and runs in its own session, stopping by itself when the launcher is gone."""
     names = [spec.name for spec in group]
-    env = dict(os.environ, PYTHONUNBUFFERED="1", **{PARENT_PID_ENV: str(os.getpid())})
+    env = dict(
+        os.environ,
+        PYTHONUNBUFFERED="1",
+        **{PARENT_PID_ENV: str(os.getpid()), RUNTIME_DIR_ENV: str(kept_params)},
+    )
     if len(group) > 1:
-        command = container.command(profile_path, names, kept_params, ahead)
+        command = container.command(profile_path, names, ahead)
     else:
         spec = group[0]
         command = process.command(spec.module_path, profile_path, spec.name)
-        env[PARAMS_FILE_ENV] = str(kept_params / f"{spec.name}.json")
     popen = subprocess.Popen(
         command,
         stdin=subprocess.PIPE if ahead else subprocess.DEVNULL,

@@ -40,9 +40,24 @@ def parent_gone() -> bool:
     return parent is not None and os.getppid() != int(parent)
 
 
-PARAMS_FILE_ENV = "PARSIMONY_PARAMS_FILE"
-"""Set by the launcher: a JSON file where a component keeps the parameters set while it runs,
-and from which it takes them back when it is started again (a restart keeps them)."""
+RUNTIME_DIR_ENV = "PARSIMONY_RUNTIME_DIR"
+"""Set by the launcher for every process it starts (one component's, or a shared one's): the
+launch's runtime directory, removed when the launch ends, where each component keeps what its
+next start takes back (``params_file``; the stop latch's ``stop/``)."""
+
+
+def runtime_dir() -> Path | None:
+    """The launch's runtime directory (``RUNTIME_DIR_ENV``); None for a process no launcher
+    started."""
+    folder = os.environ.get(RUNTIME_DIR_ENV)
+    return Path(folder) if folder else None
+
+
+def params_file(name: str) -> Path | None:
+    """Where component ``name`` keeps the parameters set while it runs, and takes them back
+    from when it is started again (a restart keeps them); None without a launcher."""
+    folder = runtime_dir()
+    return folder / f"{name}.json" if folder else None
 
 
 def command(module_path: str, profile: Path, name: str) -> list[str]:

@@ -20,7 +20,7 @@ from launch import query
 from messages import codec, topics
 from messages.commands import BaseCommand
 from messages.header import Header
-from messages.process import PARAMS_FILE_ENV
+from messages.process import RUNTIME_DIR_ENV
 from parsimony import cli
 from protocols import create_oi
 from tests.components.conftest import System
@@ -174,7 +174,7 @@ def test_a_driver_restarted_while_the_router_is_away_starts_stopped(
     the router back, the release releases it."""
     launch = tmp_path / "launch"  # the launcher's runtime directory
     launch.mkdir()
-    monkeypatch.setenv(PARAMS_FILE_ENV, str(launch / "base_driver.json"))
+    monkeypatch.setenv(RUNTIME_DIR_ENV, str(launch))
     link = FakeLink(tmp_path / "create2")
     system = driver_system(deployed, tmp_path, "base_driver", link.link)
     namespace = system.profile.namespace
@@ -220,7 +220,7 @@ def test_a_kept_stop_that_cannot_be_read_starts_the_holder_stopped(
     launch = tmp_path / "launch"
     (launch / "stop").mkdir(parents=True)
     (launch / "stop" / "talker.json").write_text('{"stopped": tr')
-    monkeypatch.setenv(PARAMS_FILE_ENV, str(launch / "talker.json"))
+    monkeypatch.setenv(RUNTIME_DIR_ENV, str(launch))
     with Node(system.profile, "talker") as talker:
         latch = StopLatch(talker)
         talker.start()
