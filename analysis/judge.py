@@ -1,30 +1,24 @@
 """A run judged from its recording alone: every figure ``report.json`` gives about a run.
 
 A session maps a topic name to its messages (``record.sessions.load_session`` of
-``JUDGED``). The run begins at its first ground truth (its first state on a robot without one)
-and ends ``HOLD_S`` after the controller's error fell under ``CONVERGED_ERROR`` for good, under
-a supervisor within its last pose phase (a drive leg's error is not the goal's); else at the
-time limit, or at the last step. What is judged against the simulator's ground truth
-(``sim/truth``, which no component of the loop reads: the true final error, the estimator's
-error in the steady state, contacts, joints at their hard stops, clearance) is None, and
-``truth`` says ``absent``, for a recording without it (a real robot's). The control inputs
-u = [x', y', phi', a velocity per arm joint of the robot's description] join the base and arm
-commands of one stamp with x' = v cos(phi) - l sin(phi), y' = v sin(phi) + l cos(phi) (l the
-lateral speed of an omnidirectional base, else 0), phi the heading of the nearest state: the
-estimate the controller turned u into the base's command with.
+``JUDGED``). The run is judged up to its end (``analysis.run_end``). What is judged against the
+simulator's ground truth (``sim/truth``, which no component of the loop reads: the true final
+error, the estimator's error in the steady state, contacts, joints at their hard stops,
+clearance) is None, and ``truth`` says ``absent``, for a recording without it (a real robot's).
+The effort and the digest are of the control inputs its commands give (``analysis.commands``).
 """
 
 from __future__ import annotations
 
-import hashlib
 import math
-import struct
 from collections import Counter
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
+from analysis.commands import Array, commands_digest, effort, nearest
+from analysis.run_end import HOLD_S, Session, messages, the_run
 from messages.topics import (
     ARM_COMMAND,
     BASE_COMMAND,
@@ -35,24 +29,14 @@ from messages.topics import (
     SIM_TRUTH,
     SUPERVISOR_STATUS,
     WORLD_OBSTACLES,
-    Topic,
 )
 from record.session_span import parted
 from wbc import dq
 from wbc.geometry.arm_clearance import part_clearances
 from wbc.geometry.obstacles import least_clearance
-from wbc.laws.kinematic_run import effort_of
 from wbc.planar import in_frame, wrap
-from wbc.planning.supervisor_phase import Phase
 from wbc.robot import MobileManipulator
 
-Array = np.ndarray
-Session = Mapping[str, Sequence[Any]]
-
-CONVERGED_ERROR = 0.01
-"""The controller's error norm ||e|| under which the goal counts as reached."""
-HOLD_S = 2.0
-"""Simulated seconds the error must stay under ``CONVERGED_ERROR``; also the steady state."""
 JUDGED = frozenset(
     t.name
     for t in (
@@ -71,13 +55,6 @@ JUDGED = frozenset(
 RERUN_SOURCE = "rerun_"
 """The source of the commands ``parsimony rerun`` computes, before the law's name: offline, on
 a recording's states, which did not follow them."""
-METRICS: Mapping[str, str] = {
-    "metric1": "velocity_l1",
-    "metric2": "velocity_l2",
-    "metric3": "acceleration_l1",
-    "metric4": "acceleration_l2",
-}
-"""Table 6.1's metrics: the ``ControlEffort`` field each reports."""
 
 
 def judge(
@@ -127,93 +104,6 @@ def open_loop(session: Session) -> bool:
     """Whether the session's commands were computed by ``parsimony rerun`` (``RERUN_SOURCE``)
     on recorded states, not in a closed loop."""
     return any(c.header.source.startswith(RERUN_SOURCE) for c in messages(session, BASE_COMMAND))
-
-
-def the_run(session: Session, time_limit_s: float | None = None) -> tuple[dict[str, list], bool]:
-    """The messages of the run, up to its end (``end_of_run``), and whether it converged: what
-    is judged, and what a report draws. Messages stamped far outside the session
-    (``record.session_span``) are left out."""
-    session = parted(session).kept
-    end_ns, converged = end_of_run(session, time_limit_s, origin_s(session))
-    return until(session, end_ns), converged
-
-
-def messages(session: Session, topic: Topic) -> list:
-    """The messages of ``topic`` in stamp order (none when the session has none)."""
-    return sorted(session.get(topic.name) or [], key=lambda m: m.header.stamp_ns)
-
-
-def origin_s(session: Session) -> float:
-    """When the run began: its first ground truth (0 in lockstep, the host's clock when the
-    simulator keeps host time), else its first state; s (inf for an empty session)."""
-    first = messages(session, SIM_TRUTH)[:1] or messages(session, ROBOT_STATE)[:1]
-    return first[0].header.stamp_ns / 1e9 if first else math.inf
-
-
-CONVERGING = frozenset(("direct", Phase.POSE, Phase.REACHED))
-"""The supervisor's phases in which the controller steps on the goal's own task: a pose goal's
-pose phase, a goal of another kind passed on as it is (``direct``), and either once reached."""
-
-
-def converged_at(diagnostics: Sequence, statuses: Sequence) -> float | None:
-    """The time since which every step's error stayed under ``CONVERGED_ERROR``; under a
-    supervisor (``statuses``), only the steps of its last run of ``CONVERGING`` phases count."""
-    pose_since = pose_phase_since(statuses)
-    if pose_since is None:
-        return None
-    since = None
-    for d in diagnostics:
-        if d.header.stamp_ns / 1e9 < pose_since:
-            continue
-        small = d.status == "optimal" and d.error_norm is not None
-        if not (small and d.error_norm < CONVERGED_ERROR):
-            since = None
-        elif since is None:
-            since = d.header.stamp_ns / 1e9
-    return since
-
-
-def pose_phase_since(statuses: Sequence) -> float | None:
-    """When the supervisor's last run of ``CONVERGING`` phases began; 0 with no supervisor,
-    None while it is in another phase."""
-    if not statuses:
-        return 0.0
-    since = None
-    for status in statuses:
-        if status.phase not in CONVERGING:
-            since = None
-        elif since is None:
-            since = status.header.stamp_ns / 1e9
-    return since
-
-
-def end_of_run(session: Session, time_limit_s: float | None, origin: float) -> tuple[int, bool]:
-    """The stamp (ns) the run ends at, ``HOLD_S`` after it converged, else ``time_limit_s``
-    after ``origin``, else its last step; and whether it converged. The limit is a simulated
-    time, and what came after it is not looked at: two lockstep runs of one set-up judge the
-    same steps, however long each went on before it was stopped."""
-    limited = time_limit_s is not None and math.isfinite(origin)
-    limit_ns = round((origin + time_limit_s) * 1e9) if limited else None
-    within = (
-        session
-        if limit_ns is None
-        else until(
-            {t.name: session.get(t.name) or [] for t in (CONTROL_DIAGNOSTICS, SUPERVISOR_STATUS)},
-            limit_ns,
-        )
-    )
-    diagnostics = messages(within, CONTROL_DIAGNOSTICS)
-    since = converged_at(diagnostics, messages(within, SUPERVISOR_STATUS))
-    if since is not None and diagnostics[-1].header.stamp_ns / 1e9 - since >= HOLD_S:
-        return round((since + HOLD_S) * 1e9), True
-    if limit_ns is not None:
-        return limit_ns, False
-    return (diagnostics[-1].header.stamp_ns if diagnostics else 0), False
-
-
-def until(session: Session, end_ns: int) -> dict[str, list]:
-    """The messages stamped up to ``end_ns``."""
-    return {n: [m for m in ms if m.header.stamp_ns <= end_ns] for n, ms in session.items()}
 
 
 def _span_s(samples: Sequence) -> float:
@@ -296,16 +186,6 @@ def arm_clearance(truth: Sequence, robot: MobileManipulator) -> dict[str, float]
     }
 
 
-def nearest(sorted_stamps: Array, stamps: Array) -> Array:
-    """The index into ``sorted_stamps`` (not empty) of the one nearest each of ``stamps``."""
-    if len(sorted_stamps) == 1:
-        return np.zeros(len(stamps), dtype=int)
-    after = np.clip(np.searchsorted(sorted_stamps, stamps), 1, len(sorted_stamps) - 1)
-    before = after - 1
-    nearer_before = stamps - sorted_stamps[before] <= sorted_stamps[after] - stamps
-    return np.where(nearer_before, before, after)
-
-
 NEAR_NS = 20_000_000
 """A truth sample stands for a state when their stamps are this close (the same stamp in
 lockstep; on host time, as with emulated devices, the step nearest the driver's reading)."""
@@ -335,89 +215,6 @@ def estimator_error(truth: Sequence, states: Sequence, since_s: float) -> dict:
         "angle_rad": round(max(angle), 5),
         "samples": len(position),
     }
-
-
-def commands(session: Session) -> tuple[Array, Array]:
-    """(stamps in ns, u rows) of the stamps that have a base and an arm command, and a state
-    to take the heading from; ``ValueError`` naming what is missing."""
-    base = {m.header.stamp_ns: m for m in required(session, BASE_COMMAND)}
-    arm = {m.header.stamp_ns: m for m in required(session, ARM_COMMAND)}
-    stamps = np.array(sorted(base.keys() & arm.keys()), dtype=np.int64)
-    if stamps.size == 0:
-        raise ValueError(
-            f"no {BASE_COMMAND.name!r} message shares a stamp with {ARM_COMMAND.name!r}"
-        )
-    states = required(session, ROBOT_STATE)
-    state_stamps = np.array([s.header.stamp_ns for s in states], dtype=np.int64)
-    phi = np.array([states[i].base_pose[2] for i in nearest(state_stamps, stamps)])
-    v = np.array([base[s].forward_velocity for s in stamps])
-    omega = np.array([base[s].angular_velocity for s in stamps])
-    joints = np.array([arm[s].joint_velocities for s in stamps])
-    if not any(base[s].lateral_velocity for s in stamps):  # as a differential base's always
-        return stamps, np.column_stack((v * np.cos(phi), v * np.sin(phi), omega, joints))
-    side = np.array([base[s].lateral_velocity for s in stamps])  # to the base's left
-    cos, sin = np.cos(phi), np.sin(phi)
-    return stamps, np.column_stack((v * cos - side * sin, v * sin + side * cos, omega, joints))
-
-
-def required(session: Session, topic: Topic) -> list:
-    """The messages of ``topic`` in stamp order; ``ValueError`` naming it when there are none
-    or they are not of its type."""
-    found = messages(session, topic)
-    if not found:
-        raise ValueError(f"the session has no messages on topic {topic.name!r}")
-    wrong = [type(m).__name__ for m in found if not isinstance(m, topic.type)]
-    if wrong:
-        raise ValueError(f"topic {topic.name!r} carries {topic.type.__name__}, got {wrong[0]}")
-    return found
-
-
-def effort(session: Session) -> dict[str, float] | None:
-    """Table 6.1's metrics of the control inputs, with dt the median command period, as
-    ``metric1`` .. ``metric4``; None with fewer than two commands."""
-    try:
-        stamps, u = commands(session)
-    except ValueError:
-        return None
-    return effort_of_inputs(stamps, u)
-
-
-def effort_of_inputs(stamps_ns: Array, u: Array) -> dict[str, float] | None:
-    """``effort_of`` rows of u stamped ``stamps_ns``, dt their median period."""
-    if len(stamps_ns) < 2:
-        return None
-    metrics = effort_of(u, float(np.median(np.diff(stamps_ns))) * 1e-9)
-    return {name: getattr(metrics, field) for name, field in METRICS.items()}
-
-
-def commands_digest(session: Session) -> str:
-    """SHA-256 of every command's stamp and values in stamp order: two runs that sent the same
-    commands have the same digest (a field at its default, such as a differential base's
-    ``lateral_velocity`` 0, is left out: the digests of older runs hold)."""
-    digest = hashlib.sha256()
-    for topic in (BASE_COMMAND, ARM_COMMAND):
-        for command in messages(session, topic):
-            values = command.model_dump(exclude={"header", "joint_names"}, exclude_defaults=True)
-            digest.update(struct.pack("<q", command.header.stamp_ns))
-            digest.update(repr(sorted(values.items())).encode())
-    return digest.hexdigest()
-
-
-def commands_csv(session: Session, robot: MobileManipulator) -> str:
-    """Every command pair the controller sent, one row per stamp (s, m/s, rad/s), the lateral
-    speed after the angular on an omnidirectional base, a column per joint of the robot's arm,
-    named as its description names it (``<name>_dot``)."""
-    arm = {a.header.stamp_ns: a.joint_velocities for a in messages(session, ARM_COMMAND)}
-    lateral = robot.base.kind == "omnidirectional"
-    base = "stamp_s,forward,angular," + ("lateral," if lateral else "")
-    lines = [base + ",".join(f"{n}_dot" for n in robot.joint_names)]
-    for b in messages(session, BASE_COMMAND):
-        joints = arm.get(b.header.stamp_ns)
-        if joints is not None:
-            side = (b.lateral_velocity,) if lateral else ()
-            values = (b.forward_velocity, b.angular_velocity, *side, *joints)
-            lines.append(f"{b.header.stamp_ns / 1e9:.3f}," + ",".join(repr(v) for v in values))
-    return "\n".join(lines) + "\n"
 
 
 def recording_check(facts: dict[str, Any], run_ns: tuple[int, int]) -> dict:

@@ -26,7 +26,7 @@ Times are in s from the session's first command.
                            time, from the ground truth (``analysis.judge.arm_clearances``, whose
                            least is the judge's ``arm_clearance_m``); written when a session's
                            truth has solids
-    effort.json, effort.md the four metrics of table 6.1 (``analysis.judge.effort_of_inputs``)
+    effort.json, effort.md the four metrics of table 6.1 (``analysis.commands.effort_of_inputs``)
 """
 
 from __future__ import annotations
@@ -39,16 +39,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from analysis.judge import (
-    Array,
-    Session,
-    arm_clearances,
-    commands,
-    effort_of_inputs,
-    messages,
-    open_loop,
-    required,
-)
+from analysis.commands import Array, commands, effort_of_inputs, required
+from analysis.judge import arm_clearances, open_loop
+from analysis.run_end import Session, messages
 from messages.goal import Goal
 from messages.topics import (
     CONTROL_DIAGNOSTICS,
@@ -73,7 +66,7 @@ FORMULAS: Mapping[str, str] = {
     "metric3": r"$\int \lVert\ddot{q}\rVert_1\,dt$",
     "metric4": r"$\sqrt{\int \lVert\ddot{q}\rVert_2^2\,dt}$",
 }
-"""Table 6.1's metrics (``analysis.judge.METRICS``) as formulas."""
+"""Table 6.1's metrics (``analysis.commands.METRICS``) as formulas."""
 
 END_EFFECTOR_TASKS = ("pose", "position")
 """The goals that give the end effector a target (a drive leg's aims the base)."""

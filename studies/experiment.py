@@ -30,17 +30,10 @@ from typing import Any
 import yaml
 import zenoh
 
-from analysis.judge import (
-    CONVERGED_ERROR,
-    HOLD_S,
-    JUDGED,
-    commands_csv,
-    end_of_run,
-    judge,
-    recording_check,
-    the_run,
-)
+from analysis.commands import commands_csv
+from analysis.judge import JUDGED, judge, recording_check
 from analysis.report import write_report
+from analysis.run_end import CONVERGED_ERROR, HOLD_S, end_of_run, the_run
 from components.cascade_controller import CascadeController
 from components.lp_controller import LPController
 from components.qp_controller import QPController

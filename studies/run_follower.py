@@ -10,7 +10,7 @@ import time
 
 import zenoh
 
-from analysis.judge import HOLD_S, converged_at
+from analysis.run_end import HOLD_S, converged_at
 from messages import codec, topics
 from messages.topics import CONTROL_DIAGNOSTICS, SIM_TRUTH, SUPERVISOR_STATUS
 

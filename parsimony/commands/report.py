@@ -9,8 +9,9 @@ import argparse
 import sys
 from pathlib import Path
 
-from analysis.judge import JUDGED, judge, open_loop, the_run
+from analysis.judge import JUDGED, judge, open_loop
 from analysis.report import write_report
+from analysis.run_end import the_run
 from outputs.stdout import emit, json_text
 from parsimony.argument_types import positive_seconds
 from parsimony.commands.robot_option import add_robot_option

@@ -6,7 +6,7 @@ the camera), with the gains of its kinematic run (``runs.laws_of``, passed as th
 ``--gain``: one declaration). Each recording is read back (``recorded``) and given to the
 same row functions as the kinematic runs (``rows``); each row is labelled as on the loop and
 printed beside its kinematic one (``beside``). A run of the loop ends by the loop's rule
-(``analysis.judge``): ``HOLD_S`` after its error stayed under ``CONVERGED_ERROR``, else at the
+(``analysis.run_end``): ``HOLD_S`` after its error stayed under ``CONVERGED_ERROR``, else at the
 time limit.
 """
 
@@ -19,7 +19,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from analysis.judge import CONVERGED_ERROR, HOLD_S
+from analysis.run_end import CONVERGED_ERROR, HOLD_S
 from studies.experiment import PROFILES, SESSION_FILE, Options, run_experiment
 from studies.gain_sets import LP_PARAMS
 from studies.reproduce import laws as L

@@ -1,12 +1,12 @@
 """A run of the whole loop read back from its recording, as the rows of `parsimony reproduce`
 take a kinematic run (``wbc.laws.kinematic_run.Run``).
 
-The run is what ``analysis.judge`` judges (``the_run``: up to ``HOLD_S`` after the controller's
-error stayed under ``CONVERGED_ERROR``, else the time limit), from the controller's first step
-of its law on: one step per diagnostics that answers a state, with u as its commands carried it
-(``analysis.judge.commands``: the base's (v, omega) after the wheel speed limit, in F0), the
-state the controller was given (the estimate, in F0), the task of the last goal it held, its
-diagnostics (status, rows at their bound, the law's step time, its error) and the simulator's
+The run is what ``analysis.judge`` judges (``analysis.run_end``: up to ``HOLD_S`` after the
+controller's error stayed under ``CONVERGED_ERROR``, else the time limit), from the controller's
+first step of its law on: one step per diagnostics that answers a state, with u as its commands
+carried it (``analysis.commands.commands``: the base's (v, omega) after the wheel speed limit, in
+F0), the state the controller was given (the estimate, in F0), the task of the last goal it held,
+its diagnostics (status, rows at their bound, the law's step time, its error) and the simulator's
 true configuration at that stamp (in the simulator's world, the kinematic runs' frame).
 """
 
@@ -18,7 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.judge import JUDGED, commands, nearest, required, the_run
+from analysis.commands import commands, nearest, required
+from analysis.judge import JUDGED
+from analysis.run_end import the_run
 from components.control_step import task_of
 from messages.topics import CONTROL_DIAGNOSTICS, CONTROL_GOAL, ROBOT_STATE, SIM_TRUTH
 from record.sessions import load_session

@@ -14,7 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from analysis.judge import CONVERGED_ERROR, JUDGED, converged_at, messages, origin_s, the_run
+from analysis.judge import JUDGED
+from analysis.run_end import CONVERGED_ERROR, converged_at, messages, origin_s, the_run
 from messages.topics import CONTROL_DIAGNOSTICS, SUPERVISOR_STATUS
 from outputs.stdout import json_text
 from profiles.profile import load_profile

@@ -13,7 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from analysis.judge import JUDGED, commands, messages, the_run
+from analysis.commands import commands
+from analysis.judge import JUDGED
+from analysis.run_end import messages, the_run
 from messages.topics import CONTROL_DIAGNOSTICS
 from profiles.deploy_files import ROBOT_FILE
 from record.sessions import load_session

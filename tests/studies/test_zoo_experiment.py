@@ -35,8 +35,10 @@ import pytest
 import yaml
 from mcap.reader import make_reader
 
-from analysis.judge import JUDGED, commands_csv, judge, the_run
+from analysis.commands import commands_csv
+from analysis.judge import JUDGED, judge
 from analysis.report import write_report
+from analysis.run_end import the_run
 from components.control_step import ControlStep
 from components.lp_controller import LPController
 from messages import topics
