@@ -12,7 +12,7 @@ from outputs.stdout import emit, json_text
 from parsimony.stop_signals import Interrupted, stop_signals
 from studies.study import results
 from studies.study.drive import drive
-from studies.study.report import check_tables, markdown, update_page
+from studies.study.report import check_tables, markdown, pages, update_page
 from studies.study.schema import StudyError, load_study
 from studies.study.sweep import expand
 
@@ -65,10 +65,20 @@ def run(args: argparse.Namespace) -> int:
     if args.report:
         rows = results.read(path)
         text = markdown(study, str(args.file), runs, rows)
-        if args.page and (study.page is None or not update_page(study.page, study, text)):
-            print(f"parsimony study: {study.name} names no page with its markers", file=sys.stderr)
-            return 2
         if args.page:
+            named = pages(study)
+            missing = [
+                str(page)
+                for page in named
+                if not update_page(page, study, markdown(study, str(args.file), runs, rows, page))
+            ]
+            if missing or not named:
+                print(
+                    f"parsimony study: {study.name}: no page with its markers "
+                    f"({', '.join(missing) or 'it names none'})",
+                    file=sys.stderr,
+                )
+                return 2
             from studies.study.plots import draw
 
             for plot in study.plots:

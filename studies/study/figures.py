@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from studies import redundancy
-from studies.goal_sets import failures, parsimony, planning, shares
+from studies.goal_sets import failures, not_reached, parsimony, planning, shares
 from studies.study.execute import OK
 from studies.study.runs import attempt_of
 from wbc import dq
@@ -98,6 +98,9 @@ KINEMATIC: dict[str, Figure] = COMMON | {
     "sets": _sets,
     "nonzero moving": _parsimony("nonzero moving", "median_nonzero_moving"),
     "nonzero near the goal": _parsimony("nonzero near the goal", "median_nonzero_settling"),
+    "nonzero near the goal, x' y' as one": _parsimony(
+        "nonzero near the goal, x' y' as one", "median_nonzero_settling_forward_as_one"
+    ),
     "contacts": lambda rows, robot: {"contacts": failures(_attempts(rows))["contacts"]},
     "clearance": lambda rows, robot: {
         "least clearance (m)": failures(_attempts(rows))["least_clearance_m"]
@@ -105,6 +108,7 @@ KINEMATIC: dict[str, Figure] = COMMON | {
     "planning": lambda rows, robot: planning(_attempts(rows)),
     "effort": _effort,
     "misses": misses,
+    "not reached": lambda rows, robot: not_reached(_attempts(rows))["failures"],
 }
 """A kinematic study's figures on goal families: each gives one or more columns."""
 
@@ -178,8 +182,35 @@ SIMULATED_COLUMNS = (
     "recordings_whole",
 )
 """The columns of ``summary`` a simulated study's table may name."""
-SIMULATED: dict[str, Figure] = {key: _summary(key) for key in SIMULATED_COLUMNS}
-"""A simulated study's figures (``SETUP``'s too)."""
+
+
+def _reports(rows: Rows) -> list[dict]:
+    return [json.loads(r["report"]) for r in ok(rows)]
+
+
+def _arm_penetrations(rows: Rows, robot: MobileManipulator) -> dict[str, int]:
+    """The runs in which a part of the arm entered a solid (the judge's ``arm_penetrations``)."""
+    return {
+        "with an arm penetration": sum((r["arm_penetrations"] or 0) > 0 for r in _reports(rows))
+    }
+
+
+def _arm_clearance(rows: Rows, robot: MobileManipulator) -> dict[str, float]:
+    """Each collision part's least clearance from the solids over the runs, m (negative: the
+    deepest penetration; the judge's ``arm_clearance_m``)."""
+    least: dict[str, float] = {}
+    for report in _reports(rows):
+        for part, clearance in (report["arm_clearance_m"] or {}).items():
+            least[part] = min(least.get(part, clearance), clearance)
+    return {f"{part} (m)": value for part, value in least.items()}
+
+
+SIMULATED: dict[str, Figure] = {key: _summary(key) for key in SIMULATED_COLUMNS} | {
+    "arm penetrations": _arm_penetrations,
+    "arm clearance": _arm_clearance,
+}
+"""A simulated study's figures (``SETUP``'s too): the experiments' summary's columns, the runs
+with an arm penetration and each part's least clearance from the solids."""
 
 
 def _converge_times(rows: Rows, robot: MobileManipulator) -> dict[str, float | None]:

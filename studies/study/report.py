@@ -13,7 +13,7 @@ from outputs.stdout import finite
 from studies.study import places
 from studies.study.figures import COMPARED, KINEMATIC, SETUP, SIMULATED, ZOO, Figure
 from studies.study.schema import Study, StudyError, Table
-from studies.study.sweep import PARAMETERS, Run
+from studies.study.sweep import PARAMETERS, Run, laws
 from wbc.robot import MobileManipulator
 
 FIGURES: dict[str, dict[str, Figure]] = {
@@ -32,13 +32,31 @@ def figures_of(study: Study) -> dict[str, Figure]:
     return {name: figure for name, figure in each[0].items() if all(name in f for f in each)}
 
 
+def values(study: Study) -> dict[str, set]:
+    """The values each parameter of ``study``'s runs takes."""
+    return {
+        "loop": set(study.loops),
+        "robot": {Path(robot).stem for robot in study.robots},
+        "family": set(study.families),
+        "experiment": set(study.experiments),
+        "task": set(study.tasks) if study.families else {None},
+        "seed": {seed for loop in study.loops for seed in study.seeds_of(loop)},
+        "goal": set(range(study.goals)) if study.families else {None},
+        "law": {label for spec in study.laws for label, _ in laws(spec)},
+    }
+
+
 def check_tables(study: Study) -> None:
-    """``StudyError`` naming a table's or a plot's unknown parameter or figure."""
+    """``StudyError`` naming a table's or a plot's unknown parameter, value or figure."""
     known = figures_of(study)
+    taken = values(study)
     for table in study.tables:
-        for name in table.by:
+        for name in [*table.by, *table.where]:
             if name not in PARAMETERS:
                 raise StudyError(f"table {table.title!r}: no parameter {name!r}; {PARAMETERS}")
+        for name, wanted in table.where.items():
+            if unknown := [value for value in wanted if value not in taken[name]]:
+                raise StudyError(f"table {table.title!r}: no {name} {unknown[0]!r} in the study")
         for name in table.figures:
             if name in COMPARED and table.against is None:
                 raise StudyError(f"table {table.title!r}: {name!r} needs 'against: LAW'")
@@ -61,13 +79,18 @@ def robots(runs: list[Run]) -> dict[str, MobileManipulator]:
     return {name: MobileManipulator.from_yaml(path) for name, path in files.items()}
 
 
-def groups(rows: list[dict[str, Any]], by: list[str], seeds: list[int] = ()) -> dict[tuple, list]:
-    """``rows`` (of ``seeds``, or every seed) grouped by the values of ``by``, in the runs'
-    order."""
+def counted(table: Table, row: dict[str, Any]) -> bool:
+    """Whether ``table`` counts ``row`` (its ``seeds`` and ``where``)."""
+    if table.seeds and row["seed"] not in table.seeds:
+        return False
+    return all(row[name] in wanted for name, wanted in table.where.items())
+
+
+def groups(rows: list[dict[str, Any]], by: list[str]) -> dict[tuple, list]:
+    """``rows`` grouped by the values of ``by``, in the runs' order."""
     found: dict[tuple, list[dict[str, Any]]] = {}
     for row in sorted(rows, key=lambda r: r["index"]):
-        if not seeds or row["seed"] in seeds:
-            found.setdefault(tuple(row[name] for name in by), []).append(row)
+        found.setdefault(tuple(row[name] for name in by), []).append(row)
     return found
 
 
@@ -76,7 +99,7 @@ def table_lines(
 ) -> list[dict[str, Any]]:
     """A line per group of ``table``: its parameters and figures."""
     figures = figures_of(study)
-    found = groups(rows, table.by, table.seeds)
+    found = groups([row for row in rows if counted(table, row)], table.by)
     lines = []
     for values, group in found.items():
         robot = loaded[group[0]["robot"]]
@@ -91,8 +114,17 @@ def table_lines(
     return lines
 
 
-def markdown(study: Study, file: str, runs: list[Run], rows: list[dict[str, Any]]) -> str:
-    """Every table of ``study`` over ``rows`` (the runs' robots from ``runs``)."""
+def pages(study: Study) -> list[Path]:
+    """The docs pages ``study``'s tables go in, in the tables' order."""
+    found = [table.page or study.page for table in study.tables] or [study.page]
+    return list(dict.fromkeys(page for page in found if page is not None))
+
+
+def markdown(
+    study: Study, file: str, runs: list[Run], rows: list[dict[str, Any]], page: Path | None = None
+) -> str:
+    """The tables of ``study`` over ``rows`` (the runs' robots from ``runs``): every table, or
+    those that go in ``page``."""
     loaded = robots(runs)
     done = sum(row["status"] == "ok" for row in rows)
     parts = [
@@ -100,6 +132,8 @@ def markdown(study: Study, file: str, runs: list[Run], rows: list[dict[str, Any]
         f"{len(runs)} runs, {done} of them run to the end."
     ]
     for table in study.tables:
+        if page is not None and (table.page or study.page) != page:
+            continue
         lines = table_lines(study, table, rows, loaded)
         text = tabulate(lines, headers="keys", tablefmt="pipe", floatfmt=".3g", missingval="")
         parts.append(f"**{table.title}**\n\n{text}")

@@ -59,6 +59,15 @@ class LawSpec(_Strict):
     gains: dict[str, Gain | list[Gain]] = Field(default_factory=dict)
     only: list[str] = []
     """The families or experiments it runs on (all by default)."""
+    task: Task | list[Task] | None = None
+    """The tasks it runs (the study's by default), kinematic."""
+
+    def tasks_of(self, study_tasks: list[str]) -> list[str]:
+        """The study's tasks this law runs."""
+        if self.task is None:
+            return study_tasks
+        mine = self.task if isinstance(self.task, list) else [self.task]
+        return [task for task in study_tasks if task in mine]
 
 
 class Table(_Strict):
@@ -71,9 +80,14 @@ class Table(_Strict):
     """Figures of ``studies.study.figures`` computed over each group's runs."""
     seeds: Seeds = []
     """The seeds whose runs it counts (every seed by default)."""
+    where: dict[str, list[int | str]] = {}
+    """Parameters (``sweep.PARAMETERS``) and the values of them whose runs it counts (every
+    run by default): ``{law: [LP, QP], task: [pose]}``."""
     against: str | None = None
     """A law's label: the figures that compare goal by goal (``figures.COMPARED``) compare
     each group's runs with that law's runs of the same goals."""
+    page: Path | None = None
+    """The docs page it goes in (the study's ``page`` by default)."""
 
 
 class Plot(_Strict):
@@ -122,7 +136,8 @@ class Study(_Strict):
     plots: list[Plot] = []
     page: Path | None = None
     """A docs page (from the repository's root) whose block between the study's markers
-    (``report.markers``) its report replaces."""
+    (``report.markers``) its report replaces with its tables (those of a table's own ``page``
+    go in that page's block)."""
 
     @property
     def tasks(self) -> list[str]:
@@ -144,6 +159,11 @@ class Study(_Strict):
                 raise ValueError("a simulated study names experiments (and no families)")
             if not self.seeds_of(loop):
                 raise ValueError(f"no seeds for the {loop} loop")
+        for spec in self.laws:
+            if spec.task is not None and not self.families:
+                raise ValueError(f"law {spec.law!r}: a task of its own needs goal families")
+            if not spec.tasks_of(self.tasks):
+                raise ValueError(f"law {spec.law!r}: none of its tasks is the study's")
         return self
 
 

@@ -68,6 +68,8 @@ def expand(study: Study, directory: Path = Path("."), runs_dir: Path = Path("run
             for seed, spec in itertools.product(study.seeds_of(loop), study.laws):
                 if spec.only and place not in spec.only:
                     continue
+                if task is not None and task not in spec.tasks_of(study.tasks):
+                    continue
                 for label, gains in laws(spec):
                     law_key = (loop, place, spec.law, json.dumps(gains, sort_keys=True), path)
                     if law_key not in checked:  # once per law, not per run
