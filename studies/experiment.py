@@ -267,6 +267,9 @@ def run_experiment(options: Options) -> dict[str, Any]:
         (followed, truth_ns), wall_s = follow(
             follower, options.time_limit_s, options.realtime, started
         )
+        # Held where the run ended: steps past it are neither judged nor worth the CPU time
+        # they would take while the processes stop.
+        query.set_param(session, profile.namespace, "simulator", "paused", "true")
         counters = component_counters(session, profile.namespace)
         say("stopping the processes (the recorder writes all it holds)")
     say("judging the recording")

@@ -14,6 +14,10 @@ from analysis.run_end import HOLD_S, converged_at
 from messages import codec, topics
 from messages.topics import CONTROL_DIAGNOSTICS, SIM_TRUTH, SUPERVISOR_STATUS
 
+PROGRESS_S = 0.2
+"""Host seconds between two looks at the run when no diagnostic arrives (a paused or slow
+loop): its time limit and its progress line."""
+
 
 class Follower:
     """What the run's end is decided on, as it arrives: the controller's diagnostics, the
@@ -23,6 +27,8 @@ class Follower:
     def __init__(self, session: zenoh.Session, namespace: str) -> None:
         self.session: dict[str, list] = {CONTROL_DIAGNOSTICS.name: [], SUPERVISOR_STATUS.name: []}
         self.truth_ns: list[int] = []  # the first and the latest
+        self.arrived = threading.Event()
+        """Set by each diagnostic or status: the run's end may have come."""
         self._lock = threading.Lock()
         self._subscribers = [
             session.declare_subscriber(topic.key(namespace), self._taker(topic))
@@ -38,8 +44,19 @@ class Follower:
                     self.truth_ns[:1] = self.truth_ns[:1] or [message.header.stamp_ns]
                 else:
                     self.session[topic.name].append(message)
+                    self.arrived.set()
 
         return take
+
+    def latest(self) -> tuple[dict[str, list], list[int]]:
+        """As ``snapshot``, but of the diagnostics only the latest: what the run's progress and
+        a first look at its end take, without copying all that came before."""
+        with self._lock:
+            latest = {
+                CONTROL_DIAGNOSTICS.name: self.session[CONTROL_DIAGNOSTICS.name][-1:],
+                SUPERVISOR_STATUS.name: list(self.session[SUPERVISOR_STATUS.name]),
+            }
+            return latest, list(self.truth_ns)
 
     def snapshot(self) -> tuple[dict[str, list], list[int]]:
         """The diagnostics and statuses so far, and the first and latest truth stamps."""
@@ -64,21 +81,28 @@ def follow(
     follower: Follower, time_limit_s: float, realtime: bool, started: float
 ) -> tuple[tuple[dict[str, list], list[int]], float]:
     """Print progress until the run converges or its time is up; return what was followed
-    (``Follower.snapshot``), and the host seconds since ``started`` when it was."""
+    (``Follower.snapshot``), and the host seconds since ``started`` when it was. The end is
+    looked for as each diagnostic arrives, so that the run is held soon after it (a lockstep
+    loop takes a step every few milliseconds); the progress is printed every second."""
     last_print = 0.0
     wall_limit = max(120.0, time_limit_s * (3.0 if realtime else 10.0))
     while True:
-        time.sleep(0.2)  # progress is sampled; the recording holds the run itself
-        followed, truth_ns = follower.snapshot()
+        follower.arrived.wait(PROGRESS_S)
+        follower.arrived.clear()
+        latest, truth_ns = follower.latest()
         origin = truth_ns[0] / 1e9 if truth_ns else math.inf
         wall = time.monotonic() - started
         if wall - last_print >= 1.0:
-            print(progress_line(followed, origin, wall), file=sys.stderr, flush=True)
+            print(progress_line(latest, origin, wall), file=sys.stderr, flush=True)
             last_print = wall
-        diagnostics = followed[CONTROL_DIAGNOSTICS.name]
+        diagnostics, statuses = latest[CONTROL_DIAGNOSTICS.name], latest[SUPERVISOR_STATUS.name]
         now_s = diagnostics[-1].header.stamp_ns / 1e9 if diagnostics else 0.0
-        since = converged_at(diagnostics, followed[SUPERVISOR_STATUS.name])
-        if since is not None and now_s - since >= HOLD_S:
-            return (followed, truth_ns), wall
+        if converged_at(diagnostics, statuses) is not None:  # the latest step counts: look back
+            followed, truth_ns = follower.snapshot()
+            found = followed[CONTROL_DIAGNOSTICS.name]
+            now_s = found[-1].header.stamp_ns / 1e9
+            since = converged_at(found, followed[SUPERVISOR_STATUS.name])
+            if since is not None and now_s - since >= HOLD_S:
+                return (followed, truth_ns), wall
         if now_s - origin >= time_limit_s or wall > wall_limit:
-            return (followed, truth_ns), wall
+            return follower.snapshot(), wall
