@@ -9,7 +9,8 @@ import math
 import numpy as np
 
 from messages.goal import Goal
-from wbc.planning.staging import StagingParams, within
+from wbc.planning.candidate import within
+from wbc.planning.staging import StagingParams
 from wbc.robot import MobileManipulator
 
 Region = tuple[tuple[float, float, float], ...]

@@ -29,8 +29,8 @@ from tests.wbc.planning.crowd import CHECK_GAP_S, crowd
 from wbc import dq
 from wbc.geometry.scenarios import HOME, REACH_GOAL
 from wbc.planar import planar_pose
+from wbc.planning.candidate import within
 from wbc.planning.drive_tasks import HeadingTask, PointTask, offset_point
-from wbc.planning.staging import within
 from wbc.robot import MobileManipulator
 from wbc.task import PoseTask, PositionTask, same_task
 

@@ -11,7 +11,7 @@ import pytest
 from sim2d.floor_view import camera_region, region_of, seen_floor
 from sim2d.pinhole import PinholeCamera, ceiling_pose
 from wbc import dq
-from wbc.planning.staging import within
+from wbc.planning.candidate import within
 
 
 def test_the_corners_of_the_seen_floor_project_onto_the_image_edges() -> None:

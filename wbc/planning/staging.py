@@ -1,22 +1,17 @@
 """Where the base should stand for a pose goal: whole-body configurations that reach it, ranked.
 
-The LP law is local: from a base that faces away from a goal, or stands where the arm can only
-reach it at a joint's limit, its steps stall. A staging candidate is a whole configuration q_c
-with fkm(q_c) = x_d, found by a bounded inverse-kinematics search from several starts:
-
-    min ||vec8(fkm(q)) - vec8(x_d)||^2  over  z = (x, y, phi, q2, ..., qn),  q1 = 0,
-
-each arm joint kept a margin inside the LP's joint box b_l [q-, q+] (5.14), so that the
-pose task started from q_c has room on every joint. The waist is held at 0: it turns the arm
-exactly as phi does (the arm stands on the base's turning axis), so the base's heading carries
-the arm's yaw. The starts place the base all round the goal, at reaches from behind the
-gripper to over the arm's back: with the wrist rolled, the base of a configuration of the goal
-may face any way from the gripper's heading, and the arm folded back puts the gripper behind
-the base. Candidates whose base, staging point or final leg comes within reach of an obstacle
-are left out, and so are those with no way round the obstacles to their staging point
-(wbc.planning.drive_planner), and those whose base, staging point or way leaves the ``region`` the
-base must keep to (the floor the camera sees, where the base keeps its fixes). Each candidate is
-scored, lower first:
+The LP law is local: from a base that faces away from a goal, or stands where the arm can only reach
+it at a joint's limit, its steps stall. A staging candidate (``wbc.planning.candidate``) is a whole
+configuration q_c with fkm(q_c) = x_d, found by a bounded inverse-kinematics search
+(``wbc.planning.whole_body_ik``) from several starts, each arm joint kept a margin inside the LP's
+joint box b_l [q-, q+] (5.14), so that the pose task started from q_c has room on every joint. The
+starts place the base all round the goal, at reaches from behind the gripper to over the arm's back:
+with the wrist rolled, the base of a configuration of the goal may face any way from the gripper's
+heading, and the arm folded back puts the gripper behind the base. Candidates whose base, staging
+point or final leg comes within reach of an obstacle are left out, and so are those with no way
+round the obstacles to their staging point (wbc.planning.drive_planner), and those whose base,
+staging point or way leaves the ``region`` the base must keep to (the floor the camera sees, where
+the base keeps its fixes). Each candidate is scored, lower first:
 
     travel + heading_weight * turning + conditioning_weight * max(0, 1 - sigma_6 / sigma_floor)
 
@@ -41,18 +36,13 @@ from wbc.geometry.obstacles import Circle
 from wbc.laws.lp_law import LPParams
 from wbc.laws.objectives.base_target import gripper_heading
 from wbc.planar import wrap
+from wbc.planning.candidate import Candidate, clear_of, same_configuration, staging_point, within
 from wbc.planning.disc_geometry import segment_clear
 from wbc.planning.drive_planner import OutOfBudget, Way, WayPlanner
+from wbc.planning.whole_body_ik import arm_box, solve_ik
 from wbc.robot import BASE_DOF, MobileManipulator
 
 Array = np.ndarray
-
-
-def free_entries(dof: int) -> list[int]:
-    """The entries of q (``dof`` of them) the search moves: the base and every arm joint but
-    the waist."""
-    return [*range(BASE_DOF), *range(BASE_DOF + 1, dof)]
-
 
 NEAR_HEADING = 0.3
 """A base within a final leg of its candidate, facing it this closely and this close to its
@@ -118,100 +108,6 @@ class StagingParams:
     both stop at it. Plans take 0.07 s median, 0.28 s p99 on the goals 'anywhere', 0.21 and
     0.77 s with an obstacle near the way (`parsimony bench`)."""
     seed: int = 0
-
-
-@dataclass(frozen=True)
-class Candidate:
-    """A configuration of the goal pose and what getting there costs."""
-
-    q: Array
-    travel: float
-    turning: float
-    sigma: float
-    score: float
-    way: Way | None
-    """The base's way from where the plan began to the staging point; None where the base
-    stood near enough to go straight to the approach (``NEAR_HEADING``)."""
-    final_leg: float
-    """The straight leg into the pose: the staging point stands this far behind the base on
-    its heading, m (ahead where negative)."""
-    roomy: bool = True
-    """The LP's obstacle constraint leaves the pose task alone at q_c and the turn at the
-    staging point: the point ``slack`` ahead of q_c's axle keeps clearance + slack from
-    every obstacle, and so does the staging point."""
-
-    @property
-    def base(self) -> Array:
-        return self.q[:BASE_DOF]
-
-    @property
-    def arm(self) -> Array:
-        return self.q[BASE_DOF:]
-
-    @property
-    def staging(self) -> Array:
-        """Where the final leg starts."""
-        return staging_point(self.base, self.final_leg)
-
-
-def staging_point(base: Array, final_leg: float) -> Array:
-    """Where the final straight leg into a base pose (x, y, phi) starts: ``final_leg`` behind
-    it, on its heading (ahead where negative)."""
-    x, y, phi = base
-    return np.array([x - final_leg * math.cos(phi), y - final_leg * math.sin(phi)])
-
-
-def arm_box(robot: MobileManipulator, safety_factor: float, margin: float) -> tuple[Array, Array]:
-    """The arm joints' search bounds: b_l [q-, q+] shrunk by ``margin`` on each side."""
-    low, high = robot.joint_box(safety_factor)
-    return low[BASE_DOF:] + margin, high[BASE_DOF:] - margin
-
-
-def solve_ik(
-    robot: MobileManipulator,
-    goal_pose: Array,
-    start: Array,
-    bounds: tuple[Array, Array],
-    tolerance: float,
-) -> Array | None:
-    """A configuration q (q1 = 0) with fkm(q) = goal_pose from ``start``, or None."""
-    from scipy.optimize import least_squares  # loaded by the first plan: see ``plan``
-
-    q = np.array(start, dtype=float)
-    q[BASE_DOF] = 0.0
-    free = free_entries(robot.dof)
-    goal = dq.nearest_equivalent(goal_pose, robot.fkm(q))
-
-    def residual(z: Array) -> Array:
-        q[free] = z
-        return robot.fkm(q) - goal
-
-    def jacobian(z: Array) -> Array:
-        q[free] = z
-        return robot.pose_jacobian(q)[:, free]
-
-    result = least_squares(
-        residual,
-        q[free],
-        jac=jacobian,
-        bounds=bounds,
-        method="trf",
-        xtol=1e-12,
-        ftol=1e-12,
-        gtol=1e-12,
-        max_nfev=200,
-    )
-    if not math.sqrt(2.0 * result.cost) < tolerance:
-        return None
-    q[free] = result.x
-    q[2] = wrap(q[2])
-    return q.copy()
-
-
-def clear_of(obstacles: Sequence[Circle], point: Array, body_radius: float) -> bool:
-    return all(
-        math.hypot(point[0] - c.x, point[1] - c.y) >= c.radius + body_radius for c in obstacles
-    )
 
 
 @dataclass(frozen=True)
@@ -423,29 +319,6 @@ def _final_leg(
         if clear_of(obstacles, staging, body) and segment_clear(staging, q, obstacles, body):
             return leg
     return None
-
-
-def within(region: Sequence[tuple[float, float, float]], *points: Array) -> bool:
-    """Every point's (x, y) inside ``region`` (``StagingParams.region``): between two of
-    them, the segment too, the region being convex."""
-    return all(a * p[0] + b * p[1] <= c for p in points for a, b, c in region)
-
-
-def same_kind(a: Array, b: Array) -> bool:
-    """The bases within 0.1 m and 0.3 rad of each other."""
-    return bool(math.hypot(*(a[:2] - b[:2])) < 0.1 and abs(wrap(a[2] - b[2])) < 0.3)
-
-
-def same_configuration(a: Array, b: Array) -> bool:
-    """Every entry within 0.02 (m or rad, headings wrapped)."""
-    return bool(
-        np.max(
-            np.abs(
-                np.concatenate((a[:2] - b[:2], [wrap(a[2] - b[2])], a[BASE_DOF:] - b[BASE_DOF:]))
-            )
-        )
-        < 0.02
-    )
 
 
 def _near(q_now: Array, q: Array, final_leg: float) -> bool:

@@ -38,8 +38,9 @@ import numpy as np
 
 from wbc.geometry.obstacles import Circle
 from wbc.planar import wrap
+from wbc.planning.candidate import Candidate, same_configuration, same_kind
 from wbc.planning.drive_tasks import HeadingTask, PointTask
-from wbc.planning.staging import Candidate, Plan, StagingParams, plan, same_configuration, same_kind
+from wbc.planning.staging import Plan, StagingParams, plan
 from wbc.planning.supervisor_phase import Phase
 from wbc.robot import MobileManipulator
 from wbc.task import PoseTask, Task

@@ -10,7 +10,7 @@ import pytest
 
 from profiles.deploy_files import ROBOTS_DIR
 from wbc.planning.drive_tasks import HeadingTask, PointTask
-from wbc.planning.staging import free_entries
+from wbc.planning.whole_body_ik import free_entries
 from wbc.robot import MobileManipulator
 
 

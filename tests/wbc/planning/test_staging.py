@@ -19,7 +19,8 @@ from wbc.laws.kinematic_run import integrate
 from wbc.laws.lp_law import LPLaw
 from wbc.planar import planar_pose
 from wbc.planning.drive_tasks import HeadingTask, PointTask, offset_point
-from wbc.planning.staging import StagingParams, arm_box, plan
+from wbc.planning.staging import StagingParams, plan
+from wbc.planning.whole_body_ik import arm_box
 
 MODEL = robot()
 STEPS = int(60.0 / DT)
