@@ -12,7 +12,7 @@ import numpy as np
 
 from wbc.geometry.obstacles import Circle
 from wbc.planar import wrap
-from wbc.planning.drive_planner import Way
+from wbc.planning.way import Way
 from wbc.robot import BASE_DOF
 
 Array = np.ndarray

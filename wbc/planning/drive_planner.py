@@ -22,7 +22,7 @@ its own tangents (the staging planner asks for many targets from one start). A t
 a grown disc, or walled off, has no way, and the reason says which. The way is handed to the
 drive as waypoints: each arc becomes the corners of the polygon circumscribed about it
 (corners at R_i / cos(delta / 2), at most ``max_turn`` apart), so every leg between waypoints
-is tangent to, and outside of, the grown discs.
+is tangent to, and outside of, the grown discs (``wbc.planning.way``).
 
 The graph of n discs has O(n^2) nodes and its edges take O(n^3) work (256 discs: 70,000
 nodes, seconds of CPU), so a planner given a ``deadline`` on its thread's CPU clock raises
@@ -49,6 +49,7 @@ from wbc.planning.disc_geometry import (
     overlaps,
     segment_clear,
 )
+from wbc.planning.way import Arc, Way
 from wbc.validation import require_finite
 
 Array = np.ndarray
@@ -62,66 +63,6 @@ SEARCH_CHECK = 1024
 
 class OutOfBudget(Exception):
     """A ``WayPlanner``'s CPU deadline passed before its work was done."""
-
-
-@dataclass(frozen=True)
-class Arc:
-    """A piece of a way on a disc: from angle ``start`` through ``sweep`` (rad, > 0
-    counter-clockwise) on radius ``radius`` about ``centre``."""
-
-    centre: tuple[float, float]
-    radius: float
-    start: float
-    sweep: float
-
-    def corners(self, max_turn: float) -> list[Array]:
-        """The corners of the polygon circumscribed about the arc, pieces of at most
-        ``max_turn`` rad: the meeting points of the tangents at its ends and between them."""
-        pieces = max(1, math.ceil(abs(self.sweep) / max_turn - 1e-9))
-        step = self.sweep / pieces
-        lifted = self.radius / math.cos(0.5 * step)
-        angles = self.start + step * (np.arange(pieces) + 0.5)
-        return [
-            np.array([self.centre[0] + lifted * math.cos(a), self.centre[1] + lifted * math.sin(a)])
-            for a in angles
-        ]
-
-
-@dataclass(frozen=True)
-class Way:
-    """The shortest way from ``start`` to ``target`` round the grown discs, or why none."""
-
-    start: Array
-    target: Array
-    arcs: tuple[Arc, ...]
-    length: float
-    """The exact length of the tangent segments and arcs, m (inf without a way)."""
-    reason: str
-    """Why there is no way; empty when there is."""
-    waypoints: tuple[Array, ...]
-    """What the drive steers to, after the start: each arc's circumscribed corners, and the
-    target last."""
-
-    @property
-    def found(self) -> bool:
-        return not self.reason
-
-    @property
-    def turning(self) -> float:
-        """The heading changes along the way, rad: a tangent path turns only on its arcs."""
-        return float(sum(abs(arc.sweep) for arc in self.arcs))
-
-    def first_bearing(self) -> float:
-        """The direction of the way's first leg, rad."""
-        return _bearing(self.start, self.waypoints[0])
-
-    def last_bearing(self) -> float:
-        """The direction of the way's last leg, into the target, rad."""
-        return _bearing(self.waypoints[-2] if len(self.waypoints) > 1 else self.start, self.target)
-
-
-def _bearing(a: Array, b: Array) -> float:
-    return math.atan2(float(b[1] - a[1]), float(b[0] - a[0]))
 
 
 def plan_way(

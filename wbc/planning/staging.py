@@ -38,7 +38,8 @@ from wbc.laws.objectives.base_target import gripper_heading
 from wbc.planar import wrap
 from wbc.planning.candidate import Candidate, clear_of, same_configuration, staging_point, within
 from wbc.planning.disc_geometry import segment_clear
-from wbc.planning.drive_planner import OutOfBudget, Way, WayPlanner
+from wbc.planning.drive_planner import OutOfBudget, WayPlanner
+from wbc.planning.way import Way
 from wbc.planning.whole_body_ik import arm_box, solve_ik
 from wbc.robot import BASE_DOF, MobileManipulator
 
