@@ -23,6 +23,7 @@ from dynamixel_sdk import COMM_SUCCESS, GroupSyncWrite, PacketHandler, PortHandl
 
 from protocols import dynamixel_v1 as dxl1
 from protocols import dynamixel_v2 as dxl2
+from protocols import x_series_units as x_units
 from protocols.dynamixel_v1 import StatusFault
 
 HOLD_SPEED = 1
@@ -131,9 +132,9 @@ class XBus(ServoBus):
     """X-series servos, protocol 2.0, in position mode."""
 
     protocol = 2.0
-    position_max = dxl2.POSITION_MAX
-    units_per_rad = dxl2.POSITION_UNITS_PER_RAD
-    speed_max = dxl2.PROFILE_VELOCITY_MAX
+    position_max = x_units.POSITION_MAX
+    units_per_rad = x_units.POSITION_UNITS_PER_RAD
+    speed_max = x_units.PROFILE_VELOCITY_MAX
     error_names = (
         *(e.name.lower() for e in dxl2.StatusError if e),
         *(bit.name.lower() for bit in dxl2.HardwareError),
@@ -141,10 +142,10 @@ class XBus(ServoBus):
     read_bytes = 8
     """Present Velocity and Present Position, from address 128."""
 
-    position_of_angle = staticmethod(dxl2.position_of_angle)
-    position_units = staticmethod(dxl2.position_units)
-    angle_of_units = staticmethod(dxl2.angle_of_units)
-    speed_units = staticmethod(dxl2.profile_velocity)
+    position_of_angle = staticmethod(x_units.position_of_angle)
+    position_units = staticmethod(x_units.position_units)
+    angle_of_units = staticmethod(x_units.angle_of_units)
+    speed_units = staticmethod(x_units.profile_velocity)
 
     def errors(self, servo: int, error: int) -> list[str]:
         """The name of a status packet's error number, and with the alert bit those of the
@@ -208,7 +209,7 @@ class XBus(ServoBus):
         if fault is not None:
             return None, fault, 0
         error, data = dxl2.status_data(answer)
-        velocity = dxl2.rad_s_of_velocity_units(dxl2.signed(data[:4]))
+        velocity = x_units.rad_s_of_velocity_units(dxl2.signed(data[:4]))
         return (dxl2.signed(data[4:8]), velocity), None, error
 
     def read_all(self, ids: Sequence[int]) -> list[Reading] | None:
@@ -251,7 +252,7 @@ class XBus(ServoBus):
             )
             if result != COMM_SUCCESS:
                 return None
-            goal = min(max(dxl2.signed(dxl2.value(position, 4)), 0), dxl2.POSITION_MAX)
+            goal = min(max(dxl2.signed(dxl2.value(position, 4)), 0), x_units.POSITION_MAX)
             result, error = self.packet.write4ByteTxRx(
                 self.port, servo, dxl2.Address.GOAL_POSITION, goal
             )

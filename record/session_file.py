@@ -1,17 +1,17 @@
 """Sessions as MCAP files: one channel per key expression, every channel with its schema.
 
-The project's messages go in as JSON (message encoding ``json``, schema encoding
-``jsonschema``, schema name the type's name, schema data its JSON Schema, ``bytes`` fields as
-base64 strings marked ``"contentEncoding": "base64"``), so Foxglove plots them as they are, and
-come back into their pydantic types exactly: Python writes a float as its shortest repr, which
-reads back bit for bit. Beside a message go its Foxglove views (``scenes.foxglove_views``), when
-asked for, on channels of their own. Each image is stored once: a view that carries a field as
-it is (a frame's JPEG or pixels in its ``foxglove.CompressedImage`` or ``RawImage``) holds it,
-and the message's JSON leaves it out; the channel's metadata names the carrier
-(``CARRIED_FIELD``, ``CARRIER``), and reading puts the field back from the view of the same
-log time. Other channels are written as given (``write_raw``). Chunks are zstd-compressed;
-``flush`` closes the current one and pushes it to the file, so a writer killed by SIGKILL loses
-only what came after its last flush.
+The project's messages go in as JSON (message encoding ``json``, schema encoding ``jsonschema``,
+schema name the type's name, schema data its JSON Schema, ``bytes`` fields as base64 strings
+marked ``"contentEncoding": "base64"``), so Foxglove plots them as they are, and come back into
+their pydantic types exactly: a float is written as its shortest round-trip text, which reads
+back bit for bit. Beside a message go its Foxglove views (``scenes.foxglove_views``), when asked
+for, on channels of their own. Each image is stored once: a view that carries a field as it is
+(a frame's JPEG or pixels in its ``foxglove.CompressedImage`` or ``RawImage``) holds it, and the
+message's JSON leaves it out; the channel's metadata names the carrier (``CARRIED_FIELD``,
+``CARRIER``), and reading puts the field back from the view of the same log time. Other channels
+are written as given (``write_raw``). Chunks are zstd-compressed; ``flush`` closes the current
+one and pushes it to the file, so a writer killed by SIGKILL loses only what came after its last
+flush.
 
 Reading them back is ``record.session_reader``'s.
 """
@@ -78,10 +78,17 @@ def to_json(message: BaseModel, left_out: str = "") -> bytes:
     """``message`` as compact JSON, its ``bytes`` fields base64 (nested bytes are refused), the
     field ``left_out`` (one a view carries) left out.
 
-    A bytes field (an image) is neither copied by ``model_dump`` nor scanned by ``json.dumps``:
-    a marker holds its place, then gives it to the base64 text, which needs no escaping.
+    Without a bytes field to write (the recorder's: an image's JSON leaves its pixels to the
+    view that carries them), the model's own compiled serializer writes it, in a fifth of the
+    time of ``json.dumps``: the same fields and values (a float's exponent is written ``1e-5``,
+    not ``1e-05``; text is UTF-8, not escaped). A bytes field (an image) is neither copied by
+    ``model_dump`` nor scanned by ``json.dumps``: a marker holds its place, then gives it to
+    the base64 text, which needs no escaping.
     """
     names = [name for name in bytes_fields(type(message)) if name != left_out]
+    if not names:  # every float is finite: the messages refuse NaN and inf (messages.base)
+        exclude = {left_out} if left_out else None
+        return type(message).__pydantic_serializer__.to_json(message, exclude=exclude)
     dumped = message.model_dump(exclude={*bytes_fields(type(message)), left_out})
     fields = {
         name: BYTES_MARKER if name in names else dumped[name]

@@ -1,6 +1,7 @@
 """Where the wall time of one lockstep pose experiment goes, printed (nothing asserted).
 
     python -m studies.bench.run_breakdown [--law lp] [--runs N] [--processes both] [--json]
+                                          [--no-figures]
     python -m studies.bench.run_breakdown --parallel 2 --runs 8      # runs per minute
 
 Each run is ``parsimony experiment pose`` in a process of its own (its profile's ``processes``
@@ -12,7 +13,8 @@ and per simulated step the host time of each stage as its component measures it 
 p99 of each subscription handler, ``components.pubsub``, and of the lockstep gate's waits,
 ``components.lockstep_gate``: ``frame`` from a camera frame's publication to its last answer,
 ``frame_wait`` a step waiting for them, ``loop`` a step waiting for the commands).
-With ``--parallel K``, K runs at a time: the whole-loop runs per minute.
+With ``--parallel K``, K runs at a time: the whole-loop runs per minute. With ``--no-figures``
+the runs draw no figures, as a study's runs (their CPU time is then the run's alone).
 """
 
 from __future__ import annotations
@@ -45,7 +47,8 @@ EVENTS = (
     ("judged", "experiment", "drawing the figures"),
 )
 """Each phase's end: a line of the experiment's progress or of its launch log (the last such
-line for ``all stopped``); the figures are written when the run's process exits."""
+line for ``all stopped``); the figures are written when the run's process exits (without
+figures, the run is judged then)."""
 STEP_S = 0.02
 """The simulator's step (its ``step_s``)."""
 
@@ -56,11 +59,12 @@ def _stamped(text: str) -> float:
     return datetime.combine(datetime.now().date(), clock).timestamp()
 
 
-def one_run(law: str, processes: str, out: Path) -> dict[str, Any]:
+def one_run(law: str, processes: str, out: Path, figures: bool = True) -> dict[str, Any]:
     """One experiment in a process of its own: its phases, CPU and report."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.time()
     command = [sys.executable, "-m", "studies.bench.run_breakdown", "--one", str(out), "--law", law]
+    command += [] if figures else ["--no-figures"]
     child = subprocess.Popen(
         [*command, "--processes", processes],
         stdout=subprocess.PIPE,
@@ -83,7 +87,7 @@ def one_run(law: str, processes: str, out: Path) -> dict[str, Any]:
     cpu_s = sum(getattr(after, f) - getattr(before, f) for f in ("ru_utime", "ru_stime"))
     launch = [(_stamped(t), t[13:]) for t in (out / "launch.log").read_text().splitlines() if t]
     found = {}
-    for name, source, text in EVENTS:
+    for name, source, text in EVENTS if figures else EVENTS[:-1]:
         stamps = [
             stamp
             for stamp, line in (lines if source == "experiment" else launch)
@@ -91,7 +95,7 @@ def one_run(law: str, processes: str, out: Path) -> dict[str, Any]:
         ]
         found[name] = stamps[-1] if stamps else float("nan")
     ends = [started, *found.values(), ended]
-    names = ["started", *found, "figures written"]
+    names = ["started", *found, "figures written" if figures else "judged"]
     phases = {
         f"{a} -> {b}": round(t1 - t0, 3)
         for (a, t0), (b, t1) in pairwise(zip(names, ends, strict=True))
@@ -136,7 +140,9 @@ def summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
     }
 
 
-def throughput(law: str, modes: list[str], runs: int, parallel: int, root: Path) -> dict:
+def throughput(
+    law: str, modes: list[str], runs: int, parallel: int, root: Path, figures: bool = True
+) -> dict:
     """Whole-loop runs per minute with ``parallel`` runs at a time, per mode (alternated:
     a batch of each mode in turn)."""
     done: dict[str, list[float]] = {mode: [] for mode in modes}
@@ -144,7 +150,7 @@ def throughput(law: str, modes: list[str], runs: int, parallel: int, root: Path)
         mode = modes[batch % len(modes)]
         started = time.monotonic()
         threads = [
-            threading.Thread(target=one_run, args=(law, mode, root / f"{batch}-{k}"))
+            threading.Thread(target=one_run, args=(law, mode, root / f"{batch}-{k}", figures))
             for k in range(parallel)
         ]
         for thread in threads:
@@ -185,24 +191,30 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--processes", default="both", choices=("both", "separate", "shared"))
     parser.add_argument("--parallel", type=int, default=0, help="K runs at a time: runs per minute")
     parser.add_argument("--json", action="store_true", help="JSON on stdout")
+    parser.add_argument(
+        "--no-figures", dest="figures", action="store_false", help="draw none, as a study's runs"
+    )
     parser.add_argument("--one", type=Path, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.one is not None:  # one run, in this process: its report on stdout
-        options = Options("pose", args.law, out=args.one, processes=args.processes)
+        options = Options(
+            "pose", args.law, out=args.one, processes=args.processes, figures=args.figures
+        )
         print(json_text(run_experiment(options)), flush=True)
         return 0
     modes = ["separate", "shared"] if args.processes == "both" else [args.processes]
     print(f"load average {os.getloadavg()[0]:.2f} before", file=sys.stderr)
     with tempfile.TemporaryDirectory(prefix="run-breakdown-") as root:
         if args.parallel:
-            rates = throughput(args.law, modes, args.runs * len(modes), args.parallel, Path(root))
+            runs = args.runs * len(modes)
+            rates = throughput(args.law, modes, runs, args.parallel, Path(root), args.figures)
             result: Any = {"parallel": args.parallel, "runs_per_minute": rates}
             text = f"{args.parallel} at a time, runs per minute (median over batches): {rates}"
         else:
             found: dict[str, list] = {mode: [] for mode in modes}
             for index in range(args.runs * len(modes)):  # the modes alternated
                 mode = modes[index % len(modes)]
-                found[mode].append(one_run(args.law, mode, Path(root) / str(index)))
+                found[mode].append(one_run(args.law, mode, Path(root) / str(index), args.figures))
             result = {mode: summary(runs) for mode, runs in found.items()}
             text = printed(result)
     print(f"load average {os.getloadavg()[0]:.2f} after", file=sys.stderr)

@@ -11,6 +11,7 @@ from dynamixel_sdk import PortHandler
 
 from components.servo_bus import XBus, open_port
 from protocols import dynamixel_v2 as dxl
+from protocols import x_series_units as x_units
 from protocols.dynamixel_v2 import Address, OperatingMode
 from sim2d.devices.servo_chain import IntegratingJoints
 from sim2d.devices.x_servos import XChainEmulator
@@ -40,18 +41,18 @@ def test_torque_comes_on_in_position_mode_with_the_goal_where_the_servo_is(chain
     assert bus.enable_torque(2) == 0
     assert servo.table[Address.OPERATING_MODE] == OperatingMode.POSITION
     assert servo.table[Address.TORQUE_ENABLE] == 1
-    assert servo.word(Address.GOAL_POSITION) == dxl.position_units(START[1])
+    assert servo.word(Address.GOAL_POSITION) == x_units.position_units(START[1])
     for _ in range(50):
         emulator.update(0.01)
         arm.step(0.01)
-    assert abs(arm.angles[1] - START[1]) <= 1.0 / dxl.POSITION_UNITS_PER_RAD
+    assert abs(arm.angles[1] - START[1]) <= 1.0 / x_units.POSITION_UNITS_PER_RAD
 
 
 def test_a_sync_read_gives_every_reading_or_none(chain) -> None:
     emulator, arm, bus = chain
     readings = bus.read_all((1, 2, 3))
     assert readings is not None
-    assert [units for (units, _), _, _ in readings] == [dxl.position_units(a) for a in START]
+    assert [units for (units, _), _, _ in readings] == [x_units.position_units(a) for a in START]
     emulator.fail(2)
     assert bus.read_all((1, 2, 3)) is None  # read one at a time, to name servo 2's fault
     assert bus.read(3)[1] is None

@@ -103,7 +103,7 @@ def test_with_views_each_image_is_stored_once_and_reads_back_exactly(tmp_path: P
 
 
 def test_floats_and_images_survive_bit_for_bit(tmp_path: Path) -> None:
-    awkward = (0.1 + 0.2, 1 / 3, -0.0, 5e-324, 1.7976931348623157e308)
+    awkward = (0.1 + 0.2, 1 / 3, -0.0, 5e-324, 1.7976931348623157e308, 1e-05, -2.5e-07, 1e22)
     message = RobotState(
         header=header(1),
         base_pose=awkward[:3],
