@@ -1,5 +1,5 @@
 """Dynamixel protocol 2.0 (X-series: XM430, XL430): instruction and status packets, the X-series
-control table and its units. Pure: bytes in, bytes out.
+control table. Pure: bytes in, bytes out.
 
 Instruction packet and status packet::
 
@@ -17,19 +17,17 @@ servo). Multi-byte values are little-endian. The e-manual's read of id 1's Prese
 The status error byte: bit 7 is the alert (a hardware error: read Hardware Error Status, 70),
 bits 0..6 the error number of the instruction (``StatusError``).
 
-Units (XM430/XL430): position 0..4095 per turn, 2048 the centre (0 rad here), counter clockwise
-positive; velocities (Present Velocity, signed; Goal and Profile Velocity and Velocity Limit)
-0.229 rpm per unit. Profile Velocity 0 means no limit but the Velocity Limit, not stop.
+The values' units (angles and speeds in and out of the table) are in
+``protocols.x_series_units``.
 """
 
 from __future__ import annotations
 
 import enum
-import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
-from protocols.dynamixel_common import FrameParser, PositionScale, speed_limit
+from protocols.dynamixel_common import FrameParser
 from protocols.dynamixel_v1 import StatusFault
 
 HEADER = b"\xff\xff\xfd\x00"
@@ -135,16 +133,6 @@ SIGNED = frozenset((Address.GOAL_VELOCITY, Address.PRESENT_VELOCITY, Address.PRE
 class OperatingMode(enum.IntEnum):
     VELOCITY = 1
     POSITION = 3
-
-
-RETURN_DELAY_US_PER_UNIT = 2.0
-POSITION_CENTER = 2048
-POSITION_MAX = 4095
-POSITION_UNITS_PER_RAD = 4096 / (2.0 * math.pi)
-"""4096 steps a turn (0.088 degree each), 2048 the centre."""
-VELOCITY_RAD_S_PER_UNIT = 0.229 * 2.0 * math.pi / 60.0
-"""0.229 rpm per unit."""
-PROFILE_VELOCITY_MAX = 32767
 
 
 class PacketError(ValueError):
@@ -376,28 +364,3 @@ class PacketParser(FrameParser[Packet]):
                 self.bad_checksums += 1
                 del buffer[:4]
             return packet
-
-
-_POSITIONS = PositionScale(POSITION_CENTER, POSITION_UNITS_PER_RAD, POSITION_MAX, math.pi + 1.0)
-position_of_angle = _POSITIONS.of_angle
-"""2048 + angle * 4096 / 2 pi: the Goal Position of an angle, before rounding."""
-position_units = _POSITIONS.units
-"""Goal Position of a joint angle (rad, 0 at the centre), clamped to 0..4095."""
-angle_of_units = _POSITIONS.angle
-
-
-def profile_velocity(rad_s: float) -> int | None:
-    """Profile Velocity of a speed magnitude: round(|rad_s| / 0.024), at most 32767; None when
-    that is 0, for Profile Velocity 0 means no limit: a joint that slow must hold. ValueError
-    for a non-finite speed."""
-    return speed_limit(rad_s, VELOCITY_RAD_S_PER_UNIT, PROFILE_VELOCITY_MAX, "profile velocity")
-
-
-def velocity_units(rad_s: float) -> int:
-    """Present or Goal Velocity (signed) of a joint velocity (rad/s)."""
-    return round(rad_s / VELOCITY_RAD_S_PER_UNIT)
-
-
-def rad_s_of_velocity_units(units: int) -> float:
-    """Joint velocity (rad/s) of a (signed) velocity value."""
-    return units * VELOCITY_RAD_S_PER_UNIT

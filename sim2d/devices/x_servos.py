@@ -28,6 +28,7 @@ from __future__ import annotations
 import time
 
 from protocols import dynamixel_v2 as dxl
+from protocols import x_series_units as x_units
 from protocols.dynamixel_v2 import (
     ALERT,
     SIZES,
@@ -56,7 +57,7 @@ _DEFAULTS: dict[Address | int, tuple[int, int]] = {
     36: (885, 2),
     38: (1193, 2),
     Address.VELOCITY_LIMIT: (167, 4),
-    Address.MAX_POSITION_LIMIT: (dxl.POSITION_MAX, 4),
+    Address.MAX_POSITION_LIMIT: (x_units.POSITION_MAX, 4),
     Address.SHUTDOWN: (52, 1),
     Address.STATUS_RETURN_LEVEL: (2, 1),
     84: (800, 2),
@@ -85,11 +86,11 @@ class XServo(ChainServo):
 
     id_address = Address.ID
     delay_address = Address.RETURN_DELAY
-    delay_us_per_unit = dxl.RETURN_DELAY_US_PER_UNIT
+    delay_us_per_unit = x_units.RETURN_DELAY_US_PER_UNIT
 
     def __init__(self, servo_id: int, return_delay_us: float, position_rad: float) -> None:
         super().__init__(default_table(servo_id), return_delay_us)
-        self._set(Address.GOAL_POSITION, dxl.position_units(position_rad))
+        self._set(Address.GOAL_POSITION, x_units.position_units(position_rad))
         self.sense_position(position_rad)
 
     def word(self, address: int) -> int:
@@ -109,11 +110,11 @@ class XServo(ChainServo):
         return bool(self.table[Address.TORQUE_ENABLE]) and not self.hardware_error
 
     def sense_position(self, position_rad: float) -> None:
-        self._set(Address.PRESENT_POSITION, round(dxl.position_of_angle(position_rad)))
+        self._set(Address.PRESENT_POSITION, round(x_units.position_of_angle(position_rad)))
 
     def sense_speed(self, velocity_rad_s: float) -> None:
         """Present Velocity, and Moving: faster than the Moving Threshold."""
-        units = dxl.velocity_units(velocity_rad_s)
+        units = x_units.velocity_units(velocity_rad_s)
         self._set(Address.PRESENT_VELOCITY, units)
         self.table[Address.MOVING] = abs(units) > self.word(Address.MOVING_THRESHOLD)
 
@@ -122,13 +123,13 @@ class XServo(ChainServo):
         Velocity; 0 with torque off or a hardware error."""
         if not self._driven():
             return 0.0
-        limit = dxl.rad_s_of_velocity_units(self.word(Address.VELOCITY_LIMIT))
+        limit = x_units.rad_s_of_velocity_units(self.word(Address.VELOCITY_LIMIT))
         if self.table[Address.OPERATING_MODE] == OperatingMode.VELOCITY:
-            velocity = dxl.rad_s_of_velocity_units(self.word(Address.GOAL_VELOCITY))
+            velocity = x_units.rad_s_of_velocity_units(self.word(Address.GOAL_VELOCITY))
             return min(max(velocity, -limit), limit)
         profile = self.word(Address.PROFILE_VELOCITY)
-        speed = min(dxl.rad_s_of_velocity_units(profile), limit) if profile else limit
-        error = dxl.angle_of_units(self.word(Address.GOAL_POSITION)) - position_rad
+        speed = min(x_units.rad_s_of_velocity_units(profile), limit) if profile else limit
+        error = x_units.angle_of_units(self.word(Address.GOAL_POSITION)) - position_rad
         return min(max(error / dt, -speed), speed)
 
     def fail(self, silent: bool) -> None:

@@ -13,7 +13,7 @@ import pytest
 
 from components.servo_bus import HOLD_SPEED
 from profiles.deploy_files import DEPLOY
-from protocols import dynamixel_v2 as dxl
+from protocols import x_series_units as x_units
 from protocols.dynamixel_v1 import StatusFault
 from protocols.dynamixel_v2 import Address
 from sim2d.devices.servo_chain import IntegratingJoints
@@ -32,7 +32,7 @@ LOW, HIGH = ROBOT.q_min[3:], ROBOT.q_max[3:]
 START = (0.0, -0.2, 0.2, 0.5)
 ANSWER_TIMEOUT_S = 1.0
 """As the AX tests': only a servo made silent is."""
-UNIT = 1.0 / dxl.POSITION_UNITS_PER_RAD
+UNIT = 1.0 / x_units.POSITION_UNITS_PER_RAD
 
 
 class Bench(ArmBench):
@@ -134,7 +134,7 @@ def test_a_silent_servo_holds_the_whole_arm_until_it_answers_again(bench: Bench)
 
 
 def test_a_reading_outside_the_limits_is_refused_and_no_goal_leaves_them(bench: Bench) -> None:
-    high_units = math.floor(dxl.position_of_angle(HIGH[2]))
+    high_units = math.floor(x_units.position_of_angle(HIGH[2]))
     bench.written((0.0, 0.0, 0.8, 0.0))
     assert bench.servos.words(Address.GOAL_POSITION)[2] <= high_units
     inside = bench.arm.angles[2]
@@ -161,8 +161,8 @@ def test_speeds_over_the_limit_go_out_at_the_limit(bench: Bench) -> None:
         return written not in ([0] * 4, [HOLD_SPEED] * 4)
 
     _wait_until(commanded, "a Sync Write of the command")
-    limit = dxl.profile_velocity(ROBOT.velocity_max[3])
-    assert written == [limit] * 3 + [dxl.profile_velocity(0.5)]
+    limit = x_units.profile_velocity(ROBOT.velocity_max[3])
+    assert written == [limit] * 3 + [x_units.profile_velocity(0.5)]
     counters = bench.counters()
     assert counters["speed_limited"] >= 3
     assert not any(v for k, v in counters.items() if k.startswith("errors."))

@@ -1,9 +1,8 @@
-"""Dynamixel protocol 2.0 packets and X-series units (protocols/dynamixel_v2.py), against the
-e-manual's examples byte for byte and the dynamixel-sdk's own stuffing and CRC."""
+"""Dynamixel protocol 2.0 packets (protocols/dynamixel_v2.py), against the e-manual's examples
+byte for byte and the dynamixel-sdk's own stuffing and CRC."""
 
 from __future__ import annotations
 
-import math
 import random
 
 import pytest
@@ -94,16 +93,3 @@ def test_packets_outside_the_protocol_are_refused() -> None:
         dxl.write(1, 0, bytes(1020))
     with pytest.raises(dxl.PacketError, match="3 data bytes, 4 expected"):
         dxl.sync_write(Address.GOAL_POSITION, 4, {1: b"\x00\x02\x00"})
-
-
-def test_units_of_the_x_series() -> None:
-    assert dxl.position_units(0.0) == 2048
-    assert dxl.position_units(math.pi / 2) == 3072
-    assert dxl.position_units(-10.0) == 0 and dxl.position_units(10.0) == 4095
-    assert abs(dxl.angle_of_units(1024) + math.pi / 2) < 1e-12
-    assert dxl.profile_velocity(0.0) is None and dxl.profile_velocity(-0.01) is None
-    assert dxl.profile_velocity(1.0) == round(1.0 / (0.229 * 2 * math.pi / 60))
-    assert dxl.velocity_units(-1.0) == -dxl.velocity_units(1.0)
-    assert dxl.signed(dxl.value(-3, 4)) == -3
-    with pytest.raises(ValueError, match="non-finite"):
-        dxl.position_units(math.nan)

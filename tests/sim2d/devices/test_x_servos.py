@@ -16,6 +16,7 @@ from dynamixel_sdk import (
 )
 
 from protocols import dynamixel_v2 as dxl
+from protocols import x_series_units as x_units
 from protocols.dynamixel_v2 import ALERT, Address, HardwareError, Instruction, StatusError
 from sim2d.devices.servo_chain import IntegratingJoints
 from sim2d.devices.x_servos import MODEL_NUMBER, XChainEmulator
@@ -37,7 +38,7 @@ def test_a_ping_answers_the_model_and_a_sync_read_every_servo_in_order(
         assert group.addParam(servo_id)
     assert group.txRxPacket() == COMM_SUCCESS
     for servo_id, angle in zip(IDS, arm.angles, strict=True):
-        assert group.getData(servo_id, Address.PRESENT_POSITION, 4) == dxl.position_units(angle)
+        assert group.getData(servo_id, Address.PRESENT_POSITION, 4) == x_units.position_units(angle)
 
 
 def test_sync_write_moves_every_joint_to_its_goal_at_its_profile_velocity(
