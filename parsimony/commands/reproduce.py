@@ -72,6 +72,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         help="with --loop, simulated seconds before a run that has not "
         f"converged stops (default {TIME_LIMIT_S:g})",
     )
+    parser.add_argument(
+        "--no-figures",
+        dest="figures",
+        action="store_false",
+        help="the rows alone: draw no figures (nor NOTES.md), the loop's runs none either",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of tables")
     return parser
 
@@ -102,13 +108,19 @@ def run(args: argparse.Namespace) -> int:
     robot = MobileManipulator.from_yaml(args.robot)
     names = tuple(name for name in NAMES if name in (args.only or NAMES))
     rows, laws, found = reproduce(robot, args.trials, names)
-    figures = write_figures(robot, found, args.out)
-    print(f"reproduce: {len(figures)} figures and notes in {args.out}", file=sys.stderr)
+    figures = write_figures(robot, found, args.out) if args.figures else []
+    if figures:
+        print(f"reproduce: {len(figures)} figures and notes in {args.out}", file=sys.stderr)
     ran = None
     if args.loop:
         try:
             loop_rows, loop_laws, ran = loop(
-                robot, names, tuple(args.law or LABELS), args.out / "loop", args.time_limit
+                robot,
+                names,
+                tuple(args.law or LABELS),
+                args.out / "loop",
+                args.time_limit,
+                args.figures,
             )
         except (ProfileError, OSError, QueryError, RuntimeError, ValueError) as error:
             print(f"parsimony reproduce: the loop: {error}", file=sys.stderr)

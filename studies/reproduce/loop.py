@@ -75,10 +75,12 @@ def run_loop(
     labels: tuple[str, ...],
     out: Path,
     time_limit_s: float,
+    figures: bool = True,
 ) -> tuple[dict[str, Experiment], list[dict]]:
     """Each law of ``labels`` in each set-up of ``names`` on the loop, its run in
-    ``out/NAME/LABEL`` (recording, report, figures): the experiments as the rows take them,
-    and what each run was (its controller, gains, verdict and wall time)."""
+    ``out/NAME/LABEL`` (recording, report, and its figures if ``figures``): the experiments
+    as the rows take them, and what each run was (its controller, gains, verdict and wall
+    time)."""
     chosen = [
         (name, label)
         for name in NAMES
@@ -98,7 +100,9 @@ def run_loop(
             flush=True,
         )
         report = run_experiment(
-            Options(name, controller, where, time_limit_s=time_limit_s, gains=gains)
+            Options(
+                name, controller, where, time_limit_s=time_limit_s, gains=gains, figures=figures
+            )
         )
         obstacles = (OBSTACLE,) if name == "obstacle" else ()
         ran = (
@@ -258,10 +262,12 @@ def loop(
     labels: tuple[str, ...],
     out: Path,
     time_limit_s: float,
+    figures: bool = True,
 ) -> tuple[list[Row], list[dict[str, str]], dict]:
-    """The rows of the loop, what each law ran there, and the summary (``summary``)."""
+    """The rows of the loop, what each law ran there, and the summary (``summary``); each run
+    draws its figures if ``figures``."""
     started = time.monotonic()
-    found, done = run_loop(robot, names, labels, out, time_limit_s)
+    found, done = run_loop(robot, names, labels, out, time_limit_s, figures)
     laws = [
         {"experiment": f"{name} {PLACE}", "label": label, "ran": text}
         for name, experiment in found.items()

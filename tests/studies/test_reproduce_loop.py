@@ -5,8 +5,6 @@ second worker runs it beside the kinematic reproduction)."""
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from dataclasses import asdict
 from pathlib import Path
 
@@ -21,7 +19,7 @@ from profiles.deploy_files import ROBOT_FILE
 from record.sessions import load_session
 from studies.reproduce.loop import folder
 from studies.reproduce.runs import laws_of
-from tests.parsimony.in_process import run_in_process
+from tests.parsimony.in_process import completed, run_in_process
 from wbc.robot import MobileManipulator
 
 pytestmark = pytest.mark.heavy  # the whole loop, twice
@@ -36,29 +34,24 @@ def test_the_loop_prints_the_rows_of_its_recordings_beside_the_kinematic_ones(
 ) -> None:
     """`reproduce --loop`: each law runs the pose set-up on the whole loop with the gains of its
     kinematic run (the recording says which), and its rows, read back from the recording,
-    follow the kinematic ones; the command says how long the loop took."""
+    follow the kinematic ones; the command says how long the loop took. (Its figures, which
+    test_reproduce reads, are not drawn: ``--no-figures``.)"""
     laws = [argument for label in LOOP_LAWS for argument in ("--law", label)]
-    done = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "parsimony.cli",
-            "reproduce",
-            "--json",
-            "--loop",
-            "--only",
-            "pose",
-            *laws,
-            "--time-limit",
-            "2",
-            "--out",
-            str(tmp_path),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=900,
+    done = completed(
+        "reproduce",
+        "--json",
+        "--loop",
+        "--only",
+        "pose",
+        *laws,
+        "--time-limit",
+        "2",
+        "--no-figures",
+        "--out",
+        str(tmp_path),
     )
     assert done.returncode == 0, done.stderr[-3000:]
+    assert not list(tmp_path.rglob("*.png")) and not (tmp_path / "NOTES.md").exists()
     found = json.loads(done.stdout)
     rows = found["rows"]
     keys = [row["key"] for row in rows]
