@@ -10,8 +10,8 @@ u = [x', y', phi', one per arm joint] of a stamp joins the base and arm commands
 x' = v cos(phi), y' = v sin(phi), phi' = omega, phi the heading of the nearest state.
 Times are in s from the session's first command.
 
-``write_report`` draws (``analysis.figures``) one or two sessions (e.g. the LP and the cascade
-law) side by side:
+``write_report`` draws (``analysis.report_figures``) one or two sessions (e.g. the LP and the
+cascade law) side by side:
 
     control_inputs.png     u over time (figs. 6.6, 6.11)
     nonzero_entries.png    nonzero entries of u per iteration, and the practical count (6.7, 6.8)
@@ -40,8 +40,8 @@ from typing import Any
 import numpy as np
 
 from analysis.commands import Array, commands, effort_of_inputs, required
-from analysis.figures import FIGURES, RecordedSession
 from analysis.judge import arm_clearances, open_loop
+from analysis.report_figures import FIGURES, RecordedSession
 from analysis.run_end import Session, messages
 from messages.topics import (
     CONTROL_DIAGNOSTICS,

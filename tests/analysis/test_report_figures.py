@@ -1,11 +1,11 @@
-"""analysis.figures on sessions made of real kinematic runs of the LP."""
+"""analysis.report_figures on sessions made of real kinematic runs of the LP."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from analysis import report as report_module
-from analysis.figures import FIGURES as DRAWN
+from analysis.report_figures import FIGURES as DRAWN
 from messages.topics import ROBOT_STATE
 from tests.analysis.conftest import ROBOT
 from wbc import dq
