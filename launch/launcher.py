@@ -96,6 +96,9 @@ class Launcher:
         """When the duration ends: set once every component is alive."""
         self._ahead: tuple[list[str], subprocess.Popen[str]] | None = None
         """The shared children's process started ahead, waiting for the word to start them."""
+        self._wake = threading.Event()
+        """Set when the supervision loop has news before its next poll: a component came alive
+        (those waiting for it start at once), a stop was asked."""
 
     def run(self, duration_s: float | None = None) -> int:
         """Run until a stop signal, the duration (from the moment every component is alive),
@@ -108,6 +111,16 @@ class Launcher:
         endpoints = ", ".join(self.profile.zenoh.router)
         self._duration_s = duration_s
         self._kept_params = Path(tempfile.mkdtemp(prefix="parsimony-params-"))
+        self._start_ahead()  # it loads its modules while the router opens
+        try:
+            return self._run_router(endpoints)
+        finally:
+            self._end_ahead(self._ahead)
+            shutil.rmtree(self._kept_params, ignore_errors=True)
+
+    def _run_router(self, endpoints: str) -> int:
+        """``run`` once the shared children's process is on its way: the router, the children
+        started and supervised, then stopped."""
         with zenoh.open(self.profile.zenoh.router_config(self.profile.namespace)) as router:
             self.output.say(f"router listening on {endpoints}, namespace {self.profile.namespace}")
             watcher = router.liveliness().declare_subscriber(
@@ -117,7 +130,6 @@ class Launcher:
             )
             try:
                 self._start_ready()
-                self._start_ahead()
                 if self.recorders and len(self.recorders) < len(self.children):
                     self.output.say(
                         f"the others start once {' and '.join(self.recorders)} "
@@ -139,9 +151,7 @@ class Launcher:
                 for stop_signal in (signal.SIGINT, signal.SIGTERM):
                     signal.signal(stop_signal, signal.SIG_IGN)
                 stop_all(self.children, self.profile, self.output)
-                self._end_ahead(self._ahead)
                 watcher.undeclare()
-                shutil.rmtree(self._kept_params, ignore_errors=True)
         failed = [child.spec.name for child in self.children if child.failed]
         if failed:
             self.output.say(f"failed: {', '.join(failed)}")
@@ -150,6 +160,7 @@ class Launcher:
     def _on_signal(self, signum: int, _frame: object) -> None:
         """Main thread, between two polls: ask the supervision loop to stop."""
         self._stop_reason = signal.Signals(signum).name
+        self._wake.set()
 
     def _on_liveliness(self, sample: zenoh.Sample) -> None:
         """Zenoh thread: report a component's token appearing or disappearing."""
@@ -157,6 +168,7 @@ class Launcher:
         alive = sample.kind == zenoh.SampleKind.PUT
         if alive:
             self._seen_alive.add(name)
+            self._wake.set()  # whoever waited for it starts now, not at the next poll
         for child in self.children:
             if child.spec.name == name:
                 child.alive, child.answered_at = alive, time.monotonic()
@@ -169,6 +181,7 @@ class Launcher:
     def _supervise(self) -> None:
         """Poll the children until a stop is asked, the duration ends or none is left."""
         while self._stop_reason is None:
+            self._wake.clear()
             self._start_ready()
             now = time.monotonic()
             if self._deadline is not None and now >= self._deadline:
@@ -189,7 +202,7 @@ class Launcher:
             if all(child.done for child in self.children):
                 self._stop_reason = self._stop_reason or "no component left running"
                 break
-            time.sleep(POLL_S)
+            self._wake.wait(POLL_S)
         self.output.say(f"stopping ({self._stop_reason})")
 
     def _watch(self, router: zenoh.Session) -> None:
@@ -289,11 +302,11 @@ class Launcher:
     def _start(self, child: Child) -> None:
         """Start a child's process; a shared child's with the others of ``shared`` not running
         and not done (in the process started ahead for them, if it waits)."""
-        group = [child]
-        if child in self.shared:
+        group, ahead = [child], None
+        if child in self.shared:  # the process started ahead is theirs alone
             group = [c for c in self.shared if c.process is None and not c.done]
+            ahead, self._ahead = self._ahead, None
         names = [c.spec.name for c in group]
-        ahead, self._ahead = self._ahead, None
         popen = None
         if ahead is not None and ahead[0] == names and ahead[1].poll() is None:
             try:

@@ -22,6 +22,9 @@ from profiles.profile import Profile
 
 STARTUP_S = 60.0
 """Host seconds the components may take to come up."""
+POLL_S = 0.02
+"""How often the router, then the components' liveliness and counters, are looked at while
+waited for: a look costs about a millisecond of CPU, a wait half a period on average."""
 
 
 @contextlib.contextmanager
@@ -57,7 +60,7 @@ def connect(profile: Profile, launcher: subprocess.Popen) -> zenoh.Session:
             if time.monotonic() > deadline:
                 raise
 
-            time.sleep(0.2)  # the launcher opens its router first thing
+            time.sleep(POLL_S)  # the launcher opens its router first thing
 
 
 def wait_alive(session: zenoh.Session, profile: Profile, launcher: subprocess.Popen) -> None:
@@ -95,4 +98,4 @@ def wait_launch(launcher: subprocess.Popen, missing: Callable[[], list[str]], wh
             raise RuntimeError(f"the launch stopped (exit {launcher.returncode}); see its log")
         if time.monotonic() > deadline:
             raise RuntimeError(f"{', '.join(waiting)} {what} in {STARTUP_S:.0f} s")
-        time.sleep(0.1)  # polling the router (liveliness tokens, the components' counters)
+        time.sleep(POLL_S)  # polling the router (liveliness tokens, the components' counters)

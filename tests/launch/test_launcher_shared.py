@@ -65,3 +65,25 @@ def test_a_bad_processes_value_is_refused_naming_the_field(tmp_path: Path) -> No
     )
     with pytest.raises(ProfileError, match=r"processes: Input should be 'separate' or 'shared'"):
         load_profile(path)
+
+
+def test_the_shared_process_loads_its_modules_while_the_recorder_starts(
+    write_profile: ProfileWriter, launch: LaunchFixture, tmp_path: Path
+) -> None:
+    """With a recorder, the components sharing a process start once it is alive, in the process
+    started before it (its modules loaded meanwhile), not in one started then."""
+    profile = write_profile(
+        [publisher("arm"), publisher("est", role="estimator")], processes="shared"
+    )
+    launched = launch(profile, "--record", str(tmp_path / "session.mcap"))
+    _, _, recorder = launched.wait_for(r"\[launch\] started recorder \(.*, pid (\d+)\)")
+    _, _, shared = launched.wait_for(r"\[launch\] started est, arm in one process .*pid (\d+)\)")
+    started = [_start_ticks(int(found.group(1))) for found in (shared, recorder)]
+    assert started == sorted(started)
+    launched.wait_for(r"\[launch\] all 3 components alive")
+    assert launched.stop(signal.SIGINT) == 0
+
+
+def _start_ticks(pid: int) -> int:
+    """When process ``pid`` started, in clock ticks since boot (Linux /proc)."""
+    return int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[19])
