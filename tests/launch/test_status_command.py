@@ -31,10 +31,13 @@ def command(*argv: str) -> int:
     return status.run(root.parse_args(["status", *argv]))
 
 
-def test_status_summarises_each_component_and_lists_every_counter_on_demand(
+def test_status_waits_for_the_launch_then_summarises_each_component_and_every_counter(
     write_profile: ProfileWriter, launch: LaunchFixture, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """A controller fed by a scripted publisher, and one malformed state sent to it."""
+    """As the README's first hour runs it: the launch in the background, `status --wait` at
+    once; it says what it waits for (the router first), then prints the status. Then a
+    controller fed by a scripted publisher, and one malformed state sent to it: a short line
+    per component, every counter on demand. (One launch for what two launches proved.)"""
     pub = {
         "name": "pub",
         "module": "scripted_publisher",
@@ -43,7 +46,25 @@ def test_status_summarises_each_component_and_lists_every_counter_on_demand(
     }
     ctl = {"name": "ctl", "module": "lp_controller", "role": "controller"}
     profile = write_profile([pub, ctl], robot=str(ROBOT_FILE))
-    launched = launch(profile)
+    waiting = subprocess.Popen(
+        [sys.executable, "-m", "parsimony.cli", "status", str(profile), "--wait"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert waiting.stderr is not None
+        first = waiting.stderr.readline()  # before the launch: nothing listens yet
+        assert first.startswith(f"status: waiting for the router at {router_of(profile)}"), first
+        launched = launch(profile)
+        out, err = waiting.communicate(timeout=120.0)  # a safety net: --wait ends in 60 s
+    finally:
+        waiting.kill()
+    assert waiting.returncode == 0, first + err
+    waited = {line.split()[0]: line.split() for line in out.splitlines()[1:]}
+    assert waited["pub"][2] == waited["ctl"][2] == "running"
+    assert "status: all 2 components alive" in err
+
     launched.wait_for(r"\[launch\] all 2 components alive")
     with query.Target.from_profile(profile).open() as session:
         deadline = time.monotonic() + 10.0
@@ -87,7 +108,7 @@ def test_status_summarises_each_component_and_lists_every_counter_on_demand(
     assert command(str(profile), "--json") == 0
     rows_json = {r["name"]: r for r in json.loads(capsys.readouterr().out)}
     assert set(rows_json["ctl"]["status"]["counters"]) >= set(counters)
-    launched.stop()
+    assert launched.stop() == 0
 
 
 def test_a_components_faults_are_told_apart_from_its_other_counters() -> None:
@@ -123,35 +144,6 @@ def test_a_components_faults_are_told_apart_from_its_other_counters() -> None:
         "clock_stalls=1",
         "port_errors=2",
     ]
-
-
-def test_status_wait_started_before_the_launch_returns_once_every_component_is_alive(
-    write_profile: ProfileWriter, launch: LaunchFixture
-) -> None:
-    """As the README's first hour runs it: the launch in the background, `status --wait` at
-    once; it says what it waits for (the router first), then prints the status."""
-    pub = {"name": "pub", "module": "scripted_publisher", "role": "tool"}
-    ctl = {"name": "ctl", "module": "lp_controller", "role": "controller"}
-    profile = write_profile([pub, ctl], robot=str(ROBOT_FILE))
-    waiting = subprocess.Popen(
-        [sys.executable, "-m", "parsimony.cli", "status", str(profile), "--wait"],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    try:
-        assert waiting.stderr is not None
-        first = waiting.stderr.readline()  # before the launch: nothing listens yet
-        assert first.startswith(f"status: waiting for the router at {router_of(profile)}"), first
-        launched = launch(profile)
-        out, err = waiting.communicate(timeout=120.0)  # a safety net: --wait ends in 60 s
-    finally:
-        waiting.kill()
-    assert waiting.returncode == 0, first + err
-    rows = {line.split()[0]: line.split() for line in out.splitlines()[1:]}
-    assert rows["pub"][2] == rows["ctl"][2] == "running"
-    assert "status: all 2 components alive" in err
-    assert launched.stop() == 0
 
 
 def test_status_wait_names_the_components_that_never_come(
