@@ -5,6 +5,7 @@ failures and planning; an experiment's summary): none is computed anew here."""
 from __future__ import annotations
 
 import json
+import re
 import statistics
 from collections import Counter
 from collections.abc import Callable
@@ -79,6 +80,15 @@ def _effort(rows: Rows, robot: MobileManipulator) -> dict[str, float]:
     return {n: float(np.median([getattr(e, n) for e in efforts])) for n in names if efforts}
 
 
+def _not_reached(rows: Rows, robot: MobileManipulator) -> dict[str, int]:
+    """The goals not reached, by reason: its head (before a colon), without the counts in
+    parentheses, so that a reason names a kind of miss, not one goal's."""
+    kinds: Counter[str] = Counter()
+    for reason, n in not_reached(_attempts(rows))["failures"].items():
+        kinds[re.sub(r" \(\d+\)", "", reason.partition(": ")[0])] += n
+    return dict(kinds)
+
+
 COMMON: dict[str, Figure] = {
     "runs": lambda rows, robot: {"runs": len(rows)},
     "failed": lambda rows, robot: {"failed": len(rows) - len(ok(rows))},
@@ -108,7 +118,7 @@ KINEMATIC: dict[str, Figure] = COMMON | {
     "planning": lambda rows, robot: planning(_attempts(rows)),
     "effort": _effort,
     "misses": misses,
-    "not reached": lambda rows, robot: not_reached(_attempts(rows))["failures"],
+    "not reached": _not_reached,
 }
 """A kinematic study's figures on goal families: each gives one or more columns."""
 

@@ -5,6 +5,7 @@ and y' as one, the goals not reached by reason, and the arm's penetrations and c
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -12,7 +13,8 @@ import pytest
 import yaml
 
 from parsimony.cli import main
-from studies.study.figures import SIMULATED
+from studies.goal_sets import Attempt
+from studies.study.figures import KINEMATIC, SIMULATED
 from studies.study.report import check_tables
 from studies.study.schema import StudyError, load_study
 from studies.study.sweep import expand
@@ -137,3 +139,21 @@ def test_the_arms_figures_count_penetrating_runs_and_keep_each_parts_least_clear
     robot = MobileManipulator.from_yaml(ROOT / "deploy/robots/little_john.yaml")
     assert SIMULATED["arm penetrations"](rows, robot) == {"with an arm penetration": 1}
     assert SIMULATED["arm clearance"](rows, robot) == {"gripper (m)": -0.055, "wrist (m)": 0.031}
+
+
+def test_the_goals_not_reached_are_counted_by_the_kind_of_their_reason() -> None:
+    """Two goals left out for the same kind of reason, each naming its own count, are one
+    kind; a goal reached has no reason."""
+    left_out = "every whole-body configuration found that reaches the goal ({n}) is left out: "
+    left_out += "{n} bring the base within 0.05 m of an obstacle"
+    reasons = [left_out.format(n=18), left_out.format(n=9), "time limit in turn", ""]
+    rows = [
+        dataclasses.asdict(Attempt(not reason, 1, 0.0, 0.0, (), (), (), reason=reason))
+        | {"status": "ok"}
+        for reason in reasons
+    ]
+    robot = MobileManipulator.from_yaml(ROOT / "deploy/robots/little_john.yaml")
+    assert KINEMATIC["not reached"](rows, robot) == {
+        "every whole-body configuration found that reaches the goal is left out": 2,
+        "time limit in turn": 1,
+    }
