@@ -6,16 +6,37 @@ fixture: a launched system, a recorded run) runs once. Tests marked ``heavy`` (m
 are handed out first, so none of them starts last and finishes after all the others. A run
 several files read (``pose_lp_run``) is made once per suite, whichever worker asks first, and
 read by the others (pytest-xdist's way: a file lock in the folder the workers share).
+
+The run keeps the bytecode it compiles (``keep_bytecode``): it starts hundreds of Python
+processes (launches, components, commands), each of which would otherwise compile the project
+and the test modules again where the environment forbids writing it (PYTHONDONTWRITEBYTECODE).
 """
 
 from __future__ import annotations
 
 import fcntl
+import os
 import shutil
+import sys
 from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+
+
+def keep_bytecode() -> None:
+    """Where PYTHONDONTWRITEBYTECODE forbids writing bytecode beside the sources, write it in
+    the virtual environment's ``pycache`` instead (Python's PYTHONPYCACHEPREFIX), for this
+    process and the processes it starts: each compiles a module once, not once a process."""
+    if not sys.dont_write_bytecode or sys.prefix == sys.base_prefix:  # not in a venv: as is
+        return
+    prefix = sys.pycache_prefix or str(Path(sys.prefix) / "pycache")
+    os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
+    os.environ["PYTHONPYCACHEPREFIX"] = prefix
+    sys.pycache_prefix, sys.dont_write_bytecode = prefix, False
+
+
+keep_bytecode()  # before the test modules are collected (and their asserts rewritten)
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
