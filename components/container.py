@@ -2,16 +2,16 @@
 
     python -m components.container --profile P --names a,b,c [--ahead]
 
-runs each named component as ``python -m components.<module>`` would, with its own ``Node``
-and threads, in this one process: the interpreter and the libraries they import (NumPy, Zenoh,
+runs each named component as ``python -m components.<module>`` would, with its own ``Node`` and
+threads, in this one process: the interpreter and the libraries they import (NumPy, Zenoh,
 OpenCV, HiGHS) load once instead of once per component, and they share one Zenoh session (unless
 the profile's components authenticate or are clients), so that a sample between two of them is
 handed over in the session, not copied over a socket. They start in the order given (with
-``--ahead``, once a line on its input says so: the launcher starts the process while the
-recorders start, so that it loads its modules meanwhile) and close in the reverse order, on
-SIGINT, SIGTERM, the end of the launcher or the ``fail`` of one of them; each keeps what its
-next start takes back in the launch's runtime directory (``messages.process.runtime_dir``), as
-a component in a process of its own does.
+``--ahead``, once a line on its input says so: the launcher starts the process before its router
+opens and the recorders start, so that it loads its modules meanwhile) and close in the reverse
+order, on SIGINT, SIGTERM, the end of the launcher or the ``fail`` of one of them; each keeps
+what its next start takes back in the launch's runtime directory
+(``messages.process.runtime_dir``), as a component in a process of its own does.
 """
 
 from __future__ import annotations
