@@ -20,8 +20,8 @@ creep. All the goals and speeds go in one Sync Write, and every goal written lie
 robot description's joint limits (the goals: ``components.arm_goals``). With no command for
 ``command_timeout_s`` the arm holds.
 
-Each answer is checked (the protocol's ``status_fault``): a servo that is silent (for
-``answer_timeout_s``, by default the SDK's packet timeout), or answers a truncated packet, a
+Each answer is checked (the protocol's ``status_fault``): a servo that is silent (for the SDK's
+packet timeout, or ``answer_timeout_s`` when that is longer), or answers a truncated packet, a
 bad checksum, another servo's id or the wrong length, is counted by that name
 (``servo_faults.<name>``); a reading outside the joint limits (by more than ``limit_margin``)
 is counted (``out_of_limits``) and never published. Either way no joint state is published,
@@ -38,7 +38,7 @@ from __future__ import annotations
 import math
 from collections.abc import Collection, Sequence
 
-from dynamixel_sdk import COMM_SUCCESS, PortHandler
+from dynamixel_sdk import COMM_SUCCESS
 
 from components.arm_goals import ArmGoals
 from components.joint_check import joints_match
@@ -120,7 +120,7 @@ class ArmDriver(Component):
             0.0,
             low=0.0,
             high=5.0,
-            doc="how long a servo's answer is awaited, s; 0: the SDK's (34 ms at 1 Mbit/s)",
+            doc="least wait for a servo's answer, s; the SDK's when longer (34 ms at 1 Mbit/s)",
         ),
     )
 
@@ -138,8 +138,10 @@ class ArmDriver(Component):
             servos = servos.with_ids(of_robot("ids", node.params["ids"], joints, names))
         self.servos = servos
         self.ids = servos.ids
-        self.port = PortHandler(str(node.params["port"]))
-        bus = self.bus = BUSES[node.params["protocol"]](self.port, node.params["answer_timeout_s"])
+        bus = self.bus = BUSES[node.params["protocol"]](
+            str(node.params["port"]), node.params["answer_timeout_s"]
+        )
+        self.port = bus.port
         self.goals = ArmGoals(servos, bus, self.low, self.high, node.params)
         self.connected = False
         for name in (

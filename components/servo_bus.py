@@ -13,6 +13,9 @@ servo. ``AXBus`` reads one servo at a time; ``XBus`` reads them all in one Sync 
 a time only when an answer of the Sync Read did not come whole, in time and from its servo (one
 instruction packet a cycle instead of one per servo: one USB round trip instead of one per
 servo on a U2D2). Both write every goal in one Sync Write.
+
+Every answer, whichever of the SDK's calls asks for it, is awaited on the bus's ``BusPort``: at
+least the bus's answer timeout, the SDK's own per-packet timeout when that is longer.
 """
 
 from __future__ import annotations
@@ -35,6 +38,26 @@ READ_WAIT_S = 0.001
 """How long one read of the serial port waits for bytes before the SDK looks again (s)."""
 
 
+class BusPort(PortHandler):
+    """The SDK's port, awaiting every answer at least ``answer_timeout_s``: the SDK sets its own
+    timeout per packet (34 ms for a short one at 1 Mbit/s: twice the USB latency timer and
+    the packet's bytes), which stays when it is the longer. A real servo answers within a
+    millisecond or two, and 0 keeps the SDK's, so that a silent servo holds the arm within
+    two cycles at 50 Hz; an emulated servo on a busy machine may answer much later, and is
+    given a generous timeout (deploy/emulated*.yaml) not to be taken for a silent one."""
+
+    def __init__(self, name: str, answer_timeout_s: float = 0.0) -> None:
+        super().__init__(name)
+        self.answer_timeout_ms = answer_timeout_s * 1e3
+
+    def setPacketTimeout(self, packet_length: int) -> None:  # noqa: N802 (the SDK's name)
+        super().setPacketTimeout(packet_length)
+        self.packet_timeout = max(self.packet_timeout, self.answer_timeout_ms)
+
+    def setPacketTimeoutMillis(self, msec: float) -> None:  # noqa: N802 (the SDK's name)
+        super().setPacketTimeoutMillis(max(msec, self.answer_timeout_ms))
+
+
 def open_port(port: PortHandler, baud: int) -> bool:
     """Open ``port`` at ``baud``; False when it cannot be. The SDK opens it non-blocking and
     spins on empty reads while a servo answers (a third of a core at 50 Hz x 5 servos, and a
@@ -50,7 +73,8 @@ def open_port(port: PortHandler, baud: int) -> bool:
 
 
 class ServoBus:
-    """What both protocols share: the port, the SDK's packet handler, the answer timeout."""
+    """What both protocols share: the port (``port_name``, each answer awaited at least
+    ``answer_timeout_s``: ``BusPort``) and the SDK's packet handler."""
 
     protocol = 1.0
     position_max: int
@@ -60,14 +84,9 @@ class ServoBus:
     """Every name an answer's error can be counted under."""
     read_bytes: int
 
-    def __init__(self, port: PortHandler, answer_timeout_s: float) -> None:
-        self.port = port
+    def __init__(self, port_name: str, answer_timeout_s: float = 0.0) -> None:
+        self.port = BusPort(port_name, answer_timeout_s)
         self.packet = PacketHandler(self.protocol)
-        self.answer_timeout_s = answer_timeout_s
-
-    def _await(self) -> None:
-        if self.answer_timeout_s > 0.0:
-            self.port.setPacketTimeoutMillis(self.answer_timeout_s * 1e3)
 
     def result_text(self, result: int) -> str:
         return self.packet.getTxRxResult(result)
@@ -105,7 +124,6 @@ class AXBus(ServoBus):
         )
         answer = b""
         if result == COMM_SUCCESS:
-            self._await()
             rx, _ = self.packet.rxPacket(self.port)
             answer = bytes(rx)
         fault = dxl1.status_fault(answer, servo, self.read_bytes)
@@ -199,7 +217,6 @@ class XBus(ServoBus):
         )
         answer = b""
         if result == COMM_SUCCESS:
-            self._await()
             answer = self._answer(servo)
             self.port.is_using = False
         return self._reading(answer, servo)
@@ -220,7 +237,6 @@ class XBus(ServoBus):
         if self.port.writePort(packet) != len(packet):
             return None
         self.port.setPacketTimeout((dxl2.MIN_STATUS_BYTES + self.read_bytes) * len(ids))
-        self._await()
         answers = {}
         for _ in ids:
             answer = self._receive()

@@ -68,7 +68,8 @@ def _data_length(pending: bytes) -> int | None:
 class Create2Emulator(SerialDevice):
     """The robot end of a pty. ``port`` is the slave's path, which a driver opens; ``mode`` the
     OI mode; ``counters`` counts commands executed and ignored, bad bytes (no known opcode),
-    unsupported stream packets, frames sent and output bytes dropped while nobody read."""
+    unsupported stream packets, the stream's periods (a frame sent in each while streaming),
+    frames sent and output bytes dropped while nobody read."""
 
     def __init__(
         self,
@@ -87,6 +88,7 @@ class Create2Emulator(SerialDevice):
                 "ignored_commands",
                 "bad_bytes",
                 "unsupported_packets",
+                "stream_periods",
                 "frames_sent",
             ),
         )
@@ -175,6 +177,7 @@ class Create2Emulator(SerialDevice):
             if time.monotonic() > deadline:
                 deadline = time.monotonic() + oi.STREAM_PERIOD_S
             with self._lock:
+                self.counters["stream_periods"] += 1
                 frame = self._frame() if self._streaming else None
             if frame is not None:
                 self.send(frame, "frames_sent")

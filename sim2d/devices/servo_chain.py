@@ -18,6 +18,11 @@ from typing import Any, Protocol
 from protocols.dynamixel_v1 import StatusFault
 from sim2d.devices.pty_link import SerialDevice
 
+ANSWER_TIMEOUT_S = 1.0
+"""How long a driver of an emulated chain awaits a servo's answer, s (deploy/emulated.yaml's
+``answer_timeout_s``): the emulator's thread, starved on a busy machine, may answer tens or
+hundreds of milliseconds late, and a late answer must not pass for a silent servo."""
+
 
 class ServoBackend(Protocol):
     def joint_positions(self) -> Sequence[float]:
@@ -177,11 +182,13 @@ class ServoChain(SerialDevice):
         if self._baud is not None and self._pty.baud() != self._baud:
             self.counters["wrong_baud_bytes"] += len(data)
             return
-        for packet in self._parser.feed(data):
-            self.instructions[packet.instruction] += 1
-            self._handle_guarded(packet)
+        packets = self._parser.feed(data)
+        # Counted before any answer goes out: whoever has an answer sees its packet counted.
         self.counters["bad_checksums"] = self._parser.bad_checksums
         self.counters["skipped_bytes"] = self._parser.skipped_bytes
+        for packet in packets:
+            self.instructions[packet.instruction] += 1
+            self._handle_guarded(packet)
 
     def _handle_guarded(self, packet: Any) -> None:
         """A fault in handling one packet is counted, not fatal: a bus keeps going."""

@@ -16,17 +16,13 @@ from profiles.deploy_files import ROBOT_FILE
 from protocols import dynamixel_v1 as dxl
 from protocols.dynamixel_v1 import Address, StatusFault
 from sim2d.devices.ax_servos import AXChainEmulator
-from sim2d.devices.servo_chain import IntegratingJoints
+from sim2d.devices.servo_chain import ANSWER_TIMEOUT_S, IntegratingJoints
 from tests.components.arm_bench import ArmBench
 from tests.components.driver_harness import driver_system, status
 from wbc.robot import MobileManipulator
 
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
 LOW, HIGH = ROBOT.q_min[3:], ROBOT.q_max[3:]
-ANSWER_TIMEOUT_S = 1.0
-"""The driver's wait for an answer: the SDK's 34 ms is less than a loaded machine may take to
-answer (every Moving Speed read 1, a hold, after such a timeout), so only a servo made silent
-is."""
 
 
 class Bench(ArmBench):

@@ -16,7 +16,7 @@ from profiles.deploy_files import DEPLOY
 from protocols import x_series_units as x_units
 from protocols.dynamixel_v1 import StatusFault
 from protocols.dynamixel_v2 import Address
-from sim2d.devices.servo_chain import IntegratingJoints
+from sim2d.devices.servo_chain import ANSWER_TIMEOUT_S, IntegratingJoints
 from sim2d.devices.x_servos import XChainEmulator
 from tests.components.arm_bench import ArmBench
 from tests.components.conftest import _wait_until
@@ -30,8 +30,6 @@ IDS = ServoMap.of(ROBOT_FILE, ROBOT.arm_dof).ids
 """The servos' bus ids, joint by joint, as the robot's description gives them."""
 LOW, HIGH = ROBOT.q_min[3:], ROBOT.q_max[3:]
 START = (0.0, -0.2, 0.2, 0.5)
-ANSWER_TIMEOUT_S = 1.0
-"""As the AX tests': only a servo made silent is."""
 UNIT = 1.0 / x_units.POSITION_UNITS_PER_RAD
 
 

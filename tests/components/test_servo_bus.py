@@ -7,28 +7,25 @@ from __future__ import annotations
 from collections.abc import Iterator
 
 import pytest
-from dynamixel_sdk import PortHandler
 
 from components.servo_bus import XBus, open_port
 from protocols import dynamixel_v2 as dxl
 from protocols import x_series_units as x_units
 from protocols.dynamixel_v2 import Address, OperatingMode
-from sim2d.devices.servo_chain import IntegratingJoints
+from sim2d.devices.servo_chain import ANSWER_TIMEOUT_S, IntegratingJoints
 from sim2d.devices.x_servos import XChainEmulator
 
 START = (0.0, 0.4, -0.6)
-ANSWER_TIMEOUT_S = 1.0
-"""A busy machine's emulator may answer late; only a silent servo reaches this."""
 
 
 @pytest.fixture
 def chain() -> Iterator[tuple[XChainEmulator, IntegratingJoints, XBus]]:
     arm = IntegratingJoints(START)
     with XChainEmulator(arm) as emulator:
-        port = PortHandler(emulator.port)
-        assert open_port(port, 1_000_000)
-        yield emulator, arm, XBus(port, ANSWER_TIMEOUT_S)
-        port.closePort()
+        bus = XBus(emulator.port, ANSWER_TIMEOUT_S)
+        assert open_port(bus.port, 1_000_000)
+        yield emulator, arm, bus
+        bus.port.closePort()
 
 
 def test_torque_comes_on_in_position_mode_with_the_goal_where_the_servo_is(chain) -> None:

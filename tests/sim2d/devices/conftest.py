@@ -1,22 +1,30 @@
 """The fixtures of the emulated servo chains' tests, whatever their protocol. A test module
 declares ``CHAIN`` (the emulator's class), ``IDS``, ``START_ANGLES``, ``PROTOCOL`` (the SDK's
-1.0 or 2.0) and, when its port is set to a baud rate, ``BAUD``."""
+1.0 or 2.0), ``PROBE`` (an id of ``IDS`` its raw exchanges never address: ``exchange``) and,
+when its port is set to a baud rate, ``BAUD``."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+import time
+from collections.abc import Callable, Iterator
+from types import ModuleType
 
 import pytest
 import serial
 from dynamixel_sdk import PacketHandler, PortHandler
 
-from sim2d.devices.servo_chain import IntegratingJoints, ServoChain
-from tests.sim2d.devices.patient_port import PatientPort
+from components.servo_bus import BusPort
+from protocols import dynamixel_v1, dynamixel_v2
+from sim2d.devices.servo_chain import ANSWER_TIMEOUT_S, IntegratingJoints, ServoChain
 
 DT = 0.01
 """The world's and the servos' step, s."""
-QUIET_S = 0.03
-"""How long the line stays quiet before an exchange is taken as answered, s."""
+SAFETY_S = 30.0
+"""How long an exchange waits for its answers at most: a safety net only, each wait ends as soon
+as the probe's answer is there."""
+PROTOCOLS: dict[float, ModuleType] = {1.0: dynamixel_v1, 2.0: dynamixel_v2}
+Exchange = Callable[[bytes], list]
+"""The ``exchange`` fixture: an instruction's bytes in, the packets answered to them out."""
 
 
 @pytest.fixture
@@ -33,7 +41,7 @@ def emulator(request: pytest.FixtureRequest, arm: IntegratingJoints) -> Iterator
 
 @pytest.fixture
 def port(request: pytest.FixtureRequest, emulator: ServoChain) -> Iterator[PortHandler]:
-    handler = PatientPort(emulator.port)
+    handler = BusPort(emulator.port, ANSWER_TIMEOUT_S)
     assert handler.openPort()
     baud = getattr(request.module, "BAUD", None)
     if baud is not None:
@@ -56,14 +64,27 @@ def simulate(emulator: ServoChain, arm: IntegratingJoints, steps: int) -> None:
 @pytest.fixture
 def raw(emulator: ServoChain) -> Iterator[serial.Serial]:
     """The chain's line as pyserial opens it, for the bytes the SDK never sends."""
-    with serial.Serial(emulator.port, 1_000_000, timeout=QUIET_S) as connection:
+    with serial.Serial(emulator.port, 1_000_000, timeout=DT) as connection:
         yield connection
 
 
-def answered(raw: serial.Serial, request: bytes) -> bytes:
-    """Write ``request``; every byte answered until the line is quiet for QUIET_S."""
-    raw.write(request)
-    answer = bytearray()
-    while chunk := raw.read(max(raw.in_waiting, 1)):
-        answer += chunk
-    return bytes(answer)
+@pytest.fixture
+def exchange(request: pytest.FixtureRequest, raw: serial.Serial) -> Exchange:
+    """``exchange(request)``: write ``request`` and a ping of the module's ``PROBE`` behind it;
+    every packet answered to ``request``. The servos answer in the order they are asked, so
+    every answer to ``request``, however late a busy machine makes it, comes before the
+    probe's, and none after: no wait on a quiet line, which a starved emulator breaks."""
+    protocol = PROTOCOLS[request.module.PROTOCOL]
+    probe = request.module.PROBE
+
+    def exchanged(instruction: bytes) -> list:
+        raw.write(instruction + protocol.instruction_packet(probe, protocol.Instruction.PING))
+        parser, answers = protocol.PacketParser(), []
+        deadline = time.monotonic() + SAFETY_S
+        while not any(packet.id == probe for packet in answers):
+            assert time.monotonic() < deadline, f"no answer to the probe in {SAFETY_S} s"
+            answers += parser.feed(raw.read(max(raw.in_waiting, 1)))
+        assert answers[-1].id == probe and answers[-1].error == 0, answers
+        return answers[:-1]
+
+    return exchanged

@@ -6,7 +6,6 @@ from __future__ import annotations
 import random
 from pathlib import Path
 
-import serial
 from dynamixel_sdk import (
     COMM_RX_TIMEOUT,
     COMM_SUCCESS,
@@ -20,13 +19,15 @@ from protocols import dynamixel_v1 as dxl
 from protocols.dynamixel_v1 import Address, Instruction, StatusError
 from sim2d.devices.ax_servos import MODEL_NUMBER, AXChainEmulator
 from sim2d.devices.servo_chain import IntegratingJoints
-from tests.sim2d.devices.conftest import answered, simulate
+from tests.sim2d.devices.conftest import Exchange, simulate
 
 IDS = (1, 2, 3, 4, 5)
 START_ANGLES = (0.0, 0.4, -0.6, 1.2, -1.0)
 CHAIN = AXChainEmulator
 PROTOCOL = 1.0
 BAUD = 1_000_000
+PROBE = 3
+"""The servo pinged behind each raw exchange (``exchange``); none of them addresses it."""
 
 
 def test_every_servo_answers_a_ping_with_the_ax18a_model(
@@ -118,49 +119,44 @@ def test_a_goal_beyond_the_angle_limit_is_clamped_with_the_angle_limit_bit(
     assert packet.read2ByteTxRx(port, 4, Address.GOAL_POSITION) == (200, COMM_SUCCESS, 0)
 
 
-def exchange(raw: serial.Serial, request: bytes) -> list[dxl.Packet]:
-    """Write ``request``; every packet answered until the line is quiet."""
-    return dxl.PacketParser().feed(answered(raw, request))
-
-
 def test_a_bad_checksum_is_answered_with_the_checksum_bit(
-    raw: serial.Serial, emulator: AXChainEmulator
+    exchange: Exchange, emulator: AXChainEmulator
 ) -> None:
     ping = dxl.instruction_packet(2, Instruction.PING)
-    (status,) = exchange(raw, ping[:-1] + bytes(((ping[-1] + 1) & 0xFF,)))
+    (status,) = exchange(ping[:-1] + bytes(((ping[-1] + 1) & 0xFF,)))
     assert (status.id, status.error) == (2, StatusError.CHECKSUM)
     assert emulator.counters["bad_checksums"] == 1
 
 
-def test_an_unknown_instruction_and_a_read_past_the_table_are_refused(raw: serial.Serial) -> None:
-    (unknown,) = exchange(raw, dxl.instruction_packet(1, 0x42))
+def test_an_unknown_instruction_and_a_read_past_the_table_are_refused(exchange: Exchange) -> None:
+    (unknown,) = exchange(dxl.instruction_packet(1, 0x42))
     assert unknown.error == StatusError.INSTRUCTION
-    (past,) = exchange(raw, dxl.instruction_packet(1, Instruction.READ, bytes((48, 4))))
+    (past,) = exchange(dxl.instruction_packet(1, Instruction.READ, bytes((48, 4))))
     assert past.error == StatusError.RANGE
 
 
-def test_broadcasts_and_absent_ids_get_no_answer(raw: serial.Serial) -> None:
-    assert exchange(raw, dxl.instruction_packet(dxl.BROADCAST_ID, Instruction.PING)) == []
-    assert exchange(raw, dxl.instruction_packet(9, Instruction.PING)) == []
+def test_broadcasts_and_absent_ids_get_no_answer(exchange: Exchange) -> None:
+    assert exchange(dxl.instruction_packet(dxl.BROADCAST_ID, Instruction.PING)) == []
+    assert exchange(dxl.instruction_packet(9, Instruction.PING)) == []
 
 
-def test_reg_write_waits_for_action(raw: serial.Serial) -> None:
+def test_reg_write_waits_for_action(exchange: Exchange) -> None:
     goal = bytes((Address.GOAL_POSITION, *dxl.word(600)))
-    (registered,) = exchange(raw, dxl.instruction_packet(5, Instruction.REG_WRITE, goal))
+    (registered,) = exchange(dxl.instruction_packet(5, Instruction.REG_WRITE, goal))
     assert registered.error == 0
     read_goal = dxl.instruction_packet(5, Instruction.READ, bytes((Address.GOAL_POSITION, 2)))
-    (before,) = exchange(raw, read_goal)
+    (before,) = exchange(read_goal)
     assert before.params != dxl.word(600)
-    assert exchange(raw, dxl.instruction_packet(dxl.BROADCAST_ID, Instruction.ACTION)) == []
-    (after,) = exchange(raw, read_goal)
+    assert exchange(dxl.instruction_packet(dxl.BROADCAST_ID, Instruction.ACTION)) == []
+    (after,) = exchange(read_goal)
     assert after.params == dxl.word(600)
 
 
-def test_the_emulator_survives_garbage(raw: serial.Serial, emulator: AXChainEmulator) -> None:
+def test_the_emulator_survives_garbage(exchange: Exchange, emulator: AXChainEmulator) -> None:
     noise = random.Random(7)
     garbage = bytes(noise.randrange(256) for _ in range(5000))
     flush = bytes(dxl.MAX_PACKET_BYTES)  # completes any frame a garbage length left pending
-    answers = exchange(raw, garbage + flush + dxl.instruction_packet(1, Instruction.PING))
+    answers = exchange(garbage + flush + dxl.instruction_packet(1, Instruction.PING))
     assert answers[-1] == dxl.Packet(1, 0, b"")
     assert emulator.counters["skipped_bytes"] > 0
 

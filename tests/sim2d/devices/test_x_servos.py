@@ -3,7 +3,6 @@ dynamixel-sdk at protocol 2.0, and by pyserial for the bytes the SDK never sends
 
 from __future__ import annotations
 
-import serial
 from dynamixel_sdk import (
     COMM_RX_TIMEOUT,
     COMM_SUCCESS,
@@ -20,12 +19,14 @@ from protocols import x_series_units as x_units
 from protocols.dynamixel_v2 import ALERT, Address, HardwareError, Instruction, StatusError
 from sim2d.devices.servo_chain import IntegratingJoints
 from sim2d.devices.x_servos import MODEL_NUMBER, XChainEmulator
-from tests.sim2d.devices.conftest import answered, simulate
+from tests.sim2d.devices.conftest import Exchange, simulate
 
 IDS = (11, 12, 13, 14)
 START_ANGLES = (0.0, 0.4, -0.6, 1.2)
 CHAIN = XChainEmulator
 PROTOCOL = 2.0
+PROBE = 11
+"""The servo pinged behind each raw exchange (``exchange``); none of them addresses it."""
 
 
 def test_a_ping_answers_the_model_and_a_sync_read_every_servo_in_order(
@@ -122,24 +123,19 @@ def test_a_silent_servo_times_out_and_an_overloaded_one_raises_the_alert(
     assert packet.read1ByteTxRx(port, 12, Address.HARDWARE_ERROR_STATUS)[:3:2] == (0, 0)
 
 
-def exchange(raw: serial.Serial, request: bytes) -> list[dxl.Packet]:
-    """Write ``request``; every packet answered until the line is quiet."""
-    return dxl.PacketParser().feed(answered(raw, request))
-
-
 def test_a_bad_crc_an_unknown_instruction_and_a_stuffed_answer(
-    raw: serial.Serial, emulator: XChainEmulator
+    exchange: Exchange, emulator: XChainEmulator
 ) -> None:
     """A goal whose bytes hold FF FF FD goes in stuffed and comes back unstuffed."""
     ping = dxl.instruction_packet(12, Instruction.PING)
-    (status,) = exchange(raw, ping[:-1] + bytes(((ping[-1] + 1) & 0xFF,)))
+    (status,) = exchange(ping[:-1] + bytes(((ping[-1] + 1) & 0xFF,)))
     assert (status.id, status.error) == (12, StatusError.CRC)
-    (unknown,) = exchange(raw, dxl.instruction_packet(12, 0x42))
+    (unknown,) = exchange(dxl.instruction_packet(12, 0x42))
     assert unknown.error == StatusError.INSTRUCTION
     address = dxl.value(Address.VELOCITY_LIMIT, 2)
     limit = b"\xff\xff\xfd\x00"  # too fast for a real XM430, fine for the bytes
-    assert exchange(raw, dxl.write(12, Address.VELOCITY_LIMIT, limit))[0].error == 0
-    (read,) = exchange(raw, dxl.instruction_packet(12, Instruction.READ, address + b"\4\0"))
+    assert exchange(dxl.write(12, Address.VELOCITY_LIMIT, limit))[0].error == 0
+    (read,) = exchange(dxl.instruction_packet(12, Instruction.READ, address + b"\4\0"))
     assert read.data == limit
-    assert exchange(raw, dxl.instruction_packet(9, Instruction.PING)) == []
+    assert exchange(dxl.instruction_packet(9, Instruction.PING)) == []
     assert emulator.counters["bad_checksums"] == 1
