@@ -33,8 +33,9 @@ optimal basis, so the dual simplex starts from the previous vertex (usually 0 to
 
 from __future__ import annotations
 
+import functools
 import operator
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from typing import NamedTuple
 
 import highspy
@@ -42,10 +43,10 @@ import numpy as np
 
 from wbc.laws.basis_reuse import KeptBasis, lapack
 from wbc.laws.constraints.base import LinearRows, OneNormBound, Rows, VelocityBounds
+from wbc.laws.lp_layout import INF, Layout, picker
 from wbc.laws.objectives.base import Cost, ResidualCost, VelocityCost
 
 Array = np.ndarray
-INF = highspy.kHighsInf
 ACTIVE_TOLERANCE = 1e-7
 SOLVER_OPTIONS = {
     "output_flag": False,
@@ -73,76 +74,6 @@ class LPSolution(NamedTuple):
     """|u_i| as Python floats, read for the active set and u's nonzero counts."""
 
 
-class _Layout:
-    """Index arrays and buffers for one shape of the problem, built once per shape.
-
-    Rows: the n velocity rows and the one-norm rows first (fixed coefficients, bounds change),
-    then the residual rows and the linear rows (replaced every step). ``matrix`` holds them
-    all, dense; ``varying`` is a view of its last rows, as passed to HiGHS.
-    """
-
-    def __init__(self, n: int, residual_count: int, counts: list[int], norm_rows: int) -> None:
-        self.key = (n, residual_count, counts, norm_rows)
-        """What makes two steps' problems one shape: n, the residual costs' count, the rows of
-        each residual cost and linear rows, and the one-norm rows."""
-        self.n, self.norm_rows = n, norm_rows
-        self.counts = (n, *counts)
-        """n and the rows of each matrix, as a step checks them."""
-        self.kinds: _Kinds | None = None
-        """The sequence of kinds of costs and rows this layout was last taken for."""
-        residual_rows = counts[:residual_count]
-        linear_rows = sum(counts[residual_count:])
-        residual_total = self.residual_rows = sum(residual_rows)
-        self.columns = 2 * n + residual_total
-        self.static_rows = n + norm_rows
-        self.varying_rows = residual_total + linear_rows
-        rows = self.static_rows + self.varying_rows
-        self.column_index = np.arange(self.columns, dtype=np.int32)
-        self.static_index = np.arange(self.static_rows, dtype=np.int32)
-        self.varying_index = np.arange(self.static_rows, rows, dtype=np.int32)
-        # Velocity row i: u_P[i] - u_N[i]; one-norm rows: all of u_P and u_N.
-        self.matrix = np.zeros((rows, self.columns))
-        self.matrix[np.arange(n), np.arange(n)] = 1.0
-        self.matrix[np.arange(n), n + np.arange(n)] = -1.0
-        self.matrix[n : self.static_rows, : 2 * n] = 1.0
-        # Residual rows [A_b -A_b -I_b], then linear rows [A -A 0].
-        self.varying = self.matrix[self.static_rows :]
-        self.varying[np.arange(residual_total), 2 * n + np.arange(residual_total)] = -1.0
-        self.starts = np.arange(0, self.varying_rows * self.columns, self.columns, dtype=np.int32)
-        self.indices = np.tile(self.column_index, self.varying_rows)
-        self.lower = np.full(rows, -INF)
-        self.upper = np.full(rows, INF)
-        self.cost = np.zeros(self.columns)
-        self.row_weight = np.zeros(residual_total)
-        """w_b of the residual cost each residual row belongs to."""
-        starts = np.cumsum([0, *residual_rows]).tolist()
-        self._slices = [slice(a, b) for a, b in zip(starts, starts[1:], strict=False)]
-        self.weights: list[float] = []
-        """The residual costs' weights ``row_weight`` and the costs of y were set from."""
-        self.col_lower = np.zeros(self.columns)
-        self.col_upper = np.full(self.columns, INF)
-        # Views of the buffers each step writes, made once for the shape.
-        static = self.static_rows
-        self.u_lower, self.u_upper = self.lower[:n], self.upper[:n]
-        self.plus, self.minus = self.varying[:, :n], self.varying[:, n : 2 * n]
-        self.residual_plus = self.plus[:residual_total]
-        """A_b of every residual cost, stacked (rows of ``plus``)."""
-        self.residual_upper = self.upper[static : static + residual_total]
-        self.linear_lower = self.lower[static + residual_total :]
-        self.linear_upper = self.upper[static + residual_total :]
-        self.cost_positive, self.cost_negative = self.cost[:n], self.cost[n : 2 * n]
-        self.filled = [i for i, count in enumerate(counts[residual_count:]) if count]
-        """The linear row sets that hold rows (by their place among the linear ones)."""
-
-    def weigh(self, weights: list[float]) -> None:
-        """Set ``row_weight`` and the costs of y from the weight of each residual cost (a step
-        calls it when they differ from ``weights``)."""
-        for rows, weight in zip(self._slices, weights, strict=True):
-            self.row_weight[rows] = weight
-        np.multiply(2.0, self.row_weight, out=self.cost[2 * self.n :])
-        self.weights = weights
-
-
 class WarmStartedLP:
     """One HiGHS model solved once per control step, warm-started from the last basis.
 
@@ -155,7 +86,7 @@ class WarmStartedLP:
         lapack()  # SciPy's LAPACK loaded with the LP, not in its first step
         for option, value in SOLVER_OPTIONS.items():
             self._highs.setOptionValue(option, value)
-        self._layout: _Layout | None = None
+        self._layout: Layout | None = None
         self._basis: KeptBasis | None = None
         self._costs: list[VelocityCost] = []
         self._cost_key: tuple[int, ...] = ()
@@ -169,24 +100,21 @@ class WarmStartedLP:
     def solve(self, costs: list[Cost], rows: list[Rows]) -> LPSolution:
         """Minimise the sum of ``costs`` over u subject to ``rows`` (5.29)."""
         items = (*costs, *rows)
-        kinds = tuple(map(type, items))
-        if kinds != self._kinds.types:
-            self._kinds = _Kinds(kinds)
-        velocity_costs, residuals, linear, bounds, norms, with_matrix = self._kinds.pick(items)
-        matrices = list(map(_MATRIX, with_matrix))
+        kinds = self._kinds
+        if tuple(map(type, items)) != kinds.types:
+            kinds = self._kinds = _Kinds(tuple(map(type, items)))
+        residuals, linear = kinds.residual(items), kinds.linear(items)
+        bounds, norms = kinds.bounds(items), kinds.norms(items)
+        matrices = list(map(_MATRIX, kinds.matrices(items)))
         n = matrices[0].shape[1]
         layout = self._layout
-        if (
-            layout is None
-            or layout.kinds is not self._kinds
-            or layout.counts != (n, *map(len, matrices))
-        ):
-            layout = self._layout_for(n, matrices, len(residuals), len(norms))
+        if layout is None or layout.kinds is not kinds or layout.counts != (n, *map(len, matrices)):
+            layout = self._layout_for(matrices, len(residuals), len(norms))
         u_lower, u_upper = layout.u_lower, layout.u_upper
         # Each bound's entries as Python floats, for the test below and the active set.
         limits = [(bound.name, bound.lower.tolist(), bound.upper.tolist()) for bound in bounds]
         if len(bounds) == 1:
-            u_lower[:], u_upper[:] = bounds[0].lower, bounds[0].upper
+            u_lower[...], u_upper[...] = bounds[0].lower, bounds[0].upper
             infeasible = any(map(operator.gt, limits[0][1], limits[0][2]))
         else:
             u_lower.fill(-INF)
@@ -201,14 +129,14 @@ class WarmStartedLP:
             layout.upper[row] = bound.limit
 
         # The varying rows: [A_b -A_b -I_b] of every residual cost, then [A -A 0] of the rows.
-        np.concatenate(matrices, out=layout.plus)
-        np.negative(layout.plus, out=layout.minus)
+        layout.fill(matrices)
         residual_upper = layout.residual_upper
-        np.concatenate(list(map(_OFFSET, residuals)), out=residual_upper)
+        for block, offset in zip(layout.offset_blocks, map(_OFFSET, residuals), strict=True):
+            block[...] = offset
         np.negative(residual_upper, out=residual_upper)
         if len(layout.filled) == 1:
             only = linear[layout.filled[0]]
-            layout.linear_lower[:], layout.linear_upper[:] = only.lower, only.upper
+            layout.linear_lower[...], layout.linear_upper[...] = only.lower, only.upper
         elif layout.filled:
             np.concatenate([linear[i].lower for i in layout.filled], out=layout.linear_lower)
             np.concatenate([linear[i].upper for i in layout.filled], out=layout.linear_upper)
@@ -217,8 +145,8 @@ class WarmStartedLP:
             layout.weigh(weights)
         # The costs of u_P: c_P - sum_b w_b 1'A_b, of u_N: c_N + sum_b w_b 1'A_b (rows weighted
         # by w), c_P and c_N the velocity costs of each entry's two directions; y_b's 2 w_b are
-        # set with the weights (``_Layout.weigh``).
-        positive, negative = self._velocity_costs(velocity_costs, n)
+        # set with the weights (``Layout.weigh``).
+        positive, negative = self._velocity_costs(kinds.velocity(items), n)
         column_sums = layout.row_weight.dot(layout.residual_plus)
         np.subtract(positive, column_sums, out=layout.cost_positive)
         np.add(negative, column_sums, out=layout.cost_negative)
@@ -252,18 +180,16 @@ class WarmStartedLP:
             )
         return self._cost_sums
 
-    def _layout_for(
-        self, n: int, stacked: list[Array], residual_count: int, norm_rows: int
-    ) -> _Layout:
+    def _layout_for(self, matrices: list[Array], residual_count: int, norm_rows: int) -> Layout:
         """The layout of this step's shape: the last one while the shape holds."""
-        key = (n, residual_count, list(map(len, stacked)), norm_rows)
+        key = (tuple(map(_SHAPE, matrices)), residual_count, norm_rows)
         if self._layout is None or self._layout.key != key:
-            self._build(_Layout(*key))
+            self._build(Layout(*key))
         assert self._layout is not None
         self._layout.kinds = self._kinds
         return self._layout
 
-    def _build(self, layout: _Layout) -> None:
+    def _build(self, layout: Layout) -> None:
         """A new model: the columns, the fixed velocity and one-norm rows, empty varying rows."""
         highs = self._highs
         highs.clearModel()
@@ -302,7 +228,7 @@ class WarmStartedLP:
         self._layout = layout
         self._basis = None
 
-    def _vertex(self, layout: _Layout) -> tuple[str, Array | None]:
+    def _vertex(self, layout: Layout) -> tuple[str, Array | None]:
         """The optimal vertex: from the kept basis if it is still optimal, else from HiGHS."""
         if self._basis is not None:
             values = self._basis.solution(layout.matrix, layout.lower, layout.upper, layout.cost)
@@ -310,7 +236,7 @@ class WarmStartedLP:
                 return "optimal", values
         return self._run(layout)
 
-    def _run(self, layout: _Layout) -> tuple[str, Array | None]:
+    def _run(self, layout: Layout) -> tuple[str, Array | None]:
         """Every call into HiGHS of one step: update the model, restore the basis, solve.
 
         Returns the status and, when optimal, the column values.
@@ -342,18 +268,20 @@ class WarmStartedLP:
         return "optimal", np.asarray(highs.getSolution().col_value)
 
 
-_MATRIX, _OFFSET, _WEIGHT = (operator.attrgetter(name) for name in ("matrix", "offset", "weight"))
+_MATRIX, _OFFSET, _WEIGHT, _SHAPE = map(
+    operator.attrgetter, ("matrix", "offset", "weight", "shape")
+)
 KINDS = (VelocityCost, ResidualCost, LinearRows, VelocityBounds, OneNormBound)
-"""What ``WarmStartedLP.solve`` takes, in the order ``_Kinds.pick`` gives them."""
+"""What ``WarmStartedLP.solve`` takes, by group (``_Kinds``)."""
 
 
 class _Kinds:
     """Where each kind of cost or rows sits among one step's items, found once for a sequence
     of types: a step whose terms return the kinds of the last picks them by place.
 
-    ``pick`` gives the velocity costs, residual costs, linear rows, velocity bounds and
-    one-norm bounds, then the residual costs and linear rows together (those with a matrix):
-    one itemgetter puts the items in that order, and each group is a slice of it.
+    One picker per group: the velocity costs, residual costs, linear rows, velocity bounds and
+    one-norm bounds, and ``matrices``, the residual costs then the linear rows (those with a
+    matrix).
     """
 
     def __init__(self, types: tuple[type, ...]) -> None:
@@ -364,24 +292,8 @@ class _Kinds:
             if group is None:
                 raise TypeError(f"not a cost or rows of the LP: {kind.__name__}")
             places[group].append(place)
-        order = [place for group in places for place in group]
-        self._order = _picker(order)
-        ends = np.cumsum([0, *map(len, places)]).tolist()
-        self._slices = [slice(a, b) for a, b in zip(ends, ends[1:], strict=False)]
-        self._slices.append(slice(ends[1], ends[3]))
-
-    def pick(self, items: tuple) -> list[tuple]:
-        return list(map(self._order(items).__getitem__, self._slices))
-
-
-def _picker(places: list[int]) -> Callable[[tuple], tuple]:
-    """The items at ``places``, as a tuple (``operator.itemgetter`` gives one item bare)."""
-    if len(places) > 1:
-        return operator.itemgetter(*places)
-    if places:
-        place = places[0]
-        return lambda items: (items[place],)
-    return lambda items: ()
+        self.velocity, self.residual, self.linear, self.bounds, self.norms = map(picker, places)
+        self.matrices = picker(places[1] + places[2])
 
 
 def _failed(n: int, status: str) -> LPSolution:
@@ -420,12 +332,20 @@ def _active(
         ):
             continue  # no entry near either bound (most steps): none to name
         active += [
-            f"{name}[{i}]"
-            for i, (x, low, high) in enumerate(zip(values, lows, highs, strict=True))
+            label
+            for label, x, low, high in zip(
+                entry_names(name, len(values)), values, lows, highs, strict=True
+            )
             if (x - low <= ACTIVE_TOLERANCE or high - x <= ACTIVE_TOLERANCE)
             and high - low > ACTIVE_TOLERANCE
         ]
     return tuple(active)
+
+
+@functools.cache
+def entry_names(name: str, n: int) -> tuple[str, ...]:
+    """The names ``name[i]`` of the n entries of a velocity bound, made once."""
+    return tuple(f"{name}[{i}]" for i in range(n))
 
 
 def _tight(rows: LinearRows, u: Array) -> bool:

@@ -102,15 +102,16 @@ def program(
     for the terms and rows that read it (``StepContext.previous_u``). The LP and the QP
     (``wbc.laws.qp_law``) solve the same one."""
     q, dt = np.asarray(q, dtype=float), float(dt)
-    # One test for a good q and dt (q'q is finite only if every q_i is, or overflows: then
-    # ``_check`` looks entry by entry); ``_check`` names what is wrong.
-    if q.ndim != 1 or not math.isfinite(q.dot(q)) or not 0.0 < dt < math.inf:
+    # One test for a good q and dt (the sum of the q_i is finite only if every q_i is, or
+    # overflows: then ``_check`` looks entry by entry); ``_check`` names what is wrong.
+    if q.ndim != 1 or not math.isfinite(sum(q.tolist())) or not 0.0 < dt < math.inf:
         _check(q, dt)
     circles, solids = _obstacles(obstacles) if obstacles else ((), ())
     chain = robot.forward(q)  # one pass for the task and the collision parts' rows
     error, task_jacobian = task.error(chain.pose, chain.jacobian, q)
     if last is not None and (last[0] is task or same_task(last[0], task)):
-        error_rate = (error - last[1]) / dt
+        error_rate = error - last[1]
+        error_rate /= dt  # in place: the same quotients, without a second array
     else:
         error_rate = -eta * error
     goal_pose = task.pose if isinstance(task, PoseTask) else None
