@@ -86,7 +86,7 @@ def to_json(message: BaseModel, left_out: str = "") -> bytes:
     the base64 text, which needs no escaping.
     """
     names = [name for name in bytes_fields(type(message)) if name != left_out]
-    if not names:  # every float is finite: the messages refuse NaN and inf (messages.base)
+    if not names and _bytes_free(type(message), left_out):  # and every float finite (messages)
         exclude = {left_out} if left_out else None
         return type(message).__pydantic_serializer__.to_json(message, exclude=exclude)
     dumped = message.model_dump(exclude={*bytes_fields(type(message)), left_out})
@@ -100,6 +100,13 @@ def to_json(message: BaseModel, left_out: str = "") -> bytes:
         value = b'"' + base64.b64encode(getattr(message, name)) + b'"'
         text = text.replace(_ENCODED_MARKER, value, 1)
     return text
+
+
+@functools.cache
+def _bytes_free(message_type: type[BaseModel], left_out: str) -> bool:
+    """Whether the JSON of a type, ``left_out`` left out, holds no bytes at any depth (its
+    schema no ``binary`` string): one that does goes the way that refuses nested bytes."""
+    return b'"binary"' not in schema_of(message_type, left_out)
 
 
 BYTES_MARKER = "\u0000bytes\u0000"

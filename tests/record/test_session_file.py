@@ -18,7 +18,7 @@ from messages import topics
 from messages.camera import CameraFrame
 from messages.clock import Clock
 from messages.state import RobotState
-from record.session_file import CARRIER, DROPPED, Entry, SessionWriter
+from record.session_file import CARRIER, DROPPED, Entry, SessionWriter, to_json
 from record.session_reader import info, read_session, recover
 from tests.parsimony.in_process import run_in_process
 from tests.record.session_messages import (
@@ -191,3 +191,17 @@ def test_what_the_recorder_lost_is_in_the_file_and_info_shows_it(
     assert info(recovered)["dropped"] == info(path)["dropped"]
     _, shown, _ = run_in_process(["info", str(path)], capsys)
     assert "lost by the recorder: 7 (overflowed.camera/image), 2 (overwritten.sim/clock)" in shown
+
+
+def test_bytes_nested_in_a_message_are_refused_not_written_as_text() -> None:
+    """Only a message's top-level bytes are written (as base64); bytes deeper down are refused,
+    whichever way the message's JSON is written."""
+
+    class Inner(BaseModel):
+        blob: bytes
+
+    class Outer(BaseModel):
+        inner: Inner
+
+    with pytest.raises(TypeError):
+        to_json(Outer(inner=Inner(blob=b"ab")))
