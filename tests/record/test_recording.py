@@ -26,18 +26,8 @@ from profiles.profile import load_profile
 from record.session_reader import info, read_session, recover
 from record.sessions import load_session
 from studies.launched import connect
-from tests.parsimony.in_process import run_in_process
+from tests.parsimony.in_process import completed, run_in_process
 from tests.studies.experiments import run_here
-
-
-def parsimony(*arguments: str, timeout: float = 300) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "parsimony.cli", *arguments],
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-    )
-
 
 pytestmark = pytest.mark.heavy  # two whole-loop runs (one the suite's shared pose_lp_run, made
 # here first: a file that reads it later finds it made) and a recorder killed mid-run
@@ -213,6 +203,7 @@ def test_a_recorder_whose_file_fills_up_stops_for_good_and_its_file_recovers(
             stdout=stream,
             stderr=subprocess.STDOUT,
             preexec_fn=small_files,
+            env={**os.environ, "PYTHONDONTWRITEBYTECODE": "1"},  # a cut .pyc breaks the next
         )
     try:
         while f"recorder exited with {EXIT_FOR_GOOD}" not in log.read_text():
@@ -260,7 +251,7 @@ def test_replay_republishes_the_sensors_with_headers_as_recorded(runs, tmp_path:
         recorded_all = load_session(path)["base/odometry"]
         first = recorded_all[0].header.stamp_ns
         recorded = [m for m in recorded_all if m.header.stamp_ns <= first + 3_000_000_000]
-        done = parsimony(
+        done = completed(  # in this process: no Python start
             "replay",
             str(path),
             "--profile",
