@@ -80,13 +80,16 @@ def _effort(rows: Rows, robot: MobileManipulator) -> dict[str, float]:
     return {n: float(np.median([getattr(e, n) for e in efforts])) for n in names if efforts}
 
 
+def by_kind(reasons: list[str]) -> dict[str, int]:
+    """Reasons counted by kind: a reason's head (before a colon), without the counts in
+    parentheses, so that it names a kind of miss, not one goal's."""
+    return dict(Counter(re.sub(r" \(\d+\)", "", r.partition(": ")[0]) for r in reasons))
+
+
 def _not_reached(rows: Rows, robot: MobileManipulator) -> dict[str, int]:
-    """The goals not reached, by reason: its head (before a colon), without the counts in
-    parentheses, so that a reason names a kind of miss, not one goal's."""
-    kinds: Counter[str] = Counter()
-    for reason, n in not_reached(_attempts(rows))["failures"].items():
-        kinds[re.sub(r" \(\d+\)", "", reason.partition(": ")[0])] += n
-    return dict(kinds)
+    """The goals not reached, by the kind of their reason (``by_kind``)."""
+    failures = not_reached(_attempts(rows))["failures"]
+    return by_kind([reason for reason, n in failures.items() for _ in range(n)])
 
 
 COMMON: dict[str, Figure] = {
@@ -215,12 +218,23 @@ def _arm_clearance(rows: Rows, robot: MobileManipulator) -> dict[str, float]:
     return {f"{part} (m)": value for part, value in least.items()}
 
 
+def _supervisor_reasons(rows: Rows, robot: MobileManipulator) -> dict[str, int]:
+    """The runs that did not converge, by the kind of the staging supervisor's reason
+    (``by_kind``; runs without a supervisor, or without a reason, are not counted)."""
+    reports = [r for r in _reports(rows) if not r["converged"]]
+    return by_kind(
+        [r["supervisor"]["reason"] for r in reports if (r["supervisor"] or {}).get("reason")]
+    )
+
+
 SIMULATED: dict[str, Figure] = {key: _summary(key) for key in SIMULATED_COLUMNS} | {
     "arm penetrations": _arm_penetrations,
     "arm clearance": _arm_clearance,
+    "not reached": _supervisor_reasons,
 }
 """A simulated study's figures (``SETUP``'s too): the experiments' summary's columns, the runs
-with an arm penetration and each part's least clearance from the solids."""
+with an arm penetration, each part's least clearance from the solids, and the runs not
+converged by the supervisor's reason."""
 
 
 def _converge_times(rows: Rows, robot: MobileManipulator) -> dict[str, float | None]:

@@ -15,7 +15,7 @@ import yaml
 from parsimony.cli import main
 from studies.goal_sets import Attempt
 from studies.study.figures import KINEMATIC, SIMULATED
-from studies.study.report import check_tables
+from studies.study.report import check_tables, markers, pages
 from studies.study.schema import StudyError, load_study
 from studies.study.sweep import expand
 from wbc.robot import MobileManipulator
@@ -141,6 +141,23 @@ def test_the_arms_figures_count_penetrating_runs_and_keep_each_parts_least_clear
     assert SIMULATED["arm clearance"](rows, robot) == {"gripper (m)": -0.055, "wrist (m)": 0.031}
 
 
+def test_whole_loop_runs_not_converged_are_counted_by_the_supervisors_reason() -> None:
+    """Two runs left out for one kind of reason (each naming its count) and a converged run
+    and a run without a supervisor, which count for none."""
+    reason = "every whole-body configuration found that reaches the goal ({n}) is left out: "
+    reports = [
+        {"converged": False, "supervisor": {"reason": reason.format(n=40)}},
+        {"converged": False, "supervisor": {"reason": reason.format(n=38)}},
+        {"converged": True, "supervisor": {"reason": ""}},
+        {"converged": False, "supervisor": None},
+    ]
+    rows = [{"status": "ok", "report": json.dumps(report)} for report in reports]
+    robot = MobileManipulator.from_yaml(ROOT / "deploy/robots/little_john.yaml")
+    assert SIMULATED["not reached"](rows, robot) == {
+        "every whole-body configuration found that reaches the goal is left out": 2
+    }
+
+
 def test_the_goals_not_reached_are_counted_by_the_kind_of_their_reason() -> None:
     """Two goals left out for the same kind of reason, each naming its own count, are one
     kind; a goal reached has no reason."""
@@ -157,3 +174,15 @@ def test_the_goals_not_reached_are_counted_by_the_kind_of_their_reason() -> None
         "every whole-body configuration found that reaches the goal is left out": 2,
         "time limit in turn": 1,
     }
+
+
+@pytest.mark.parametrize(
+    "file", sorted((ROOT / "studies/files").glob("*.yaml")), ids=lambda p: p.stem
+)
+def test_every_study_file_of_the_docs_is_a_study_whose_tables_its_runs_fill(file: Path) -> None:
+    """Each study file loads, and its tables name parameters, values and figures it has; each
+    page it writes into has the study's block."""
+    study = load_study(file)
+    check_tables(study)
+    for page in pages(study):
+        assert markers(study)[0] in (ROOT / page).read_text(), page
