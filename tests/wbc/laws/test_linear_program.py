@@ -320,3 +320,11 @@ def test_reset_forgets_the_basis_only() -> None:
     lp.reset()
     again = solve(lp, jacobian, rhs, rows)
     assert again.objective == pytest.approx(first.objective, abs=OBJECTIVE_TOL)
+
+
+def test_rows_of_another_width_than_u_are_refused_naming_it() -> None:
+    jacobian, rhs, rows = random_problem(3)
+    n = jacobian.shape[1]
+    narrow = LinearRows("narrow", np.ones((1, n - 1)), np.zeros(1), np.zeros(1))
+    with pytest.raises(ValueError, match=f"needs {n} columns, got one of \\(1, {n - 1}\\)"):
+        solve(WarmStartedLP(), jacobian, rhs, [*rows, narrow])
