@@ -88,6 +88,10 @@ class ZenohSettings(StrictModel):
     def router_config(self, namespace: str = "") -> zenoh.Config:
         """The config of the launcher's router session (its access rules act on ``namespace``)."""
         config = self._config("router", listen=self.router, connect=self.uplinks)
+        # Zenoh's open waits scouting/delay (0.5 s) for peers to find it before it returns; the
+        # router needs none to route, and the peers that connect to it say so by their
+        # liveliness tokens, which the launcher waits on.
+        config.insert_json5("scouting/delay", "0")
         if self.access is not None:
             insert(config, self.access.router_json(namespace))
         return config
