@@ -179,6 +179,14 @@ def test_speeds_after_lost_frames_are_taken_over_the_time_that_passed(
     assert 0.0 < after.forward_velocity <= 0.25, after.forward_velocity
 
 
+def dead(pid: int) -> bool:
+    """Whether process ``pid`` has ended (a zombie not yet reaped has)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(") ", 1)[1].startswith("Z")
+    except FileNotFoundError:
+        return True
+
+
 def test_a_killed_driver_comes_back_at_once_and_stops_the_wheels_first(
     tmp_path: Path, wait_until
 ) -> None:
@@ -201,6 +209,9 @@ def test_a_killed_driver_comes_back_at_once_and_stops_the_wheels_first(
         wait_until(create.drive, "Drive Direct 100 100 mm/s")
         pid = query.statuses(session, profile.namespace)["base_driver"].pid
         os.kill(pid, signal.SIGKILL)
+        wait_until(lambda: dead(pid), "the killed driver gone")
+        while create.link.read():  # what the killed driver wrote: its restart takes far longer
+            pass
         create.received.clear()
         wait_until(lambda: create.heard(STARTED), "the restarted driver's start", timeout_s=30.0)
         first_move = create.received.find(create_oi.drive_direct(100, 100))
