@@ -10,6 +10,8 @@ A servo of a chain (``AXServo``, ``XServo``) has an ``id``, ``silent``, ``corrup
 
 from __future__ import annotations
 
+import threading
+import time
 from collections import Counter
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -125,6 +127,19 @@ class ServoChain(SerialDevice):
         """Fault injection (see the servo's ``fail``)."""
         with self._lock:
             self._named(servo_id).fail(silent)
+
+    def stall(self, seconds: float) -> None:
+        """Fault injection: no packet carried out for ``seconds`` from now, as when a busy
+        machine starves the chain's thread (its answers come late); returns at once."""
+        begun = threading.Event()
+
+        def hold() -> None:
+            with self._lock:
+                begun.set()
+                time.sleep(seconds)
+
+        threading.Thread(target=hold, name="servo-stall", daemon=True).start()
+        begun.wait()
 
     def recover(self, servo_id: int) -> None:
         """A silent servo answers again, its torque off as after a brown-out."""

@@ -8,10 +8,11 @@ from collections.abc import Iterator
 
 import pytest
 
-from components.servo_bus import XBus, open_port
+from components.servo_bus import BUSES, XBus, open_port
 from protocols import dynamixel_v2 as dxl
 from protocols import x_series_units as x_units
 from protocols.dynamixel_v2 import Address, OperatingMode
+from sim2d.devices.ax_servos import AXChainEmulator
 from sim2d.devices.servo_chain import ANSWER_TIMEOUT_S, IntegratingJoints
 from sim2d.devices.x_servos import XChainEmulator
 
@@ -53,3 +54,27 @@ def test_a_sync_read_gives_every_reading_or_none(chain) -> None:
     emulator.fail(2)
     assert bus.read_all((1, 2, 3)) is None  # read one at a time, to name servo 2's fault
     assert bus.read(3)[1] is None
+
+
+LATE_S = 0.1
+"""How late the stalled chain answers: more than the SDK's own timeout (34 ms), far less than
+the bus's answer timeout."""
+
+
+@pytest.mark.parametrize("protocol", [1, 2])
+def test_a_late_answer_is_an_answer_on_every_exchange(protocol: int) -> None:
+    """A chain starved past the SDK's packet timeout answers a torque enable (the SDK's own
+    exchange) and a read late: each is an answer, for the bus awaits its answer timeout
+    whichever call asks. (Before, a torque enable kept the SDK's 34 ms and came back None.)"""
+    chain_type = {1: AXChainEmulator, 2: XChainEmulator}[protocol]
+    with chain_type(IntegratingJoints(START)) as emulator:
+        bus = BUSES[protocol](emulator.port, ANSWER_TIMEOUT_S)
+        assert open_port(bus.port, 1_000_000)
+        emulator.stall(LATE_S)
+        assert bus.enable_torque(2) == 0
+        emulator.stall(LATE_S)
+        assert bus.read(3)[1] is None
+        if protocol == 2:
+            emulator.stall(LATE_S)
+            assert bus.read_all((1, 2, 3)) is not None
+        bus.port.closePort()
