@@ -24,7 +24,7 @@ from launch.doctor_devices import Check, Joint, create_check, servo_checks
 from launch.graph import component_class
 from profiles.profile import ComponentSpec, Profile
 from protocols import dynamixel_v1 as dxl1
-from protocols import dynamixel_v2 as dxl2
+from protocols import x_series_units as dxl2
 from vision.camera_file import read_camera_file
 from vision.frame_source import FrameSourceError, ask_size, open_capture
 from vision.markers import MarkerDetector
