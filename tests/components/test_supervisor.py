@@ -70,7 +70,8 @@ class Operator:
         fields = {"header": header().model_dump(), "task": "pose", **fields}
         self.request.put(msgpack.packb([codec.FORMAT_TAG, "Goal", fields], use_bin_type=True))
 
-    def send_state(self, q: np.ndarray, valid: bool = True, age_s: float = 0.0) -> None:
+    def send_state(self, q: np.ndarray, valid: bool = True, age_s: float = 0.0) -> int:
+        """A state at q; its stamp, which the supervisor's status answering it carries."""
         header = Header(stamp_ns=time.time_ns(), frame="world", seq=0, source="test")
         x = tuple(self.robot.fkm(q))
         state = RobotState(
@@ -82,6 +83,7 @@ class Operator:
             age_s=age_s,
         )
         self.state.put(codec.encode(state))
+        return header.stamp_ns
 
     def send_goal(self, goal: Goal) -> None:
         self.request.put(codec.encode(goal))
