@@ -39,10 +39,12 @@ $(CLIENT_STAMP): $(FOXGLOVE_CLIENT)/package.json $(FOXGLOVE_CLIENT)/package-lock
 
 foxglove-client: $(CLIENT_STAMP)
 
+# Three test workers on CI's two cores: many tests wait on a real-time run or a child process,
+# and a third worker fills those waits (one core kept busy: 464 s with two, 396 s with three).
 test: $(STAMP) $(CLIENT_STAMP)
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
-	$(VENV)/bin/python -m pytest -q -n 2 --dist loadfile --durations=20
+	$(VENV)/bin/python -m pytest -q -n 3 --dist loadfile --durations=20
 
 # The documentation site (docs/, mkdocs.yml) into site/, strict: a broken link or a missing page
 # fails. make test builds it too (tests/test_docs.py). The banners about MkDocs' future are muted.
