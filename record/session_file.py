@@ -85,10 +85,10 @@ def to_json(message: BaseModel, left_out: str = "") -> bytes:
     ``model_dump`` nor scanned by ``json.dumps``: a marker holds its place, then gives it to
     the base64 text, which needs no escaping.
     """
-    names = [name for name in bytes_fields(type(message)) if name != left_out]
-    if not names and _bytes_free(type(message), left_out):  # and every float finite (messages)
+    if _bytes_free(type(message), left_out):  # no bytes field either; every float finite
         exclude = {left_out} if left_out else None
         return type(message).__pydantic_serializer__.to_json(message, exclude=exclude)
+    names = [name for name in bytes_fields(type(message)) if name != left_out]
     dumped = message.model_dump(exclude={*bytes_fields(type(message)), left_out})
     fields = {
         name: BYTES_MARKER if name in names else dumped[name]

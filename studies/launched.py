@@ -53,14 +53,10 @@ def connect(profile: Profile, launcher: subprocess.Popen) -> zenoh.Session:
         try:
             return query.Target(profile.namespace, profile.zenoh).open()
         except query.QueryError:
-            if launcher.poll() is not None:  # it refused the profile, or failed at once
-                raise RuntimeError(
-                    f"the launch stopped (exit {launcher.returncode}); see its log"
-                ) from None
-            if time.monotonic() > deadline:
+            if launcher.poll() is None and time.monotonic() > deadline:
                 raise
-
-            time.sleep(POLL_S)  # the launcher opens its router first thing
+        running(launcher)  # it refused the profile, or failed at once
+        time.sleep(POLL_S)  # the launcher opens its router first thing
 
 
 def wait_alive(session: zenoh.Session, profile: Profile, launcher: subprocess.Popen) -> None:
@@ -94,8 +90,13 @@ def wait_launch(launcher: subprocess.Popen, missing: Callable[[], list[str]], wh
     them, when the launch stops or after ``STARTUP_S``."""
     deadline = time.monotonic() + STARTUP_S
     while waiting := missing():
-        if launcher.poll() is not None:
-            raise RuntimeError(f"the launch stopped (exit {launcher.returncode}); see its log")
+        running(launcher)
         if time.monotonic() > deadline:
             raise RuntimeError(f"{', '.join(waiting)} {what} in {STARTUP_S:.0f} s")
         time.sleep(POLL_S)  # polling the router (liveliness tokens, the components' counters)
+
+
+def running(launcher: subprocess.Popen) -> None:
+    """RuntimeError, with its exit code, when the launch has stopped."""
+    if launcher.poll() is not None:
+        raise RuntimeError(f"the launch stopped (exit {launcher.returncode}); see its log")
