@@ -40,7 +40,8 @@ $(CLIENT_STAMP): $(FOXGLOVE_CLIENT)/package.json $(FOXGLOVE_CLIENT)/package-lock
 foxglove-client: $(CLIENT_STAMP)
 
 # Three test workers on CI's two cores: many tests wait on a real-time run or a child process,
-# and a third worker fills those waits (one core kept busy: 464 s with two, 396 s with three).
+# which a third worker may fill (one core kept busy, pytest's seconds: 464 with two workers;
+# 396, 457 and 489 with three: not clearly faster, the spread larger than the gain).
 test: $(STAMP) $(CLIENT_STAMP)
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
