@@ -18,6 +18,7 @@ import msgpack
 import numpy as np
 import pytest
 import yaml
+import zenoh
 
 from components.lp_controller import LPController
 from components.runtime import Node
@@ -65,8 +66,11 @@ class Operator:
         session = system.router
         self.namespace = namespace
         self.state_key = topics.ROBOT_STATE.key(namespace)
-        self.state = session.declare_publisher(self.state_key)
-        self.goal = session.declare_publisher(topics.CONTROL_GOAL.key(namespace))
+        block = zenoh.CongestionControl.BLOCK  # the tests count every message: none dropped
+        self.state = session.declare_publisher(self.state_key, congestion_control=block)
+        self.goal = session.declare_publisher(
+            topics.CONTROL_GOAL.key(namespace), congestion_control=block
+        )
         self.base = system.inbox(topics.BASE_COMMAND)
         self.arm = system.inbox(topics.ARM_COMMAND)
         self.diagnostics = system.inbox(topics.CONTROL_DIAGNOSTICS)
@@ -493,8 +497,9 @@ def test_a_flood_of_huge_obstacle_messages_never_silences_the_controller(
     from messages.obstacles import Circle as CircleMessage
     from messages.obstacles import Obstacles
 
-    obstacles = operator.system.router.declare_publisher(
-        topics.WORLD_OBSTACLES.key(operator.namespace)
+    obstacles = operator.system.router.declare_publisher(  # every message arrives: none dropped
+        topics.WORLD_OBSTACLES.key(operator.namespace),
+        congestion_control=zenoh.CongestionControl.BLOCK,
     )
     header = Header(stamp_ns=operator.stamp(), frame="world", seq=0, source="test")
     circles = (CircleMessage(x=1.0, y=0.0, radius=0.1),) * 100_000
