@@ -41,11 +41,14 @@ foxglove-client: $(CLIENT_STAMP)
 
 # Three test workers on CI's two cores: many tests wait on a real-time run or a child process,
 # which a third worker may fill (one core kept busy, pytest's seconds: 464 with two workers;
-# 396, 457 and 489 with three: not clearly faster, the spread larger than the gain).
+# 396, 457 and 489 with three: not clearly faster, the spread larger than the gain). Files go
+# out in the order tests/conftest.py sorts them (the heavy ones first): pytest-xdist's own order
+# (most tests first) handed out the one-test files last, the README's first hour among them,
+# which then ran alone for the last minute and a half.
 test: $(STAMP) $(CLIENT_STAMP)
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
-	$(VENV)/bin/python -m pytest -q -n 3 --dist loadfile --durations=20
+	$(VENV)/bin/python -m pytest -q -n 3 --dist loadfile --no-loadscope-reorder --durations=20
 
 # The documentation site (docs/, mkdocs.yml) into site/, strict: a broken link or a missing page
 # fails. make test builds it too (tests/test_docs.py). The banners about MkDocs' future are muted.
