@@ -48,6 +48,9 @@ from wbc.laws.objectives.base import Cost, ResidualCost, VelocityCost
 
 Array = np.ndarray
 ACTIVE_TOLERANCE = 1e-7
+FAR_MARGIN, FAR_LIMIT = 1e-6, 1e6
+"""|u_i| + FAR_MARGIN below every velocity bound's magnitude, |u_i| under FAR_LIMIT: each u_i is
+further than 2 ACTIVE_TOLERANCE from its bounds, whatever the rounding of that sum."""
 SOLVER_OPTIONS = {
     "output_flag": False,
     "solver": "simplex",
@@ -112,11 +115,14 @@ class WarmStartedLP:
             layout = self._layout_for(matrices, len(residuals), len(norms))
         u_lower, u_upper = layout.u_lower, layout.u_upper
         # Each bound's entries as Python floats, for the test below and the active set.
-        limits = [(bound.name, bound.lower.tolist(), bound.upper.tolist()) for bound in bounds]
         if len(bounds) == 1:
-            u_lower[...], u_upper[...] = bounds[0].lower, bounds[0].upper
-            infeasible = any(map(operator.gt, limits[0][1], limits[0][2]))
+            (bound,) = bounds
+            lows, highs = bound.lower.tolist(), bound.upper.tolist()
+            limits = [(bound.name, lows, highs)]
+            u_lower[...], u_upper[...] = bound.lower, bound.upper
+            infeasible = any(map(operator.gt, lows, highs))
         else:
+            limits = [(bound.name, bound.lower.tolist(), bound.upper.tolist()) for bound in bounds]
             u_lower.fill(-INF)
             u_upper.fill(INF)
             for bound in bounds:
@@ -133,7 +139,7 @@ class WarmStartedLP:
         residual_upper = layout.residual_upper
         for block, offset in zip(layout.offset_blocks, map(_OFFSET, residuals), strict=True):
             block[...] = offset
-        np.negative(residual_upper, out=residual_upper)
+        np.negative(residual_upper, residual_upper)  # out given by place: less parsing
         if len(layout.filled) == 1:
             only = linear[layout.filled[0]]
             layout.linear_lower[...], layout.linear_upper[...] = only.lower, only.upper
@@ -147,9 +153,9 @@ class WarmStartedLP:
         # by w), c_P and c_N the velocity costs of each entry's two directions; y_b's 2 w_b are
         # set with the weights (``Layout.weigh``).
         positive, negative = self._velocity_costs(kinds.velocity(items), n)
-        column_sums = layout.row_weight.dot(layout.residual_plus)
-        np.subtract(positive, column_sums, out=layout.cost_positive)
-        np.add(negative, column_sums, out=layout.cost_negative)
+        column_sums = layout.row_weight.dot(layout.residual_stack)
+        np.subtract(positive, column_sums, layout.cost_positive)
+        np.add(negative, column_sums, layout.cost_negative)
         status, values = self._vertex(layout)
         if values is None:
             return _failed(n, status)
@@ -315,22 +321,29 @@ def _active(
     (named ``name[i]``) when u_i sits on a finite, non-degenerate bound. ``values`` and
     ``magnitudes`` are u_i and |u_i| as Python floats.
     """
-    active = [
-        rows.name
-        for rows in linear
-        if rows.engaged and (rows.lower is rows.upper or _tight(rows, u))
-    ]
+    # Loops, not comprehensions: a comprehension is a call of its own (Python 3.11), dearer than
+    # the loop over these few rows.
+    active = []
+    for rows in linear:
+        if rows.engaged and (rows.lower is rows.upper or _tight(rows, u)):
+            active.append(rows.name)
     if norms:
         split_sum = sum(magnitudes)  # 1'(u_P + u_N), the halves split canonically
-        active += [bound.name for bound in norms if split_sum >= bound.limit - ACTIVE_TOLERANCE]
+        for bound in norms:
+            if split_sum >= bound.limit - ACTIVE_TOLERANCE:
+                active.append(bound.name)
+    largest = max(magnitudes) if limits else 0.0
     for name, lows, highs in limits:
         # An infinite bound is never within the tolerance of u; a degenerate one never counts.
         # On Python floats: the same IEEE arithmetic, and at 8 to 40 entries faster than NumPy.
-        if (
+        # No entry near either bound (most steps): none to name. First by |u| against the
+        # bounds nearest 0 (every u_i - lower_i and upper_i - u_i is then above twice the
+        # tolerance), then entry by entry.
+        if (largest < FAR_LIMIT and largest + FAR_MARGIN < min(-max(lows), min(highs))) or (
             min(map(operator.sub, values, lows)) > ACTIVE_TOLERANCE
             and min(map(operator.sub, highs, values)) > ACTIVE_TOLERANCE
         ):
-            continue  # no entry near either bound (most steps): none to name
+            continue
         active += [
             label
             for label, x, low, high in zip(

@@ -87,8 +87,9 @@ class Layout:
         ends = np.cumsum([0, *(counts[i] for i in filled)]).tolist()
         self.blocks = [self.stack[a:b] for a, b in zip(ends, ends[1:], strict=False)]
         """The rows of ``stack`` each of them fills."""
-        self.residual_plus = self.plus[:residual_total]
-        """A_b of every residual cost, stacked (rows of ``plus``)."""
+        self.residual_stack = self.stack[:residual_total]
+        """A_b of every residual cost, stacked: the first rows of ``stack`` (contiguous, as BLAS
+        reads them without the strides of ``plus``; the same values)."""
         self.residual_upper = self.upper[static : static + residual_total]
         self.linear_lower = self.lower[static + residual_total :]
         self.linear_upper = self.upper[static + residual_total :]
@@ -103,7 +104,7 @@ class Layout:
         for block, matrix in zip(self.blocks, self.nonempty(matrices), strict=True):
             block[...] = matrix
         self.plus[...] = stack
-        np.negative(stack, out=self._negated)
+        np.negative(stack, self._negated)  # out given by place: less of NumPy's argument parsing
         self.minus[...] = self._negated
 
     def weigh(self, weights: list[float]) -> None:
