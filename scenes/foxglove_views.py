@@ -48,7 +48,6 @@ from dataclasses import dataclass
 from typing import Any
 
 from foxglove import messages as fox
-from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
 
 from messages import topics
 from messages.camera import CHANNELS, COMPRESSED, CameraFrame
@@ -154,7 +153,10 @@ CARRIERS = (fox.CompressedImage, fox.RawImage)
 
 @functools.cache
 def _protobuf_type(schema_name: str) -> type:
-    """A carrier's protobuf class, built from the schema foxglove-sdk writes for it."""
+    """A carrier's protobuf class, built from the schema foxglove-sdk writes for it (protobuf
+    imported here: only a reader of images needs it, not the recorder)."""
+    from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
+
     schemas = {carrier.get_schema().name: carrier.get_schema() for carrier in CARRIERS}
     if schema_name not in schemas:
         raise ValueError(f"a {schema_name} carries no field of a project message")
