@@ -43,6 +43,7 @@ import numpy as np
 
 from wbc.laws.basis_reuse import KeptBasis, lapack
 from wbc.laws.constraints.base import LinearRows, OneNormBound, Rows, VelocityBounds
+from wbc.laws.kept import KEPT
 from wbc.laws.lp_layout import INF, Layout, picker
 from wbc.laws.objectives.base import Cost, ResidualCost, VelocityCost
 
@@ -135,14 +136,13 @@ class WarmStartedLP:
             layout.upper[row] = bound.limit
 
         # The varying rows: [A_b -A_b -I_b] of every residual cost, then [A -A 0] of the rows.
-        layout.fill(matrices)
-        residual_upper = layout.residual_upper
-        for block, offset in zip(layout.offset_blocks, map(_OFFSET, residuals), strict=True):
-            block[...] = offset
-        np.negative(residual_upper, residual_upper)  # out given by place: less parsing
+        layout.fill(matrices, map(_OFFSET, residuals))
         if len(layout.filled) == 1:
-            only = linear[layout.filled[0]]
-            layout.linear_lower[...], layout.linear_upper[...] = only.lower, only.upper
+            only, kept = linear[layout.filled[0]], layout.linear_sources
+            if only.lower is not kept[0] or id(only.lower) not in KEPT:
+                layout.linear_lower[...] = kept[0] = only.lower
+            if only.upper is not kept[1] or id(only.upper) not in KEPT:
+                layout.linear_upper[...] = kept[1] = only.upper
         elif layout.filled:
             np.concatenate([linear[i].lower for i in layout.filled], out=layout.linear_lower)
             np.concatenate([linear[i].upper for i in layout.filled], out=layout.linear_upper)
@@ -167,6 +167,7 @@ class WarmStartedLP:
         # Less the constant -sum_b w_b 1'b_b (the residual rows' upper bounds hold -b): plus
         # sum_b w_b 1'(-b_b), the same IEEE sum. ndarray.dot: the same BLAS sums as @, in about
         # half the time for vectors this short.
+        residual_upper = layout.residual_upper
         objective = float(layout.cost.dot(values)) + float(layout.row_weight.dot(residual_upper))
         values = u.tolist()
         magnitudes = list(map(abs, values))

@@ -7,10 +7,12 @@ A step of ``wbc.laws.linear_program.WarmStartedLP`` writes its data into views o
 from __future__ import annotations
 
 import operator
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 
 import highspy
 import numpy as np
+
+from wbc.laws.kept import KEPT
 
 Array = np.ndarray
 INF = highspy.kHighsInf
@@ -87,6 +89,12 @@ class Layout:
         ends = np.cumsum([0, *(counts[i] for i in filled)]).tolist()
         self.blocks = [self.stack[a:b] for a, b in zip(ends, ends[1:], strict=False)]
         """The rows of ``stack`` each of them fills."""
+        self._sources: list[Array | None] = [None] * len(self.blocks)
+        self._offset_sources: list[Array | None] = [None] * residual_count
+        """The matrix each block and the offset each residual cost's rows were last filled from."""
+        self.linear_sources: list[Array | None] = [None, None]
+        """The lower and upper bounds of the linear rows were last set from, when one set fills
+        them."""
         self.residual_stack = self.stack[:residual_total]
         """A_b of every residual cost, stacked: the first rows of ``stack`` (contiguous, as BLAS
         reads them without the strides of ``plus``; the same values)."""
@@ -97,12 +105,20 @@ class Layout:
         self.filled = [i for i, count in enumerate(counts[residual_count:]) if count]
         """The linear row sets that hold rows (by their place among the linear ones)."""
 
-    def fill(self, matrices: Sequence[Array]) -> None:
+    def fill(self, matrices: Sequence[Array], offsets: Iterable[Array]) -> None:
         """The varying rows' [A -A] from the step's ``matrices`` (each residual cost's, then
-        each linear rows')."""
-        stack = self.stack
-        for block, matrix in zip(self.blocks, self.nonempty(matrices), strict=True):
-            block[...] = matrix
+        each linear rows') and the residual rows' upper bounds -b from the residual costs'
+        ``offsets``. A kept array (``wbc.laws.kept``) found where it was at the last step is
+        in the buffers already: it is not copied again."""
+        stack, sources, blocks = self.stack, self._sources, self.blocks
+        for place, matrix in enumerate(self.nonempty(matrices)):
+            if matrix is not sources[place] or id(matrix) not in KEPT:
+                blocks[place][...] = sources[place] = matrix
+        sources, blocks = self._offset_sources, self.offset_blocks
+        for place, offset in enumerate(offsets):
+            if offset is not sources[place] or id(offset) not in KEPT:
+                np.negative(offset, blocks[place])
+                sources[place] = offset
         self.plus[...] = stack
         np.negative(stack, self._negated)  # out given by place: less of NumPy's argument parsing
         self.minus[...] = self._negated

@@ -15,6 +15,7 @@ from typing import NamedTuple, Protocol
 
 import numpy as np
 
+from wbc.laws.kept import zeros
 from wbc.laws.step_context import StepContext
 
 Array = np.ndarray
@@ -33,9 +34,7 @@ class LinearRows(NamedTuple):
 @functools.cache
 def no_rows(name: str, dof: int) -> LinearRows:
     """No row (switched off), for u of ``dof`` entries: one read-only value per name and size."""
-    matrix, bounds = np.zeros((0, dof)), np.zeros(0)
-    matrix.flags.writeable = bounds.flags.writeable = False
-    return LinearRows(name, matrix, bounds, bounds, engaged=False)
+    return LinearRows(name, zeros(0, dof), zeros(0), zeros(0), engaged=False)
 
 
 class VelocityBounds(NamedTuple):

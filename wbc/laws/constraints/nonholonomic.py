@@ -11,6 +11,7 @@ import numpy as np
 
 from wbc.laws.constraints.base import LinearRows
 from wbc.laws.gains import gain
+from wbc.laws.kept import zeros
 from wbc.laws.step_context import StepContext
 
 
@@ -39,5 +40,5 @@ class Nonholonomic:
         phi = float(context.q[2])
         row = np.zeros((1, context.robot.dof))
         row[0, 0], row[0, 1] = math.sin(phi), -math.cos(phi)
-        zero = np.zeros(1)
+        zero = zeros(1)  # kept (wbc.laws.kept): the LP's buffers hold it from the last step
         return LinearRows(self.name, row, zero, zero)

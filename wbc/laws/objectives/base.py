@@ -17,6 +17,7 @@ from typing import NamedTuple, Protocol
 
 import numpy as np
 
+from wbc.laws.kept import kept, zeros
 from wbc.laws.step_context import StepContext
 
 Array = np.ndarray
@@ -36,17 +37,14 @@ def unit_row(dof: int, column: int) -> Array:
     """The read-only row (1, dof) that picks entry ``column`` of u."""
     row = np.zeros((1, dof))
     row[0, column] = 1.0
-    row.flags.writeable = False
-    return row
+    return kept(row)
 
 
 @functools.cache
 def no_cost(name: str, dof: int) -> ResidualCost:
     """A term that asks nothing (weight 0) of u of ``dof`` entries, holding its place among
     the rows: one read-only value per name and size."""
-    matrix, offset = np.zeros((1, dof)), np.zeros(1)
-    matrix.flags.writeable = offset.flags.writeable = False
-    return ResidualCost(name, matrix, offset, 0.0)
+    return ResidualCost(name, zeros(1, dof), zeros(1), 0.0)
 
 
 class VelocityCost(NamedTuple):

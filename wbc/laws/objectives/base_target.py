@@ -41,6 +41,7 @@ import numpy as np
 
 from wbc import dq
 from wbc.laws.gains import gain
+from wbc.laws.kept import zeros
 from wbc.laws.objectives.base import Latch, ResidualCost, unit_row
 from wbc.laws.step_context import StepContext
 from wbc.planar import wrap
@@ -189,7 +190,7 @@ class BaseTarget:
     def cost(self, context: StepContext) -> ResidualCost:
         row = unit_row(context.robot.dof, 2)
         if context.goal_pose is None:
-            return ResidualCost(self.name, row, np.zeros(1), 0.0)
+            return ResidualCost(self.name, row, zeros(1), 0.0)
         x, y, phi = context.q[:3].tolist()
         target_x, target_y = self.target(context.goal_pose)
         distance = math.hypot(target_x - x, target_y - y)
@@ -200,7 +201,7 @@ class BaseTarget:
         if not steering:
             if self.latch is not None:
                 self.latch.engaged = False
-            return ResidualCost(self.name, row, np.zeros(1), 0.0)
+            return ResidualCost(self.name, row, zeros(1), 0.0)
         return ResidualCost(self.name, row, np.array([-self.gain * turn]), self.weight * ramp)
 
     def reset(self) -> None:
