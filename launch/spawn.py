@@ -8,6 +8,7 @@ import threading
 from pathlib import Path
 
 from components import container
+from launch.forked import Forked, forked, single_threaded
 from launch.output import Output
 from messages import process
 from messages.process import PARENT_PID_ENV, RUNTIME_DIR_ENV
@@ -21,12 +22,15 @@ def spawn(
     pass_fds: tuple[int, ...],
     output: Output,
     ahead: bool = False,
-) -> subprocess.Popen[str]:
+) -> subprocess.Popen[str] | Forked:
     """The process of ``group`` (one component, or shared ones: ``components.container``,
     waiting for a word on its input when ``ahead``) and the threads forwarding its output.
 
     Its parameters set at run time are kept under ``kept_params``; it inherits ``pass_fds``
-    and runs in its own session, stopping by itself when the launcher is gone."""
+    and runs in its own session, stopping by itself when the launcher is gone. A launcher of
+    one thread (forked for a study's run, before its router opens: the process started ahead)
+    forks it (``launch.forked``): the component modules its dataflow check loaded are loaded
+    in it too."""
     names = [spec.name for spec in group]
     env = dict(
         os.environ,
@@ -38,17 +42,19 @@ def spawn(
     else:
         spec = group[0]
         command = process.command(spec.module_path, profile_path, spec.name)
-    popen = subprocess.Popen(
-        command,
-        stdin=subprocess.PIPE if ahead else subprocess.DEVNULL,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        env=env,
-        text=True,
-        errors="replace",
-        start_new_session=True,
-        pass_fds=pass_fds,
-    )
+    how = {
+        "stdin": subprocess.PIPE if ahead else subprocess.DEVNULL,
+        "stdout": subprocess.PIPE,
+        "stderr": subprocess.PIPE,
+        "env": env,
+        "start_new_session": True,
+        "pass_fds": pass_fds,
+    }
+    popen: subprocess.Popen[str] | Forked
+    if single_threaded():
+        popen = forked(command[2:], **how)  # [sys.executable, "-m", module, args...]
+    else:
+        popen = subprocess.Popen(command, text=True, errors="replace", **how)
     prefix = "+".join(names)
     for pipe, stream in ((popen.stdout, output.out), (popen.stderr, output.err)):
         threading.Thread(target=output.forward, args=(pipe, stream, prefix), daemon=True).start()

@@ -30,6 +30,11 @@ from typing import Any
 import yaml
 import zenoh
 
+import components.recorder  # noqa: F401 - loaded with this module, see below
+import components.simulator  # noqa: F401
+import components.state_estimator  # noqa: F401
+import components.supervisor  # noqa: F401
+import components.vision_tracker  # noqa: F401
 from analysis.commands import commands_csv
 from analysis.judge import JUDGED, judge, recording_check
 from analysis.report import write_report
@@ -57,6 +62,9 @@ from wbc.laws.lp_law import LPParams
 from wbc.planar import inverse
 from wbc.robot import MobileManipulator
 
+# The components of the experiments' profiles are imported with this module (above): a study's
+# worker loads them once, and the launcher forked for each of its runs (studies.launched)
+# checks their dataflow on them and forks their shared process with them (launch.forked).
 PROFILES = {
     "lp": DEPLOY / "sim.yaml",
     "cascade": DEPLOY / "sim_cascade.yaml",

@@ -3,24 +3,18 @@ session to its router, and the waits until its components are alive and reached 
 simulator's clock.
 
 A process with a single thread (a study's run, forked from its worker with the modules loaded)
-forks its launcher instead of starting a new interpreter: the child runs ``parsimony.cli`` as
-``python -m`` would, on the modules already imported, which saves the interpreter's start and
-imports (about half a second of CPU a run). Any other process (more threads: a fork would
-copy the state of a Zenoh runtime or a lock without the threads that own it) starts it as a
-new interpreter.
+forks its launcher instead of starting a new interpreter (``launch.forked``); any other starts
+``python -m parsimony.cli launch`` as a new interpreter.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
-import runpy
-import select
 import signal
 import subprocess
 import sys
 import time
-import traceback
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO
@@ -28,6 +22,7 @@ from typing import IO
 import zenoh
 
 from launch import query
+from launch.forked import Forked, forked, single_threaded
 from messages import process
 from profiles.profile import Profile
 
@@ -46,98 +41,18 @@ def launched(
     the block it is stopped by SIGINT (its components in order), killed after
     ``stop_timeout_s`` (None: the launcher's own limits, a recorder's progress, decide)."""
     command = ["parsimony.cli", "launch", str(profile_path)]
+    env = {**os.environ, process.PARENT_PID_ENV: str(os.getpid())}  # it stops if we die
     launcher: Launcher
-    if len(os.listdir("/proc/self/task")) == 1:
-        launcher = forked(command, log)
+    if single_threaded():  # a study's run: forked from its worker, the modules loaded
+        launcher = forked(command, stdout=log, stderr=subprocess.STDOUT, env=env)
     else:
         launcher = subprocess.Popen(
-            [sys.executable, "-m", *command],
-            stdout=log,
-            stderr=subprocess.STDOUT,
-            env={**os.environ, process.PARENT_PID_ENV: str(os.getpid())},  # it stops if we die
+            [sys.executable, "-m", *command], stdout=log, stderr=subprocess.STDOUT, env=env
         )
     try:
         yield launcher
     finally:
         process.stop(launcher, signal.SIGINT, stop_timeout_s)
-
-
-class Forked:
-    """A child forked by ``forked``, seen as the ``subprocess.Popen`` of a launcher is."""
-
-    def __init__(self, pid: int, args: list[str]) -> None:
-        self.pid, self.args = pid, args
-        self.returncode: int | None = None
-
-    def poll(self) -> int | None:
-        if self.returncode is None:
-            pid, status = os.waitpid(self.pid, os.WNOHANG)
-            if pid:
-                self.returncode = os.waitstatus_to_exitcode(status)
-        return self.returncode
-
-    def wait(self, timeout: float | None = None) -> int:
-        """Its exit code, once it ends (``subprocess.TimeoutExpired`` after ``timeout``)."""
-        if self.poll() is None and timeout is not None:
-            pidfd = os.pidfd_open(self.pid)
-            try:
-                if not select.select([pidfd], [], [], timeout)[0]:
-                    raise subprocess.TimeoutExpired(self.args, timeout)
-            finally:
-                os.close(pidfd)
-        if self.returncode is None:
-            self.returncode = os.waitstatus_to_exitcode(os.waitpid(self.pid, 0)[1])
-        return self.returncode
-
-    def send_signal(self, signum: int) -> None:
-        if self.poll() is None:
-            os.kill(self.pid, signum)
-
-    def kill(self) -> None:
-        self.send_signal(signal.SIGKILL)
-
-
-def forked(command: list[str], log: IO[str] | int) -> Forked:
-    """``python -m MODULE ARGS...`` (``command``) in a child forked from this process, its
-    output to ``log``, its standard input and environment this process's; it stops if we die
-    (``PARENT_PID_ENV``), and it holds no other file of ours."""
-    opened = isinstance(log, int) and log == subprocess.DEVNULL
-    if isinstance(log, int):
-        target = os.open(os.devnull, os.O_WRONLY) if opened else log
-    else:
-        log.flush()
-        target = log.fileno()
-    parent = os.getpid()
-    sys.stdout.flush()
-    sys.stderr.flush()
-    pid = os.fork()
-    if pid:
-        if opened:
-            os.close(target)
-        return Forked(pid, command)
-    code = 1
-    try:  # as a new interpreter starts: the default handlers, fresh streams, only 0, 1, 2 open
-        signal.signal(signal.SIGINT, signal.default_int_handler)
-        signal.signal(signal.SIGTERM, signal.SIG_DFL)
-        os.dup2(target, 1)
-        os.dup2(target, 2)
-        os.closerange(3, os.sysconf("SC_OPEN_MAX"))
-        sys.stdout = open(1, "w", closefd=False)  # the child's own, never closed
-        sys.stderr = open(2, "w", closefd=False)
-        os.environ[process.PARENT_PID_ENV] = str(parent)
-        sys.argv = ["-m", *command[1:]]
-        sys.modules.pop(command[0], None)  # run afresh as __main__, as ``-m`` runs it
-        runpy.run_module(command[0], run_name="__main__", alter_sys=True)
-        code = 0
-    except SystemExit as end:
-        code = end.code if isinstance(end.code, int) else (0 if end.code is None else 1)
-    except BaseException:  # noqa: BLE001 - said on its output, as an interpreter would
-        traceback.print_exc()
-    finally:
-        with contextlib.suppress(Exception):
-            sys.stdout.flush()
-            sys.stderr.flush()
-        os._exit(code)
 
 
 Launcher = subprocess.Popen | Forked

@@ -1,21 +1,18 @@
 """A launch from a study's run (studies/launched.py): a process with one thread forks its
-launcher, which runs, answers and stops as the one a new interpreter runs; a forked child
-keeps a Popen's poll, wait and signals."""
+launcher, which forks the shared process it starts ahead; both run, answer and stop as a new
+interpreter's do."""
 
 from __future__ import annotations
 
 import json
 import os
-import signal
 import subprocess
 import sys
 from pathlib import Path
 
-import pytest
 import yaml
 
 from profiles.endpoints import free_port
-from studies.launched import forked
 
 ONE_THREAD = """
 import json, os, sys
@@ -28,22 +25,29 @@ profile, out = Path(sys.argv[1]), Path(sys.argv[2])
 threads = len(os.listdir("/proc/self/task"))
 with (out / "launch.log").open("w") as log, launched(profile, log) as launcher:
     with connect(load_profile(profile), launcher) as session:
-        while "pub" not in live_components(session, "forked", 0.5):
+        while {"pub", "echo"} - set(live_components(session, "forked", 0.5)):
             assert launcher.poll() is None
+        task = f"/proc/{launcher.pid}/task/{launcher.pid}/children"
+        commands = [Path(f"/proc/{pid}/cmdline").read_bytes() for pid in open(task).read().split()]
     kind = type(launcher).__name__
+forked = [b"-m\\x00components.container" not in command for command in commands]
 code = launcher.returncode
-print(json.dumps({"threads": threads, "launcher": kind, "code": code, "pid": launcher.pid}))
+print(json.dumps({"threads": threads, "launcher": kind, "code": code, "forked": forked}))
 """
 """A run's launch in a process of one thread (OpenBLAS held to one): its launcher, started,
 answering and stopped."""
 
 
-def test_a_process_of_one_thread_forks_a_launcher_that_runs_and_stops(tmp_path: Path) -> None:
+def test_a_process_of_one_thread_forks_a_launcher_and_its_shared_process(tmp_path: Path) -> None:
+    """The launcher forked, and the shared process it starts ahead forked from it: both run,
+    answer and stop as a new interpreter's do."""
     profile = tmp_path / "system.yaml"
-    component = {"name": "pub", "module": "scripted_publisher", "role": "tool"}
+    components = [
+        {"name": name, "module": "scripted_publisher", "role": "tool"} for name in ("pub", "echo")
+    ]
     router = {"router": [f"tcp/127.0.0.1:{free_port()}"]}
-    system = {"namespace": "forked", "zenoh": router, "components": [component]}
-    profile.write_text(yaml.safe_dump(system))
+    system = {"namespace": "forked", "zenoh": router, "processes": "shared"}
+    profile.write_text(yaml.safe_dump(system | {"components": components}))
     done = subprocess.run(
         [sys.executable, "-c", ONE_THREAD, str(profile), str(tmp_path)],
         capture_output=True,
@@ -53,27 +57,8 @@ def test_a_process_of_one_thread_forks_a_launcher_that_runs_and_stops(tmp_path: 
     )
     assert done.returncode == 0, done.stderr
     found = json.loads(done.stdout)
-    assert found | {"pid": 0} == {"threads": 1, "launcher": "Forked", "code": 0, "pid": 0}
+    assert found == {"threads": 1, "launcher": "Forked", "code": 0, "forked": [True]}
     log = (tmp_path / "launch.log").read_text()
-    assert "[launch] router listening" in log
-    assert "pub alive" in log and "pub stopped (0)" in log
-
-
-def test_a_forked_child_runs_its_module_and_answers_as_a_popen(tmp_path: Path) -> None:
-    with (tmp_path / "out.log").open("w") as log:
-        child = forked(["platform"], log)
-        assert child.wait(60) == 0 and child.poll() == 0
-    assert (tmp_path / "out.log").read_text().startswith("Linux")
-    with (tmp_path / "error.log").open("w") as log:
-        assert forked(["no_such_module_here"], log).wait(60) == 1
-    assert "No module named no_such_module_here" in (tmp_path / "error.log").read_text()
-
-
-def test_a_forked_child_waited_for_too_briefly_is_stopped_by_a_signal() -> None:
-    child = forked(["timeit", "-n1", "-r1", "import time; time.sleep(60)"], subprocess.DEVNULL)
-    with pytest.raises(subprocess.TimeoutExpired):
-        child.wait(0.05)
-    assert child.poll() is None
-    child.send_signal(signal.SIGINT)  # Python's KeyboardInterrupt, as in a new interpreter
-    assert child.wait(60) != 0
-    child.kill()  # gone already: nothing to do
+    assert "[launch] router listening" in log and "pub, echo in one process" in log
+    assert "INFO pub running" in log and "INFO echo running" in log  # their own log lines
+    assert "pub stopped (0)" in log and "echo stopped (0)" in log

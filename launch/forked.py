@@ -1,0 +1,171 @@
+"""``python -m MODULE ARGS...`` in a child forked from this process, when this process has one
+thread: the child runs the module on the modules this process has imported, without an
+interpreter's start and imports (half a second of CPU for a component's process or a
+launcher's).
+
+A study's run is forked from its worker with the modules loaded; it forks its launcher
+(``studies.launched``), which forks the shared components' process it starts ahead, before its
+router opens (``launch.spawn``). A process of more threads starts a new interpreter instead
+(``single_threaded``): a fork copies the state of a Zenoh runtime or a held lock without the
+threads that own them. The child starts as a new interpreter does: Python's default SIGINT and
+SIGTERM handlers, fresh standard streams, no logging handler, only its standard descriptors and
+``pass_fds`` open, the environment given. ``Forked`` is seen as the ``subprocess.Popen`` of
+such a process is (``pid``, ``args``, ``returncode``, ``stdin``, ``stdout``, ``stderr``,
+``poll``, ``wait``, ``send_signal``, ``kill``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import runpy
+import select
+import signal
+import subprocess
+import sys
+import threading
+import traceback
+from collections.abc import Mapping
+from typing import IO
+
+
+def single_threaded() -> bool:
+    """Whether this process has one thread (Linux /proc): a fork copies all of it."""
+    return len(os.listdir("/proc/self/task")) == 1
+
+
+class Forked:
+    """A child forked by ``forked``, seen as a ``subprocess.Popen`` in text mode."""
+
+    def __init__(self, pid: int, args: list[str], pipes: dict[str, IO[str] | None]) -> None:
+        self.pid, self.args = pid, args
+        self.stdin, self.stdout, self.stderr = pipes["stdin"], pipes["stdout"], pipes["stderr"]
+        self.returncode: int | None = None
+        self._lock = threading.Lock()
+
+    def _reaped(self, flags: int) -> int | None:
+        with self._lock:
+            if self.returncode is None:
+                try:
+                    pid, status = os.waitpid(self.pid, flags)
+                except ChildProcessError:  # reaped elsewhere: its code is lost, as Popen says
+                    pid, status = self.pid, 0
+                if pid:
+                    self.returncode = os.waitstatus_to_exitcode(status)
+            return self.returncode
+
+    def poll(self) -> int | None:
+        return self._reaped(os.WNOHANG)
+
+    def wait(self, timeout: float | None = None) -> int:
+        """Its exit code, once it ends (``subprocess.TimeoutExpired`` after ``timeout``)."""
+        if self.poll() is None and timeout is not None:
+            pidfd = os.pidfd_open(self.pid)
+            try:
+                if not select.select([pidfd], [], [], timeout)[0]:
+                    raise subprocess.TimeoutExpired(self.args, timeout)
+            finally:
+                os.close(pidfd)
+        code = self._reaped(0)
+        assert code is not None
+        return code
+
+    def send_signal(self, signum: int) -> None:
+        if self.poll() is None:
+            os.kill(self.pid, signum)
+
+    def kill(self) -> None:
+        self.send_signal(signal.SIGKILL)
+
+
+def forked(
+    command: list[str],
+    stdin: int | None = None,
+    stdout: IO[str] | int | None = None,
+    stderr: IO[str] | int | None = None,
+    env: Mapping[str, str] | None = None,
+    start_new_session: bool = False,
+    pass_fds: tuple[int, ...] = (),
+) -> Forked:
+    """``command`` (``[MODULE, ARGS...]``) in a forked child: ``stdin``, ``stdout`` and
+    ``stderr`` as ``subprocess.Popen`` takes them (None: this process's; ``PIPE``,
+    ``DEVNULL``, ``STDOUT`` for ``stderr``, a file or a descriptor), ``env`` (None: this
+    process's), in a session of its own if ``start_new_session``."""
+    parent_ends: dict[str, IO[str] | None] = {"stdin": None, "stdout": None, "stderr": None}
+    child_fds: dict[int, int] = {}  # the child's standard descriptor -> where it comes from
+    closed_after: list[int] = []  # the parent's copies of what only the child keeps
+    for target, (name, given) in enumerate(
+        (("stdin", stdin), ("stdout", stdout), ("stderr", stderr))
+    ):
+        if given is None:
+            continue
+        if given == subprocess.STDOUT:
+            child_fds[target] = 1
+        elif given == subprocess.PIPE:
+            read, write = os.pipe()
+            mine, theirs = (write, read) if target == 0 else (read, write)
+            mode = "w" if target == 0 else "r"
+            parent_ends[name] = open(mine, mode, errors="replace")  # noqa: SIM115 - the caller's
+            child_fds[target] = theirs
+            closed_after.append(theirs)
+        elif given == subprocess.DEVNULL:
+            child_fds[target] = os.open(os.devnull, os.O_RDONLY if target == 0 else os.O_WRONLY)
+            closed_after.append(child_fds[target])
+        else:
+            if not isinstance(given, int):
+                given.flush()
+            child_fds[target] = given if isinstance(given, int) else given.fileno()
+    for stream in (sys.stdout, sys.stderr):
+        stream.flush()
+    pid = os.fork()
+    if pid == 0:
+        _child(command, child_fds, env, start_new_session, pass_fds)
+    for descriptor in closed_after:
+        os.close(descriptor)
+    return Forked(pid, command, parent_ends)
+
+
+def _child(
+    command: list[str],
+    child_fds: dict[int, int],
+    env: Mapping[str, str] | None,
+    start_new_session: bool,
+    pass_fds: tuple[int, ...],
+) -> None:
+    """Run ``command`` as a new interpreter would, then end with its exit code; never returns."""
+    code = 1
+    try:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        if start_new_session:
+            os.setsid()
+        for target in sorted(child_fds):
+            os.dup2(child_fds[target], target)
+        start = 3
+        for kept in sorted(set(pass_fds)):
+            os.closerange(start, kept)
+            start = kept + 1
+        os.closerange(start, os.sysconf("SC_OPEN_MAX"))
+        sys.stdin = open(0, closefd=False)  # noqa: SIM115 - the child's own, never closed
+        sys.stdout = open(1, "w", buffering=1, closefd=False)  # noqa: SIM115
+        sys.stderr = open(2, "w", buffering=1, closefd=False)  # noqa: SIM115
+        logging.root.handlers.clear()
+        logging.root.setLevel(logging.WARNING)
+        if env is not None:
+            os.environ.clear()
+            os.environ.update(env)
+        sys.argv = ["-m", *command[1:]]
+        sys.modules.pop(command[0], None)  # run afresh as __main__, as ``-m`` runs it
+        runpy.run_module(command[0], run_name="__main__", alter_sys=True)
+        code = 0
+    except SystemExit as end:
+        code = end.code if isinstance(end.code, int) else (0 if end.code is None else 1)
+    except BaseException:  # noqa: BLE001 - said on its output, as an interpreter would
+        traceback.print_exc()
+    finally:
+        with contextlib.suppress(Exception):
+            logging.shutdown()
+            sys.stdout.flush()
+            sys.stderr.flush()
+        os._exit(code)
