@@ -77,8 +77,11 @@ class KeptBasis:
         self._matrix[self.basic_rows, slack_columns] = -1.0
         self._basic_cost = np.zeros(rows)
 
-    def solution(self, matrix: Array, lower: Array, upper: Array, cost: Array) -> Array | None:
-        """The column values at this basis if it is optimal for the data given, else None."""
+    def solution(
+        self, matrix: Array, lower: Array, upper: Array, cost: Array, out: Array
+    ) -> Array | None:
+        """The column values at this basis, written into ``out``, if it is optimal for the data
+        given, else None (``out`` untouched)."""
         if not self.valid:
             return None
         basic, rows = self.basic_columns, self.basic_rows
@@ -113,6 +116,6 @@ class KeptBasis:
             or np.count_nonzero(np.abs(duals[self.free]) > DUAL_TOLERANCE)
         ):
             return None
-        solution = np.zeros(matrix.shape[1])
-        solution[basic] = np.maximum(basic_values, 0.0)
-        return solution
+        out.fill(0.0)
+        out[basic] = np.maximum(basic_values, 0.0)
+        return out

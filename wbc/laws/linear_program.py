@@ -152,7 +152,10 @@ class WarmStartedLP:
         # The costs of u_P: c_P - sum_b w_b 1'A_b, of u_N: c_N + sum_b w_b 1'A_b (rows weighted
         # by w), c_P and c_N the velocity costs of each entry's two directions; y_b's 2 w_b are
         # set with the weights (``Layout.weigh``).
-        positive, negative = self._velocity_costs(kinds.velocity(items), n)
+        velocity = kinds.velocity(items)
+        if (n, *map(id, velocity)) != self._cost_key:
+            self._sum_velocity_costs(velocity, n)
+        positive, negative = self._cost_sums
         column_sums = layout.row_weight.dot(layout.residual_stack)
         np.subtract(positive, column_sums, layout.cost_positive)
         np.add(negative, column_sums, layout.cost_negative)
@@ -163,7 +166,7 @@ class WarmStartedLP:
         # the one-norm row tight only through that waste (its dual 0). One degenerate pivot away
         # lies the same u with the halves split canonically (each less their minimum); their
         # difference is u_P - u_N bit for bit (IEEE rounding is symmetric, x - x is +0).
-        u = values[:n] - values[n : 2 * n]
+        u = layout.values_plus - layout.values_minus  # values is layout.values
         # Less the constant -sum_b w_b 1'b_b (the residual rows' upper bounds hold -b): plus
         # sum_b w_b 1'(-b_b), the same IEEE sum. ndarray.dot: the same BLAS sums as @, in about
         # half the time for vectors this short.
@@ -175,17 +178,15 @@ class WarmStartedLP:
         # The named tuple built by tuple.__new__: the same value, without its __new__'s frame.
         return tuple.__new__(LPSolution, (u, status, objective, active, magnitudes))
 
-    def _velocity_costs(self, costs: list[VelocityCost], n: int) -> tuple[Array, Array]:
-        """c_P and c_N, the sums of the velocity costs' weights, kept while the terms return the
-        same costs (the same objects, held here so that no other takes their ids) for u of n."""
-        key = (n, *map(id, costs))
-        if key != self._cost_key:
-            self._costs, self._cost_key = costs, key
-            self._cost_sums = (
-                sum((cost.weights for cost in costs), np.zeros(n)),
-                sum((cost.negative_weights for cost in costs), np.zeros(n)),
-            )
-        return self._cost_sums
+    def _sum_velocity_costs(self, costs: Sequence[VelocityCost], n: int) -> None:
+        """c_P and c_N, the sums of the velocity costs' weights (``_cost_sums``), kept while the
+        terms return the same costs (the same objects, held here so that no other takes their
+        ids; a step compares ``_cost_key``) for u of n."""
+        self._costs, self._cost_key = costs, (n, *map(id, costs))
+        self._cost_sums = (
+            sum((cost.weights for cost in costs), np.zeros(n)),
+            sum((cost.negative_weights for cost in costs), np.zeros(n)),
+        )
 
     def _layout_for(self, matrices: list[Array], residual_count: int, norm_rows: int) -> Layout:
         """The layout of this step's shape: the last one while the shape holds."""
@@ -238,7 +239,9 @@ class WarmStartedLP:
     def _vertex(self, layout: Layout) -> tuple[str, Array | None]:
         """The optimal vertex: from the kept basis if it is still optimal, else from HiGHS."""
         if self._basis is not None:
-            values = self._basis.solution(layout.matrix, layout.lower, layout.upper, layout.cost)
+            values = self._basis.solution(
+                layout.matrix, layout.lower, layout.upper, layout.cost, layout.values
+            )
             if values is not None:
                 return "optimal", values
         return self._run(layout)
@@ -272,7 +275,8 @@ class WarmStartedLP:
             self._basis = None
             return highs.modelStatusToString(model_status).lower(), None
         self._basis = KeptBasis(highs.getBasis())
-        return "optimal", np.asarray(highs.getSolution().col_value)
+        layout.values[...] = highs.getSolution().col_value
+        return "optimal", layout.values
 
 
 _MATRIX, _OFFSET, _WEIGHT, _SHAPE = map(

@@ -68,6 +68,9 @@ class Layout:
         self.lower = np.full(rows, -INF)
         self.upper = np.full(rows, INF)
         self.cost = np.zeros(self.columns)
+        self.values = np.zeros(self.columns)
+        """The vertex's column values, as the kept basis or HiGHS gives them at a step."""
+        self.values_plus, self.values_minus = self.values[:n], self.values[n : 2 * n]
         self.row_weight = np.zeros(residual_total)
         """w_b of the residual cost each residual row belongs to."""
         starts = np.cumsum([0, *residual_rows]).tolist()
