@@ -46,9 +46,10 @@ import zenoh
 
 from components import container
 from launch.child import Child
+from launch.forked import Forked, single_threaded
 from launch.output import Output
 from launch.query import statuses
-from launch.spawn import spawn
+from launch.spawn import forward, spawn
 from launch.stop import stop_all
 from messages import topics
 from messages.process import EXIT_CONFIG_ERROR, EXIT_FOR_GOOD, parent_gone
@@ -94,8 +95,9 @@ class Launcher:
         self._duration_s: float | None = None
         self._deadline: float | None = None
         """When the duration ends: set once every component is alive."""
-        self._ahead: tuple[list[str], subprocess.Popen[str]] | None = None
-        """The shared children's process started ahead, waiting for the word to start them."""
+        self._ahead: dict[tuple[str, ...], subprocess.Popen[str] | Forked] = {}
+        """The processes started ahead, by the names of their children, waiting for the word to
+        start them."""
         self._wake = threading.Event()
         """Set when the supervision loop has news before its next poll: a component came alive
         (those waiting for it start at once), a stop was asked."""
@@ -111,11 +113,12 @@ class Launcher:
         endpoints = ", ".join(self.profile.zenoh.router)
         self._duration_s = duration_s
         self._kept_params = Path(tempfile.mkdtemp(prefix="parsimony-params-"))
-        self._start_ahead()  # it loads its modules while the router opens
+        self._start_ahead()  # they load their modules while the router opens
         try:
             return self._run_router(endpoints)
         finally:
-            self._end_ahead(self._ahead)
+            for ahead in self._ahead.values():
+                self._end_ahead(ahead)
             shutil.rmtree(self._kept_params, ignore_errors=True)
 
     def _run_router(self, endpoints: str) -> int:
@@ -302,17 +305,17 @@ class Launcher:
     def _start(self, child: Child) -> None:
         """Start a child's process; a shared child's with the others of ``shared`` not running
         and not done (in the process started ahead for them, if it waits)."""
-        group, ahead = [child], None
+        group, key = [child], (child.spec.name,)
         if child in self.shared:  # the process started ahead is theirs alone
             group = [c for c in self.shared if c.process is None and not c.done]
-            ahead, self._ahead = self._ahead, None
+            key = tuple(c.spec.name for c in self.shared)
         names = [c.spec.name for c in group]
-        popen = None
-        if ahead is not None and ahead[0] == names and ahead[1].poll() is None:
+        ahead, popen = self._ahead.pop(key, None), None
+        if ahead is not None and list(key) == names and ahead.poll() is None:
             try:
-                ahead[1].stdin.write("go\n")
-                ahead[1].stdin.close()
-                popen = ahead[1]
+                ahead.stdin.write("go\n")
+                ahead.stdin.close()
+                popen = ahead
             except OSError:  # it ended meanwhile
                 pass
         if popen is None:
@@ -326,22 +329,33 @@ class Launcher:
         self.output.say(f"started {label} ({module}, pid {popen.pid})")
 
     def _start_ahead(self) -> None:
-        """The shared children's process, started while they wait for the recorders: it loads
-        its modules meanwhile, and starts them on the word (``_start``)."""
-        if self.shared and all(c.waiting for c in self.shared):
-            names = [c.spec.name for c in self.shared]
-            self._ahead = (names, self._spawn(self.shared, ahead=True))
+        """The shared children's process, started while they wait for the recorders, and in a
+        launcher of one thread (forked for a study's run: ``launch.forked``) each recorder's,
+        all before the router opens: they load their modules meanwhile (forked, they have
+        them), and start their children on the word (``_start``). All are forked before a
+        thread forwards their output."""
+        fork = single_threaded()
+        groups = [self.shared] if self.shared and all(c.waiting for c in self.shared) else []
+        if fork:
+            groups += [[c] for c in self.children if c.spec.name in self.recorders]
+        started = [(group, self._spawn(group, True, fork, False)) for group in groups]
+        for group, popen in started:
+            names = [c.spec.name for c in group]
+            forward(popen, names, self.output)
+            self._ahead[tuple(names)] = popen
 
-    def _end_ahead(self, ahead: tuple[list[str], subprocess.Popen[str]] | None) -> None:
+    def _end_ahead(self, ahead: subprocess.Popen[str] | Forked | None) -> None:
         if ahead is not None:
-            ahead[1].kill()
-            ahead[1].wait()
+            ahead.kill()
+            ahead.wait()
 
-    def _spawn(self, group: list[Child], ahead: bool = False) -> subprocess.Popen[str]:
+    def _spawn(
+        self, group: list[Child], ahead: bool = False, fork: bool | None = None, forwarding=True
+    ) -> subprocess.Popen[str] | Forked:
         """``spawn`` the process of ``group`` with this launch's profile file, kept parameters
         and inherited descriptors."""
-        specs = [c.spec for c in group]
-        return spawn(specs, self.profile_path, self._kept_params, self.pass_fds, self.output, ahead)
+        specs, kept, fds = [c.spec for c in group], self._kept_params, self.pass_fds
+        return spawn(specs, self.profile_path, kept, fds, self.output, ahead, fork, forwarding)
 
     def _on_exit(self, child: Child, code: int, now: float) -> None:
         """Decide what a child's exit means: done, failed, or a restart after a backoff."""

@@ -22,22 +22,25 @@ def spawn(
     pass_fds: tuple[int, ...],
     output: Output,
     ahead: bool = False,
+    fork: bool | None = None,
+    forwarding: bool = True,
 ) -> subprocess.Popen[str] | Forked:
     """The process of ``group`` (one component, or shared ones: ``components.container``,
-    waiting for a word on its input when ``ahead``) and the threads forwarding its output.
+    waiting for a word on its input when ``ahead``) and, if ``forwarding``, the threads
+    forwarding its output (``forward``).
 
     Its parameters set at run time are kept under ``kept_params``; it inherits ``pass_fds``
-    and runs in its own session, stopping by itself when the launcher is gone. A launcher of
-    one thread (forked for a study's run, before its router opens: the process started ahead)
-    forks it (``launch.forked``): the component modules its dataflow check loaded are loaded
-    in it too."""
+    and runs in its own session, stopping by itself when the launcher is gone. It is forked
+    (``launch.forked``) if ``fork``, by default if this launcher has one thread (forked for a
+    study's run, before its router opens: the processes started ahead), with the component
+    modules its dataflow check loaded."""
     names = [spec.name for spec in group]
     env = dict(
         os.environ,
         PYTHONUNBUFFERED="1",
         **{PARENT_PID_ENV: str(os.getpid()), RUNTIME_DIR_ENV: str(kept_params)},
     )
-    if len(group) > 1:
+    if len(group) > 1 or ahead:
         command = container.command(profile_path, names, ahead)
     else:
         spec = group[0]
@@ -51,11 +54,17 @@ def spawn(
         "pass_fds": pass_fds,
     }
     popen: subprocess.Popen[str] | Forked
-    if single_threaded():
+    if single_threaded() if fork is None else fork:
         popen = forked(command[2:], **how)  # [sys.executable, "-m", module, args...]
     else:
         popen = subprocess.Popen(command, text=True, errors="replace", **how)
+    if forwarding:
+        forward(popen, names, output)
+    return popen
+
+
+def forward(popen: subprocess.Popen[str] | Forked, names: list[str], output: Output) -> None:
+    """Threads forwarding the output of the process of components ``names``, prefixed."""
     prefix = "+".join(names)
     for pipe, stream in ((popen.stdout, output.out), (popen.stderr, output.err)):
         threading.Thread(target=output.forward, args=(pipe, stream, prefix), daemon=True).start()
-    return popen

@@ -13,11 +13,12 @@ from pathlib import Path
 import yaml
 
 from profiles.endpoints import free_port
+from record.session_reader import info
 
 ONE_THREAD = """
 import json, os, sys
 from pathlib import Path
-from launch.query import live_components
+from launch.query import live_components, statuses
 from profiles.profile import load_profile
 from studies.launched import connect, launched
 
@@ -25,12 +26,14 @@ profile, out = Path(sys.argv[1]), Path(sys.argv[2])
 threads = len(os.listdir("/proc/self/task"))
 with (out / "launch.log").open("w") as log, launched(profile, log) as launcher:
     with connect(load_profile(profile), launcher) as session:
-        while {"pub", "echo"} - set(live_components(session, "forked", 0.5)):
+        while {"pub", "echo", "rec"} - set(live_components(session, "forked", 0.5)):
+            assert launcher.poll() is None
+        while statuses(session, "forked")["rec"].counters["written"] == 0:
             assert launcher.poll() is None
         task = f"/proc/{launcher.pid}/task/{launcher.pid}/children"
         commands = [Path(f"/proc/{pid}/cmdline").read_bytes() for pid in open(task).read().split()]
     kind = type(launcher).__name__
-forked = [b"-m\\x00components.container" not in command for command in commands]
+forked = [b"-m\\x00components." not in command for command in commands]
 code = launcher.returncode
 print(json.dumps({"threads": threads, "launcher": kind, "code": code, "forked": forked}))
 """
@@ -38,13 +41,17 @@ print(json.dumps({"threads": threads, "launcher": kind, "code": code, "forked": 
 answering and stopped."""
 
 
-def test_a_process_of_one_thread_forks_a_launcher_and_its_shared_process(tmp_path: Path) -> None:
-    """The launcher forked, and the shared process it starts ahead forked from it: both run,
-    answer and stop as a new interpreter's do."""
-    profile = tmp_path / "system.yaml"
+def test_a_process_of_one_thread_forks_a_launcher_and_the_processes_it_starts_ahead(
+    tmp_path: Path,
+) -> None:
+    """The launcher forked, and the shared process and the recorder's it starts ahead forked
+    from it: they run, answer, record and stop as a new interpreter's do."""
+    profile, recording = tmp_path / "system.yaml", tmp_path / "session.mcap"
     components = [
         {"name": name, "module": "scripted_publisher", "role": "tool"} for name in ("pub", "echo")
     ]
+    recorder = {"name": "rec", "module": "recorder", "role": "recorder"}
+    components.append(recorder | {"params": {"path": str(recording)}})
     router = {"router": [f"tcp/127.0.0.1:{free_port()}"]}
     system = {"namespace": "forked", "zenoh": router, "processes": "shared"}
     profile.write_text(yaml.safe_dump(system | {"components": components}))
@@ -57,8 +64,10 @@ def test_a_process_of_one_thread_forks_a_launcher_and_its_shared_process(tmp_pat
     )
     assert done.returncode == 0, done.stderr
     found = json.loads(done.stdout)
-    assert found == {"threads": 1, "launcher": "Forked", "code": 0, "forked": [True]}
+    assert found == {"threads": 1, "launcher": "Forked", "code": 0, "forked": [True, True]}
     log = (tmp_path / "launch.log").read_text()
     assert "[launch] router listening" in log and "pub, echo in one process" in log
     assert "INFO pub running" in log and "INFO echo running" in log  # their own log lines
-    assert "pub stopped (0)" in log and "echo stopped (0)" in log
+    assert "pub stopped (0)" in log and "echo stopped (0)" in log and "rec stopped (0)" in log
+    recorded = info(recording)
+    assert recorded["complete"] and recorded["messages"] > 0
