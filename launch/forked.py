@@ -106,7 +106,7 @@ def forked(
             read, write = os.pipe()
             mine, theirs = (write, read) if target == 0 else (read, write)
             mode = "w" if target == 0 else "r"
-            parent_ends[name] = open(mine, mode, errors="replace")  # noqa: SIM115 - the caller's
+            parent_ends[name] = open(mine, mode, errors="replace")  # the caller's to close
             child_fds[target] = theirs
             closed_after.append(theirs)
         elif given == subprocess.DEVNULL:
@@ -147,9 +147,7 @@ def _child(
             os.closerange(start, kept)
             start = kept + 1
         os.closerange(start, os.sysconf("SC_OPEN_MAX"))
-        sys.stdin = open(0, closefd=False)  # noqa: SIM115 - the child's own, never closed
-        sys.stdout = open(1, "w", buffering=1, closefd=False)  # noqa: SIM115
-        sys.stderr = open(2, "w", buffering=1, closefd=False)  # noqa: SIM115
+        sys.stdin, sys.stdout, sys.stderr = (_stream(0, "r"), _stream(1, "w"), _stream(2, "w"))
         logging.root.handlers.clear()
         logging.root.setLevel(logging.WARNING)
         if env is not None:
@@ -161,7 +159,7 @@ def _child(
         code = 0
     except SystemExit as end:
         code = end.code if isinstance(end.code, int) else (0 if end.code is None else 1)
-    except BaseException:  # noqa: BLE001 - said on its output, as an interpreter would
+    except BaseException:  # said on its output, as an interpreter says it
         traceback.print_exc()
     finally:
         with contextlib.suppress(Exception):
@@ -169,3 +167,13 @@ def _child(
             sys.stdout.flush()
             sys.stderr.flush()
         os._exit(code)
+
+
+def _stream(descriptor: int, mode: str) -> IO[str] | None:
+    """A fresh standard stream on ``descriptor`` (line-buffered for writing), None when it is
+    not open, as a new interpreter has them."""
+    try:
+        os.fstat(descriptor)
+    except OSError:
+        return None
+    return open(descriptor, mode, buffering=-1 if mode == "r" else 1, closefd=False)
