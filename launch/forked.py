@@ -17,6 +17,7 @@ such a process is (``pid``, ``args``, ``returncode``, ``stdin``, ``stdout``, ``s
 from __future__ import annotations
 
 import contextlib
+import gc
 import logging
 import os
 import runpy
@@ -136,6 +137,9 @@ def _child(
     """Run ``command`` as a new interpreter would, then end with its exit code; never returns."""
     code = 1
     try:
+        # What this process held as garbage stays uncollected: a finalizer of it would close a
+        # descriptor number closed below and maybe reused by then.
+        gc.freeze()
         signal.signal(signal.SIGINT, signal.default_int_handler)
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
         if start_new_session:
