@@ -27,7 +27,10 @@ in one process (``components.container``), started once the recorders are alive.
 watched, reported and stopped by name, but a fault that ends that process (a kill, a component
 found hung) ends them all, and those restarted by their policy start again together.
 
-A child's process is started by ``launch.spawn`` and stopped by ``launch.stop``.
+A child's process is started by ``launch.spawn`` and stopped by ``launch.stop``. The shared
+process is started ahead, before the router opens, to load its modules meanwhile; a launcher of
+one thread (forked for a study's run, ``launch.forked``) forks it and each recorder's process
+then, on the modules it holds, and gives them the word to start their components in turn.
 """
 
 from __future__ import annotations
