@@ -14,7 +14,9 @@ p99 of each subscription handler, ``components.pubsub``, and of the lockstep gat
 ``components.lockstep_gate``: ``frame`` from a camera frame's publication to its last answer,
 ``frame_wait`` a step waiting for them, ``loop`` a step waiting for the commands).
 With ``--parallel K``, K runs at a time: the whole-loop runs per minute. With ``--no-figures``
-the runs draw no figures, as a study's runs (their CPU time is then the run's alone).
+the runs draw no figures and each is forked from this process, as a study's runs are (its
+launcher and the processes it starts ahead forked in turn, ``launch.forked``; this process opens
+no Zenoh session); the CPU time is then the run's alone.
 """
 
 from __future__ import annotations
@@ -34,6 +36,7 @@ from itertools import pairwise
 from pathlib import Path
 from typing import Any
 
+from launch.forked import Forked, forked
 from outputs.stdout import json_text
 from studies.experiment import Options, run_experiment
 
@@ -63,14 +66,14 @@ def one_run(law: str, processes: str, out: Path, figures: bool = True) -> dict[s
     """One experiment in a process of its own: its phases, CPU and report."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.time()
-    command = [sys.executable, "-m", "studies.bench.run_breakdown", "--one", str(out), "--law", law]
-    command += [] if figures else ["--no-figures"]
-    child = subprocess.Popen(
-        [*command, "--processes", processes],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    command = ["studies.bench.run_breakdown", "--one", str(out), "--law", law]
+    command += ["--processes", processes, *([] if figures else ["--no-figures"])]
+    pipes = {"stdout": subprocess.PIPE, "stderr": subprocess.PIPE}
+    child: subprocess.Popen | Forked
+    if figures:  # as the command runs it: a new interpreter
+        child = subprocess.Popen([sys.executable, "-m", *command], text=True, **pipes)
+    else:  # as a study runs it: forked from this process, its modules loaded
+        child = forked(command, **pipes)
     lines: list[tuple[float, str]] = []
     reader = threading.Thread(
         target=lambda: lines.extend((time.time(), text) for text in child.stderr), daemon=True
