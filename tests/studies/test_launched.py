@@ -28,7 +28,7 @@ with (out / "launch.log").open("w") as log, launched(profile, log) as launcher:
     with connect(load_profile(profile), launcher) as session:
         while {"pub", "echo", "rec"} - set(live_components(session, "forked", 0.5)):
             assert launcher.poll() is None
-        while statuses(session, "forked")["rec"].counters["written"] == 0:
+        while not getattr(statuses(session, "forked").get("rec"), "counters", {}).get("written"):
             assert launcher.poll() is None
         task = f"/proc/{launcher.pid}/task/{launcher.pid}/children"
         commands = [Path(f"/proc/{pid}/cmdline").read_bytes() for pid in open(task).read().split()]
