@@ -341,22 +341,17 @@ def _active(
     for name, lows, highs in limits:
         # An infinite bound is never within the tolerance of u; a degenerate one never counts.
         # On Python floats: the same IEEE arithmetic, and at 8 to 40 entries faster than NumPy.
-        # No entry near either bound (most steps): none to name. First by |u| against the
-        # bounds nearest 0 (every u_i - lower_i and upper_i - u_i is then above twice the
-        # tolerance), then entry by entry.
-        if (largest < FAR_LIMIT and largest + FAR_MARGIN < min(-max(lows), min(highs))) or (
-            min(map(operator.sub, values, lows)) > ACTIVE_TOLERANCE
-            and min(map(operator.sub, highs, values)) > ACTIVE_TOLERANCE
-        ):
+        # Most steps no entry is near either bound: |u| + a margin below the bounds nearest 0
+        # puts every u_i - lower_i and upper_i - u_i above twice the tolerance.
+        if largest < FAR_LIMIT and largest + FAR_MARGIN < min(-max(lows), min(highs)):
             continue
-        active += [
-            label
-            for label, x, low, high in zip(
-                entry_names(name, len(values)), values, lows, highs, strict=True
-            )
-            if (x - low <= ACTIVE_TOLERANCE or high - x <= ACTIVE_TOLERANCE)
-            and high - low > ACTIVE_TOLERANCE
-        ]
+        for label, x, low, high in zip(
+            entry_names(name, len(values)), values, lows, highs, strict=True
+        ):
+            if (x - low <= ACTIVE_TOLERANCE or high - x <= ACTIVE_TOLERANCE) and (
+                high - low > ACTIVE_TOLERANCE
+            ):
+                active.append(label)
     return tuple(active)
 
 
