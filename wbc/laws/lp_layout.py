@@ -76,7 +76,7 @@ class Layout:
         starts = np.cumsum([0, *residual_rows]).tolist()
         self._slices = [slice(a, b) for a, b in zip(starts, starts[1:], strict=False)]
         self.offset_blocks = [self.upper[static + s.start : static + s.stop] for s in self._slices]
-        """The rows of ``upper`` each residual cost's offset fills (then negated: -b)."""
+        """The rows of ``upper`` each residual cost's offset fills, negated (-b)."""
         self.weights: list[float] = []
         """The residual costs' weights ``row_weight`` and the costs of y were set from."""
         self.col_lower = np.zeros(self.columns)
