@@ -178,7 +178,10 @@ class ArmDriver(Component):
             return
         self.connected = True
         self.node.state = "running"
-        self._enable_torque()
+        try:
+            self._enable_torque()
+        except (OSError, TypeError) as error:  # the port went away under the SDK
+            self._lost(error)
 
     def _enable_torque(self) -> None:
         """Torque on for every servo (a servo that browned out comes back with it off)."""

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Iterator
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -130,9 +131,15 @@ def test_the_simulator_keeps_the_last_good_arm_command(
 
 
 def test_the_arm_driver_holds_on_a_command_of_other_joints(
-    caplog: pytest.LogCaptureFixture,
+    caplog: pytest.LogCaptureFixture, tmp_path: Path
 ) -> None:
-    profile = load_profile(DEPLOY / "emulated.yaml")
+    # A port of its own that is absent (the emulated profile's is another test's emulator).
+    text = (DEPLOY / "emulated.yaml").read_text()
+    text = text.replace("/tmp/parsimony-emulated/servos", str(tmp_path / "servos"))
+    emulated = tmp_path / "emulated.yaml"
+    emulated.write_text(text.replace("extends: hardware.yaml", f"extends: {DEPLOY}/hardware.yaml"))
+    profile = load_profile(emulated)
+    assert profile.component("arm_driver").params["port"] == str(tmp_path / "servos")
     with Node(profile, "arm_driver", ArmDriver.params) as node:
         driver = ArmDriver(node)  # its port is absent: it holds, and counts what it refuses
         with caplog.at_level(logging.WARNING):
