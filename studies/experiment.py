@@ -233,6 +233,12 @@ def say(text: str) -> None:
 
 def run_experiment(options: Options) -> dict[str, Any]:
     """Run one experiment; return its report (also written to ``out/report.json``)."""
+    return judged_experiment(options)[0]
+
+
+def judged_experiment(options: Options) -> tuple[dict[str, Any], dict[str, list]]:
+    """Run one experiment; return its report (also written to ``out/report.json``) and the run
+    it judged (``analysis.run_end.the_run`` of its recording)."""
     if options.name in SUPERVISED and options.controller != "lp":
         raise ProfileError(
             f"the {options.name} experiment runs the LP under the staging "
@@ -322,7 +328,7 @@ def run_experiment(options: Options) -> dict[str, Any]:
         drawn = write_report([(label, run)], robot, options.out, profile.scene.reference_pose)
         report["figures"] = [str(path) for path in drawn["figures"]]
     (options.out / "report.json").write_text(json_text(report, indent=2))
-    return report
+    return report, run
 
 
 def starting(profile: Profile) -> str:

@@ -1,7 +1,7 @@
 """What one run of a sweep does, in the process it is given, as a row of figures: a kinematic
 attempt at one goal of a family (``studies.goal_sets.attempt``) or of the zoo
 (``studies.redundancy.run_one``), an experiment's set-up run kinematically, or one experiment
-on the whole simulated loop (``studies.experiment.run_experiment``). A set-up's run and an
+on the whole simulated loop (``studies.experiment.judged_experiment``). A set-up's run and an
 experiment's give the same columns (``SETUP_COLUMNS``), so one loop's table compares with the
 other's."""
 
@@ -14,15 +14,13 @@ from typing import Any
 
 import numpy as np
 
-from analysis.judge import JUDGED
-from analysis.run_end import CONVERGED_ERROR, converged_at, messages, origin_s, the_run
+from analysis.run_end import CONVERGED_ERROR, converged_at, messages, origin_s
 from messages.topics import CONTROL_DIAGNOSTICS, SUPERVISOR_STATUS
 from outputs.stdout import json_text
 from profiles.profile import load_profile
-from record.sessions import load_session
 from sim2d.scenarios import scenario
 from studies import redundancy
-from studies.experiment import PROFILES, SESSION_FILE, TIME_LIMIT_S, Options, run_experiment
+from studies.experiment import PROFILES, TIME_LIMIT_S, Options, judged_experiment
 from studies.goal_families import FAMILIES, OBSTACLE_FAMILIES, goals, obstacle_goals
 from studies.goal_sets import MOVING_ERROR, SUPERVISED, Attempt, attempt
 from studies.study.places import GOALS, SETUP, ZOO, ZOO_FAMILY, kind, law
@@ -122,9 +120,8 @@ def simulated(run: Run) -> dict[str, Any]:
         gains=json.loads(p["gains"]),
         figures=False,
     )
-    report = run_experiment(options)
+    report, session = judged_experiment(options)  # the run its report judged
     whole_recording(report)
-    session, _ = the_run(load_session(Path(run.out) / SESSION_FILE, JUDGED), TIME_LIMIT_S)
     diagnostics = messages(session, CONTROL_DIAGNOSTICS)
     since = converged_at(diagnostics, messages(session, SUPERVISOR_STATUS))
     moving = [
