@@ -341,7 +341,7 @@ class Launcher:
         groups = [self.shared] if self.shared and all(c.waiting for c in self.shared) else []
         if fork:
             groups += [[c] for c in self.children if c.spec.name in self.recorders]
-        started = [(group, self._spawn(group, True, fork, False)) for group in groups]
+        started = [(g, self._spawn(g, ahead=True, fork=fork, forwarding=False)) for g in groups]
         for group, popen in started:
             names = [c.spec.name for c in group]
             forward(popen, names, self.output)
@@ -353,7 +353,7 @@ class Launcher:
             ahead.wait()
 
     def _spawn(
-        self, group: list[Child], ahead: bool = False, fork: bool | None = None, forwarding=True
+        self, group: list[Child], ahead: bool = False, fork: bool = False, forwarding: bool = True
     ) -> subprocess.Popen[str] | Forked:
         """``spawn`` the process of ``group`` with this launch's profile file, kept parameters
         and inherited descriptors."""

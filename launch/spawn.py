@@ -8,7 +8,7 @@ import threading
 from pathlib import Path
 
 from components import container
-from launch.forked import Forked, forked, single_threaded
+from launch.forked import Forked, forked
 from launch.output import Output
 from messages import process
 from messages.process import PARENT_PID_ENV, RUNTIME_DIR_ENV
@@ -22,7 +22,7 @@ def spawn(
     pass_fds: tuple[int, ...],
     output: Output,
     ahead: bool = False,
-    fork: bool | None = None,
+    fork: bool = False,
     forwarding: bool = True,
 ) -> subprocess.Popen[str] | Forked:
     """The process of ``group`` (one component, or shared ones: ``components.container``,
@@ -31,9 +31,9 @@ def spawn(
 
     Its parameters set at run time are kept under ``kept_params``; it inherits ``pass_fds``
     and runs in its own session, stopping by itself when the launcher is gone. It is forked
-    (``launch.forked``) if ``fork``, by default if this launcher has one thread (forked for a
-    study's run, before its router opens: the processes started ahead), with the component
-    modules its dataflow check loaded."""
+    (``launch.forked``) if ``fork``: a launcher of one thread (forked for a study's run) forks
+    the processes it starts ahead, before its router opens, with the component modules its
+    dataflow check loaded."""
     names = [spec.name for spec in group]
     env = dict(
         os.environ,
@@ -54,7 +54,7 @@ def spawn(
         "pass_fds": pass_fds,
     }
     popen: subprocess.Popen[str] | Forked
-    if single_threaded() if fork is None else fork:
+    if fork:
         popen = forked(command[2:], **how)  # [sys.executable, "-m", module, args...]
     else:
         popen = subprocess.Popen(command, text=True, errors="replace", **how)

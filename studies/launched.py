@@ -33,10 +33,14 @@ POLL_S = 0.02
 waited for: a look costs about a millisecond of CPU, a wait half a period on average."""
 
 
+Launcher = subprocess.Popen | Forked
+"""A launcher as ``launched`` gives it: a new interpreter's, or a forked one."""
+
+
 @contextlib.contextmanager
 def launched(
     profile_path: Path, log: IO[str] | int = subprocess.DEVNULL, stop_timeout_s: float | None = 30.0
-) -> Iterator[subprocess.Popen | Forked]:
+) -> Iterator[Launcher]:
     """``parsimony launch PROFILE`` as a child process, its output to ``log``; at the end of
     the block it is stopped by SIGINT (its components in order), killed after
     ``stop_timeout_s`` (None: the launcher's own limits, a recorder's progress, decide)."""
@@ -53,10 +57,6 @@ def launched(
         yield launcher
     finally:
         process.stop(launcher, signal.SIGINT, stop_timeout_s)
-
-
-Launcher = subprocess.Popen | Forked
-"""A launcher as ``launched`` gives it: a new interpreter's, or a forked one."""
 
 
 def connect(profile: Profile, launcher: Launcher) -> zenoh.Session:
