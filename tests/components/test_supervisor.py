@@ -62,8 +62,9 @@ class Operator:
             assert time.monotonic() < deadline, "the supervisor did not subscribe in time"
             time.sleep(0.005)
 
-    def ask(self, pose: np.ndarray) -> None:
-        self.request.put(codec.encode(Goal(header=header(), task="pose", pose=tuple(pose))))
+    def ask(self, pose: np.ndarray) -> int:
+        """A pose goal; its stamp, which the statuses once it is taken carry."""
+        return self.send_goal(Goal(header=header(), task="pose", pose=tuple(pose)))
 
     def ask_raw(self, fields: dict) -> None:
         """A request as its bytes, whatever its fields hold (a NaN, a pose of norm 2...)."""
@@ -85,15 +86,26 @@ class Operator:
         self.state.put(codec.encode(state))
         return header.stamp_ns
 
-    def send_goal(self, goal: Goal) -> None:
+    def send_goal(self, goal: Goal) -> int:
+        """``goal``; its stamp, which the statuses once it is taken carry."""
         self.request.put(codec.encode(goal))
+        return goal.header.stamp_ns
 
-    def statuses_after(
-        self, count: int, q: np.ndarray, what: str, **state: object
+    def status_answering(self, q: np.ndarray, what: str, **state: object) -> SupervisorStatus:
+        """A state at q, and the status the supervisor published for it (stamped with it): not
+        one published before it (a tick's, an earlier state's still on its way)."""
+        stamp = self.send_state(q, **state)
+        return self.statuses.wait_for(lambda s: s.header.stamp_ns == stamp, what)
+
+    def answer_to(
+        self, goal_stamp: int, q: np.ndarray, what: str, **state: object
     ) -> SupervisorStatus:
-        """A state at q, and the first status of the supervisor's ``count``-th on."""
-        self.send_state(q, **state)
-        return self.statuses.wait_for(lambda s: self.statuses.messages.index(s) >= count, what)
+        """States at q until one is answered with the goal of ``goal_stamp`` taken (a goal and
+        a state travel apart): the status answering that state."""
+        deadline = time.monotonic() + DEADLINE_S
+        while (status := self.status_answering(q, what, **state)).request_stamp_ns != goal_stamp:
+            assert time.monotonic() < deadline, f"the goal was never taken ({what})"
+        return status
 
 
 def header() -> Header:
@@ -251,8 +263,7 @@ def test_a_refused_request_is_on_the_status_with_its_reason_and_the_goal_stays(
         refused = refusal(operator, refusals)
         assert f"Goal.{blamed}" in refused.last_refusal, (fields, refused.last_refusal)
         assert refused.phase not in ("idle", "planning", "unreachable"), refused
-        count = len(operator.statuses.messages)
-        after = operator.statuses_after(count, REACH_GOAL, "a status after the refusal")
+        after = operator.status_answering(REACH_GOAL, "a status after the refusal")
         assert after.phase == refused.phase and after.refusals == refusals
 
 
@@ -325,11 +336,10 @@ def test_a_goal_of_every_kind_has_a_status_with_every_state_until_and_after_it_i
     assert direct.error_norm is not None and direct.error_norm > 0.01
     passed = operator.goals.wait_for(lambda g: g.task == goal.task, "the goal passed on")
     assert passed.model_dump(exclude={"header"}) == goal.model_dump(exclude={"header"})
-    count = len(operator.statuses.messages)
-    reached = operator.statuses_after(count, REACH_GOAL, "the status of the goal met")
+    reached = operator.status_answering(REACH_GOAL, "the status of the goal met")
     assert reached.phase == "reached" and reached.error_norm < 1e-9, reached
     for _ in range(3):
-        after = operator.statuses_after(len(operator.statuses.messages), REACH_GOAL, "one more")
+        after = operator.status_answering(REACH_GOAL, "one more")
         assert after.phase == "reached"
     # The component's own state says the phase too: the launcher prints its every change.
     namespace = operator.system.profile.namespace
@@ -347,9 +357,7 @@ def test_an_invalid_state_aborts_the_goal_refuses_new_ones_and_the_status_says_w
     operator.ask(operator.robot.fkm(REACH_GOAL))
     operator.send_state(HOME)
     operator.statuses.wait_for(lambda s: s.phase not in ("idle", "planning"), "the plan")
-    aborted = operator.statuses_after(
-        len(operator.statuses.messages), HOME, "the abort", valid=False, age_s=12.0
-    )
+    aborted = operator.status_answering(HOME, "the abort", valid=False, age_s=12.0)
     assert aborted.phase == "aborted" and aborted.state == "invalid", aborted
     assert aborted.no_fix_s == 12.0 and aborted.state_since_s is not None
     assert "no valid robot state for 0.0 s (no camera fix of the base for 12.0 s)" in (
@@ -357,20 +365,16 @@ def test_an_invalid_state_aborts_the_goal_refuses_new_ones_and_the_status_says_w
     ), aborted.reason
     goals = len(operator.goals.messages)
     for _ in range(3):
-        later = operator.statuses_after(
-            len(operator.statuses.messages), HOME, "a later status", valid=False, age_s=13.0
-        )
+        later = operator.status_answering(HOME, "a later status", valid=False, age_s=13.0)
         assert later.phase == "aborted" and later.no_fix_s == 13.0
-    operator.ask(operator.robot.fkm(REACH_GOAL))
-    refused = operator.statuses_after(
-        len(operator.statuses.messages), HOME, "the refusal", valid=False, age_s=14.0
-    )
+    asked = operator.ask(operator.robot.fkm(REACH_GOAL))
+    refused = operator.answer_to(asked, HOME, "the refusal", valid=False, age_s=14.0)
     assert refused.phase == "refused" and refused.refusals == 1, refused
     assert refused.reason == refused.last_refusal and "no camera fix of the base for 14.0 s" in (
         refused.reason
     )
     assert len(operator.goals.messages) == goals  # nothing for the controller meanwhile
-    back = operator.statuses_after(len(operator.statuses.messages), REACH_GOAL, "valid again")
+    back = operator.status_answering(REACH_GOAL, "valid again")
     assert back.phase == "refused" and back.state == "valid"
     hold = operator.goals.wait_for(lambda g: operator.goals.messages.index(g) >= goals, "hold")
     assert hold.task == "point"
@@ -419,8 +423,8 @@ def test_goals_that_would_take_the_base_out_of_the_cameras_sight_are_turned_down
     out_of_sight = np.concatenate(([3.5, 0.0, 0.0], REACH_GOAL[3:]))
     assert not within(region, out_of_sight[:2])
     target = dq.translation(operator.robot.fkm(out_of_sight))[1:]
-    operator.send_goal(Goal(header=header(), task="position", position=tuple(target)))
-    refused = operator.statuses_after(len(operator.statuses.messages), HOME, "the refusal")
+    asked = operator.send_goal(Goal(header=header(), task="position", position=tuple(target)))
+    refused = operator.answer_to(asked, HOME, "the refusal")
     assert refused.phase == "refused" and "the camera cannot see the base" in refused.reason
     status = unreachable(operator, operator.robot.fkm(out_of_sight), "cannot see it")
     assert "take the base where the camera cannot see it" in status.reason, status.reason
@@ -454,10 +458,10 @@ def test_a_position_goal_too_far_is_refused_in_a_few_words_and_statuses_go_on(
     """A position goal at 1e300 m: its error is no float a status can carry; it is refused
     like a pose goal that far, in a short reason, and the statuses go on."""
     operator = supervised(deployed)
-    operator.send_goal(Goal(header=header(), task="position", position=(1e300, 0.0, 0.3)))
-    refused = operator.statuses_after(len(operator.statuses.messages), HOME, "the refusal")
+    asked = operator.send_goal(Goal(header=header(), task="position", position=(1e300, 0.0, 0.3)))
+    refused = operator.answer_to(asked, HOME, "the refusal")
     assert refused.phase == "refused" and len(refused.reason) < 120, refused.reason
     assert "farther than the 10 m a goal may lie" in refused.reason, refused.reason
-    after = operator.statuses_after(len(operator.statuses.messages), HOME, "one more")
+    after = operator.status_answering(HOME, "one more")
     assert after.phase == "refused"
     assert operator.goals.messages[-1].task == "point"  # held where it stands
