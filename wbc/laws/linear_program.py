@@ -33,7 +33,6 @@ optimal basis, so the dual simplex starts from the previous vertex (usually 0 to
 
 from __future__ import annotations
 
-import functools
 import operator
 from collections.abc import Sequence
 from typing import NamedTuple
@@ -41,6 +40,7 @@ from typing import NamedTuple
 import highspy
 import numpy as np
 
+from wbc.laws.active_set import BoundEntries, active
 from wbc.laws.basis_reuse import KeptBasis, lapack
 from wbc.laws.constraints.base import LinearRows, OneNormBound, Rows, VelocityBounds
 from wbc.laws.kept import KEPT
@@ -48,10 +48,6 @@ from wbc.laws.lp_layout import INF, Layout, picker
 from wbc.laws.objectives.base import Cost, ResidualCost, VelocityCost
 
 Array = np.ndarray
-ACTIVE_TOLERANCE = 1e-7
-FAR_MARGIN, FAR_LIMIT = 1e-6, 1e6
-"""|u_i| + FAR_MARGIN below every velocity bound's magnitude, |u_i| under FAR_LIMIT: each u_i is
-further than 2 ACTIVE_TOLERANCE from its bounds, whatever the rounding of that sum."""
 SOLVER_OPTIONS = {
     "output_flag": False,
     "solver": "simplex",
@@ -96,6 +92,8 @@ class WarmStartedLP:
         self._cost_key: tuple[int, ...] = ()
         self._cost_sums: tuple[Array, Array] = (np.zeros(0), np.zeros(0))
         self._kinds = _Kinds(())
+        self._entries: dict[tuple[str, int], BoundEntries] = {}
+        """The entries of each velocity bound seen, by its name and size (``active``)."""
 
     def reset(self) -> None:
         """Forget the previous basis: the next solve starts cold."""
@@ -119,11 +117,15 @@ class WarmStartedLP:
         if len(bounds) == 1:
             (bound,) = bounds
             lows, highs = bound.lower.tolist(), bound.upper.tolist()
-            limits = [(bound.name, lows, highs)]
+            entries = self._entries.get((bound.name, n)) or self._entries_of(bound.name, n)
+            limits = [(entries, lows, highs)]
             u_lower[...], u_upper[...] = bound.lower, bound.upper
             infeasible = any(map(operator.gt, lows, highs))
         else:
-            limits = [(bound.name, bound.lower.tolist(), bound.upper.tolist()) for bound in bounds]
+            limits = [
+                (self._entries_of(bound.name, n), bound.lower.tolist(), bound.upper.tolist())
+                for bound in bounds
+            ]
             u_lower.fill(-INF)
             u_upper.fill(INF)
             for bound in bounds:
@@ -174,9 +176,16 @@ class WarmStartedLP:
         objective = float(layout.cost.dot(values)) + float(layout.row_weight.dot(residual_upper))
         values = u.tolist()
         magnitudes = list(map(abs, values))
-        active = _active(u, values, magnitudes, linear, norms, limits)
+        named = active(u, values, magnitudes, linear, norms, limits)
         # The named tuple built by tuple.__new__: the same value, without its __new__'s frame.
-        return tuple.__new__(LPSolution, (u, status, objective, active, magnitudes))
+        return tuple.__new__(LPSolution, (u, status, objective, named, magnitudes))
+
+    def _entries_of(self, name: str, n: int) -> BoundEntries:
+        """The entries of the velocity bound ``name`` of n entries, made at its first step."""
+        entries = self._entries.get((name, n))
+        if entries is None:
+            entries = self._entries[name, n] = BoundEntries(name, n)
+        return entries
 
     def _sum_velocity_costs(self, costs: Sequence[VelocityCost], n: int) -> None:
         """c_P and c_N, the sums of the velocity costs' weights (``_cost_sums``), kept while the
@@ -309,64 +318,3 @@ class _Kinds:
 
 def _failed(n: int, status: str) -> LPSolution:
     return LPSolution(np.zeros(n), status, None, (), [0.0] * n)
-
-
-def _active(
-    u: Array,
-    values: list[float],
-    magnitudes: list[float],
-    linear: Sequence[LinearRows],
-    norms: Sequence[OneNormBound],
-    limits: Sequence[tuple[str, list[float], list[float]]],
-) -> tuple[str, ...]:
-    """Names of the constraints that hold with equality at the solution.
-
-    Engaged equality rows are active, and engaged inequality rows that one of their finite
-    bounds holds tight; a one-norm bound when 1'(u_P + u_N) reaches it; a velocity bound entry
-    (named ``name[i]``) when u_i sits on a finite, non-degenerate bound. ``values`` and
-    ``magnitudes`` are u_i and |u_i| as Python floats.
-    """
-    # Loops, not comprehensions: a comprehension is a call of its own (Python 3.11), dearer than
-    # the loop over these few rows.
-    active = []
-    for rows in linear:
-        if rows.engaged and (rows.lower is rows.upper or _tight(rows, u)):
-            active.append(rows.name)
-    if norms:
-        split_sum = sum(magnitudes)  # 1'(u_P + u_N), the halves split canonically
-        for bound in norms:
-            if split_sum >= bound.limit - ACTIVE_TOLERANCE:
-                active.append(bound.name)
-    largest = max(magnitudes) if limits else 0.0
-    for name, lows, highs in limits:
-        # An infinite bound is never within the tolerance of u; a degenerate one never counts.
-        # On Python floats: the same IEEE arithmetic, and at 8 to 40 entries faster than NumPy.
-        # Most steps no entry is near either bound: |u| + a margin below the bounds nearest 0
-        # puts every u_i - lower_i and upper_i - u_i above twice the tolerance.
-        if largest < FAR_LIMIT and largest + FAR_MARGIN < min(-max(lows), min(highs)):
-            continue
-        for label, x, low, high in zip(
-            entry_names(name, len(values)), values, lows, highs, strict=True
-        ):
-            if (x - low <= ACTIVE_TOLERANCE or high - x <= ACTIVE_TOLERANCE) and (
-                high - low > ACTIVE_TOLERANCE
-            ):
-                active.append(label)
-    return tuple(active)
-
-
-@functools.cache
-def entry_names(name: str, n: int) -> tuple[str, ...]:
-    """The names ``name[i]`` of the n entries of a velocity bound, made once."""
-    return tuple(f"{name}[{i}]" for i in range(n))
-
-
-def _tight(rows: LinearRows, u: Array) -> bool:
-    """An equality, or an inequality one of whose rows sits on a finite bound."""
-    if rows.lower is rows.upper or (
-        rows.lower.shape == rows.upper.shape and not np.count_nonzero(rows.lower != rows.upper)
-    ):
-        return True
-    value = rows.matrix @ u
-    distance = np.minimum(np.abs(value - rows.lower), np.abs(rows.upper - value))
-    return bool(np.count_nonzero(distance <= ACTIVE_TOLERANCE))
