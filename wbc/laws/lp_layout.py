@@ -6,6 +6,7 @@ A step of ``wbc.laws.linear_program.WarmStartedLP`` writes its data into views o
 
 from __future__ import annotations
 
+import math
 import operator
 from collections.abc import Callable, Iterable, Sequence
 
@@ -77,8 +78,12 @@ class Layout:
         self._slices = [slice(a, b) for a, b in zip(starts, starts[1:], strict=False)]
         self.offset_blocks = [self.upper[static + s.start : static + s.stop] for s in self._slices]
         """The rows of ``upper`` each residual cost's offset fills, negated (-b)."""
-        self.weights: list[float] = []
-        """The residual costs' weights ``row_weight`` and the costs of y were set from."""
+        self.weights: list[float] = [math.nan] * residual_count
+        """The residual costs' weights ``row_weight`` and the costs of y were set from (none
+        yet: NaN is no weight)."""
+        y_costs = self.cost[2 * n :]
+        self._weight_blocks = [(self.row_weight[s], y_costs[s]) for s in self._slices]
+        """Each residual cost's rows of ``row_weight`` and of the costs of its y."""
         self.col_lower = np.zeros(self.columns)
         self.col_upper = np.full(self.columns, INF)
         # Views of the buffers each step writes, made once for the shape.
@@ -127,11 +132,15 @@ class Layout:
         self.minus[...] = self._negated
 
     def weigh(self, weights: list[float]) -> None:
-        """Set ``row_weight`` and the costs of y from the weight of each residual cost (a step
-        calls it when they differ from ``weights``)."""
-        for rows, weight in zip(self._slices, weights, strict=True):
-            self.row_weight[rows] = weight
-        np.multiply(2.0, self.row_weight, out=self.cost[2 * self.n :])
+        """Set ``row_weight`` and the costs of y, 2 w_b, from the weight w_b of each residual
+        cost (a step calls it when they differ from ``weights``): the rows of those whose
+        weight changed (a base target's ramps as the base nears it), not all."""
+        for (rows, y_costs), weight, last in zip(
+            self._weight_blocks, weights, self.weights, strict=True
+        ):
+            if weight != last:
+                rows.fill(weight)
+                y_costs.fill(2.0 * weight)
         self.weights = weights
 
 
