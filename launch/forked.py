@@ -4,8 +4,8 @@ interpreter's start and imports (half a second of CPU for a component's process 
 launcher's).
 
 A study's run is forked from its worker with the modules loaded; it forks its launcher
-(``studies.launched``), which forks the shared components' process it starts ahead, before its
-router opens (``launch.spawn``). A process of more threads starts a new interpreter instead
+(``studies.launched``), which forks its fork server (``launch.fork_server``, which forks each
+component's process in turn). A process of more threads starts a new interpreter instead
 (``single_threaded``): a fork copies the state of a Zenoh runtime or a held lock without the
 threads that own them. The child starts as a new interpreter does: Python's default SIGINT and
 SIGTERM handlers, fresh standard streams, no logging handler, only its standard descriptors and
@@ -17,6 +17,7 @@ such a process is (``pid``, ``args``, ``returncode``, ``stdin``, ``stdout``, ``s
 from __future__ import annotations
 
 import contextlib
+import fcntl
 import gc
 import logging
 import os
@@ -80,34 +81,32 @@ class Forked:
         self.send_signal(signal.SIGKILL)
 
 
-def forked(
-    command: list[str],
-    stdin: int | None = None,
-    stdout: IO[str] | int | None = None,
-    stderr: IO[str] | int | None = None,
-    env: Mapping[str, str] | None = None,
-    start_new_session: bool = False,
-    pass_fds: tuple[int, ...] = (),
-) -> Forked:
-    """``command`` (``[MODULE, ARGS...]``) in a forked child: ``stdin``, ``stdout`` and
-    ``stderr`` as ``subprocess.Popen`` takes them (None: this process's; ``PIPE``,
-    ``DEVNULL``, ``STDOUT`` for ``stderr``, a file or a descriptor), ``env`` (None: this
-    process's), in a session of its own if ``start_new_session``."""
+def child_ends(
+    stdin: int | None, stdout: IO[str] | int | None, stderr: IO[str] | int | None
+) -> tuple[dict[str, IO[str] | None], dict[int, int], list[int]]:
+    """The standard streams of a child to be, given as ``subprocess.Popen`` takes them (None:
+    this process's; ``PIPE``, ``DEVNULL``, ``STDOUT`` for ``stderr``, a file or a
+    descriptor): this process's ends of its pipes (the caller's to close), the child's
+    standard descriptors (open here) by where they come from, and the descriptors to close
+    here once the child has them."""
     parent_ends: dict[str, IO[str] | None] = {"stdin": None, "stdout": None, "stderr": None}
     child_fds: dict[int, int] = {}  # the child's standard descriptor -> where it comes from
-    closed_after: list[int] = []  # the parent's copies of what only the child keeps
+    closed_after: list[int] = []  # this process's copies of what only the child keeps
     for target, (name, given) in enumerate(
         (("stdin", stdin), ("stdout", stdout), ("stderr", stderr))
     ):
         if given is None:
-            continue
-        if given == subprocess.STDOUT:
-            child_fds[target] = 1
+            with contextlib.suppress(OSError):  # not open here: not open there either
+                os.fstat(target)
+                child_fds[target] = target
+        elif given == subprocess.STDOUT:
+            if 1 in child_fds:
+                child_fds[target] = child_fds[1]
         elif given == subprocess.PIPE:
             read, write = os.pipe()
             mine, theirs = (write, read) if target == 0 else (read, write)
             mode = "w" if target == 0 else "r"
-            parent_ends[name] = open(mine, mode, errors="replace")  # the caller's to close
+            parent_ends[name] = open(mine, mode, errors="replace")
             child_fds[target] = theirs
             closed_after.append(theirs)
         elif given == subprocess.DEVNULL:
@@ -119,22 +118,39 @@ def forked(
             child_fds[target] = given if isinstance(given, int) else given.fileno()
     for stream in (sys.stdout, sys.stderr):
         stream.flush()
+    return parent_ends, child_fds, closed_after
+
+
+def forked(
+    command: list[str],
+    stdin: int | None = None,
+    stdout: IO[str] | int | None = None,
+    stderr: IO[str] | int | None = None,
+    env: Mapping[str, str] | None = None,
+    start_new_session: bool = False,
+    pass_fds: tuple[int, ...] = (),
+) -> Forked:
+    """``command`` (``[MODULE, ARGS...]``) in a forked child: ``stdin``, ``stdout`` and
+    ``stderr`` as ``child_ends`` takes them, ``env`` (None: this process's), in a session of
+    its own if ``start_new_session``, with ``pass_fds`` open."""
+    parent_ends, child_fds, closed_after = child_ends(stdin, stdout, stderr)
     pid = os.fork()
     if pid == 0:
-        _child(command, child_fds, env, start_new_session, pass_fds)
+        run_child(command, child_fds | {fd: fd for fd in pass_fds}, env, start_new_session)
     for descriptor in closed_after:
         os.close(descriptor)
     return Forked(pid, command, parent_ends)
 
 
-def _child(
+def run_child(
     command: list[str],
     child_fds: dict[int, int],
     env: Mapping[str, str] | None,
     start_new_session: bool,
-    pass_fds: tuple[int, ...],
 ) -> None:
-    """Run ``command`` as a new interpreter would, then end with its exit code; never returns."""
+    """Run ``command`` as a new interpreter would, with ``child_fds`` (its descriptor -> where it
+    comes from here) and no other descriptor open, then end with its exit code; never
+    returns."""
     code = 1
     try:
         # What this process held as garbage stays uncollected: a finalizer of it would close a
@@ -144,12 +160,14 @@ def _child(
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
         if start_new_session:
             os.setsid()
-        for target in sorted(child_fds):
-            os.dup2(child_fds[target], target)
-        start = 3
-        for kept in sorted(set(pass_fds)):
-            os.closerange(start, kept)
-            start = kept + 1
+        floor = max(child_fds, default=0) + 1  # above every target: none is overwritten
+        moved = {target: fcntl.fcntl(fd, fcntl.F_DUPFD, floor) for target, fd in child_fds.items()}
+        start = 0
+        for target in sorted(moved):
+            os.dup2(moved[target], target)
+            if start < target:  # closerange(n, n) would close them all
+                os.closerange(start, target)
+            start = target + 1
         os.closerange(start, os.sysconf("SC_OPEN_MAX"))
         sys.stdin, sys.stdout, sys.stderr = (_stream(0, "r"), _stream(1, "w"), _stream(2, "w"))
         logging.root.handlers.clear()

@@ -27,10 +27,10 @@ in one process (``components.container``), started once the recorders are alive.
 watched, reported and stopped by name, but a fault that ends that process (a kill, a component
 found hung) ends them all, and those restarted by their policy start again together.
 
-A child's process is started by ``launch.spawn`` and stopped by ``launch.stop``. The shared
-process is started ahead, before the router opens, to load its modules meanwhile; a launcher of
-one thread (forked for a study's run, ``launch.forked``) forks it and each recorder's process
-then, on the modules it holds, and gives them the word to start their components in turn.
+A child's process is started by ``launch.spawn`` and stopped by ``launch.stop``: it is forked by
+the launch's fork server (``launch.fork_server``), which loads the components' modules while the
+router opens, or is a new interpreter if the server is gone. The shared process is started
+ahead, before the recorders are alive, and given the word to start its components then.
 """
 
 from __future__ import annotations
@@ -49,10 +49,10 @@ import zenoh
 
 from components import container
 from launch.child import Child
-from launch.forked import Forked, single_threaded
+from launch.fork_server import ForkServer, Served
 from launch.output import Output
 from launch.query import statuses
-from launch.spawn import forward, spawn
+from launch.spawn import spawn
 from launch.stop import stop_all
 from messages import topics
 from messages.process import EXIT_CONFIG_ERROR, EXIT_FOR_GOOD, parent_gone
@@ -98,12 +98,14 @@ class Launcher:
         self._duration_s: float | None = None
         self._deadline: float | None = None
         """When the duration ends: set once every component is alive."""
-        self._ahead: dict[tuple[str, ...], subprocess.Popen[str] | Forked] = {}
+        self._ahead: dict[tuple[str, ...], subprocess.Popen[str] | Served] = {}
         """The processes started ahead, by the names of their children, waiting for the word to
         start them."""
         self._wake = threading.Event()
         """Set when the supervision loop has news before its next poll: a component came alive
         (those waiting for it start at once), a stop was asked."""
+        self._server: ForkServer | None = None
+        """The fork server of the children's processes, while ``run`` runs."""
 
     def run(self, duration_s: float | None = None) -> int:
         """Run until a stop signal, the duration (from the moment every component is alive),
@@ -116,19 +118,26 @@ class Launcher:
         endpoints = ", ".join(self.profile.zenoh.router)
         self._duration_s = duration_s
         self._kept_params = Path(tempfile.mkdtemp(prefix="parsimony-params-"))
-        self._start_ahead()  # they load their modules while the router opens
+        self._server = ForkServer(self._modules())  # it loads them while the router opens
         try:
             return self._run_router(endpoints)
         finally:
             for ahead in self._ahead.values():
                 self._end_ahead(ahead)
+            self._server.close()
             shutil.rmtree(self._kept_params, ignore_errors=True)
 
+    def _modules(self) -> list[str]:
+        """The modules the children's processes run."""
+        modules = {child.spec.module_path for child in self.children}
+        return sorted(modules | ({container.MODULE} if self.shared else set()))
+
     def _run_router(self, endpoints: str) -> int:
-        """``run`` once the shared children's process is on its way: the router, the children
-        started and supervised, then stopped."""
+        """``run`` once the fork server is on its way: the router, the children started and
+        supervised, then stopped."""
         with zenoh.open(self.profile.zenoh.router_config(self.profile.namespace)) as router:
             self.output.say(f"router listening on {endpoints}, namespace {self.profile.namespace}")
+            self._start_ahead()
             watcher = router.liveliness().declare_subscriber(
                 topics.liveliness_selector(self.profile.namespace),
                 self._on_liveliness,
@@ -332,33 +341,22 @@ class Launcher:
         self.output.say(f"started {label} ({module}, pid {popen.pid})")
 
     def _start_ahead(self) -> None:
-        """The shared children's process, started while they wait for the recorders, and in a
-        launcher of one thread (forked for a study's run: ``launch.forked``) each recorder's,
-        all before the router opens: they load their modules meanwhile (forked, they have
-        them), and start their children on the word (``_start``). All are forked before a
-        thread forwards their output."""
-        fork = single_threaded()
-        groups = [self.shared] if self.shared and all(c.waiting for c in self.shared) else []
-        if fork:
-            groups += [[c] for c in self.children if c.spec.name in self.recorders]
-        started = [(g, self._spawn(g, ahead=True, fork=fork, forwarding=False)) for g in groups]
-        for group, popen in started:
-            names = [c.spec.name for c in group]
-            forward(popen, names, self.output)
-            self._ahead[tuple(names)] = popen
+        """The shared children's process, started while they wait for the recorders, ready to
+        start them on the word (``_start``)."""
+        if self.shared and all(c.waiting for c in self.shared):
+            names = tuple(c.spec.name for c in self.shared)
+            self._ahead[names] = self._spawn(self.shared, ahead=True)
 
-    def _end_ahead(self, ahead: subprocess.Popen[str] | Forked | None) -> None:
+    def _end_ahead(self, ahead: subprocess.Popen[str] | Served | None) -> None:
         if ahead is not None:
             ahead.kill()
             ahead.wait()
 
-    def _spawn(
-        self, group: list[Child], ahead: bool = False, fork: bool = False, forwarding: bool = True
-    ) -> subprocess.Popen[str] | Forked:
-        """``spawn`` the process of ``group`` with this launch's profile file, kept parameters
-        and inherited descriptors."""
+    def _spawn(self, group: list[Child], ahead: bool = False) -> subprocess.Popen[str] | Served:
+        """``spawn`` the process of ``group`` with this launch's profile file, kept parameters,
+        inherited descriptors and fork server."""
         specs, kept, fds = [c.spec for c in group], self._kept_params, self.pass_fds
-        return spawn(specs, self.profile_path, kept, fds, self.output, ahead, fork, forwarding)
+        return spawn(specs, self.profile_path, kept, fds, self.output, ahead, self._server)
 
     def _on_exit(self, child: Child, code: int, now: float) -> None:
         """Decide what a child's exit means: done, failed, or a restart after a backoff."""

@@ -8,7 +8,7 @@ import threading
 from pathlib import Path
 
 from components import container
-from launch.forked import Forked, forked
+from launch.fork_server import ForkServer, Served
 from launch.output import Output
 from messages import process
 from messages.process import PARENT_PID_ENV, RUNTIME_DIR_ENV
@@ -22,18 +22,16 @@ def spawn(
     pass_fds: tuple[int, ...],
     output: Output,
     ahead: bool = False,
-    fork: bool = False,
-    forwarding: bool = True,
-) -> subprocess.Popen[str] | Forked:
+    server: ForkServer | None = None,
+) -> subprocess.Popen[str] | Served:
     """The process of ``group`` (one component, or shared ones: ``components.container``,
-    waiting for a word on its input when ``ahead``) and, if ``forwarding``, the threads
-    forwarding its output (``forward``).
+    waiting for a word on its input when ``ahead``) and the threads forwarding its output
+    (``forward``).
 
     Its parameters set at run time are kept under ``kept_params``; it inherits ``pass_fds``
-    and runs in its own session, stopping by itself when the launcher is gone. It is forked
-    (``launch.forked``) if ``fork``: a launcher of one thread (forked for a study's run) forks
-    the processes it starts ahead, before its router opens, with the component modules its
-    dataflow check loaded."""
+    and runs in its own session, stopping by itself when its parent is gone. It is forked by
+    ``server`` (``launch.fork_server``: its parent then) if there is one that serves, else it
+    is a new interpreter, the launcher's child."""
     names = [spec.name for spec in group]
     env = dict(
         os.environ,
@@ -53,17 +51,14 @@ def spawn(
         "start_new_session": True,
         "pass_fds": pass_fds,
     }
-    popen: subprocess.Popen[str] | Forked
-    if fork:
-        popen = forked(command[2:], **how)  # [sys.executable, "-m", module, args...]
-    else:
+    popen = None if server is None else server.spawn(command[2:], **how)  # [python, -m, ...]
+    if popen is None:
         popen = subprocess.Popen(command, text=True, errors="replace", **how)
-    if forwarding:
-        forward(popen, names, output)
+    forward(popen, names, output)
     return popen
 
 
-def forward(popen: subprocess.Popen[str] | Forked, names: list[str], output: Output) -> None:
+def forward(popen: subprocess.Popen[str] | Served, names: list[str], output: Output) -> None:
     """Threads forwarding the output of the process of components ``names``, prefixed."""
     prefix = "+".join(names)
     for pipe, stream in ((popen.stdout, output.out), (popen.stderr, output.err)):

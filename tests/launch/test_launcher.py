@@ -203,7 +203,8 @@ def test_a_hung_component_is_restarted_by_the_watchdog_with_its_parameters_set_a
 ) -> None:
     """SIGSTOP leaves the process and its session up but answering nothing: before, it was
     reported lost only after the ~10 s session lease and never restarted. A parameter set
-    before: its restart has it. Then the launcher is killed: the component stops by itself.
+    before: its restart has it. Then the launcher is killed: its fork server ends, and the
+    component, the server's child, stops by itself.
     (One launch for what two proved: the parameter's component was killed by the test.)"""
     profile = write_profile([publisher("pub")], watchdog_s=1.0)
     launched = launch(profile)
@@ -221,12 +222,16 @@ def test_a_hung_component_is_restarted_by_the_watchdog_with_its_parameters_set_a
         launched.wait_for(r"\[launch\] pub alive", after=restarted)
         assert query.get_param(session, "test", "pub", "rate_hz") == 7.5
         assert query.get_param(session, "test", "pub", "goal_task") == "position"  # untouched
+    pid = int(match.group(1))
+    # Forked by the launch's fork server, no interpreter of its own (launch/fork_server.py).
+    server = int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
+    assert server != launched.process.pid
+    assert b"-m\x00launch.fork_server\x00" in Path(f"/proc/{pid}/cmdline").read_bytes()
     launched.process.kill()
     launched.process.wait()
-    pid = int(match.group(1))
     deadline = time.monotonic() + DEADLINE_S
-    while not process_gone(pid):
-        assert time.monotonic() < deadline, "component outlived its launcher by 60 s"
+    while not (process_gone(pid) and process_gone(server)):
+        assert time.monotonic() < deadline, "a process outlived its launcher by 60 s"
         time.sleep(0.02)
 
 

@@ -1,6 +1,6 @@
 """A launch from a study's run (studies/launched.py): a process with one thread forks its
-launcher, which forks the shared process it starts ahead; both run, answer and stop as a new
-interpreter's do."""
+launcher, which forks its fork server, which forks its children; all run, answer and stop as a
+new interpreter's do."""
 
 from __future__ import annotations
 
@@ -30,8 +30,10 @@ with (out / "launch.log").open("w") as log, launched(profile, log) as launcher:
             assert launcher.poll() is None
         while not getattr(statuses(session, "forked").get("rec"), "counters", {}).get("written"):
             assert launcher.poll() is None
-        task = f"/proc/{launcher.pid}/task/{launcher.pid}/children"
-        commands = [Path(f"/proc/{pid}/cmdline").read_bytes() for pid in open(task).read().split()]
+        def children(pid):
+            return open(f"/proc/{pid}/task/{pid}/children").read().split()
+        served = [pid for server in children(launcher.pid) for pid in children(server)]
+        commands = [Path(f"/proc/{pid}/cmdline").read_bytes() for pid in served]
     kind = type(launcher).__name__
 forked = [b"-m\\x00components." not in command for command in commands]
 code = launcher.returncode
@@ -41,11 +43,11 @@ print(json.dumps({"threads": threads, "launcher": kind, "code": code, "forked": 
 answering and stopped."""
 
 
-def test_a_process_of_one_thread_forks_a_launcher_and_the_processes_it_starts_ahead(
+def test_a_process_of_one_thread_forks_a_launcher_whose_fork_server_forks_its_children(
     tmp_path: Path,
 ) -> None:
-    """The launcher forked, and the shared process and the recorder's it starts ahead forked
-    from it: they run, answer, record and stop as a new interpreter's do."""
+    """The launcher forked, and the shared process and the recorder's forked from its fork
+    server, itself forked: they run, answer, record and stop as a new interpreter's do."""
     profile, recording = tmp_path / "system.yaml", tmp_path / "session.mcap"
     components = [
         {"name": name, "module": "scripted_publisher", "role": "tool"} for name in ("pub", "echo")

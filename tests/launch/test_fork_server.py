@@ -1,0 +1,103 @@
+"""The fork server (launch/fork_server.py): a served child runs as a new interpreter's would (its
+module and arguments, environment, session, pipes and descriptors by number), is the server's
+child, and answers as a Popen; once the server is gone, its children are seen ending and new
+ones are refused."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from launch.fork_server import LOST, ForkServer
+from messages.process import PARENT_PID_ENV
+from tests.launch.conftest import DEADLINE_S
+
+SAYS = (
+    "import json, os; print(json.dumps({'ppid': os.getppid(), 'parent': os.environ['%s'], "
+    "'x': os.environ.get('X'), 'own_session': os.getsid(0) == os.getpid(), "
+    "'read': open('/proc/self/fd/%d').read()}))"
+)
+"""What a served child says of itself: ``timeit -n1 -r1`` runs it once."""
+
+
+def timeit(statement: str) -> list[str]:
+    """``python -m timeit`` running ``statement`` once."""
+    return ["timeit", "-n1", "-r1", statement]
+
+
+@pytest.fixture(scope="module")
+def server() -> Iterator[ForkServer]:
+    """One fork server, a new interpreter (this process has more than one thread)."""
+    served = ForkServer(["json"])
+    yield served
+    served.close()
+
+
+def test_a_served_child_runs_its_module_as_the_servers_child_with_its_descriptors(
+    server: ForkServer, tmp_path: Path
+) -> None:
+    """Its arguments, environment, session, output pipe and a passed descriptor at its own
+    number (as ``parsimony launch --record`` passes its profile); its parent is the server,
+    which its ``PARENT_PID_ENV`` names."""
+    (tmp_path / "profile.yaml").write_text("namespace: test\n")
+    given = os.open(tmp_path / "profile.yaml", os.O_RDONLY)
+    number = os.dup2(given, 97 if given != 97 else 98, inheritable=False)
+    os.close(given)
+    env = {**os.environ, "X": "y", PARENT_PID_ENV: str(os.getpid())}
+    child = server.spawn(
+        timeit(SAYS % (PARENT_PID_ENV, number)),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        env=env,
+        start_new_session=True,
+        pass_fds=(number,),
+    )
+    os.close(number)
+    assert child is not None and child.stdout is not None
+    lines = child.stdout.read().splitlines()
+    assert child.wait(DEADLINE_S) == 0 and child.poll() == 0
+    said = json.loads(lines[0])
+    server_pid = server.process.pid
+    assert said == {
+        "ppid": server_pid,
+        "parent": str(server_pid),
+        "x": "y",
+        "own_session": True,
+        "read": "namespace: test\n",
+    }
+    assert lines[1].startswith("1 loop, best of 1")  # timeit's arguments, as given
+
+
+def test_a_served_childs_exit_code_is_reported_and_a_wait_may_time_out(
+    server: ForkServer,
+) -> None:
+    failing = server.spawn(timeit("import os; os._exit(3)"), stdout=subprocess.DEVNULL)
+    assert failing is not None and failing.wait(DEADLINE_S) == 3
+    sleeping = server.spawn(timeit("import time; time.sleep(60)"), stdout=subprocess.DEVNULL)
+    assert sleeping is not None
+    with pytest.raises(subprocess.TimeoutExpired):
+        sleeping.wait(0.05)
+    assert sleeping.poll() is None
+    sleeping.kill()
+    assert sleeping.wait(DEADLINE_S) == -signal.SIGKILL
+    sleeping.send_signal(signal.SIGTERM)  # ended: nothing to do
+
+
+def test_once_the_server_is_gone_its_children_are_seen_ending_and_new_ones_are_refused() -> None:
+    """Never a wait that hangs: a child whose end the server could not report is seen ended
+    when its process is; the launcher then starts a new interpreter (``spawn`` says None)."""
+    server = ForkServer([])
+    child = server.spawn(timeit("import time; time.sleep(60)"), stdout=subprocess.DEVNULL)
+    assert child is not None
+    server.process.kill()
+    server.process.wait()
+    assert server.spawn(["platform"], stdout=subprocess.DEVNULL) is None
+    os.kill(child.pid, signal.SIGKILL)
+    assert child.wait(DEADLINE_S) == LOST
+    server.close()
