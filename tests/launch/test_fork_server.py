@@ -101,3 +101,20 @@ def test_once_the_server_is_gone_its_children_are_seen_ending_and_new_ones_are_r
     os.kill(child.pid, signal.SIGKILL)
     assert child.wait(DEADLINE_S) == LOST
     server.close()
+
+
+def test_a_server_of_more_than_one_thread_refuses_to_fork(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A module it loaded started a thread: a fork would copy that thread's state without it,
+    so the server refuses and the caller starts a new interpreter (``spawn`` says None)."""
+    (tmp_path / "starts_a_thread.py").write_text(
+        "import threading, time\n"
+        "threading.Thread(target=time.sleep, args=(60,), daemon=True).start()\n"
+    )
+    monkeypatch.setenv("PYTHONPATH", str(tmp_path))
+    server = ForkServer(["starts_a_thread"])
+    try:
+        assert server.spawn(["platform"], stdout=subprocess.DEVNULL) is None
+    finally:
+        server.close()
