@@ -226,7 +226,8 @@ def test_a_hung_component_is_restarted_by_the_watchdog_with_its_parameters_set_a
     # Forked by the launch's fork server, no interpreter of its own (launch/fork_server.py).
     server = int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
     assert server != launched.process.pid
-    assert b"-m\x00launch.fork_server\x00" in Path(f"/proc/{pid}/cmdline").read_bytes()
+    command = Path(f"/proc/{pid}/cmdline").read_bytes()
+    assert command == Path(f"/proc/{server}/cmdline").read_bytes()
     launched.process.kill()
     launched.process.wait()
     deadline = time.monotonic() + DEADLINE_S
