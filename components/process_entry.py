@@ -35,8 +35,11 @@ from profiles.profile import ProfileError, load_profile
 log = logging.getLogger("components")
 
 
-class StopRequested(Exception):
-    """Raised in the main thread by SIGINT or SIGTERM."""
+class StopRequested(BaseException):
+    """Raised in the main thread by SIGINT or SIGTERM. Not an ``Exception``, as
+    ``KeyboardInterrupt`` is not: a handler of errors (logging's, which prints "--- Logging
+    error ---" and goes on) would otherwise swallow it when the signal lands inside a log call,
+    and the stop would be lost (its signals are ignored from then on)."""
 
 
 def _on_stop_signal(signum: int, _frame: object) -> None:
