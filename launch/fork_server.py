@@ -75,6 +75,9 @@ class Served:
     def kill(self) -> None:
         self.send_signal(signal.SIGKILL)
 
+    def terminate(self) -> None:
+        self.send_signal(signal.SIGTERM)
+
 
 class ForkServer:
     """The launcher's side of a fork server loading ``modules``: its process and its replies,

@@ -80,6 +80,9 @@ class Forked:
     def kill(self) -> None:
         self.send_signal(signal.SIGKILL)
 
+    def terminate(self) -> None:
+        self.send_signal(signal.SIGTERM)
+
 
 def child_ends(
     stdin: int | None, stdout: IO[str] | int | None, stderr: IO[str] | int | None

@@ -17,6 +17,7 @@ import yaml
 import zenoh
 from pydantic import BaseModel
 
+from launch.fork_server import ForkServer, Served
 from messages import codec, topics
 from profiles.deploy_files import DEPLOY
 from profiles.endpoints import free_port
@@ -27,6 +28,23 @@ M = TypeVar("M", bound=BaseModel)
 
 DEADLINE_S = 60.0
 """Generous limit for anything that involves starting a process on a loaded machine."""
+
+COMPONENT_MODULES = sorted(
+    f"components.{path.stem}"
+    for path in (Path(__file__).resolve().parents[2] / "components").glob("*.py")
+    if "run_component(" in path.read_text()
+)
+"""Every component's module, which the tests' fork server loads."""
+
+
+@pytest.fixture(scope="session")
+def component_server() -> Iterator[ForkServer]:
+    """One fork server per test process (``launch.fork_server``) with every component module
+    loaded: a component's process starts as a launcher starts it, without an interpreter's
+    start (half a second of CPU)."""
+    server = ForkServer(COMPONENT_MODULES)
+    yield server
+    server.close()
 
 
 def _wait_until(condition: Callable[[], bool], what: str, timeout_s: float = DEADLINE_S) -> None:
@@ -55,7 +73,9 @@ class System:
     profile: Profile
     router: zenoh.Session
     deadline_s: float = DEADLINE_S
-    processes: list[subprocess.Popen[str]] = field(default_factory=list)
+    server: ForkServer | None = None
+    """Where its component processes are forked (None: each a new interpreter)."""
+    processes: list[subprocess.Popen[str] | Served] = field(default_factory=list)
 
     def liveliness(self) -> LivelinessLog:
         """Start recording the liveliness changes of the namespace."""
@@ -65,14 +85,17 @@ class System:
         """Start collecting the messages of ``topic`` in the namespace."""
         return Inbox(self.router, self.profile.namespace, topic)
 
-    def start(self, name: str) -> subprocess.Popen[str]:
-        """Start the profile's component ``name`` as its own process; what it logs goes to
-        ``<name>.log`` beside the profile (a pipe nobody reads would block it once full)."""
+    def start(self, name: str) -> subprocess.Popen[str] | Served:
+        """Start the profile's component ``name`` as its own process (forked by the server, if
+        the system has one); what it logs goes to ``<name>.log`` beside the profile (a pipe
+        nobody reads would block it once full)."""
         module = self.profile.component(name).module_path
-        command = [sys.executable, "-m", module, "--profile", str(self.path), "--name", name]
+        command = [module, "--profile", str(self.path), "--name", name]
         with (self.path.parent / f"{name}.log").open("a") as log:
-            self.processes.append(subprocess.Popen(command, stderr=log, text=True))
-        return self.processes[-1]
+            served = self.server.spawn(command, stderr=log) if self.server else None
+            process = served or subprocess.Popen([sys.executable, "-m", *command], stderr=log)
+        self.processes.append(process)
+        return process
 
     def log(self, name: str) -> str:
         """What component ``name`` has logged so far."""
@@ -92,7 +115,7 @@ class System:
 
 
 @pytest.fixture
-def system(tmp_path: Path) -> Iterator[System]:
+def system(tmp_path: Path, component_server: ForkServer) -> Iterator[System]:
     """Namespace ``test``: ``pub`` (a scripted publisher process) and in-process nodes."""
     in_process = {"module": "scripted_publisher", "role": "tool", "enabled": False}
     data = {
@@ -113,12 +136,14 @@ def system(tmp_path: Path) -> Iterator[System]:
     path.write_text(yaml.safe_dump(data))
     profile = load_profile(path)
     with zenoh.open(profile.zenoh.router_config()) as router:
-        system = System(path, profile, router)
+        system = System(path, profile, router, server=component_server)
         yield system
         system.stop_processes()
 
 
-def _deployer(stack: ExitStack, directory: Path) -> Callable[[str | Path], System]:
+def _deployer(
+    stack: ExitStack, directory: Path, server: ForkServer
+) -> Callable[[str | Path], System]:
     """``deploy(profile)``: a profile of ``deploy/`` (its path, or its YAML text) copied into
     ``directory`` with its router open until ``stack`` closes.
 
@@ -138,7 +163,7 @@ def _deployer(stack: ExitStack, directory: Path) -> Callable[[str | Path], Syste
         path.write_text(yaml.safe_dump(data, sort_keys=False))
         profile = load_profile(path)
         router = stack.enter_context(zenoh.open(profile.zenoh.router_config()))
-        system = System(path, profile, router)
+        system = System(path, profile, router, server=server)
         stack.callback(system.stop_processes)
         return system
 
@@ -146,20 +171,22 @@ def _deployer(stack: ExitStack, directory: Path) -> Callable[[str | Path], Syste
 
 
 @pytest.fixture
-def deployed(tmp_path: Path) -> Iterator[Callable[[str | Path], System]]:
+def deployed(
+    tmp_path: Path, component_server: ForkServer
+) -> Iterator[Callable[[str | Path], System]]:
     """``deployed(profile)``: a profile of ``deploy/`` with its router open, for one test
     (``_deployer``)."""
     with ExitStack() as stack:
-        yield _deployer(stack, tmp_path)
+        yield _deployer(stack, tmp_path, component_server)
 
 
 @pytest.fixture(scope="module")
 def deployed_for_module(
-    tmp_path_factory: pytest.TempPathFactory,
+    tmp_path_factory: pytest.TempPathFactory, component_server: ForkServer
 ) -> Iterator[Callable[[str | Path], System]]:
     """``deployed`` for a system the tests of a module share (started once)."""
     with ExitStack() as stack:
-        yield _deployer(stack, tmp_path_factory.mktemp("deployed"))
+        yield _deployer(stack, tmp_path_factory.mktemp("deployed"), component_server)
 
 
 class LivelinessLog:
