@@ -5,7 +5,11 @@ from __future__ import annotations
 import subprocess
 from dataclasses import dataclass
 
+from launch.fork_server import Served
 from profiles.profile import ComponentSpec
+
+Process = subprocess.Popen[str] | Served
+"""A component's process: forked by the launch's fork server, or a new interpreter."""
 
 
 @dataclass
@@ -13,7 +17,7 @@ class Child:
     """One component's process and its restart bookkeeping."""
 
     spec: ComponentSpec
-    process: subprocess.Popen[str] | None = None
+    process: Process | None = None
     waiting: bool = True
     """Not started yet: it waits for the components it starts ``after``."""
     started_at: float = 0.0

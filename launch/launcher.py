@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import shutil
 import signal
-import subprocess
 import sys
 import tempfile
 import threading
@@ -48,8 +47,8 @@ from typing import IO
 import zenoh
 
 from components import container
-from launch.child import Child
-from launch.fork_server import ForkServer, Served
+from launch.child import Child, Process
+from launch.fork_server import ForkServer
 from launch.output import Output
 from launch.query import statuses
 from launch.spawn import spawn
@@ -98,7 +97,7 @@ class Launcher:
         self._duration_s: float | None = None
         self._deadline: float | None = None
         """When the duration ends: set once every component is alive."""
-        self._ahead: dict[tuple[str, ...], subprocess.Popen[str] | Served] = {}
+        self._ahead: dict[tuple[str, ...], Process] = {}
         """The processes started ahead, by the names of their children, waiting for the word to
         start them."""
         self._wake = threading.Event()
@@ -347,12 +346,12 @@ class Launcher:
             names = tuple(c.spec.name for c in self.shared)
             self._ahead[names] = self._spawn(self.shared, ahead=True)
 
-    def _end_ahead(self, ahead: subprocess.Popen[str] | Served | None) -> None:
+    def _end_ahead(self, ahead: Process | None) -> None:
         if ahead is not None:
             ahead.kill()
             ahead.wait()
 
-    def _spawn(self, group: list[Child], ahead: bool = False) -> subprocess.Popen[str] | Served:
+    def _spawn(self, group: list[Child], ahead: bool = False) -> Process:
         """``spawn`` the process of ``group`` with this launch's profile file, kept parameters,
         inherited descriptors and fork server."""
         specs, kept, fds = [c.spec for c in group], self._kept_params, self.pass_fds

@@ -8,7 +8,8 @@ import threading
 from pathlib import Path
 
 from components import container
-from launch.fork_server import ForkServer, Served
+from launch.child import Process
+from launch.fork_server import ForkServer
 from launch.output import Output
 from messages import process
 from messages.process import PARENT_PID_ENV, RUNTIME_DIR_ENV
@@ -23,7 +24,7 @@ def spawn(
     output: Output,
     ahead: bool = False,
     server: ForkServer | None = None,
-) -> subprocess.Popen[str] | Served:
+) -> Process:
     """The process of ``group`` (one component, or shared ones: ``components.container``,
     waiting for a word on its input when ``ahead``) and the threads forwarding its output
     (``forward``).
@@ -58,7 +59,7 @@ def spawn(
     return popen
 
 
-def forward(popen: subprocess.Popen[str] | Served, names: list[str], output: Output) -> None:
+def forward(popen: Process, names: list[str], output: Output) -> None:
     """Threads forwarding the output of the process of components ``names``, prefixed."""
     prefix = "+".join(names)
     for pipe, stream in ((popen.stdout, output.out), (popen.stderr, output.err)):

@@ -10,7 +10,7 @@ import time
 from itertools import groupby
 from pathlib import Path
 
-from launch.child import Child
+from launch.child import Child, Process
 from launch.output import Output
 from profiles.profile import ROLES, Profile
 
@@ -29,7 +29,7 @@ def cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
-def wait_ended(process: subprocess.Popen[str], timeout_s: float) -> int:
+def wait_ended(process: Process, timeout_s: float) -> int:
     """``process.wait(timeout_s)``, woken by the process's end (a Linux pidfd), not by
     ``wait``'s polls, which grow to 50 ms apart: each stop waited for ends when it does."""
     try:
@@ -68,7 +68,7 @@ def stop_all(children: list[Child], profile: Profile, output: Output) -> None:
             _reap(child, child.process, stopped_at + child.spec.stop_timeout_s, output)
 
 
-def _reap(child: Child, process: subprocess.Popen[str], deadline: float, output: Output) -> None:
+def _reap(child: Child, process: Process, deadline: float, output: Output) -> None:
     """Wait for a child sent SIGTERM until ``deadline``, then kill it."""
     code = _wait_stopped(child, process, deadline, output)
     if code is None:
@@ -82,9 +82,7 @@ def _reap(child: Child, process: subprocess.Popen[str], deadline: float, output:
     child.process = None
 
 
-def _wait_stopped(
-    child: Child, process: subprocess.Popen[str], deadline: float, output: Output
-) -> int | None:
+def _wait_stopped(child: Child, process: Process, deadline: float, output: Output) -> int | None:
     """Its exit code, or None once ``deadline`` passed; a recorder's deadline moves on
     while it spends CPU time. A wait longer than ``QUIET_WAIT_S`` is said."""
     spent, said = cpu_seconds(process.pid), False

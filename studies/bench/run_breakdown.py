@@ -15,8 +15,8 @@ p99 of each subscription handler, ``components.pubsub``, and of the lockstep gat
 ``frame_wait`` a step waiting for them, ``loop`` a step waiting for the commands).
 With ``--parallel K``, K runs at a time: the whole-loop runs per minute. With ``--no-figures``
 the runs draw no figures and each is forked from this process, as a study's runs are (its
-launcher and the processes it starts ahead forked in turn, ``launch.forked``; this process opens
-no Zenoh session); the CPU time is then the run's alone.
+launcher forked, ``launch.forked``, and the launcher's fork server, ``launch.fork_server``; this
+process opens no Zenoh session); the CPU time is then the run's alone.
 """
 
 from __future__ import annotations
