@@ -26,10 +26,9 @@ import subprocess
 import sys
 import threading
 from collections import deque
-from collections.abc import Mapping
-from typing import IO
+from typing import IO, Unpack
 
-from launch.forked import Forked, child_ends, forked, run_child, single_threaded
+from launch.forked import ChildOptions, Forked, child_ends, forked, run_child, single_threaded
 from messages.process import PARENT_PID_ENV
 
 MODULE = "launch.fork_server"
@@ -86,7 +85,7 @@ class ForkServer:
     def __init__(self, modules: list[str]) -> None:
         self._channel, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
         command = [MODULE, str(theirs.fileno()), *modules]
-        how = {
+        how: ChildOptions = {
             "stdin": subprocess.DEVNULL,
             "env": {**os.environ, "OPENBLAS_NUM_THREADS": "1"},  # one thread, as it forks
             "start_new_session": True,
@@ -103,25 +102,19 @@ class ForkServer:
         self._gone = False
         threading.Thread(target=self._read, daemon=True).start()
 
-    def spawn(
-        self,
-        command: list[str],
-        stdin: int | None = None,
-        stdout: IO[str] | int | None = None,
-        stderr: IO[str] | int | None = None,
-        env: Mapping[str, str] | None = None,
-        start_new_session: bool = False,
-        pass_fds: tuple[int, ...] = (),
-    ) -> Served | None:
-        """``command`` (``[MODULE, ARGS...]``) forked by the server, as ``forked`` takes it
-        (``env`` None: this process's); None when the server is gone or refuses (it has more
-        than one thread), the caller then starting a new interpreter."""
-        parent_ends, child_fds, closed_after = child_ends(stdin, stdout, stderr)
-        child_fds |= {fd: fd for fd in pass_fds}
+    def spawn(self, command: list[str], **how: Unpack[ChildOptions]) -> Served | None:
+        """``command`` (``[MODULE, ARGS...]``) forked by the server, started as ``forked``
+        starts it; None when the server is gone or refuses (it has more than one thread), the
+        caller then starting a new interpreter."""
+        parent_ends, child_fds, closed_after = child_ends(
+            how.get("stdin"), how.get("stdout"), how.get("stderr")
+        )
+        child_fds |= {fd: fd for fd in how.get("pass_fds", ())}
+        env = how.get("env")
         request = {
             "command": command,
             "env": dict(os.environ if env is None else env),
-            "session": start_new_session,
+            "session": how.get("start_new_session", False),
             "fds": list(child_fds),
         }
         served = Served(command, parent_ends)

@@ -29,7 +29,7 @@ import sys
 import threading
 import traceback
 from collections.abc import Mapping
-from typing import IO
+from typing import IO, TypedDict, Unpack
 
 
 def single_threaded() -> bool:
@@ -124,22 +124,28 @@ def child_ends(
     return parent_ends, child_fds, closed_after
 
 
-def forked(
-    command: list[str],
-    stdin: int | None = None,
-    stdout: IO[str] | int | None = None,
-    stderr: IO[str] | int | None = None,
-    env: Mapping[str, str] | None = None,
-    start_new_session: bool = False,
-    pass_fds: tuple[int, ...] = (),
-) -> Forked:
-    """``command`` (``[MODULE, ARGS...]``) in a forked child: ``stdin``, ``stdout`` and
-    ``stderr`` as ``child_ends`` takes them, ``env`` (None: this process's), in a session of
-    its own if ``start_new_session``, with ``pass_fds`` open."""
-    parent_ends, child_fds, closed_after = child_ends(stdin, stdout, stderr)
+class ChildOptions(TypedDict, total=False):
+    """How a child starts, as ``subprocess.Popen`` takes it: its ``stdin``, ``stdout`` and
+    ``stderr`` (``child_ends``), ``env`` (None: this process's), in a session of its own if
+    ``start_new_session``, with ``pass_fds`` open (at their numbers)."""
+
+    stdin: int | None
+    stdout: IO[str] | int | None
+    stderr: IO[str] | int | None
+    env: Mapping[str, str] | None
+    start_new_session: bool
+    pass_fds: tuple[int, ...]
+
+
+def forked(command: list[str], **how: Unpack[ChildOptions]) -> Forked:
+    """``command`` (``[MODULE, ARGS...]``) in a forked child started as ``how`` says."""
+    parent_ends, child_fds, closed_after = child_ends(
+        how.get("stdin"), how.get("stdout"), how.get("stderr")
+    )
+    child_fds |= {fd: fd for fd in how.get("pass_fds", ())}
     pid = os.fork()
     if pid == 0:
-        run_child(command, child_fds | {fd: fd for fd in pass_fds}, env, start_new_session)
+        run_child(command, child_fds, how.get("env"), how.get("start_new_session", False))
     for descriptor in closed_after:
         os.close(descriptor)
     return Forked(pid, command, parent_ends)

@@ -10,6 +10,7 @@ from pathlib import Path
 from components import container
 from launch.child import Process
 from launch.fork_server import ForkServer
+from launch.forked import ChildOptions
 from launch.output import Output
 from messages import process
 from messages.process import PARENT_PID_ENV, RUNTIME_DIR_ENV
@@ -44,7 +45,7 @@ def spawn(
     else:
         spec = group[0]
         command = process.command(spec.module_path, profile_path, spec.name)
-    how = {
+    how: ChildOptions = {
         "stdin": subprocess.PIPE if ahead else subprocess.DEVNULL,
         "stdout": subprocess.PIPE,
         "stderr": subprocess.PIPE,
