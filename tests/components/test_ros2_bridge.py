@@ -30,6 +30,7 @@ from profiles.profile_files import read_profile_data
 from ros2.urdf import urdf
 from tests.components.conftest import DEADLINE_S, System
 from tests.robot_states import state_at
+from tests.ros2.pose_stamped import pose_stamped
 from wbc import dq
 from wbc.robot import MobileManipulator
 
@@ -120,21 +121,6 @@ class Bridge:
             assert time.monotonic() < deadline, f"{name} stayed {counters.get(name)}"
             time.sleep(0.01)
         return counters
-
-
-def pose_stamped(frame: str, position, orientation=(1.0, 0.0, 0.0, 0.0)) -> bytes:
-    types = store().types
-    w, x, y, z = orientation
-    message = types["geometry_msgs/msg/PoseStamped"](
-        header=types["std_msgs/msg/Header"](
-            stamp=types["builtin_interfaces/msg/Time"](sec=0, nanosec=0), frame_id=frame
-        ),
-        pose=types["geometry_msgs/msg/Pose"](
-            position=types["geometry_msgs/msg/Point"](x=position[0], y=position[1], z=position[2]),
-            orientation=types["geometry_msgs/msg/Quaternion"](x=x, y=y, z=z, w=w),
-        ),
-    )
-    return bytes(store().serialize_cdr(message, "geometry_msgs/msg/PoseStamped"))
 
 
 ATTACHMENT = struct.pack("<qqB16s", 1, time.time_ns(), 16, bytes(16))

@@ -10,28 +10,13 @@ import pytest
 
 from messages.header import Header
 from ros2.goal_in import ECHO_CHARS, MAX_BYTES, Refused, goal_of
-from ros2.wire import typestore
+from tests.ros2.pose_stamped import pose_stamped
 from wbc import dq
 
 HEADER = Header(stamp_ns=1, frame="world", seq=0, source="test")
 BASE = np.array([[0.0, -1.0, 0.0, 1.0], [1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0, 0, 0, 1]])
 """A base a quarter turn about z, at (1, 0, 0) in the world."""
 FRAMES = {"world": np.eye(4), "base_footprint": BASE}
-
-
-def pose_stamped(frame: str, position, orientation=(1.0, 0.0, 0.0, 0.0)) -> bytes:
-    types = typestore().types
-    w, x, y, z = orientation
-    message = types["geometry_msgs/msg/PoseStamped"](
-        header=types["std_msgs/msg/Header"](
-            stamp=types["builtin_interfaces/msg/Time"](sec=0, nanosec=0), frame_id=frame
-        ),
-        pose=types["geometry_msgs/msg/Pose"](
-            position=types["geometry_msgs/msg/Point"](x=position[0], y=position[1], z=position[2]),
-            orientation=types["geometry_msgs/msg/Quaternion"](x=x, y=y, z=z, w=w),
-        ),
-    )
-    return bytes(typestore().serialize_cdr(message, "geometry_msgs/msg/PoseStamped"))
 
 
 def refusal(data: bytes, frames=FRAMES) -> Refused:
