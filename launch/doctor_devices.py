@@ -74,8 +74,11 @@ def model_name(number: int) -> str:
 class Bus:
     """A servo bus opened at ``baud`` for Pings and Reads of one protocol (1 or 2)."""
 
-    def __init__(self, port: str, baud: int, protocol: int) -> None:
+    def __init__(self, port: str, baud: int, protocol: int, answer_timeout_s: float = 0.0) -> None:
+        """``answer_timeout_s``: the least wait for an expected servo's answer (the arm
+        driver's parameter: an emulated chain's may come late, and late is not silent)."""
         self.serial = serial.Serial(port, baud, timeout=0.002)
+        self.answer_timeout_s = max(ANSWER_TIMEOUT_S, answer_timeout_s)
         self.protocol = protocol
         self.dxl = dxl1 if protocol == 1 else dxl2
 
@@ -107,9 +110,12 @@ class Bus:
             buffer = buffer[length:]
         return answers
 
-    def ping(self, servo: int, timeout_s: float = ANSWER_TIMEOUT_S) -> bool:
+    def ping(self, servo: int, timeout_s: float | None = None) -> bool:
+        """Whether ``servo`` answers a Ping within ``timeout_s`` (None: an expected servo's
+        wait)."""
         packet = self.dxl.instruction_packet(servo, self.dxl.Instruction.PING)
-        return any(a[len(self.dxl.HEADER)] == servo for a in self._answers(packet, 1, timeout_s))
+        wait = self.answer_timeout_s if timeout_s is None else timeout_s
+        return any(a[len(self.dxl.HEADER)] == servo for a in self._answers(packet, 1, wait))
 
     def broadcast_ping(self, timeout_s: float = ANSWER_TIMEOUT_S) -> list[int]:
         """Protocol 2.0: the ids of every servo that answers a broadcast Ping."""
@@ -122,7 +128,7 @@ class Bus:
             packet = dxl1.instruction_packet(servo, dxl1.Instruction.READ, bytes((address, length)))
         else:
             packet = dxl2.read(servo, address, length)
-        for answer in self._answers(packet, 1, ANSWER_TIMEOUT_S):
+        for answer in self._answers(packet, 1, self.answer_timeout_s):
             if self.dxl.status_fault(answer, servo, length) is None:
                 return answer[5:-1] if self.protocol == 1 else dxl2.status_data(answer)[1]
         return None
@@ -147,7 +153,7 @@ class Bus:
                 if baud == profile_baud:
                     continue
                 self.set_baud(baud)
-                if any(self.ping(i) for i in ids):
+                if any(self.ping(i, ANSWER_TIMEOUT_S) for i in ids):
                     return baud
             return None
         finally:
@@ -216,11 +222,13 @@ def _servo_line(bus: Bus, joint: Joint, baud: int) -> Check:
     return Check(name, "ok", f"{detail} (the joint's {joint.low}..{joint.high} inside)")
 
 
-def servo_checks(port: str, baud: int, protocol: int, joints: Sequence[Joint]) -> list[Check]:
+def servo_checks(
+    port: str, baud: int, protocol: int, joints: Sequence[Joint], answer_timeout_s: float = 0.0
+) -> list[Check]:
     """A line per servo of the arm on ``port`` (opened already: the port's own line says why
-    not)."""
+    not), each awaited ``answer_timeout_s`` at least (``Bus``)."""
     try:
-        bus = Bus(port, baud, protocol)
+        bus = Bus(port, baud, protocol, answer_timeout_s)
     except (OSError, ValueError) as error:
         return [Check("servos", "fail", f"cannot open {port}: {error}", "see the port's line")]
     try:

@@ -19,7 +19,7 @@ from protocols import dynamixel_v2 as dxl2
 from sim2d.camera import ImageNoise, PlacedMarker, render
 from sim2d.devices.ax_servos import AXChainEmulator
 from sim2d.devices.create2 import Create2Emulator
-from sim2d.devices.servo_chain import IntegratingJoints
+from sim2d.devices.servo_chain import ANSWER_TIMEOUT_S, IntegratingJoints
 from sim2d.devices.x_servos import XChainEmulator
 from sim2d.pinhole import ceiling_camera
 from wbc.planar import planar_pose
@@ -114,7 +114,13 @@ def bench(directory: Path, setup: Setup) -> Iterator[Bench]:
         "namespace": "doctor",
         "components": [
             {"name": "base_driver", "params": {"port": str(directory / "create2")}},
-            {"name": "arm_driver", "params": {"port": setup.arm_port or str(directory / "servos")}},
+            {
+                "name": "arm_driver",
+                "params": {
+                    "port": setup.arm_port or str(directory / "servos"),
+                    "answer_timeout_s": ANSWER_TIMEOUT_S,
+                },
+            },
         ],
     }
     if setup.protocol == 2:
