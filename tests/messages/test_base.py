@@ -1,4 +1,6 @@
-"""Validation of the message models: what each one accepts and refuses."""
+"""messages.base: what every message model refuses (a float that is not finite, a change, an
+unknown field), the pose every model takes (a unit dual quaternion), and the arm's joints and
+their names (``RobotState``'s and ``ArmCommand``'s, which both take base's rules)."""
 
 from __future__ import annotations
 
@@ -8,7 +10,7 @@ from typing import Any
 
 import pytest
 from hypothesis import given
-from message_examples import EXAMPLES, HEADER, IMAGE, POSE_GOAL, QUARTER_TURN_SHIFTED, STATE
+from message_examples import EXAMPLES, HEADER, STATE
 from message_strategies import unit_dual_quaternions
 from pydantic import ValidationError
 
@@ -16,17 +18,12 @@ from messages import (
     IDENTITY_POSE,
     MESSAGE_TYPES,
     ArmCommand,
-    CameraFrame,
     Circle,
     Goal,
-    Header,
-    JointStates,
     MarkerDetection,
     RobotState,
 )
 from messages.base import Message
-from messages.obstacles import Cylinder, Plane, Solids
-from wbc.geometry import obstacles3d
 
 
 def _float_paths(value: Any, path: tuple[Any, ...] = ()) -> Iterator[tuple[Any, ...]]:
@@ -80,17 +77,6 @@ def test_messages_are_frozen() -> None:
 def test_unknown_fields_are_refused() -> None:
     with pytest.raises(ValidationError, match="Extra inputs"):
         Circle(x=0, y=0, radius=1, colour="red")  # type: ignore[call-arg]
-
-
-def test_header_counts_are_non_negative() -> None:
-    with pytest.raises(ValidationError, match="stamp_ns"):
-        Header(stamp_ns=-1, frame="world", seq=0, source="test")
-    with pytest.raises(ValidationError, match="seq"):
-        Header(stamp_ns=0, frame="world", seq=2**64, source="test")
-
-
-def test_configuration_is_base_pose_then_arm_joints() -> None:
-    assert STATE.configuration() == [1.0, 2.0, 0.3, 0.1, -0.2, 0.3, -0.4, 0.5]
 
 
 @pytest.mark.parametrize("length", [1, 4, 7, 12])
@@ -161,88 +147,3 @@ def test_unit_tolerance_is_one_in_a_million() -> None:
     assert Goal(header=HEADER, task="pose", pose=nearly).pose == nearly
     with pytest.raises(ValidationError, match="norm"):
         Goal(header=HEADER, task="pose", pose=(1.0 + 2e-6, *IDENTITY_POSE[1:]))
-
-
-@pytest.mark.parametrize(
-    ("fields", "complaint"),
-    [
-        ({"task": "pose"}, "a pose task needs a pose"),
-        ({"task": "pose", "pose": QUARTER_TURN_SHIFTED, "position": (0, 0, 0)}, "no position"),
-        ({"task": "position"}, "a position task needs a position"),
-        ({"task": "position", "position": (0, 0, 0), "pose": IDENTITY_POSE}, "no pose"),
-        ({"task": "orientation", "pose": IDENTITY_POSE}, "task"),
-        ({"task": "point", "point": (0, 0), "lookahead": 0.1}, "a point task needs an arm"),
-        ({"task": "heading", "heading": 1.0, "arm": (0, 0, 0, 0, 0)}, "needs a point"),
-        (
-            {
-                "task": "point",
-                "point": (0, 0),
-                "arm": (0, 0, 0, 0, 0),
-                "lookahead": 0.1,
-                "heading": 0.0,
-            },
-            "a point task takes no heading",
-        ),
-        (
-            {"task": "point", "point": (0, math.nan), "arm": (0, 0, 0, 0, 0), "lookahead": 0.1},
-            "point",
-        ),
-        ({"task": "pose", "pose": IDENTITY_POSE, "eta": 0.0}, "eta"),
-        ({"task": "pose", "pose": IDENTITY_POSE, "beta": -1.0}, "beta"),
-    ],
-)
-def test_goal_target_must_match_task(fields: dict[str, Any], complaint: str) -> None:
-    with pytest.raises(ValidationError, match=complaint):
-        Goal(header=HEADER, **fields)
-
-
-def test_goal_gains_default_to_the_controllers_own() -> None:
-    goal = Goal(header=HEADER, task="position", position=(1.0, 2.0, 0.5))
-    assert (goal.eta, goal.beta, goal.pose) == (None, None, None)
-    assert POSE_GOAL.eta == 5.0
-
-
-@pytest.mark.parametrize(("encoding", "pixel_bytes"), [("mono8", 1), ("bgr8", 3), ("rgb8", 3)])
-def test_image_data_must_fill_width_height_channels(encoding: str, pixel_bytes: int) -> None:
-    fields = {**IMAGE.model_dump(), "encoding": encoding, "width": 4, "height": 3}
-    frame = CameraFrame.model_validate(fields | {"data": bytes(12 * pixel_bytes)})
-    assert len(frame.data) == 12 * pixel_bytes
-    with pytest.raises(ValidationError, match=f"data has 13 bytes, expected {12 * pixel_bytes}"):
-        CameraFrame.model_validate(fields | {"data": bytes(13)})
-
-
-def test_image_repr_leaves_out_the_pixels() -> None:
-    assert len(repr(IMAGE)) < 500
-
-
-def test_joint_states_must_line_up() -> None:
-    with pytest.raises(ValidationError, match=r"lengths \(2, 2, 1\)"):
-        JointStates(header=HEADER, names=("a", "b"), positions=(0, 0), velocities=(0,))
-    with pytest.raises(ValidationError, match="not unique"):
-        JointStates(header=HEADER, names=("a", "a"), positions=(0, 0), velocities=(0, 0))
-
-
-def test_obstacle_radius_is_positive() -> None:
-    with pytest.raises(ValidationError, match="radius"):
-        Circle(x=0.0, y=0.0, radius=0.0)
-
-
-def test_a_plane_must_be_a_solid_wbc_accepts() -> None:
-    """A unit normal, and a footprint only on a horizontal plane, convex: the error names the
-    field, as wbc.geometry.obstacles3d does."""
-    with pytest.raises(ValidationError, match="normal: expected a unit vector"):
-        Plane(normal=(0.0, 0.0, 2.0), offset=0.4)
-    with pytest.raises(ValidationError, match="footprint: only a horizontal plane"):
-        Plane(normal=(1.0, 0.0, 0.0), offset=0.4, footprint=((0, 0), (1, 0), (1, 1)))
-    with pytest.raises(ValidationError, match="radius"):
-        Cylinder(x=0.0, y=0.0, radius=-0.1)
-    with pytest.raises(ValidationError, match="radius"):
-        Cylinder(x=0.0, y=0.0, radius=1e300)
-
-
-def test_solids_come_back_as_the_wbc_obstacles_they_were_made_of() -> None:
-    solids = (
-        obstacles3d.Plane((0.0, 0.0, 1.0), 0.4, ((0.5, -0.4), (1.1, -0.4), (1.1, 0.4))),
-        obstacles3d.Cylinder(0.2, -0.3, 0.05, None, "pole"),
-    )
-    assert Solids.of(solids).solids() == solids
