@@ -2,43 +2,20 @@
 
 from __future__ import annotations
 
-import logging
-import math
 import signal
 import threading
 from typing import TYPE_CHECKING
 
-import pytest
-
-from components import rate_limited_log
 from components.params import Param
-from components.pubsub import Input
-from components.rate_limited_log import RateLimitedLog
 from components.runtime import WAITING_FOR_CLOCK, Node
 from launch import query
 from messages import codec, topics
-from messages.base import IDENTITY_POSE
 from messages.goal import Goal
-from messages.header import Header
 from messages.state import RobotState
+from tests.components.plain_state import UNSTAMPED_SEQ, robot_state
 
 if TYPE_CHECKING:
     from tests.components.conftest import System, WaitUntil
-
-
-UNSTAMPED_SEQ = 10**9
-"""A seq the publisher must overwrite with its own count."""
-
-
-def robot_state(base_x: float = 0.25, valid: bool = True) -> RobotState:
-    return RobotState(
-        header=Header(stamp_ns=1, frame="world", seq=UNSTAMPED_SEQ, source="test"),
-        base_pose=(base_x, 0.0, 0.0),
-        arm_joints=(0.0, 0.1, 0.2, 0.3, 0.4),
-        end_effector=IDENTITY_POSE,
-        valid=valid,
-        age_s=0.0,
-    )
 
 
 def test_typed_round_trip_between_two_nodes(system: System, wait_until: WaitUntil) -> None:
@@ -57,45 +34,6 @@ def test_typed_round_trip_between_two_nodes(system: System, wait_until: WaitUnti
         assert subscription.latest is not None and subscription.age_s() < system.deadline_s
     assert listener.counters["received.robot/state"] >= 1
     assert listener.counters["rejected.robot/state"] == 0
-
-
-@pytest.mark.parametrize(("queue", "dropped"), [(None, "overwritten"), (4, "overflowed")])
-def test_a_busy_handler_gets_the_newest_or_every_sample_and_drops_are_counted(
-    system: System, wait_until: WaitUntil, queue: int | None, dropped: str
-) -> None:
-    """While the handler is busy, 12 samples arrive. The newest-only input hands it the last;
-    a queue of 4 hands it the last 4 in order. Either way, handled + dropped = sent."""
-    release = threading.Event()
-    handled: list[float] = []
-
-    def on_state(message: RobotState) -> None:
-        handled.append(message.base_pose[0])
-        release.wait(system.deadline_s)
-
-    key = topics.ROBOT_STATE.key("test")
-    with Node(system.profile, "listener") as listener:
-        listener.subscribe(topics.ROBOT_STATE, on_state, queue=queue)
-        listener.start()
-        publisher = system.router.declare_publisher(key)
-        wait_until(lambda: publisher.matching_status.matching, "the subscription to propagate")
-        publisher.put(codec.encode(robot_state(base_x=0.0)))
-        wait_until(lambda: handled == [0.0], "the first sample in the handler")
-        for index in range(1, 12):
-            publisher.put(codec.encode(robot_state(base_x=float(index))))
-        counters = listener.counters
-        sent = 12
-        wait_until(
-            lambda: counters[f"{dropped}.robot/state"] + len(handled) + (queue or 1) >= sent,
-            "every sample kept or counted",
-        )
-        release.set()
-        wait_until(
-            lambda: counters[f"{dropped}.robot/state"] + len(handled) == sent,
-            "the waiting samples handled",
-        )
-    kept = queue or 1
-    assert handled == [0.0, *[float(i) for i in range(sent - kept, sent)]]
-    assert counters[f"{dropped}.robot/state"] == sent - 1 - kept
 
 
 def test_component_process_publishes_its_params_and_stops_on_sigterm(
@@ -124,40 +62,6 @@ def test_component_process_publishes_its_params_and_stops_on_sigterm(
     finally:
         process.kill()
         process.wait()
-
-
-def test_malformed_messages_are_dropped_counted_and_the_component_keeps_answering(
-    system: System, wait_until: WaitUntil
-) -> None:
-    handled: list[RobotState] = []
-
-    def on_state(message: RobotState) -> None:
-        if not message.valid:
-            raise RuntimeError("the handler refuses invalid states")
-        handled.append(message)
-
-    nan_state = RobotState.model_construct(**{**dict(robot_state()), "age_s": math.nan})
-    key = topics.ROBOT_STATE.key("test")
-    with Node(system.profile, "listener") as listener:
-        listener.subscribe(topics.ROBOT_STATE, on_state)
-        listener.start()
-        publisher = system.router.declare_publisher(key)
-        wait_until(lambda: publisher.matching_status.matching, "the subscription to propagate")
-        counters = listener.counters
-        for payload, counter, count in (
-            (b"\x00garbage\xff", "rejected.robot/state", 1),
-            (codec.encode(nan_state), "rejected.robot/state", 2),
-            (codec.encode(robot_state(valid=False)), "errors.robot/state", 1),
-            (codec.encode(robot_state(base_x=2.0)), "received.robot/state", 2),
-        ):
-            publisher.put(payload)
-            wait_until(lambda c=counter, n=count: counters[c] == n, f"{counter} == {count}")
-        assert [m.base_pose[0] for m in handled] == [2.0]
-        status = query.statuses(system.router, "test")["listener"]
-    assert status.state == "running"
-    assert status.counters["rejected.robot/state"] == 2
-    assert status.counters["errors.robot/state"] == 1
-    assert status.counters["received.robot/state"] == 2
 
 
 def test_sim_clock_drives_stamps_and_timers(system: System, wait_until: WaitUntil) -> None:
@@ -227,32 +131,3 @@ def test_shutdown_runs_on_the_handler_thread_before_the_session_closes(system: S
         node.start(lambda: threads.append(threading.current_thread().name))
     assert threads == ["listener-handler"]
     assert node.session.is_closed()
-
-
-def test_repeated_warnings_are_logged_once_then_summarised(
-    monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
-) -> None:
-    now = [0]
-    monkeypatch.setattr(rate_limited_log.time, "monotonic_ns", lambda: now[0])
-    warnings = RateLimitedLog(logging.getLogger("test"), interval_s=5.0)
-    for step_s in (0, 1, 2, 3, 6, 7):
-        now[0] = step_s * 1_000_000_000
-        warnings.warning("rejected.robot/state", f"bad message at {step_s} s")
-    warnings.warning("errors.robot/state", "handler failed")
-    assert [record.getMessage() for record in caplog.records] == [
-        "bad message at 0 s",
-        "bad message at 6 s (3 more since the last report)",
-        "handler failed",
-    ]
-
-
-def test_a_node_refuses_topics_its_component_did_not_declare(system: System) -> None:
-    reads = (Input(topics.ROBOT_STATE, queue=8),)
-    with Node(system.profile, "listener", reads=reads, writes=(topics.CONTROL_GOAL,)) as node:
-        node.subscribe(topics.ROBOT_STATE)
-        assert "overflowed.robot/state" in node.counters  # the declared mode: a queue
-        node.publisher(topics.CONTROL_GOAL)
-        with pytest.raises(ValueError, match="reads control/goal without declaring it"):
-            node.subscribe(topics.CONTROL_GOAL)
-        with pytest.raises(ValueError, match="writes robot/state without declaring it"):
-            node.publisher(topics.ROBOT_STATE)
