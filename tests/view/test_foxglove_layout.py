@@ -198,7 +198,7 @@ def test_the_joints_plot_has_a_series_per_joint_of_the_description() -> None:
 
 def test_the_teleop_panel_drives_the_base_on_the_stations_teleop_channel() -> None:
     """Its topic is one the control station takes as teleop/command
-    (``tests.view.test_station_stop`` drives through it); a held button puts its twist
+    (``tests.view.test_station_teleop`` drives through it); a held button puts its twist
     several times within the controller's dead-man timeout, and a released one stops."""
     config = teleop_config(json.loads(layout(NAMESPACE).to_json()))
     assert config is not None
