@@ -1,4 +1,4 @@
-"""The nonholonomic row (wbc/laws/constraints/nonholonomic.py; 5.11, 5.12)."""
+"""The nonholonomic row (wbc.laws.constraints.nonholonomic; 5.11, 5.12)."""
 
 from __future__ import annotations
 
