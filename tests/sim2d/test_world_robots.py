@@ -1,6 +1,6 @@
 """The world follows its robot's description: any number of arm joints, a prismatic joint,
 and the base's kind (an omnidirectional base moves sideways as commanded, a fixed one never
-moves); the simulator's sensors read it as the robot's drivers would."""
+moves)."""
 
 from __future__ import annotations
 
@@ -10,30 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from components.sim_sensors import SimSensors
-from messages.header import Header
-from profiles.deploy_files import DEPLOY, ROBOT_FILE, ROBOTS_DIR
-from profiles.profile import load_profile
+from profiles.deploy_files import ROBOT_FILE
 from sim2d.world import World
+from tests.sim2d.robot_worlds import DT, middle, robot, run
 from wbc.robot import MobileManipulator
-
-DT = 0.01
-HEADER = Header(stamp_ns=0, frame="world", seq=0, source="test")
-
-
-def robot(name: str) -> MobileManipulator:
-    return MobileManipulator.from_yaml(ROBOTS_DIR / f"{name}.yaml")
-
-
-def run(world: World, seconds: float) -> None:
-    for _ in range(round(seconds / DT)):
-        world.step(DT)
-
-
-def middle(robot: MobileManipulator) -> np.ndarray:
-    """A start with every arm joint in the middle of its range, the base at (1, 2, 0.3)."""
-    arm = 0.5 * (robot.q_min[3:] + robot.q_max[3:])
-    return np.concatenate(([1.0, 2.0, 0.3], arm))
 
 
 @pytest.mark.parametrize("name", ["arm7_differential", "snake12"])
@@ -103,24 +83,3 @@ def test_a_fixed_base_never_moves() -> None:
     np.testing.assert_array_equal(world.q[:3], start[:3])
     np.testing.assert_allclose(world.q[3:], start[3:] + 0.05)
     assert world.odometry_pose == (0.0, 0.0, 0.0)
-
-
-@pytest.mark.parametrize("name", ["youbot", "ur5e_fixed", "snake12"])
-def test_the_sensors_read_the_robots_joints_and_base(name: str) -> None:
-    arm = robot(name)
-    world = World(arm, middle(arm), [])
-    scene = load_profile(DEPLOY / "sim.yaml").scene
-    sensors = SimSensors(world, scene, (), scene.arm_obstacles, 508)
-    if arm.base.kind == "differential":
-        world.command(0.1, 0.1, np.zeros(arm.arm_dof))
-    else:
-        world.drive(0.1, 0.0, 0.0, np.zeros(arm.arm_dof))
-    run(world, 0.5)
-    joints = sensors.joints(HEADER)
-    assert joints.names == arm.joint_names and len(joints.positions) == arm.arm_dof
-    odometry = sensors.odometry(HEADER)
-    moved = 0.0 if arm.base.kind == "fixed" else 0.1 * (0.5 - DT)
-    ramp = 0.5 * 0.1**2 / 1.0 if arm.base.kind == "differential" else 0.0  # 1 m/s^2 wheels
-    assert odometry.x == pytest.approx(moved - ramp, abs=2e-3)
-    truth = sensors.truth(HEADER, (0.0, 0.0, 0.0))
-    assert truth.arm_joints == tuple(world.q[3:])
