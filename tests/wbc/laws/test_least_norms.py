@@ -1,51 +1,21 @@
-"""What each law minimises, on random states: among the velocities with the same task
-velocity J u, the pseudoinverse's u has the least 2-norm (with no constraint, or under 5.11),
-and the LP's u the least (weighted) 1-norm inside the LP's own constraints (an independent LP,
-scipy's, solves that)."""
+"""What the LP minimises, on random states: among the velocities with the same task velocity
+J u, the LP's u has the least (weighted) 1-norm inside the LP's own constraints (an independent
+LP, scipy's, solves that; the pseudoinverse's least 2-norm: test_pinv_law.py)."""
 
 from __future__ import annotations
 
 import numpy as np
 from hypothesis import given, settings
-from hypothesis import strategies as st
 from scipy.optimize import linprog
 
-from tests.wbc.wbc_scenarios import robot
+from tests.wbc.laws.drawn_states import MODEL, states, unit
 from wbc.geometry.scenarios import DT
 from wbc.laws.constraints.base import LinearRows, OneNormBound, VelocityBounds
 from wbc.laws.lp_law import LPLaw, LPParams
-from wbc.laws.pinv_law import PinvParams, PseudoinverseLaw, nonholonomic_basis
 from wbc.laws.step_context import StepContext
 from wbc.task import PoseTask
 
-MODEL = robot()
 TIE_BREAK_ONLY = LPParams(waist_hold=0.0, base_target=0.0, obstacle_mode="off")
-
-
-def states(draw_q: np.ndarray, draw_goal: np.ndarray) -> tuple[np.ndarray, PoseTask]:
-    low, high = 0.8 * MODEL.q_min[3:], 0.8 * MODEL.q_max[3:]
-    q = np.concatenate((draw_q[:3], low + (high - low) * draw_q[3:]))
-    goal = np.concatenate((draw_goal[:3], low + (high - low) * draw_goal[3:]))
-    return q, PoseTask(MODEL.fkm(goal))
-
-
-unit = st.lists(st.floats(0.0, 1.0), min_size=8, max_size=8).map(np.array)
-
-
-@settings(max_examples=40, deadline=None)
-@given(unit, unit)
-def test_the_pseudoinverse_takes_the_least_2_norm_for_its_task_velocity(a, b) -> None:
-    q, task = states(a, b)
-    pose, jacobian = MODEL.kinematics(q)
-    _, task_jacobian = task.error(pose, jacobian, q)
-    for nonholonomic in (False, True):
-        u = PseudoinverseLaw(MODEL, PinvParams(nonholonomic=nonholonomic)).step(q, task, DT).u
-        basis = nonholonomic_basis(q[2], MODEL.dof) if nonholonomic else np.eye(MODEL.dof)
-        # Any other velocity of the same J u inside the allowed space is u + N z, J N z = 0:
-        # u is orthogonal to every such N z.
-        _, singular, vt = np.linalg.svd(task_jacobian @ basis)
-        null = basis @ vt[np.sum(singular > 1e-9 * singular[0]) :].T
-        assert np.allclose(null.T @ u, 0.0, atol=1e-9)
 
 
 def least_weighted_norm(
