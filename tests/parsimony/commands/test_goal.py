@@ -26,6 +26,7 @@ from profiles.endpoints import free_port
 from profiles.profile import Profile, load_profile
 from studies.launched import connect, launched, wait_alive, wait_reached
 from tests.parsimony.in_process import completed as parsimony  # in this process: no Python start
+from tests.parsimony.in_process import run_in_process
 from wbc import dq
 from wbc.planar import offset_of
 
@@ -233,3 +234,23 @@ def test_a_goal_no_configuration_reaches_is_unreachable_with_the_reason(
     outcome = json.loads(result.stdout)
     assert outcome["result"] == "unreachable" and outcome["reason"], outcome
     assert f"goal unreachable: {outcome['reason']}" in result.stderr
+
+
+@pytest.mark.parametrize(
+    ("argv", "error"),
+    [
+        (("0.5", "nan", "0.4"), "argument Y: expected a finite number, got 'nan'"),
+        (("0.5", "0", "0.4", "--position", "--yaw", "30"), "--position takes no --yaw or --rpy"),
+        (("0.5", "0", "0.4", "--yaw", "10", "--rpy", "0", "0", "10"), "not allowed with"),
+        (
+            ("0.5", "0", "0.4", "--wait", "--profile", "deploy/sim.yaml"),
+            "--wait follows supervisor/status, and no component of deploy/sim.yaml writes it",
+        ),
+    ],
+)
+def test_goal_refuses_input_it_cannot_use_with_exit_2(
+    argv: tuple[str, ...], error: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Before anything is sent, and with no running system to ask."""
+    code, _, err = run_in_process(["goal", *argv], capsys)
+    assert code == 2 and error in err, err

@@ -1,4 +1,5 @@
-"""`parsimony launch PROFILE --record FILE`: the profile and a recorder of every topic, as a
+"""`parsimony launch PROFILE`: a --duration that is not a positive number of seconds refused, and
+`--record FILE`: the profile and a recorder of every topic, as a
 newcomer's first hour runs it (before, a recording needed a second command in a second
 terminal, `parsimony record`, started after the launch, which missed the session's start)."""
 
@@ -85,3 +86,12 @@ def test_a_profile_that_already_records_is_refused(
     (line,) = err.splitlines()
     assert "already records" in line and "'rec'" in line and "without --record" in line
     assert not (tmp_path / "mine.mcap").exists() and not (tmp_path / "its.mcap").exists()
+
+
+@pytest.mark.parametrize("duration", ["nan", "inf", "-1", "0", "soon"])
+def test_launch_refuses_a_duration_that_is_not_a_positive_number_of_seconds(duration, capsys):
+    code, _, err = run_in_process(
+        ["launch", "deploy/controllers.yaml", "--duration", duration], capsys
+    )
+    assert code == 2
+    assert "--duration" in err and repr(duration) in err

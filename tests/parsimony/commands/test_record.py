@@ -20,6 +20,7 @@ import zenoh
 
 from launch.query import live_components, statuses
 from messages.process import EXIT_FOR_GOOD
+from profiles.deploy_files import DEPLOY
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.session_reader import info
@@ -207,7 +208,8 @@ def test_record_onto_a_full_disk_says_so_in_one_line_and_its_file_recovers(
         [unshare, "-rm", "sh", "-c", script],
         capture_output=True,
         text=True,
-        cwd=Path(__file__).parents[2],  # the flushed check imports the project
+        cwd=DEPLOY.parent,  # the project's root: the flushed check imports the project
+        timeout=600,  # a safety net: a recorder that never flushes fails the test, not the suite
     )
     assert done.returncode == EXIT_FOR_GOOD, done.stderr
     assert "Traceback" not in done.stderr, done.stderr

@@ -1,5 +1,6 @@
 """`parsimony status` on a launched system: a short line per component by default, every
-counter on demand (before, 20 or more unexplained counters per component on one line)."""
+counter on demand (before, 20 or more unexplained counters per component on one line); a
+misspelt profile or an unreachable router said in one line."""
 
 from __future__ import annotations
 
@@ -20,6 +21,7 @@ from messages.status import ComponentStatus
 from parsimony.commands import status
 from profiles.deploy_files import ROBOT_FILE
 from profiles.endpoints import free_port
+from tests.parsimony.cli_process import run_cli
 
 if TYPE_CHECKING:
     from tests.launch.conftest import LaunchFixture, ProfileWriter
@@ -172,3 +174,16 @@ def test_status_wait_names_the_components_that_never_come(
 
 def router_of(profile: Path) -> str:
     return query.Target.from_profile(profile).zenoh.router[0]
+
+
+def test_status_of_a_misspelt_profile_says_the_file_does_not_exist():
+    result = run_cli("status", "deploy/controlers.yaml")
+    assert result.returncode == 2
+    assert "deploy/controlers.yaml: no such profile file" in result.stderr
+
+
+def test_zenoh_errors_reach_the_user_as_one_readable_line():
+    result = run_cli("status", "test", "--router", "tcp/127.0.0.1:1", "--timeout", "0.5")
+    assert result.returncode == 2
+    assert "cannot reach a router at tcp/127.0.0.1:1" in result.stderr
+    assert ".rs:" not in result.stderr and len(result.stderr.strip().splitlines()) == 1
