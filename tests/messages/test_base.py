@@ -10,8 +10,6 @@ from typing import Any
 
 import pytest
 from hypothesis import given
-from message_examples import EXAMPLES, HEADER, STATE
-from message_strategies import unit_dual_quaternions
 from pydantic import ValidationError
 
 from messages import (
@@ -24,6 +22,8 @@ from messages import (
     RobotState,
 )
 from messages.base import Message
+from tests.messages.message_examples import EXAMPLES, HEADER, STATE
+from tests.messages.message_strategies import unit_dual_quaternions
 
 
 def _float_paths(value: Any, path: tuple[Any, ...] = ()) -> Iterator[tuple[Any, ...]]:

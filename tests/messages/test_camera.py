@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import pytest
-from message_examples import IMAGE
 from pydantic import ValidationError
 
 from messages import CameraFrame
+from tests.messages.message_examples import IMAGE
 
 
 @pytest.mark.parametrize(("encoding", "pixel_bytes"), [("mono8", 1), ("bgr8", 3), ("rgb8", 3)])

@@ -9,8 +9,6 @@ import msgpack
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from message_examples import EXAMPLES, IMAGE, POSITION_GOAL, STATE
-from message_strategies import MESSAGES
 
 from messages import (
     FORMAT_TAG,
@@ -24,6 +22,8 @@ from messages import (
     encode,
 )
 from messages.base import Message
+from tests.messages.message_examples import EXAMPLES, IMAGE, POSITION_GOAL, STATE
+from tests.messages.message_strategies import MESSAGES
 
 
 def _fields(message: Message) -> dict[str, Any]:

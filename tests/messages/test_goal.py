@@ -7,10 +7,10 @@ import math
 from typing import Any
 
 import pytest
-from message_examples import HEADER, POSE_GOAL, QUARTER_TURN_SHIFTED
 from pydantic import ValidationError
 
 from messages import IDENTITY_POSE, Goal
+from tests.messages.message_examples import HEADER, POSE_GOAL, QUARTER_TURN_SHIFTED
 
 
 @pytest.mark.parametrize(

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import pytest
-from message_examples import HEADER
 from pydantic import ValidationError
 
 from messages import JointStates
+from tests.messages.message_examples import HEADER
 
 
 def test_joint_states_must_line_up() -> None:

@@ -4,11 +4,11 @@ image gave them."""
 from __future__ import annotations
 
 import pytest
-from message_examples import HEADER
 from pydantic import ValidationError
 
 from messages import IDENTITY_POSE, MarkerDetection, MarkerDetections
 from messages.markers import MAX_MARKERS
+from tests.messages.message_examples import HEADER
 
 
 def test_one_image_holds_at_most_as_many_markers_as_a_4x4_dictionary_and_some() -> None:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from message_examples import STATE
+from tests.messages.message_examples import STATE
 
 
 def test_configuration_is_base_pose_then_arm_joints() -> None:

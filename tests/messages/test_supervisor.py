@@ -4,10 +4,10 @@ carries."""
 from __future__ import annotations
 
 import pytest
-from message_examples import HEADER
 from pydantic import ValidationError
 
 from messages.supervisor import MAX_WAY, PHASES, SupervisorStatus
+from tests.messages.message_examples import HEADER
 
 
 def _status(**fields: object) -> SupervisorStatus:

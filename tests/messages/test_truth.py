@@ -3,11 +3,10 @@ scene fields."""
 
 from __future__ import annotations
 
-from message_examples import HEADER
-
 from messages import IDENTITY_POSE
 from messages.obstacles import Solids
 from messages.truth import SimTruth
+from tests.messages.message_examples import HEADER
 
 
 def test_true_configuration_is_base_pose_then_arm_joints() -> None:
