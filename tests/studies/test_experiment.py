@@ -177,7 +177,7 @@ def test_obstacle_experiment_with_the_lp_goes_round_the_obstacle_on_the_saddle_s
 def test_an_experiment_runs_the_obstacle_constraint_it_is_given(tmp_path: Path) -> None:
     """--gain obstacle_mode=border: the controller runs 5.28 instead, its row engaged within
     the first simulated second (the run cut at SHORT_RUN_S; that 5.28 takes the base round to
-    the goal is `parsimony demo`'s, tests/parsimony/test_cli.py)."""
+    the goal is `parsimony demo`'s, tests/parsimony/commands/test_demo.py)."""
     report = run_here(tmp_path, "obstacle", gains={"obstacle_mode": "border"}, **SHORT_RUN)
     assert report["gains"] == {"obstacle_mode": "border"} and report["contacts"] == 0
     assert report["min_obstacle_clearance_m"] > 0.0
@@ -189,7 +189,7 @@ def test_table_experiment_reaches_over_the_edge_without_touching_the_table(tmp_p
     estimator publishes it, the LP's rows keep every collision part clear, and the simulator
     counts the penetrations from the true kinematics; blind to it, the LP goes through the
     table's edge within the first simulated second (the blind run cut at SHORT_RUN_S; that it
-    reaches the goal so is `parsimony demo`'s, tests/parsimony/test_cli.py)."""
+    reaches the goal so is `parsimony demo`'s, tests/parsimony/commands/test_demo.py)."""
     report = run_here(tmp_path / "guarded", "table", figures=True)
     assert_sound(report)
     assert report["arm_penetrations"] == 0
