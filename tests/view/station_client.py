@@ -18,6 +18,13 @@ GOAL = json.dumps(
 """A good goal (with no robot state known, only the message is checked)."""
 
 
+def goal_channel(client: FoxgloveClient, topic: str) -> int:
+    """The channel the client advertises to send pose goals on ``topic``, once the station
+    took it."""
+    client.send("advertise", topic=topic, encoding="json", schemaName="foxglove.PoseInFrame")
+    return client.wait_for(lambda e: e["event"] == "advertised", "the channel")["channel"]
+
+
 def statuses(client: FoxgloveClient, start: int = 0) -> list[str]:
     return [e["message"] for e in client.events[start:] if e["event"] == "status"]
 

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 from messages import topics
 from tests.foxglove_client.client import DEADLINE_S, FoxgloveClient
-from tests.view.station_client import GOAL, answer, statuses
+from tests.view.station_client import GOAL, answer, goal_channel, statuses
 from view.client_limits import GOAL_RATE, STATUS_CHARS
 
 if TYPE_CHECKING:
@@ -70,13 +70,7 @@ def test_a_client_sending_goals_faster_than_their_rate_is_told_its_goals_are_dro
     sent = 30
     with FoxgloveClient(view.address) as client:
         client.server_info()
-        client.send(
-            "advertise",
-            topic=topics.GOAL_REQUEST.name,
-            encoding="json",
-            schemaName="foxglove.PoseInFrame",
-        )
-        channel = client.wait_for(lambda e: e["event"] == "advertised", "the channel")["channel"]
+        channel = goal_channel(client, topics.GOAL_REQUEST.name)
         began = time.monotonic()
         for _ in range(sent):
             client.send("publish", channel=channel, text=GOAL)

@@ -15,7 +15,7 @@ import zenoh
 from messages import topics
 from parsimony.commands.view import stopped
 from tests.foxglove_client.client import FoxgloveClient
-from tests.view.station_client import GOAL, NAMESPACE, answer
+from tests.view.station_client import GOAL, NAMESPACE, answer, goal_channel
 
 if TYPE_CHECKING:
     from tests.view.conftest import View
@@ -34,13 +34,7 @@ def test_after_its_session_fails_the_station_says_so_and_goes_on_on_a_new_one(
             lambda e: e["event"] == "parameterValues" and e.get("id") == "all", "every parameter"
         )
         assert {p["name"] for p in listed["parameters"]} == {"ctl.eta", "ctl.mode"}
-        client.send(
-            "advertise",
-            topic=topics.GOAL_REQUEST.key(NAMESPACE),
-            encoding="json",
-            schemaName="foxglove.PoseInFrame",
-        )
-        channel = client.wait_for(lambda e: e["event"] == "advertised", "the channel")["channel"]
+        channel = goal_channel(client, topics.GOAL_REQUEST.key(NAMESPACE))
         client.send("publish", channel=channel, text=GOAL)
         client.wait_for(lambda e: e["event"] == "status" and "sent" in e["message"], "the goal")
     assert view.station.session is not failed and view.station.session_errors == 1
@@ -64,13 +58,7 @@ def test_when_no_new_session_can_be_opened_each_goal_and_set_says_so(
     """And `parsimony view` says so when it stops, and exits 1."""
     with FoxgloveClient(view.address) as client:
         client.server_info()
-        client.send(
-            "advertise",
-            topic=topics.GOAL_REQUEST.name,
-            encoding="json",
-            schemaName="foxglove.PoseInFrame",
-        )
-        channel = client.wait_for(lambda e: e["event"] == "advertised", "the channel")["channel"]
+        channel = goal_channel(client, topics.GOAL_REQUEST.name)
         view.station.session.close()
         view.router.close()  # and no router to open a new session with
         client.send("publish", channel=channel, text=GOAL)
