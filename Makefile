@@ -41,11 +41,11 @@ foxglove-client: $(CLIENT_STAMP)
 
 # Three test workers on CI's two cores: many tests wait on a real-time run or a child process,
 # which a third worker may fill (one core kept busy, pytest's seconds: 464 with two workers;
-# 396, 457 and 489 with three: not clearly faster, the spread larger than the gain; 336 with
-# three once launches and the component tests forked their processes from a fork server). Files go
-# out in the order tests/conftest.py sorts them (the heavy ones first): pytest-xdist's own order
-# (most tests first) handed out the one-test files last, the README's first hour among them,
-# which then ran alone for the last minute and a half.
+# 396, 457 and 489 with three: not clearly faster, the spread larger than the gain; 336, 243
+# and 243 with three once launches and the component tests forked their processes from a fork
+# server). Files go out in the order tests/conftest.py sorts them (the heavy ones first):
+# pytest-xdist's own order (most tests first) handed out the one-test files last, the README's
+# first hour among them, which then ran alone for the last minute and a half.
 test: $(STAMP) $(CLIENT_STAMP)
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
