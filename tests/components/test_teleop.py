@@ -26,7 +26,7 @@ from messages.teleop import TeleopCommand
 from parsimony.commands.teleop import Hand, press
 from profiles.deploy_files import DEPLOY, ROBOT_FILE
 from tests.components.conftest import DEADLINE_S
-from tests.components.test_supervisor import header, met_at, supervised
+from tests.components.supervised import header, met_at, supervised
 from wbc.geometry.scenarios import HOME, REACH_GOAL
 from wbc.robot import MobileManipulator
 
