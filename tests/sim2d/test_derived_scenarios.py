@@ -10,7 +10,7 @@ import pytest
 
 from profiles.deploy_files import zoo
 from sim2d.scenarios import DECLARED_FOR, DERIVED, NAMES, goal_above, scenario
-from tests.sim2d.test_scenarios import camera, markers, scene
+from tests.sim2d.sim_scene import camera, markers, scene
 from wbc import dq
 from wbc.laws.kinematic_run import integrate
 from wbc.laws.lp_law import LPLaw

@@ -3,16 +3,12 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from components.simulator import Simulator
 from profiles.deploy_files import ROBOT_FILE
-from profiles.profile import load_profile
-from profiles.scene import Scene
-from sim2d.pinhole import PinholeCamera, ceiling_camera
 from sim2d.scenarios import (
     ANYWHERE_OBSTACLE,
     ANYWHERE_START,
@@ -25,6 +21,7 @@ from sim2d.scenarios import (
     SimScenario,
     scenario,
 )
+from tests.sim2d.sim_scene import camera, markers, scene
 from wbc.geometry.arm_clearance import part_clearances
 from wbc.geometry.scenarios import HOME, OBSTACLE, REACH_GOAL, TABLE, TABLE_GOAL, TABLE_START
 from wbc.laws.lp_law import LPParams
@@ -33,16 +30,9 @@ from wbc.planning.disc_geometry import segment_clear
 from wbc.planning.staging import plan
 from wbc.robot import BASE_DOF, MobileManipulator
 
-REPO = Path(__file__).resolve().parents[2]
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
-SCENE = load_profile(REPO / "deploy/sim.yaml").scene
 SEEDS = range(50)
 DEFAULT_BIN = np.array(planar_of(ROBOT.fkm(REACH_GOAL)))
-
-
-def scene() -> Scene:
-    assert SCENE is not None
-    return SCENE
 
 
 def test_the_default_goal_is_the_dissertations_reach_goal() -> None:
@@ -169,28 +159,6 @@ def test_sim_params_are_the_simulators_typed_values_of_the_set_up(
     assert held["obstacles"] == tuple((c.x, c.y, c.radius) for c in setup.obstacles)
     two = SimScenario("obstacle", "pose", tuple(HOME), (1.0, 0.0, 0.0), (OBSTACLE, OBSTACLE))
     assert len(declared["obstacles"].check(two.sim_params()["obstacles"])) == 2
-
-
-def camera() -> PinholeCamera:
-    return ceiling_camera(scene().camera)
-
-
-def markers(setup: SimScenario) -> list[tuple[str, float, float, float, float]]:
-    """(what, x, y, height, size) of every marker: F0, F1 on the base at its start, F2, F3."""
-    s = scene()
-    x, y, phi = setup.start[:3]
-    ox, oy = s.base.offset
-    c, s_ = math.cos(phi), math.sin(phi)
-    base = (x + c * ox - s_ * oy, y + s_ * ox + c * oy)
-    found = [
-        ("reference", *s.reference_pose[:2], s.reference.height_m, s.reference.size_m),
-        ("base", *base, s.base.height_m, s.base.size_m),
-        ("bin", *setup.bin[:2], setup.goal_height or s.goal.height_m, s.goal.size_m),
-    ]
-    found += [
-        ("obstacle", c.x, c.y, s.obstacles.height_m, s.obstacles.size_m) for c in setup.obstacles
-    ]
-    return found
 
 
 @pytest.mark.parametrize("name", NAMES)
