@@ -31,26 +31,13 @@ from ros2.urdf import urdf
 from tests.components.conftest import DEADLINE_S, System
 from tests.robot_states import state_at
 from tests.ros2.pose_stamped import pose_stamped
+from tests.ros2.rmw_keys import ATTACHMENT, DOMAIN, design_key, store
 from wbc import dq
 from wbc.robot import MobileManipulator
 
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
-DOMAIN = 7
 Q = np.array([1.0, 0.5, 0.3, 0.1, -0.4, 0.6, 0.2, 0.0])[: 3 + ROBOT.arm_dof]
 JPEG = b"\xff\xd8\xff\xe0" + bytes(60) + b"\xff\xd9"
-
-
-def store():
-    """rosbags' Jazzy types (the independent serialiser)."""
-    from rosbags.typesys import Stores, get_typestore
-
-    return get_typestore(Stores.ROS2_JAZZY)
-
-
-def design_key(topic: str, msgtype: str) -> str:
-    """The data key as the design document writes it, from rosbags' hash."""
-    package, _, name = msgtype.split("/")
-    return f"{DOMAIN}/{topic}/{package}::msg::dds_::{name}_/{store().hash_rihs01(msgtype)}"
 
 
 class RosSide:
@@ -121,9 +108,6 @@ class Bridge:
             assert time.monotonic() < deadline, f"{name} stayed {counters.get(name)}"
             time.sleep(0.01)
         return counters
-
-
-ATTACHMENT = struct.pack("<qqB16s", 1, time.time_ns(), 16, bytes(16))
 
 
 def declared(component: type[Component]) -> tuple:

@@ -20,7 +20,8 @@ from profiles.deploy_files import ROBOT_FILE
 from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from tests.components.conftest import DEADLINE_S
-from tests.components.test_ros2_bridge import ATTACHMENT, DOMAIN, POSE_KEY, pose_stamped
+from tests.ros2.pose_stamped import pose_stamped
+from tests.ros2.rmw_keys import ATTACHMENT, DOMAIN, design_key
 
 NAMESPACE = "rosacl"
 
@@ -59,7 +60,7 @@ def goals_on_request(tmp_path: Path, writers: list[str]) -> tuple[int, int]:
         component = Ros2Bridge(node)
         node.start(component.shutdown)
         operator.declare_subscriber(topics.GOAL_REQUEST.key(NAMESPACE), lambda _: arrived.set())
-        ros = operator.declare_publisher(POSE_KEY)
+        ros = operator.declare_publisher(design_key("goal_pose", "geometry_msgs/msg/PoseStamped"))
         deadline = time.monotonic() + DEADLINE_S
         while not ros.matching_status.matching:
             assert time.monotonic() < deadline, "the bridge did not subscribe to /goal_pose"

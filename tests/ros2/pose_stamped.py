@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-from rosbags.typesys import Stores, get_typestore
+from tests.ros2.rmw_keys import store
 
 
 def pose_stamped(frame: str, position, orientation=(1.0, 0.0, 0.0, 0.0)) -> bytes:
     """A ``geometry_msgs/msg/PoseStamped`` in ``frame`` at ``position`` with ``orientation``
     (w, x, y, z), stamped 0, as CDR."""
-    store = get_typestore(Stores.ROS2_JAZZY)
-    types = store.types
+    types = (typestore := store()).types
     w, x, y, z = orientation
     message = types["geometry_msgs/msg/PoseStamped"](
         header=types["std_msgs/msg/Header"](
@@ -20,4 +19,4 @@ def pose_stamped(frame: str, position, orientation=(1.0, 0.0, 0.0, 0.0)) -> byte
             orientation=types["geometry_msgs/msg/Quaternion"](x=x, y=y, z=z, w=w),
         ),
     )
-    return bytes(store.serialize_cdr(message, "geometry_msgs/msg/PoseStamped"))
+    return bytes(typestore.serialize_cdr(message, "geometry_msgs/msg/PoseStamped"))
