@@ -157,3 +157,15 @@ def running_pub(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
         assert launched.stop(signal.SIGTERM) == 0
     finally:
         launched.shut_down()
+
+
+def publisher(name: str, role: str = "tool", **fields: object) -> dict[str, object]:
+    """A scripted publisher component that restarts quickly."""
+    return {
+        "name": name,
+        "module": "scripted_publisher",
+        "role": role,
+        "params": {"rate_hz": 20.0},
+        "restart": {"backoff_initial_s": 0.1},
+        **fields,
+    }

@@ -14,23 +14,11 @@ import yaml
 from launch import query
 from profiles.deploy_files import ROBOT_FILE
 from profiles.profile import Profile
-from tests.launch.conftest import DEADLINE_S, free_port
+from tests.launch.conftest import DEADLINE_S, free_port, publisher
 from tests.processes import process_gone
 
 if TYPE_CHECKING:
     from tests.launch.conftest import LaunchFixture, ProfileWriter
-
-
-def publisher(name: str, role: str = "tool", **fields: object) -> dict[str, object]:
-    """A scripted publisher component that restarts quickly."""
-    return {
-        "name": name,
-        "module": "scripted_publisher",
-        "role": role,
-        "params": {"rate_hz": 20.0},
-        "restart": {"backoff_initial_s": 0.1},
-        **fields,
-    }
 
 
 def test_a_killed_component_comes_back_at_once_then_after_a_backoff_until_restarts_run_out(

@@ -11,7 +11,7 @@ import pytest
 
 from launch import query
 from profiles.profile import ProfileError, load_profile
-from tests.launch.test_launcher import publisher
+from tests.launch.conftest import publisher
 
 if TYPE_CHECKING:
     from tests.launch.conftest import LaunchFixture, ProfileWriter

@@ -90,3 +90,17 @@ def view(tmp_path: Path) -> Iterator[View]:
         watcher.undeclare()
         if station.session is own:  # else Zenoh panicked in it: it cannot even close
             own.close()
+
+
+def teleop_config(node: object) -> dict | None:
+    """The config of the Teleop panel of a layout's document, None without one."""
+    if isinstance(node, dict):
+        if node.get("panelType") == "Teleop":
+            return node["config"]
+        node = list(node.values())
+    if isinstance(node, list):
+        for item in node:
+            found = teleop_config(item)
+            if found is not None:
+                return found
+    return None

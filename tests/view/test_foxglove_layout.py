@@ -25,6 +25,7 @@ from record.session_reader import info
 from scenes.foxglove_views import Viewer
 from tests.parsimony.in_process import run_in_process
 from tests.scenes.views_read import ROBOT, pose_dq, robot_state
+from tests.view.conftest import teleop_config
 from view.foxglove_layout import layout
 from view.station_teleop import teleop_topic
 from vision.images import jpeg
@@ -126,20 +127,6 @@ def named_topics(node: object) -> set[str]:
         for item in node:
             found |= named_topics(item)
     return found
-
-
-def teleop_config(node: object) -> dict | None:
-    """The config of the Teleop panel of a layout's document, None without one."""
-    if isinstance(node, dict):
-        if node.get("panelType") == "Teleop":
-            return node["config"]
-        node = list(node.values())
-    if isinstance(node, list):
-        for item in node:
-            found = teleop_config(item)
-            if found is not None:
-                return found
-    return None
 
 
 def test_every_topic_the_layout_names_is_a_channel_of_the_namespace(tmp_path: Path) -> None:

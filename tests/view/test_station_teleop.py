@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 from messages import codec, topics
 from messages.teleop import TeleopCommand
 from tests.foxglove_client.client import DEADLINE_S, FoxgloveClient
-from tests.view.test_foxglove_layout import teleop_config
+from tests.view.conftest import teleop_config
 from view.foxglove_layout import layout
 
 if TYPE_CHECKING:
