@@ -26,6 +26,7 @@ import subprocess
 import sys
 import threading
 from collections import deque
+from collections.abc import Callable
 from typing import IO, Unpack
 
 from launch.forked import ChildOptions, Forked, child_ends, forked, run_child, single_threaded
@@ -38,6 +39,15 @@ LOST = 1
 """The exit code of a child whose server ended before it: its own is lost."""
 CLOSE_S = 10.0
 """How long the server may take to end once the launcher closes it; then it is killed."""
+ANSWER_S = 60.0
+"""How long a request may wait for the server's answer, its modules loading first (a second or
+two); then the server is taken for hung, a module that never loads: it is killed, and this
+child and the next start as new interpreters."""
+
+
+def warn(text: str) -> None:
+    """``text`` on the error stream, a line."""
+    print(text, file=sys.stderr, flush=True)
 
 
 class Served:
@@ -82,7 +92,10 @@ class ForkServer:
     """The launcher's side of a fork server loading ``modules``: its process and its replies,
     read by one thread."""
 
-    def __init__(self, modules: list[str]) -> None:
+    def __init__(
+        self, modules: list[str], say: Callable[[str], None] = warn, answer_s: float = ANSWER_S
+    ) -> None:
+        self._say, self.answer_s = say, answer_s
         self._channel, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
         command = [MODULE, str(theirs.fileno()), *modules]
         how: ChildOptions = {
@@ -104,8 +117,8 @@ class ForkServer:
 
     def spawn(self, command: list[str], **how: Unpack[ChildOptions]) -> Served | None:
         """``command`` (``[MODULE, ARGS...]``) forked by the server, started as ``forked``
-        starts it; None when the server is gone or refuses (it has more than one thread), the
-        caller then starting a new interpreter."""
+        starts it; None when the server is gone, refuses (it has more than one thread) or does
+        not answer in ``answer_s`` (then killed), the caller then starting a new interpreter."""
         parent_ends, child_fds, closed_after = child_ends(
             how.get("stdin"), how.get("stdout"), how.get("stderr")
         )
@@ -130,7 +143,11 @@ class ForkServer:
                 except OSError:  # gone, its end not read yet
                     self._asked.remove(served)
                     served._answered.set()
-        served._answered.wait()
+        if not served._answered.wait(self.answer_s):
+            self._say(f"the fork server did not answer in {self.answer_s:g} s: killed; the")
+            self._say("components start as new interpreters from now on")
+            self.process.kill()  # its end answers every request (``_read``)
+            served._answered.wait()
         for descriptor in closed_after:
             os.close(descriptor)
         if served.pid:

@@ -117,7 +117,8 @@ class Launcher:
         endpoints = ", ".join(self.profile.zenoh.router)
         self._duration_s = duration_s
         self._kept_params = Path(tempfile.mkdtemp(prefix="parsimony-params-"))
-        self._server = ForkServer(self._modules())  # it loads them while the router opens
+        # The server loads the modules while the router opens.
+        self._server = ForkServer(self._modules(), self.output.say)
         try:
             return self._run_router(endpoints)
         finally:

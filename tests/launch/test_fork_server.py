@@ -118,3 +118,22 @@ def test_a_server_of_more_than_one_thread_refuses_to_fork(
         assert server.spawn(["platform"], stdout=subprocess.DEVNULL) is None
     finally:
         server.close()
+
+
+def test_a_server_that_never_answers_is_killed_and_its_caller_starts_a_new_interpreter(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A module that never finishes loading: the request waits ``answer_s``, not for ever; the
+    server is killed, which the launch is told, and ``spawn`` says None, now and for the next
+    child."""
+    (tmp_path / "never_loads.py").write_text("import threading\nthreading.Event().wait()\n")
+    monkeypatch.setenv("PYTHONPATH", str(tmp_path))
+    said: list[str] = []
+    server = ForkServer(["never_loads"], said.append, answer_s=0.5)
+    try:
+        assert server.spawn(["platform"], stdout=subprocess.DEVNULL) is None
+        assert "did not answer in 0.5 s" in said[0], said
+        assert server.process.wait(DEADLINE_S) == -signal.SIGKILL
+        assert server.spawn(["platform"], stdout=subprocess.DEVNULL) is None
+    finally:
+        server.close()
