@@ -11,7 +11,10 @@ as ``foxglove.SceneUpdate``, markers on the image as ``foxglove.ImageAnnotations
 Foxglove's 3D, Image and Plot panels open the file as it is. ``keys`` limits the recording to
 topics whose names match one of its comma-separated ``fnmatch`` patterns. A message stamped
 far outside the session (``record.session_span``: a wall-clock stamp among simulated ones) is
-recorded, counted (``outside.<topic>``) and said once per topic.
+recorded, counted (``outside.<topic>``) and said once per topic. A message that never reached
+the recorder (Zenoh drops a sample when a publisher's queue is full) is seen by the gap it leaves
+in its publisher's ``seq``: the gaps of a topic less the samples the recorder itself dropped or
+refused are counted (``missed.<topic>``) and written into the file beside the recorder's losses.
 
 The current chunk is flushed every ``flush_s`` (SIGKILL loses at most that much and what
 waits); a clean stop writes all that waits, then the file's footer and index. A recorder stops
@@ -32,6 +35,7 @@ from components.process_entry import run_component
 from components.pubsub import Input
 from components.runtime import Component, Node
 from messages import topics
+from messages.header import Header
 from record.session_file import DROPPED, SessionWriter, stamp_of
 from record.session_span import Span, inside, outside_line
 from scenes.foxglove_views import Viewer
@@ -74,6 +78,10 @@ class Recorder(Component):
             if any(fnmatch.fnmatch(topic.name, pattern) for pattern in patterns)
         ]
         self.dropped: dict[str, int] = {}
+        self.last_seq: dict[tuple[str, str], int] = {}
+        """The ``seq`` of the last message of each topic and source."""
+        self.gaps: dict[str, int] = {}
+        """The messages of each topic its sources' ``seq`` skipped."""
         self.span = Span()
         node.timer(node.params["flush_s"], lambda: self._writing(self._flush))
 
@@ -89,6 +97,7 @@ class Recorder(Component):
             if self._writing(self.writer.write, key, message, views=self.node.params["views"]):
                 self.node.counters["written"] += 1
                 self._place(name, stamp_of(message))
+                self._follow(name, getattr(message, "header", None))
 
         return write
 
@@ -107,6 +116,27 @@ class Recorder(Component):
                 outside_line({name: (1, stamp_ns)}, session),
             )
         self.node.count(counter)
+
+    def _follow(self, name: str, header: Header | None) -> None:
+        """Add to the gaps of ``name`` the messages its source published between the last one
+        and this one. A ``seq`` that goes back is a publisher started anew (a restarted
+        component), not a loss."""
+        if header is None:
+            return
+        key = (name, header.source)
+        last = self.last_seq.get(key)
+        self.last_seq[key] = header.seq
+        if last is not None and header.seq > last + 1:
+            self.gaps[name] = self.gaps.get(name, 0) + header.seq - last - 1
+
+    def _missed(self) -> None:
+        """``missed.<topic>``: its gaps less what the recorder dropped or refused itself (a gap
+        is seen when the next message is handled, so it may trail the drop a while)."""
+        counters = self.node.counters
+        for name, gaps in self.gaps.items():
+            own = counters.get(f"overflowed.{name}", 0) + counters.get(f"rejected.{name}", 0)
+            if gaps > own:
+                counters[f"missed.{name}"] = gaps - own
 
     def _writing(self, operation, *args, **kwargs) -> bool:
         """Run a write of the file; on an OSError stop for good (once), saying why."""
@@ -128,10 +158,11 @@ class Recorder(Component):
     def _flush(self) -> None:
         """The chunk to the file, and what was lost since the last flush, if anything (the
         file's ``DROPPED`` metadata)."""
+        self._missed()
         dropped = {
             k: v
             for k, v in self.node.counters.items()
-            if k.startswith(("overflowed.", "overwritten.")) and v
+            if k.startswith(("overflowed.", "overwritten.", "missed.")) and v
         }
         if dropped != self.dropped:
             self.writer.metadata(DROPPED, dropped)

@@ -47,7 +47,8 @@ CARRIER = "parsimony.carrier"
 """Channel metadata: the channel whose message of the same log time holds ``CARRIED_FIELD``."""
 DROPPED = "parsimony.dropped"
 """Metadata record: the samples the recorder lost, by counter (``overflowed.<topic>``,
-``overwritten.<topic>``), those that are not 0; written as they change and at the end."""
+``overwritten.<topic>``, and ``missed.<topic>``: those that never reached it), those that are not
+0; written as they change and at the end."""
 
 
 @dataclass(frozen=True)

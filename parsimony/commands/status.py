@@ -32,6 +32,7 @@ FAULT_WORDS = (
     "rejected",
     "error",
     "overflowed",
+    "missed",
     "fail",
     "bad_",
     "refus",

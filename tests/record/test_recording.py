@@ -223,7 +223,7 @@ def test_a_recorder_whose_file_fills_up_stops_for_good_and_its_file_recovers(
     seqs = [s.header.seq for s in states]  # none lost in between but what the recorder said
     lost = info(path)["dropped"]  # (a loaded machine may overflow the recorder's queue)
     missing = set(range(seqs[0], seqs[-1] + 1)) - set(seqs)
-    said = lost.get("overflowed.robot/state", 0) + lost.get("overwritten.robot/state", 0)
+    said = sum(lost.get(f"{kind}.robot/state", 0) for kind in ("overflowed", "missed"))
     assert seqs == sorted(seqs) and len(missing) <= said, (sorted(missing), lost)
 
 
