@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from collections.abc import Sequence
@@ -110,8 +111,10 @@ def program(
     chain = robot.forward(q)  # one pass for the task and the collision parts' rows
     error, task_jacobian = task.error(chain.pose, chain.jacobian, q)
     if last is not None and (last[0] is task or same_task(last[0], task)):
-        error_rate = error - last[1]
-        error_rate /= dt  # in place: the same quotients, without a second array
+        error_rate = np.subtract(error, last[1])
+        # In place, by dt as a 0-d array: the same quotients, without NumPy's conversion of a
+        # Python float at every step (half the time of ``/= dt``).
+        np.divide(error_rate, _period(dt), error_rate)
     else:
         error_rate = -eta * error
     goal_pose = task.pose if isinstance(task, PoseTask) else None
@@ -149,6 +152,14 @@ def terms(
     costs = [ResidualCost("task", task_jacobian, eta * context.error)]  # what a row engaged
     costs += [term.cost(context) for term in objectives]
     return costs, rows
+
+
+@functools.lru_cache(maxsize=4)
+def _period(dt: float) -> Array:
+    """dt as a read-only 0-d array, made once for the few periods a controller steps at."""
+    period = np.array(dt)
+    period.flags.writeable = False
+    return period
 
 
 def _check(q: Array, dt: float) -> None:
