@@ -81,9 +81,11 @@ class Layout:
         self.weights: list[float] = [math.nan] * residual_count
         """The residual costs' weights ``row_weight`` and the costs of y were set from (none
         yet: NaN is no weight)."""
-        y_costs = self.cost[2 * n :]
-        self._weight_blocks = [(self.row_weight[s], y_costs[s]) for s in self._slices]
-        """Each residual cost's rows of ``row_weight`` and of the costs of its y."""
+        self.y_costs = self.cost[2 * n :]
+        self._weight_rows = [s.start if s.stop - s.start == 1 else s for s in self._slices]
+        """Each residual cost's rows of ``row_weight`` and of the costs of its y: its one row's
+        index (an item is set in a fraction of the time of a slice or a view's fill), or a
+        slice."""
         self.col_lower = np.zeros(self.columns)
         self.col_upper = np.full(self.columns, INF)
         # Views of the buffers each step writes, made once for the shape.
@@ -135,12 +137,12 @@ class Layout:
         """Set ``row_weight`` and the costs of y, 2 w_b, from the weight w_b of each residual
         cost (a step calls it when they differ from ``weights``): the rows of those whose
         weight changed (a base target's ramps as the base nears it), not all."""
-        for (rows, y_costs), weight, last in zip(
-            self._weight_blocks, weights, self.weights, strict=True
-        ):
-            if weight != last:
-                rows.fill(weight)
-                y_costs.fill(2.0 * weight)
+        row_weight, y_costs, last = self.row_weight, self.y_costs, self.weights
+        for place, rows in enumerate(self._weight_rows):
+            weight = weights[place]
+            if weight != last[place]:
+                row_weight[rows] = weight
+                y_costs[rows] = 2.0 * weight
         self.weights = weights
 
 
