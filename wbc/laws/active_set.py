@@ -29,8 +29,8 @@ class BoundEntries:
 
     def __init__(self, name: str, n: int) -> None:
         self.names = entry_names(name, n)
-        self.equal: Callable[[Sequence], tuple] = picker([])
-        """The entries whose bounds were equal, picked from a list of n."""
+        self.equal: Callable[[Sequence], tuple] | None = None
+        """The entries whose bounds were equal, picked from a list of n (None: none)."""
         self.free: Callable[[Sequence], tuple] | None = None
         """The others, in order (None: all n)."""
         self.free_names = self.names
@@ -39,7 +39,7 @@ class BoundEntries:
         """Split the entries by ``lows`` and ``highs``, a step's bounds."""
         equal = [i for i, (low, high) in enumerate(zip(lows, highs, strict=True)) if low == high]
         free = [i for i in range(len(self.names)) if i not in equal]
-        self.equal = picker(equal)
+        self.equal = picker(equal) if equal else None
         self.free = picker(free) if equal else None
         self.free_names = self.free(self.names) if self.free else self.names
 
@@ -75,15 +75,16 @@ def active(
         # (an infinite bound always does; a NaN difference is skipped by min or is its result,
         # failing the test, and an entry with a NaN bound never counts).
         equal = entries.equal
-        if equal(lows) != equal(highs):
+        if equal is not None and equal(lows) != equal(highs):
             entries.split(lows, highs)
         free = entries.free
         if free is None:
             xs = values
-        elif free(values):
-            xs, lows, highs = free(values), free(lows), free(highs)
         else:
-            continue
+            xs = free(values)
+            if not xs:
+                continue
+            lows, highs = free(lows), free(highs)
         if (
             min(map(sub, xs, lows)) > ACTIVE_TOLERANCE
             and min(map(sub, highs, xs)) > ACTIVE_TOLERANCE

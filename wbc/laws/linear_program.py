@@ -34,7 +34,7 @@ optimal basis, so the dual simplex starts from the previous vertex (usually 0 to
 from __future__ import annotations
 
 import operator
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import NamedTuple
 
 import highspy
@@ -117,15 +117,17 @@ class WarmStartedLP:
         if len(bounds) == 1:
             (bound,) = bounds
             lows, highs = bound.lower.tolist(), bound.upper.tolist()
-            entries = self._entries.get((bound.name, n)) or self._entries_of(bound.name, n)
+            entries = self._entries.get((bound.name, n)) or self._entries_of(
+                bound.name, lows, highs
+            )
             limits = [(entries, lows, highs)]
             u_lower[...], u_upper[...] = bound.lower, bound.upper
             infeasible = any(map(operator.gt, lows, highs))
         else:
-            limits = [
-                (self._entries_of(bound.name, n), bound.lower.tolist(), bound.upper.tolist())
-                for bound in bounds
-            ]
+            limits = []
+            for bound in bounds:
+                lows, highs = bound.lower.tolist(), bound.upper.tolist()
+                limits.append((self._entries_of(bound.name, lows, highs), lows, highs))
             u_lower.fill(-INF)
             u_upper.fill(INF)
             for bound in bounds:
@@ -180,11 +182,14 @@ class WarmStartedLP:
         # The named tuple built by tuple.__new__: the same value, without its __new__'s frame.
         return tuple.__new__(LPSolution, (u, status, objective, named, magnitudes))
 
-    def _entries_of(self, name: str, n: int) -> BoundEntries:
-        """The entries of the velocity bound ``name`` of n entries, made at its first step."""
+    def _entries_of(self, name: str, lows: list[float], highs: list[float]) -> BoundEntries:
+        """The entries of the velocity bound ``name`` whose entries are ``lows`` and ``highs``,
+        made and split at its first step of their size."""
+        n = len(lows)
         entries = self._entries.get((name, n))
         if entries is None:
             entries = self._entries[name, n] = BoundEntries(name, n)
+            entries.split(lows, highs)
         return entries
 
     def _sum_velocity_costs(self, costs: Sequence[VelocityCost], n: int) -> None:
@@ -312,8 +317,16 @@ class _Kinds:
             if group is None:
                 raise TypeError(f"not a cost or rows of the LP: {kind.__name__}")
             places[group].append(place)
-        self.velocity, self.residual, self.linear, self.bounds, self.norms = map(picker, places)
-        self.matrices = picker(places[1] + places[2])
+        self.velocity, self.residual, self.linear, self.bounds, self.norms = map(_picker, places)
+        self.matrices = _picker(places[1] + places[2])
+
+
+def _picker(places: list[int]) -> Callable[[tuple], tuple]:
+    """The items of a tuple at ``places``: one slice where they follow each other (a group of
+    one, most often: no Python call at a step), else ``picker``'s."""
+    if places and places == list(range(places[0], places[-1] + 1)):
+        return operator.itemgetter(slice(places[0], places[-1] + 1))
+    return picker(places)
 
 
 def _failed(n: int, status: str) -> LPSolution:
