@@ -4,7 +4,6 @@ the drive tasks the supervisor gives the law (wbc/planning/drive_tasks.py)."""
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 import pytest
@@ -118,10 +117,10 @@ def test_a_plan_round_the_most_circles_a_message_holds_keeps_to_its_cpu_budget()
     x, y = dq.translation(goal)[1:3]
     circles = [Circle(*c) for c in crowd(((HOME[0], HOME[1]), (x, y)))]
     params = StagingParams(budget_s=0.3)
-    started = time.thread_time()
     spent = plan(MODEL, HOME, goal, circles, params)
-    cpu_s = time.thread_time() - started
-    assert cpu_s <= params.budget_s + CHECK_GAP_S, cpu_s
+    # The plan's own CPU time: SciPy's import, before its clocks, is not the budget's (0.24 s
+    # when this test is the first to plan in its process).
+    assert spent.cpu_s <= params.budget_s + CHECK_GAP_S, spent.cpu_s
     assert not spent.candidates and "planning budget of 0.3 s" in spent.reason, spent.reason
 
 
