@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from types import ModuleType
 
 import pytest
@@ -20,8 +21,9 @@ from sim2d.devices.servo_chain import ANSWER_TIMEOUT_S, IntegratingJoints, Servo
 DT = 0.01
 """The world's and the servos' step, s."""
 SAFETY_S = 30.0
-"""How long an exchange waits for its answers at most: a safety net only, each wait ends as soon
-as the probe's answer is there."""
+"""How long an exchange, or the SDK, waits for an answer at most: a safety net only, each wait
+ends as soon as the answer is there. (The emulator's threads share this process's interpreter
+with the SDK's polling: on a loaded machine an answer came later than a driver's 1 s.)"""
 PROTOCOLS: dict[float, ModuleType] = {1.0: dynamixel_v1, 2.0: dynamixel_v2}
 Exchange = Callable[[bytes], list]
 """The ``exchange`` fixture: an instruction's bytes in, the packets answered to them out."""
@@ -41,7 +43,7 @@ def emulator(request: pytest.FixtureRequest, arm: IntegratingJoints) -> Iterator
 
 @pytest.fixture
 def port(request: pytest.FixtureRequest, emulator: ServoChain) -> Iterator[PortHandler]:
-    handler = BusPort(emulator.port, ANSWER_TIMEOUT_S)
+    handler = BusPort(emulator.port, SAFETY_S)
     assert handler.openPort()
     baud = getattr(request.module, "BAUD", None)
     if baud is not None:
@@ -53,6 +55,17 @@ def port(request: pytest.FixtureRequest, emulator: ServoChain) -> Iterator[PortH
 @pytest.fixture
 def packet(request: pytest.FixtureRequest) -> PacketHandler:
     return PacketHandler(request.module.PROTOCOL)
+
+
+@contextmanager
+def silent_awaited(port: BusPort) -> Iterator[None]:
+    """Within: the port awaits an answer as an emulated chain's driver does (``ANSWER_TIMEOUT_S``),
+    for a servo that never answers (a test's wait is otherwise ``SAFETY_S``)."""
+    port.answer_timeout_ms = ANSWER_TIMEOUT_S * 1e3
+    try:
+        yield
+    finally:
+        port.answer_timeout_ms = SAFETY_S * 1e3
 
 
 def simulate(emulator: ServoChain, arm: IntegratingJoints, steps: int) -> None:

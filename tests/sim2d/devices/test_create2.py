@@ -14,14 +14,13 @@ import serial
 
 from protocols import create_oi as oi
 from sim2d.devices.create2 import Create2Emulator, Mode
+from tests.sim2d.devices.conftest import SAFETY_S
 
 WHEEL_DIAMETER_M = 0.072
 START_COUNTS = 65_400
 """Both encoders start near 2^16, so the streamed counts wrap during a test."""
 
 
-SAFETY_S = 30.0
-"""How long a wait may last at most: a safety net only, each wait ends on what it waits for."""
 STOP_S = 2.0
 """A stop's bound: its threads wait 20 ms at a time for bytes or the next frame, and a busy
 machine delays their ends by far less; a stop that waited on a blocking read would not end."""

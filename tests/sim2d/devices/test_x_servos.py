@@ -19,7 +19,7 @@ from protocols import x_series_units as x_units
 from protocols.dynamixel_v2 import ALERT, Address, HardwareError, Instruction, StatusError
 from sim2d.devices.servo_chain import IntegratingJoints
 from sim2d.devices.x_servos import MODEL_NUMBER, XChainEmulator
-from tests.sim2d.devices.conftest import Exchange, simulate
+from tests.sim2d.devices.conftest import Exchange, silent_awaited, simulate
 
 IDS = (11, 12, 13, 14)
 START_ANGLES = (0.0, 0.4, -0.6, 1.2)
@@ -110,7 +110,8 @@ def test_a_silent_servo_times_out_and_an_overloaded_one_raises_the_alert(
     port: PortHandler, packet: PacketHandler, emulator: XChainEmulator, arm: IntegratingJoints
 ) -> None:
     emulator.fail(13)
-    assert packet.read4ByteTxRx(port, 13, Address.PRESENT_POSITION)[1] == COMM_RX_TIMEOUT
+    with silent_awaited(port):
+        assert packet.read4ByteTxRx(port, 13, Address.PRESENT_POSITION)[1] == COMM_RX_TIMEOUT
     assert packet.read4ByteTxRx(port, 14, Address.PRESENT_POSITION)[1] == COMM_SUCCESS
     emulator.fail(12, silent=False)
     assert packet.write1ByteTxRx(port, 12, Address.TORQUE_ENABLE, 1) == (COMM_SUCCESS, ALERT)
