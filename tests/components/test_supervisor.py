@@ -41,8 +41,8 @@ def test_a_goal_behind_the_robot_is_planned_off_the_handler_thread_then_driven_t
     operator = supervised(deployed)
     assert operator.statuses.messages[0].phase == "idle"
     behind = operator.robot.fkm(np.concatenate(([-0.8, 0.2, 3.0], REACH_GOAL[3:])))
-    operator.ask(behind)
-    operator.send_state(HOME)
+    asked = operator.ask(behind)
+    operator.answer_to(asked, HOME, "the goal taken")
     first = operator.goals.wait_for(lambda g: True, "the controller's first goal")
     planning = operator.statuses.wait_for(lambda s: s.phase != "idle", "a status of the goal")
     assert planning.phase == "planning" and planning.plans == 0
@@ -85,8 +85,8 @@ def test_the_status_of_a_drive_round_an_obstacle_carries_its_whole_planned_way(
     post = Circle(x=-0.4, y=0.1, radius=0.15)
     take_obstacles(operator, (post,))
     behind = operator.robot.fkm(np.concatenate(([-0.8, 0.2, 3.0], REACH_GOAL[3:])))
-    operator.ask(behind)
-    operator.send_state(HOME)
+    asked = operator.ask(behind)
+    operator.answer_to(asked, HOME, "the goal taken")
     drive = operator.statuses.wait_for(lambda s: s.phase == "drive", "the drive's status")
     assert len(drive.way) > 2, drive.way  # a way round the post, not straight at it
     assert drive.candidate_base is not None
@@ -207,8 +207,8 @@ def test_status_queries_are_answered_while_a_plan_runs_on_the_planner_thread(
         for a in np.linspace(0.0, 2.0 * math.pi, 30, endpoint=False)
     )
     take_obstacles(operator, ring)
-    operator.ask(operator.robot.fkm(np.array([2.0, 0.0, 0.0, 0.0, -0.3, -0.4, 0.2, 0.3])))
-    operator.send_state(HOME)
+    asked = operator.ask(operator.robot.fkm(np.array([2.0, 0.0, 0.0, 0.0, -0.3, -0.4, 0.2, 0.3])))
+    operator.answer_to(asked, HOME, "the goal taken")
     operator.statuses.wait_for(lambda s: s.phase == "planning", "the plan handed over")
     answer = component_status(operator.system, "supervisor")
     assert answer is not None, "no answer to the status query while the plan ran"
@@ -228,8 +228,8 @@ def test_a_goal_of_every_kind_has_a_status_with_every_state_until_and_after_it_i
     ``direct`` with the task's error, then ``reached``, and statuses go on after it."""
     operator = supervised(deployed)
     goal = met_at(REACH_GOAL)[kind]
-    operator.send_goal(goal)
-    operator.send_state(HOME)
+    asked = operator.send_goal(goal)
+    operator.answer_to(asked, HOME, "the goal taken")
     direct = operator.statuses.wait_for(lambda s: s.phase == "direct", "the goal's first status")
     assert direct.error_norm is not None and direct.error_norm > 0.01
     passed = operator.goals.wait_for(lambda g: g.task == goal.task, "the goal passed on")
@@ -252,8 +252,8 @@ def test_an_invalid_state_aborts_the_goal_refuses_new_ones_and_the_status_says_w
     why and since when; the goal under way is aborted, a new one refused with that reason,
     and when the state is valid again the robot is held where it stands, not sent on."""
     operator = supervised(deployed)
-    operator.ask(operator.robot.fkm(REACH_GOAL))
-    operator.send_state(HOME)
+    asked = operator.ask(operator.robot.fkm(REACH_GOAL))
+    operator.answer_to(asked, HOME, "the goal taken")
     operator.statuses.wait_for(lambda s: s.phase not in ("idle", "planning"), "the plan")
     aborted = operator.status_answering(HOME, "the abort", valid=False, age_s=12.0)
     assert aborted.phase == "aborted" and aborted.state == "invalid", aborted
@@ -295,8 +295,8 @@ def test_a_plan_round_256_circles_keeps_to_its_cpu_budget_and_says_it_ran_out(
         operator,
         tuple(Circle(x=cx, y=cy, radius=r) for cx, cy, r in crowd(((HOME[0], HOME[1]), (x, y)))),
     )
-    operator.ask(goal)
-    operator.send_state(HOME)
+    asked = operator.ask(goal)
+    operator.answer_to(asked, HOME, "the goal taken")
     verdict = operator.statuses.wait_for(
         lambda s: s.phase == "unreachable", "the verdict", timeout_s=60.0
     )
@@ -326,11 +326,13 @@ def test_goals_that_would_take_the_base_out_of_the_cameras_sight_are_turned_down
     assert refused.phase == "refused" and "the camera cannot see the base" in refused.reason
     status = unreachable(operator, operator.robot.fkm(out_of_sight), "cannot see it")
     assert "take the base where the camera cannot see it" in status.reason, status.reason
-    operator.ask(operator.robot.fkm(REACH_GOAL))
-    operator.send_state(HOME)
+    asked = operator.ask(operator.robot.fkm(REACH_GOAL))
+    operator.answer_to(asked, HOME, "the goal in sight taken")
     drive = operator.statuses.wait_for(
-        lambda s: s.plans == 1 and s.phase != "unreachable", "the plan in sight"
+        lambda s: s.request_stamp_ns == asked and (s.plans == 1 or s.phase == "unreachable"),
+        "the plan in sight, or its verdict",
     )
+    assert drive.phase != "unreachable", drive.reason
     assert drive.candidate_base is not None and within(region, *drive.way, drive.candidate_base)
 
 
