@@ -174,8 +174,7 @@ def test_the_supervisor_holds_while_stopped_and_yields_to_a_hand_until_a_new_goa
         answered()
         return len(operator.goals.messages) - before
 
-    operator.send_goal(first)
-    operator.send_state(HOME)
+    operator.answer_to(operator.send_goal(first), HOME, "the goal taken")
     operator.goals.wait_for(lambda g: g.task == "position", "the goal passed on")
     stop = router.declare_publisher(topics.CONTROL_STOP.key(namespace))
     stop.put(codec.encode(stop_state(True, "test")))
@@ -191,8 +190,7 @@ def test_the_supervisor_holds_while_stopped_and_yields_to_a_hand_until_a_new_goa
         assert time.monotonic() < deadline, "goals went on while teleoperated"
     operator.send_goal(first.model_copy(update={"header": header()}))
     assert goals_after_a_state() == 0  # the same goal: still yielding
-    operator.send_goal(second)
-    operator.send_state(HOME)
+    operator.answer_to(operator.send_goal(second), HOME, "the goal taken")
     operator.goals.wait_for(lambda g: g.task == "point", "the new goal passed on")
 
 
