@@ -15,40 +15,24 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
-import yaml
 import zenoh
 
 from launch.query import live_components, statuses
 from messages.process import EXIT_FOR_GOOD
 from profiles.deploy_files import DEPLOY
-from profiles.endpoints import free_port
 from profiles.profile import load_profile
 from record.session_reader import info
 from record.sessions import load_session
 from studies.launched import connect, launched
+from tests.launch.conftest import profile_file
 from tests.parsimony.in_process import completed
 from tests.processes import process_gone
 
 
-def system_profile(tmp_path: Path) -> Path:
-    path = tmp_path / "system.yaml"
-    path.write_text(
-        yaml.safe_dump(
-            {
-                "namespace": "rec",
-                "zenoh": {"router": [f"tcp/127.0.0.1:{free_port()}"]},
-                "components": [
-                    {
-                        "name": "pub",
-                        "module": "scripted_publisher",
-                        "role": "tool",
-                        "params": {"rate_hz": 100.0},
-                    }
-                ],
-            }
-        )
-    )
-    return path
+def system_profile(directory: Path) -> Path:
+    """A profile of one scripted publisher at 100 Hz, namespace ``rec``."""
+    publisher = {"name": "pub", "module": "scripted_publisher", "role": "tool"}
+    return profile_file(directory, [{**publisher, "params": {"rate_hz": 100.0}}], namespace="rec")
 
 
 @dataclass
