@@ -120,8 +120,8 @@ def arm_checks(profile: Profile, spec: ComponentSpec) -> list[Check]:
     if line.status == "fail":
         return [line]
     joints = _joints(profile, params)
-    bus = (int(params["baud"]), int(params["protocol"]))
-    return [line, *servo_checks(port, *bus, joints, float(params["answer_timeout_s"]))]
+    baud, protocol = int(params["baud"]), int(params["protocol"])
+    return [line, *servo_checks(port, baud, protocol, joints, float(params["answer_timeout_s"]))]
 
 
 def base_checks(spec: ComponentSpec) -> list[Check]:

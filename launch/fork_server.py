@@ -144,8 +144,8 @@ class ForkServer:
                     self._asked.remove(served)
                     served._answered.set()
         if not served._answered.wait(self.answer_s):
-            self._say(f"the fork server did not answer in {self.answer_s:g} s: killed; the")
-            self._say("components start as new interpreters from now on")
+            waited = f"the fork server did not answer in {self.answer_s:g} s"
+            self._say(f"{waited}: killed, components start as new interpreters")
             self.process.kill()  # its end answers every request (``_read``)
             served._answered.wait()
         for descriptor in closed_after:
