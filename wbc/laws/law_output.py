@@ -5,8 +5,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any, NamedTuple, Protocol
 
 import numpy as np
 
@@ -22,9 +21,9 @@ PRACTICAL_THRESHOLD = 0.01
 """Upsilon of section 6.2.1: the smallest velocity a motor acts on (rad/s or m/s)."""
 
 
-@dataclass(frozen=True)
-class LawOutput:
-    """u = [x', y', phi', q1'..q5'] and how it was obtained."""
+class LawOutput(NamedTuple):
+    """u = [x', y', phi', q1'..q5'] and how it was obtained (a named tuple: built at every
+    step in a fraction of the time of a frozen dataclass)."""
 
     u: Array
     status: str
@@ -95,15 +94,17 @@ def summarise(
             nonzero += 1
             if magnitude >= PRACTICAL_THRESHOLD:
                 practical += 1
-    output = object.__new__(LawOutput)  # the frozen dataclass, its fields set at once
-    output.__dict__.update(
-        u=u,
-        status=status,
-        objective=objective,
-        nonzero=nonzero,
-        practical_nonzero=practical,
-        active_constraints=active,
-        solve_time_s=time.perf_counter() - start,
-        error_norm=math.sqrt(error.dot(error)),  # ndarray.dot: @'s sum, in half the time
+    # Built by tuple.__new__: the same value, without the named tuple's own __new__'s frame.
+    return tuple.__new__(
+        LawOutput,
+        (
+            u,
+            status,
+            objective,
+            nonzero,
+            practical,
+            active,
+            time.perf_counter() - start,
+            math.sqrt(error.dot(error)),  # ndarray.dot: @'s sum, in half the time
+        ),
     )
-    return output

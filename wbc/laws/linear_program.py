@@ -122,7 +122,7 @@ class WarmStartedLP:
             )
             limits = [(entries, lows, highs)]
             u_lower[...], u_upper[...] = bound.lower, bound.upper
-            infeasible = any(map(operator.gt, lows, highs))
+            infeasible = not bound.ordered and any(map(operator.gt, lows, highs))
         else:
             limits = []
             for bound in bounds:
@@ -175,7 +175,7 @@ class WarmStartedLP:
         # sum_b w_b 1'(-b_b), the same IEEE sum. ndarray.dot: the same BLAS sums as @, in about
         # half the time for vectors this short.
         residual_upper = layout.residual_upper
-        objective = float(layout.cost.dot(values)) + float(layout.row_weight.dot(residual_upper))
+        objective = float(layout.cost.dot(values) + layout.row_weight.dot(residual_upper))
         values = u.tolist()
         magnitudes = list(map(abs, values))
         named = active(u, values, magnitudes, linear, norms, limits)

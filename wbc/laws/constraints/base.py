@@ -38,11 +38,13 @@ def no_rows(name: str, dof: int) -> LinearRows:
 
 
 class VelocityBounds(NamedTuple):
-    """lower <= u <= upper, one pair per entry of u."""
+    """lower <= u <= upper, one pair per entry of u; ``ordered`` where lower <= upper holds by
+    construction (bounds made by an entry's minimum and maximum), so the LP need not test it."""
 
     name: str
     lower: Array
     upper: Array
+    ordered: bool = False
 
 
 class OneNormBound(NamedTuple):

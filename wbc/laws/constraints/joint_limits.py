@@ -66,4 +66,6 @@ class JointLimits:
         upper = np.minimum(high - scaled_q, speed)
         np.minimum(lower, speed, out=lower)
         np.maximum(upper, slowest, out=upper)
-        return VelocityBounds(self.name, np.minimum(lower, upper), np.maximum(lower, upper))
+        return VelocityBounds(
+            self.name, np.minimum(lower, upper), np.maximum(lower, upper), ordered=True
+        )
