@@ -88,7 +88,8 @@ def test_joint_beyond_the_lower_margin_must_move_back(
 def test_joint_limit_bounds_are_ordered_and_within_speed(q: list[float], gain: float) -> None:
     bounds = JointLimits(gain, 0.9).rows(context(np.array(q)))
     speed = ROBOT.velocity_max
-    assert np.all(bounds.lower <= bounds.upper)
+    # Declared ordered, so the LP skips its test of lower > upper: it must hold.
+    assert bounds.ordered and np.all(bounds.lower <= bounds.upper)
     assert np.all(-speed <= bounds.lower) and np.all(bounds.upper <= speed)
     assert np.all(np.isfinite(bounds.lower)) and np.all(np.isfinite(bounds.upper))
 
