@@ -22,8 +22,9 @@ PRACTICAL_THRESHOLD = 0.01
 
 
 class LawOutput(NamedTuple):
-    """u = [x', y', phi', q1'..q5'] and how it was obtained (a named tuple: built at every
-    step in a fraction of the time of a frozen dataclass)."""
+    """u = [x', y', phi', q_1'..q_n'] (the base's velocities, then each arm joint's) and how
+    it was obtained (a named tuple: built at every step in a fraction of the time of a frozen
+    dataclass)."""
 
     u: Array
     status: str
