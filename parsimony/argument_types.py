@@ -28,3 +28,22 @@ def positive(what: str) -> Callable[[str], float]:
 
 positive_seconds = positive("seconds")
 """A duration in seconds."""
+
+
+def count(what: str) -> Callable[[str], int]:
+    """An argument type: a whole number >= 1 of ``what`` (``0``, ``-2`` and ``1.5`` are refused,
+    saying what was expected)."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"expected a whole number of {what}, got {text!r}"
+            ) from None
+        if value < 1:
+            raise argparse.ArgumentTypeError(f"expected at least 1 of {what}, got {text!r}")
+        return value
+
+    parse.__name__ = what
+    return parse

@@ -167,16 +167,18 @@ def run_bench(
     robot_file: Path = ROBOT_FILE,
     zoo: Sequence[Path] | None = None,
     zoo_only: bool = False,
+    runs: int = 1,
 ) -> dict:
     """Every figure of `parsimony bench`, measured in this run; progress goes to stderr.
 
     ``zoo``: the robot descriptions whose step times are taken (None: every one of
-    deploy/robots); ``zoo_only``: those step times and nothing else (a quick run)."""
+    deploy/robots); ``zoo_only``: those step times and nothing else (a quick run); ``runs``:
+    how many times the zoo is timed (``zoo_step_times``)."""
     report = {} if zoo_only else robot_figures(repeats, trials, goals, robot_file)
     zoo = deploy_files.zoo() if zoo is None else zoo
     if zoo:
-        progress(f"control steps on {len(zoo)} robots")
-        report["zoo"] = zoo_step_times(zoo, repeats)
+        progress(f"control steps on {len(zoo)} robots" + (f", {runs} runs" if runs > 1 else ""))
+        report["zoo"] = zoo_step_times(zoo, repeats, runs)
     return report
 
 
@@ -250,11 +252,19 @@ def zoo_tables(zoo: dict) -> list[str]:
         }
         for name, row in zoo.items()
     ]
+    runs = max(len(row["glue_share"]["runs"]) for row in zoo.values())
+    shares = ("median", "low", "high") if runs > 1 else ("median",)
     parts = [
-        {"LP step, median us by part": name, **row["lp_breakdown_us"]} for name, row in zoo.items()
+        {
+            "LP step, median us by part": name,
+            **row["lp_breakdown_us"],
+            **{f"glue share {figure}": row["glue_share"][figure] for figure in shares},
+        }
+        for name, row in zoo.items()
     ]
+    over = f", the median of {runs} runs" if runs > 1 else ""
     return [
-        "Control step by robot, us (median, p99; laws in turn on one trajectory)",
+        f"Control step by robot, us (median, p99; laws in turn on one trajectory{over})",
         table(steps, floatfmt=".1f"),
         "",
         table(parts, floatfmt=".2f"),

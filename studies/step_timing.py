@@ -191,22 +191,52 @@ def lp_breakdown(
     return result
 
 
-def zoo_step_times(robot_files: Iterable[Path], repeats: int) -> dict[str, dict]:
+def zoo_step_times(robot_files: Iterable[Path], repeats: int, runs: int = 1) -> dict[str, dict]:
     """Per robot of the zoo (by its name): its size, each law's step time on its own
     ``scenario`` (Little John's: its experiments' HOME and REACH_GOAL, as ``step_times``), the
-    LP's median over the classic law's (same run) and the LP step's parts."""
+    LP's median over the classic law's (same run) and the LP step's parts.
+
+    ``runs`` times over, every robot in turn in each run (a machine whose speed drifts drifts
+    for all): each figure is the median of the runs' (``lp_over_classic`` of each run's ratio),
+    and ``glue_share``, the glue's share of the LP step, gives each run's with their median and
+    range (``runs``, ``median``, ``low``, ``high``)."""
+    files = list(robot_files)
+    robots = [MobileManipulator.from_yaml(path) for path in files]
+    scenarios = [
+        (HOME, REACH_GOAL) if Path(path).resolve() == ROBOT_FILE.resolve() else scenario(robot)
+        for path, robot in zip(files, robots, strict=True)
+    ]
+    measured: dict[str, list[tuple[dict, dict]]] = {robot.name: [] for robot in robots}
+    for _ in range(runs):
+        for robot, (start, goal) in zip(robots, scenarios, strict=True):
+            steps = step_times(robot, repeats, start, goal)
+            measured[robot.name].append((steps, lp_breakdown(robot, repeats, start, goal)))
     results = {}
-    for path in robot_files:
-        robot = MobileManipulator.from_yaml(path)
-        own = Path(path).resolve() == ROBOT_FILE.resolve()
-        start, goal = (HOME, REACH_GOAL) if own else scenario(robot)
-        steps = step_times(robot, repeats, start, goal)
+    for robot in robots:
+        taken = measured[robot.name]
+        shares = [parts["glue"] / parts["total"] for _, parts in taken]
         results[robot.name] = {
             "dof": robot.dof,
             "arm_dof": robot.arm_dof,
             "base": robot.base.kind,
-            "step": steps,
-            "lp_over_classic": steps["lp"]["median_us"] / steps["classic"]["median_us"],
-            "lp_breakdown_us": lp_breakdown(robot, repeats, start, goal),
+            "step": {
+                law: {
+                    figure: float(np.median([steps[law][figure] for steps, _ in taken]))
+                    for figure in figures
+                }
+                for law, figures in taken[0][0].items()
+            },
+            "lp_over_classic": float(
+                np.median([s["lp"]["median_us"] / s["classic"]["median_us"] for s, _ in taken])
+            ),
+            "lp_breakdown_us": {
+                part: float(np.median([parts[part] for _, parts in taken])) for part in taken[0][1]
+            },
+            "glue_share": {
+                "runs": shares,
+                "median": float(np.median(shares)),
+                "low": min(shares),
+                "high": max(shares),
+            },
         }
     return results

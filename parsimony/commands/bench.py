@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from outputs.stdout import emit, json_text
+from parsimony.argument_types import count
 from profiles.deploy_files import ROBOT_FILE
 from studies.benchmark import format_report, run_bench
 from wbc.robot import MobileManipulator, RobotDescriptionError
@@ -30,6 +31,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     parser.add_argument(
         "--zoo-only", action="store_true", help="only the step times of each robot (a quick run)"
     )
+    parser.add_argument(
+        "--runs",
+        type=count("runs"),
+        default=1,
+        help="time the zoo this many times, robot after robot: each figure the runs' median, the "
+        "glue's share of the LP step with its range",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     return parser
 
@@ -41,6 +49,8 @@ def run(args: argparse.Namespace) -> int:
         except RobotDescriptionError as error:
             print(f"parsimony bench: {error}", file=sys.stderr)
             return 2
-    report = run_bench(args.repeats, args.trials, args.goals, args.robot, args.zoo, args.zoo_only)
+    report = run_bench(
+        args.repeats, args.trials, args.goals, args.robot, args.zoo, args.zoo_only, args.runs
+    )
     emit(json_text(report, indent=2) if args.json else format_report(report))
     return 0

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import statistics
 
 from profiles.deploy_files import ROBOT_FILE, zoo
 from studies.benchmark import convergence_test, format_report, run_bench
@@ -45,3 +46,17 @@ def test_the_zoo_bench_times_every_law_on_every_robot():
         parts = row["lp_breakdown_us"]
         assert min(parts["kinematics"], parts["rows"], parts["vertex"]) > 0.0
     assert "LP / classic" in format_report({"zoo": timed})
+
+
+def test_the_zoo_timed_several_times_gives_each_runs_glue_share_and_their_median():
+    """Two runs of one robot: the glue's share of the LP step in each run, their median and range,
+    and the table's columns for them; every figure the median of the two runs'."""
+    [robot] = [path for path in zoo() if path.stem == "youbot"]
+    [row] = run_bench(20, 0, 0, zoo=[robot], zoo_only=True, runs=2)["zoo"].values()
+    share = row["glue_share"]
+    assert len(share["runs"]) == 2 and all(math.isfinite(value) for value in share["runs"])
+    assert share["median"] == statistics.median(share["runs"])
+    assert (share["low"], share["high"]) == (min(share["runs"]), max(share["runs"]))
+    table = format_report({"zoo": {"youbot": row}})
+    assert "glue share low" in table and "the median of 2 runs" in table
+    assert 0.0 < row["step"]["lp"]["median_us"] <= row["step"]["lp"]["p99_us"]
