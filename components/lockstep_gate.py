@@ -6,7 +6,10 @@ controller answers the state of t with the commands of t); a camera frame stampe
 sensors of t + the camera's latency and before the next frame. The gate keeps the stamps each
 topic has answered (``messages.lockstep.AnswerStamps``), the one wait under way and the frame
 not yet answered. A wait still open ``timeout_s()`` host seconds after it began is overdue: it
-is counted (``lockstep_timeouts``) and given up, and the step goes on.
+is counted (``lockstep_timeouts``) and given up, and the step goes on. A wait for answers owed
+since before a component restarted (``forsake``) is given up sooner, RESTART_GRACE_S after the
+restart: the new process never saw what it would have answered (the others' answers still come,
+within the grace).
 
 Host time the answers took is kept in ``counters`` (``components.durations``): ``frame``, from
 publishing a frame to its last answer; ``frame_wait``, how long a step waited for a frame's
@@ -25,6 +28,9 @@ from messages.lockstep import AnswerStamps
 
 FRAME_ANSWERS = tuple(topic.name for topic in topics.FRAME_ANSWERS)
 COMMANDS = (topics.BASE_COMMAND.name, topics.ARM_COMMAND.name)
+RESTART_GRACE_S = 2.0
+"""Host seconds the answers owed since before a restart may still take (a restarted process owes
+none of them; the others answer in milliseconds)."""
 
 
 @dataclass(frozen=True)
@@ -67,6 +73,8 @@ class LockstepGate:
         self.answers = AnswerStamps()
         self.awaited: Awaited | None = None
         self.unanswered: Frame | None = None
+        self.forsaken: tuple[int, str, float] | None = None
+        """The last stamp awaited when a component restarted, its name and when (``forsake``)."""
         self._counters = counters
         self._times = {k: Durations(counters, k) for k in ("frame", "frame_wait", "loop")}
         counters["lockstep_timeouts"] = 0
@@ -126,15 +134,31 @@ class LockstepGate:
         self._times[kind].note(self.host_clock() - awaited.since)
         return self._release()
 
-    def overdue(self) -> tuple[Awaited, list[str]] | None:
-        """The wait under way and the topics that have not answered, given up (and counted)
-        once its deadline has passed; else None."""
-        awaited = self.awaited
-        if awaited is None or self.host_clock() <= awaited.deadline:
+    def forsake(self, name: str) -> None:
+        """Component ``name`` restarted: the answers awaited now (the wait under way and the frame
+        not yet answered) are owed for stamps it never saw; a wait for them is given up
+        RESTART_GRACE_S after this (``overdue``)."""
+        owed = [item.stamp_ns for item in (self.awaited, self.unanswered) if item is not None]
+        if self.forsaken is not None:
+            owed.append(self.forsaken[0])
+        if owed:
+            self.forsaken = (max(owed), name, self.host_clock())
+
+    def overdue(self) -> tuple[Awaited, list[str], str | None] | None:
+        """The wait under way, the topics that have not answered and the component whose restart
+        forsook it (None: its deadline passed), given up and counted once its deadline has passed
+        or, its stamp forsaken (``forsake``), the restart's grace; else None."""
+        awaited, forsaken, now = self.awaited, self.forsaken, self.host_clock()
+        if awaited is None:
+            return None
+        restarted = None
+        if forsaken and awaited.stamp_ns <= forsaken[0] and now > forsaken[2] + RESTART_GRACE_S:
+            restarted = forsaken[1]
+        if restarted is None and now <= awaited.deadline:
             return None
         missing = self.answers.missing(awaited.stamp_ns, awaited.topics)
         self._counters["lockstep_timeouts"] += 1
-        return self._release(), missing
+        return self._release(), missing, restarted
 
     def _release(self) -> Awaited:
         awaited, self.awaited = self.awaited, None

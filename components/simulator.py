@@ -35,9 +35,11 @@ never replaced by the next before it is answered. Frames are drawn on a thread o
 while the loop answers the sensors of the same step (published first when the latency is a
 step or more). Only then does t advance, so a run does not
 depend on the machine's load. An answer missing for ``ack_timeout_s`` host seconds is counted
-(``lockstep_timeouts``) and the step goes on; the waiting itself is the lockstep gate's
-(``components.lockstep_gate``). The simulator starts when ``paused`` is set false (a profile
-may start it so).
+(``lockstep_timeouts``) and the step goes on; one owed since before a component of the
+namespace restarted (its liveliness token dropped and came back: the new process never saw what
+it would answer) is given up sooner, ``lockstep_gate.RESTART_GRACE_S`` after the restart; the
+waiting itself is the lockstep gate's (``components.lockstep_gate``). The simulator starts when
+``paused`` is set false (a profile may start it so).
 """
 
 from __future__ import annotations
@@ -45,6 +47,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
+import zenoh
 
 from components.joint_check import joints_match
 from components.lockstep_gate import COMMANDS, FRAME_ANSWERS, Awaited, LockstepGate
@@ -234,6 +237,11 @@ class Simulator(Component):
             node.timer(p["step_s"] / p["real_time_factor"], self._paced_tick)
         node.timer(LOCKSTEP_CHECK_S, self._check_overdue)
         node.timer(PAUSED_CLOCK_S, self._paused_clock)
+        self._gone: set[str] = set()
+        """Components whose liveliness token dropped and has not come back."""
+        self._tokens = node.session.liveliness().declare_subscriber(
+            topics.liveliness_selector(node.namespace), self._on_token, history=True
+        )
 
     # -- the loop -------------------------------------------------------------------------
 
@@ -321,13 +329,30 @@ class Simulator(Component):
     def _check_overdue(self) -> None:
         overdue = self.gate.overdue()
         if overdue is not None:
-            awaited, missing = overdue
+            awaited, missing, restarted = overdue
+            why = f" ({restarted} restarted)" if restarted else ""
             self.node.warn(
                 "lockstep_timeouts",
-                f"no answer on {', '.join(missing)} for t={awaited.stamp_ns / 1e9:.3f} s; going on",
+                f"no answer on {', '.join(missing)} for t={awaited.stamp_ns / 1e9:.3f} s{why}; "
+                "going on",
             )
             self._proceed(awaited)
         self._kick()  # also starts a run once ``paused`` is set false
+
+    def _on_token(self, sample: zenoh.Sample) -> None:
+        """Zenoh thread: a component's liveliness token declared or dropped, handed on."""
+        name = topics.component_of_liveliness_key(self.node.namespace, str(sample.key_expr))
+        alive = sample.kind == zenoh.SampleKind.PUT
+        self.node.post(lambda: self._token(name, alive))
+
+    def _token(self, name: str, alive: bool) -> None:
+        """A component's token dropped, or came back: the component restarted, and what the
+        lockstep gate awaits now is forsaken (the new process never saw it)."""
+        if not alive:
+            self._gone.add(name)
+        elif name in self._gone:
+            self._gone.discard(name)
+            self.gate.forsake(name)
 
     # -- commands in ----------------------------------------------------------------------
 
@@ -378,6 +403,7 @@ class Simulator(Component):
             self.world.drive(*velocity, joints)
 
     def shutdown(self) -> None:
+        self._tokens.undeclare()
         self.outputs.shutdown()
 
 

@@ -85,7 +85,10 @@ LOCKSTEP_WATCHDOG_S = 30.0
 """Host seconds a component of a lockstep run may answer no status query before the launcher
 takes it for hung (the profile's default is 10 s): the loop waits for its slowest member, and on a
 machine shared with other work a sound controller was seen silent for 3 s, killed and restarted
-mid-run, which cut its recording's diagnostics in two."""
+mid-run, which cut its recording's diagnostics in two. The simulator waits as long for an answer
+(``ack_timeout_s``, 2 s by default): a loaded machine once took a lockstep run past the default,
+and a step given up changes the run; a process that dies is restarted, and the simulator gives up
+what it owed at once (``components.lockstep_gate``)."""
 SESSION_FILE = "session.mcap"
 """The recording of a run, beside its report."""
 
@@ -173,6 +176,8 @@ def experiment_profile(options: Options, base: Path, setup: SimScenario) -> dict
         "lockstep": not options.realtime,
         "real_time_factor": 1.0 if options.realtime else 0.0,
     }
+    if not options.realtime:
+        simulator["ack_timeout_s"] = LOCKSTEP_WATCHDOG_S
     if options.hide_base_marker is not None:
         simulator["hide_base_marker"] = [list(options.hide_base_marker)]
     controller = {"module": MODULES[options.controller], "params": law_overrides(options)}

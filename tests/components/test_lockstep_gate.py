@@ -1,13 +1,13 @@
 """components.lockstep_gate: a lockstep step waits for the commands of its stamp, a camera
 frame for its answers before the sensors its latency reaches, and an answer overdue by the
-timeout is counted and given up so the run goes on.
+timeout, or owed since before a component restarted, is counted and given up so the run goes on.
 
 The gate is pure logic over a host clock it is given: here a clock the test moves by hand,
 so no verdict depends on the machine's speed."""
 
 from __future__ import annotations
 
-from components.lockstep_gate import COMMANDS, FRAME_ANSWERS, LockstepGate
+from components.lockstep_gate import COMMANDS, FRAME_ANSWERS, RESTART_GRACE_S, LockstepGate
 from messages import topics
 
 MS = 1_000_000
@@ -24,10 +24,12 @@ class HandClock:
         return self.now
 
 
-def gate(latency_ns: int = 0) -> tuple[LockstepGate, dict[str, int], HandClock]:
+def gate(
+    latency_ns: int = 0, timeout_s: float = TIMEOUT_S
+) -> tuple[LockstepGate, dict[str, int], HandClock]:
     counters: dict[str, int] = {}
     clock = HandClock()
-    return LockstepGate(counters, latency_ns, lambda: TIMEOUT_S, clock), counters, clock
+    return LockstepGate(counters, latency_ns, lambda: timeout_s, clock), counters, clock
 
 
 def test_the_answers_are_the_topic_tables_commands_and_frame_answers() -> None:
@@ -65,8 +67,9 @@ def test_an_answer_overdue_by_the_timeout_is_counted_named_and_given_up() -> Non
     clock.now += 0.001
     overdue = lockstep.overdue()
     assert overdue is not None
-    awaited, missing = overdue
+    awaited, missing, restarted = overdue
     assert awaited.stamp_ns == 40 * MS and missing == [topics.ARM_COMMAND.name]
+    assert restarted is None
     assert counters["lockstep_timeouts"] == 1 and not lockstep.waiting
     assert lockstep.overdue() is None  # counted once
 
@@ -124,3 +127,38 @@ def test_an_overdue_frame_is_given_up_and_the_next_one_goes() -> None:
     assert overdue is not None and overdue[1] == [topics.WORLD_MARKERS.name]
     assert counters["lockstep_timeouts"] == 1
     assert lockstep.unanswered is None and not lockstep.frame_pending()
+
+
+def test_a_restart_gives_up_what_was_awaited_before_it_and_nothing_after() -> None:
+    """A component restarted: the answers of the wait under way and of the frame not yet answered
+    may still come within the grace (the others' do), and are given up after it, named with the
+    component, though the timeout is far; a step sent after the restart waits as before."""
+    lockstep, counters, clock = gate(latency_ns=30 * MS, timeout_s=30.0)  # an experiment's
+    lockstep.forsake("vision_tracker")  # nothing awaited: nothing given up
+    lockstep.frame_taken(100 * MS)
+    lockstep.wait(COMMANDS, 110 * MS)
+    lockstep.forsake("state_estimator")
+    clock.now += RESTART_GRACE_S  # the grace: the answers may still come
+    assert lockstep.overdue() is None and lockstep.waiting
+    clock.now += 0.001
+    overdue = lockstep.overdue()
+    assert overdue is not None
+    awaited, missing, restarted = overdue
+    assert (awaited.stamp_ns, missing, restarted) == (110 * MS, list(COMMANDS), "state_estimator")
+    assert lockstep.frame_due(130 * MS)  # the frame sent before the restart is waited for...
+    overdue = lockstep.overdue()  # ...and given up, the grace over
+    assert overdue is not None and overdue[0].frame and overdue[2] == "state_estimator"
+    lockstep.wait(COMMANDS, 140 * MS)  # sent after the restart
+    clock.now += RESTART_GRACE_S + 0.1
+    assert lockstep.overdue() is None and lockstep.waiting
+    assert counters["lockstep_timeouts"] == 2
+
+
+def test_answers_that_come_within_a_restarts_grace_end_the_wait() -> None:
+    lockstep, counters, clock = gate()
+    lockstep.wait(COMMANDS, 50 * MS)
+    lockstep.forsake("supervisor")  # answers nothing the gate awaits
+    clock.now += 0.01
+    lockstep.note(COMMANDS[0], 50 * MS)
+    assert lockstep.note(COMMANDS[1], 50 * MS) is not None and not lockstep.waiting
+    assert counters["lockstep_timeouts"] == 0
