@@ -288,18 +288,22 @@ def test_no_state_no_goal_an_invalid_and_an_old_state_command_zero_and_say_why(
     operator.assert_every_command_finite()
 
 
-def test_states_that_stop_arriving_command_zero_within_the_timeout(operator: Operator) -> None:
+def test_states_that_stop_arriving_command_zero_once_the_timeout_has_passed(
+    operator: Operator,
+) -> None:
+    """Judged by stamps on the controller's clock (the host's), not by how soon the stale comes:
+    a stale computed before this state was handled (the last test's state aging) is stamped
+    within the timeout of it, and is not the one awaited."""
     operator.send_goal()
     last = operator.send_state()
-    sent = time.monotonic()
     assert operator.answer(last)[0].status == "optimal"
+    timeout_ns = round(STALE_TIMEOUT_S * 1e9)
     stale = operator.diagnostics.wait_for(
-        lambda m: m.header.stamp_ns > last and m.status == "stale", "stale after the last state"
+        lambda m: m.header.stamp_ns >= last + timeout_ns and m.status == "stale",
+        "stale the timeout after the last state",
     )
-    elapsed = time.monotonic() - sent
     assert stale.reason.startswith("no robot/state for")
-    timer_period_s, margin_s = 0.1, 0.4
-    assert STALE_TIMEOUT_S <= elapsed <= STALE_TIMEOUT_S + timer_period_s + margin_s
+    assert float(stale.reason.split()[3]) >= STALE_TIMEOUT_S, stale.reason
     _, base, arm = operator.answer(stale.header.stamp_ns)
     assert is_zero(base, arm)
 
