@@ -46,7 +46,8 @@ waits for them), odometry by the estimator's state."""
 ANSWERING = {topic.name: topic for answers in ANSWERS.values() for topic in answers}
 """The topics that carry answers, by name."""
 ANSWER_TIMEOUT_S = 1.0
-"""Host seconds ``--lockstep`` waits for an answer before it goes on (said and counted)."""
+"""Host seconds ``--lockstep`` waits for an answer before it goes on (said and counted), unless
+``--answer-timeout`` says otherwise."""
 KEYS_HELP = "space: pause/play, s or right arrow: step, +/-: rate, q: quit"
 
 
@@ -191,7 +192,10 @@ class Progress:
 class Answers:
     """The live loop's answers (``ANSWERS``) to the message just sent."""
 
-    def __init__(self, session: zenoh.Session, namespace: str) -> None:
+    def __init__(
+        self, session: zenoh.Session, namespace: str, timeout_s: float = ANSWER_TIMEOUT_S
+    ) -> None:
+        self.timeout_s = timeout_s
         self._stamps = AnswerStamps()
         self._changed = threading.Condition()
         self.timeouts = 0
@@ -219,11 +223,11 @@ class Answers:
 
     def wait(self, record: Recorded) -> bool:
         """Until every answer to ``record`` (stamped with its log time) is in, at most
-        ``ANSWER_TIMEOUT_S``; False (and counted in ``timeouts``) when one did not come."""
+        ``timeout_s``; False (and counted in ``timeouts``) when one did not come."""
         names = [t.name for t in ANSWERS[record.topic_name]]
         with self._changed:
             if self._changed.wait_for(
-                lambda: self._stamps.answered(record.log_time_ns, names), ANSWER_TIMEOUT_S
+                lambda: self._stamps.answered(record.log_time_ns, names), self.timeout_s
             ):
                 return True
         self.timeouts += 1
@@ -233,7 +237,8 @@ class Answers:
 @dataclass(frozen=True)
 class Playing:
     """How a replay plays: its ``rate``, its window (``start_offset_s``, ``duration_s``),
-    whether it ``loop``s, publishes ``clock``, waits in ``lockstep``, starts paused."""
+    whether it ``loop``s, publishes ``clock``, waits in ``lockstep`` (at most
+    ``answer_timeout_s`` for an answer), starts paused."""
 
     rate: float = 1.0
     start_offset_s: float = 0.0
@@ -242,6 +247,7 @@ class Playing:
     clock: bool = False
     lockstep: bool = False
     start_paused: bool = False
+    answer_timeout_s: float = ANSWER_TIMEOUT_S
 
 
 class Player:
@@ -261,7 +267,9 @@ class Player:
         self.pace = Pace(playing.rate, self.first_ns, time.monotonic(), paused=playing.start_paused)
         self.sent = 0
         """The messages sent in this pass."""
-        self.answers = Answers(session, namespace) if playing.lockstep else None
+        self.answers = (
+            Answers(session, namespace, playing.answer_timeout_s) if playing.lockstep else None
+        )
         names = recording.names | ({"sim/clock"} if playing.clock else set())
         block = zenoh.CongestionControl.BLOCK  # a replay waits rather than drop a sample
         self.publishers = {
@@ -286,7 +294,8 @@ class Player:
                 raise
             if self.answers is not None and self.answers.timeouts:
                 self.progress.say(
-                    f"{self.answers.timeouts} messages not answered within {ANSWER_TIMEOUT_S:g} s"
+                    f"{self.answers.timeouts} messages not answered within "
+                    f"{self.answers.timeout_s:g} s"
                 )
             self.progress.say(f"{sent} messages sent" + (" (quit)" if quit_asked else ""))
             if quit_asked or not self.playing.loop:
@@ -356,7 +365,7 @@ class Player:
                 stamp_s = record.log_time_ns / 1e9
                 self.progress.say(
                     f"no answer to {record.topic_name} of {stamp_s:.3f} s "
-                    f"in {ANSWER_TIMEOUT_S:g} s; going on"
+                    f"in {self.answers.timeout_s:g} s; going on"
                 )
             self.pace.anchor_s += time.monotonic() - started
 

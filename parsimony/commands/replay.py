@@ -52,7 +52,7 @@ from parsimony.target_options import fail, target_options
 from profiles.endpoints import endpoint_problem
 from profiles.profile import Profile, ProfileError, load_profile
 from record.replay_keys import terminal_keys
-from record.replayer import ANSWERING, SENSORS, Player, Playing, Recording
+from record.replayer import ANSWER_TIMEOUT_S, ANSWERING, SENSORS, Player, Playing, Recording
 from view.live_view import DEFAULT_PORT
 from wbc.robot import MobileManipulator
 
@@ -99,6 +99,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         "--lockstep",
         action="store_true",
         help="wait for the live tracker's and estimator's answers",
+    )
+    parser.add_argument(
+        "--answer-timeout",
+        type=positive_seconds,
+        default=ANSWER_TIMEOUT_S,
+        help=f"seconds --lockstep waits for an answer before it goes on (default "
+        f"{ANSWER_TIMEOUT_S:g})",
     )
     parser.add_argument(
         "--start-paused",
@@ -201,6 +208,7 @@ def played(
         args.clock,
         args.lockstep,
         args.start_paused,
+        args.answer_timeout,
     )
     try:
         with view as served:

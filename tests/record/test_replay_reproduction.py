@@ -39,6 +39,9 @@ RATE = 4.0
 """The replay's rate: ``--lockstep`` waits for the tracker's and estimator's answers to each
 frame and odometry message, so the rate only bounds how fast the replay may go."""
 DEADLINE_S = 60.0
+ANSWER_WAIT_S = 30.0
+"""How long the replay waits for each answer (``--answer-timeout``): a live loop that answers
+slowly on a loaded machine still answers; only a dead one makes the replay go on."""
 
 
 def complete_until(session: dict[str, list]) -> int:
@@ -110,6 +113,8 @@ def replay_into(profile_path: Path, recording: Path, stamps: set[int]) -> dict[i
                     "--sensors",
                     "--clock",
                     "--lockstep",
+                    "--answer-timeout",
+                    str(ANSWER_WAIT_S),
                     "--rate",
                     str(RATE),
                     "--duration",

@@ -1,6 +1,7 @@
 """`parsimony replay` with no system running: it serves a router of its own on the profile's
 loopback endpoint, and the replay is watched in Foxglove as a live system is, through
-`replay --view` and through `parsimony view` of the same profile."""
+`replay --view` and through `parsimony view` of the same profile; under ``--lockstep`` it says
+each message nothing answered within ``--answer-timeout``, and goes on."""
 
 from __future__ import annotations
 
@@ -17,6 +18,7 @@ from profiles.endpoints import free_port
 from record.replayer import Recording
 from record.session_file import SessionWriter, from_json
 from tests.parsimony.in_process import completed
+from tests.record.session_messages import image
 from tests.view.live_view_client import (
     StderrLines,
     background_job,
@@ -106,3 +108,32 @@ def test_without_a_profile_a_replay_goes_into_its_recorded_namespace(
         f"replay: {tmp_path / 'two.mcap'}: recorded in the namespaces "
         f"{INTO}, {RECORDED}: give --namespace\n"
     )
+
+
+def test_a_lockstep_replay_that_nothing_answers_says_so_after_the_timeout_given(
+    tmp_path: Path,
+) -> None:
+    profile = write_profile(tmp_path)  # nothing is running: no tracker, no estimator
+    frames = [10**9 + k * 10**8 for k in range(3)]
+    with SessionWriter(tmp_path / "frames.mcap") as writer:
+        for stamp in frames:
+            writer.write(topics.CAMERA_IMAGE.key(RECORDED), image(stamp))
+    done = completed(
+        "replay",
+        str(tmp_path / "frames.mcap"),
+        "--profile",
+        str(profile),
+        "--namespace",
+        INTO,
+        "--lockstep",
+        "--answer-timeout",
+        "0.05",
+        "--rate",
+        "100",
+    )
+    assert done.returncode == 0, done.stderr
+    for stamp in frames:
+        assert f"no answer to camera/image of {stamp / 1e9:.3f} s in 0.05 s; going on" in (
+            done.stderr
+        ), done.stderr
+    assert "3 messages not answered within 0.05 s" in done.stderr, done.stderr
