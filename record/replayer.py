@@ -192,9 +192,7 @@ class Progress:
 class Answers:
     """The live loop's answers (``ANSWERS``) to the message just sent."""
 
-    def __init__(
-        self, session: zenoh.Session, namespace: str, timeout_s: float = ANSWER_TIMEOUT_S
-    ) -> None:
+    def __init__(self, session: zenoh.Session, namespace: str, timeout_s: float) -> None:
         self.timeout_s = timeout_s
         self._stamps = AnswerStamps()
         self._changed = threading.Condition()

@@ -88,7 +88,7 @@ machine shared with other work a sound controller was seen silent for 3 s, kille
 mid-run, which cut its recording's diagnostics in two. The simulator waits as long for an answer
 (``ack_timeout_s``, 2 s by default): a loaded machine once took a lockstep run past the default,
 and a step given up changes the run; a process that dies is restarted, and the simulator gives up
-what it owed at once (``components.lockstep_gate``)."""
+what it owed 2 s after it is back (``components.lockstep_gate.RESTART_GRACE_S``)."""
 SESSION_FILE = "session.mcap"
 """The recording of a run, beside its report."""
 

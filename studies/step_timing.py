@@ -191,6 +191,11 @@ def lp_breakdown(
     return result
 
 
+def medians(runs: Sequence[dict[str, float]]) -> dict[str, float]:
+    """Each figure of the ``runs`` (dicts with the same keys), the median of its values."""
+    return {key: float(np.median([run[key] for run in runs])) for key in runs[0]}
+
+
 def zoo_step_times(robot_files: Iterable[Path], repeats: int, runs: int = 1) -> dict[str, dict]:
     """Per robot of the zoo (by its name): its size, each law's step time on its own
     ``scenario`` (Little John's: its experiments' HOME and REACH_GOAL, as ``step_times``), the
@@ -219,19 +224,11 @@ def zoo_step_times(robot_files: Iterable[Path], repeats: int, runs: int = 1) -> 
             "dof": robot.dof,
             "arm_dof": robot.arm_dof,
             "base": robot.base.kind,
-            "step": {
-                law: {
-                    figure: float(np.median([steps[law][figure] for steps, _ in taken]))
-                    for figure in figures
-                }
-                for law, figures in taken[0][0].items()
-            },
+            "step": {law: medians([steps[law] for steps, _ in taken]) for law in taken[0][0]},
             "lp_over_classic": float(
                 np.median([s["lp"]["median_us"] / s["classic"]["median_us"] for s, _ in taken])
             ),
-            "lp_breakdown_us": {
-                part: float(np.median([parts[part] for _, parts in taken])) for part in taken[0][1]
-            },
+            "lp_breakdown_us": medians([parts for _, parts in taken]),
             "glue_share": {
                 "runs": shares,
                 "median": float(np.median(shares)),
