@@ -133,15 +133,16 @@ def lp_breakdown(
     """Median microseconds of one LP step spent in each part, the rest being Python glue.
 
     The law's own parts are wrapped with timers: the forward pass (fkm and J), the rows and
-    terms (the task's error e and Jacobian at x, ``task.error``, then ``lp_law.terms``: the
-    constraints' rows and the objective's terms, the task's ||J u + eta e|| first), the vertex
-    (the kept basis tested, or the calls into HiGHS: model update, basis, run, solution) and
-    HiGHS alone; ``highs_runs`` is the share of steps that called HiGHS. The step (``total``)
-    is the law's own, untimed: a twin law with no timers steps the same states in turn, BLOCK
-    at a time, and a step's glue is its time less the parts the timed law spent on the same
-    state (the two in alternate order, block by block), so the timers' own cost (about half a
-    microsecond a call, some two microseconds a step) is in no part. Both laws give the same
-    outputs, so take the same path, at each state.
+    terms (the task's error e and Jacobian at x, ``task.error``, its rate e', ``lp_law.
+    error_rate``, then ``lp_law.terms``: the constraints' rows and the objective's terms, the
+    task's ||J u + eta e|| first), the vertex (the LP solved from its data: the costs of u_P and
+    u_N, the kept basis tested or the calls into HiGHS, u = u_P - u_N) and HiGHS alone (model
+    update, basis, run, solution); ``highs_runs`` is the share of steps that called HiGHS. The
+    step (``total``) is the law's own, untimed: a twin law with no timers steps the same states
+    in turn, BLOCK at a time, and a step's glue is its time less the parts the timed law spent
+    on the same state (the two in alternate order, block by block), so of the timers' own cost
+    (about half a microsecond a call) only what a timer does between its two reads of the clock
+    falls in a part. Both laws give the same outputs, so take the same path, at each state.
     """
     task, plain = PoseTask(robot.fkm(goal)), PoseTask(robot.fkm(goal))
     states = trajectory(robot, start, goal, repeats)
@@ -163,15 +164,18 @@ def lp_breakdown(
     law.robot.forward = timed("kinematics", robot.forward)  # type: ignore[method-assign]
     # The task's term (e, J of ||J u + eta e||) is timed as the other terms are.
     object.__setattr__(task, "error", timed("rows", task.error))
-    law._lp._vertex = timed("vertex", law._lp._vertex)  # type: ignore[method-assign]
+    law._lp._optimum = timed("vertex", law._lp._optimum)  # type: ignore[method-assign]
     law._lp._run = timed("highs", law._lp._run)  # type: ignore[method-assign]
     parts: dict[str, list[float]] = {name: [] for name in (*spent, "glue", "total")}
-    terms, timed_terms = lp_law.terms, timed("rows", lp_law.terms)
+    # The module's functions the step calls, timed for the law and as they are for its twin.
+    plain_calls = {name: getattr(lp_law, name) for name in ("error_rate", "terms")}
+    timed_calls = {name: timed("rows", call) for name, call in plain_calls.items()}
     untimed: list[float] = []
     try:
         for index, block in enumerate(blocks(states, repeats, (law, twin))):
             for twin_turn in (index % 2 == 1, index % 2 == 0):  # each first every other block
-                lp_law.terms = terms if twin_turn else timed_terms
+                for name, call in (plain_calls if twin_turn else timed_calls).items():
+                    setattr(lp_law, name, call)
                 for q in block:
                     spent.update(dict.fromkeys(spent, 0.0))
                     begin = time.perf_counter()
@@ -183,7 +187,8 @@ def lp_breakdown(
                         for name, value in spent.items():
                             parts[name].append(value)
     finally:
-        lp_law.terms = terms
+        for name, call in plain_calls.items():
+            setattr(lp_law, name, call)
     named = np.sum([parts[name] for name in ("kinematics", "rows", "vertex")], axis=0)
     parts["glue"], parts["total"] = list(np.array(untimed) - named), untimed
     result = {name: float(np.median(values) * 1e6) for name, values in parts.items()}

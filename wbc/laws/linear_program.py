@@ -153,29 +153,18 @@ class WarmStartedLP:
         weights = list(map(_WEIGHT, residuals))
         if weights != layout.weights:
             layout.weigh(weights)
-        # The costs of u_P: c_P - sum_b w_b 1'A_b, of u_N: c_N + sum_b w_b 1'A_b (rows weighted
-        # by w), c_P and c_N the velocity costs of each entry's two directions; y_b's 2 w_b are
-        # set with the weights (``Layout.weigh``).
+        # c_P and c_N, the velocity costs of each entry's two directions (``_optimum``).
         velocity = kinds.velocity(items)
         if (n, *map(id, velocity)) != self._cost_key:
             self._sum_velocity_costs(velocity, n)
-        positive, negative = self._cost_sums
-        column_sums = layout.row_weight.dot(layout.residual_stack)
-        np.subtract(positive, column_sums, layout.cost_positive)
-        np.add(negative, column_sums, layout.cost_negative)
-        status, values = self._vertex(layout)
-        if values is None:
+        status, u = self._optimum(layout)
+        if u is None:
             return _failed(n, status)
-        # With no cost on u_P + u_N (c = 0) a vertex may hold both halves of one u_i positive,
-        # the one-norm row tight only through that waste (its dual 0). One degenerate pivot away
-        # lies the same u with the halves split canonically (each less their minimum); their
-        # difference is u_P - u_N bit for bit (IEEE rounding is symmetric, x - x is +0).
-        u = layout.values_plus - layout.values_minus  # values is layout.values
-        # Less the constant -sum_b w_b 1'b_b (the residual rows' upper bounds hold -b): plus
-        # sum_b w_b 1'(-b_b), the same IEEE sum. ndarray.dot: the same BLAS sums as @, in about
-        # half the time for vectors this short.
+        # The vertex's cost less the constant -sum_b w_b 1'b_b (the residual rows' upper bounds
+        # hold -b): plus sum_b w_b 1'(-b_b), the same IEEE sum. ndarray.dot: the same BLAS sums
+        # as @, in about half the time for vectors this short.
         residual_upper = layout.residual_upper
-        objective = float(layout.cost.dot(values) + layout.row_weight.dot(residual_upper))
+        objective = float(layout.cost.dot(layout.values) + layout.row_weight.dot(residual_upper))
         values = u.tolist()
         magnitudes = list(map(abs, values))
         named = active(u, values, magnitudes, linear, norms, limits)
@@ -250,15 +239,33 @@ class WarmStartedLP:
         self._layout = layout
         self._basis = None
 
-    def _vertex(self, layout: Layout) -> tuple[str, Array | None]:
-        """The optimal vertex: from the kept basis if it is still optimal, else from HiGHS."""
+    def _optimum(self, layout: Layout) -> tuple[str, Array | None]:
+        """The LP solved from the data in ``layout``, and u = u_P - u_N at its optimal vertex
+        (None where HiGHS finds no optimum), with the status.
+
+        The costs of u_P are c_P - sum_b w_b 1'A_b, of u_N c_N + sum_b w_b 1'A_b (rows weighted
+        by w), c_P and c_N the velocity costs of each entry's two directions (y_b's 2 w_b are
+        set with the weights, ``Layout.weigh``). The vertex comes from the kept basis if it is
+        still optimal, else from HiGHS.
+        """
+        positive, negative = self._cost_sums
+        column_sums = layout.row_weight.dot(layout.residual_stack)
+        np.subtract(positive, column_sums, layout.cost_positive)
+        np.add(negative, column_sums, layout.cost_negative)
+        status, values = "optimal", None
         if self._basis is not None:
             values = self._basis.solution(
                 layout.matrix, layout.lower, layout.upper, layout.cost, layout.values
             )
-            if values is not None:
-                return "optimal", values
-        return self._run(layout)
+        if values is None:
+            status, values = self._run(layout)
+            if values is None:
+                return status, None
+        # With no cost on u_P + u_N (c = 0) a vertex may hold both halves of one u_i positive,
+        # the one-norm row tight only through that waste (its dual 0). One degenerate pivot away
+        # lies the same u with the halves split canonically (each less their minimum); their
+        # difference is u_P - u_N bit for bit (IEEE rounding is symmetric, x - x is +0).
+        return status, layout.values_plus - layout.values_minus
 
     def _run(self, layout: Layout) -> tuple[str, Array | None]:
         """Every call into HiGHS of one step: update the model, restore the basis, solve.

@@ -96,8 +96,8 @@ def program(
     previous_u: Array | None = None,
 ) -> tuple[list, list, Array, tuple[Task, Array]]:
     """One step's program of 5.29: the inputs checked (``NonFiniteInputError``, dt > 0), e
-    and e' measured (e' = (e - e_last) / dt against the ``last`` error of the same task, else
-    the commanded -eta e), the costs (the task's first, ||J u + eta e||) and the rows; with e
+    and e' measured (``error_rate``, against the ``last`` error if it was the same task's), the
+    costs (the task's first, ||J u + eta e||) and the rows; with e
     and the new ``last``. ``obstacles`` mixes circles for the base and solids in 3-D
     (``wbc.geometry.obstacles.split``). ``previous_u`` is the u the law gave at its previous step,
     for the terms and rows that read it (``StepContext.previous_u``). The LP and the QP
@@ -110,13 +110,10 @@ def program(
     circles, solids = _obstacles(obstacles) if obstacles else ((), ())
     chain = robot.forward(q)  # one pass for the task and the collision parts' rows
     error, task_jacobian = task.error(chain.pose, chain.jacobian, q)
+    last_error = None
     if last is not None and (last[0] is task or same_task(last[0], task)):
-        error_rate = np.subtract(error, last[1])
-        # In place, by dt as a 0-d array: the same quotients, without NumPy's conversion of a
-        # Python float at every step (half the time of ``/= dt``).
-        np.divide(error_rate, _period(dt), error_rate)
-    else:
-        error_rate = -eta * error
+        last_error = last[1]
+    rate = error_rate(error, last_error, eta, dt)
     goal_pose = task.pose if isinstance(task, PoseTask) else None
     # The named tuple built by tuple.__new__: the same value, without its own __new__'s frame.
     context = tuple.__new__(
@@ -125,7 +122,7 @@ def program(
             robot,
             q,
             error,
-            error_rate,
+            rate,
             task.goal_position[:2],
             circles,
             goal_pose,
@@ -137,6 +134,18 @@ def program(
     )
     costs, rows = terms(context, task_jacobian, eta, constraints, objectives)
     return costs, rows, error, (task, error)
+
+
+def error_rate(error: Array, last_error: Array | None, eta: float, dt: float) -> Array:
+    """e' = (e - e_last) / dt against the ``last_error`` of the same task, else (None) the
+    commanded -eta e."""
+    if last_error is None:
+        return -eta * error
+    rate = np.subtract(error, last_error)
+    # In place, by dt as a 0-d array: the same quotients, without NumPy's conversion of a
+    # Python float at every step (half the time of ``/= dt``).
+    np.divide(rate, _period(dt), rate)
+    return rate
 
 
 def terms(
