@@ -8,6 +8,8 @@ import statistics
 from profiles.deploy_files import ROBOT_FILE, zoo
 from studies.benchmark import convergence_test, format_report, run_bench
 from studies.reproduce.efficiency import section_6_3
+from studies.step_timing import lp_breakdown
+from wbc.laws import lp_law
 from wbc.robot import MobileManipulator
 
 ROBOT = MobileManipulator.from_yaml(ROBOT_FILE)
@@ -60,3 +62,12 @@ def test_the_zoo_timed_several_times_gives_each_runs_glue_share_and_their_median
     table = format_report({"zoo": {"youbot": row}})
     assert "glue share low" in table and "the median of 2 runs" in table
     assert 0.0 < row["step"]["lp"]["median_us"] <= row["step"]["lp"]["p99_us"]
+
+
+def test_the_lp_breakdown_leaves_the_law_as_it_found_it():
+    """The breakdown times the law's module functions (e' and the terms) for its timed law only:
+    after it, the law's own functions are back, so no later step pays for the timers."""
+    plain = (lp_law.error_rate, lp_law.terms)
+    parts = lp_breakdown(MobileManipulator.from_yaml(ROBOT_FILE), 20)
+    assert lp_law.error_rate is plain[0] and lp_law.terms is plain[1]
+    assert min(parts["kinematics"], parts["rows"], parts["vertex"]) > 0.0

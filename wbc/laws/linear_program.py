@@ -240,8 +240,9 @@ class WarmStartedLP:
         self._basis = None
 
     def _optimum(self, layout: Layout) -> tuple[str, Array | None]:
-        """The LP solved from the data in ``layout``, and u = u_P - u_N at its optimal vertex
-        (None where HiGHS finds no optimum), with the status.
+        """The LP solved from this step's data (``layout``'s buffers, the velocity costs' sums),
+        and u = u_P - u_N at its optimal vertex (None where HiGHS finds no optimum), with the
+        status.
 
         The costs of u_P are c_P - sum_b w_b 1'A_b, of u_N c_N + sum_b w_b 1'A_b (rows weighted
         by w), c_P and c_N the velocity costs of each entry's two directions (y_b's 2 w_b are

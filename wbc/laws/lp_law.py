@@ -97,11 +97,10 @@ def program(
 ) -> tuple[list, list, Array, tuple[Task, Array]]:
     """One step's program of 5.29: the inputs checked (``NonFiniteInputError``, dt > 0), e
     and e' measured (``error_rate``, against the ``last`` error if it was the same task's), the
-    costs (the task's first, ||J u + eta e||) and the rows; with e
-    and the new ``last``. ``obstacles`` mixes circles for the base and solids in 3-D
-    (``wbc.geometry.obstacles.split``). ``previous_u`` is the u the law gave at its previous step,
-    for the terms and rows that read it (``StepContext.previous_u``). The LP and the QP
-    (``wbc.laws.qp_law``) solve the same one."""
+    costs (the task's first, ||J u + eta e||) and the rows; with e and the new ``last``.
+    ``obstacles`` mixes circles for the base and solids in 3-D (``wbc.geometry.obstacles.split``).
+    ``previous_u`` is the u the law gave at its previous step, for the terms and rows that read
+    it (``StepContext.previous_u``). The LP and the QP (``wbc.laws.qp_law``) solve the same one."""
     q, dt = np.asarray(q, dtype=float), float(dt)
     # One test for a good q and dt (the sum of the q_i is finite only if every q_i is, or
     # overflows: then ``_check`` looks entry by entry); ``_check`` names what is wrong.
@@ -138,7 +137,7 @@ def program(
 
 def error_rate(error: Array, last_error: Array | None, eta: float, dt: float) -> Array:
     """e' = (e - e_last) / dt against the ``last_error`` of the same task, else (None) the
-    commanded -eta e."""
+    commanded -eta e: what 5.10 bounds ||u||_1 by (beta ||e'||_1)."""
     if last_error is None:
         return -eta * error
     rate = np.subtract(error, last_error)

@@ -8,7 +8,7 @@ import pytest
 from tests.wbc.wbc_scenarios import pose_task, robot
 from wbc.geometry.obstacles import Circle
 from wbc.geometry.scenarios import DT, HOME, STARTS_AND_GOALS
-from wbc.laws.lp_law import LPLaw, LPParams
+from wbc.laws.lp_law import LPLaw, LPParams, error_rate
 from wbc.task import PoseTask
 from wbc.validation import NonFiniteInputError
 
@@ -154,3 +154,14 @@ def test_the_cascades_point_tracks_the_reference_as_appendix_b_linearises_it():
     expected = reference_velocity(lagging, reference) + np.array([1.5, 3.0]) * (target - point)
     np.testing.assert_allclose(point_velocity(lagging, u), expected, atol=1e-12)
     assert abs(u[0] * np.sin(lagging[2]) - u[1] * np.cos(lagging[2])) < 1e-12  # 5.11
+
+
+def test_the_error_rate_is_the_difference_over_dt_or_the_commanded_rate():
+    """e' = (e - e_last) / dt against the last error of the same task; -eta e at a task's first
+    step (no last error); neither input written to."""
+    error, last = np.array([0.3, -0.2, 0.0, 1e-3]), np.array([0.1, -0.25, 0.0, 2e-3])
+    given = error.copy(), last.copy()
+    np.testing.assert_array_equal(error_rate(error, last, 0.6, 0.05), (error - last) / 0.05)
+    np.testing.assert_array_equal(error_rate(error, None, 0.6, 0.05), -0.6 * error)
+    np.testing.assert_array_equal(error, given[0])
+    np.testing.assert_array_equal(last, given[1])
