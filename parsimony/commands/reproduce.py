@@ -10,6 +10,7 @@ from pathlib import Path
 
 from launch.query import QueryError
 from outputs.stdout import emit, json_text
+from parsimony.argument_types import count
 from parsimony.commands.experiment import time_limit
 from profiles.deploy_files import ROBOT_FILE
 from profiles.profile import ProfileError, load_profile
@@ -34,7 +35,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     )
     parser.add_argument(
         "--trials",
-        type=int,
+        type=count("trials"),
         default=TRIALS,
         help=f"trials of each law in each test of 6.3 (default {TRIALS}; the "
         "dissertation ran 10,000)",
@@ -84,8 +85,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
 
 def usage_error(args: argparse.Namespace) -> str | None:
     """Why the arguments cannot run, or None."""
-    if args.trials < 1:
-        return f"--trials must be at least 1, got {args.trials}"
     if args.law and not args.loop:
         return "--law chooses the laws of the loop: add --loop"
     if args.loop:
